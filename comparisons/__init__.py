@@ -1,0 +1,1 @@
+"""Approximate-vs-exact comparison harness (segments, seeding, error tables, benchmarks)."""

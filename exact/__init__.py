@@ -1,0 +1,27 @@
+"""The full peeling model and its solvers.
+
+``simulate(params, t_end, ...)`` integrates the differential-algebraic system
+FLOW1, FLOW2, flow3 with the constraint CONSTR of De, Maybhate and
+Ananthakrishna, either in the ε → 0 limit (``method="hybrid"``, default) or
+with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
+"""
+
+from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+
+from ._simulate import ATOL_SCALE, compile_kernels, initial_state, simulate
+from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
+
+__all__ = [
+    "simulate",
+    "initial_state",
+    "compile_kernels",
+    "ATOL_SCALE",
+    "Trajectory",
+    "Jumps",
+    "Jump",
+    "State",
+    "SolverStats",
+    "ModelBreakdown",
+    "SolverBudgetExceeded",
+    "SolverFailure",
+]

@@ -1,0 +1,425 @@
+"""``exact.simulate``: argument checking, the default initial state, dispatch."""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from typing import Callable, Optional, Sequence, Union
+
+import numpy as np
+
+from peelapprox import PeelParams
+from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox._generated import closure_exact, closure_paper
+from peelapprox._peelforce import (
+    BRANCHES,
+    branch_inverse,
+    branch_structure,
+    peel_force,
+    peel_force_coefficients,
+)
+
+from . import _hybrid as H
+from ._trajectory import Jumps, SolverStats, State, Trajectory
+
+__all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE"]
+
+METHODS = ("hybrid", "regularized")
+SOLVERS = ("Radau", "BDF", "LSODA")
+SAVES = ("steps", "jumps")
+
+#: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
+#: components.  Hybrid: (τ [s], α [rad], ω [rad/s], v [m/s]); regularised:
+#: (α, ω, F [N], v).  The scales are the smallest magnitudes that matter on the
+#: orbits of the paper: α oscillates with amplitude ≥ ~1e-3 rad, v on AB is
+#: ≥ ~1e-3 m/s, segment durations are ≥ ~1e-4 s.
+ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1e-6), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
+
+_COMPILE_TIME = {"hybrid": None}
+
+
+def _closure(params: PeelParams, alpha: float) -> float:
+    fun = closure_paper if params.geometry == "paper" else closure_exact
+    return float(fun(alpha, params.R, params.l)[0])
+
+
+def _finite(name: str, x) -> float:
+    try:
+        y = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
+    if not math.isfinite(y):
+        raise ValueError(f"{name} must be finite, got {x!r}")
+    return y
+
+
+def initial_state(
+    params: PeelParams,
+    *,
+    alpha0: float = 0.0,
+    omega0: Optional[float] = None,
+    F0: Optional[float] = None,
+    branch0: Optional[str] = None,
+    t0: float = 0.0,
+) -> State:
+    """The consistent initial state used by :func:`simulate`.
+
+    Defaults (documented behaviour): ``α = 0``, ``ω = V/R``,
+    ``F = 1.01 f(V, V)`` and v the lowest-velocity stable root of CONSTR,
+    ``f(v, V) = F (1 - cos θ)``: on AB if the level lies in AB's range
+    ``(f(0+), f_max]``, otherwise on CD.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and its valid range, if the level
+        ``F0 (1 - cos θ(α0))`` has no root on the requested branch (or on
+        any branch), or if ``1 - cos θ(α0) <= 0``.
+    """
+    if not isinstance(params, PeelParams):
+        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
+    a0 = _finite("alpha0", alpha0)
+    w0 = params.V / params.R if omega0 is None else _finite("omega0", omega0)
+    F = 1.01 * float(peel_force(params.V, params.V)) if F0 is None else _finite("F0", F0)
+    c = _closure(params, a0)
+    if not (1.0 + c > 0.0):
+        raise ValueError(f"alpha0={a0} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
+    G = F * (1.0 + c)
+    bs = branch_structure(params.V)
+    if branch0 is None:
+        for cand in ("AB", "CD") if bs.has_folds else ("AB",):
+            lo, hi = bs.level_range(cand)
+            if (lo < G <= hi) if cand == "AB" else (lo <= G < hi):
+                branch0 = cand
+                break
+        else:
+            raise ValueError(
+                f"F0={F} gives F0*(1 - cos theta)={G}, below f(0+, V)={bs.f_zero}: no stable root of CONSTR; "
+                f"F0 must exceed {bs.f_zero / (1 + c)} at alpha0={a0}"
+            )
+    if branch0 not in BRANCHES:
+        raise ValueError(f"branch0 must be 'AB' or 'CD' (or None for the lowest root), got {branch0!r}")
+    lo, hi = bs.level_range(branch0)  # raises for CD without folds
+    ok = (lo < G <= hi) if branch0 == "AB" else (lo <= G < hi)
+    if not ok:
+        raise ValueError(
+            f"F0={F} at alpha0={a0} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
+            f"valid F0 range on {branch0}: ({lo / (1 + c)}, {hi / (1 + c)})"
+        )
+    v = branch_inverse(G, params.V, branch0)
+    return State(float(t0), a0, w0, F, float(v), branch0)
+
+
+def _atol_vector(method: str, rtol: float, atol) -> np.ndarray:
+    if atol is None:
+        return rtol * np.asarray(ATOL_SCALE[method], dtype=float)
+    a = np.broadcast_to(np.asarray(atol, dtype=float), (4,)).copy() if np.ndim(atol) == 0 else np.asarray(atol, float)
+    if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise ValueError(f"atol must be a scalar or 4 values, finite and >= 0, got {atol!r}")
+    return a
+
+
+def compile_kernels() -> float:
+    """Compile (or load from numba's on-disk cache) the hybrid kernel.
+
+    Returns the seconds spent in this process the first time; 0 afterwards.
+    """
+    if _COMPILE_TIME["hybrid"] is not None:
+        return 0.0
+    t0 = time.perf_counter()
+    p = PeelParams(V=1.0, I=1e-5)
+    st = initial_state(p)
+    _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None, 1e-9)
+    _COMPILE_TIME["hybrid"] = time.perf_counter() - t0
+    return _COMPILE_TIME["hybrid"]
+
+
+def _progress_printer(label: str) -> Callable[[float, float], None]:
+    last = [0.0]
+
+    def report(t: float, t_end: float) -> None:
+        now = time.perf_counter()
+        if now - last[0] >= 0.5 or t >= t_end:
+            last[0] = now
+            sys.stderr.write(f"\r{label}: t = {t:.6g} / {t_end:.6g} s ({100 * t / t_end:5.1f} %)")
+            if t >= t_end:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    return report
+
+
+def simulate(
+    params: PeelParams,
+    t_end: float,
+    *,
+    alpha0: float = 0.0,
+    omega0: Optional[float] = None,
+    F0: Optional[float] = None,
+    branch0: Optional[str] = None,
+    method: str = "hybrid",
+    solver: str = "Radau",
+    rtol: float = 1e-8,
+    atol: Union[None, float, Sequence[float]] = None,
+    eps: float = 1e-7,
+    t_transient: float = 0.0,
+    t_eval: Optional[Sequence[float]] = None,
+    save: str = "steps",
+    max_points: int = 5_000_000,
+    max_steps: int = 200_000_000,
+    max_jumps: int = 20_000_000,
+    v_floor: float = 1e-9,
+    progress: Union[None, bool, Callable[[float, float], None]] = None,
+) -> Trajectory:
+    """Integrate the peeling model (FLOW1, FLOW2, flow3, CONSTR) from t = 0 to t_end.
+
+    Parameters
+    ----------
+    params : PeelParams
+        Physical parameters and the ``cos θ`` closure (``geometry``).
+    t_end : float
+        Final time [s], > 0.
+    alpha0, omega0, F0, branch0 : optional
+        Initial state; defaults ``α = 0``, ``ω = V/R``, ``F = 1.01 f(V, V)``,
+        ``branch0=None`` meaning the lowest-velocity stable root of CONSTR
+        (see :func:`initial_state`).  v is always the root of CONSTR on
+        ``branch0``, so the start is consistent.
+    method : {"hybrid", "regularized"}
+        ``"hybrid"`` (default): the ε → 0 limit, event-driven, compiled DOP853
+        on the desingularised branch dynamics with exact fold jumps (see
+        :mod:`exact._hybrid`).  ``"regularized"``: the paper's scheme, mass
+        matrix ``diag(1, 1, 1, ε)``, integrated by scipy's stiff ``solver``.
+    solver : {"Radau", "BDF", "LSODA"}
+        scipy solver for ``method="regularized"`` (analytic Jacobian).
+    rtol, atol : float, float or 4 floats
+        Local error control per step: RMS over components of
+        ``err_i / (atol_i + rtol |y_i|) <= 1``.  Hybrid components are
+        ``(τ, α, ω, v)`` (τ = time since the last jump), regularised ones are
+        ``(α, ω, F, v)``.  ``atol=None`` uses ``rtol * ATOL_SCALE[method]``.
+    eps : float
+        Regularisation ε (``method="regularized"`` only), default 1e-7 as in
+        the paper.
+    t_transient : float
+        Integrate from 0 but store nothing (points or jumps) before this time.
+    t_eval : array_like, optional
+        Store the state exactly at these times (sorted, within
+        ``[t_transient, t_end]``) instead of at every step.
+    save : {"steps", "jumps"}
+        Without ``t_eval``: ``"steps"`` stores every accepted step plus the
+        states just before and after each jump; ``"jumps"`` stores only jumps
+        (memory proportional to the number of jumps, not of steps).
+    max_points, max_steps, max_jumps : int
+        Budgets.  Exceeding one raises :class:`SolverBudgetExceeded` (with the
+        partial trajectory); nothing is truncated silently.
+    v_floor : float
+        On AB, v falling to this value [m/s] means CONSTR is losing its root
+        (``F(1 - cos θ) → f(0+, V)``): :class:`ModelBreakdown`.
+    progress : bool or callable, optional
+        ``True`` prints progress to stderr; a callable receives ``(t, t_end)``
+        between chunks of work.
+
+    Returns
+    -------
+    Trajectory
+        Stored points, jumps, counters (``stats``), settings and the final
+        state.
+
+    Raises
+    ------
+    ValueError
+        Bad arguments, naming the argument and its valid range.
+    ModelBreakdown
+        The model breaks down along the orbit (see the exception).
+    SolverBudgetExceeded, SolverFailure
+        Budget used up / the integrator cannot proceed.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if method == "regularized" and solver not in SOLVERS:
+        raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    t_end = _finite("t_end", t_end)
+    if t_end <= 0:
+        raise ValueError(f"t_end must be in (0, inf), got {t_end}")
+    rtol = _finite("rtol", rtol)
+    if not (1e-14 <= rtol <= 1e-2):
+        raise ValueError(f"rtol must be in [1e-14, 1e-2], got {rtol}")
+    atol_v = _atol_vector(method, rtol, atol)
+    eps = _finite("eps", eps)
+    if not eps > 0:
+        raise ValueError(f"eps must be in (0, inf), got {eps}")
+    t_transient = _finite("t_transient", t_transient)
+    if not (0 <= t_transient <= t_end):
+        raise ValueError(f"t_transient must be in [0, t_end] = [0, {t_end}], got {t_transient}")
+    if save not in SAVES:
+        raise ValueError(f"save must be one of {SAVES}, got {save!r}")
+    te = None
+    if t_eval is not None:
+        te = np.asarray(t_eval, dtype=float).ravel()
+        if te.size == 0 or not np.all(np.isfinite(te)) or np.any(np.diff(te) < 0):
+            raise ValueError("t_eval must be a non-empty, finite, sorted sequence of times")
+        if te[0] < t_transient or te[-1] > t_end:
+            raise ValueError(f"t_eval must lie within [t_transient, t_end] = [{t_transient}, {t_end}]")
+        if te.size > max_points:
+            raise ValueError(f"t_eval has {te.size} points, more than max_points={max_points}")
+    for name, val in (("max_points", max_points), ("max_steps", max_steps), ("max_jumps", max_jumps)):
+        if int(val) != val or val < 1:
+            raise ValueError(f"{name} must be a positive integer, got {val!r}")
+    v_floor = _finite("v_floor", v_floor)
+    if not v_floor > 0:
+        raise ValueError(f"v_floor must be in (0, inf), got {v_floor}")
+    if progress is True:
+        progress = _progress_printer(f"simulate V={params.V} I={params.I}")
+    elif progress is False:
+        progress = None
+    elif progress is not None and not callable(progress):
+        raise ValueError("progress must be None, a bool or a callable (t, t_end)")
+
+    st0 = initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
+    if method == "hybrid":
+        ct = compile_kernels()
+        traj = _run_hybrid(
+            params, t_end, st0, rtol, atol_v, t_transient, te, save, max_points, max_steps, max_jumps, progress, v_floor
+        )
+        if ct:
+            traj.stats = SolverStats(**{**traj.stats.__dict__, "compile_time": ct})
+        return traj
+    from ._regularized import run_regularized
+
+    return run_regularized(
+        params, t_end, st0, solver, rtol, atol_v, eps, t_transient, te, save, max_points, max_steps, max_jumps, progress, v_floor
+    )
+
+
+def _param_vector(params: PeelParams, v_floor: float) -> np.ndarray:
+    bs = branch_structure(params.V)
+    b, A = peel_force_coefficients(params.V)
+    p = np.zeros(H.N_P)
+    p[H.P_V], p[H.P_I], p[H.P_K], p[H.P_R], p[H.P_L] = params.V, params.I, params.k, params.R, params.l
+    p[H.P_B], p[H.P_A] = b, A
+    p[H.P_GEOM] = 0.0 if params.geometry == "paper" else 1.0
+    p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
+    p[H.P_VMAX] = bs.v_max if bs.has_folds else math.inf
+    p[H.P_VMIN] = bs.v_min if bs.has_folds else 0.0
+    p[H.P_VLCD] = bs.v_land_cd if bs.has_folds else 0.0
+    p[H.P_VLAB] = bs.v_land_ab if (bs.has_folds and bs.v_land_ab is not None) else -1.0
+    p[H.P_VFLOOR] = v_floor
+    p[H.P_VCEIL] = 1e3
+    return p
+
+
+_PAUSE_STEPS = 250_000  # steps per kernel call between progress/budget checks
+
+
+def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, max_steps, max_jumps, progress, v_floor):
+    p = _param_vector(params, v_floor)
+    st = np.array([s0.t, 0.0, s0.alpha, s0.omega, s0.v, 0.0, BRANCHES.index(s0.branch)], dtype=float)
+    cnt = np.zeros(H.N_C, dtype=np.int64)
+    if te is not None:
+        mode, cap = H.SAVE_TEVAL, te.size
+        t_eval = te
+    else:
+        mode = H.SAVE_STEPS if save == "steps" else H.SAVE_NONE
+        cap = min(max_points, 1 << 16) if mode == H.SAVE_STEPS else 1
+        t_eval = np.zeros(0)
+    out = np.empty((cap, H.N_O))
+    out_br = np.empty(cap, dtype=np.int8)
+    jcap = min(max_jumps, 1 << 14)
+    jbuf = np.empty((jcap, H.N_J))
+    chunks, bchunks, jchunks = [], [], []
+    n_stored = 0
+    if mode == H.SAVE_STEPS and s0.t >= t_store:
+        out[0] = (s0.t, s0.alpha, s0.omega, s0.F, s0.v)
+        out_br[0] = st[H.S_BR]
+        cnt[H.C_NOUT] = 1
+
+    def state_dict():
+        a, v = st[H.S_AL], st[H.S_V]
+        F = float(H.pull_force(a, v, p)) if v > 0 else float("nan")
+        return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
+                    branch=BRANCHES[int(st[H.S_BR])])
+
+    wall0 = time.perf_counter()
+
+    def build(final: bool = True) -> Trajectory:
+        data = np.concatenate(chunks + [out[: cnt[H.C_NOUT]]]) if chunks else out[: cnt[H.C_NOUT]].copy()
+        brs = np.concatenate(bchunks + [out_br[: cnt[H.C_NOUT]]]) if bchunks else out_br[: cnt[H.C_NOUT]].copy()
+        jd = np.concatenate(jchunks + [jbuf[: cnt[H.C_NJOUT]]]) if jchunks else jbuf[: cnt[H.C_NJOUT]].copy()
+        sd = state_dict()
+        stats = SolverStats(
+            n_steps=int(cnt[H.C_STEPS]),
+            n_rejected=int(cnt[H.C_REJ]),
+            n_rhs=int(cnt[H.C_RHS]),
+            n_jumps=int(cnt[H.C_JUMPS]),
+            wall_time=time.perf_counter() - wall0,
+        )
+        return Trajectory(
+            t=data[:, H.O_T], alpha=data[:, H.O_AL], omega=data[:, H.O_OM], F=data[:, H.O_F], v=data[:, H.O_V],
+            branch=brs, jumps=Jumps.from_buffer(jd), stats=stats, params=params, method="hybrid", solver="DOP853",
+            rtol=rtol, atol=atol, eps=None, initial_state=s0, final_state=State(**sd), t_end=t_end,
+            t_transient=t_store, status=0 if final else 1,
+            message="reached t_end" if final else "stopped early",
+        )
+
+    while True:
+        quota = min(_PAUSE_STEPS, max_steps - int(cnt[H.C_STEPS]))
+        status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out, out_br, jbuf, cnt, quota)
+        if status == H.DONE:
+            if progress:
+                progress(t_end, t_end)
+            return build()
+        if status == H.OUT_FULL:
+            n = int(cnt[H.C_NOUT])
+            n_stored += n
+            if n_stored + 2 > max_points:
+                raise SolverBudgetExceeded(
+                    f"more than max_points={max_points} stored points before t_end={t_end} "
+                    f"(stopped at t={state_dict()['t']:.6g}); pass t_eval, save='jumps' or a larger max_points",
+                    budget="max_points", limit=max_points, t=state_dict()["t"], state=state_dict(), partial=build(False),
+                )
+            chunks.append(out[:n].copy())
+            bchunks.append(out_br[:n].copy())
+            cnt[H.C_NOUT] = 0
+            continue
+        if status == H.JUMPS_FULL:
+            jchunks.append(jbuf[: cnt[H.C_NJOUT]].copy())
+            cnt[H.C_NJOUT] = 0
+            if int(cnt[H.C_JUMPS]) >= max_jumps:
+                raise SolverBudgetExceeded(
+                    f"more than max_jumps={max_jumps} jumps before t_end={t_end} (stopped at t={state_dict()['t']:.6g})",
+                    budget="max_jumps", limit=max_jumps, t=state_dict()["t"], state=state_dict(), partial=build(False),
+                )
+            continue
+        if status == H.PAUSE:
+            if int(cnt[H.C_STEPS]) >= max_steps:
+                raise SolverBudgetExceeded(
+                    f"more than max_steps={max_steps} steps before t_end={t_end} (stopped at t={state_dict()['t']:.6g})",
+                    budget="max_steps", limit=max_steps, t=state_dict()["t"], state=state_dict(), partial=build(False),
+                )
+            if int(cnt[H.C_JUMPS]) > max_jumps:
+                raise SolverBudgetExceeded(
+                    f"more than max_jumps={max_jumps} jumps before t_end={t_end} (stopped at t={state_dict()['t']:.6g})",
+                    budget="max_jumps", limit=max_jumps, t=state_dict()["t"], state=state_dict(), partial=build(False),
+                )
+            if progress:
+                progress(float(st[H.S_T0] + st[H.S_TAU]), t_end)
+            continue
+        sd = state_dict()
+        if status == H.STEP_FAIL:
+            raise SolverFailure(
+                f"hybrid solver: step size collapsed at t={sd['t']:.9g} on {sd['branch']} (v={sd['v']:.6g})",
+                t=sd["t"], state=sd, partial=build(False),
+            )
+        bs = branch_structure(params.V)
+        reasons = {
+            H.BREAK_VFLOOR: ("v_floor", f"v fell to v_floor={v_floor} m/s on AB: F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N, "
+                             "CONSTR loses its stable root (the peel front would have to stop)"),
+            H.BREAK_NOLAND: ("no_landing", f"CD fold reached but f_min={bs.f_min} <= f(0+, V)={bs.f_zero:.6g}: "
+                             "no AB root to land on"),
+            H.BREAK_ALPHA: ("geometry", "1 - cos(theta) reached 0: the peel geometry degenerates (alpha -> -pi/2)"),
+            H.BREAK_NONFINITE: ("nonfinite", "the state became non-finite"),
+            H.BREAK_VCEIL: ("v_ceiling", "v exceeded 1000 m/s on CD: the pull force is running away"),
+        }
+        reason, text = reasons.get(status, ("unknown", f"kernel status {status}"))
+        raise ModelBreakdown(f"model breakdown at t={sd['t']:.9g}: {text}", t=sd["t"], state=sd, reason=reason,
+                             partial=build(False))

@@ -1,0 +1,294 @@
+"""Result objects of :func:`exact.simulate`."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from peelapprox import PeelParams
+from peelapprox._peelforce import BRANCHES, peel_force
+
+__all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
+
+
+@dataclass(frozen=True)
+class State:
+    """A point of the orbit: time, ``(α, ω, F, v)`` and the branch name."""
+
+    t: float
+    alpha: float
+    omega: float
+    F: float
+    v: float
+    branch: str
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class Jump:
+    """One stick-slip jump at a fold: (α, ω, F) continuous, v jumps."""
+
+    t: float
+    from_branch: str
+    to_branch: str
+    alpha: float
+    omega: float
+    F: float
+    v_before: float
+    v_after: float
+
+
+@dataclass(frozen=True)
+class Jumps:
+    """All stored jumps, as arrays (memory proportional to the number of jumps).
+
+    ``from_branch``/``to_branch`` hold integer codes into :data:`BRANCHES`
+    (0 = AB, 1 = CD).  Index it to get a :class:`Jump`.
+    """
+
+    t: np.ndarray
+    from_branch: np.ndarray
+    to_branch: np.ndarray
+    alpha: np.ndarray
+    omega: np.ndarray
+    F: np.ndarray
+    v_before: np.ndarray
+    v_after: np.ndarray
+
+    FIELDS = ("t", "from_branch", "to_branch", "alpha", "omega", "F", "v_before", "v_after")
+
+    @classmethod
+    def from_buffer(cls, buf: np.ndarray) -> "Jumps":
+        buf = np.asarray(buf, dtype=float).reshape(-1, 8)
+        return cls(
+            t=buf[:, 0].copy(),
+            from_branch=buf[:, 1].astype(np.int8),
+            to_branch=buf[:, 2].astype(np.int8),
+            alpha=buf[:, 3].copy(),
+            omega=buf[:, 4].copy(),
+            F=buf[:, 5].copy(),
+            v_before=buf[:, 6].copy(),
+            v_after=buf[:, 7].copy(),
+        )
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __getitem__(self, i: int) -> Jump:
+        return Jump(
+            float(self.t[i]),
+            BRANCHES[int(self.from_branch[i])],
+            BRANCHES[int(self.to_branch[i])],
+            float(self.alpha[i]),
+            float(self.omega[i]),
+            float(self.F[i]),
+            float(self.v_before[i]),
+            float(self.v_after[i]),
+        )
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self)))
+
+    def to_csv(self, path) -> None:
+        """Write one row per jump with a header (branch names spelled out)."""
+        with open(path, "w") as fh:
+            fh.write(",".join(self.FIELDS) + "\n")
+            for j in self:
+                fh.write(
+                    f"{j.t!r},{j.from_branch},{j.to_branch},{j.alpha!r},{j.omega!r},{j.F!r},{j.v_before!r},{j.v_after!r}\n"
+                )
+
+
+@dataclass(frozen=True)
+class SolverStats:
+    """Work counters of one run.
+
+    ``n_steps`` accepted steps, ``n_rejected`` rejected step attempts,
+    ``n_rhs`` right-hand-side evaluations (all stages, dense-output stages and
+    starting-step probes), ``n_jac`` Jacobian evaluations and ``n_lu`` LU
+    factorisations (regularised method only), ``n_jumps`` all jumps (also
+    those before ``t_transient``), ``wall_time`` [s] of the integration
+    excluding one-off compilation, ``compile_time`` [s] spent compiling or
+    loading the kernels in this call (0 when already loaded).
+    """
+
+    n_steps: int
+    n_rejected: int
+    n_rhs: int
+    n_jumps: int
+    wall_time: float
+    compile_time: float = 0.0
+    n_jac: int = 0
+    n_lu: int = 0
+
+
+class Trajectory:
+    """An orbit of the peeling model as computed by :func:`exact.simulate`.
+
+    Attributes
+    ----------
+    t, alpha, omega, F, v : ndarray
+        Stored points.  ``t`` is non-decreasing; equal consecutive times occur
+        only at a jump, where the two rows hold the states just before (``v``
+        at the fold) and just after (``v`` at the landing root).
+    branch : ndarray of int8
+        0 (AB) or 1 (CD) at each stored point; names in :data:`BRANCHES`.
+    jumps : Jumps
+        Every jump with ``t >= t_transient``.
+    stats : SolverStats
+    params : PeelParams
+    method, solver : str
+    rtol : float
+    atol : ndarray
+    eps : float or None
+        Regularisation parameter (``method="regularized"`` only).
+    initial_state, final_state : State
+        Where the run started and ended (``final_state`` continues a run).
+    status : int
+        0 = reached ``t_end``.  Failed runs raise instead of returning.
+    message : str
+    """
+
+    def __init__(
+        self,
+        *,
+        t,
+        alpha,
+        omega,
+        F,
+        v,
+        branch,
+        jumps: Jumps,
+        stats: SolverStats,
+        params: PeelParams,
+        method: str,
+        solver: str,
+        rtol: float,
+        atol,
+        eps: Optional[float],
+        initial_state: State,
+        final_state: State,
+        t_end: float,
+        t_transient: float,
+        status: int = 0,
+        message: str = "reached t_end",
+    ):
+        self.t = np.asarray(t, dtype=float)
+        self.alpha = np.asarray(alpha, dtype=float)
+        self.omega = np.asarray(omega, dtype=float)
+        self.F = np.asarray(F, dtype=float)
+        self.v = np.asarray(v, dtype=float)
+        self.branch = np.asarray(branch, dtype=np.int8)
+        self.jumps = jumps
+        self.stats = stats
+        self.params = params
+        self.method = method
+        self.solver = solver
+        self.rtol = float(rtol)
+        self.atol = np.asarray(atol, dtype=float)
+        self.eps = eps
+        self.initial_state = initial_state
+        self.final_state = final_state
+        self.t_end = float(t_end)
+        self.t_transient = float(t_transient)
+        self.status = status
+        self.message = message
+
+    def __repr__(self) -> str:
+        p = self.params
+        return (
+            f"Trajectory(V={p.V}, I={p.I}, method={self.method!r}, t=[{self.initial_state.t}, {self.t_end}], "
+            f"points={len(self.t)}, jumps={len(self.jumps)}, steps={self.stats.n_steps}, "
+            f"wall_time={self.stats.wall_time:.3g}s)"
+        )
+
+    @property
+    def branch_names(self) -> np.ndarray:
+        """Branch of each stored point as strings ``"AB"``/``"CD"``."""
+        return np.asarray(BRANCHES)[self.branch]
+
+    @property
+    def closure_c(self) -> np.ndarray:
+        """``c(α) = -cos θ`` at the stored points (the model's closure)."""
+        from peelapprox._generated import closure_exact, closure_paper
+
+        fun = closure_paper if self.params.geometry == "paper" else closure_exact
+        return np.asarray(fun(self.alpha, self.params.R, self.params.l)[0], dtype=float)
+
+    def constraint_residual(self, relative: bool = False) -> np.ndarray:
+        """``F (1 - cos θ) - f(v, V)`` at every stored point (CONSTR) [N].
+
+        With ``relative=True``, divided by ``f(v, V)``.
+        """
+        if len(self.t) == 0:
+            return np.zeros(0)
+        f = peel_force(self.v, self.params.V)
+        r = self.F * (1.0 + self.closure_c) - f
+        return r / f if relative else r
+
+    # ------------------------------------------------------------ I/O
+    def to_npz(self, path) -> None:
+        """Save everything (arrays, jumps, counters, settings) to a ``.npz``."""
+        meta = {
+            "params": dataclasses.asdict(self.params),
+            "stats": dataclasses.asdict(self.stats),
+            "method": self.method,
+            "solver": self.solver,
+            "rtol": self.rtol,
+            "eps": self.eps,
+            "initial_state": self.initial_state.as_dict(),
+            "final_state": self.final_state.as_dict(),
+            "t_end": self.t_end,
+            "t_transient": self.t_transient,
+            "status": self.status,
+            "message": self.message,
+        }
+        jb = np.column_stack([np.asarray(getattr(self.jumps, f), dtype=float) for f in Jumps.FIELDS]) if len(
+            self.jumps
+        ) else np.zeros((0, 8))
+        np.savez_compressed(
+            path,
+            t=self.t,
+            alpha=self.alpha,
+            omega=self.omega,
+            F=self.F,
+            v=self.v,
+            branch=self.branch,
+            jumps=jb,
+            atol=self.atol,
+            meta=np.array(json.dumps(meta)),
+        )
+
+    @classmethod
+    def from_npz(cls, path) -> "Trajectory":
+        """Load a trajectory written by :meth:`to_npz`."""
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"]))
+            return cls(
+                t=z["t"],
+                alpha=z["alpha"],
+                omega=z["omega"],
+                F=z["F"],
+                v=z["v"],
+                branch=z["branch"],
+                jumps=Jumps.from_buffer(z["jumps"]),
+                stats=SolverStats(**meta["stats"]),
+                params=PeelParams(**meta["params"]),
+                method=meta["method"],
+                solver=meta["solver"],
+                rtol=meta["rtol"],
+                atol=z["atol"],
+                eps=meta["eps"],
+                initial_state=State(**meta["initial_state"]),
+                final_state=State(**meta["final_state"]),
+                t_end=meta["t_end"],
+                t_transient=meta["t_transient"],
+                status=meta["status"],
+                message=meta["message"],
+            )
