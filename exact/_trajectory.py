@@ -109,7 +109,8 @@ class Jumps:
 class SolverStats:
     """Work counters of one run.
 
-    ``n_steps`` accepted steps, ``n_rejected`` rejected step attempts,
+    ``n_steps`` accepted steps, ``n_rejected`` rejected step attempts (-1 where
+    the solver does not report it: scipy's stiff solvers),
     ``n_rhs`` right-hand-side evaluations (all stages, dense-output stages and
     starting-step probes), ``n_jac`` Jacobian evaluations and ``n_lu`` LU
     factorisations (regularised method only), ``n_jumps`` all jumps (also

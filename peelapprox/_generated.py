@@ -91,20 +91,20 @@ def regularized_jacobian(alpha, omega, F, v, c, dc, fp, eps, V, I, k, R):
     x2 = R*c
     x3 = c + 1
     x4 = eps**(-1.0)
-    j00 = 0
-    j01 = 1
-    j02 = 0
+    j00 = 0.0
+    j01 = 1.00000000000000
+    j02 = 0.0
     j03 = -1/R
     j10 = -R*x0*x1
-    j11 = 0
+    j11 = 0.0
     j12 = -x0*x2
-    j13 = 0
+    j13 = 0.0
     j20 = dc*k*(R*omega - v)
     j21 = k*x2
-    j22 = 0
+    j22 = 0.0
     j23 = -k*x3
     j30 = x1*x4
-    j31 = 0
+    j31 = 0.0
     j32 = x3*x4
     j33 = -fp*x4
     return j00, j01, j02, j03, j10, j11, j12, j13, j20, j21, j22, j23, j30, j31, j32, j33

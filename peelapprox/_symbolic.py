@@ -184,6 +184,7 @@ def _render_function(name, args, exprs, doc, out_names=None):
         lines.append(f"    {sym} = {printer.doprint(e)}")
     outs = out_names or [f"r{i}" for i in range(len(red))]
     for o, e in zip(outs, red):
+        e = sp.Float(e) if e.is_Number else e  # homogeneous float tuples for numba
         lines.append(f"    {o} = {printer.doprint(e)}")
     ret = ", ".join(outs)
     lines.append(f"    return {ret}" + ("," if len(outs) == 1 else ""))

@@ -1,0 +1,168 @@
+"""The paper's ε-regularised scheme (Sec. III, XDAE) on scipy's stiff solvers.
+
+``M Ẋ = φ(X)``, ``X = (α, ω, F, v)``, ``M = diag(1, 1, 1, ε)``: the singular
+mass matrix of the DAE is perturbed by ε (the paper used ε = 1e-7 and MATLAB's
+ode15s).  With ε > 0 M is invertible, so we integrate the equivalent ODE
+``v̇ = [F(1 - cos θ) - f(v, V)] / ε`` with scipy's Radau, BDF or LSODA and the
+analytic Jacobian generated from the symbolic model.
+
+A *jump* of the regularised orbit is recorded when v crosses the inflection
+velocity ``v_infl`` of f (the minimiser of f', inside the unstable part): the
+time of the crossing is located on the solver's dense output.  Its
+``v_before`` and ``v_after`` both hold ``v_infl``; (α, ω, F) are the crossing
+values.  ``branch`` at stored points is 0 where ``v <= v_infl`` and 1 above.
+As ε → 0 these jump times converge to the hybrid ones with the fold-passage
+delay ~ ε^(2/3) (see docs/theory.md).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numba import njit
+from scipy import integrate
+from scipy.optimize import brentq
+
+from peelapprox import _generated as _g
+from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_fp_jit
+
+from ._trajectory import Jumps, SolverStats, State, Trajectory
+
+_rhs_g = njit(cache=True)(_g.regularized_rhs)
+_jac_g = njit(cache=True)(_g.regularized_jacobian)
+_cl_paper = njit(cache=True)(_g.closure_paper)
+_cl_exact = njit(cache=True)(_g.closure_exact)
+
+_SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
+
+
+@njit(cache=True)
+def _fun(y, q):
+    # q = V, I, k, R, l, b, A, eps, geom
+    v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
+    f, _ = peel_force_fp_jit(v, q[5], q[6])
+    if q[8] == 0.0:
+        c, _ = _cl_paper(y[0], q[3], q[4])
+    else:
+        c, _ = _cl_exact(y[0], q[3], q[4])
+    r = _rhs_g(y[0], y[1], y[2], v, c, f, q[7], q[0], q[1], q[2], q[3])
+    return np.array([r[0], r[1], r[2], r[3]])
+
+
+@njit(cache=True)
+def _jac(y, q):
+    v = max(y[3], 1e-300)
+    _, fp = peel_force_fp_jit(v, q[5], q[6])
+    if q[8] == 0.0:
+        c, dc = _cl_paper(y[0], q[3], q[4])
+    else:
+        c, dc = _cl_exact(y[0], q[3], q[4])
+    j = _jac_g(y[0], y[1], y[2], v, c, dc, fp, q[7], q[0], q[1], q[2], q[3])
+    out = np.empty((4, 4))
+    for i in range(16):
+        out[i // 4, i % 4] = j[i]
+    return out
+
+
+def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, save, max_points, max_steps, max_jumps,
+                    progress, v_floor):
+    """Driver for ``simulate(method="regularized")`` (arguments already validated)."""
+    bs = branch_structure(params.V)
+    b, A = peel_force_coefficients(params.V)
+    q = np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
+                  0.0 if params.geometry == "paper" else 1.0])
+    v_mid = bs.v_inflection
+    fun = lambda t, y: _fun(y, q)  # noqa: E731
+    jac = lambda t, y: _jac(y, q)  # noqa: E731
+    y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v])
+    wall0 = time.perf_counter()
+    ode = _SOLVERS[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, jac=jac)
+
+    rows, brs, jumps = [], [], []
+    t_eval_i = 0
+
+    def side(v):
+        return 0 if v <= v_mid else 1
+
+    def store(t, y):
+        if len(rows) >= max_points:
+            raise SolverBudgetExceeded(
+                f"more than max_points={max_points} stored points before t_end={t_end}; pass t_eval or save='jumps'",
+                budget="max_points", limit=max_points, t=t, state=sdict(t, y), partial=build(False))
+        rows.append((t, y[0], y[1], y[2], y[3]))
+        brs.append(side(y[3]))
+
+    def sdict(t, y):
+        return dict(t=float(t), alpha=float(y[0]), omega=float(y[1]), F=float(y[2]), v=float(y[3]),
+                    branch=BRANCHES[side(y[3])])
+
+    def build(final=True):
+        arr = np.array(rows, dtype=float).reshape(-1, 5)
+        njac = getattr(ode, "njev", 0)
+        nlu = getattr(ode, "nlu", 0)
+        stats = SolverStats(n_steps=n_steps, n_rejected=-1, n_rhs=int(ode.nfev), n_jumps=n_jumps,
+                            wall_time=time.perf_counter() - wall0, n_jac=int(njac), n_lu=int(nlu))
+        return Trajectory(
+            t=arr[:, 0], alpha=arr[:, 1], omega=arr[:, 2], F=arr[:, 3], v=arr[:, 4], branch=np.array(brs, np.int8),
+            jumps=Jumps.from_buffer(np.array(jumps, dtype=float).reshape(-1, 8)), stats=stats, params=params,
+            method="regularized", solver=solver, rtol=rtol, atol=atol, eps=eps, initial_state=s0,
+            final_state=State(**sdict(ode.t, ode.y)), t_end=t_end, t_transient=t_store, status=0 if final else 1,
+            message="reached t_end" if final else "stopped early")
+
+    n_steps = 0
+    n_jumps = 0
+    if te is None and save == "steps" and s0.t >= t_store:
+        store(s0.t, y0)
+    last_report = time.perf_counter()
+    while ode.status == "running":
+        t_old, y_old = ode.t, ode.y.copy()
+        msg = ode.step()
+        if ode.status == "failed":
+            raise SolverFailure(f"regularized {solver} failed at t={ode.t:.9g}: {msg}", t=float(ode.t),
+                                state=sdict(ode.t, ode.y), partial=build(False))
+        n_steps += 1
+        y = ode.y
+        if not np.all(np.isfinite(y)):
+            raise ModelBreakdown(f"state became non-finite at t={ode.t:.9g}", t=float(ode.t),
+                                 state=sdict(t_old, y_old), reason="nonfinite", partial=build(False))
+        if y[3] <= v_floor:
+            raise ModelBreakdown(
+                f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
+                f"(F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)",
+                t=float(ode.t), state=sdict(ode.t, y), reason="v_floor", partial=build(False))
+        dense = None
+        s_old, s_new = side(y_old[3]), side(y[3])
+        if s_old != s_new:
+            dense = ode.dense_output()
+            tj = brentq(lambda tt: dense(tt)[3] - v_mid, t_old, ode.t, xtol=1e-15, rtol=8.9e-16)
+            yj = dense(tj)
+            n_jumps += 1
+            if tj >= t_store:
+                jumps.append((tj, s_old, s_new, yj[0], yj[1], yj[2], v_mid, v_mid))
+            if n_jumps > max_jumps:
+                raise SolverBudgetExceeded(f"more than max_jumps={max_jumps} jumps before t_end={t_end}",
+                                           budget="max_jumps", limit=max_jumps, t=float(tj), state=sdict(tj, yj),
+                                           partial=build(False))
+        if te is not None:
+            while t_eval_i < te.size and te[t_eval_i] <= ode.t:
+                dense = dense or ode.dense_output()
+                store(te[t_eval_i], dense(te[t_eval_i]))
+                t_eval_i += 1
+        elif save == "steps" and ode.t >= t_store:
+            store(ode.t, y)
+        if n_steps >= max_steps and ode.status == "running":
+            raise SolverBudgetExceeded(f"more than max_steps={max_steps} steps before t_end={t_end}",
+                                       budget="max_steps", limit=max_steps, t=float(ode.t), state=sdict(ode.t, y),
+                                       partial=build(False))
+        if progress and time.perf_counter() - last_report > 0.5:
+            last_report = time.perf_counter()
+            progress(float(ode.t), t_end)
+    if progress:
+        progress(t_end, t_end)
+    if not math.isclose(ode.t, t_end, rel_tol=0, abs_tol=0) and ode.t != t_end:
+        raise SolverFailure(f"regularized {solver} stopped at t={ode.t} before t_end={t_end}", t=float(ode.t),
+                            state=sdict(ode.t, ode.y), partial=build(False))
+    return build()
