@@ -1,0 +1,144 @@
+"""Command line: ``peelapprox simulate ...``.
+
+The CLI is the only place that ties the three packages (peelapprox, exact,
+comparisons) together; it imports the solvers lazily per subcommand.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Optional, Sequence
+
+from ._params import GEOMETRIES, PeelParams
+
+__all__ = ["main"]
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    from exact import ModelBreakdown, SolverBudgetExceeded, simulate
+
+    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, l=args.l, geometry=args.geometry)
+    save = "jumps" if args.jumps_only else "steps"
+    try:
+        traj = simulate(
+            params,
+            args.t_end,
+            alpha0=args.alpha0,
+            omega0=args.omega0,
+            F0=args.F0,
+            branch0=args.branch0,
+            method=args.method,
+            solver=args.solver,
+            rtol=args.rtol,
+            eps=args.eps,
+            t_transient=args.t_transient,
+            save=save,
+            progress=not args.quiet,
+        )
+    except (ModelBreakdown, SolverBudgetExceeded) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    s = traj.stats
+    summary = {
+        "V": params.V,
+        "I": params.I,
+        "method": traj.method,
+        "solver": traj.solver,
+        "rtol": traj.rtol,
+        "t_end": traj.t_end,
+        "points": int(len(traj.t)),
+        "jumps": int(len(traj.jumps)),
+        "steps": s.n_steps,
+        "rejected": s.n_rejected,
+        "rhs_evaluations": s.n_rhs,
+        "wall_time_s": round(s.wall_time, 6),
+        "compile_time_s": round(s.compile_time, 3),
+        "final_state": traj.final_state.as_dict(),
+    }
+    if len(traj.jumps):
+        summary["F_at_jumps_range"] = [float(traj.jumps.F.min()), float(traj.jumps.F.max())]
+    if args.format == "json":
+        print(json.dumps(summary, indent=2))
+    else:
+        for key, val in summary.items():
+            print(f"{key:>18}: {val}")
+    if args.out:
+        traj.to_npz(args.out)
+        print(f"wrote {args.out}", file=sys.stderr)
+    if args.jumps_csv:
+        traj.jumps.to_csv(args.jumps_csv)
+        print(f"wrote {args.jumps_csv}", file=sys.stderr)
+    if args.plot:
+        if args.jumps_only:
+            print("error: --plot needs stored steps; drop --jumps-only", file=sys.stderr)
+            return 2
+        from .plotting import plot_trajectory
+
+        plot_trajectory(traj, args.plot)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return 0
+
+
+def _folds(args: argparse.Namespace) -> int:
+    from ._peelforce import branch_structure, fixed_point
+
+    bs = branch_structure(args.V)
+    fp = fixed_point(args.V)
+    row = {**bs.__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
+    if args.format == "json":
+        print(json.dumps(row, indent=2))
+    else:
+        for key, val in row.items():
+            print(f"{key:>18}: {val}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="peelapprox", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    sp = sub.add_parser("simulate", help="integrate the full model (exact solution)")
+    sp.add_argument("--V", type=float, required=True, help="pull speed [m/s]")
+    sp.add_argument("--I", type=float, required=True, help="roller inertia [kg m^2]")
+    sp.add_argument("--k", type=float, default=1000.0, help="tape stiffness [N/m] (1000)")
+    sp.add_argument("--R", type=float, default=0.1, help="roller radius [m] (0.1)")
+    sp.add_argument("--l", type=float, default=1.0, help="roller-motor distance [m] (1)")
+    sp.add_argument("--geometry", choices=GEOMETRIES, default="paper")
+    sp.add_argument("--t-end", type=float, required=True, help="final time [s]")
+    sp.add_argument("--alpha0", type=float, default=0.0)
+    sp.add_argument("--omega0", type=float, default=None, help="default V/R")
+    sp.add_argument("--F0", type=float, default=None, help="default 1.01 f(V, V)")
+    sp.add_argument("--branch0", choices=("AB", "CD"), default=None, help="default: lowest-velocity stable root")
+    sp.add_argument("--method", choices=("hybrid", "regularized"), default="hybrid")
+    sp.add_argument("--solver", choices=("Radau", "BDF", "LSODA"), default="Radau", help="for --method regularized")
+    sp.add_argument("--rtol", type=float, default=1e-8)
+    sp.add_argument("--eps", type=float, default=1e-7, help="regularisation epsilon (regularized only)")
+    sp.add_argument("--t-transient", type=float, default=0.0, help="store nothing before this time [s]")
+    sp.add_argument("--jumps-only", action="store_true", help="store only the jumps (long runs)")
+    sp.add_argument("--out", help="write the trajectory to this .npz")
+    sp.add_argument("--jumps-csv", help="write the jumps to this CSV")
+    sp.add_argument("--plot", help="write F(t), alpha(t), v(t) and the v-F plane to this image")
+    sp.add_argument("--format", choices=("table", "json"), default="table", help="summary format")
+    sp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    sp.set_defaults(func=_simulate)
+
+    fo = sub.add_parser("folds", help="folds, landing velocities and fixed point of f(v, V)")
+    fo.add_argument("--V", type=float, required=True)
+    fo.add_argument("--format", choices=("table", "json"), default="table")
+    fo.set_defaults(func=_folds)
+    return ap
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    try:
+        return args.func(args)
+    except ValueError as exc:
+        ap.exit(2, f"peelapprox {args.command}: error: {exc}\n")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

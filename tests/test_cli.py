@@ -1,0 +1,37 @@
+"""The command line, run as a user would (in-process via main())."""
+
+import json
+
+import numpy as np
+import pytest
+
+from exact import Trajectory
+from peelapprox.cli import main
+
+
+def test_simulate_writes_npz_csv_plot(tmp_path, capsys):
+    """`peelapprox simulate` writes a loadable .npz, a jumps CSV with one row per jump, and a PNG."""
+    out, csv, png = tmp_path / "r.npz", tmp_path / "j.csv", tmp_path / "r.png"
+    rc = main(["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.2", "--out", str(out), "--jumps-csv", str(csv),
+               "--plot", str(png), "--format", "json", "--quiet"])
+    assert rc == 0
+    summary = json.loads(capsys.readouterr().out)
+    tr = Trajectory.from_npz(out)
+    assert summary["jumps"] == len(tr.jumps) >= 4
+    lines = csv.read_text().splitlines()
+    assert lines[0].startswith("t,from_branch,to_branch") and len(lines) == len(tr.jumps) + 1
+    assert png.stat().st_size > 20_000
+    assert np.isclose(float(lines[1].split(",")[0]), tr.jumps.t[0], rtol=0, atol=0)
+
+
+def test_bad_argument_exit_code(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "--V", "1", "--I", "-1", "--t-end", "1"])
+    assert exc.value.code == 2
+    assert "I must be finite and in (0, inf)" in capsys.readouterr().err
+
+
+def test_folds_json(capsys):
+    assert main(["folds", "--V", "4", "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)
+    assert row["has_folds"] and abs(row["f_max"] - 307.21) < 0.01 and abs(row["f_min"] - 293.34) < 0.01
