@@ -116,8 +116,10 @@ def lagrange_equations():
 
     Returns
     -------
-    (motion1, motion2, omega_dot_symbol, fsym)
-        ``fsym`` stands for ``f(v, V)`` and ``omega_dot_symbol`` for ``ω̇``.
+    (motion1, motion2, omega_dot_symbol, fsym, cos_theta_fn, u_fn)
+        ``fsym`` stands for ``f(v, V)``, ``omega_dot_symbol`` for ``ω̇``,
+        ``cos_theta_fn`` is the undefined function ``cos_theta(alpha(t))`` and
+        ``u_fn`` is ``u(t)``.
     """
     a = sp.Function("alpha")(t)
     uu = sp.Function("u")(t)
@@ -140,8 +142,8 @@ def lagrange_equations():
     return m1, m2, wdot, fsym, cth, uu
 
 
-def regularized_system(geometry: str):
-    """Right-hand side and Jacobian of the ε-regularised XDAE.
+def regularized_system():
+    """Right-hand side and Jacobian of the ε-regularised XDAE (both closures).
 
     ``M Ẋ = φ(X)`` with ``X = (α, ω, F, v)`` and ``M = diag(1, 1, 1, ε)``;
     dividing the last row by ε gives an ODE with ``v̇ = [F(1 - cos θ) - f]/ε``.
@@ -264,7 +266,7 @@ def render_module() -> str:
             ["G_dot"],
         )
     )
-    rhs, J, fp = regularized_system("paper")
+    rhs, J, fp = regularized_system()
     fs = sp.Symbol("f")
     rhs = rhs.subs(peel_force_expr(v, V), fs)
     parts.append(
