@@ -191,15 +191,21 @@ def _initial_step(y0, f0, p, rtol, atol, work):
 
 
 @njit(cache=True)
+def _combine(y, h, K, coef, n, out):
+    """out = y + h * sum_{j<n} coef[j] K[j]  (an RK stage argument or the step result)."""
+    for i in range(4):
+        acc = 0.0
+        for j in range(n):
+            acc += K[j, i] * coef[j]
+        out[i] = y[i] + h * acc
+
+
+@njit(cache=True)
 def _dense_coeffs(y_old, y_new, f_new, K, h, p, Fc, tmp):
     """Extra stages and the 7 interpolation coefficient rows (scipy Dop853DenseOutput)."""
     for si in range(_NX - _NS - 1):
         s = _NS + 1 + si
-        for i in range(4):
-            acc = 0.0
-            for j in range(s):
-                acc += K[j, i] * _AX[si, j]
-            tmp[i] = y_old[i] + h * acc
+        _combine(y_old, h, K, _AX[si], s, tmp)
         _rhs(tmp, p, K[s])
     for i in range(4):
         dy = y_new[i] - y_old[i]
@@ -353,17 +359,9 @@ def run(
         while True:
             K[0, :] = f0
             for s in range(1, _NS):
-                for i in range(4):
-                    acc = 0.0
-                    for j in range(s):
-                        acc += K[j, i] * _A[s, j]
-                    tmp[i] = y[i] + h * acc
+                _combine(y, h, K, _A[s], s, tmp)
                 _rhs(tmp, p, K[s])
-            for i in range(4):
-                acc = 0.0
-                for j in range(_NS):
-                    acc += K[j, i] * _B[j]
-                y_new[i] = y[i] + h * acc
+            _combine(y, h, K, _B, _NS, y_new)
             _rhs(y_new, p, K[_NS])
             cnt[C_RHS] += _NS
             e5 = 0.0
