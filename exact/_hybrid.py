@@ -92,8 +92,8 @@ N_P = 15
 S_T0, S_TAU, S_AL, S_OM, S_V, S_H, S_BR = range(7)
 N_S = 7
 # counters
-C_STEPS, C_REJ, C_RHS, C_JUMPS, C_NOUT, C_NJOUT, C_TEVAL, C_REJ_DOMAIN = range(8)
-N_C = 8
+C_STEPS, C_REJ, C_RHS, C_JUMPS, C_NOUT, C_NJOUT, C_TEVAL = range(7)
+N_C = 7
 # output columns
 O_T, O_AL, O_OM, O_F, O_V = range(5)
 N_O = 5
@@ -393,7 +393,6 @@ def run(
             # rejected (err >= 1 or NaN from a stage outside the domain)
             if err != err or err == np.inf:
                 h *= 0.25
-                cnt[C_REJ_DOMAIN] += 1
             else:
                 h *= max(MIN_FACTOR, SAFETY * err**ERR_EXP)
             rejected = True
@@ -467,7 +466,7 @@ def run(
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
-        if x_stop < 1.0 or x_fold <= 1.0 or x_end <= 1.0:
+        if x_fold <= 1.0 or x_end <= 1.0:
             _interp(y, Fc, x_stop, ye)
         else:
             for i in range(4):

@@ -17,7 +17,6 @@ delay ~ ε^(2/3) (see docs/theory.md).
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -162,7 +161,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
             progress(float(ode.t), t_end)
     if progress:
         progress(t_end, t_end)
-    if not math.isclose(ode.t, t_end, rel_tol=0, abs_tol=0) and ode.t != t_end:
+    if ode.t != t_end:
         raise SolverFailure(f"regularized {solver} stopped at t={ode.t} before t_end={t_end}", t=float(ode.t),
                             state=sdict(ode.t, ode.y), partial=build(False))
     return build()

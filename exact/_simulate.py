@@ -11,7 +11,6 @@ import numpy as np
 
 from peelapprox import PeelParams
 from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from peelapprox._generated import closure_exact, closure_paper
 from peelapprox._peelforce import (
     BRANCHES,
     branch_inverse,
@@ -37,11 +36,6 @@ SAVES = ("steps", "jumps")
 ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1e-6), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
 
 _COMPILE_TIME = {"hybrid": None}
-
-
-def _closure(params: PeelParams, alpha: float) -> float:
-    fun = closure_paper if params.geometry == "paper" else closure_exact
-    return float(fun(alpha, params.R, params.l)[0])
 
 
 def _finite(name: str, x) -> float:
@@ -82,15 +76,14 @@ def initial_state(
     a0 = _finite("alpha0", alpha0)
     w0 = params.V / params.R if omega0 is None else _finite("omega0", omega0)
     F = 1.01 * float(peel_force(params.V, params.V)) if F0 is None else _finite("F0", F0)
-    c = _closure(params, a0)
+    c = float(params.closure(a0)[0])
     if not (1.0 + c > 0.0):
         raise ValueError(f"alpha0={a0} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
     G = F * (1.0 + c)
     bs = branch_structure(params.V)
     if branch0 is None:
         for cand in ("AB", "CD") if bs.has_folds else ("AB",):
-            lo, hi = bs.level_range(cand)
-            if (lo < G <= hi) if cand == "AB" else (lo <= G < hi):
+            if bs.has_root(G, cand):
                 branch0 = cand
                 break
         else:
@@ -101,8 +94,7 @@ def initial_state(
     if branch0 not in BRANCHES:
         raise ValueError(f"branch0 must be 'AB' or 'CD' (or None for the lowest root), got {branch0!r}")
     lo, hi = bs.level_range(branch0)  # raises for CD without folds
-    ok = (lo < G <= hi) if branch0 == "AB" else (lo <= G < hi)
-    if not ok:
+    if not bs.has_root(G, branch0):
         raise ValueError(
             f"F0={F} at alpha0={a0} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
             f"valid F0 range on {branch0}: ({lo / (1 + c)}, {hi / (1 + c)})"
@@ -361,6 +353,14 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             message="reached t_end" if final else "stopped early",
         )
 
+    def over_budget(name: str, limit: int) -> SolverBudgetExceeded:
+        sd = state_dict()
+        hint = "; pass t_eval, save='jumps' or a larger max_points" if name == "max_points" else ""
+        return SolverBudgetExceeded(
+            f"more than {name}={limit} {name[4:]} before t_end={t_end} (stopped at t={sd['t']:.6g}){hint}",
+            budget=name, limit=limit, t=sd["t"], state=sd, partial=build(False),
+        )
+
     while True:
         quota = min(_PAUSE_STEPS, max_steps - int(cnt[H.C_STEPS]))
         status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out, out_br, jbuf, cnt, quota)
@@ -372,11 +372,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             n = int(cnt[H.C_NOUT])
             n_stored += n
             if n_stored + 2 > max_points:
-                raise SolverBudgetExceeded(
-                    f"more than max_points={max_points} stored points before t_end={t_end} "
-                    f"(stopped at t={state_dict()['t']:.6g}); pass t_eval, save='jumps' or a larger max_points",
-                    budget="max_points", limit=max_points, t=state_dict()["t"], state=state_dict(), partial=build(False),
-                )
+                raise over_budget("max_points", max_points)
             chunks.append(out[:n].copy())
             bchunks.append(out_br[:n].copy())
             cnt[H.C_NOUT] = 0
@@ -385,22 +381,13 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             jchunks.append(jbuf[: cnt[H.C_NJOUT]].copy())
             cnt[H.C_NJOUT] = 0
             if int(cnt[H.C_JUMPS]) >= max_jumps:
-                raise SolverBudgetExceeded(
-                    f"more than max_jumps={max_jumps} jumps before t_end={t_end} (stopped at t={state_dict()['t']:.6g})",
-                    budget="max_jumps", limit=max_jumps, t=state_dict()["t"], state=state_dict(), partial=build(False),
-                )
+                raise over_budget("max_jumps", max_jumps)
             continue
         if status == H.PAUSE:
             if int(cnt[H.C_STEPS]) >= max_steps:
-                raise SolverBudgetExceeded(
-                    f"more than max_steps={max_steps} steps before t_end={t_end} (stopped at t={state_dict()['t']:.6g})",
-                    budget="max_steps", limit=max_steps, t=state_dict()["t"], state=state_dict(), partial=build(False),
-                )
+                raise over_budget("max_steps", max_steps)
             if int(cnt[H.C_JUMPS]) > max_jumps:
-                raise SolverBudgetExceeded(
-                    f"more than max_jumps={max_jumps} jumps before t_end={t_end} (stopped at t={state_dict()['t']:.6g})",
-                    budget="max_jumps", limit=max_jumps, t=state_dict()["t"], state=state_dict(), partial=build(False),
-                )
+                raise over_budget("max_jumps", max_jumps)
             if progress:
                 progress(float(st[H.S_T0] + st[H.S_TAU]), t_end)
             continue

@@ -217,10 +217,7 @@ class Trajectory:
     @property
     def closure_c(self) -> np.ndarray:
         """``c(α) = -cos θ`` at the stored points (the model's closure)."""
-        from peelapprox._generated import closure_exact, closure_paper
-
-        fun = closure_paper if self.params.geometry == "paper" else closure_exact
-        return np.asarray(fun(self.alpha, self.params.R, self.params.l)[0], dtype=float)
+        return np.asarray(self.params.closure(self.alpha)[0], dtype=float)
 
     def constraint_residual(self, relative: bool = False) -> np.ndarray:
         """``F (1 - cos θ) - f(v, V)`` at every stored point (CONSTR) [N].

@@ -76,6 +76,13 @@ class PeelParams:
         if self.geometry not in GEOMETRIES:
             raise ValueError(f"geometry must be one of {GEOMETRIES}, got {self.geometry!r}")
 
+    def closure(self, alpha):
+        """``(c, dc/dα)`` with ``c = -cos θ`` for this geometry; scalar or array ``alpha``."""
+        from . import _generated
+
+        fun = _generated.closure_paper if self.geometry == "paper" else _generated.closure_exact
+        return fun(alpha, self.R, self.l)
+
     def replace(self, **changes) -> "PeelParams":
         """Return a copy with some fields changed (validated again)."""
         import dataclasses

@@ -161,6 +161,11 @@ class BranchStructure:
             return (self.v_min, math.inf)
         raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
 
+    def has_root(self, G: float, branch: str) -> bool:
+        """True if ``f(v, V) = G`` has a root on the branch: AB ``(f(0+), f_max]``, CD ``[f_min, inf)``."""
+        lo, hi = self.level_range(branch)
+        return (lo < G <= hi) if branch == "AB" else (lo <= G < hi)
+
     def level_range(self, branch: str) -> tuple[float, float]:
         """Range of levels ``G = F(1 - cos θ)`` for which the branch has a root."""
         if branch == "AB":
@@ -213,9 +218,8 @@ def branch_structure(V: float) -> BranchStructure:
 
 
 def _invert(G: float, bs: BranchStructure, branch: str, b: float, A: float) -> float:
-    lo, hi = bs.level_range(branch)
-    inside = (lo < G <= hi) if branch == "AB" else (lo <= G < hi)
-    if not inside:
+    if not bs.has_root(G, branch):
+        lo, hi = bs.level_range(branch)
         raise ValueError(
             f"level G={G!r} has no root on branch {branch} for V={bs.V}: valid range is "
             f"{'(' if branch == 'AB' else '['}{lo}, {hi}{']' if branch == 'AB' else ')'}"
