@@ -39,14 +39,12 @@ const).
 
 Integrator
 ----------
-Dormand–Prince 8(5,3) with its 7th-order dense output (Hairer, Nørsett &
-Wanner, *Solving ODEs I*, II.10), using scipy's coefficient tables and
-scipy's step-size controller (safety 0.9, factors in [0.2, 10], error
-exponent -1/8), on the state ``y = (τ, α, ω, v)`` where ``τ = t - t_seg`` is the
-time since the segment started (so the error control of the time is relative
-to the segment duration, not to the absolute time).  Tolerance semantics are
-scipy's: the step is accepted when the RMS over components of
-``err_i / (atol_i + rtol·max(|y_i|, |y_new_i|))`` is below 1.
+The one compiled integrator of the package, :mod:`peelapprox._dop853`
+(Dormand–Prince 8(5,3), scipy's coefficients and controller, scipy's
+tolerance semantics), on the state ``y = (τ, α, ω, v)`` where ``τ = t - t_seg``
+is the time since the segment started (so the error control of the time is
+relative to the segment duration, not to the absolute time).  This module is
+its event driver: folds, jumps, t_end, output and breakdown checks.
 
 Everything per step runs inside one numba function; Python is entered only
 when an output buffer fills or the run ends.
@@ -56,9 +54,10 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from peelapprox import _generated as _g
+from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS, N_STAGES_EXTENDED as _NX
+from peelapprox._dop853 import interp, interp1, make_dop853, solve_theta
 from peelapprox._peelforce import peel_force_fp_jit
 
 # the model's equations, compiled from the one generated source
@@ -66,23 +65,6 @@ closure_paper = njit(cache=True)(_g.closure_paper)
 closure_exact = njit(cache=True)(_g.closure_exact)
 slow_rates = njit(cache=True)(_g.slow_rates)
 constraint_rate = njit(cache=True)(_g.constraint_rate)
-
-# ---------------------------------------------------------------- tableau
-_NS = _dop.N_STAGES  # 12
-_A = np.ascontiguousarray(_dop.A[:_NS, :_NS])
-_B = np.ascontiguousarray(_dop.B)
-_C = np.ascontiguousarray(_dop.C[:_NS])
-_E3 = np.ascontiguousarray(_dop.E3)
-_E5 = np.ascontiguousarray(_dop.E5)
-_D = np.ascontiguousarray(_dop.D)
-_AX = np.ascontiguousarray(_dop.A[_NS + 1 :])
-_CX = np.ascontiguousarray(_dop.C[_NS + 1 :])
-_NX = _dop.N_STAGES_EXTENDED  # 16
-
-SAFETY = 0.9
-MIN_FACTOR = 0.2
-MAX_FACTOR = 10.0
-ERR_EXP = -1.0 / 8.0
 
 # ---------------------------------------------------------------- layouts
 # parameter vector
@@ -149,124 +131,7 @@ def _rhs(y, p, out):
     out[3] = v * Gd
 
 
-@njit(cache=True)
-def _norm(x):
-    s = 0.0
-    for i in range(4):
-        s += x[i] * x[i]
-    return np.sqrt(s / 4.0)
-
-
-@njit(cache=True)
-def _initial_step(y0, f0, p, rtol, atol, work):
-    """Hairer's starting-step heuristic (as scipy.integrate select_initial_step)."""
-    sc = work[0]
-    tmp = work[1]
-    f1 = work[2]
-    for i in range(4):
-        sc[i] = atol[i] + abs(y0[i]) * rtol
-    for i in range(4):
-        tmp[i] = y0[i] / sc[i]
-    d0 = _norm(tmp)
-    for i in range(4):
-        tmp[i] = f0[i] / sc[i]
-    d1 = _norm(tmp)
-    if d0 < 1e-5 or d1 < 1e-5:
-        h0 = 1e-6
-    else:
-        h0 = 0.01 * d0 / d1
-    for i in range(4):
-        tmp[i] = y0[i] + h0 * f0[i]
-    _rhs(tmp, p, f1)
-    for i in range(4):
-        tmp[i] = (f1[i] - f0[i]) / sc[i]
-    d2 = _norm(tmp) / h0
-    if not np.isfinite(d2):
-        return h0 * 1e-3
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1)
-
-
-@njit(cache=True)
-def _combine(y, h, K, coef, n, out):
-    """out = y + h * sum_{j<n} coef[j] K[j]  (an RK stage argument or the step result)."""
-    for i in range(4):
-        acc = 0.0
-        for j in range(n):
-            acc += K[j, i] * coef[j]
-        out[i] = y[i] + h * acc
-
-
-@njit(cache=True)
-def _dense_coeffs(y_old, y_new, f_new, K, h, p, Fc, tmp):
-    """Extra stages and the 7 interpolation coefficient rows (scipy Dop853DenseOutput)."""
-    for si in range(_NX - _NS - 1):
-        s = _NS + 1 + si
-        _combine(y_old, h, K, _AX[si], s, tmp)
-        _rhs(tmp, p, K[s])
-    for i in range(4):
-        dy = y_new[i] - y_old[i]
-        Fc[0, i] = dy
-        Fc[1, i] = h * K[0, i] - dy
-        Fc[2, i] = 2.0 * dy - h * (f_new[i] + K[0, i])
-        for r in range(4):
-            acc = 0.0
-            for j in range(_NX):
-                acc += _D[r, j] * K[j, i]
-            Fc[3 + r, i] = h * acc
-
-
-@njit(cache=True)
-def _interp1(y_old, Fc, x, i):
-    """Component i of the dense output at fraction x of the step."""
-    yv = 0.0
-    for r in range(6, -1, -1):
-        yv += Fc[r, i]
-        if (6 - r) % 2 == 0:
-            yv *= x
-        else:
-            yv *= 1.0 - x
-    return yv + y_old[i]
-
-
-@njit(cache=True)
-def _interp(y_old, Fc, x, out):
-    for i in range(4):
-        out[i] = _interp1(y_old, Fc, x, i)
-
-
-@njit(cache=True)
-def _solve_theta(y_old, Fc, i, target, g0, xb, g1):
-    """x in [0, xb] with interp_i(x) = target; g0, g1 = values - target at 0, xb of
-    opposite sign (or g1 == 0).  Illinois-modified regula falsi, to ~1 ulp in x."""
-    if g1 == 0.0:
-        return xb
-    a, b = 0.0, xb
-    ga, gb = g0, g1
-    side = 0
-    for _ in range(200):
-        x = (a * gb - b * ga) / (gb - ga)
-        if not (a < x < b):
-            x = 0.5 * (a + b)
-        gx = _interp1(y_old, Fc, x, i) - target
-        if gx == 0.0:
-            return x
-        if (gx > 0.0) == (gb > 0.0):
-            b, gb = x, gx
-            if side == 1:
-                ga *= 0.5
-            side = 1
-        else:
-            a, ga = x, gx
-            if side == -1:
-                gb *= 0.5
-            side = -1
-        if b - a <= 4e-16:
-            break
-    return b if abs(gb) < abs(ga) else a
+_dop = make_dop853(_rhs)
 
 
 @njit(cache=True)
@@ -338,7 +203,7 @@ def run(
     _rhs(y, p, f0)
     cnt[C_RHS] += 1
     if h <= 0.0:
-        h = _initial_step(y, f0, p, rtol, atol, work)
+        h = _dop.initial_step(y, f0, p, rtol, atol, work)
         cnt[C_RHS] += 1
 
     while True:
@@ -354,53 +219,12 @@ def run(
             return JUMPS_FULL
 
         # ---- one accepted step
-        rejected = False
-        n_rej_row = 0
-        while True:
-            K[0, :] = f0
-            for s in range(1, _NS):
-                _combine(y, h, K, _A[s], s, tmp)
-                _rhs(tmp, p, K[s])
-            _combine(y, h, K, _B, _NS, y_new)
-            _rhs(y_new, p, K[_NS])
-            cnt[C_RHS] += _NS
-            e5 = 0.0
-            e3 = 0.0
-            for i in range(4):
-                sc[i] = atol[i] + max(abs(y[i]), abs(y_new[i])) * rtol
-                a5 = 0.0
-                a3 = 0.0
-                for j in range(_NS + 1):
-                    a5 += K[j, i] * _E5[j]
-                    a3 += K[j, i] * _E3[j]
-                a5 /= sc[i]
-                a3 /= sc[i]
-                e5 += a5 * a5
-                e3 += a3 * a3
-            if e5 == 0.0 and e3 == 0.0:
-                err = 0.0
-            else:
-                err = abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * 4.0)
-            if err < 1.0:
-                if err == 0.0:
-                    fac = MAX_FACTOR
-                else:
-                    fac = min(MAX_FACTOR, SAFETY * err**ERR_EXP)
-                if rejected:
-                    fac = min(1.0, fac)
-                h_next = h * fac
-                break
-            # rejected (err >= 1 or NaN from a stage outside the domain)
-            if err != err or err == np.inf:
-                h *= 0.25
-            else:
-                h *= max(MIN_FACTOR, SAFETY * err**ERR_EXP)
-            rejected = True
-            cnt[C_REJ] += 1
-            n_rej_row += 1
-            if n_rej_row > 60 or h <= 1e-300:
-                _save(st, y, h)
-                return STEP_FAIL
+        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
+        cnt[C_REJ] += n_rej
+        cnt[C_RHS] += n_rhs
+        if status == STEP_FAILED:
+            _save(st, y, h)
+            return STEP_FAIL
         cnt[C_STEPS] += 1
         calls += 1
 
@@ -420,10 +244,10 @@ def run(
                 gB = y_new[3] - vf
                 crossed = gB <= 0.0
             if crossed:
-                _dense_coeffs(y, y_new, K[_NS], K, h, p, Fc, tmp)
+                _dop.dense(y, y_new, K, h, p, Fc, tmp)
                 cnt[C_RHS] += _NX - _NS - 1
                 dense = True
-                x_fold = _solve_theta(y, Fc, 3, vf, gA, 1.0, gB)
+                x_fold = solve_theta(y, Fc, 3, vf, gA, 1.0, gB)
         # breakdown on AB: v -> 0 (checked at step end; the kernel never
         # accepts a step whose stages left v > 0)
         if br == 0 and y_new[3] <= p[P_VFLOOR] and x_fold > 1.0:
@@ -436,10 +260,10 @@ def run(
         tau_end = t_end - t0
         if y_new[0] >= tau_end:
             if not dense:
-                _dense_coeffs(y, y_new, K[_NS], K, h, p, Fc, tmp)
+                _dop.dense(y, y_new, K, h, p, Fc, tmp)
                 cnt[C_RHS] += _NX - _NS - 1
                 dense = True
-            x_end = _solve_theta(y, Fc, 0, tau_end, y[0] - tau_end, 1.0, y_new[0] - tau_end)
+            x_end = solve_theta(y, Fc, 0, tau_end, y[0] - tau_end, 1.0, y_new[0] - tau_end)
         x_stop = min(x_fold, x_end)
         if x_stop > 1.0:
             x_stop = 1.0
@@ -447,27 +271,27 @@ def run(
         # ---- t_eval output strictly before the stop point of this step
         if save_mode == SAVE_TEVAL:
             if x_stop < 1.0:
-                tau_stop = _interp1(y, Fc, x_stop, 0)
+                tau_stop = interp1(y, Fc, x_stop, 0)
             else:
                 tau_stop = y_new[0]
             while cnt[C_TEVAL] < n_teval and t_eval[cnt[C_TEVAL]] - t0 <= tau_stop:
                 te = t_eval[cnt[C_TEVAL]]
                 if not dense:
-                    _dense_coeffs(y, y_new, K[_NS], K, h, p, Fc, tmp)
+                    _dop.dense(y, y_new, K, h, p, Fc, tmp)
                     cnt[C_RHS] += _NX - _NS - 1
                     dense = True
                 if te - t0 <= y[0]:
                     xe = 0.0
                 else:
-                    xe = _solve_theta(y, Fc, 0, te - t0, y[0] - (te - t0), x_stop, tau_stop - (te - t0))
-                _interp(y, Fc, xe, ye)
+                    xe = solve_theta(y, Fc, 0, te - t0, y[0] - (te - t0), x_stop, tau_stop - (te - t0))
+                interp(y, Fc, xe, ye)
                 ye[0] = te - t0
                 _store(out, cnt[C_NOUT], te, ye, pull_force(ye[1], ye[3], p), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
         if x_fold <= 1.0 or x_end <= 1.0:
-            _interp(y, Fc, x_stop, ye)
+            interp(y, Fc, x_stop, ye)
         else:
             for i in range(4):
                 ye[i] = y_new[i]
@@ -540,7 +364,7 @@ def run(
                 _store(out, cnt[C_NOUT], tj, y, Fj, out_br, br)
                 cnt[C_NOUT] += 1
             _rhs(y, p, f0)
-            h = _initial_step(y, f0, p, rtol, atol, work)
+            h = _dop.initial_step(y, f0, p, rtol, atol, work)
             cnt[C_RHS] += 2
             continue
 
