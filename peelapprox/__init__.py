@@ -2,12 +2,40 @@
 
 Companion library to R. De, A. Maybhate and G. Ananthakrishna, "Dynamics of
 stick-slip in peeling of an adhesive tape".  The core package holds the model
-parameters and the peel-force function; the exact DAE solvers live in the
+parameters, the peel-force function, the paper's reduced branch-wise
+equations (Sec. V) and regime estimates; the exact DAE solvers live in the
 ``exact`` package and the approximate-vs-exact harness in ``comparisons``.
 """
 
+from ._alpha import (
+    ALPHA_FORMS,
+    InertialPeriods,
+    airy_alpha,
+    alpha_numerical,
+    cd_damping_time,
+    cd_decay_alpha,
+    harmonic_alpha,
+    inertial_frequency,
+    inertial_period,
+    inertial_periods,
+    sinusoid_alpha,
+    wkb_alpha,
+    wkb_amplitude_phase,
+    wkb_error_bound,
+)
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import GEOMETRIES, PeelParams
+from ._estimate import (
+    INERTIA_RULE,
+    VELOCITY_RULE,
+    RegimeEstimate,
+    SlopeCriterion,
+    crude_branch_time,
+    estimate,
+    force_bounds,
+    quasi_static_branch_time,
+    slope_criterion,
+)
 from ._peelforce import (
     BRANCHES,
     BranchStructure,
@@ -18,6 +46,7 @@ from ._peelforce import (
     peel_force,
     peel_force_derivative,
 )
+from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 
 __version__ = "0.1.0"
 
@@ -35,4 +64,34 @@ __all__ = [
     "ModelBreakdown",
     "SolverBudgetExceeded",
     "SolverFailure",
+    # reduced α equations (Sec. V)
+    "inertial_frequency",
+    "inertial_period",
+    "inertial_periods",
+    "InertialPeriods",
+    "harmonic_alpha",
+    "airy_alpha",
+    "sinusoid_alpha",
+    "wkb_amplitude_phase",
+    "wkb_alpha",
+    "wkb_error_bound",
+    "alpha_numerical",
+    "ALPHA_FORMS",
+    "cd_damping_time",
+    "cd_decay_alpha",
+    # reduced velocity equation on a branch
+    "reduced_segment",
+    "ReducedSegment",
+    "ALPHA_MODELS",
+    "V_EQUATIONS",
+    # estimates
+    "estimate",
+    "RegimeEstimate",
+    "INERTIA_RULE",
+    "VELOCITY_RULE",
+    "crude_branch_time",
+    "quasi_static_branch_time",
+    "force_bounds",
+    "slope_criterion",
+    "SlopeCriterion",
 ]

@@ -1,4 +1,4 @@
-"""Command line: ``peelapprox simulate ...``.
+"""Command line: ``peelapprox simulate | folds | estimate | segment ...``.
 
 The CLI is the only place that ties the three packages (peelapprox, exact,
 comparisons) together; it imports the solvers lazily per subcommand.
@@ -95,6 +95,91 @@ def _folds(args: argparse.Namespace) -> int:
     return 0
 
 
+def _write_rows(path: str, rows: list[dict]) -> None:
+    """Write rows as CSV or JSON, chosen by the file extension."""
+    import csv
+
+    if path.endswith(".json"):
+        with open(path, "w") as fh:
+            json.dump(rows, fh, indent=2)
+    elif path.endswith(".csv"):
+        with open(path, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    else:
+        raise ValueError(f"--out must end in .csv or .json, got {path!r}")
+    print(f"wrote {path}", file=sys.stderr)
+
+
+def _print_mapping(row: dict, fmt: str) -> None:
+    if fmt == "json":
+        print(json.dumps(row, indent=2))
+    else:
+        width = max(len(k) for k in row)
+        for key, val in row.items():
+            if isinstance(val, float):
+                val = f"{val:.6g}"
+            print(f"{key:>{width}}: {val}")
+
+
+def _estimate(args: argparse.Namespace) -> int:
+    from ._estimate import estimate
+
+    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    row = estimate(params, alpha_min=args.alpha_min, alpha_max=args.alpha_max).as_dict()
+    _print_mapping(row, args.format)
+    if args.out:
+        _write_rows(args.out, [row])
+    return 0
+
+
+def _segment(args: argparse.Namespace) -> int:
+    from ._errors import ModelBreakdown, SolverBudgetExceeded
+    from ._segment import reduced_segment
+
+    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    try:
+        seg = reduced_segment(
+            params, args.branch, F_in=args.F_in, alpha_in=args.alpha_in, alphadot_in=args.alphadot_in,
+            amplitude=args.amplitude, phase=args.phase, v_in=args.v_in, v_f=args.v_f,
+            alpha_model=args.alpha_model, v_equation=args.v_equation, rtol=args.rtol,
+        )
+    except (ModelBreakdown, SolverBudgetExceeded) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    _print_mapping(seg.as_dict(), args.format)
+    if args.out:
+        _write_rows(args.out, [seg.as_dict()])
+    if args.curves or args.plot:
+        # smooth curves: the same integration again, sampled by dense output
+        import numpy as np
+
+        seg = reduced_segment(
+            params, args.branch, F_in=args.F_in, alpha_in=args.alpha_in, alphadot_in=args.alphadot_in,
+            amplitude=args.amplitude, phase=args.phase, v_in=args.v_in, v_f=args.v_f,
+            alpha_model=args.alpha_model, v_equation=args.v_equation, rtol=args.rtol,
+            t_eval=np.linspace(0.0, seg.dt, 801)[:-1],
+        )
+    if args.curves:
+        rows = [dict(t=float(a), v=float(b), F=float(c), alpha=float(d), alphadot=float(e))
+                for a, b, c, d, e in zip(seg.t, seg.v, seg.F, seg.alpha, seg.alphadot)]
+        _write_rows(args.curves, rows)
+    if args.plot:
+        from .plotting import plot_segment
+
+        plot_segment(seg, args.plot)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return 0
+
+
+def _add_params(sp: argparse.ArgumentParser) -> None:
+    sp.add_argument("--V", type=float, required=True, help="pull speed [m/s]")
+    sp.add_argument("--I", type=float, required=True, help="roller inertia [kg m^2]")
+    sp.add_argument("--k", type=float, default=1000.0, help="tape stiffness [N/m] (1000)")
+    sp.add_argument("--R", type=float, default=0.1, help="roller radius [m] (0.1)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="peelapprox", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -128,6 +213,35 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--V", type=float, required=True)
     fo.add_argument("--format", choices=("table", "json"), default="table")
     fo.set_defaults(func=_folds)
+
+    es = sub.add_parser("estimate", help="regime estimate from the reduced equations (no DAE solve)")
+    _add_params(es)
+    es.add_argument("--alpha-min", type=float, default=None, help="for the force bound f_max/(1+sin alpha_min)")
+    es.add_argument("--alpha-max", type=float, default=None, help="for the force bound f_min/(1+sin alpha_max)")
+    es.add_argument("--format", choices=("table", "json"), default="table")
+    es.add_argument("--out", help="also write the estimate to this .csv or .json")
+    es.set_defaults(func=_estimate)
+
+    from ._segment import ALPHA_MODELS, V_EQUATIONS
+
+    sg = sub.add_parser("segment", help="one branch from the reduced v equation coupled to an alpha model")
+    _add_params(sg)
+    sg.add_argument("--branch", choices=("AB", "CD"), required=True)
+    sg.add_argument("--F-in", type=float, required=True, help="pull force at entry [N]")
+    sg.add_argument("--alpha-in", type=float, default=None, help="peel angle at entry [rad]")
+    sg.add_argument("--alphadot-in", type=float, default=None, help="its rate at entry [rad/s]")
+    sg.add_argument("--amplitude", type=float, default=None, help="sinusoid amplitude (alpha-model sinusoid)")
+    sg.add_argument("--phase", type=float, default=None, help="sinusoid phase (alpha-model sinusoid)")
+    sg.add_argument("--v-in", type=float, default=None, help="entry velocity (default: landing velocity)")
+    sg.add_argument("--v-f", type=float, default=None, help="exit velocity (default: the branch's fold)")
+    sg.add_argument("--alpha-model", choices=ALPHA_MODELS, default="approxalpha")
+    sg.add_argument("--v-equation", choices=V_EQUATIONS, default="approxvdot")
+    sg.add_argument("--rtol", type=float, default=1e-10)
+    sg.add_argument("--format", choices=("table", "json"), default="table")
+    sg.add_argument("--out", help="also write the summary to this .csv or .json")
+    sg.add_argument("--curves", help="write t, v, F, alpha, alphadot to this .csv or .json")
+    sg.add_argument("--plot", help="write v(t), alpha(t), F(t) to this image")
+    sg.set_defaults(func=_segment)
     return ap
 
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._peelforce import branch_structure, peel_force
 
-__all__ = ["plot_trajectory"]
+__all__ = ["plot_trajectory", "plot_segment"]
 
 
 def _pyplot():
@@ -65,6 +65,44 @@ def plot_trajectory(traj: Any, path: Optional[str] = None, *, title: Optional[st
     ax[1, 1].legend(loc="best", fontsize=8)
     ttl = title or f"V = {p.V} m/s, I = {p.I:g} kg m², k = {p.k:g} N/m, method = {traj.method}"
     fig.suptitle(ttl)
+    if path:
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+    return fig
+
+
+def plot_segment(seg: Any, path: Optional[str] = None, *, exact: Any = None, title: Optional[str] = None):
+    """v(t), α(t) and F(t) of a reduced branch solution (as the paper's Figs. 8 and 9).
+
+    Parameters
+    ----------
+    seg : peelapprox.ReducedSegment
+        From :func:`peelapprox.reduced_segment` with stored curves.
+    path : str, optional
+        Write the figure there (format from the extension) and close it.
+    exact : object, optional
+        Anything with arrays ``t`` (from the branch entry), ``v``, ``alpha``,
+        ``F``: drawn dotted for comparison (the paper's "numerically exact").
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(3, 1, figsize=(7, 8), sharex=True, constrained_layout=True)
+    label = f"{seg.alpha_model} + {seg.v_equation}"
+    for a, y, name in ((ax[0], "v", "v [m/s]"), (ax[1], "alpha", r"$\alpha$ [rad]"), (ax[2], "F", "F [N]")):
+        a.plot(seg.t, getattr(seg, y), lw=1.2, color="C0", label=label)
+        if exact is not None:
+            a.plot(exact.t, getattr(exact, y), ":", lw=1.5, color="k", label="exact")
+        a.set_ylabel(name)
+    if seg.branch == "AB":
+        ax[0].set_yscale("log")
+    ax[0].axhline(seg.v_f, color="C1", lw=0.8, ls="--", label=f"v_f = {seg.v_f:.4g}")
+    ax[0].legend(loc="best", fontsize=8)
+    ax[2].set_xlabel("t since branch entry [s]")
+    fig.suptitle(title or f"{seg.branch}: Δt = {seg.dt:.4g} s, ΔF = {seg.dF:.4g} N")
     if path:
         fig.savefig(path, dpi=120)
         plt.close(fig)

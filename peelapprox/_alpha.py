@@ -1,0 +1,434 @@
+"""Reduced equations for the peel angle α on one branch (paper Sec. V).
+
+All of them come from genalpha, ``α̈ = -F R α/I - v̇/R`` (FLOW1 and FLOW2
+with ``sin α ≈ α``), by dropping or freezing terms:
+
+=====================  =============================================  =========================
+label                  equation                                        here
+=====================  =============================================  =========================
+approxalpha            ``I α̈ = -F R α``, F constant                   :func:`harmonic_alpha`,
+                                                                       :func:`inertial_frequency`
+Airy                   ``I α̈ = -(F_in + s t) R α``, ``s = k(V - v)``   :func:`airy_alpha` (exact, Ai/Bi),
+                                                                       :func:`alpha_numerical`
+(paper's sinusoid)     ``α ≈ A (F_in/F)^¼ sin(∫√(FR/I) dt + φ)``        :func:`sinusoid_alpha`,
+                                                                       :func:`wkb_alpha`
+Airy1                  ``α̈ = -FRα/I - (Ḟ + F α̇)/(R f'(v))``           :func:`alpha_numerical`
+Airy2                  ``α̈ = -FRα/I - F α̇/(R f'(v))``                 :func:`alpha_numerical`
+CD limit of Airy2      ``α̇ = -F α/(R f'(v))``, frozen f', F            :func:`cd_decay_alpha`
+=====================  =============================================  =========================
+
+Here the force on the branch is the paper's ``F = F_in + k(V - v) t`` with v
+frozen (``s = F_rate``, default ``k V``: the paper drops v on AB).  Coupling
+to the peel velocity (approxvdot, fullvdot, genalpha with v̇) is in
+:mod:`peelapprox._segment`.
+
+Units: t [s], α [rad], α̇ [rad/s], F [N], R [m], I [kg m²], k [N/m], v, V [m/s].
+
+The closed forms are written once, as functions of scalars that work both on
+numpy arrays and inside numba (``_sinusoid``, ``_harmonic``, ``_decay``); the
+compiled segment solver uses the same functions.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple, Optional
+
+import numpy as np
+from scipy import integrate, special
+
+from ._params import PeelParams
+from ._peelforce import branch_structure, peel_force_derivative
+
+__all__ = [
+    "inertial_frequency",
+    "inertial_period",
+    "InertialPeriods",
+    "inertial_periods",
+    "harmonic_alpha",
+    "airy_alpha",
+    "sinusoid_alpha",
+    "wkb_amplitude_phase",
+    "wkb_alpha",
+    "wkb_error_bound",
+    "alpha_numerical",
+    "cd_damping_time",
+    "cd_decay_alpha",
+    "ALPHA_FORMS",
+]
+
+#: equations accepted by :func:`alpha_numerical`
+ALPHA_FORMS = ("airy", "airy1", "airy2")
+
+
+# ------------------------------------------------------------ shared closed forms
+# (numpy- and numba-compatible: only arithmetic and np ufuncs)
+
+
+def _sinusoid(t, A, phi, F_in, s, R, I):
+    """(α, α̇) of the WKB sinusoid with amplitude A and phase φ at t = 0."""
+    F = F_in + s * t
+    sqF = np.sqrt(F)
+    sqFin = np.sqrt(F_in)
+    # ∫0^t sqrt(R F/I) dt' = (2/(3s)) sqrt(R/I) (F^1.5 - F_in^1.5), written without 1/s
+    Phi = (2.0 / 3.0) * np.sqrt(R / I) * t * (F + sqF * sqFin + F_in) / (sqF + sqFin)
+    env = A * np.sqrt(np.sqrt(F_in / F))
+    sn = np.sin(Phi + phi)
+    cs = np.cos(Phi + phi)
+    return env * sn, env * (np.sqrt(R * F / I) * cs - s / (4.0 * F) * sn)
+
+
+def _harmonic(t, alpha_in, alphadot_in, F, R, I):
+    """(α, α̇) of approxalpha with constant F."""
+    Om = np.sqrt(R * F / I)
+    c = np.cos(Om * t)
+    s = np.sin(Om * t)
+    return alpha_in * c + alphadot_in / Om * s, -alpha_in * Om * s + alphadot_in * c
+
+
+def _decay(t, alpha_in, tau):
+    """(α, α̇) of ``α̇ = -α/τ``."""
+    a = alpha_in * np.exp(-t / tau)
+    return a, -a / tau
+
+
+# ------------------------------------------------------------ validators
+
+
+def _finite(name: str, x) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {x!r}")
+    return v
+
+
+def _positive(name: str, x) -> float:
+    v = _finite(name, x)
+    if v <= 0.0:
+        raise ValueError(f"{name} must be in (0, inf), got {x!r}")
+    return v
+
+
+def _times(t) -> np.ndarray:
+    a = np.asarray(t, dtype=float)
+    if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise ValueError("t must be a non-empty array of finite times in [0, inf) measured from the branch entry")
+    return a
+
+
+def _force_ramp(params: PeelParams, t: np.ndarray, F_in, F_rate) -> tuple[float, float]:
+    """Validate ``F = F_in + F_rate t`` (default rate ``k V``) and keep it positive over t."""
+    F_in = _positive("F_in", F_in)
+    s = params.k * params.V if F_rate is None else _finite("F_rate", F_rate)
+    F_end = F_in + s * float(np.max(t))
+    if not F_end > 0.0:
+        raise ValueError(
+            f"F = F_in + F_rate*t must stay in (0, inf) over t; with F_in={F_in} and F_rate={s} it reaches "
+            f"{F_end} at t={float(np.max(t))}: valid range is t < {F_in / -s if s < 0 else math.inf}"
+        )
+    return F_in, s
+
+
+# ------------------------------------------------------------ approxalpha
+
+
+def inertial_frequency(params: PeelParams, F):
+    """Angular frequency ``2πν = sqrt(F R / I)`` of approxalpha [rad/s].
+
+    Parameters
+    ----------
+    params : PeelParams
+        Uses ``R`` [m] and ``I`` [kg m²].
+    F : float or array_like
+        Pull force [N] (> 0).
+
+    Returns
+    -------
+    float or ndarray
+        ``sqrt(F R / I)`` [rad/s].  Valid on AB, where ``v/R`` is small in
+        FLOW1 so that ``v̇/R`` drops out of genalpha (paper Sec. V, Case I).
+    """
+    Fa = np.asarray(F, dtype=float)
+    if not np.all(np.isfinite(Fa)) or np.any(Fa <= 0):
+        raise ValueError("F must be finite and in (0, inf)")
+    out = np.sqrt(Fa * params.R / params.I)
+    return float(out) if out.ndim == 0 else out
+
+
+def inertial_period(params: PeelParams, F):
+    """Period ``T = 2π sqrt(I / (F R))`` of approxalpha [s] (``1/ν``)."""
+    return 2.0 * np.pi / inertial_frequency(params, F)
+
+
+class InertialPeriods(NamedTuple):
+    """Inertial periods of approxalpha at the branch force levels [s]."""
+
+    at_f_min: float
+    at_f_max: float
+    at_mean: float
+    f_min: float
+    f_max: float
+    F_mean: float
+
+
+def inertial_periods(params: PeelParams, F_mean: Optional[float] = None) -> InertialPeriods:
+    """Periods of approxalpha at ``F = f_min``, ``f_max`` and a mean force.
+
+    Signature: ``inertial_periods(params, F_mean=None) -> InertialPeriods``.
+
+    The paper (Case I a) estimates the high-frequency α oscillation on AB at
+    the lowest force ``F_min ≈ f_min`` and the highest ``F_max ≈ f_max``, and
+    for high inertia at a mean ``F`` (default ``(f_min + f_max)/2``).
+
+    Raises
+    ------
+    ValueError
+        If ``f(v, V)`` has no folds (no stick-slip window for this V) and no
+        ``F_mean`` is given.
+    """
+    bs = branch_structure(params.V)
+    if not bs.has_folds:
+        raise ValueError(f"V={params.V} is outside the stick-slip window (f(v, V) has no folds): f_min/f_max undefined")
+    Fm = 0.5 * (bs.f_min + bs.f_max) if F_mean is None else _positive("F_mean", F_mean)
+    return InertialPeriods(
+        inertial_period(params, bs.f_min), inertial_period(params, bs.f_max), inertial_period(params, Fm),
+        bs.f_min, bs.f_max, Fm,
+    )
+
+
+def harmonic_alpha(params: PeelParams, t, *, F: float, alpha_in: float, alphadot_in: float):
+    """Exact solution of approxalpha, ``I α̈ = -F R α`` with constant F.
+
+    Signature: ``harmonic_alpha(params, t, *, F, alpha_in, alphadot_in) -> (alpha, alphadot)``.
+
+    Returns ``α(t) = α_in cos Ωt + (α̇_in/Ω) sin Ωt`` and its derivative,
+    ``Ω = sqrt(F R/I)``; arrays shaped like ``t`` (time since branch entry, s).
+    """
+    t = _times(t)
+    return _harmonic(t, _finite("alpha_in", alpha_in), _finite("alphadot_in", alphadot_in), _positive("F", F),
+                     params.R, params.I)
+
+
+# ------------------------------------------------------------ Airy
+
+
+def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
+               F_rate: Optional[float] = None):
+    """Exact solution of the Airy-type equation ``I α̈ = -(F_in + s t) R α`` (Airy).
+
+    Signature: ``airy_alpha(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> (alpha, alphadot)``.
+
+    The paper says this equation "does not have an exact solution"; it does.
+    With ``a = cbrt(R s / I)`` and ``x = -a (t + F_in/s)`` it becomes Airy's
+    equation ``d²α/dx² = x α``, so ``α = c1 Ai(x) + c2 Bi(x)``.  Matching
+    ``(α_in, α̇_in)`` at t = 0 with the Wronskian ``W(Ai, Bi) = 1/π``::
+
+        c1 =  π (α_in Bi'(x0) + (α̇_in/a) Bi(x0))
+        c2 = -π (α_in Ai'(x0) + (α̇_in/a) Ai(x0))
+
+    ``x < 0`` whenever ``F > 0``, so only the oscillatory side of Ai/Bi is
+    used (no exponential growth or cancellation).  Evaluated with
+    :func:`scipy.special.airy`; ``s = 0`` is approxalpha (:func:`harmonic_alpha`).
+
+    Parameters
+    ----------
+    params : PeelParams
+        ``R``, ``I`` and (for the default rate) ``k``, ``V``.
+    t : array_like
+        Times since the branch entry [s], ``>= 0``.
+    F_in : float
+        Pull force at entry [N] (the paper's ``F_min`` on AB).
+    alpha_in, alphadot_in : float
+        Peel angle [rad] and its rate [rad/s] at entry.
+    F_rate : float, optional
+        ``s = dF/dt`` [N/s]; default ``k V`` (v dropped on AB, as the paper does).
+
+    Returns
+    -------
+    alpha, alphadot : ndarray
+        Shaped like ``t``.
+    """
+    t = _times(t)
+    F_in, s = _force_ramp(params, t, F_in, F_rate)
+    a_in, ad_in = _finite("alpha_in", alpha_in), _finite("alphadot_in", alphadot_in)
+    if s == 0.0:
+        return _harmonic(t, a_in, ad_in, F_in, params.R, params.I)
+    a = np.cbrt(params.R * s / params.I)
+    x0 = -a * F_in / s
+    ai0, aip0, bi0, bip0 = special.airy(x0)
+    c1 = np.pi * (a_in * bip0 + ad_in / a * bi0)
+    c2 = -np.pi * (a_in * aip0 + ad_in / a * ai0)
+    ai, aip, bi, bip = special.airy(-a * (t + F_in / s))
+    return c1 * ai + c2 * bi, -a * (c1 * aip + c2 * bip)
+
+
+def sinusoid_alpha(params: PeelParams, t, *, F_in: float, amplitude: float, phase: float,
+                   F_rate: Optional[float] = None):
+    """The paper's slowly varying sinusoid for α on AB, as the WKB form of Airy.
+
+    Signature: ``sinusoid_alpha(params, t, *, F_in, amplitude, phase, F_rate=None) -> (alpha, alphadot)``.
+
+    ``α = A (F_in/F)^(1/4) sin(Φ(t) + φ)``, ``Φ = ∫0^t sqrt(F R/I) dt'``,
+    ``F = F_in + s t``.  The paper writes ``α = α_in sin(2πνt + φ)`` with
+    ``2πν = sqrt(F R/I)`` and "F treated as a slowly increasing parameter";
+    the Liouville–Green (WKB) form makes that precise: the phase is the
+    integral of the local frequency and the amplitude follows the adiabatic
+    invariant ``∝ F^(-1/4)``.  Its error is bounded by :func:`wkb_error_bound`.
+
+    Parameters
+    ----------
+    amplitude, phase : float
+        ``A`` [rad] (the paper's ``α_in``) and ``φ`` [rad] at t = 0.
+    Other parameters as in :func:`airy_alpha`.
+    """
+    t = _times(t)
+    F_in, s = _force_ramp(params, t, F_in, F_rate)
+    return _sinusoid(t, _finite("amplitude", amplitude), _finite("phase", phase), F_in, s, params.R, params.I)
+
+
+def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alphadot_in: float,
+                        F_rate: Optional[float] = None) -> tuple[float, float]:
+    """``(A, φ)`` of :func:`sinusoid_alpha` matching ``(α_in, α̇_in)`` at t = 0.
+
+    Solves ``A sin φ = α_in`` and ``A (Ω_in cos φ - s/(4 F_in) sin φ) = α̇_in``.
+    """
+    F_in, s = _force_ramp(params, np.zeros(1), F_in, F_rate)
+    a_in, ad_in = _finite("alpha_in", alpha_in), _finite("alphadot_in", alphadot_in)
+    Om = math.sqrt(params.R * F_in / params.I)
+    c = (ad_in + s * a_in / (4.0 * F_in)) / Om
+    return math.hypot(a_in, c), math.atan2(a_in, c)
+
+
+def wkb_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
+              F_rate: Optional[float] = None):
+    """:func:`sinusoid_alpha` matched to ``(α_in, α̇_in)`` (see :func:`wkb_amplitude_phase`).
+
+    Signature: ``wkb_alpha(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> (alpha, alphadot)``.
+    """
+    A, phi = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in, F_rate=F_rate)
+    return sinusoid_alpha(params, t, F_in=F_in, amplitude=A, phase=phi, F_rate=F_rate)
+
+
+def wkb_error_bound(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
+                    F_rate: Optional[float] = None):
+    """Rigorous bound on ``|α_Airy(t) - α_WKB(t)|`` [rad].
+
+    Signature: ``wkb_error_bound(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> ndarray``.
+
+    Liouville–Green theorem (Olver, *Asymptotics and Special Functions*,
+    Ch. 6, Thm 2.2 and §2.4) for ``α̈ = -Q α``, ``Q = R F(t)/I``: the exact
+    solutions are ``Q^(-1/4) e^(±iΦ)(1 + ε±)`` with ``ε±`` and ``ε±'``
+    vanishing at the reference point t = 0 and ``|ε±| <= exp(𝒱(t)) - 1``,
+    where 𝒱 is the variation of the error-control function
+    ``∫ Q^(-1/4) d²/dt² Q^(-1/4) dt``.  For ``F = F_in + s t`` this is, in
+    closed form::
+
+        𝒱(t) = (5/24) sqrt(I/R) |s| |F_in^(-3/2) - F(t)^(-3/2)|
+
+    Both α and its WKB form are the same combination of the two basis
+    solutions (the matching at t = 0 is exact), so
+    ``|α - α_WKB| <= A(t) (exp(𝒱) - 1)`` with the WKB envelope
+    ``A(t) = A (F_in/F)^(1/4)``.  𝒱 is first order in the adiabatic
+    parameter ``s/(F·sqrt(FR/I))``.
+    """
+    t = _times(t)
+    F_in, s = _force_ramp(params, t, F_in, F_rate)
+    A, _ = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in, F_rate=F_rate)
+    F = F_in + s * t
+    var = (5.0 / 24.0) * math.sqrt(params.I / params.R) * abs(s) * np.abs(F_in**-1.5 - F**-1.5)
+    return A * (F_in / F) ** 0.25 * np.expm1(var)
+
+
+# ------------------------------------------------------------ numerical / damped
+
+
+def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
+                    form: str = "airy", F_rate: Optional[float] = None, v: Optional[float] = None,
+                    rtol: float = 1e-12, atol: float = 1e-15):
+    """Integrate an α equation of Sec. V numerically with v frozen.
+
+    Signature: ``alpha_numerical(params, t, *, F_in, alpha_in, alphadot_in, form="airy",
+    F_rate=None, v=None, rtol=1e-12, atol=1e-15) -> (alpha, alphadot)``.
+
+    ``form`` selects (``F = F_in + s t``, ``s = F_rate``, ``f' = f'(v, V)`` frozen):
+
+    * ``"airy"``: Airy, ``α̈ = -F R α/I``;
+    * ``"airy2"``: Airy2, ``α̈ = -F R α/I - F α̇/(R f')``;
+    * ``"airy1"``: Airy1, ``α̈ = -F R α/I - (s + F α̇)/(R f')``.
+
+    Integrated by :func:`scipy.integrate.solve_ivp` (DOP853) with its
+    ``rtol``/``atol`` semantics on the state ``(α, α̇)``.  Airy2/Airy1 need
+    ``v`` [m/s] on a stable branch (``f'(v, V) > 0``); the damping time is
+    ``R f'/F`` (:func:`cd_damping_time`).  The default rate is ``k (V - v)``
+    when ``v`` is given, else ``k V``.
+    """
+    if form not in ALPHA_FORMS:
+        raise ValueError(f"form must be one of {ALPHA_FORMS}, got {form!r}")
+    t = _times(t)
+    if v is not None:
+        v = _positive("v", v)
+        if F_rate is None:
+            F_rate = params.k * (params.V - v)
+    F_in, s = _force_ramp(params, t, F_in, F_rate)
+    R, I = params.R, params.I
+    damp = 0.0
+    if form != "airy":
+        if v is None:
+            raise ValueError(f"form={form!r} needs the peel velocity v (f'(v, V) sets the damping)")
+        fp = float(peel_force_derivative(v, params.V))
+        if not fp > 0:
+            raise ValueError(f"v={v} is not on a stable branch of f(., V={params.V}): f'(v) = {fp} <= 0")
+        damp = 1.0 / (R * fp)
+    drive = s if form == "airy1" else 0.0
+
+    def rhs(tt, y):
+        F = F_in + s * tt
+        return [y[1], -F * R * y[0] / I - damp * (drive + F * y[1])]
+
+    order = np.argsort(t.ravel(), kind="stable")
+    tv = t.ravel()[order]
+    sol = integrate.solve_ivp(rhs, (0.0, float(tv[-1])), [_finite("alpha_in", alpha_in),
+                              _finite("alphadot_in", alphadot_in)], method="DOP853", t_eval=tv,
+                              rtol=rtol, atol=atol)
+    if sol.status != 0:
+        raise RuntimeError(f"solve_ivp failed: {sol.message}")
+    al = np.empty(t.size)
+    ad = np.empty(t.size)
+    al[order] = sol.y[0]
+    ad[order] = sol.y[1]
+    return al.reshape(t.shape), ad.reshape(t.shape)
+
+
+def cd_damping_time(params: PeelParams, F, v):
+    """Damping time ``R f'(v, V) / F`` of α on CD [s] (the coefficient in Airy1/Airy2).
+
+    The paper compares it with the inertial period (Sec. V, Case a): when
+    ``2π sqrt(I/(FR))`` exceeds it, the damping term of Airy1 controls α on CD
+    (high inertia).  ``v`` must be on a stable branch.
+    """
+    fp = np.asarray(peel_force_derivative(v, params.V), dtype=float)
+    Fa = np.asarray(F, dtype=float)
+    if np.any(fp <= 0):
+        raise ValueError(f"v must be on a stable branch of f(., V={params.V}) (f'(v) > 0)")
+    if not np.all(np.isfinite(Fa)) or np.any(Fa <= 0):
+        raise ValueError("F must be finite and in (0, inf)")
+    out = params.R * fp / Fa
+    return float(out) if out.ndim == 0 else out
+
+
+def cd_decay_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, v_in: float):
+    """CD limit of Airy2: ``α̇ = -F α/(R f')`` with f', F frozen at entry (exponential decay).
+
+    Signature: ``cd_decay_alpha(params, t, *, F_in, alpha_in, v_in) -> (alpha, alphadot)``.
+
+    Returns ``α = α_in exp(-t/τ)``, ``τ = R f'(v_in)/F_in``.  The paper uses
+    it on CD at high inertia, where ``FRα/I`` is small against the damping
+    and the stay is short (Case II).  First order: ``α̇_in = -α_in/τ`` is
+    implied, not free.
+    """
+    t = _times(t)
+    tau = cd_damping_time(params, _positive("F_in", F_in), _positive("v_in", v_in))
+    return _decay(t, _finite("alpha_in", alpha_in), tau)

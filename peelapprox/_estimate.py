@@ -1,0 +1,305 @@
+"""Regime estimates without running the DAE (paper Sec. V).
+
+Everything here is closed form or one quadrature of ``f'(v, V)``: the folds,
+the fixed point and its Hopf stability, the inertial periods (approxalpha),
+the CD damping time (Airy2), branch times and force changes in the
+quasi-static limit, the paper's crude estimates, the force bounds
+``F = f/(1 + sin α)`` and the slope criterion for the switch from the jumping
+mode to a monotonic rise.  :func:`estimate` collects them with a regime label.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Callable, Optional
+
+import numpy as np
+from scipy import integrate
+
+from ._alpha import cd_damping_time, inertial_frequency, inertial_periods
+from ._params import PeelParams
+from ._peelforce import BranchStructure, FixedPoint, branch_structure, fixed_point, peel_force_derivative
+
+__all__ = [
+    "crude_branch_time",
+    "quasi_static_branch_time",
+    "force_bounds",
+    "SlopeCriterion",
+    "slope_criterion",
+    "RegimeEstimate",
+    "estimate",
+    "INERTIA_RULE",
+    "VELOCITY_RULE",
+]
+
+#: How :func:`estimate` labels inertia (stated once, printed by the CLI).
+INERTIA_RULE = (
+    "r = T_mean / tau_CD, the inertial period 2*pi*sqrt(I/(F_mean R)) over the CD damping time R f'(v_land_cd)/F_mean "
+    "(coefficient of Airy2): low if r < 1 (alpha oscillates freely through the short CD stays: Case I), "
+    "intermediate if 1 <= r < 5, high if r >= 5 (CD stays damp alpha-dot and alpha sweeps slowly on AB: Case II)"
+)
+#: How :func:`estimate` labels the pull speed.
+VELOCITY_RULE = (
+    "stable if f'(V,V) > 0 (fixed point stable, no stick-slip; Hopf criterion); otherwise g = (f_max - f_min)/f_max: "
+    "low V if g >= 0.1, high V if g < 0.1 (f nearly flat: a peel angle of 0.1 rad changes F = f/(1+sin alpha) by "
+    "more than the fold window, so alpha sets the force bounds: Case III)"
+)
+
+
+def _folds(params: PeelParams) -> BranchStructure:
+    bs = branch_structure(params.V)
+    if not bs.has_folds:
+        raise ValueError(f"V={params.V} is outside the stick-slip window: f(v, V) has no folds")
+    return bs
+
+
+def crude_branch_time(params: PeelParams) -> float:
+    """The paper's rough AB time ``(f_max - f_min)/(k V)`` [s] (Sec. V, Case a).
+
+    F rises at ``k V`` (v ≪ V on AB) from ``f_min`` to ``f_max``; α and v are
+    ignored.  V=1: 0.0862 s (the paper, reading 284 and 200 off a figure: 0.084).
+    """
+    bs = _folds(params)
+    return (bs.f_max - bs.f_min) / (params.k * params.V)
+
+
+def quasi_static_branch_time(
+    params: PeelParams,
+    branch: str = "AB",
+    *,
+    v_in: Optional[float] = None,
+    v_f: Optional[float] = None,
+    fprime: Optional[Callable[[np.ndarray], np.ndarray]] = None,
+    rate: str = "k(V-v)",
+) -> float:
+    """Branch time of approxvdot with α̇ = 0: ``Δt = ∫ f'(v) / Ḟ dv`` [s].
+
+    Signature: ``quasi_static_branch_time(params, branch="AB", *, v_in=None, v_f=None,
+    fprime=None, rate="k(V-v)") -> float``.
+
+    With α̇ = 0, approxvdot reads ``f'(v) v̇ = k(V - v)``, so the time from
+    ``v_in`` to ``v_f`` is the quadrature above (:func:`scipy.integrate.quad`,
+    relative accuracy ~1e-10).  This is the inertia-free limit and equals
+    ``reduced_segment(..., alpha_model="static")``.
+
+    Parameters
+    ----------
+    branch : {"AB", "CD"}
+    v_in, v_f : float, optional
+        Default: the landing velocity on the branch and the branch's fold.
+    fprime : callable, optional
+        Replace ``f'(v, V)`` (e.g. the paper's crude linear form); vectorised
+        in v.
+    rate : {"k(V-v)", "kV"}
+        ``Ḟ``: the approxvdot rate, or ``k V`` (v dropped, the paper's crude
+        estimates).
+
+    Returns
+    -------
+    float
+        Δt [s] (positive for a forward passage along the branch).
+    """
+    bs = _folds(params)
+    if branch not in ("AB", "CD"):
+        raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
+    if rate not in ("k(V-v)", "kV"):
+        raise ValueError(f"rate must be 'k(V-v)' or 'kV', got {rate!r}")
+    if branch == "AB":
+        v_in = bs.v_land_ab if v_in is None else float(v_in)
+        v_f = bs.v_max if v_f is None else float(v_f)
+        if v_in is None:
+            raise ValueError(f"no AB landing velocity for V={params.V}; give v_in")
+    else:
+        v_in = bs.v_land_cd if v_in is None else float(v_in)
+        v_f = bs.v_min if v_f is None else float(v_f)
+    for name, x in (("v_in", v_in), ("v_f", v_f)):
+        if not (math.isfinite(x) and x > 0):
+            raise ValueError(f"{name} must be finite and in (0, inf), got {x}")
+    fpr = (lambda v: peel_force_derivative(v, params.V)) if fprime is None else fprime
+    k, V = params.k, params.V
+    if rate == "kV":
+        integrand = lambda v: float(fpr(v)) / (k * V)  # noqa: E731
+    else:
+        if min(v_in, v_f) <= V <= max(v_in, v_f):
+            raise ValueError(f"k(V - v) vanishes at v = V = {V} between v_in={v_in} and v_f={v_f}")
+        integrand = lambda v: float(fpr(v)) / (k * (V - v))  # noqa: E731
+    # the AB integrand is ∝ v^-0.85 near 0: integrate in ln v
+    val, _ = integrate.quad(lambda w: integrand(math.exp(w)) * math.exp(w), math.log(v_in), math.log(v_f),
+                            epsabs=0.0, epsrel=1e-11, limit=200)
+    return abs(val) if branch == "CD" else val
+
+
+def force_bounds(params: PeelParams, alpha_min: float, alpha_max: float, *, linear: bool = False
+                 ) -> tuple[float, float]:
+    """``F_max ≈ f_max/(1 + sin α_min)`` and ``F_min ≈ f_min/(1 + sin α_max)`` [N].
+
+    Signature: ``force_bounds(params, alpha_min, alpha_max, *, linear=False) -> (F_max, F_min)``.
+
+    From CONSTR, ``F = f(v, V)/(1 + sin α)``: the pull force overshoots the
+    folds by the peel-angle factor (paper Sec. V, Case III).  ``linear=True``
+    uses the paper's ``1 + α`` (its quoted 438 N and 181 N at V=4, I=1e-2).
+    """
+    bs = _folds(params)
+    for name, a in (("alpha_min", alpha_min), ("alpha_max", alpha_max)):
+        if not (math.isfinite(a) and -math.pi / 2 < a < math.pi / 2):
+            raise ValueError(f"{name} must be in (-pi/2, pi/2), got {a}")
+    if alpha_min > alpha_max:
+        raise ValueError(f"alpha_min must be <= alpha_max, got {alpha_min} > {alpha_max}")
+    g = (lambda a: 1.0 + a) if linear else (lambda a: 1.0 + math.sin(a))
+    if g(alpha_min) <= 0:
+        raise ValueError(f"1 + alpha_min must be > 0 for the linear closure, got alpha_min={alpha_min}")
+    return bs.f_max / g(alpha_min), bs.f_min / g(alpha_max)
+
+
+@dataclass(frozen=True)
+class SlopeCriterion:
+    """Result of :func:`slope_criterion`.
+
+    ``natural_slope = 2πν α₀`` [rad/s]; ``ratio = α̇_in / natural_slope``;
+    ``compatible``: the entry slope can start a sinusoidal sojourn
+    (``0 < ratio <= 1 + tol``).
+    """
+
+    natural_slope: float
+    ratio: float
+    compatible: bool
+    tol: float
+
+
+def slope_criterion(params: PeelParams, *, F_in: float, alphadot_in: float, alpha0: float, tol: float = 0.25
+                    ) -> SlopeCriterion:
+    """The paper's test for leaving the jumping mode on AB (Case II points a vs k).
+
+    Signature: ``slope_criterion(params, *, F_in, alphadot_in, alpha0, tol=0.25) -> SlopeCriterion``.
+
+    A sinusoid ``α₀ sin 2πνt`` has its largest slope ``2πν α₀`` at α ≈ 0,
+    with ``2πν = sqrt(F_in R/I)`` (approxalpha).  An AB entry whose α̇ has
+    the sign of α₀ (the direction of the sinusoidal stretch: α₀ > 0 for a
+    rise, < 0 for a fall) and does not exceed that slope can start the
+    monotonic stretch (point a: 9.7 vs 10); a larger or opposite slope cannot,
+    and the orbit makes another small loop (point k: 18.3).  ``tol`` absorbs
+    the asymmetry from ``v/R`` in FLOW1 that the argument neglects; 0.25 puts
+    the paper's two points on either side.
+    """
+    if not (math.isfinite(alpha0) and alpha0 != 0.0):
+        raise ValueError(f"alpha0 must be finite and non-zero (signed amplitude), got {alpha0}")
+    if not (math.isfinite(tol) and tol >= 0):
+        raise ValueError(f"tol must be finite and >= 0, got {tol}")
+    nat = float(inertial_frequency(params, F_in)) * alpha0
+    ratio = float(alphadot_in) / nat
+    return SlopeCriterion(nat, ratio, bool(0.0 < ratio <= 1.0 + tol), tol)
+
+
+@dataclass(frozen=True)
+class RegimeEstimate:
+    """Everything :func:`estimate` knows about a parameter point without solving the DAE.
+
+    Times in s, forces in N, velocities in m/s.  Fold fields are None outside
+    the stick-slip window.
+    """
+
+    V: float
+    I: float
+    k: float
+    R: float
+    has_folds: bool
+    v_max: Optional[float]
+    f_max: Optional[float]
+    v_min: Optional[float]
+    f_min: Optional[float]
+    v_land_ab: Optional[float]
+    v_land_cd: Optional[float]
+    fixed_point_v: float
+    fixed_point_F: float
+    fixed_point_fprime: float
+    fixed_point_stable: bool
+    F_mean: Optional[float]
+    period_at_f_min: Optional[float]
+    period_at_f_max: Optional[float]
+    period_at_mean: Optional[float]
+    cd_damping_time: Optional[float]
+    inertia_ratio: Optional[float]
+    t_ab_crude: Optional[float]
+    t_ab_quasi_static: Optional[float]
+    t_cd_quasi_static: Optional[float]
+    dF_ab_quasi_static: Optional[float]
+    dF_cd_quasi_static: Optional[float]
+    oscillations_per_ab: Optional[float]
+    force_gap: Optional[float]
+    inertia: str
+    velocity: str
+    F_max_bound: Optional[float] = None
+    F_min_bound: Optional[float] = None
+    inertia_rule: str = INERTIA_RULE
+    velocity_rule: str = VELOCITY_RULE
+
+    @property
+    def label(self) -> str:
+        """``"<inertia> inertia, <velocity> V"`` or ``"no stick-slip"``."""
+        if self.velocity == "stable":
+            return "no stick-slip (stable fixed point)"
+        return f"{self.inertia} inertia, {self.velocity} V"
+
+    def as_dict(self) -> dict:
+        d = asdict(self)
+        d["label"] = self.label
+        return d
+
+
+def estimate(params: PeelParams, *, alpha_min: Optional[float] = None, alpha_max: Optional[float] = None
+             ) -> RegimeEstimate:
+    """Regime estimate for one parameter point, without running the DAE.
+
+    Signature: ``estimate(params, *, alpha_min=None, alpha_max=None) -> RegimeEstimate``.
+
+    Returns the folds, the fixed point and its Hopf stability, the inertial
+    periods of approxalpha at ``f_min``, ``f_max`` and ``F_mean = (f_min +
+    f_max)/2``, the CD damping time ``R f'(v_land_cd)/F_mean`` (Airy2), the
+    crude and quasi-static branch times and force changes, and the regime
+    labels (rules in :data:`INERTIA_RULE`, :data:`VELOCITY_RULE`).  Force
+    bounds ``f/(1 + sin α)`` are added when both α extremes are given.
+    A few milliseconds per call after the first for a given V (the fold
+    search is cached).
+    """
+    if not isinstance(params, PeelParams):
+        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
+    bs = branch_structure(params.V)
+    fp: FixedPoint = fixed_point(params.V, params.R)
+    velocity = "stable" if fp.stable else None
+    if not bs.has_folds:
+        return RegimeEstimate(
+            params.V, params.I, params.k, params.R, False, None, None, None, None, None, None, fp.v, fp.F,
+            fp.fprime, fp.stable, None, None, None, None, None, None, None, None, None, None, None, None, None,
+            "n/a", "stable")
+    per = inertial_periods(params)
+    tau_cd = cd_damping_time(params, per.F_mean, bs.v_land_cd)
+    ratio = per.at_mean / tau_cd
+    inertia = "low" if ratio < 1.0 else ("intermediate" if ratio < 5.0 else "high")
+    gap = (bs.f_max - bs.f_min) / bs.f_max
+    if velocity is None:
+        velocity = "low" if gap >= 0.1 else "high"
+    # quasi-static passages exist only if F keeps moving towards the fold: on AB
+    # F rises while v < V, so the fold must lie below V (else the orbit settles
+    # at the stable fixed point v = V); on CD F falls while v > V.
+    t_ab = t_cd = None
+    if bs.v_land_ab is not None and bs.v_max < params.V:
+        t_ab = quasi_static_branch_time(params, "AB")
+    if bs.v_min > params.V:
+        t_cd = quasi_static_branch_time(params, "CD")
+    Fmax_b = Fmin_b = None
+    if alpha_min is not None or alpha_max is not None:
+        if alpha_min is None or alpha_max is None:
+            raise ValueError("give both alpha_min and alpha_max for the force bounds")
+        Fmax_b, Fmin_b = force_bounds(params, float(alpha_min), float(alpha_max))
+    return RegimeEstimate(
+        V=params.V, I=params.I, k=params.k, R=params.R, has_folds=True, v_max=bs.v_max, f_max=bs.f_max,
+        v_min=bs.v_min, f_min=bs.f_min, v_land_ab=bs.v_land_ab, v_land_cd=bs.v_land_cd, fixed_point_v=fp.v,
+        fixed_point_F=fp.F, fixed_point_fprime=fp.fprime, fixed_point_stable=fp.stable, F_mean=per.F_mean,
+        period_at_f_min=per.at_f_min, period_at_f_max=per.at_f_max, period_at_mean=per.at_mean,
+        cd_damping_time=tau_cd, inertia_ratio=ratio, t_ab_crude=crude_branch_time(params),
+        t_ab_quasi_static=t_ab, t_cd_quasi_static=t_cd,
+        dF_ab_quasi_static=bs.f_max - bs.f_min, dF_cd_quasi_static=bs.f_min - bs.f_max,
+        oscillations_per_ab=(t_ab / per.at_mean) if t_ab is not None else None, force_gap=gap,
+        inertia=inertia, velocity=velocity, F_max_bound=Fmax_b, F_min_bound=Fmin_b,
+    )

@@ -1,0 +1,570 @@
+"""The paper's reduced velocity equation on one branch, coupled to an α model.
+
+Sec. V (Case b) estimates how long the orbit stays on a branch by integrating
+the velocity equation from the landing velocity ``v_in`` until v reaches the
+fold ``v_f`` (where ``f'(v_f, V) = 0`` and the orbit must jump):
+
+* approxvdot: ``f'(v) v̇ = k(V - v) + F α̇``, ``Ḟ = k(V - v)``;
+* fullvdot:   ``f'(v) v̇ = Ḟ (1 + α) + F α̇``, ``Ḟ = k(V - v + R α α̇)`` (FLOW3).
+
+The paper writes the force as ``F ≃ F_in + k(V - v) t``; with v changing
+along the branch we integrate ``Ḟ`` instead (the two agree when v is
+constant, and the integral is what reproduces the paper's CD number
+ΔF = 19.4 N; see ``docs/paper-notes.md``).
+
+α comes from one of the models in :data:`ALPHA_MODELS`:
+
+==================  ================================================================  ==========
+model               α equation                                                        inputs
+==================  ================================================================  ==========
+``"sinusoid"``      WKB sinusoid ``A (F_in/F_lin)^¼ sin(∫√(F_lin R/I) + φ)``,          (A, φ) or
+                    ``F_lin = F_in + s t`` (closed form)                                (α_in, α̇_in)
+``"harmonic"``      approxalpha with F frozen at ``F_in`` (closed form)                (α_in, α̇_in)
+``"approxalpha"``   approxalpha with the branch force: ``α̈ = -F R α/I`` (Airy when    (α_in, α̇_in)
+                    v ≪ V)
+``"airy2"``         Airy2: ``α̈ = -F R α/I - F α̇/(R f'(v))``                           (α_in, α̇_in)
+``"airy2_frozen"``  Airy2 with F and f' frozen at entry (the paper's CD shortcut)      (α_in, α̇_in)
+``"airy1"``         Airy1: ``α̈ = -F R α/I - (Ḟ + F α̇)/(R f'(v))``                     (α_in, α̇_in)
+``"genalpha"``      genalpha: ``α̈ = -F R α/I - v̇/R`` with v̇ from the v equation       (α_in, α̇_in)
+                    (Case III, high I and V)
+``"exponential"``   CD limit ``α = α_in exp(-t/τ)``, ``τ = R f'(v_in)/F_in`` (closed)  α_in
+``"static"``        ``α = α_in``, ``α̇ = 0``: the quasi-static (inertia-free) limit      α_in
+==================  ================================================================  ==========
+
+``genalpha`` with ``fullvdot`` is the full model FLOW1–FLOW3 + CONSTR
+linearised in α (``sin α → α``), so it reproduces the exact branch dynamics
+up to O(α³) (tested).
+
+Formulation and solver
+----------------------
+v̇ is singular at the fold (``f' → 0``), the very point we integrate to.  As in
+the hybrid solver, time is desingularised, ``dt/ds = v f'(v)``, on the state
+``y = (t, ln v, F, α, α̇)``::
+
+    dt/ds = v f',   d ln v/ds = N,   dF/ds = v f' Ḟ,   dα/ds = v f' α̇,
+    dα̇/ds = v f' (-F R α/I) - [damping terms × v f']
+
+with ``N`` the numerator of the v equation; every ``1/f'`` cancels, so the
+field is smooth through the fold and the exit is the transversal event
+``ln v = ln v_f``.  Closed-form α models are evaluated at the current t.
+
+The integrator is the package's one compiled DOP853 (:mod:`peelapprox._dop853`)
+with scipy's tolerance semantics: a step is accepted when the RMS of
+``err_i / (atol_i + rtol·|y_i|)`` is below 1 over ``y = (t, ln v, F, α, α̇)``.
+The default ``atol = rtol × (1 ms, 1, F_in, α_scale, Ω_in α_scale)`` with
+``α_scale = max(|α_in|, |α̇_in|/Ω_in, 1e-8)``, ``Ω_in = sqrt(F_in R/I)``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+from numba import njit
+
+from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
+from ._dop853 import N_STAGES as _NS
+from ._dop853 import N_STAGES_EXTENDED as _NX
+from ._dop853 import STEP_FAILED, interp, interp1, make_dop853, solve_theta
+from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from ._params import PeelParams
+from ._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_derivative, peel_force_fp_jit
+
+__all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
+
+#: α models accepted by :func:`reduced_segment` (module docstring)
+ALPHA_MODELS = (
+    "sinusoid", "harmonic", "approxalpha", "airy2", "airy2_frozen", "airy1", "genalpha", "exponential", "static",
+)
+#: velocity equations accepted by :func:`reduced_segment`
+V_EQUATIONS = ("approxvdot", "fullvdot")
+
+AM_SIN, AM_HARM, AM_APPROX, AM_AIRY2, AM_AIRY2F, AM_AIRY1, AM_GEN, AM_EXP, AM_STATIC = range(9)
+VE_APPROX, VE_FULL = range(2)
+_CLOSED = (AM_SIN, AM_HARM, AM_EXP, AM_STATIC)
+
+# parameter vector layout
+(Q_V, Q_I, Q_K, Q_R, Q_B, Q_A, Q_AM, Q_VE, Q_FIN, Q_VIN, Q_FPIN, Q_S, Q_AMP, Q_PH, Q_AIN, Q_ADIN, Q_TAU) = range(17)
+N_Q = 17
+# counters
+C_STEPS, C_REJ, C_RHS, C_NOUT, C_TEVAL = range(5)
+# save modes
+SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = range(3)
+# status codes
+EXIT, OUT_FULL, T_MAX, MAX_STEPS, BREAK_VFLOOR, BREAK_VCEIL, BREAK_F, BREAK_NONFINITE, STEP_FAIL = range(9)
+
+_sinusoid_jit = njit(cache=True)(_sinusoid)
+_harmonic_jit = njit(cache=True)(_harmonic)
+_decay_jit = njit(cache=True)(_decay)
+
+
+@njit(cache=True)
+def _alpha_of(y, q):
+    """(α, α̇) at state y: closed forms evaluated at t, else the state's own."""
+    am = int(q[Q_AM])
+    t = y[0]
+    if am == AM_SIN:
+        return _sinusoid_jit(t, q[Q_AMP], q[Q_PH], q[Q_FIN], q[Q_S], q[Q_R], q[Q_I])
+    if am == AM_HARM:
+        return _harmonic_jit(t, q[Q_AIN], q[Q_ADIN], q[Q_FIN], q[Q_R], q[Q_I])
+    if am == AM_EXP:
+        return _decay_jit(t, q[Q_AIN], q[Q_TAU])
+    if am == AM_STATIC:
+        return q[Q_AIN], 0.0
+    return y[3], y[4]
+
+
+@njit(cache=True)
+def _field(y, q, out):
+    """d(t, ln v, F, α, α̇)/ds with dt/ds = v f'(v) (module docstring)."""
+    v = np.exp(y[1])
+    F = y[2]
+    if not (v > 0.0 and F > 0.0 and np.isfinite(v)):
+        for i in range(5):
+            out[i] = np.nan
+        return
+    V, I, k, R = q[Q_V], q[Q_I], q[Q_K], q[Q_R]
+    f, fp = peel_force_fp_jit(v, q[Q_B], q[Q_A])
+    g = v * fp
+    al, ad = _alpha_of(y, q)
+    am = int(q[Q_AM])
+    if int(q[Q_VE]) == VE_APPROX:
+        Fd = k * (V - v)
+        N = Fd + F * ad
+    else:
+        Fd = k * (V - v + R * al * ad)
+        N = Fd * (1.0 + al) + F * ad
+    out[0] = g
+    out[1] = N
+    out[2] = g * Fd
+    if am == AM_SIN or am == AM_HARM or am == AM_EXP or am == AM_STATIC:
+        out[3] = 0.0
+        out[4] = 0.0
+        return
+    out[3] = g * ad
+    if am == AM_AIRY2F:
+        Fi = q[Q_FIN]
+        out[4] = g * (-Fi * R * al / I) - g * Fi * ad / (R * q[Q_FPIN])
+        return
+    acc = g * (-F * R * al / I)
+    if am == AM_AIRY2:
+        acc -= v * F * ad / R
+    elif am == AM_AIRY1:
+        acc -= v * (Fd + F * ad) / R
+    elif am == AM_GEN:
+        acc -= v * N / R
+    out[4] = acc
+
+
+_dop = make_dop853(_field)
+
+
+@njit(cache=True)
+def _store(out, row, y, q):
+    al, ad = _alpha_of(y, q)
+    out[row, 0] = y[0]
+    out[row, 1] = np.exp(y[1])
+    out[row, 2] = y[2]
+    out[row, 3] = al
+    out[row, 4] = ad
+
+
+@njit(cache=True)
+def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
+    """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state."""
+    K = np.empty((_NX, 5))
+    y_new = np.empty(5)
+    f0 = np.empty(5)
+    tmp = np.empty(5)
+    sc = np.empty(5)
+    work = np.empty((3, 5))
+    Fc = np.empty((7, 5))
+    ye = np.empty(5)
+    cap = out.shape[0]
+    n_te = t_eval.shape[0]
+
+    _field(y, q, f0)
+    h = _dop.initial_step(y, f0, q, rtol, atol, work)
+    cnt[C_RHS] += 2
+    if save_mode == SAVE_STEPS:
+        _store(out, cnt[C_NOUT], y, q)
+        cnt[C_NOUT] += 1
+    while True:
+        if cnt[C_STEPS] >= max_steps:
+            return MAX_STEPS
+        if save_mode == SAVE_STEPS and cnt[C_NOUT] + 2 > cap:
+            return OUT_FULL
+        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, q, rtol, atol, K, y_new, tmp, sc)
+        cnt[C_REJ] += n_rej
+        cnt[C_RHS] += n_rhs
+        if status == STEP_FAILED:
+            return STEP_FAIL
+        cnt[C_STEPS] += 1
+        dense = False
+        x_exit = 2.0
+        gA = y[1] - x_f
+        gB = y_new[1] - x_f
+        if (upward and gB >= 0.0) or ((not upward) and gB <= 0.0):
+            _dop.dense(y, y_new, K, h, q, Fc, tmp)
+            cnt[C_RHS] += _NX - _NS - 1
+            dense = True
+            x_exit = solve_theta(y, Fc, 1, x_f, gA, 1.0, gB)
+        x_tmax = 2.0
+        if y_new[0] >= t_max:
+            if not dense:
+                _dop.dense(y, y_new, K, h, q, Fc, tmp)
+                cnt[C_RHS] += _NX - _NS - 1
+                dense = True
+            x_tmax = solve_theta(y, Fc, 0, t_max, y[0] - t_max, 1.0, y_new[0] - t_max)
+        x_stop = min(x_exit, x_tmax, 1.0)
+        if save_mode == SAVE_TEVAL:
+            t_stop = interp1(y, Fc, x_stop, 0) if x_stop < 1.0 else y_new[0]
+            while cnt[C_TEVAL] < n_te and t_eval[cnt[C_TEVAL]] <= t_stop:
+                te = t_eval[cnt[C_TEVAL]]
+                if not dense:
+                    _dop.dense(y, y_new, K, h, q, Fc, tmp)
+                    cnt[C_RHS] += _NX - _NS - 1
+                    dense = True
+                if te <= y[0]:
+                    xe = 0.0
+                else:
+                    xe = solve_theta(y, Fc, 0, te, y[0] - te, x_stop, t_stop - te)
+                interp(y, Fc, xe, ye)
+                ye[0] = te
+                _store(out, cnt[C_NOUT], ye, q)
+                cnt[C_NOUT] += 1
+                cnt[C_TEVAL] += 1
+        if x_stop < 1.0 or x_exit == 1.0 or x_tmax == 1.0:
+            interp(y, Fc, x_stop, ye)
+            for i in range(5):
+                y[i] = ye[i]
+            if x_exit <= x_tmax:
+                y[1] = x_f
+                code = EXIT
+            else:
+                y[0] = t_max
+                code = T_MAX
+            if save_mode == SAVE_STEPS:
+                _store(out, cnt[C_NOUT], y, q)
+                cnt[C_NOUT] += 1
+            return code
+        for i in range(5):
+            if not np.isfinite(y_new[i]):
+                return BREAK_NONFINITE
+        for i in range(5):
+            y[i] = y_new[i]
+            f0[i] = K[_NS, i]
+        h = h_next
+        if save_mode == SAVE_STEPS:
+            _store(out, cnt[C_NOUT], y, q)
+            cnt[C_NOUT] += 1
+        if y[1] <= x_lo:
+            return BREAK_VFLOOR
+        if y[1] >= x_hi:
+            return BREAK_VCEIL
+        if y[2] <= 0.0:
+            return BREAK_F
+
+
+@dataclass(frozen=True)
+class ReducedSegment:
+    """One branch integrated with a reduced equation (:func:`reduced_segment`).
+
+    Attributes
+    ----------
+    branch, alpha_model, v_equation : str
+        What was integrated.
+    dt : float
+        Time to reach ``v_f`` [s] (the branch stay, Δt).
+    F_in, F_exit, dF : float
+        Pull force at entry and exit and ``ΔF = F_exit - F_in`` [N].
+    v_in, v_f : float
+        Entry and exit velocities [m/s].
+    alpha_in, alphadot_in, alpha_exit, alphadot_exit : float
+        α [rad] and α̇ [rad/s] at entry and exit (closed-form models: their value).
+    t, v, F, alpha, alphadot : ndarray
+        The curves at the accepted steps (``save="steps"``) or at ``t_eval``;
+        empty for ``save="none"``.  t is measured from the branch entry.
+    n_steps, n_rejected, n_rhs : int
+        Solver counters; ``wall_time`` [s] of the call.
+    rtol : float
+    atol : ndarray
+        Tolerances on ``(t, ln v, F, α, α̇)``.
+    """
+
+    branch: str
+    alpha_model: str
+    v_equation: str
+    dt: float
+    F_in: float
+    F_exit: float
+    dF: float
+    v_in: float
+    v_f: float
+    alpha_in: float
+    alphadot_in: float
+    alpha_exit: float
+    alphadot_exit: float
+    t: np.ndarray = field(repr=False)
+    v: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
+    alpha: np.ndarray = field(repr=False)
+    alphadot: np.ndarray = field(repr=False)
+    n_steps: int = 0
+    n_rejected: int = 0
+    n_rhs: int = 0
+    wall_time: float = 0.0
+    rtol: float = 0.0
+    atol: np.ndarray = field(default=None, repr=False)
+
+    def as_dict(self) -> dict:
+        """Scalars only (no curves), for tables and JSON."""
+        keys = ("branch", "alpha_model", "v_equation", "dt", "F_in", "F_exit", "dF", "v_in", "v_f", "alpha_in",
+                "alphadot_in", "alpha_exit", "alphadot_exit", "n_steps", "n_rejected", "n_rhs", "wall_time", "rtol")
+        return {k: getattr(self, k) for k in keys}
+
+
+def _opt_finite(name, x):
+    if x is None:
+        return None
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {x!r}")
+    return v
+
+
+def reduced_segment(
+    params: PeelParams,
+    branch: str,
+    *,
+    F_in: float,
+    alpha_in: Optional[float] = None,
+    alphadot_in: Optional[float] = None,
+    amplitude: Optional[float] = None,
+    phase: Optional[float] = None,
+    v_in: Optional[float] = None,
+    v_f: Optional[float] = None,
+    alpha_model: str = "approxalpha",
+    v_equation: str = "approxvdot",
+    F_rate: Optional[float] = None,
+    rtol: float = 1e-10,
+    atol=None,
+    t_max: Optional[float] = None,
+    save: str = "steps",
+    t_eval=None,
+    max_steps: int = 1_000_000,
+) -> ReducedSegment:
+    """Time and force change on one branch from the paper's reduced equations.
+
+    Signature: ``reduced_segment(params, branch, *, F_in, alpha_in, alphadot_in, ...) -> ReducedSegment``.
+
+    Integrates approxvdot or fullvdot (module docstring) coupled to an α
+    model from ``v_in`` until v reaches ``v_f`` and returns Δt, ΔF, the exit
+    state and the v(t), α(t) curves (the paper's Figs. 8 and 9).
+
+    Parameters
+    ----------
+    params : PeelParams
+        V, I, k, R.  The reduced equations are linear in α (the paper's
+        ``sin α ≈ α``), whatever ``params.geometry``.
+    branch : {"AB", "CD"}
+        AB: v rises from ``v_in`` to ``v_f`` (default ``v_max``); CD: v falls
+        from ``v_in`` to ``v_f`` (default ``v_min``).
+    F_in : float
+        Pull force at entry [N].
+    alpha_in, alphadot_in : float
+        α [rad] and α̇ [rad/s] at entry.  ``"exponential"`` and ``"static"``
+        use ``alpha_in`` only; ``"sinusoid"`` accepts ``amplitude``/``phase``
+        instead.
+    amplitude, phase : float, optional
+        The paper's ``(α_in, φ)`` of the sinusoid (``"sinusoid"`` only).
+    v_in : float, optional
+        Entry velocity [m/s]; default the landing velocity of a jump onto the
+        branch (``branch_structure(V).v_land_ab`` / ``v_land_cd``).
+    v_f : float, optional
+        Exit velocity [m/s]; default the branch's fold.
+    alpha_model : str, default "approxalpha"
+        One of :data:`ALPHA_MODELS`.
+    v_equation : {"approxvdot", "fullvdot"}
+    F_rate : float, optional
+        Slope ``s`` of ``F_lin = F_in + s t`` used by ``"sinusoid"``;
+        default ``k (V - v_in)``.
+    rtol : float, default 1e-10
+    atol : float or array_like of 5, optional
+        Tolerances (module docstring for the semantics and the default).
+    t_max : float, optional
+        Horizon [s]; default ``20 (f_max - f_min)/(k V) + 20 × 2π/Ω_in``.
+    save : {"steps", "none"}
+        Store the curves at accepted steps, or only entry and exit.
+        Ignored when ``t_eval`` is given.
+    t_eval : array_like, optional
+        Increasing times [s, from entry] at which to store the curves (dense
+        output); times after the exit are not filled.
+    max_steps : int
+        Step budget.
+
+    Returns
+    -------
+    ReducedSegment
+
+    Raises
+    ------
+    ValueError
+        For an unknown model, a velocity off the branch, or missing inputs.
+    ModelBreakdown
+        If v → 0 on AB, v runs away on CD, or F reaches 0 (reason in the
+        exception, with the time and state).
+    SolverBudgetExceeded
+        If v does not reach ``v_f`` before ``t_max`` or within ``max_steps``.
+    """
+    t_wall = time.perf_counter()
+    if not isinstance(params, PeelParams):
+        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
+    if branch not in BRANCHES:
+        raise ValueError(f"branch must be one of {BRANCHES}, got {branch!r}")
+    if alpha_model not in ALPHA_MODELS:
+        raise ValueError(f"alpha_model must be one of {ALPHA_MODELS}, got {alpha_model!r}")
+    if v_equation not in V_EQUATIONS:
+        raise ValueError(f"v_equation must be one of {V_EQUATIONS}, got {v_equation!r}")
+    if save not in ("steps", "none"):
+        raise ValueError(f"save must be 'steps' or 'none', got {save!r}")
+    rtol = _opt_finite("rtol", rtol)
+    if not 1e-14 <= rtol <= 1e-2:
+        raise ValueError(f"rtol must be in [1e-14, 1e-2], got {rtol}")
+    if int(max_steps) < 1:
+        raise ValueError(f"max_steps must be >= 1, got {max_steps}")
+    bs = branch_structure(params.V)
+    F_in = _opt_finite("F_in", F_in)
+    if F_in is None or F_in <= 0:
+        raise ValueError(f"F_in must be finite and in (0, inf), got {F_in!r}")
+
+    # ---- velocities
+    if branch == "CD" and not bs.has_folds:
+        raise ValueError(f"branch 'CD' does not exist for V={params.V}: f(v, V) has no folds")
+    if v_in is None:
+        v_in = bs.v_land_ab if branch == "AB" else bs.v_land_cd
+        if v_in is None:
+            raise ValueError(f"no AB landing velocity for V={params.V} (f_min <= f(0+)); give v_in explicitly")
+    v_in = _opt_finite("v_in", v_in)
+    lo, hi = bs.branch_range(branch)
+    if not (lo < v_in < hi):
+        raise ValueError(f"v_in must be on branch {branch}, i.e. in ({lo}, {hi}) for V={params.V}; got {v_in}")
+    if v_f is None:
+        if not bs.has_folds:
+            raise ValueError(f"V={params.V} has no fold; give v_f explicitly")
+        v_f = bs.v_max if branch == "AB" else bs.v_min
+    v_f = _opt_finite("v_f", v_f)
+    if branch == "AB" and not (v_in < v_f <= hi):
+        raise ValueError(f"v_f must be in (v_in, v_max] = ({v_in}, {hi}] on AB, got {v_f}")
+    if branch == "CD" and not (lo <= v_f < v_in):
+        raise ValueError(f"v_f must be in [v_min, v_in) = [{lo}, {v_in}) on CD, got {v_f}")
+
+    # ---- α inputs
+    am = ALPHA_MODELS.index(alpha_model)
+    alpha_in = _opt_finite("alpha_in", alpha_in)
+    alphadot_in = _opt_finite("alphadot_in", alphadot_in)
+    amplitude = _opt_finite("amplitude", amplitude)
+    phase = _opt_finite("phase", phase)
+    s = params.k * (params.V - v_in) if F_rate is None else _opt_finite("F_rate", F_rate)
+    fp_in = float(peel_force_derivative(v_in, params.V))
+    tau = params.R * fp_in / F_in
+    if am == AM_SIN:
+        if amplitude is not None or phase is not None:
+            if amplitude is None or phase is None:
+                raise ValueError("alpha_model='sinusoid' needs both amplitude and phase (or alpha_in and alphadot_in)")
+        elif alpha_in is None or alphadot_in is None:
+            raise ValueError("alpha_model='sinusoid' needs (amplitude, phase) or (alpha_in, alphadot_in)")
+        else:
+            amplitude, phase = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in,
+                                                   F_rate=s)
+        alpha_in, alphadot_in = (float(x) for x in _sinusoid(0.0, amplitude, phase, F_in, s, params.R, params.I))
+    elif am in (AM_EXP, AM_STATIC):
+        if alpha_in is None:
+            raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in")
+        alphadot_in = -alpha_in / tau if am == AM_EXP else 0.0
+    elif alpha_in is None or alphadot_in is None:
+        raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in and alphadot_in")
+
+    b, A = peel_force_coefficients(params.V)
+    q = np.zeros(N_Q)
+    q[[Q_V, Q_I, Q_K, Q_R, Q_B, Q_A]] = params.V, params.I, params.k, params.R, b, A
+    q[Q_AM] = am
+    q[Q_VE] = V_EQUATIONS.index(v_equation)
+    q[[Q_FIN, Q_VIN, Q_FPIN, Q_S, Q_AIN, Q_ADIN, Q_TAU]] = F_in, v_in, fp_in, s, alpha_in, alphadot_in, tau
+    q[Q_AMP] = amplitude if amplitude is not None else 0.0
+    q[Q_PH] = phase if phase is not None else 0.0
+
+    Om = math.sqrt(F_in * params.R / params.I)
+    a_scale = max(abs(alpha_in), abs(alphadot_in) / Om, 1e-8)
+    if atol is None:
+        atol_v = rtol * np.array([1e-3, 1.0, F_in, a_scale, Om * a_scale])
+    else:
+        atol_v = np.broadcast_to(np.asarray(atol, dtype=float), (5,)).copy()
+        if not np.all(np.isfinite(atol_v)) or np.any(atol_v <= 0):
+            raise ValueError("atol must be finite and > 0 (a scalar or one value per (t, ln v, F, alpha, alphadot))")
+    if t_max is None:
+        gap = (bs.f_max - bs.f_min) if bs.has_folds else F_in
+        t_max = 20.0 * gap / (params.k * params.V) + 20.0 * 2.0 * math.pi / Om
+    t_max = _opt_finite("t_max", t_max)
+    if t_max <= 0:
+        raise ValueError(f"t_max must be > 0, got {t_max}")
+
+    if t_eval is not None:
+        te = np.asarray(t_eval, dtype=float).ravel()
+        if te.size == 0 or not np.all(np.isfinite(te)) or np.any(te < 0) or np.any(np.diff(te) <= 0):
+            raise ValueError("t_eval must be a non-empty, strictly increasing array of finite times >= 0")
+        mode, cap = SAVE_TEVAL, te.size
+    else:
+        te = np.empty(0)
+        mode, cap = (SAVE_STEPS, 4096) if save == "steps" else (SAVE_NONE, 1)
+
+    y0 = np.array([0.0, math.log(v_in), F_in, alpha_in, alphadot_in])
+    x_lo = math.log(max(v_in, 1e-300)) - 60.0 if branch == "AB" else -np.inf  # v fell by e^60: v -> 0
+    x_hi = math.log(1e3 * v_in) if branch == "CD" else np.inf
+    while True:
+        y = y0.copy()
+        out = np.empty((cap, 5))
+        cnt = np.zeros(5, dtype=np.int64)
+        code = _run(y, q, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max, int(max_steps), mode,
+                    te, out, cnt)
+        if code == OUT_FULL:
+            cap *= 4
+            continue
+        break
+    n_out = int(cnt[C_NOUT])
+    rows = out[:n_out]
+    al_e, ad_e = (float(x) for x in _alpha_of(y, q))
+    state = {"t": float(y[0]), "v": float(np.exp(y[1])), "F": float(y[2]), "alpha": al_e, "alphadot": ad_e}
+    res = ReducedSegment(
+        branch=branch, alpha_model=alpha_model, v_equation=v_equation, dt=float(y[0]), F_in=F_in,
+        F_exit=float(y[2]), dF=float(y[2] - F_in), v_in=v_in, v_f=v_f, alpha_in=float(alpha_in),
+        alphadot_in=float(alphadot_in), alpha_exit=al_e, alphadot_exit=ad_e,
+        t=rows[:, 0].copy(), v=rows[:, 1].copy(), F=rows[:, 2].copy(), alpha=rows[:, 3].copy(),
+        alphadot=rows[:, 4].copy(), n_steps=int(cnt[C_STEPS]), n_rejected=int(cnt[C_REJ]), n_rhs=int(cnt[C_RHS]),
+        wall_time=time.perf_counter() - t_wall, rtol=rtol, atol=atol_v,
+    )
+    if code == EXIT:
+        return res
+    where = f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})"
+    if code == T_MAX:
+        raise SolverBudgetExceeded(
+            f"{alpha_model}+{v_equation} on {branch}: v did not reach v_f={v_f} before t_max={t_max} s",
+            budget="t_max", limit=t_max, t=state["t"], state=state, partial=res)
+    if code == MAX_STEPS:
+        raise SolverBudgetExceeded(f"{alpha_model}+{v_equation} on {branch}: max_steps={max_steps} reached {where}",
+                                   budget="max_steps", limit=int(max_steps), t=state["t"], state=state, partial=res)
+    if code == STEP_FAIL:
+        raise SolverFailure(f"step size underflow {where}", t=state["t"], state=state, partial=res)
+    reason = {BREAK_VFLOOR: "v_floor", BREAK_VCEIL: "v_ceiling", BREAK_F: "F_nonpositive",
+              BREAK_NONFINITE: "nonfinite"}[code]
+    text = {BREAK_VFLOOR: "v -> 0 on AB (fell by a factor e^60 below v_in)",
+            BREAK_VCEIL: "v ran away on CD (1000 x v_in)", BREAK_F: "the pull force reached 0",
+            BREAK_NONFINITE: "the state became non-finite"}[code]
+    raise ModelBreakdown(f"{alpha_model}+{v_equation} on {branch}: {text} {where}", t=state["t"], state=state,
+                         reason=reason, partial=res)
