@@ -22,7 +22,11 @@ Use
 returns them as a :class:`Dop853` tuple.  The field is bound as a closure
 variable, not passed as an argument: numba caches closures over jitted
 functions across processes, but not functions taking a dispatcher argument
-(numba issue #2956).  The pieces that do not call the field (``combine``,
+(numba issue #2956); each field's pieces are renamed after the field so
+that their cache files are distinct.  numba does not invalidate a cached
+function when a function it calls changes in *another* file: after editing
+a vector field or ``_generated.py``, delete the ``__pycache__/*.nb*`` files.
+The pieces that do not call the field (``combine``,
 ``interp1``, ``interp``, ``solve_theta``) are module-level.
 """
 
@@ -182,7 +186,6 @@ def make_dop853(rhs) -> Dop853:
     Dop853
     """
 
-    @njit(cache=True)
     def initial_step(y0, f0, p, rtol, atol, work):
         n = y0.shape[0]
         sc = work[0]
@@ -214,7 +217,6 @@ def make_dop853(rhs) -> Dop853:
             h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
         return min(100.0 * h0, h1)
 
-    @njit(cache=True)
     def step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc):
         n = y.shape[0]
         rejected = False
@@ -263,7 +265,6 @@ def make_dop853(rhs) -> Dop853:
             if n_rej > MAX_REJECTIONS or h <= 1e-300:
                 return STEP_FAILED, h, h, n_rej, n_rhs
 
-    @njit(cache=True)
     def dense(y_old, y_new, K, h, p, Fc, tmp):
         n = y_old.shape[0]
         for si in range(_NX - _NS - 1):
@@ -282,4 +283,14 @@ def make_dop853(rhs) -> Dop853:
                     acc += _D[r, j] * K[j, i]
                 Fc[3 + r, i] = h * acc
 
-    return Dop853(initial_step, step, dense)
+    # Each field gets its own cache files: numba names them after the
+    # qualname, and closures of one factory would otherwise share an index
+    # and load each other's machine code.
+    py = getattr(rhs, "py_func", rhs)
+    tag = f"{py.__module__}.{py.__qualname__}".replace(".", "_").replace("<", "").replace(">", "")
+
+    def jit(fn):
+        fn.__qualname__ = fn.__name__ = f"{fn.__name__}__{tag}"
+        return njit(cache=True)(fn)
+
+    return Dop853(jit(initial_step), jit(step), jit(dense))
