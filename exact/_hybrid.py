@@ -57,7 +57,7 @@ from numba import njit
 
 from peelapprox import _generated as _g
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS, N_STAGES_EXTENDED as _NX
-from peelapprox._dop853 import interp, interp1, make_dop853, solve_theta
+from peelapprox._dop853 import interp, interp1, make_dop853, solve_theta, workspace
 from peelapprox._peelforce import peel_force_fp_jit
 
 # the model's equations, compiled from the one generated source
@@ -176,15 +176,8 @@ def run(
     in ``st`` and ``cnt``; the caller empties full buffers and calls again.
     In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.
     """
-    K = np.empty((_NX, 4))
+    K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
-    y_new = np.empty(4)
-    f0 = np.empty(4)
-    tmp = np.empty(4)
-    sc = np.empty(4)
-    work = np.empty((3, 4))
-    Fc = np.empty((7, 4))
-    ye = np.empty(4)
 
     nout_cap = out.shape[0]
     njump_cap = jbuf.shape[0]

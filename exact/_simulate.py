@@ -11,6 +11,7 @@ import numpy as np
 
 from peelapprox import PeelParams
 from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox._validate import finite as _finite
 from peelapprox._peelforce import (
     BRANCHES,
     branch_inverse,
@@ -36,16 +37,6 @@ SAVES = ("steps", "jumps")
 ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1e-6), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
 
 _COMPILE_TIME = {"hybrid": None}
-
-
-def _finite(name: str, x) -> float:
-    try:
-        y = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
-    if not math.isfinite(y):
-        raise ValueError(f"{name} must be finite, got {x!r}")
-    return y
 
 
 def initial_state(

@@ -39,6 +39,8 @@ from scipy import integrate, special
 
 from ._params import PeelParams
 from ._peelforce import branch_structure, peel_force_derivative
+from ._validate import finite as _finite
+from ._validate import positive as _positive
 
 __all__ = [
     "inertial_frequency",
@@ -93,23 +95,6 @@ def _decay(t, alpha_in, tau):
 
 
 # ------------------------------------------------------------ validators
-
-
-def _finite(name: str, x) -> float:
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {x!r}")
-    return v
-
-
-def _positive(name: str, x) -> float:
-    v = _finite(name, x)
-    if v <= 0.0:
-        raise ValueError(f"{name} must be in (0, inf), got {x!r}")
-    return v
 
 
 def _times(t) -> np.ndarray:

@@ -42,6 +42,7 @@ __all__ = [
     "Dop853",
     "make_dop853",
     "combine",
+    "workspace",
     "interp1",
     "interp",
     "solve_theta",
@@ -95,6 +96,14 @@ class Dop853(NamedTuple):
     initial_step: Callable
     step: Callable
     dense: Callable
+
+
+@njit(cache=True)
+def workspace(n):
+    """Scratch arrays for a driver on an n-dimensional state:
+    ``(K, y_new, f0, tmp, sc, work, Fc, ye)`` with K of shape (16, n), work (3, n), Fc (7, n)."""
+    return (np.empty((_NX, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty((3, n)),
+            np.empty((7, n)), np.empty(n))
 
 
 @njit(cache=True)

@@ -33,7 +33,7 @@ model               α equation                                                 
 
 ``genalpha`` with ``fullvdot`` is the full model FLOW1–FLOW3 + CONSTR
 linearised in α (``sin α → α``), so it reproduces the exact branch dynamics
-up to O(α³) (tested).
+up to O(α²) relative (the closure slope ``cos α`` vs 1; tested).
 
 Formulation and solver
 ----------------------
@@ -68,9 +68,10 @@ from numba import njit
 from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import N_STAGES_EXTENDED as _NX
-from ._dop853 import STEP_FAILED, interp, interp1, make_dop853, solve_theta
+from ._dop853 import STEP_FAILED, interp, interp1, make_dop853, solve_theta, workspace
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import PeelParams
+from ._validate import optional_finite as _opt_finite
 from ._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_derivative, peel_force_fp_jit
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
@@ -175,14 +176,7 @@ def _store(out, row, y, q):
 @njit(cache=True)
 def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
     """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state."""
-    K = np.empty((_NX, 5))
-    y_new = np.empty(5)
-    f0 = np.empty(5)
-    tmp = np.empty(5)
-    sc = np.empty(5)
-    work = np.empty((3, 5))
-    Fc = np.empty((7, 5))
-    ye = np.empty(5)
+    K, y_new, f0, tmp, sc, work, Fc, ye = workspace(5)
     cap = out.shape[0]
     n_te = t_eval.shape[0]
 
@@ -325,18 +319,6 @@ class ReducedSegment:
         keys = ("branch", "alpha_model", "v_equation", "dt", "F_in", "F_exit", "dF", "v_in", "v_f", "alpha_in",
                 "alphadot_in", "alpha_exit", "alphadot_exit", "n_steps", "n_rejected", "n_rhs", "wall_time", "rtol")
         return {k: getattr(self, k) for k in keys}
-
-
-def _opt_finite(name, x):
-    if x is None:
-        return None
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {x!r}")
-    return v
 
 
 def reduced_segment(
