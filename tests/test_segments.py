@@ -60,3 +60,21 @@ def test_jumps_only_trajectory_gives_entries_without_periods():
     assert [s.dt for s in a] == [s.dt for s in b]
     assert all(len(s.periods) == 0 for s in a)
     assert a[1].entry()["v_f"] == b[1].v_out
+
+
+def test_compare_rows(low):
+    """compare() gives one row per (segment, model of its branch); genalpha + fullvdot, the full model linearised
+    in α, matches every segment's Δt and ΔF to 1e-3 (O(α²), α <= 0.07) and the AB α period to 1e-3."""
+    from comparisons import DEFAULT_MODELS, compare
+
+    segs = segments(low)
+    rows = compare(low, segs=segs[:4])
+    assert len(rows) == sum(len(DEFAULT_MODELS[s.branch]) for s in segs[:4])
+    assert all(r.status == "ok" for r in rows)
+    gen = [r for r in rows if r.alpha_model == "genalpha"]
+    assert len(gen) == 4
+    for r in gen:
+        assert abs(r.dt_rel_error) <= 1e-3 and abs(r.dF_rel_error) <= 1e-3
+        assert r.dt_abs_error == pytest.approx(r.dt_approx - r.dt_exact, abs=0)
+        if r.branch == "AB":
+            assert abs(r.period_rel_error) <= 1e-3
