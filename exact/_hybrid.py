@@ -57,7 +57,7 @@ from numba import njit
 
 from peelapprox import _generated as _g
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS, N_STAGES_EXTENDED as _NX
-from peelapprox._dop853 import interp, interp1, make_dop853, solve_theta, workspace
+from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from peelapprox._peelforce import peel_force_fp_jit
 
 # the model's equations, compiled from the one generated source
@@ -256,7 +256,7 @@ def run(
                 _dop.dense(y, y_new, K, h, p, Fc, tmp)
                 cnt[C_RHS] += _NX - _NS - 1
                 dense = True
-            x_end = solve_theta(y, Fc, 0, tau_end, y[0] - tau_end, 1.0, y_new[0] - tau_end)
+            x_end = crossing(y, Fc, 0, tau_end, 1.0, y_new[0])
         x_stop = min(x_fold, x_end)
         if x_stop > 1.0:
             x_stop = 1.0
@@ -273,12 +273,7 @@ def run(
                     _dop.dense(y, y_new, K, h, p, Fc, tmp)
                     cnt[C_RHS] += _NX - _NS - 1
                     dense = True
-                if te - t0 <= y[0]:
-                    xe = 0.0
-                else:
-                    xe = solve_theta(y, Fc, 0, te - t0, y[0] - (te - t0), x_stop, tau_stop - (te - t0))
-                interp(y, Fc, xe, ye)
-                ye[0] = te - t0
+                state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
                 _store(out, cnt[C_NOUT], te, ye, pull_force(ye[1], ye[3], p), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1

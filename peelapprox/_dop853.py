@@ -46,6 +46,8 @@ __all__ = [
     "interp1",
     "interp",
     "solve_theta",
+    "crossing",
+    "state_at",
     "N_STAGES",
     "N_STAGES_EXTENDED",
     "STEP_OK",
@@ -177,6 +179,23 @@ def solve_theta(y_old, Fc, i, target, g0, xb, g1):
         if b - a <= 4e-16:
             break
     return b if abs(gb) < abs(ga) else a
+
+
+@njit(cache=True)
+def crossing(y_old, Fc, i, target, xb, value_b):
+    """Fraction x in [0, xb] of the step where the increasing component i reaches
+    ``target`` (0 if it is already there); ``value_b`` is its value at xb."""
+    if target <= y_old[i]:
+        return 0.0
+    return solve_theta(y_old, Fc, i, target, y_old[i] - target, xb, value_b - target)
+
+
+@njit(cache=True)
+def state_at(y_old, Fc, i, target, xb, value_b, out):
+    """Dense-output state where the increasing component i equals ``target``
+    (a ``t_eval`` point); component i is set to ``target`` exactly."""
+    interp(y_old, Fc, crossing(y_old, Fc, i, target, xb, value_b), out)
+    out[i] = target
 
 
 def make_dop853(rhs) -> Dop853:

@@ -127,7 +127,7 @@ def quasi_static_branch_time(
     # the AB integrand is ∝ v^-0.85 near 0: integrate in ln v
     val, _ = integrate.quad(lambda w: integrand(math.exp(w)) * math.exp(w), math.log(v_in), math.log(v_f),
                             epsabs=0.0, epsrel=1e-11, limit=200)
-    return abs(val) if branch == "CD" else val
+    return val
 
 
 def force_bounds(params: PeelParams, alpha_min: float, alpha_max: float, *, linear: bool = False

@@ -68,7 +68,7 @@ from numba import njit
 from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import N_STAGES_EXTENDED as _NX
-from ._dop853 import STEP_FAILED, interp, interp1, make_dop853, solve_theta, workspace
+from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import PeelParams
 from ._validate import optional_finite as _opt_finite
@@ -212,7 +212,7 @@ def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode,
                 _dop.dense(y, y_new, K, h, q, Fc, tmp)
                 cnt[C_RHS] += _NX - _NS - 1
                 dense = True
-            x_tmax = solve_theta(y, Fc, 0, t_max, y[0] - t_max, 1.0, y_new[0] - t_max)
+            x_tmax = crossing(y, Fc, 0, t_max, 1.0, y_new[0])
         x_stop = min(x_exit, x_tmax, 1.0)
         if save_mode == SAVE_TEVAL:
             t_stop = interp1(y, Fc, x_stop, 0) if x_stop < 1.0 else y_new[0]
@@ -222,16 +222,11 @@ def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode,
                     _dop.dense(y, y_new, K, h, q, Fc, tmp)
                     cnt[C_RHS] += _NX - _NS - 1
                     dense = True
-                if te <= y[0]:
-                    xe = 0.0
-                else:
-                    xe = solve_theta(y, Fc, 0, te, y[0] - te, x_stop, t_stop - te)
-                interp(y, Fc, xe, ye)
-                ye[0] = te
+                state_at(y, Fc, 0, te, x_stop, t_stop, ye)
                 _store(out, cnt[C_NOUT], ye, q)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
-        if x_stop < 1.0 or x_exit == 1.0 or x_tmax == 1.0:
+        if min(x_exit, x_tmax) <= 1.0:  # the exit or t_max lies in this step
             interp(y, Fc, x_stop, ye)
             for i in range(5):
                 y[i] = ye[i]
