@@ -1,6 +1,18 @@
-"""Approximate-vs-exact comparison harness (segments, seeding, error tables, benchmarks)."""
+"""Approximate-vs-exact comparison harness (segments, seeding, the paper's scenes, error tables).
 
-from ._compare import DEFAULT_MODELS, ComparisonRow, compare
-from ._segments import Segment, segments
+Public names are re-exported here; the modules are private.
+"""
 
-__all__ = ["Segment", "segments", "compare", "ComparisonRow", "DEFAULT_MODELS"]
+from ._compare import DEFAULT_MODELS, ComparisonRow, compare, run_reduction
+from ._report import STAT_RUNS, CompareReport, StatRow, markdown, run_compare, statistics
+from ._runs import RUNS, ExactRun, RunSpec, TransientCheck, TransientNotPassed, check_past_transient, exact_run
+from ._scenes import CLAIM, SCENES, Row, Scene, scene_rows
+from ._segments import Segment, local_period, segments
+
+__all__ = [
+    "Segment", "segments", "local_period",
+    "compare", "run_reduction", "ComparisonRow", "DEFAULT_MODELS",
+    "RunSpec", "RUNS", "ExactRun", "exact_run", "check_past_transient", "TransientCheck", "TransientNotPassed",
+    "Row", "Scene", "SCENES", "scene_rows", "CLAIM",
+    "StatRow", "CompareReport", "statistics", "run_compare", "markdown", "STAT_RUNS",
+]

@@ -3,7 +3,7 @@
 ``compare(trajectory, models)`` runs every reduction on every complete segment
 of an exact trajectory, seeded with the segment's entry state (F, α, α̇, v) and
 integrated to the segment's exit velocity (the fold), and reports Δt, ΔF and
-the median local α period from both, with absolute and relative errors.  A
+the local α period (:meth:`Segment.local_period`) from both, with absolute and relative errors.  A
 reduction that breaks down (for example v → 0 on AB) or does not reach the
 fold is reported as a failed row with its reason, never silently dropped.
 """
@@ -13,19 +13,18 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
-import numpy as np
-
 from peelapprox import ModelBreakdown, SolverBudgetExceeded, reduced_segment
 
-from ._segments import Segment, _crossings, segments
+from ._segments import Segment, _crossings, _extrema, local_period, segments
 
-__all__ = ["DEFAULT_MODELS", "ComparisonRow", "compare"]
+__all__ = ["DEFAULT_MODELS", "ComparisonRow", "compare", "run_reduction"]
 
 #: reductions tried on each branch by default: (alpha_model, v_equation)
 DEFAULT_MODELS: Dict[str, Tuple[Tuple[str, str], ...]] = {
-    "AB": (("approxalpha", "approxvdot"), ("sinusoid", "approxvdot"), ("genalpha", "fullvdot")),
-    "CD": (("airy2", "approxvdot"), ("airy2_frozen", "approxvdot"), ("exponential", "approxvdot"),
+    "AB": (("approxalpha", "approxvdot"), ("sinusoid", "approxvdot"), ("genalpha", "approxvdot"),
            ("genalpha", "fullvdot")),
+    "CD": (("airy2", "approxvdot"), ("airy2_frozen", "approxvdot"), ("exponential", "approxvdot"),
+           ("genalpha", "approxvdot"), ("genalpha", "fullvdot")),
 }
 
 
@@ -53,6 +52,25 @@ class ComparisonRow:
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+def run_reduction(params, branch: str, alpha_model: str, v_equation: str, **seed):
+    """One reduced solve that reports a physical breakdown as a status instead of raising.
+
+    Signature: ``run_reduction(params, branch, alpha_model, v_equation, **seed) -> (ReducedSegment | None, status)``.
+
+    ``seed`` goes to :func:`peelapprox.reduced_segment`.  ``status`` is ``"ok"``,
+    ``"breakdown: <reason>"`` (:class:`~peelapprox.ModelBreakdown`) or
+    ``"no exit: <budget>"`` (:class:`~peelapprox.SolverBudgetExceeded`); the
+    result is None unless the status is ``"ok"``.  Bad arguments still raise
+    ``ValueError``.
+    """
+    try:
+        return reduced_segment(params, branch, alpha_model=alpha_model, v_equation=v_equation, **seed), "ok"
+    except ModelBreakdown as exc:
+        return None, f"breakdown: {exc.reason}"
+    except SolverBudgetExceeded as exc:
+        return None, f"no exit: {exc.budget}"
 
 
 def _err(a: Optional[float], e: Optional[float]):
@@ -88,20 +106,13 @@ def compare(trajectory, models: Optional[Dict[str, Sequence[Tuple[str, str]]]] =
     params = trajectory.params
     rows: List[ComparisonRow] = []
     for s in (segments(trajectory) if segs is None else segs):
-        p_ex = float(np.median(s.periods)) if len(s.periods) else None
+        p_ex = s.local_period()
         for am, ve in models.get(s.branch, ()):
             dt_a = dF_a = p_a = None
-            try:
-                r = reduced_segment(params, s.branch, alpha_model=am, v_equation=ve, rtol=rtol, **s.entry())
-                status = "ok"
+            r, status = run_reduction(params, s.branch, am, ve, rtol=rtol, **s.entry())
+            if r is not None:
                 dt_a, dF_a = r.dt, r.dF
-                cr = _crossings(r.t, r.alpha, r.alphadot)
-                if len(cr) >= 2:
-                    p_a = float(np.median(np.diff(cr)))
-            except ModelBreakdown as exc:
-                status = f"breakdown: {exc.reason}"
-            except SolverBudgetExceeded as exc:
-                status = f"no exit: {exc.budget}"
+                p_a = local_period(_crossings(r.t, r.alpha, r.alphadot), _extrema(r.t, r.alpha, r.alphadot))
             dt_abs, dt_rel = _err(dt_a, s.dt)
             dF_abs, dF_rel = _err(dF_a, s.dF)
             _, p_rel = _err(p_a, p_ex)

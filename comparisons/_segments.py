@@ -7,12 +7,15 @@ solver tolerance.  The local periods of the α oscillation inside a segment are
 the intervals between successive upward zero crossings of α, located by cubic
 Hermite interpolation of the stored ``(α, α̇ = ω - v/R)`` pairs (4th order in
 the step size, so the DOP853 step output suffices; no dense output needed).
+Where a stay holds less than one full α cycle (the high-inertia AB stays of
+Case II), the interior extrema of α (roots of the same interpolant's
+derivative) give the half periods instead.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import List
+from typing import List, Optional
 
 import numpy as np
 
@@ -43,6 +46,8 @@ class Segment:
     F_at_periods : ndarray
         Mean pull force over each period [N] (for comparison with
         ``2π sqrt(I/(F R))``).
+    extrema : ndarray
+        Times of the interior extrema of α (α̇ = 0) inside the segment [s].
     """
 
     index: int
@@ -62,6 +67,7 @@ class Segment:
     crossings: np.ndarray = field(repr=False)
     periods: np.ndarray = field(repr=False)
     F_at_periods: np.ndarray = field(repr=False)
+    extrema: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))
 
     @property
     def dt(self) -> float:
@@ -71,19 +77,30 @@ class Segment:
     def dF(self) -> float:
         return self.F_out - self.F_in
 
+    def local_period(self) -> Optional[float]:
+        """The α period inside this stay [s], or None if it cannot be measured.
+
+        The median of :attr:`periods` (successive upward zero crossings) when
+        there are any; otherwise twice the median spacing of successive α
+        extrema (a max→min half cycle), which needs at least two extrema.
+        """
+        return local_period(self.crossings, self.extrema)
+
     def entry(self) -> dict:
         """Keyword arguments seeding :func:`peelapprox.reduced_segment` from this segment's entry."""
         return dict(F_in=self.F_in, alpha_in=self.alpha_in, alphadot_in=self.alphadot_in, v_in=self.v_in,
                     v_f=self.v_out)
 
 
+def _hermite_coefficients(h, a0, a1, d0, d1):
+    """``a(s) = c0 + c1 s + c2 s^2 + c3 s^3`` on s in [0, 1] with end values a and slopes d (per unit t)."""
+    return a0, d0 * h, 3 * (a1 - a0) - (2 * d0 + d1) * h, 2 * (a0 - a1) + (d0 + d1) * h
+
+
 def _hermite_roots(t0, t1, a0, a1, d0, d1):
     """Upward roots in (t0, t1] of the cubic Hermite interpolant with values a and slopes d."""
     h = t1 - t0
-    # a(s) = c0 + c1 s + c2 s^2 + c3 s^3, s in [0, 1]
-    c0, c1 = a0, d0 * h
-    c2 = 3 * (a1 - a0) - (2 * d0 + d1) * h
-    c3 = 2 * (a0 - a1) + (d0 + d1) * h
+    c0, c1, c2, c3 = _hermite_coefficients(h, a0, a1, d0, d1)
     roots = np.roots([c3, c2, c1, c0]) if abs(c3) > 0 else np.roots([c2, c1, c0])
     out = []
     for r in roots:
@@ -104,6 +121,31 @@ def _crossings(t, a, d):
             continue
         out.extend(_hermite_roots(t[i], t[i + 1], a[i], a[i + 1], d[i], d[i + 1]))
     return np.array(sorted(set(out)))
+
+
+def local_period(crossings, extrema) -> Optional[float]:
+    """Median spacing of upward zero crossings, else twice the median spacing of extrema, else None [s]."""
+    if len(crossings) >= 2:
+        return float(np.median(np.diff(crossings)))
+    if len(extrema) >= 2:
+        return 2.0 * float(np.median(np.diff(extrema)))
+    return None
+
+
+def _extrema(t, a, d):
+    """Times where α̇ changes sign between samples, refined as the stationary point of the Hermite cubic."""
+    out = []
+    for i in np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]:
+        h = t[i + 1] - t[i]
+        if h <= 0:
+            continue
+        _, c1, c2, c3 = _hermite_coefficients(h, a[i], a[i + 1], d[i], d[i + 1])
+        roots = np.roots([3 * c3, 2 * c2, c1]) if abs(c3) > 0 else np.roots([2 * c2, c1])
+        inside = [r.real for r in roots if abs(r.imag) < 1e-12 and 0.0 <= r.real <= 1.0]
+        # a sign change of d guarantees a root in [0, 1]; take the one nearest the linear estimate
+        s_lin = d[i] / (d[i] - d[i + 1])
+        out.append(t[i] + h * (min(inside, key=lambda r: abs(r - s_lin)) if inside else s_lin))
+    return np.array(out)
 
 
 def segments(trajectory) -> List[Segment]:
@@ -139,6 +181,7 @@ def segments(trajectory) -> List[Segment]:
         cross = np.empty(0)
         per = np.empty(0)
         Fp = np.empty(0)
+        ext = np.empty(0)
         if len(t):
             lo = np.searchsorted(t, a.t, side="right") - 1  # the stored landing point (second row at a.t)
             hi = np.searchsorted(t, b.t, side="left") + 1   # through the fold point at b.t
@@ -148,6 +191,8 @@ def segments(trajectory) -> List[Segment]:
             keep = (tt >= a.t) & (tt <= b.t)
             tt, aa, dd, FF = tt[keep], aa[keep], dd[keep], FF[keep]
             if len(tt) >= 2:
+                ext = _extrema(tt, aa, dd)
+                ext = ext[(ext > a.t) & (ext < b.t)]
                 cross = _crossings(tt, aa, dd)
                 cross = cross[(cross > a.t) & (cross < b.t)]
                 per = np.diff(cross)
@@ -158,6 +203,6 @@ def segments(trajectory) -> List[Segment]:
             index=len(out), branch=a.to_branch, t_in=a.t, alpha_in=a.alpha, alphadot_in=a.omega - a.v_after / R,
             omega_in=a.omega, F_in=a.F, v_in=a.v_after, t_out=b.t, alpha_out=b.alpha,
             alphadot_out=b.omega - b.v_before / R, omega_out=b.omega, F_out=b.F, v_out=b.v_before,
-            crossings=cross, periods=per, F_at_periods=Fp,
+            crossings=cross, periods=per, F_at_periods=Fp, extrema=ext,
         ))
     return out

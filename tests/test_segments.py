@@ -71,7 +71,7 @@ def test_compare_rows(low):
     rows = compare(low, segs=segs[:4])
     assert len(rows) == sum(len(DEFAULT_MODELS[s.branch]) for s in segs[:4])
     assert all(r.status == "ok" for r in rows)
-    gen = [r for r in rows if r.alpha_model == "genalpha"]
+    gen = [r for r in rows if (r.alpha_model, r.v_equation) == ("genalpha", "fullvdot")]
     assert len(gen) == 4
     for r in gen:
         assert abs(r.dt_rel_error) <= 1e-3 and abs(r.dF_rel_error) <= 1e-3
