@@ -169,7 +169,10 @@ def _fmt(x) -> str:
 
 
 def _pct(x, signed: bool = True) -> str:
-    return "–" if x is None else (f"{100 * x:+.1f} %" if signed else f"{100 * x:.1f} %")
+    if x is None:
+        return "–"
+    digits = ".1f" if abs(x) >= 1e-3 or x == 0 else ".1e"
+    return f"{100 * x:{'+' if signed else ''}{digits}} %"
 
 
 def markdown(report: CompareReport, *, figures_rel: Optional[str] = None) -> str:
