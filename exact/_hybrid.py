@@ -56,7 +56,7 @@ import numpy as np
 from numba import njit
 
 from peelapprox import _generated as _g
-from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS, N_STAGES_EXTENDED as _NX
+from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from peelapprox._peelforce import peel_force_fp_jit
 
@@ -237,9 +237,7 @@ def run(
                 gB = y_new[3] - vf
                 crossed = gB <= 0.0
             if crossed:
-                _dop.dense(y, y_new, K, h, p, Fc, tmp)
-                cnt[C_RHS] += _NX - _NS - 1
-                dense = True
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
                 x_fold = solve_theta(y, Fc, 3, vf, gA, 1.0, gB)
         # breakdown on AB: v -> 0 (checked at step end; the kernel never
         # accepts a step whose stages left v > 0)
@@ -252,10 +250,7 @@ def run(
         x_end = 2.0
         tau_end = t_end - t0
         if y_new[0] >= tau_end:
-            if not dense:
-                _dop.dense(y, y_new, K, h, p, Fc, tmp)
-                cnt[C_RHS] += _NX - _NS - 1
-                dense = True
+            dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
             x_end = crossing(y, Fc, 0, tau_end, 1.0, y_new[0])
         x_stop = min(x_fold, x_end)
         if x_stop > 1.0:
@@ -269,10 +264,7 @@ def run(
                 tau_stop = y_new[0]
             while cnt[C_TEVAL] < n_teval and t_eval[cnt[C_TEVAL]] - t0 <= tau_stop:
                 te = t_eval[cnt[C_TEVAL]]
-                if not dense:
-                    _dop.dense(y, y_new, K, h, p, Fc, tmp)
-                    cnt[C_RHS] += _NX - _NS - 1
-                    dense = True
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
                 state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
                 _store(out, cnt[C_NOUT], te, ye, pull_force(ye[1], ye[3], p), out_br, br)
                 cnt[C_NOUT] += 1

@@ -93,11 +93,16 @@ class Dop853(NamedTuple):
     dense : ``(y_old, y_new, K, h, p, Fc, tmp)``
         The extra stages and the 7 interpolation rows ``Fc`` of the step just
         taken (costs ``N_STAGES_EXTENDED - N_STAGES - 1 = 3`` field evaluations).
+    ensure_dense : ``(done, y_old, y_new, K, h, p, Fc, tmp, cnt, i_rhs) -> True``
+        ``dense`` unless ``done`` (the coefficients of this step already exist),
+        adding its field evaluations to the counter ``cnt[i_rhs]``: the drivers'
+        lazy idiom ``done = ensure_dense(done, ...)``.
     """
 
     initial_step: Callable
     step: Callable
     dense: Callable
+    ensure_dense: Callable
 
 
 @njit(cache=True)
@@ -214,6 +219,12 @@ def make_dop853(rhs) -> Dop853:
     Dop853
     """
 
+    tag = _cache_tag(rhs)
+
+    def jit(fn):
+        fn.__qualname__ = fn.__name__ = f"{fn.__name__}__{tag}"
+        return njit(cache=True)(fn)
+
     def initial_step(y0, f0, p, rtol, atol, work):
         n = y0.shape[0]
         sc = work[0]
@@ -311,14 +322,20 @@ def make_dop853(rhs) -> Dop853:
                     acc += _D[r, j] * K[j, i]
                 Fc[3 + r, i] = h * acc
 
+    dense_j = jit(dense)
+
+    def ensure_dense(done, y_old, y_new, K, h, p, Fc, tmp, cnt, i_rhs):
+        if not done:
+            dense_j(y_old, y_new, K, h, p, Fc, tmp)
+            cnt[i_rhs] += _NX - _NS - 1
+        return True
+
+    return Dop853(jit(initial_step), jit(step), dense_j, jit(ensure_dense))
+
+
+def _cache_tag(rhs) -> str:
     # Each field gets its own cache files: numba names them after the
     # qualname, and closures of one factory would otherwise share an index
     # and load each other's machine code.
     py = getattr(rhs, "py_func", rhs)
-    tag = f"{py.__module__}.{py.__qualname__}".replace(".", "_").replace("<", "").replace(">", "")
-
-    def jit(fn):
-        fn.__qualname__ = fn.__name__ = f"{fn.__name__}__{tag}"
-        return njit(cache=True)(fn)
-
-    return Dop853(jit(initial_step), jit(step), jit(dense))
+    return f"{py.__module__}.{py.__qualname__}".replace(".", "_").replace("<", "").replace(">", "")

@@ -67,7 +67,6 @@ from numba import njit
 
 from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
-from ._dop853 import N_STAGES_EXTENDED as _NX
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import PeelParams
@@ -202,26 +201,18 @@ def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode,
         gA = y[1] - x_f
         gB = y_new[1] - x_f
         if (upward and gB >= 0.0) or ((not upward) and gB <= 0.0):
-            _dop.dense(y, y_new, K, h, q, Fc, tmp)
-            cnt[C_RHS] += _NX - _NS - 1
-            dense = True
+            dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
             x_exit = solve_theta(y, Fc, 1, x_f, gA, 1.0, gB)
         x_tmax = 2.0
         if y_new[0] >= t_max:
-            if not dense:
-                _dop.dense(y, y_new, K, h, q, Fc, tmp)
-                cnt[C_RHS] += _NX - _NS - 1
-                dense = True
+            dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
             x_tmax = crossing(y, Fc, 0, t_max, 1.0, y_new[0])
         x_stop = min(x_exit, x_tmax, 1.0)
         if save_mode == SAVE_TEVAL:
             t_stop = interp1(y, Fc, x_stop, 0) if x_stop < 1.0 else y_new[0]
             while cnt[C_TEVAL] < n_te and t_eval[cnt[C_TEVAL]] <= t_stop:
                 te = t_eval[cnt[C_TEVAL]]
-                if not dense:
-                    _dop.dense(y, y_new, K, h, q, Fc, tmp)
-                    cnt[C_RHS] += _NX - _NS - 1
-                    dense = True
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
                 state_at(y, Fc, 0, te, x_stop, t_stop, ye)
                 _store(out, cnt[C_NOUT], ye, q)
                 cnt[C_NOUT] += 1
