@@ -37,7 +37,7 @@ from peelapprox import (
 
 from ._compare import compare, run_reduction
 from ._runs import ExactRun, exact_run
-from ._segments import Segment, _crossings
+from ._segments import Segment, _crossings, time_mean
 
 __all__ = ["Row", "Scene", "SCENES", "scene_rows", "CLAIM"]
 
@@ -373,7 +373,7 @@ def _alpha_cycle(run: ExactRun):
     m = t <= t[0] + 1.5 * T
     i = int(np.argmax(np.where(m, a, -np.inf)))
     j = i + int(np.argmin(np.where(t[i:] <= t[i] + T, a[i:], np.inf)))
-    return t[i], t[j], T, float(np.mean(tr.F[i:j + 1]))
+    return t[i], t[j], T, time_mean(t, tr.F, t[i], t[j])
 
 
 def _up_crossings(run: ExactRun):
@@ -385,7 +385,8 @@ def _periods_high_inertia_v1(run: ExactRun) -> List[Row]:
     p = run.spec.params
     a = _point_a(run)
     T_ex = a.local_period()
-    F_ex = float(np.mean(_window(run, a).F))
+    w = _window(run, a)
+    F_ex = time_mean(w.t, w.F, w.t[0], w.t[-1])
     return [
         _row("periods-I1e-2-V1", "V=1: α period on the a→b AB stay [s]", "paper", "approxalpha at mean F = 240",
              0.128, 0.11, float(inertial_period(p, 240.0)), T_ex, claim=CLAIM,

@@ -148,6 +148,17 @@ def _extrema(t, a, d):
     return np.array(out)
 
 
+def time_mean(t: np.ndarray, x: np.ndarray, t0: float, t1: float) -> float:
+    """Time average of the sampled x(t) over [t0, t1] (trapezoid on the stored points, the end values
+    interpolated linearly), independent of how densely the solver happened to store points."""
+    if not t1 > t0:
+        raise ValueError(f"time_mean needs t1 > t0, got [{t0}, {t1}]")
+    m = (t > t0) & (t < t1)
+    tt = np.concatenate(([t0], t[m], [t1]))
+    xx = np.concatenate(([np.interp(t0, t, x)], x[m], [np.interp(t1, t, x)]))
+    return float(np.trapezoid(xx, tt) / (t1 - t0))
+
+
 def segments(trajectory) -> List[Segment]:
     """Complete branch segments of an exact trajectory, in time order.
 
@@ -197,8 +208,7 @@ def segments(trajectory) -> List[Segment]:
                 cross = cross[(cross > a.t) & (cross < b.t)]
                 per = np.diff(cross)
                 if len(per):
-                    Fp = np.array([np.mean(np.interp(np.linspace(c0, c1, 9), tt, FF))
-                                   for c0, c1 in zip(cross[:-1], cross[1:])])
+                    Fp = np.array([time_mean(tt, FF, c0, c1) for c0, c1 in zip(cross[:-1], cross[1:])])
         out.append(Segment(
             index=len(out), branch=a.to_branch, t_in=a.t, alpha_in=a.alpha, alphadot_in=a.omega - a.v_after / R,
             omega_in=a.omega, F_in=a.F, v_in=a.v_after, t_out=b.t, alpha_out=b.alpha,

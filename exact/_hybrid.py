@@ -37,6 +37,22 @@ CD, or ``f = f_min`` on AB) with (α, ω, F) continuous: this is the ε → 0 li
 of the paper's singularly perturbed scheme (the fast fibre is ``α, ω, F`` =
 const).
 
+Folded singularities
+--------------------
+Where the fold is reached with ``Ġ = 0`` (a folded singularity: v̇ = Ġ/f'
+stays finite, the canard point of the fold) the desingularised field has an
+equilibrium on the fold and the solution approaches ``v_fold`` only
+exponentially in s, with t increments that shrink below the step's error
+tolerance.  Two guards keep this finite and monotone: the fold event fires at
+``v_fold (1 ∓ FOLD_REL)`` (relative 1e-9; after a transversal approach this
+moves the jump time by ``f''(δ v_fold)²/(2Ġ)``, below 1e-16 s on the paper's
+scenes, and by ``δ v_fold/|v̇|`` near a folded singularity, ~1e-11 s), and
+``τ`` is kept non-decreasing from step to step (τ does not enter the field,
+so this changes nothing else).  The jump itself is taken at ``v = v_fold``
+exactly, so the stored before-jump state lies on the fold.  Found by the
+trajectory-invariant property test (``tests/test_properties.py``) at V = 3.875,
+I = 10^-3.25, α0 = 0.25, where stored time went back by 8.5e-13 s.
+
 Integrator
 ----------
 The one compiled integrator of the package, :mod:`peelapprox._dop853`
@@ -81,6 +97,9 @@ O_T, O_AL, O_OM, O_F, O_V = range(5)
 N_O = 5
 # jump columns: t, from, to, alpha, omega, F, v_before, v_after
 N_J = 8
+#: the fold event fires at v = v_max (1 - FOLD_REL) on AB, v_min (1 + FOLD_REL)
+#: on CD (module docstring, "Folded singularities")
+FOLD_REL = 1e-9
 # save modes
 SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = 0, 1, 2
 # status codes returned by the kernel
@@ -227,12 +246,12 @@ def run(
         x_fold = 2.0
         if has_folds:
             if br == 0:
-                vf = p[P_VMAX]
+                vf = p[P_VMAX] * (1.0 - FOLD_REL)
                 gA = y[3] - vf
                 gB = y_new[3] - vf
                 crossed = gB >= 0.0
             else:
-                vf = p[P_VMIN]
+                vf = p[P_VMIN] * (1.0 + FOLD_REL)
                 gA = y[3] - vf
                 gB = y_new[3] - vf
                 crossed = gB <= 0.0
@@ -246,12 +265,19 @@ def run(
                 y[i] = y_new[i]
             _save(st, y, h_next)
             return BREAK_VFLOOR
-        # end time (τ monotone within a branch: f' > 0)
+        # end time: τ increases up to the fold (f' > 0 on the branch) and falls
+        # again beyond it, so t_end is looked for in [0, min(x_fold, 1)]
         x_end = 2.0
         tau_end = t_end - t0
-        if y_new[0] >= tau_end:
+        if x_fold <= 1.0:
+            x_b = x_fold
+            tau_b = interp1(y, Fc, x_fold, 0)
+        else:
+            x_b = 1.0
+            tau_b = y_new[0]
+        if tau_b >= tau_end:
             dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
-            x_end = crossing(y, Fc, 0, tau_end, 1.0, y_new[0])
+            x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
         x_stop = min(x_fold, x_end)
         if x_stop > 1.0:
             x_stop = 1.0
@@ -306,6 +332,7 @@ def run(
         if x_fold <= 1.0:
             # ---- jump at the fold: v exactly at the fold value, (α, ω, F) continuous
             ye[3] = p[P_VMAX] if br == 0 else p[P_VMIN]
+            ye[0] = max(ye[0], y[0])  # as for a plain step (below)
             tj = t0 + ye[0]
             Fj = pull_force(ye[1], ye[3], p)
             if br == 0:
@@ -349,6 +376,11 @@ def run(
             continue
 
         # ---- plain accepted step
+        if y_new[0] < y[0]:
+            # t(s) increases on a stable branch; near a folded singularity its
+            # increments fall below the step's error tolerance (module
+            # docstring): keep the invariant.  τ does not enter the field.
+            y_new[0] = y[0]
         for i in range(4):
             y[i] = y_new[i]
             f0[i] = K[_NS, i]
