@@ -303,11 +303,13 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         t_eval = te
     else:
         mode = H.SAVE_STEPS if save == "steps" else H.SAVE_NONE
-        cap = min(max_points, 1 << 16) if mode == H.SAVE_STEPS else 1
+        # two rows of slack: a step may store two (at a jump), and the budget raises only when *more*
+        # than max_points rows are needed (the kernel returns OUT_FULL before a step without room for two)
+        cap = min(max_points + 2, 1 << 16) if mode == H.SAVE_STEPS else 1
         t_eval = np.zeros(0)
     out = np.empty((cap, H.N_O))
     out_br = np.empty(cap, dtype=np.int8)
-    jcap = min(max_jumps, 1 << 14)
+    jcap = min(max_jumps + 1, 1 << 14)  # one slot of slack: JUMPS_FULL in the last view means > max_jumps
     jbuf = np.empty((jcap, H.N_J))
     chunks, bchunks, jchunks = [], [], []
     n_stored = 0
@@ -352,27 +354,37 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             budget=name, limit=limit, t=sd["t"], state=sd, partial=build(False),
         )
 
+    n_jstored = 0
     while True:
         quota = min(_PAUSE_STEPS, max_steps - int(cnt[H.C_STEPS]))
-        status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out, out_br, jbuf, cnt, quota)
+        # buffer views never reach past the budgets (+ slack), so a full buffer that ends at the budget
+        # means the run needs more than the budget
+        nv = cap if mode != H.SAVE_STEPS else min(cap, max_points + 2 - n_stored)
+        jv = min(jcap, max_jumps + 1 - n_jstored)
+        status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv], cnt, quota)
         if status == H.DONE:
+            if n_stored + int(cnt[H.C_NOUT]) > max_points:
+                raise over_budget("max_points", max_points)
+            if n_jstored + int(cnt[H.C_NJOUT]) > max_jumps:
+                raise over_budget("max_jumps", max_jumps)
             if progress:
                 progress(t_end, t_end)
             return build()
         if status == H.OUT_FULL:
+            if n_stored + int(cnt[H.C_NOUT]) + 2 > max_points + 2:
+                raise over_budget("max_points", max_points)
             n = int(cnt[H.C_NOUT])
             n_stored += n
-            if n_stored + 2 > max_points:
-                raise over_budget("max_points", max_points)
             chunks.append(out[:n].copy())
             bchunks.append(out_br[:n].copy())
             cnt[H.C_NOUT] = 0
             continue
         if status == H.JUMPS_FULL:
+            if n_jstored + int(cnt[H.C_NJOUT]) > max_jumps:
+                raise over_budget("max_jumps", max_jumps)
+            n_jstored += int(cnt[H.C_NJOUT])
             jchunks.append(jbuf[: cnt[H.C_NJOUT]].copy())
             cnt[H.C_NJOUT] = 0
-            if int(cnt[H.C_JUMPS]) >= max_jumps:
-                raise over_budget("max_jumps", max_jumps)
             continue
         if status == H.PAUSE:
             if int(cnt[H.C_STEPS]) >= max_steps:
