@@ -18,25 +18,27 @@ def peel_force_coefficients(V):
 
 def peel_force_fp(v, b, A):
     """f(v, V) (fvV) and df/dv for v > 0, given (b, A) = peel_force_coefficients(V)."""
-    x0 = v**(3/20)
-    x1 = v**(7/20)
-    x2 = A*numpy.sqrt(v)
+    lv = numpy.log(v)
+    x0 = A*numpy.sqrt(v)
+    x1 = numpy.exp((3/20)*lv)
+    x2 = numpy.exp((7/20)*lv)
     x3 = numpy.exp((1/11)*v)
-    f = b + 110*x0 + 400*x1 - x2 + 130*x3
-    fp = ((130/11)*v*x3 + (33/2)*x0 + 140*x1 - 1/2*x2)/v
+    f = b - x0 + 110*x1 + 400*x2 + 130*x3
+    fp = ((130/11)*v*x3 - 1/2*x0 + (33/2)*x1 + 140*x2)/v
     return f, fp
 
 
 def peel_force_fpp(v, b, A):
     """f(v, V) (fvV), df/dv and d2f/dv2 for v > 0, given (b, A) = peel_force_coefficients(V)."""
-    x0 = v**(3/20)
-    x1 = v**(7/20)
-    x2 = A*numpy.sqrt(v)
+    lv = numpy.log(v)
+    x0 = A*numpy.sqrt(v)
+    x1 = numpy.exp((3/20)*lv)
+    x2 = numpy.exp((7/20)*lv)
     x3 = numpy.exp((1/11)*v)
     x4 = v**2
-    f = b + 110*x0 + 400*x1 - x2 + 130*x3
-    fp = ((130/11)*v*x3 + (33/2)*x0 + 140*x1 - 1/2*x2)/v
-    fpp = (-561/40*x0 - 91*x1 + (1/4)*x2 + (130/121)*x3*x4)/x4
+    f = b - x0 + 110*x1 + 400*x2 + 130*x3
+    fp = ((130/11)*v*x3 - 1/2*x0 + (33/2)*x1 + 140*x2)/v
+    fpp = ((1/4)*x0 - 561/40*x1 - 91*x2 + (130/121)*x3*x4)/x4
     return f, fp, fpp
 
 

@@ -176,12 +176,13 @@ import numpy
 '''
 
 
-def _render_function(name, args, exprs, doc, out_names=None):
+def _render_function(name, args, exprs, doc, out_names=None, prelude=()):
     from sympy.printing.numpy import NumPyPrinter
 
     printer = NumPyPrinter({"fully_qualified_modules": True, "inline": True})
     repl, red = sp.cse(list(exprs), symbols=sp.numbered_symbols("x"), optimizations="basic")
     lines = [f"def {name}({', '.join(args)}):", f'    """{doc}"""']
+    lines += [f"    {sym} = {printer.doprint(e)}" for sym, e in prelude]
     for sym, e in repl:
         lines.append(f"    {sym} = {printer.doprint(e)}")
     outs = out_names or [f"r{i}" for i in range(len(red))]
@@ -217,6 +218,17 @@ def render_module() -> str:
     f0 = fw.subs(sub)
     f1 = (f_w / sp.exp(w)).subs(sub)
     f2 = ((f_ww - f_w) / sp.exp(2 * w)).subs(sub)
+    # Speed: the fractional powers v^(3/20), v^(7/20) become exp(r ln v) with ln v computed once (one log
+    # and two exps instead of two pow calls: the peel force is ~2/3 of a hybrid field evaluation, and this
+    # cuts it by a third).  sqrt stays native.  Accuracy is unchanged (~1e-15 relative in f).
+    lv = sp.Symbol("lv")
+    frac = {}
+    for e in (f0, f1, f2):
+        for pw in e.atoms(sp.Pow):
+            if pw.base == vv and pw.exp.is_Rational and not pw.exp.is_Integer and pw.exp.q != 2:
+                frac[pw] = sp.exp(pw.exp * lv)
+    f0, f1, f2 = (e.xreplace(frac) for e in (f0, f1, f2))
+    prelude = [(lv, sp.log(vv))]
     for name, exprs, outs, what in (
         ("peel_force_fp", [f0, f1], ["f", "fp"], "f(v, V) (fvV) and df/dv"),
         ("peel_force_fpp", [f0, f1, f2], ["f", "fp", "fpp"], "f(v, V) (fvV), df/dv and d2f/dv2"),
@@ -228,6 +240,7 @@ def render_module() -> str:
                 exprs,
                 f"{what} for v > 0, given (b, A) = peel_force_coefficients(V).",
                 outs,
+                prelude,
             )
         )
 

@@ -21,22 +21,24 @@ FAST = settings(max_examples=60, deadline=None, derandomize=True)
 @FAST
 @given(V=Vs, u=st.floats(1e-4, 1 - 1e-6))
 def test_ab_inverse_round_trips(V, u):
-    """For any v on AB, ``branch_inverse(f(v, V), V, "AB")`` returns v.  Tolerance 1e-9 relative in v: the
-    inverse is solved to rounding in f, and dv = df/f' with f' bounded away from 0 at u <= 1 - 1e-6."""
+    """For any v on AB, ``branch_inverse(f(v, V), V, "AB")`` returns v.  Tolerance: the inverse is solved
+    to rounding in f, whose evaluation noise is ~4 eps times its largest term (~1000 N), i.e. 1e-12 N; it
+    moves the root by dv = 1e-12 N / f'(v), which is large next to the folds (the inverse's conditioning),
+    plus 1e-9 relative for brentq's own tolerance."""
     bs = branch_structure(V)
     v = u * bs.v_max
     back = float(branch_inverse(float(peel_force(v, V)), V, "AB"))
-    assert abs(back - v) <= 1e-9 * v + 1e-12
+    assert abs(back - v) <= 1e-9 * v + 1e-12 / float(peel_force_derivative(v, V))
 
 
 @FAST
 @given(V=Vs, w=st.floats(1e-6, 5.0))
 def test_cd_inverse_round_trips(V, w):
-    """For any v on CD (v = v_min (1 + w)), the CD inverse returns v to 1e-9 relative (same argument)."""
+    """For any v on CD (v = v_min (1 + w)), the CD inverse returns v (same tolerance and argument)."""
     bs = branch_structure(V)
     v = bs.v_min * (1 + w)
     back = float(branch_inverse(float(peel_force(v, V)), V, "CD"))
-    assert abs(back - v) <= 1e-9 * v
+    assert abs(back - v) <= 1e-9 * v + 1e-12 / float(peel_force_derivative(v, V))
 
 
 @FAST
