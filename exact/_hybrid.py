@@ -77,10 +77,12 @@ from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_the
 from peelapprox._peelforce import peel_force_fp_jit
 
 # the model's equations, compiled from the one generated source
-closure_paper = njit(cache=True)(_g.closure_paper)
-closure_exact = njit(cache=True)(_g.closure_exact)
-slow_rates = njit(cache=True)(_g.slow_rates)
-constraint_rate = njit(cache=True)(_g.constraint_rate)
+# (inline="always": numba then inlines them at the IR level; as separately compiled functions their calls
+# cost half of a field evaluation, 72 -> 35 ns measured)
+closure_paper = njit(cache=True, inline="always")(_g.closure_paper)
+closure_exact = njit(cache=True, inline="always")(_g.closure_exact)
+slow_rates = njit(cache=True, inline="always")(_g.slow_rates)
+constraint_rate = njit(cache=True, inline="always")(_g.constraint_rate)
 
 # ---------------------------------------------------------------- layouts
 # parameter vector
@@ -115,7 +117,7 @@ BREAK_VCEIL = 14  # v ran away on CD
 STEP_FAIL = 20  # step size underflow / repeated rejection
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _closure(alpha, p):
     if p[P_GEOM] == 0.0:
         return closure_paper(alpha, p[P_R], p[P_L])

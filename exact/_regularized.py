@@ -30,10 +30,10 @@ from peelapprox._peelforce import BRANCHES, branch_structure, peel_force_coeffic
 
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
-_rhs_g = njit(cache=True)(_g.regularized_rhs)
-_jac_g = njit(cache=True)(_g.regularized_jacobian)
-_cl_paper = njit(cache=True)(_g.closure_paper)
-_cl_exact = njit(cache=True)(_g.closure_exact)
+_rhs_g = njit(cache=True, inline="always")(_g.regularized_rhs)
+_jac_g = njit(cache=True, inline="always")(_g.regularized_jacobian)
+_cl_paper = njit(cache=True, inline="always")(_g.closure_paper)
+_cl_exact = njit(cache=True, inline="always")(_g.closure_exact)
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 

@@ -49,7 +49,7 @@ BRANCHES = ("AB", "CD")
 peel_force_coefficients = _g.peel_force_coefficients
 
 #: numba-compiled scalar ``(f, f')`` at ``v`` given ``(b, A) = peel_force_coefficients(V)``.
-peel_force_fp_jit = njit(cache=True, fastmath=False)(_g.peel_force_fp)
+peel_force_fp_jit = njit(cache=True, fastmath=False, inline="always")(_g.peel_force_fp)
 #: numba-compiled scalar ``(f, f', f'')``.
 peel_force_fpp_jit = njit(cache=True, fastmath=False)(_g.peel_force_fpp)
 

@@ -96,12 +96,12 @@ SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = range(3)
 # status codes
 EXIT, OUT_FULL, T_MAX, MAX_STEPS, BREAK_VFLOOR, BREAK_VCEIL, BREAK_F, BREAK_NONFINITE, STEP_FAIL = range(9)
 
-_sinusoid_jit = njit(cache=True)(_sinusoid)
-_harmonic_jit = njit(cache=True)(_harmonic)
-_decay_jit = njit(cache=True)(_decay)
+_sinusoid_jit = njit(cache=True, inline="always")(_sinusoid)
+_harmonic_jit = njit(cache=True, inline="always")(_harmonic)
+_decay_jit = njit(cache=True, inline="always")(_decay)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # inlined into the field (numba does not inline separate dispatchers)
 def _alpha_of(y, q):
     """(α, α̇) at state y: closed forms evaluated at t, else the state's own."""
     am = int(q[Q_AM])

@@ -1,0 +1,509 @@
+"""External compiled peer solvers on the paper's ε-regularised system.
+
+The system is the one integrated by ``exact.simulate(method="regularized")``
+(see :mod:`exact._regularized`): state ``X = (α, ω, F, v)``,
+
+    M Ẋ = φ(X),   M = diag(1, 1, 1, ε),
+
+with φ from :func:`peelapprox._generated.regularized_rhs` (FLOW1, FLOW2,
+flow3 and ``φ_v = F (1 - cos θ) - f(v, V)``), the closure of ``cos θ`` given by
+``params.geometry`` and the peel force f of Eq. (fvV).  The same initial state
+as the hybrid and the scipy solvers (:func:`exact.initial_state`) is used.
+
+Peers
+-----
+``"ida"``
+    SUNDIALS IDA (variable-order, variable-step BDF for implicit DAEs) through
+    ``sksundae.ida`` in residual form ``r = M Ẋ - φ(X)``, with the analytic
+    Jacobian ``∂r/∂X + c_j ∂r/∂Ẋ = -∂φ/∂X + c_j M`` and a consistent ``Ẋ(0)``.
+``"cvode"``
+    SUNDIALS CVODE through ``sksundae.cvode`` on the equivalent ODE
+    ``Ẋ = M⁻¹ φ(X)``: BDF, dense direct linear solver, analytic Jacobian.
+``"diffsol"``
+    pydiffsol (the Rust crate diffsol): its BDF (NDF, after ode15s) with the
+    mass matrix M, the model written in DiffSL (:func:`diffsl_code`) and
+    JIT-compiled by LLVM; the Jacobian comes from the compiler's automatic
+    differentiation.
+
+The two SUNDIALS peers call back into Python for every right-hand-side or
+Jacobian evaluation; the callbacks are the numba-compiled kernels of
+:mod:`exact._regularized` (``_fun``, ``_jac``), so only the call overhead is
+Python.  diffsol evaluates the model in JIT-compiled code with no Python in
+the loop.
+
+Tolerances
+----------
+Every peer controls the local error per step in a weighted RMS norm,
+``sqrt(mean_i (err_i / (atol_i + rtol |X_i|))^2) <= 1``, as scipy's solvers do,
+with ``atol`` defaulting to ``rtol * exact.ATOL_SCALE["regularized"]``
+exactly as ``exact.simulate(method="regularized")``.  pydiffsol accepts only a
+scalar ``atol``; the DiffSL model therefore integrates the scaled state
+``y_i = X_i / atol_i`` with ``atol = 1``, which gives exactly the weights
+``atol_i + rtol |X_i|`` on X (the relative part is scale invariant).  The
+tolerances are *local*: equal ``rtol`` does not mean equal global accuracy
+across peers (different methods, orders and error estimators).
+
+Jumps
+-----
+A jump is recorded where v crosses the inflection velocity ``v_infl`` of
+``f(·, V)`` in either direction, as :mod:`exact._regularized` does.  IDA and
+CVODE locate it with their root finders (``eventsfn``, non-terminal, on
+``v - v_infl``).  For diffsol the DiffSL model carries ``stop { v - v_infl }``
+with an identity ``reset``: diffsol's root finder stops the integration at the
+crossing, records the state twice (before and after the identity reset) and
+restarts the BDF there; those duplicated output times are the crossing
+times.  (Restarting at each crossing is part of diffsol's cost.)
+
+Time
+----
+``wall_time`` is ``time.perf_counter()`` around the integration call only
+(``solve``).  Model construction is reported separately in
+``compile_time``: for diffsol the DiffSL JIT compilation, for the SUNDIALS
+peers the loading (from numba's on-disk cache) or compiling of the numba
+kernels, which happens once per process, plus the solver object's
+construction.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import math
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Sequence, Union
+
+import numpy as np
+
+from exact._simulate import ATOL_SCALE, initial_state
+from peelapprox._peelforce import branch_structure, peel_force_coefficients
+
+if TYPE_CHECKING:  # pragma: no cover
+    from peelapprox import PeelParams
+
+__all__ = [
+    "PEERS",
+    "PeerResult",
+    "PeerUnavailableError",
+    "available_peers",
+    "run_peer",
+    "diffsl_code",
+    "diffsl_model",
+    "diffsl_inputs",
+]
+
+#: The peers :func:`run_peer` knows.
+PEERS = ("ida", "cvode", "diffsol")
+
+#: Package (import name, pip name) each peer needs.
+_PACKAGES = {
+    "ida": ("sksundae", "scikit-sundae"),
+    "cvode": ("sksundae", "scikit-sundae"),
+    "diffsol": ("pydiffsol", "pydiffsol"),
+}
+
+#: Step budget passed to SUNDIALS (its default, 500 per output interval, is far too small for save-every-step solves).
+_MAX_NUM_STEPS = 100_000_000
+
+
+class PeerUnavailableError(ImportError):
+    """The package a peer needs is missing or does not work here."""
+
+
+@dataclass(frozen=True)
+class PeerResult:
+    """Outcome of one peer run.
+
+    Attributes
+    ----------
+    peer : str
+        One of :data:`PEERS`.
+    eps, rtol : float
+        Regularisation ε and relative tolerance used.
+    atol : ndarray, shape (4,)
+        Absolute tolerances used for ``(α, ω, F, v)``.
+    jump_t, jump_F : ndarray
+        Times [s] where v crossed the inflection velocity (either direction)
+        and F [N] there, in time order.  On failure: IDA and CVODE keep the
+        crossings found before the solver stopped; diffsol raises inside its
+        ``solve`` and returns nothing, so they are empty.
+    n_steps : int
+        Accepted steps (IDA, CVODE: internal steps returned by the one-step
+        solve; diffsol: output intervals of ``solve``, crossings not counted);
+        -1 if unavailable.
+    n_rhs : int
+        Right-hand-side (IDA: residual) evaluations; -1 if the peer does not
+        expose it (diffsol).
+    wall_time : float
+        Seconds spent in the integration call only.
+    compile_time : float
+        Seconds spent building the model in this call (JIT compilation,
+        kernel loading, solver construction).
+    status : str
+        ``"ok"`` or ``"failed: <message>"``.
+    """
+
+    peer: str
+    eps: float
+    rtol: float
+    atol: np.ndarray
+    jump_t: np.ndarray
+    jump_F: np.ndarray
+    n_steps: int
+    n_rhs: int
+    wall_time: float
+    compile_time: float
+    status: str
+
+
+# --------------------------------------------------------------------------
+# availability
+# --------------------------------------------------------------------------
+
+
+def _import(peer: str):
+    mod, pip = _PACKAGES[peer]
+    try:
+        return importlib.import_module(mod)
+    except ImportError as exc:
+        raise PeerUnavailableError(
+            f"peer {peer!r} needs the package {pip!r} (import {mod}), which is not installed: "
+            f"pip install {pip} (or the 'bench' extra: pip install peelapprox[bench])"
+        ) from exc
+
+
+@functools.lru_cache(maxsize=None)
+def _works(peer: str) -> bool:
+    try:
+        mod = _import(peer)
+        if peer == "diffsol":
+            ode = mod.Ode("u { 1.0 } F { -u }")
+            return abs(float(ode.solve(np.zeros(0), 1.0).ys[0, -1]) - math.exp(-1.0)) < 1e-3
+        if peer == "cvode":
+            def rhs(t, y, yp):
+                yp[0] = -y[0]
+            r = mod.cvode.CVODE(rhs).solve([0.0, 1.0], [1.0])
+        else:
+            def res(t, y, yp, out):
+                out[0] = yp[0] + y[0]
+            r = mod.ida.IDA(res).solve([0.0, 1.0], [1.0], [-1.0])
+        return bool(r.success) and abs(float(r.y[-1, 0]) - math.exp(-1.0)) < 1e-3
+    except Exception:  # noqa: BLE001 - any failure means "not usable here"
+        return False
+
+
+def available_peers() -> tuple[str, ...]:
+    """The peers whose package imports and solves a one-line ODE here.
+
+    Returns
+    -------
+    tuple of str
+        A subset of :data:`PEERS`, in that order.  The check runs once per
+        process and peer.
+    """
+    return tuple(p for p in PEERS if _works(p))
+
+
+# --------------------------------------------------------------------------
+# the model in DiffSL
+# --------------------------------------------------------------------------
+
+#: Inputs of the DiffSL model, in order (``in_i``): physical parameters, the
+#: inflection velocity, the initial state and the state scales (= atol).
+DIFFSL_INPUTS = ("V", "I", "k", "R", "l", "eps", "vm", "a0", "w0", "F0", "v0", "sa", "sw", "sF", "sv")
+
+_GEOMETRIES = ("paper", "exact")
+
+
+def _diffsl_expressions(geometry: str) -> dict:
+    """DiffSL (C-syntax) expressions of c(α), φ_α, φ_ω, φ_F and φ_v, printed from the one symbolic source
+    :mod:`peelapprox._symbolic` (``cos_theta_expr``, ``equations_of_motion``; fvV inside CONSTR), so the
+    peer integrates the same model as every other solver without a second copy of the formulas.  The pull
+    force is named ``Fp`` in DiffSL (``F_i`` is DiffSL's right-hand side)."""
+    import sympy as sp
+
+    from peelapprox import _symbolic as S
+
+    Fp = sp.Symbol("Fp", real=True)
+    alpha_dot, omega_dot, F_dot, constraint = S.equations_of_motion(S.c_)
+    sub = {S.F: Fp}
+    code = {name: sp.ccode(e.xreplace(sub)) for name, e in
+            (("phi_a", alpha_dot), ("phi_w", omega_dot), ("phi_F", F_dot), ("phi_v", constraint))}
+    code["c"] = sp.ccode(-S.cos_theta_expr(geometry))
+    return code
+
+
+def diffsl_code(geometry: str = "paper") -> str:
+    """The DiffSL source of the regularised system for pydiffsol.
+
+    Printed from the symbolic model (:func:`_diffsl_expressions`).  The state is ``y = X / s`` with
+    ``s = (sa, sw, sF, sv)`` (the absolute tolerances, see the module
+    docstring), the mass matrix is ``diag(1, 1, 1, eps)`` and
+    ``F_i = φ_i(s ∘ y) / s_i``.  ``stop``/``reset`` mark the crossings of
+    ``v = vm``.
+
+    Parameters
+    ----------
+    geometry : {"paper", "exact"}
+        Closure of ``cos θ`` (``PeelParams.geometry``).
+
+    Returns
+    -------
+    str
+    """
+    if geometry not in _GEOMETRIES:
+        raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {geometry!r}")
+    inputs = ", ".join(f"{n} = 1.0" for n in DIFFSL_INPUTS)
+    e = _diffsl_expressions(geometry)
+    return f"""
+in_i {{ {inputs} }}
+u_i {{ ya = a0 / sa, yw = w0 / sw, yF = F0 / sF, yv = v0 / sv }}
+dudt_i {{ dya = 0.0, dyw = 0.0, dyF = 0.0, dyv = 0.0 }}
+alpha {{ ya * sa }}
+omega {{ yw * sw }}
+Fp {{ yF * sF }}
+v {{ yv * sv }}
+c {{ {e["c"]} }}
+M_i {{ dya, dyw, dyF, eps * dyv }}
+F_i {{
+  ({e["phi_a"]}) / sa,
+  ({e["phi_w"]}) / sw,
+  ({e["phi_F"]}) / sF,
+  ({e["phi_v"]}) / sv,
+}}
+stop {{ v - vm }}
+reset_i {{ ya, yw, yF, yv }}
+"""
+
+
+def diffsl_model(geometry: str = "paper"):
+    """JIT-compile :func:`diffsl_code` into a ``pydiffsol.Ode`` (dense LU, BDF).
+
+    Raises
+    ------
+    PeerUnavailableError
+        If pydiffsol is not installed.
+    """
+    ds = _import("diffsol")
+    return ds.Ode(diffsl_code(geometry), matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
+
+
+def diffsl_inputs(params: "PeelParams", eps: float, state, scale) -> np.ndarray:
+    """The ``in_i`` vector of :func:`diffsl_code` (order :data:`DIFFSL_INPUTS`).
+
+    Parameters
+    ----------
+    params : PeelParams
+    eps : float
+        Regularisation ε.
+    state : sequence of 4 floats
+        Initial ``(α, ω, F, v)``.
+    scale : sequence of 4 floats
+        State scales ``s`` (``y = X / s``), all > 0.
+    """
+    vm = branch_structure(params.V).v_inflection
+    return np.array([params.V, params.I, params.k, params.R, params.l, eps, vm, *state, *scale], dtype=float)
+
+
+# --------------------------------------------------------------------------
+# running a peer
+# --------------------------------------------------------------------------
+
+
+def _check(peer, params, t_end, eps, rtol, atol):
+    from peelapprox import PeelParams
+
+    if peer not in PEERS:
+        raise ValueError(f"peer must be one of {PEERS}, got {peer!r}")
+    if not isinstance(params, PeelParams):
+        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
+    vals = {}
+    for name, val in (("t_end", t_end), ("eps", eps), ("rtol", rtol)):
+        try:
+            vals[name] = float(val)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a real number, got {val!r}") from None
+    if not (math.isfinite(vals["t_end"]) and vals["t_end"] > 0):
+        raise ValueError(f"t_end must be in (0, inf), got {t_end!r}")
+    if not (math.isfinite(vals["eps"]) and vals["eps"] > 0):
+        raise ValueError(f"eps must be in (0, inf), got {eps!r}")
+    if not (0.0 < vals["rtol"] < 1.0):
+        raise ValueError(f"rtol must be in (0, 1), got {rtol!r}")
+    rt = vals["rtol"]
+    if atol is None:
+        a = rt * np.asarray(ATOL_SCALE["regularized"], dtype=float)
+    else:
+        a = np.asarray(atol, dtype=float)
+        if a.ndim == 0:
+            a = np.full(4, float(a))
+        if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a <= 0):
+            raise ValueError(f"atol must be None, a scalar or 4 values (alpha, omega, F, v), finite and in (0, inf), "
+                             f"got {atol!r}")
+    return vals["t_end"], vals["eps"], rt, a
+
+
+def _qvec(params, eps):
+    b, A = peel_force_coefficients(params.V)
+    return np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
+                     0.0 if params.geometry == "paper" else 1.0])
+
+
+def _run_sundials(peer, params, t_end, eps, rtol, atol, y0, vm):
+    sun = _import(peer)
+    c0 = time.perf_counter()
+    from exact._regularized import _fun, _jac  # numba kernels: load / compile once per process
+
+    q = _qvec(params, eps)
+    q1 = q.copy()
+    q1[7] = 1.0  # with eps = 1 the kernels give phi and d(phi)/dX themselves (M = I)
+    _fun(y0, q), _jac(y0, q)
+    mass = np.array([1.0, 1.0, 1.0, eps])
+    mass_m = np.diag(mass)
+    common = dict(rtol=rtol, atol=atol, num_events=1, max_num_steps=_MAX_NUM_STEPS, linsolver="dense")
+    if peer == "cvode":
+        def rhs(t, y, yp):
+            yp[:] = _fun(y, q)
+
+        def jac(t, y, yp, JJ):
+            JJ[:, :] = _jac(y, q)
+
+        def events(t, y, ev):
+            ev[0] = y[3] - vm
+
+        events.terminal, events.direction = [False], [0]
+        solver = sun.cvode.CVODE(rhs, method="BDF", jacfn=jac, eventsfn=events, **common)
+        args = ([0.0, t_end], y0)
+    else:
+        def res(t, y, yp, out):
+            out[:] = mass * yp - _fun(y, q1)
+
+        def jac(t, y, yp, r, cj, JJ):
+            JJ[:, :] = cj * mass_m - _jac(y, q1)
+
+        def events(t, y, yp, ev):
+            ev[0] = y[3] - vm
+
+        events.terminal, events.direction = [False], [0]
+        solver = sun.ida.IDA(res, jacfn=jac, eventsfn=events, **common)
+        args = ([0.0, t_end], y0, _fun(y0, q))  # consistent yp0 = M^-1 phi(y0)
+    compile_time = time.perf_counter() - c0
+    w0 = time.perf_counter()
+    try:
+        r = solver.solve(*args)
+    except Exception as exc:  # noqa: BLE001 - report, never raise, a solver failure
+        return dict(wall_time=time.perf_counter() - w0, compile_time=compile_time, status=f"failed: {exc}",
+                    jump_t=np.zeros(0), jump_F=np.zeros(0), n_steps=-1, n_rhs=-1)
+    wall = time.perf_counter() - w0
+    jt = np.zeros(0) if r.t_events is None else np.asarray(r.t_events, float).copy()
+    jF = np.zeros(0) if r.y_events is None else np.asarray(r.y_events, float)[:, 2].copy()
+    t_last = float(r.t[-1]) if len(r.t) else float("nan")
+    if not r.success:
+        status = f"failed: {r.message} (status {r.status}, t={t_last:.9g})"
+    elif not t_last == t_end:
+        status = f"failed: stopped at t={t_last:.9g} before t_end={t_end}"
+    else:
+        status = "ok"
+    return dict(wall_time=wall, compile_time=compile_time, status=status, jump_t=jt, jump_F=jF,
+                n_steps=len(r.t) - 1, n_rhs=int(r.nfev))
+
+
+#: pydiffsol ``Ode.options`` changed from their defaults to pass the folds
+#: (see :func:`run_peer`): a fresh Newton matrix and right-hand-side Jacobian at
+#: every step (defaults: after 20 and 50 steps) and ``min_timestep`` 1e-18
+#: instead of 1e-13.
+DIFFSOL_OPTIONS = dict(min_timestep=1e-18, update_jacobian_after_steps=1, update_rhs_jacobian_after_steps=1)
+
+
+def _run_diffsol(params, t_end, eps, rtol, atol, y0, vm):
+    c0 = time.perf_counter()
+    ode = diffsl_model(params.geometry)
+    ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0  # scalar atol 1 on y = X / atol
+    for name, val in DIFFSOL_OPTIONS.items():
+        setattr(ode.options, name, val)
+    p = diffsl_inputs(params, eps, y0, atol)
+    compile_time = time.perf_counter() - c0
+    w0 = time.perf_counter()
+    try:
+        sol = ode.solve(p, t_end)
+    except Exception as exc:  # noqa: BLE001 - report, never raise, a solver failure
+        return dict(wall_time=time.perf_counter() - w0, compile_time=compile_time, status=f"failed: {exc}",
+                    jump_t=np.zeros(0), jump_F=np.zeros(0), n_steps=-1, n_rhs=-1)
+    wall = time.perf_counter() - w0
+    ts = np.asarray(sol.ts, float)
+    ys = np.asarray(sol.ys, float)
+    dup = np.nonzero(np.diff(ts) == 0.0)[0]  # stop + identity reset: the crossing is stored twice
+    jt = ts[dup].copy()
+    jF = ys[2, dup] * atol[2]
+    status = "ok" if ts.size and ts[-1] == t_end else f"failed: stopped at t={ts[-1] if ts.size else 0:.9g}"
+    return dict(wall_time=wall, compile_time=compile_time, status=status, jump_t=jt, jump_F=jF,
+                n_steps=int(ts.size - 1 - dup.size), n_rhs=-1)
+
+
+def run_peer(
+    peer: str,
+    params: "PeelParams",
+    t_end: float,
+    *,
+    eps: float,
+    rtol: float,
+    atol: Union[None, float, Sequence[float]] = None,
+    alpha0: float = 0.0,
+) -> PeerResult:
+    """Integrate the ε-regularised system from 0 to ``t_end`` with an external peer.
+
+    Parameters
+    ----------
+    peer : {"ida", "cvode", "diffsol"}
+        See the module docstring.
+    params : PeelParams
+        Physical parameters and ``geometry`` (closure of ``cos θ``).
+    t_end : float
+        Final time [s], > 0.
+    eps : float
+        Regularisation ε > 0 (the paper: 1e-7).
+    rtol : float
+        Relative tolerance, in (0, 1).
+    atol : None, float or 4 floats, optional
+        Absolute tolerances for ``(α, ω, F, v)``, all > 0; default
+        ``rtol * exact.ATOL_SCALE["regularized"]`` as in
+        ``exact.simulate(method="regularized")``.
+    alpha0 : float
+        Initial α; the rest of the initial state is
+        :func:`exact.initial_state` ``(params, alpha0=alpha0)``.
+
+    Returns
+    -------
+    PeerResult
+        Crossings of the inflection velocity, counters and timings.  A solver
+        failure does not raise: ``status`` is ``"failed: <message>"``.
+
+    Raises
+    ------
+    ValueError
+        Unknown ``peer``, ``eps <= 0``, ``rtol`` outside (0, 1), bad
+        ``t_end``/``atol``/``params``, or an ``alpha0`` with no consistent
+        initial state; the message names the argument and its valid range.
+    PeerUnavailableError
+        (an ``ImportError``) if the peer's package is not installed.
+
+    Notes
+    -----
+    Options set beyond tolerances: SUNDIALS ``max_num_steps`` = 1e8 (the
+    whole run is one ``solve``), analytic Jacobians, dense LU, all else at
+    SUNDIALS' defaults (BDF up to order 5).  diffsol: :data:`DIFFSOL_OPTIONS`.
+    With diffsol's defaults the stale Jacobian across a fold makes Newton
+    fail ("Exceeded maximum number of nonlinear solver failures") at, e.g.,
+    ε = 1e-7, rtol = 1e-6, and the restart after a crossing needs steps
+    below the default ``min_timestep`` = 1e-13 s ("Step size is too small")
+    at ε = 1e-9 or rtol <= 1e-10.
+    """
+    t_end, eps, rtol, a = _check(peer, params, t_end, eps, rtol, atol)
+    s0 = initial_state(params, alpha0=alpha0)
+    _import(peer)
+    y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v])
+    vm = branch_structure(params.V).v_inflection
+    if peer == "diffsol":
+        out = _run_diffsol(params, t_end, eps, rtol, a, y0, vm)
+    else:
+        out = _run_sundials(peer, params, t_end, eps, rtol, a, y0, vm)
+    return PeerResult(peer=peer, eps=eps, rtol=rtol, atol=a, **out)
