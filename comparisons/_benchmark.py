@@ -65,7 +65,9 @@ __all__ = [
     "jump_errors",
     "work_precision",
     "matched_ratios",
+    "ratio_summary",
     "eps_study",
+    "small_eps_check",
     "fit_power_law",
     "speed_targets",
     "run_benchmark",
@@ -335,6 +337,15 @@ def matched_ratios(rows: Sequence[WPRow]) -> List[dict]:
     return out
 
 
+def ratio_summary(ratios: Sequence[dict]) -> dict:
+    """``{solver: {scene: smallest ratio}}`` over :func:`matched_ratios` (each peer's best showing)."""
+    out: dict = {}
+    for m in ratios:
+        per = out.setdefault(m["solver"], {})
+        per[m["scene"]] = min(per.get(m["scene"], math.inf), m["ratio"])
+    return out
+
+
 # ---------------------------------------------------------------------------------------------- ε study
 @dataclass
 class EpsRow:
@@ -359,7 +370,7 @@ def eps_study(
     *,
     solver: str = "Radau",
     rtol: float = 1e-10,
-    max_steps: int = 200_000,
+    max_steps: int = 60_000,
     progress: Optional[Callable[[str], None]] = None,
 ) -> List[EpsRow]:
     """Fold-passage delay of the regularised scheme vs ε, against the ε → 0 (hybrid, rtol 1e-13) jumps.
@@ -367,8 +378,8 @@ def eps_study(
     The horizon ends halfway between the reference's second and third jump, so one passage of each fold
     is measured from the same initial state (over longer horizons the delays accumulate and, at V=1,
     I=1e-5, the orbit eventually changes).  Every ε is run once; a failure (e.g. at ε = 1e-15) or a run
-    over ``max_steps`` (Radau at ε <= 1e-12 grinds at the CD fold: 90 s at 1e-12, 540 s at 1e-13 before
-    failing) is a row with its status, not an exception.
+    over ``max_steps`` (Radau at ε <= 1e-12 grinds at the CD fold: 70-90 s at 1e-12, 540 s at 1e-13 before
+    failing; ε = 1e-11 needs 35 000 steps) is a row with its status, not an exception.
     """
     say = progress or (lambda msg: None)
     full = simulate(scene.params, scene.horizon, alpha0=scene.alpha0, rtol=1e-13, save="jumps").jumps
@@ -394,6 +405,42 @@ def eps_study(
             continue
         rows.append(EpsRow(eps, solver, rtol, tr.jumps.t[0] - ref[0].t, tr.jumps.t[1] - ref[1].t,
                            max(abs(tr.jumps.F[i] - ref[i].F) / ref[i].F for i in (0, 1)), wall, tr.stats.n_steps))
+    return rows
+
+
+def small_eps_check(
+    scene: BenchScene,
+    eps_values: Sequence[float] = (1e-12, 1e-15),
+    *,
+    rtol: float = 1e-8,
+    peers: Sequence[str] = (),
+    progress: Optional[Callable[[str], None]] = None,
+) -> List[EpsRow]:
+    """Which solvers of the regularised system get through both folds at tiny ε in double precision (the
+    paper: results do not depend on ε for 1e-7 … 1e-15).  The horizon and delays are as in :func:`eps_study`;
+    scipy Radau in the ODE form ``v̇ = φ_v/ε`` and every installed peer (IDA integrates the DAE residual
+    ``M Ẋ − φ``, as MATLAB's ode15s does with a mass matrix)."""
+    from ._peers import run_peer
+
+    say = progress or (lambda msg: None)
+    full = simulate(scene.params, scene.horizon, alpha0=scene.alpha0, rtol=1e-13, save="jumps").jumps
+    horizon = 0.5 * (full.t[1] + full.t[2])
+    rows = []
+    for eps in eps_values:
+        say(f"small eps {eps:.0e}: Radau")
+        rows += eps_study(scene, (eps,), rtol=rtol, max_steps=50_000)
+        for peer in peers:
+            say(f"small eps {eps:.0e}: {peer}")
+            with _c_stdout_to_stderr():
+                r = run_peer(peer, scene.params, horizon, eps=eps, rtol=rtol, alpha0=scene.alpha0)
+            if r.status != "ok" or len(r.jump_t) != 2:
+                status = r.status if r.status != "ok" else f"{len(r.jump_t)} jumps instead of 2"
+                rows.append(EpsRow(eps, peer, rtol, math.nan, math.nan, math.nan, r.wall_time, r.n_steps,
+                                   status=status[:100]))
+                continue
+            rows.append(EpsRow(eps, peer, rtol, r.jump_t[0] - full.t[0], r.jump_t[1] - full.t[1],
+                               max(abs(r.jump_F[i] - full.F[i]) / full.F[i] for i in (0, 1)), r.wall_time,
+                               r.n_steps))
     return rows
 
 
@@ -478,6 +525,7 @@ class BenchmarkReport:
     ratios: List[dict]
     eps_rows: List[EpsRow]
     eps_fit: dict
+    small_eps: List[EpsRow]
     targets: List[dict]
     peers: tuple
     quick: bool
@@ -515,7 +563,8 @@ def run_benchmark(*, quick: bool = False, peers: Optional[Sequence[str]] = None,
         refs.append(ref)
     eps_values = (1e-4, 1e-6, 1e-8, 1e-10, 1e-15) if quick else \
         (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-15)
-    eps_rows = eps_study(BENCH_SCENES[0], eps_values, max_steps=50_000 if quick else 200_000, progress=progress)
+    eps_rows = eps_study(BENCH_SCENES[0], eps_values, max_steps=60_000, progress=progress)
+    small_eps = small_eps_check(BENCH_SCENES[0], peers=peers, progress=progress)
     eps_fit = {}
     for key in ("delay_ab", "delay_cd"):
         ok = [e for e in eps_rows if e.status == "ok" and 1e-12 <= e.eps <= 1e-5]
@@ -528,7 +577,7 @@ def run_benchmark(*, quick: bool = False, peers: Optional[Sequence[str]] = None,
         progress("compile costs (fresh processes, cold and cached)")
     compile_ = compile_costs()
     machine = f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
-    return BenchmarkReport(rows, refs, matched_ratios(rows), eps_rows, eps_fit, targets, peers, quick,
+    return BenchmarkReport(rows, refs, matched_ratios(rows), eps_rows, eps_fit, small_eps, targets, peers, quick,
                            time.perf_counter() - t_start, machine, compile_)
 
 
@@ -551,6 +600,13 @@ def markdown(rep: BenchmarkReport) -> str:
         eps = "0" if r.method == "hybrid" else f"{r.eps:.0e}"
         L.append(f"| {r.scene} | {r.method} | {r.solver} | {eps} | {r.rtol:.0e} | {_g3(r.error)} | {_g3(r.err_t)} | "
                  f"{_g3(r.err_F)} | {_g3(r.time)} | {r.steps} | {r.n_rhs} | {r.status} |")
+    L += ["", "### Speed-up at matched error: summary", "",
+          "The smallest ratio over each solver's runs (its best showing) per scene; details below.", "",
+          "| solver | " + " | ".join(s.name for s in BENCH_SCENES) + " |",
+          "|---|" + "---|" * len(BENCH_SCENES)]
+    for solver, per in ratio_summary(rep.ratios).items():
+        L.append(f"| {solver} | " + " | ".join(f"{per[s.name]:.0f}×" if s.name in per else "–"
+                                                for s in BENCH_SCENES) + " |")
     L += ["", "### Speed-up at matched error", "",
           "Each regularised run against the fastest hybrid run with an error at most as large.", "",
           "| scene | run | its error | its time [s] | hybrid rtol | hybrid error | hybrid time [s] | ratio |",
@@ -567,7 +623,12 @@ def markdown(rep: BenchmarkReport) -> str:
                  f" {e.status} |")
     for key, (C, p, res) in rep.eps_fit.items():
         L += ["", f"Fit of the {key.replace('delay_', '').upper()} delay over ε ∈ [1e-12, 1e-5]: "
-                  f"{C:.3g} · ε^{p:.3f} s (max relative residual {res:.2f})."]
+                  f"{C:.3g} · ε^{p:.4f} s (max relative residual {res:.1e})."]
+    L += ["", "### Tiny ε in double precision (same horizon, rtol 1e-8)", "",
+          "| ε | solver | delay at the AB fold [s] | delay at the CD fold [s] | time [s] | status |",
+          "|---|---|---|---|---|---|"]
+    for e in rep.small_eps:
+        L.append(f"| {e.eps:.0e} | {e.solver} | {_g3(e.delay_ab)} | {_g3(e.delay_cd)} | {_g3(e.time)} | {e.status} |")
     L += ["", "### Speed targets", "",
           "| scene | simulated [s] | wall [s] | steps | jumps | µs/step | RHS/step | ns/RHS | RHS share of time | steps/jump |",
           "|---|---|---|---|---|---|---|---|---|---|"]
@@ -634,5 +695,5 @@ def plot_eps_study(rep: BenchmarkReport, path) -> None:
 
 
 def rows_as_dicts(rep: BenchmarkReport) -> tuple[List[dict], List[dict]]:
-    """(work-precision rows, ε rows) as plain dicts for CSV/JSON."""
-    return [asdict(r) for r in rep.rows], [asdict(e) for e in rep.eps_rows]
+    """(work-precision rows, ε rows including the tiny-ε check) as plain dicts for CSV/JSON."""
+    return [asdict(r) for r in rep.rows], [asdict(e) for e in rep.eps_rows + rep.small_eps]
