@@ -58,6 +58,8 @@ from typing import Any, Callable, Iterable, Optional, Sequence
 
 import numpy as np
 
+from peelapprox._validate import positive
+
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
     "ALLOWED_PREFIXES", "BUG_CLASSES",
@@ -122,15 +124,6 @@ _GEOMETRIES = ("paper", "exact")
 _SAVES = ("steps", "jumps")
 
 
-def _pos(name: str, x: Any) -> float:
-    try:
-        y = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number in (0, inf), got {x!r}") from None
-    if not (math.isfinite(y) and y > 0):
-        raise ValueError(f"{name} must be finite and in (0, inf), got {x!r}")
-    return y
-
 
 def _posint(name: str, x: Any) -> int:
     if isinstance(x, bool) or not isinstance(x, (int, np.integer, float)) or int(x) != x or x < 1:
@@ -191,7 +184,7 @@ class StressPoint:
 
     def __post_init__(self) -> None:
         for name in ("V", "I", "k", "t_end"):
-            object.__setattr__(self, name, _pos(name, getattr(self, name)))
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
         try:
             a0 = float(self.alpha0)
         except (TypeError, ValueError):
@@ -199,7 +192,7 @@ class StressPoint:
         if not math.isfinite(a0):
             raise ValueError(f"alpha0 must be a finite real number [rad], got {self.alpha0!r}")
         object.__setattr__(self, "alpha0", a0)
-        rt = _pos("rtol", self.rtol)
+        rt = positive("rtol", self.rtol)
         if not (1e-14 <= rt <= 1e-2):
             raise ValueError(f"rtol must be in [1e-14, 1e-2], got {self.rtol!r}")
         object.__setattr__(self, "rtol", rt)
@@ -234,7 +227,7 @@ def grid_points(quick: bool = False, t_end: float = GRID_T_END) -> list[StressPo
     t_end : float
         Simulated horizon per point [s], > 0 (default 1 s).
     """
-    t_end = _pos("t_end", t_end)
+    t_end = positive("t_end", t_end)
     Is, Vs, ks, a0s = (QUICK_I, QUICK_V, QUICK_K, QUICK_ALPHA0) if quick else (GRID_I, GRID_V, GRID_K, GRID_ALPHA0)
     return [StressPoint(V=V, I=I, k=k, alpha0=a0, t_end=t_end) for I in Is for V in Vs for k in ks for a0 in a0s]
 
@@ -315,7 +308,7 @@ def random_points(n: int = N_RANDOM, seed: int = RANDOM_SEED, t_end: float = GRI
     """
     if isinstance(n, bool) or int(n) != n or n < 0:
         raise ValueError(f"n must be an integer >= 0, got {n!r}")
-    t_end = _pos("t_end", t_end)
+    t_end = positive("t_end", t_end)
     rng = np.random.default_rng(int(seed))
     B = RANDOM_BOX
 
@@ -572,8 +565,8 @@ class StressRunner:
 
     def __init__(self, timeout: float = 60.0, func: Optional[Callable[[Any], Any]] = None, start_timeout: float = 300.0,
                  warm: bool = True):
-        self.timeout = _pos("timeout", timeout)
-        self.start_timeout = _pos("start_timeout", start_timeout)
+        self.timeout = positive("timeout", timeout)
+        self.start_timeout = positive("start_timeout", start_timeout)
         self.func = _run_task if func is None else func
         if not callable(self.func):
             raise ValueError(f"func must be a picklable module-level callable, got {func!r}")
@@ -616,7 +609,7 @@ class StressRunner:
         timeout : float, optional
             Overrides the runner's timeout for this task (> 0).
         """
-        tmo = self.timeout if timeout is None else _pos("timeout", timeout)
+        tmo = self.timeout if timeout is None else positive("timeout", timeout)
         if self._proc is None or not self._proc.is_alive():
             if self._proc is not None:
                 self._kill()
@@ -705,7 +698,7 @@ def run_points(points: Sequence[StressPoint], timeout: float = 60.0, progress: b
     list of dict
         One record per point, in order (see :func:`run_point`).
     """
-    timeout = _pos("timeout", timeout)
+    timeout = positive("timeout", timeout)
     for p in points:
         if not isinstance(p, StressPoint):
             raise ValueError(f"points must contain StressPoint instances, got {type(p).__name__}")
@@ -750,7 +743,7 @@ def budget_edge_probes(runner: Optional[StressRunner] = None, timeout: float = 6
     list of dict
         The reference record and the three edge records (``expect="ok"``).
     """
-    timeout = _pos("timeout", timeout)
+    timeout = positive("timeout", timeout)
     own = runner is None
     runner = runner or StressRunner(timeout=timeout)
     try:

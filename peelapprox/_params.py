@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
+
+from ._validate import positive
 
 __all__ = ["PeelParams", "GEOMETRIES"]
 
@@ -12,15 +13,6 @@ __all__ = ["PeelParams", "GEOMETRIES"]
 #: is the full geometry ``cos θ = -l sin α / L``, ``L² = l² + R² - 2 l R cos α``.
 GEOMETRIES = ("paper", "exact")
 
-
-def _check_positive_finite(name: str, value: float) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number in (0, inf), got {value!r}") from None
-    if not math.isfinite(x) or x <= 0.0:
-        raise ValueError(f"{name} must be finite and in (0, inf), got {value!r}")
-    return x
 
 
 @dataclass(frozen=True)
@@ -68,7 +60,7 @@ class PeelParams:
 
     def __post_init__(self) -> None:
         for name in ("V", "I", "k", "R", "l"):
-            object.__setattr__(self, name, _check_positive_finite(name, getattr(self, name)))
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
         if self.l <= self.R:
             raise ValueError(
                 f"l must be greater than R (valid range: l in (R, inf) = ({self.R}, inf)), got l={self.l}"

@@ -20,10 +20,13 @@ def finite(name: str, x) -> float:
 
 
 def positive(name: str, x) -> float:
-    """Like :func:`finite`, and the value must be in (0, inf)."""
-    y = finite(name, x)
-    if y <= 0.0:
-        raise ValueError(f"{name} must be in (0, inf), got {x!r}")
+    """``float(x)`` if it is a finite number in (0, inf), else ValueError naming ``name`` and the range."""
+    try:
+        y = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number in (0, inf), got {x!r}") from None
+    if not (math.isfinite(y) and y > 0.0):
+        raise ValueError(f"{name} must be finite and in (0, inf), got {x!r}")
     return y
 
 
