@@ -47,6 +47,19 @@ from ._peelforce import (
     peel_force_derivative,
 )
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
+from ._sweep import MEASURES, SweepResult, load_sweep, parse_grid, register_measure, sweep
+from ._dynamics import (
+    Attractor,
+    LyapunovResult,
+    Periodicity,
+    attractors,
+    benettin,
+    force_drops,
+    lyapunov,
+    periodicity,
+    return_map,
+    settle_time,
+)
 
 __version__ = "0.1.0"
 
@@ -94,4 +107,22 @@ __all__ = [
     "force_bounds",
     "slope_criterion",
     "SlopeCriterion",
+    # dynamics of the exact solution (need the exact package at call time)
+    "return_map",
+    "periodicity",
+    "Periodicity",
+    "force_drops",
+    "settle_time",
+    "attractors",
+    "Attractor",
+    "lyapunov",
+    "LyapunovResult",
+    "benettin",
+    # (I, V) sweeps
+    "sweep",
+    "load_sweep",
+    "SweepResult",
+    "register_measure",
+    "MEASURES",
+    "parse_grid",
 ]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 import sys
 from typing import Optional, Sequence
@@ -269,6 +270,147 @@ def _benchmark(args: argparse.Namespace) -> int:
     return 0
 
 
+def _sweep(args: argparse.Namespace) -> int:
+    import os
+
+    from ._sweep import RESULTS, load_sweep, parse_grid, sweep
+
+    I_values = parse_grid(args.I, name="--I")
+    V_values = parse_grid(args.V, name="--V")
+    options = {key: val for key, val in (("t_end", args.t_end), ("t_transient", args.t_transient),
+                                         ("rtol", args.rtol), ("alpha0", args.alpha0), ("k", args.k),
+                                         ("R", args.R)) if val is not None}
+    if args.workers is not None and args.workers < 0:
+        raise ValueError(f"--workers must be >= 0 (0: in this process), got {args.workers}")
+    if args.dask_local is not None and args.dask_local < 1:
+        raise ValueError(f"--dask-local must be >= 1 workers, got {args.dask_local}")
+    if os.path.exists(os.path.join(args.out, "sweep.json")):
+        prev = load_sweep(args.out)
+        print(f"{args.out} holds a sweep with {len(prev.records)}/{prev.I_values.size * prev.V_values.size} points "
+              "done: resuming it if grid, measures and options match", file=sys.stderr)
+    client = cluster = None
+    executor, max_workers = None, None
+    if args.dask_local or args.dask_scheduler:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            print("error: --dask-local/--dask-scheduler need dask.distributed: pip install 'peelapprox[distributed]'",
+                  file=sys.stderr)
+            return 2
+        if args.dask_local:
+            cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
+            client = Client(cluster)
+        else:
+            client = Client(args.dask_scheduler)
+        print(f"dask: {client}", file=sys.stderr)
+        executor = client.get_executor()
+    elif args.workers == 0:
+        executor = "serial"
+    else:
+        max_workers = args.workers
+    t0 = time.perf_counter()
+    try:
+        result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor, max_workers=max_workers,
+                       options=options, progress=not args.quiet)
+    except RuntimeError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    print(f"sweep: {len(result.records)} points in {args.out}/{RESULTS} ({time.perf_counter() - t0:.1f} s)",
+          file=sys.stderr)
+    csv_path = os.path.join(args.out, "results.csv")
+    result.to_csv(csv_path)
+    print(f"wrote {csv_path}", file=sys.stderr)
+    rows = result.rows()
+    cols = result.keys()
+    if args.format == "json":
+        print(json.dumps(rows, indent=2))
+    elif args.format == "csv":
+        with open(csv_path) as fh:
+            sys.stdout.write(fh.read())
+    else:
+        def cell(v) -> str:
+            return "" if v is None else (f"{v:.6g}" if isinstance(v, float) else str(v))
+
+        print("| " + " | ".join(cols) + " |")
+        print("|" + "|".join("---" for _ in cols) + "|")
+        for r in rows:
+            print("| " + " | ".join(cell(r.get(c)) for c in cols) + " |")
+    if args.plot:
+        from .plotting import plot_phase_diagram
+
+        png = os.path.join(args.out, f"{args.plot}.png")
+        plot_phase_diagram(result, args.plot, png)
+        print(f"wrote {png}", file=sys.stderr)
+    return 0 if all(r.get("status") == "ok" for r in rows) else 1
+
+
+def _figures(args: argparse.Namespace) -> int:
+    from comparisons._figures import FIGURES, figures_markdown, make_figures
+
+    if args.list:
+        for name, fig in FIGURES.items():
+            print(f"{name}: {fig.caption}  [{fig.params}]")
+        return 0
+    files = make_figures(args.only, args.out, progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+    for name, paths in files.items():
+        print(f"{name}: {', '.join(paths)}")
+    if args.markdown:
+        rel = os.path.relpath(args.out, os.path.dirname(os.path.abspath(args.markdown)) or ".")
+        with open(args.markdown, "w") as fh:
+            fh.write(figures_markdown(files, rel=rel))
+        print(f"wrote {args.markdown}", file=sys.stderr)
+    return 0
+
+
+def _dynamics(args: argparse.Namespace) -> int:
+    from exact import ModelBreakdown, simulate
+
+    from ._dynamics import attractors, force_drops, lyapunov, periodicity, return_map, settle_time
+
+    p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
+    try:
+        tr = simulate(p, args.t_transient + args.window, alpha0=args.alpha0, t_transient=args.t_transient,
+                      rtol=args.rtol, save="jumps")
+        x, d = return_map(tr), force_drops(tr)
+        per = periodicity(x, max_period=args.max_period) if x.size > 1 else None
+        full = simulate(p, args.t_transient + args.window, alpha0=args.alpha0, rtol=args.rtol, save="jumps")
+        row.update(returns=int(x.size), period=per.label if per else "no stick-slip",
+                   period_mismatch=per.mismatch if per else None,
+                   settle_time=settle_time(full, max_period=args.max_period),
+                   mean_force_drop=float(d.mean()) if d.size else None,
+                   force_drop_std=float(d.std()) if d.size else None,
+                   F_min_at_jumps=float(x.min()) if x.size else None, F_max_at_jumps=float(x.max()) if x.size else None)
+    except ModelBreakdown as exc:
+        row.update(status=f"breakdown:{exc.reason} at t={exc.t:.6g}")
+    if args.lyapunov:
+        print("lyapunov: two-trajectory renormalisation ...", file=sys.stderr, flush=True)
+        ly = lyapunov(p, t_transient=args.t_transient, alpha0=args.alpha0)
+        row.update(lyapunov_bits_per_s=ly.bits_per_s, lyapunov_stderr=ly.stderr_bits)
+    _print_mapping(row, args.format)
+    if args.attractors:
+        a0s = [float(a) for a in args.attractors.split(",")]
+        res = attractors(p, a0s, t_transient=args.t_transient, window=args.window,
+                         progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+        rows = [dict(attractor=a.label, starts=" ".join(f"{s:g}" for s in a.starts), F_min=a.F_range[0],
+                     F_max=a.F_range[1]) for a in res]
+        if args.format == "json":
+            print(json.dumps(rows, indent=2))
+        else:
+            print(f"{len(res)} attractor(s) from {len(a0s)} starts:")
+            for r in rows:
+                print(f"  {r['attractor']:>14}  F at AB→CD jumps {r['F_min']:.4g}…{r['F_max']:.4g} N  "
+                      f"from alpha0 = {r['starts']}")
+    if args.out:
+        _write_rows(args.out, [row])
+    return 0
+
+
 def _add_params(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--V", type=float, required=True, help="pull speed [m/s]")
     sp.add_argument("--I", type=float, required=True, help="roller inertia [kg m^2]")
@@ -359,6 +501,56 @@ def build_parser() -> argparse.ArgumentParser:
     bm.add_argument("--out", metavar="DIR", help="write DIR/benchmark.md, work_precision.{csv,json,png}, "
                                                  "eps_study.{csv,json,png}, ratios.{csv,json}, targets.{csv,json}")
     bm.set_defaults(func=_benchmark)
+
+    sw = sub.add_parser("sweep", help="measures over an (I, V) grid on a process pool or a dask cluster; "
+                                      "incremental output, resumes automatically")
+    sw.add_argument("--I", required=True, metavar="SPEC",
+                    help="roller inertias [kg m^2]: start:stop:num[:log] or a comma list, e.g. 1e-5:1e-2:8:log")
+    sw.add_argument("--V", required=True, metavar="SPEC", help="pull speeds [m/s], same syntax, e.g. 0.4:4:10")
+    sw.add_argument("--measure", default="regime", metavar="NAMES",
+                    help="comma-separated measures (regime; jumps; others registered via register_measure)")
+    sw.add_argument("--out", required=True, metavar="DIR",
+                    help="output directory: sweep.json, results.jsonl (one line per point), results.csv; "
+                         "an existing DIR with the same grid, measures and options is resumed")
+    where = sw.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="local worker processes (default: all CPUs; 0: in this process)")
+    where.add_argument("--dask-local", type=int, default=None, metavar="N",
+                       help="start a dask LocalCluster with N single-threaded worker processes")
+    where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
+                       help="connect to a running dask scheduler, e.g. tcp://host:8786")
+    sw.add_argument("--t-end", type=float, default=None, help="jumps: final time [s] (20)")
+    sw.add_argument("--t-transient", type=float, default=None, help="jumps: transient skipped [s] (10)")
+    sw.add_argument("--rtol", type=float, default=None, help="jumps: solver tolerance (1e-8)")
+    sw.add_argument("--alpha0", type=float, default=None, help="jumps: initial peel angle [rad] (0)")
+    sw.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (1000)")
+    sw.add_argument("--R", type=float, default=None, help="roller radius [m] (0.1)")
+    sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label")
+    sw.add_argument("--format", choices=("md", "csv", "json"), default="md", help="table printed at the end (md)")
+    sw.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
+    sw.set_defaults(func=_sweep)
+
+    fg = sub.add_parser("figures", help="the paper's Figs. 2-9 from our exact solutions")
+    fg.add_argument("--only", action="append", metavar="NAME", help="draw only this figure (repeatable): fig2 … fig9")
+    fg.add_argument("--out", default="docs/figures", help="output directory (docs/figures)")
+    fg.add_argument("--markdown", metavar="PATH", help="also write the captioned page, e.g. docs/figures.md")
+    fg.add_argument("--list", action="store_true", help="list the figures and exit")
+    fg.set_defaults(func=_figures)
+
+    dy = sub.add_parser("dynamics", help="period of the return map, force drops, settle time, attractors, "
+                                         "Lyapunov exponent at one (V, I)")
+    _add_params(dy)
+    dy.add_argument("--alpha0", type=float, default=0.0)
+    dy.add_argument("--t-transient", type=float, default=30.0, help="discarded [s] (30)")
+    dy.add_argument("--window", type=float, default=20.0, help="analysed [s] (20)")
+    dy.add_argument("--rtol", type=float, default=1e-10)
+    dy.add_argument("--max-period", type=int, default=32)
+    dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (~5 s)")
+    dy.add_argument("--attractors", metavar="A0,A0,...", help="sample these initial peel angles for coexisting "
+                                                              "attractors")
+    dy.add_argument("--format", choices=("table", "json"), default="table")
+    dy.add_argument("--out", help="also write the summary row to this .csv or .json")
+    dy.set_defaults(func=_dynamics)
     return ap
 
 

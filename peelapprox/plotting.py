@@ -107,3 +107,82 @@ def plot_segment(seg: Any, path: Optional[str] = None, *, exact: Any = None, tit
         fig.savefig(path, dpi=120)
         plt.close(fig)
     return fig
+
+
+def plot_phase_diagram(result: Any, key: str, path: Optional[str] = None, *, log_I: bool = True,
+                       log_V: bool = False, title: Optional[str] = None):
+    """A sweep quantity over the (V, I) plane, one cell per grid point (pcolormesh).
+
+    Parameters
+    ----------
+    result : peelapprox.SweepResult
+        From :func:`peelapprox.sweep` or :func:`peelapprox.load_sweep`.
+    key : str
+        A record key, e.g. ``"regime_label"`` or ``"jumps_mean_period"``.
+        Numbers get a colour bar; anything else (labels, statuses) is
+        categorical: one discrete colour per value, with a legend.  Points
+        without a value are left blank (white).
+    path : str, optional
+        Write the figure there (format from the extension) and close it.
+    log_I, log_V : bool
+        Logarithmic I (default) / V axis; cell edges are the midpoints
+        between grid values on that scale.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _pyplot()
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    vals = result.values(key)
+    I = np.asarray(result.I_values, float)
+    V = np.asarray(result.V_values, float)
+    oi, ov = np.argsort(I), np.argsort(V)
+    I, V, vals = I[oi], V[ov], vals[np.ix_(oi, ov)]
+
+    def edges(x: np.ndarray, log: bool) -> np.ndarray:
+        y = np.log10(x) if log else x
+        if y.size == 1:
+            h = 0.5 if log else max(0.1 * abs(y[0]), 1e-12)
+            e = np.array([y[0] - h, y[0] + h])
+        else:
+            mid = 0.5 * (y[1:] + y[:-1])
+            e = np.concatenate([[2 * y[0] - mid[0]], mid, [2 * y[-1] - mid[-1]]])
+        return 10.0 ** e if log else e
+
+    VE, IE = edges(V, log_V), edges(I, log_I)
+    fig, ax = plt.subplots(figsize=(8, 5.5), constrained_layout=True)
+    if vals.dtype == object:
+        cats = list(dict.fromkeys(v for v in vals.ravel() if v is not None))
+        cmap_name = "tab10" if len(cats) <= 10 else "tab20"
+        base = plt.get_cmap(cmap_name)
+        colours = [base(i % base.N) for i in range(max(len(cats), 1))]
+        codes = np.full(vals.shape, np.nan)
+        for n, c in enumerate(cats):
+            codes[vals == c] = n
+        cmap = ListedColormap(colours).with_extremes(bad="white")
+        norm = BoundaryNorm(np.arange(-0.5, len(colours) + 0.5), len(colours))
+        ax.pcolormesh(VE, IE, np.ma.masked_invalid(codes), cmap=cmap, norm=norm, edgecolors="face")
+        ax.legend(handles=[Patch(facecolor=colours[n], label=str(c)) for n, c in enumerate(cats)],
+                  loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, title=key, title_fontsize=8)
+    else:
+        cmap = plt.get_cmap("viridis").with_extremes(bad="white")
+        mesh = ax.pcolormesh(VE, IE, np.ma.masked_invalid(vals), cmap=cmap, edgecolors="face")
+        fig.colorbar(mesh, ax=ax, label=key)
+    if log_I:
+        ax.set_yscale("log")
+    if log_V:
+        ax.set_xscale("log")
+    ax.set(xlabel="V [m/s]", ylabel="I [kg m²]", xlim=(VE[0], VE[-1]), ylim=(IE[0], IE[-1]))
+    n_done = sum(1 for _ in result.records)
+    ax.set_title(title or f"{key} over (V, I): {n_done}/{I.size * V.size} points")
+    if path:
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+    return fig
+
+
+__all__.append("plot_phase_diagram")

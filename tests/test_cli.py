@@ -35,3 +35,27 @@ def test_folds_json(capsys):
     assert main(["folds", "--V", "4", "--format", "json"]) == 0
     row = json.loads(capsys.readouterr().out)
     assert row["has_folds"] and abs(row["f_max"] - 307.21) < 0.01 and abs(row["f_min"] - 293.34) < 0.01
+
+
+def test_cli_dynamics_reports_the_period_and_force_drop(capsys):
+    """``peelapprox dynamics --V 1 --I 1e-2`` (Fig. 4's point) prints the return-map period (period-8, as in
+    the paper) and a positive mean force drop; JSON output parses."""
+    import json as _json
+
+    from peelapprox.cli import main
+
+    assert main(["dynamics", "--V", "1", "--I", "1e-2", "--format", "json"]) == 0
+    row = _json.loads(capsys.readouterr().out)
+    assert row["period"] == "period-8" and row["mean_force_drop"] > 0
+
+
+def test_cli_figures_list_and_bad_name(capsys):
+    """``figures --list`` names fig2 … fig9; an unknown ``--only`` is a clean usage error (exit 2)."""
+    from peelapprox.cli import main
+
+    assert main(["figures", "--list"]) == 0
+    out = capsys.readouterr().out
+    assert all(f"fig{n}:" in out for n in range(2, 10))
+    with pytest.raises(SystemExit) as exc:
+        main(["figures", "--only", "fig1", "--out", "/tmp/unused-figs"])
+    assert exc.value.code == 2

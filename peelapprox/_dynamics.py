@@ -1,0 +1,468 @@
+"""Dynamics of the exact solution: periodicity, force drops, transients, attractors, Lyapunov exponents.
+
+Everything here reads the *jump sequence* of an exact (hybrid, ε → 0) trajectory, the natural Poincaré
+section of stick-slip: the pull force at the AB→CD jumps, ``x_k = F(t_k)``, is the return map whose
+periods the paper reports ("period 4 at V = 2, I = 1e-5", "period 8 at V = 1, I = 1e-2", ...).
+
+* :func:`return_map` — ``x_k``, the F values at AB→CD jumps.
+* :func:`periodicity` — period-n (n <= 32) of ``x_k`` to a stated tolerance, or aperiodic.
+* :func:`force_drops` — ``ΔF_k = F(AB→CD jump k) − F(next CD→AB jump)``, the slip's force drop (Fig. 6).
+* :func:`settle_time` — when a periodic orbit is reached (the transient's end).
+* :func:`attractors` — sample initial states and group the attractors they reach.
+* :func:`benettin` — the largest Lyapunov exponent of any flow by the two-trajectory renormalisation
+  method (Benettin et al. 1980), tested on systems with known exponents; :func:`lyapunov` applies it to
+  the peeling model in bits/s.
+
+Exact solutions come from :func:`exact.simulate` (imported lazily: ``exact`` depends on this package).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from ._params import PeelParams
+from ._peelforce import BRANCHES, branch_structure
+from ._validate import positive
+
+__all__ = [
+    "return_map",
+    "Periodicity",
+    "periodicity",
+    "force_drops",
+    "settle_time",
+    "Attractor",
+    "attractors",
+    "BenettinResult",
+    "benettin",
+    "LyapunovResult",
+    "lyapunov",
+]
+
+_AB = BRANCHES.index("AB")
+
+
+def return_map(trajectory) -> np.ndarray:
+    """``x_k``: the pull force [N] at the AB→CD jumps of an exact trajectory (its stored window).
+
+    Signature: ``return_map(trajectory) -> ndarray``.
+    """
+    J = trajectory.jumps
+    return np.asarray(J.F)[np.asarray(J.from_branch) == _AB]
+
+
+@dataclass(frozen=True)
+class Periodicity:
+    """Period of the return map ``x_k`` (see :func:`periodicity`).
+
+    ``kind`` is ``"periodic"`` (``period`` = the smallest n that repeats), ``"aperiodic"`` (no n <=
+    ``max_period`` repeats; ``period`` None) or ``"too short"`` (fewer than ``2 max_period + 1`` returns
+    were given *and* no shorter period repeated).  ``mismatch`` = ``max_k |x_{k+n} − x_k| / max|x|`` for
+    the period found, or the smallest over all n tried; ``n_returns`` = ``len(x)``.
+    """
+
+    kind: str
+    period: Optional[int]
+    mismatch: float
+    n_returns: int
+    rtol: float
+
+    @property
+    def label(self) -> str:
+        return f"period-{self.period}" if self.kind == "periodic" else self.kind
+
+
+def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int = 2) -> Periodicity:
+    """Classify the return map as period-n or aperiodic.
+
+    Signature: ``periodicity(x, *, rtol=1e-6, max_period=32, min_repeats=2) -> Periodicity``.
+
+    Parameters
+    ----------
+    x : array_like or exact.Trajectory
+        The F values at AB→CD jumps (or a trajectory, through :func:`return_map`), after the transient.
+    rtol : float
+        Tolerance: period n is accepted when ``max_k |x_{k+n} − x_k| <= rtol · max|x|`` over every k.  The
+        hybrid solver at rtol 1e-10 reproduces a periodic orbit's jump forces to ~1e-12, so 1e-6 separates
+        periodic orbits from chaotic ones, whose returns do not come within 1e-6 for n <= 32.
+    max_period : int
+        Largest n tried (the issue asks n <= 32).
+    min_repeats : int
+        A period n needs at least ``min_repeats · n`` pairs ``(x_k, x_{k+n})``.
+
+    Returns
+    -------
+    Periodicity
+    """
+    if hasattr(x, "jumps"):
+        x = return_map(x)
+    x = np.asarray(x, dtype=float)
+    rtol = positive("rtol", rtol)
+    if int(max_period) < 1:
+        raise ValueError(f"max_period must be an integer >= 1, got {max_period!r}")
+    if int(min_repeats) < 1:
+        raise ValueError(f"min_repeats must be an integer >= 1, got {min_repeats!r}")
+    if x.ndim != 1 or x.size < 2 or not np.all(np.isfinite(x)):
+        raise ValueError(f"x must be a 1-D finite sequence of at least 2 returns, got shape {x.shape}")
+    scale = float(np.max(np.abs(x)))
+    best = math.inf
+    for n in range(1, int(max_period) + 1):
+        if x.size - n < int(min_repeats) * n:
+            break
+        mis = float(np.max(np.abs(x[n:] - x[:-n]))) / scale
+        if mis <= rtol:
+            return Periodicity("periodic", n, mis, x.size, rtol)
+        best = min(best, mis)
+    enough = x.size - int(max_period) >= int(min_repeats) * int(max_period)
+    return Periodicity("aperiodic" if enough else "too short", None, best, x.size, rtol)
+
+
+def force_drops(trajectory) -> np.ndarray:
+    """Force drop of each slip [N]: ``F`` at an AB→CD jump minus ``F`` at the next CD→AB jump.
+
+    Signature: ``force_drops(trajectory) -> ndarray`` (one value per completed slip in the stored window).
+    The paper's Fig. 6 plots their mean against V.
+    """
+    J = trajectory.jumps
+    fb = np.asarray(J.from_branch)
+    F = np.asarray(J.F)
+    idx = np.flatnonzero(fb[:-1] == _AB)  # AB→CD followed by CD→AB (jumps alternate)
+    return F[idx] - F[idx + 1]
+
+
+def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> Optional[float]:
+    """The time from which the return map is periodic to the end of the stored window, or None.
+
+    Signature: ``settle_time(trajectory, *, rtol=1e-6, max_period=32) -> float | None``.
+
+    The orbit's period n is found on the last half of the returns (:func:`periodicity`); the settle time is
+    that of the earliest AB→CD jump from which ``|x_{k+n} − x_k| <= rtol·max|x|`` holds for every later k.
+    None means no period was found in the last half (aperiodic, or still in the transient).
+    """
+    J = trajectory.jumps
+    m = np.asarray(J.from_branch) == _AB
+    x, t = np.asarray(J.F)[m], np.asarray(J.t)[m]
+    if x.size < 4:
+        return None
+    per = periodicity(x[x.size // 2:], rtol=rtol, max_period=max_period)
+    if per.kind != "periodic":
+        return None
+    n = per.period
+    bad = np.abs(x[n:] - x[:-n]) > rtol * float(np.max(np.abs(x)))
+    k = int(np.flatnonzero(bad)[-1]) + 1 if bad.any() else 0
+    return float(t[k])
+
+
+# ---------------------------------------------------------------------------------------------- attractors
+@dataclass(frozen=True)
+class Attractor:
+    """One attractor reached from sampled initial states (see :func:`attractors`).
+
+    ``signature`` is the sorted cycle of return-map values (periodic) or the (min, max, mean) of the
+    returns (aperiodic), rounded; ``starts`` the initial α0 values that reach it.
+    """
+
+    label: str
+    period: Optional[int]
+    signature: Tuple[float, ...]
+    F_range: Tuple[float, float]
+    starts: Tuple[float, ...]
+    settle_times: Tuple[Optional[float], ...]
+
+
+def attractors(
+    params: PeelParams,
+    alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
+    *,
+    t_transient: float = 30.0,
+    window: float = 10.0,
+    rtol: float = 1e-10,
+    period_rtol: float = 1e-6,
+    match_rtol: float = 1e-4,
+    progress: Optional[Callable[[str], None]] = None,
+) -> List[Attractor]:
+    """Sample initial peel angles and group the attractors they reach.
+
+    Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=10, rtol=1e-10,
+    period_rtol=1e-6, match_rtol=1e-4, progress=None) -> list[Attractor]``.
+
+    Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
+    (discarded) and ``window`` s (stored jumps).  Two periodic orbits are the same attractor when their
+    periods agree and their sorted return-map cycles agree to ``match_rtol`` relative (a cycle is the same
+    set of jump forces whatever its phase); aperiodic windows are grouped by their return range.  A start
+    that breaks down (``ModelBreakdown``) or is infeasible (``ValueError``) is reported as its own entry.
+    More than one entry means coexisting attractors — or a transient longer than ``t_transient``: the
+    entries' settle times tell which.
+    """
+    from exact import ModelBreakdown, simulate
+
+    say = progress or (lambda msg: None)
+    groups: List[dict] = []
+    for a0 in alpha0s:
+        say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
+        try:
+            tr = simulate(params, t_transient + window, alpha0=a0, rtol=rtol, t_transient=t_transient,
+                          save="jumps")
+        except (ModelBreakdown, ValueError) as exc:
+            groups.append(dict(label=f"{type(exc).__name__}: {str(exc)[:80]}", period=None, signature=(),
+                               F_range=(math.nan, math.nan), starts=[a0], settle=[None]))
+            continue
+        x = return_map(tr)
+        if x.size < 2:
+            groups.append(dict(label="no stick-slip", period=None, signature=(), F_range=(math.nan, math.nan),
+                               starts=[a0], settle=[None]))
+            continue
+        per = periodicity(x, rtol=period_rtol)
+        if per.kind == "periodic":
+            sig = tuple(float(v) for v in np.sort(x[: per.period]))
+        else:
+            sig = (float(x.min()), float(x.max()), float(x.mean()))
+        st = settle_time(tr, rtol=period_rtol)
+        for g in groups:
+            if g["period"] == per.period and g["label"] == per.label and len(g["signature"]) == len(sig) and \
+                    np.allclose(g["signature"], sig, rtol=match_rtol, atol=0.0):
+                g["starts"].append(a0)
+                g["settle"].append(st)
+                break
+        else:
+            groups.append(dict(label=per.label, period=per.period, signature=sig,
+                               F_range=(float(x.min()), float(x.max())), starts=[a0], settle=[st]))
+    return [Attractor(g["label"], g["period"], tuple(round(s, 6) for s in g["signature"]), g["F_range"],
+                      tuple(float(a) for a in g["starts"]), tuple(g["settle"])) for g in groups]
+
+
+# ---------------------------------------------------------------------------------------------- Lyapunov
+@dataclass
+class BenettinResult:
+    """Largest Lyapunov exponent by two-trajectory renormalisation.
+
+    ``exponent`` [1/time unit, natural log] = ``Σ log(d_k/d0) / T`` over the kept intervals; ``running``
+    the running estimate after each interval; ``local`` the per-interval rates ``log(d_k/d0)/Δt_k``;
+    ``stderr`` the standard error of the mean local rate (intervals treated as independent; a rough
+    convergence indicator); ``time`` the total kept time.
+    """
+
+    exponent: float
+    running: np.ndarray
+    local: np.ndarray
+    stderr: float
+    time: float
+    n: int
+    d0: float
+    wall_time: float
+
+
+def benettin(
+    advance: Callable,
+    x_ref,
+    x_pert,
+    distance: Callable,
+    rescale: Callable,
+    n: int,
+    *,
+    n_discard: int = 0,
+) -> BenettinResult:
+    """The largest Lyapunov exponent of a flow by the two-trajectory (Benettin) method.
+
+    Signature: ``benettin(advance, x_ref, x_pert, distance, rescale, n, *, n_discard=0) -> BenettinResult``.
+
+    Parameters
+    ----------
+    advance : callable
+        ``advance(x_ref, x_pert) -> (x_ref, x_pert, dt)``: both states advanced by the same time ``dt``
+        (the caller chooses the renormalisation interval; it may vary, e.g. to avoid renormalising across
+        a switching surface).
+    x_ref, x_pert : state
+        The reference state and a perturbed one at distance ``d0 = distance(x_ref, x_pert)`` (small).
+    distance : callable
+        ``distance(a, b) -> float``, any norm (the exponent does not depend on it).
+    rescale : callable
+        ``rescale(x_ref, x_pert, factor) -> x_pert`` putting the perturbation back to ``factor`` times its
+        size along its current direction.
+    n : int
+        Number of renormalisation intervals kept.
+    n_discard : int
+        Intervals run first and not counted (the perturbation aligning with the most unstable direction).
+
+    Returns
+    -------
+    BenettinResult
+    """
+    if int(n) < 2:
+        raise ValueError(f"n must be an integer >= 2, got {n!r}")
+    if int(n_discard) < 0:
+        raise ValueError(f"n_discard must be an integer >= 0, got {n_discard!r}")
+    d0 = float(distance(x_ref, x_pert))
+    if not (d0 > 0.0 and math.isfinite(d0)):
+        raise ValueError(f"the initial perturbation must have a finite positive size, got {d0}")
+    wall0 = time.perf_counter()
+    logs, dts = [], []
+    for k in range(int(n_discard) + int(n)):
+        x_ref, x_pert, dt = advance(x_ref, x_pert)
+        d = float(distance(x_ref, x_pert))
+        if not (d > 0.0 and math.isfinite(d)):
+            raise ValueError(f"the perturbation collapsed or diverged at interval {k} (distance {d}); choose a "
+                             f"different d0 or interval")
+        if k >= n_discard:
+            logs.append(math.log(d / d0))
+            dts.append(dt)
+        x_pert = rescale(x_ref, x_pert, d0 / d)
+    logs, dts = np.array(logs), np.array(dts)
+    T = float(dts.sum())
+    local = logs / dts
+    return BenettinResult(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local,
+                          float(np.std(local, ddof=1) / math.sqrt(len(local))), T, len(logs), d0,
+                          time.perf_counter() - wall0)
+
+
+@dataclass
+class LyapunovResult:
+    """The peeling model's largest Lyapunov exponent (see :func:`lyapunov`).
+
+    ``bits_per_s`` = ``per_s / ln 2`` (the paper's unit); ``benettin`` holds the running estimate and the
+    local rates; ``n_jumps`` the jumps the reference orbit made while measured."""
+
+    per_s: float
+    bits_per_s: float
+    stderr_bits: float
+    benettin: BenettinResult
+    params: PeelParams
+    tau: float
+    n_jumps: int
+    method: str = "hybrid two-trajectory (Benettin)"
+    notes: List[str] = field(default_factory=list)
+
+
+def lyapunov(
+    params: PeelParams,
+    *,
+    t_transient: float = 30.0,
+    tau: float = 0.005,
+    n: int = 10000,
+    n_discard: int = 200,
+    d0: float = 1e-7,
+    alpha0: float = 0.0,
+    rtol: float = 1e-12,
+) -> LyapunovResult:
+    """Largest Lyapunov exponent of the exact (hybrid) peeling dynamics, in bits/s.
+
+    Signature: ``lyapunov(params, *, t_transient=30, tau=0.005, n=10000, n_discard=200, d0=1e-7, alpha0=0,
+    rtol=1e-12) -> LyapunovResult`` (50 s measured after 30 s of transient; ~4 s of wall time).
+
+    Method: :func:`benettin` on the hybrid solver.  The state is ``(α, ω, F, branch)`` — v follows from
+    CONSTR — and the distance is measured in the continuous variables scaled by their natural sizes,
+    ``(Δα/1 rad, Δω/(V/R), ΔF/f_max)``; α, ω and F are continuous across jumps, so two neighbouring orbits
+    stay close in this norm while they jump at slightly different times (the jump is a state-dependent
+    switching).  Renormalisation happens every ``tau`` seconds, postponed in steps of ``tau/8`` while the
+    two orbits are on different branches (a renormalised state must lie on its branch).  The exponent is
+    ``Σ log(d_k/d0)/T`` over ``n`` intervals after ``n_discard``.
+
+    **d0 against rtol.**  Each interval restarts both orbits, so the solver's local errors enter as fresh
+    perturbations every ``tau``, and the jumps amplify them.  Unless ``d0/rtol >= 1e5`` this noise inflates
+    the exponent: at V = 2, I = 1e-4 we measured 9.5-13.5 bits/s with d0/rtol = 10-100, and 4.06-4.15 bits/s
+    for every d0/rtol >= 1e5 (d0 from 1e-8 to 1e-6, rtol 1e-12 or 1e-13, tau = 0.005; docs/dynamics.md).
+    Hence the defaults d0 = 1e-7, rtol = 1e-12.
+
+    The tangent-dynamics version (variational equations with saltation matrices at the jumps) is not
+    implemented; the running estimate and ``stderr_bits`` show the convergence.
+    """
+    from exact import initial_state, simulate
+
+    tau = positive("tau", tau)
+    d0 = positive("d0", d0)
+    t_transient = float(t_transient)
+    if not (math.isfinite(t_transient) and t_transient >= 0):
+        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
+    bs = branch_structure(params.V)
+    scale = np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
+    jumps = [0]
+
+    def run(state, dt):
+        a, w, F, br = state
+        tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps")
+        s = tr.final_state
+        return (s.alpha, s.omega, s.F, s.branch), len(tr.jumps)
+
+    def vec(s):
+        return np.array(s[:3]) / scale
+
+    def distance(a, b):
+        return float(np.linalg.norm(vec(a) - vec(b)))
+
+    def rescale(ref, pert, factor):
+        x = (vec(ref) + factor * (vec(pert) - vec(ref))) * scale
+        return (float(x[0]), float(x[1]), float(x[2]), ref[3])
+
+    def advance(ref, pert):
+        ref, nj = run(ref, tau)
+        pert, _ = run(pert, tau)
+        dt = tau
+        while ref[3] != pert[3]:
+            ref, nj2 = run(ref, tau / 8)
+            pert, _ = run(pert, tau / 8)
+            dt += tau / 8
+            nj += nj2
+        jumps[0] += nj
+        return ref, pert, dt
+
+    s0 = initial_state(params, alpha0=alpha0)
+    ref = (s0.alpha, s0.omega, s0.F, s0.branch)
+    if t_transient > 0:
+        ref, _ = run(ref, t_transient)
+    # the perturbation: along F (the variable the constraint and the jumps act on), size d0
+    pert = (ref[0], ref[1], ref[2] + d0 * scale[2], ref[3])
+    res = benettin(advance, ref, pert, distance, rescale, n, n_discard=n_discard)
+    ln2 = math.log(2.0)
+    return LyapunovResult(res.exponent, res.exponent / ln2, res.stderr / ln2, res, params, tau, jumps[0])
+
+
+# ---------------------------------------------------------------------------------------------- sweep measures
+def measure_period(params: PeelParams, options) -> dict:
+    """Sweep measure ``period``: the return map's period over ``[t_transient, t_end]`` (options
+    ``t_transient`` = 30 s, ``t_end`` = 50 s, ``rtol`` = 1e-10 of the solver, ``period_rtol`` = 1e-6,
+    ``alpha0`` = 0).  ``period`` is None when aperiodic (no n <= 32 repeats) or too short; a
+    ``ModelBreakdown`` is ``status = "breakdown:<reason>"``."""
+    from exact import ModelBreakdown, simulate
+
+    t_tr = float(options.get("t_transient", 30.0))
+    try:
+        tr = simulate(params, float(options.get("t_end", t_tr + 20.0)), t_transient=t_tr, save="jumps",
+                      rtol=float(options.get("rtol", 1e-10)), alpha0=float(options.get("alpha0", 0.0)))
+    except ModelBreakdown as exc:
+        return {"status": f"breakdown:{exc.reason}"}
+    x = return_map(tr)
+    if x.size < 2:
+        return {"status": "ok", "label": "no stick-slip", "period": None, "mismatch": None, "n_returns": int(x.size)}
+    p = periodicity(x, rtol=float(options.get("period_rtol", 1e-6)))
+    return {"status": "ok", "label": p.label, "period": p.period, "mismatch": p.mismatch, "n_returns": p.n_returns}
+
+
+def measure_lyapunov(params: PeelParams, options) -> dict:
+    """Sweep measure ``lyapunov``: :func:`lyapunov` with its defaults, except options ``t_transient`` (30 s)
+    and ``lyapunov_time`` (50 s of renormalisation intervals of 0.005 s)."""
+    from exact import ModelBreakdown
+
+    tau = 0.005
+    try:
+        r = lyapunov(params, t_transient=float(options.get("t_transient", 30.0)), tau=tau,
+                     n=max(2, int(float(options.get("lyapunov_time", 50.0)) / tau)),
+                     alpha0=float(options.get("alpha0", 0.0)))
+    except ModelBreakdown as exc:
+        return {"status": f"breakdown:{exc.reason}"}
+    return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}
+
+
+def _register_measures() -> None:
+    try:
+        from ._sweep import register_measure
+    except ImportError:  # pragma: no cover - the sweep engine is part of the package
+        return
+    register_measure("period", measure_period)
+    register_measure("lyapunov", measure_lyapunov)
+
+
+_register_measures()

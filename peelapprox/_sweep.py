@@ -1,0 +1,864 @@
+"""(I, V) parameter sweeps that scale from a laptop to a cluster.
+
+A sweep evaluates named *measures* at every point of a grid of roller
+inertias ``I`` and pull speeds ``V``, one task per point, on any
+:class:`concurrent.futures.Executor`: a local process pool by default, a dask
+cluster by passing ``executor=Client(...).get_executor()``.  Each finished
+point is appended to ``out/results.jsonl`` and forced to disk at once, so a
+killed sweep loses only the points that were running, and calling
+:func:`sweep` again with the same arguments finishes the rest.
+
+Measures
+--------
+A measure is ``fn(params: PeelParams, options: Mapping) -> dict`` returning a
+flat dict of JSON scalars (``float, int, str, bool, None``; numpy scalars are
+converted).  Keys are prefixed ``"<name>_"`` by the engine unless they already
+equal ``name`` or start with ``"<name>_"``.  Register with
+:func:`register_measure`; the built-ins are ``"regime"`` (closed-form regime
+estimate, milliseconds) and ``"jumps"`` (statistics of the stick-slip jumps of
+the exact solution).  The engine imports :mod:`peelapprox._dynamics` lazily
+(if it exists) before resolving names, so measures registered there are
+available too.
+
+Options
+-------
+``options`` is one JSON-serialisable dict passed to every measure.  The engine
+itself reads ``k, R, l, geometry`` (the :class:`PeelParams` fields other than
+I and V; defaults as there); the built-in measures read ``t_end`` (20 s),
+``t_transient`` (10 s), ``rtol`` (1e-8) and ``alpha0`` (0).
+
+Output directory
+----------------
+``out/sweep.json``
+    Manifest: grid values, measures, options, how to import each measure,
+    package versions, creation time.  Written once, atomically.
+``out/results.jsonl``
+    One JSON object per finished point, in completion order: ``I``, ``V``,
+    ``status`` (``"ok"`` or ``"error: <Type>: <message>"``, the first failing
+    measure), then the measures' keys; a failing measure records
+    ``"<name>_status": "error: ..."`` and the others still run.  Non-finite
+    floats are written as ``NaN``/``Infinity`` (Python's JSON extension).
+    Records hold no timings or host names, so the same inputs give the same
+    records.
+``out/.lock``
+    Held (``flock``) while a sweep writes, so two sweeps cannot share ``out``.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import importlib
+import json
+import math
+import numbers
+import os
+import re
+import sys
+import threading
+import time
+import warnings
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from types import MappingProxyType
+from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from ._params import PeelParams
+
+__all__ = [
+    "MEASURES",
+    "register_measure",
+    "sweep",
+    "load_sweep",
+    "SweepResult",
+    "parse_grid",
+]
+
+MANIFEST = "sweep.json"
+RESULTS = "results.jsonl"
+LOCK = ".lock"
+FORMAT = "peelapprox.sweep/1"
+#: Reserved record keys (set by the engine, not by measures).
+RESERVED = ("I", "V", "status")
+#: Options the engine turns into :class:`PeelParams` fields.
+PARAM_OPTIONS = ("k", "R", "l", "geometry")
+#: Grid values of a resumed sweep may differ from the manifest's by this relative amount (a grid rebuilt by
+#: ``geomspace`` on another machine); the manifest's values are then used, so record keys stay exact.
+GRID_RTOL = 1e-12
+
+Measure = Callable[[PeelParams, Mapping], dict]
+
+#: name -> measure function.  Add entries with :func:`register_measure`.
+MEASURES: dict[str, Measure] = {}
+
+_NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_PLUGIN_MODULES = ("peelapprox._dynamics",)
+_plugin_errors: dict[str, str] = {}
+
+
+def _ref(fn: Callable) -> str:
+    return f"{getattr(fn, '__module__', '?')}:{getattr(fn, '__qualname__', '?')}"
+
+
+def register_measure(name: str, fn: Optional[Measure] = None, *, replace: bool = False):
+    """Register ``fn(params, options) -> dict`` under ``name``.
+
+    Signature: ``register_measure(name, fn=None, *, replace=False)``; without
+    ``fn`` it returns a decorator.  Registering another function under a taken
+    name raises ValueError unless ``replace=True`` (registering the same
+    function again, e.g. on re-import, is allowed).  For process pools and
+    clusters the function must be module level in an importable module: the
+    workers import it by ``module:qualname``.
+
+    Returns the function.
+    """
+    if fn is None:
+        return lambda f: register_measure(name, f, replace=replace)
+    if not isinstance(name, str) or not _NAME_RE.match(name) or name in RESERVED:
+        raise ValueError(
+            f"measure name must match [A-Za-z][A-Za-z0-9_]* and not be one of {RESERVED}, got {name!r}")
+    if not callable(fn):
+        raise ValueError(f"measure {name!r}: fn must be callable (params, options) -> dict, got {fn!r}")
+    old = MEASURES.get(name)
+    if old is not None and old is not fn and _ref(old) != _ref(fn) and not replace:
+        raise ValueError(f"measure {name!r} is already registered as {_ref(old)}; pass replace=True to replace it")
+    MEASURES[name] = fn
+    return fn
+
+
+def _load_plugins() -> None:
+    """Import the modules that register further measures (once; missing ones are skipped)."""
+    for mod in _PLUGIN_MODULES:
+        if mod in sys.modules or mod in _plugin_errors:
+            continue
+        try:
+            importlib.import_module(mod)
+        except ImportError as exc:  # not written yet / optional dependency missing
+            _plugin_errors[mod] = f"{type(exc).__name__}: {exc}"
+        except Exception as exc:  # a broken plugin must not break the other measures
+            _plugin_errors[mod] = f"{type(exc).__name__}: {exc}"
+            warnings.warn(f"importing {mod} failed, its measures are unavailable: {type(exc).__name__}: {exc}",
+                          RuntimeWarning, stacklevel=3)
+
+
+# --------------------------------------------------------------------------------------------- built-in measures
+
+def _measure_regime(params: PeelParams, options: Mapping) -> dict:
+    """Regime label of :func:`peelapprox.estimate` and its closed-form time scales (a few ms)."""
+    from ._estimate import estimate
+
+    e = estimate(params)
+    return {
+        "label": e.label,
+        "inertia": e.inertia,
+        "velocity": e.velocity,
+        "fixed_point_stable": bool(e.fixed_point_stable),
+        "inertia_ratio": e.inertia_ratio,
+        "period_at_mean": e.period_at_mean,
+        "cd_damping_time": e.cd_damping_time,
+        "t_ab_crude": e.t_ab_crude,
+        "t_ab_quasi_static": e.t_ab_quasi_static,
+        "t_cd_quasi_static": e.t_cd_quasi_static,
+        "oscillations_per_ab": e.oscillations_per_ab,
+        "force_gap": e.force_gap,
+    }
+
+
+def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
+    """Stick-slip jump statistics of the exact solution in the window ``[t_transient, t_end]``.
+
+    ``count`` jumps in the window, ``n_slips`` of them AB→CD; ``mean_interval``
+    = mean time between consecutive jumps (either kind), ``mean_period`` =
+    mean time between consecutive AB→CD jumps (the stick-slip period);
+    ``mean_force_drop`` = mean over AB→CD jumps of F there minus F at the next
+    CD→AB jump [N].  Statistics that need more jumps than the window holds are
+    None.  A :class:`ModelBreakdown` gives ``status = "breakdown:<reason>"``
+    and the breakdown time ``t_breakdown``.
+    """
+    from exact import simulate
+
+    from ._errors import ModelBreakdown
+
+    t_end = float(options.get("t_end", 20.0))
+    try:
+        traj = simulate(params, t_end, t_transient=float(options.get("t_transient", 10.0)), save="jumps",
+                        rtol=float(options.get("rtol", 1e-8)), alpha0=float(options.get("alpha0", 0.0)))
+    except ModelBreakdown as exc:
+        return {"status": f"breakdown:{exc.reason}", "t_breakdown": float(exc.t)}
+    from ._dynamics import force_drops, return_map
+
+    t = np.asarray(traj.jumps.t, dtype=float)
+    t_slip = t[np.asarray(traj.jumps.from_branch) == 0]  # AB -> CD
+    drops = force_drops(traj)
+    return {
+        "status": "ok",
+        "count": int(t.size),
+        "n_slips": int(return_map(traj).size),
+        "mean_interval": float(np.mean(np.diff(t))) if t.size >= 2 else None,
+        "mean_period": float(np.mean(np.diff(t_slip))) if t_slip.size >= 2 else None,
+        "mean_force_drop": float(np.mean(drops)) if drops.size else None,
+    }
+
+
+register_measure("regime", _measure_regime)
+register_measure("jumps", _measure_jumps)
+
+
+# --------------------------------------------------------------------------------------------- the task
+
+def _import_ref(ref: str) -> Callable:
+    mod, _, qual = ref.partition(":")
+    obj: Any = importlib.import_module(mod)
+    for part in qual.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+def _resolve(name: str, ref: Optional[str]) -> Measure:
+    """The measure function in this (worker) process: by import reference, else by registry name."""
+    if ref is not None:
+        fn = MEASURES.get(name)
+        if fn is not None and _ref(fn) == ref:
+            return fn
+        try:
+            return _import_ref(ref)
+        except Exception:
+            pass
+    if name not in MEASURES:
+        _load_plugins()
+    if name in MEASURES:
+        return MEASURES[name]
+    raise LookupError(f"measure {name!r} cannot be resolved in this process (import reference {ref!r}); "
+                      "define it at module level in a module the workers can import")
+
+
+def _scalar(v: Any) -> Any:
+    if v is None or isinstance(v, (bool, str)):
+        return v
+    if isinstance(v, np.generic) or (isinstance(v, np.ndarray) and v.ndim == 0):
+        v = v.item()
+        return v if isinstance(v, (bool, str)) else _scalar(v)
+    if isinstance(v, numbers.Integral):
+        return int(v)
+    if isinstance(v, numbers.Real):
+        return float(v)
+    raise TypeError(f"value {v!r} of type {type(v).__name__} is not a JSON scalar (float, int, str, bool, None)")
+
+
+def _prefixed(name: str, out: Any) -> dict:
+    if not isinstance(out, Mapping):
+        raise TypeError(f"measure {name!r} must return a dict, got {type(out).__name__}")
+    rec = {}
+    for key, val in out.items():
+        if not isinstance(key, str) or not key:
+            raise TypeError(f"measure {name!r} returned a non-string key {key!r}")
+        full = key if (key == name or key.startswith(name + "_")) else f"{name}_{key}"
+        try:
+            rec[full] = _scalar(val)
+        except TypeError as exc:
+            raise TypeError(f"measure {name!r}, key {key!r}: {exc}") from None
+    return rec
+
+
+def _error(exc: BaseException) -> str:
+    msg = " ".join(str(exc).split())
+    if len(msg) > 500:
+        msg = msg[:497] + "..."
+    return f"error: {type(exc).__name__}: {msg}"
+
+
+def _make_params(I: float, V: float, options: Mapping) -> PeelParams:
+    return PeelParams(V=V, I=I, **{k: options[k] for k in PARAM_OPTIONS if k in options})
+
+
+def _run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
+               refs: Optional[Mapping[str, str]] = None) -> dict:
+    """Evaluate ``measures`` at one grid point; never raises for a measure's failure.
+
+    Module level and plain-data in/out, so any executor can ship it.  Returns
+    the record ``{"I", "V", "status", <measure keys>...}``.
+    """
+    refs = refs or {}
+    body: dict = {}
+    status = "ok"
+    try:
+        params = _make_params(I, V, options)
+    except Exception as exc:
+        return {"I": I, "V": V, "status": _error(exc)}
+    opts = MappingProxyType(dict(options))
+    for name in measures:
+        try:
+            out = _prefixed(name, _resolve(name, refs.get(name))(params, opts))
+            clash = (set(out) & set(body)) | (set(out) & set(RESERVED))
+            if clash:
+                raise ValueError(f"measure {name!r} returned keys that are already taken: {sorted(clash)}")
+            body.update(out)
+        except Exception as exc:
+            err = _error(exc)
+            body[f"{name}_status"] = err
+            if status == "ok":
+                status = err
+    return {"I": I, "V": V, "status": status, **body}
+
+
+def _worker_init(parent_pid: int) -> None:  # pragma: no cover - runs in the workers
+    """Exit when the sweeping process dies (e.g. SIGKILL), instead of idling as an orphan."""
+
+    def watch() -> None:
+        while True:
+            time.sleep(0.5)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="peelapprox-sweep-orphan-watch", daemon=True).start()
+
+
+# --------------------------------------------------------------------------------------------- files
+
+def _json_norm(x: Any) -> Any:
+    return json.loads(json.dumps(x))
+
+
+def _versions() -> dict:
+    from importlib import metadata
+
+    v = {"python": sys.version.split()[0]}
+    for pkg in ("peelapprox", "numpy", "scipy", "numba"):
+        try:
+            v[pkg] = metadata.version(pkg)
+        except Exception:
+            v[pkg] = None
+    return v
+
+
+def _fsync_dir(path: str) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:  # pragma: no cover - e.g. Windows
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover
+        pass
+    finally:
+        os.close(fd)
+
+
+def _write_manifest(out: str, manifest: dict) -> None:
+    tmp = os.path.join(out, MANIFEST + ".tmp")
+    with open(tmp, "w") as fh:
+        json.dump(manifest, fh, indent=2)
+        fh.write("\n")
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, os.path.join(out, MANIFEST))
+    _fsync_dir(out)
+
+
+def _read_manifest(out: str) -> dict:
+    path = os.path.join(out, MANIFEST)
+    try:
+        with open(path) as fh:
+            m = json.load(fh)
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ValueError(f"out={out!r}: cannot read the manifest {path}: {exc}") from None
+    if not isinstance(m, dict) or m.get("format") != FORMAT:
+        raise ValueError(f"out={out!r}: {path} is not a {FORMAT} manifest")
+    return m
+
+
+def _read_records(path: str) -> tuple[list[dict], int, bool]:
+    """Complete records of ``results.jsonl``, the byte length they span, and whether a partial tail follows.
+
+    A last line without its newline (the process died while writing it) is
+    ignored.  A malformed complete line raises ValueError.
+    """
+    if not os.path.exists(path):
+        return [], 0, False
+    with open(path, "rb") as fh:
+        data = fh.read()
+    end = data.rfind(b"\n") + 1
+    recs = []
+    for n, line in enumerate(data[:end].splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            rec = json.loads(line)
+            if not isinstance(rec, dict) or "I" not in rec or "V" not in rec:
+                raise ValueError("not a record with I and V")
+        except ValueError as exc:
+            raise ValueError(f"{path}, line {n}: malformed record ({exc}); repair or remove the line to resume") \
+                from None
+        recs.append(rec)
+    return recs, end, end < len(data)
+
+
+def _lock(out: str):
+    fh = open(os.path.join(out, LOCK), "a+")
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows: no protection against two writers
+        return fh
+    try:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        fh.close()
+        raise RuntimeError(f"out={out!r} is in use by another sweep (lock {os.path.join(out, LOCK)} is held)") \
+            from None
+    return fh
+
+
+# --------------------------------------------------------------------------------------------- result
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, str)
+
+
+class SweepResult:
+    """Records of a sweep on its (I, V) grid.
+
+    Attributes
+    ----------
+    I_values, V_values : ndarray
+        The grid axes, in the order given (``values()`` arrays are indexed
+        ``[i, j]`` for ``I_values[i], V_values[j]``).
+    measures : tuple of str
+    options : dict
+    records : list of dict
+        Finished points, in grid order (I major); see the module docstring.
+    manifest : dict
+    out : str or None
+    """
+
+    def __init__(self, I_values, V_values, measures, options, records: Iterable[dict], *,
+                 manifest: Optional[dict] = None, out: Optional[str] = None):
+        self.I_values = np.asarray(I_values, dtype=float)
+        self.V_values = np.asarray(V_values, dtype=float)
+        self.measures = tuple(measures)
+        self.options = dict(options)
+        self.manifest = manifest or {}
+        self.out = out
+        index = {(float(I), float(V)): (i, j) for i, I in enumerate(self.I_values) for j, V in enumerate(self.V_values)}
+        by_key: dict = {}
+        for rec in records:
+            key = (float(rec["I"]), float(rec["V"]))
+            if key in index and key not in by_key:
+                by_key[key] = rec
+        self._index = index
+        self._by_key = by_key
+        self.records = [by_key[k] for k in sorted(by_key, key=index.__getitem__)]
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self.I_values.size, self.V_values.size)
+
+    @property
+    def complete(self) -> bool:
+        """Every grid point has a record."""
+        return len(self.records) == self.I_values.size * self.V_values.size
+
+    def missing(self) -> list[tuple[float, float]]:
+        """(I, V) of the points without a record, in grid order."""
+        return [k for k in self._index if k not in self._by_key]
+
+    def record(self, I: float, V: float) -> Optional[dict]:
+        """The record at exactly (I, V), or None."""
+        return self._by_key.get((float(I), float(V)))
+
+    def keys(self) -> list[str]:
+        """All record keys, ``I, V, status`` first, then in order of first appearance."""
+        seen = dict.fromkeys(RESERVED)
+        for rec in self.records:
+            seen.update(dict.fromkeys(rec))
+        return list(seen)
+
+    def values(self, key: str) -> np.ndarray:
+        """``key`` over the grid as a 2-D array, shape ``(len(I_values), len(V_values))``.
+
+        A float array when every present value is a number (bools become 0/1);
+        NaN marks only the points that have no such value: not computed yet,
+        the key absent from the record (e.g. ``jumps_count`` after a model
+        breakdown, or a failed measure) or None (a statistic that needs more
+        jumps than the window has).  Otherwise (e.g. ``regime_label``) an
+        object array with None at those points.
+
+        Raises
+        ------
+        KeyError
+            If no record has ``key`` (the message lists the keys that exist).
+        """
+        if not any(key in rec for rec in self.records):
+            raise KeyError(f"no record has key {key!r}; keys: {self.keys()}")
+        present = [rec[key] for rec in self.records if rec.get(key) is not None]
+        numeric = all(_is_number(v) for v in present)
+        arr = np.full(self.shape, np.nan if numeric else None, dtype=float if numeric else object)
+        for rec in self.records:
+            v = rec.get(key)
+            if v is not None:
+                arr[self._by_key_index(rec)] = float(v) if numeric else v
+        return arr
+
+    def _by_key_index(self, rec: dict) -> tuple[int, int]:
+        return self._index[(float(rec["I"]), float(rec["V"]))]
+
+    def rows(self) -> list[dict]:
+        """The records as a list of dicts (copies), in grid order."""
+        return [dict(r) for r in self.records]
+
+    def to_csv(self, path) -> None:
+        """One row per finished point; columns :meth:`keys`; None/absent as an empty cell; floats in full precision."""
+        cols = self.keys()
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(cols)
+            for rec in self.records:
+                w.writerow(["" if rec.get(c) is None else (repr(rec[c]) if isinstance(rec[c], float) else rec[c])
+                            for c in cols])
+
+    def __repr__(self) -> str:
+        n = self.I_values.size * self.V_values.size
+        return (f"SweepResult({self.I_values.size} I x {self.V_values.size} V, measures={list(self.measures)}, "
+                f"{len(self.records)}/{n} points, out={self.out!r})")
+
+
+def load_sweep(out) -> SweepResult:
+    """Read a sweep directory (finished or not) without changing it.
+
+    A truncated last line of ``results.jsonl`` is ignored; if a point occurs
+    twice (only possible if the file was edited) the first record is used.
+    """
+    out = os.fspath(out)
+    m = _read_manifest(out)
+    recs, _, _ = _read_records(os.path.join(out, RESULTS))
+    return SweepResult(m["I_values"], m["V_values"], m["measures"], m["options"], recs, manifest=m, out=out)
+
+
+# --------------------------------------------------------------------------------------------- grid helpers
+
+def parse_grid(spec: str, *, name: str = "values") -> np.ndarray:
+    """Grid values from ``"start:stop:num"`` (linspace), ``"start:stop:num:log"`` (geometric, exact endpoints)
+    or a comma list ``"0.4,1,2"``.
+
+    Raises ValueError naming ``name`` on a malformed spec.
+    """
+    s = str(spec).strip()
+    try:
+        if ":" in s:
+            parts = s.split(":")
+            if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
+                raise ValueError("expected start:stop:num or start:stop:num:log")
+            a, b = float(parts[0]), float(parts[1])
+            n = int(parts[2])
+            if n < 1:
+                raise ValueError(f"num must be >= 1, got {n}")
+            if len(parts) == 4 and parts[3] == "log":
+                if not (a > 0 and b > 0):
+                    raise ValueError("a log range needs start > 0 and stop > 0")
+                return np.geomspace(a, b, n)
+            return np.linspace(a, b, n)
+        vals = [float(x) for x in s.split(",") if x.strip()]
+        if not vals:
+            raise ValueError("empty list")
+        return np.asarray(vals)
+    except ValueError as exc:
+        raise ValueError(f"{name}: cannot parse {spec!r} ({exc}); use start:stop:num[:log] or a comma list") \
+            from None
+
+
+def _check_axis(name: str, values) -> list[float]:
+    try:
+        arr = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a non-empty sequence of finite values in (0, inf), got {values!r}") \
+            from None
+    if arr.size == 0:
+        raise ValueError(f"{name} must be a non-empty sequence of finite values in (0, inf), got an empty grid")
+    bad = arr[~(np.isfinite(arr) & (arr > 0))]
+    if bad.size:
+        raise ValueError(f"{name} must hold finite values in (0, inf), got {bad.tolist()}")
+    vals = [float(x) for x in arr]
+    if len(set(vals)) != len(vals):
+        dup = sorted({x for x in vals if vals.count(x) > 1})
+        raise ValueError(f"{name} must not repeat a value, got duplicates {dup}")
+    return vals
+
+
+def _close(a: Sequence[float], b: Sequence[float]) -> bool:
+    return len(a) == len(b) and all(abs(x - y) <= GRID_RTOL * max(abs(x), abs(y)) for x, y in zip(a, b))
+
+
+def _describe(vals: Sequence[float]) -> str:
+    return f"{len(vals)} values [{vals[0]:.6g} .. {vals[-1]:.6g}]" if len(vals) > 3 else str(list(vals))
+
+
+def _compare_manifest(m: dict, I_vals, V_vals, measures, options, out: str) -> None:
+    diffs = []
+    for name, old, new in (("I_values", m.get("I_values"), I_vals), ("V_values", m.get("V_values"), V_vals)):
+        if not _close(old or [], new):
+            diffs.append(f"{name}: existing {_describe(old or [])}, requested {_describe(new)}")
+    if list(m.get("measures", [])) != list(measures):
+        diffs.append(f"measures: existing {list(m.get('measures', []))}, requested {list(measures)}")
+    old_o, new_o = m.get("options", {}), _json_norm(options)
+    if old_o != new_o:
+        keys = sorted(set(old_o) | set(new_o))
+        parts = [f"{k!r}: existing {old_o.get(k, '<unset>')!r}, requested {new_o.get(k, '<unset>')!r}"
+                 for k in keys if old_o.get(k, "<unset>") != new_o.get(k, "<unset>")]
+        diffs.append("options differ in " + "; ".join(parts))
+    if diffs:
+        raise ValueError(f"out={out!r} holds a different sweep, cannot resume: " + "; ".join(diffs)
+                         + ". Use another out directory (or delete this one).")
+
+
+# --------------------------------------------------------------------------------------------- the sweep
+
+class _Stderr:
+    def __init__(self, total: int, done0: int):
+        self.t0 = time.perf_counter()
+        self.done0 = done0
+        self.total = total
+
+    def __call__(self, done: int, total: int, rec: dict) -> None:
+        el = time.perf_counter() - self.t0
+        n = done - self.done0
+        eta = el / n * (total - done) if n else float("nan")
+        w = len(str(total))
+        sys.stderr.write(f"sweep [{done:>{w}}/{total}] I={rec['I']:.4g} V={rec['V']:.4g} {rec['status'][:60]}  "
+                         f"elapsed {_hms(el)}, ETA {_hms(eta)}\n")
+        sys.stderr.flush()
+
+
+def _hms(s: float) -> str:
+    if not math.isfinite(s):
+        return "?"
+    s = int(round(s))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}" if s >= 3600 else f"{s // 60}:{s % 60:02d}"
+
+
+def sweep(
+    I_values: Sequence[float],
+    V_values: Sequence[float],
+    measures: Union[str, Sequence[str]] = ("regime",),
+    *,
+    out,
+    executor: Union[None, str, Executor] = None,
+    max_workers: Optional[int] = None,
+    options: Optional[Mapping[str, Any]] = None,
+    progress: Union[bool, Callable[[int, int, dict], None], None] = True,
+    resume: bool = True,
+) -> SweepResult:
+    """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
+
+    Signature: ``sweep(I_values, V_values, measures=("regime",), *, out, executor=None, max_workers=None,
+    options=None, progress=True, resume=True) -> SweepResult``.
+
+    Parameters
+    ----------
+    I_values, V_values : sequence of float
+        Grid axes (finite, > 0, no repeats); every pair is one task.
+    measures : str or sequence of str
+        Names in :data:`MEASURES` (``"regime,jumps"`` is split at commas).
+    out : path
+        Output directory (created); see the module docstring for its files.
+    executor : None, "serial" or concurrent.futures.Executor
+        ``None``: a local :class:`ProcessPoolExecutor` (``spawn`` start
+        method, ``max_workers`` processes, shut down at the end).
+        ``"serial"``: in this process, one point after another (debugging).
+        Any Executor: used as is and left running, e.g.
+        ``distributed.Client(...).get_executor()`` for a dask cluster.
+    max_workers : int, optional
+        Processes of the local pool (default: CPUs available, at most the
+        number of points to compute).  Only with ``executor=None``.
+    options : mapping, optional
+        JSON-serialisable settings passed to every measure (module docstring).
+    progress : bool or callable
+        ``True``: one line per finished point on stderr, with an ETA.  A
+        callable receives ``(done, total, record)`` (``done`` counts resumed
+        points too).
+    resume : bool
+        With an existing sweep in ``out`` (same grid, measures and options,
+        else ValueError naming what differs): skip its finished points.
+        ``resume=False`` refuses a non-empty ``out`` (ValueError) rather than
+        overwrite it.
+
+    Returns
+    -------
+    SweepResult
+        All records in ``out`` (the resumed and the new ones).
+
+    Raises
+    ------
+    ValueError
+        Invalid arguments (naming the argument and its valid range), unknown
+        measures (listing the known ones), an ``out`` holding another sweep.
+    RuntimeError
+        ``out`` is locked by another sweep; or tasks were lost to the
+        executor (a worker died): the records written stay, and calling
+        :func:`sweep` again computes the lost points.
+
+    Notes
+    -----
+    A point whose measure raises is recorded with ``status = "error: ..."``
+    and the sweep goes on; such points count as finished on resume.
+    """
+    I_vals = _check_axis("I_values", I_values)
+    V_vals = _check_axis("V_values", V_values)
+    if isinstance(measures, str):
+        measures = [m.strip() for m in measures.split(",") if m.strip()]
+    measures = list(measures)
+    if not measures:
+        raise ValueError(f"measures must name at least one measure; known: {sorted(MEASURES)}")
+    if len(set(measures)) != len(measures):
+        raise ValueError(f"measures must not repeat a name, got {measures}")
+    _load_plugins()
+    unknown = [m for m in measures if m not in MEASURES]
+    if unknown:
+        hint = "".join(f"; {mod} could not be imported ({err})" for mod, err in _plugin_errors.items()
+                       if not err.startswith("ModuleNotFoundError: No module named 'peelapprox._")) \
+            if _plugin_errors else ""
+        raise ValueError(f"unknown measure(s) {unknown}; known: {sorted(MEASURES)}{hint}")
+    options = {} if options is None else options
+    if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
+        raise ValueError(f"options must be a mapping with str keys, got {options!r}")
+    try:
+        options = _json_norm(dict(options))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
+            from None
+    if max_workers is not None:
+        if isinstance(max_workers, bool) or not isinstance(max_workers, numbers.Integral) or max_workers < 1:
+            raise ValueError(f"max_workers must be a positive integer (valid range [1, inf)) or None, "
+                             f"got {max_workers!r}")
+        if executor is not None:
+            raise ValueError("max_workers applies only to the local process pool (executor=None); "
+                             "size your executor instead")
+    if executor is not None and executor != "serial" and not callable(getattr(executor, "submit", None)):
+        raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
+    if not (isinstance(progress, bool) or progress is None or callable(progress)):
+        raise ValueError("progress must be a bool, None or a callable (done, total, record)")
+    refs = {name: _ref(MEASURES[name]) for name in measures}
+    if executor != "serial":
+        bad = [n for n in measures if "<" in refs[n]]
+        if bad:
+            raise ValueError(f"measure(s) {bad} are lambdas or local functions ({[refs[n] for n in bad]}): "
+                             "worker processes cannot import them; define them at module level or use "
+                             "executor='serial'")
+    try:
+        _make_params(I_vals[0], V_vals[0], options)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"options: invalid PeelParams fields {[k for k in PARAM_OPTIONS if k in options]}: {exc}") \
+            from None
+
+    out = os.fspath(out)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise ValueError(f"out={out!r} exists and is not a directory")
+    os.makedirs(out, exist_ok=True)
+    lock = _lock(out)
+    try:
+        return _sweep_locked(I_vals, V_vals, measures, options, refs, out, executor, max_workers, progress, resume)
+    finally:
+        lock.close()
+
+
+def _sweep_locked(I_vals, V_vals, measures, options, refs, out, executor, max_workers, progress, resume):
+    mpath, rpath = os.path.join(out, MANIFEST), os.path.join(out, RESULTS)
+    others = [f for f in os.listdir(out) if f not in (LOCK, MANIFEST + ".tmp")]
+    if os.path.exists(mpath):
+        if not resume:
+            raise ValueError(f"out={out!r} already holds a sweep and resume=False: refusing to overwrite it; "
+                             "pass resume=True to continue it, or use another directory")
+        m = _read_manifest(out)
+        _compare_manifest(m, I_vals, V_vals, measures, options, out)
+        I_vals, V_vals = [float(x) for x in m["I_values"]], [float(x) for x in m["V_values"]]
+        mine = {k: v for k, v in _versions().items() if k != "python"}
+        theirs = {k: v for k, v in (m.get("versions") or {}).items() if k in mine}
+        if theirs and theirs != mine:
+            warnings.warn(f"resuming a sweep made with {theirs} under {mine}: records may mix versions",
+                          RuntimeWarning, stacklevel=3)
+    elif others:
+        raise ValueError(f"out={out!r} is not empty and holds no sweep manifest ({MANIFEST}): "
+                         f"refusing to write into it (found {sorted(others)[:5]})")
+    else:
+        m = {
+            "format": FORMAT,
+            "I_values": I_vals,
+            "V_values": V_vals,
+            "measures": measures,
+            "options": options,
+            "measure_refs": refs,
+            "grid_order": "I major: results arrays are [i, j] for I_values[i], V_values[j]",
+            "versions": _versions(),
+            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        }
+        _write_manifest(out, m)
+
+    recs, end, partial = _read_records(rpath)
+    if partial:  # the last write was cut off: drop it so appends start on a clean line
+        with open(rpath, "r+b") as fh:
+            fh.truncate(end)
+            fh.flush()
+            os.fsync(fh.fileno())
+    grid = [(I, V) for I in I_vals for V in V_vals]
+    on_grid = set(grid)
+    done = {}
+    for rec in recs:
+        key = (float(rec["I"]), float(rec["V"]))
+        if key in on_grid and key not in done:
+            done[key] = rec
+    todo = [k for k in grid if k not in done]
+    total = len(grid)
+    report = _Stderr(total, len(done)) if progress is True else (progress or None)
+
+    lost: list[tuple[tuple[float, float], str]] = []
+    with open(rpath, "a") as fh:
+        def write(rec: dict) -> None:
+            fh.write(json.dumps(rec, separators=(",", ":")) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+            done[(rec["I"], rec["V"])] = rec
+            if report:
+                report(len(done), total, rec)
+
+        if executor == "serial":
+            for I, V in todo:
+                write(_run_point(I, V, measures, options, refs))
+        elif todo:
+            own = executor is None
+            if own:
+                import multiprocessing
+
+                n = max_workers or (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                                    else (os.cpu_count() or 1))
+                ex = ProcessPoolExecutor(max_workers=max(1, min(n, len(todo))),
+                                         mp_context=multiprocessing.get_context("spawn"),
+                                         initializer=_worker_init, initargs=(os.getpid(),))
+            else:
+                ex = executor
+            futs: dict[Future, tuple[float, float]] = {}
+            try:
+                for I, V in todo:
+                    futs[ex.submit(_run_point, I, V, measures, options, refs)] = (I, V)
+                for fut in as_completed(futs):
+                    key = futs.pop(fut)
+                    try:
+                        rec = fut.result()
+                    except Exception as exc:  # the executor lost the task (worker died, cancelled): not a result
+                        lost.append((key, _error(exc)))
+                        continue
+                    if (float(rec["I"]), float(rec["V"])) != key:  # pragma: no cover - defensive
+                        raise RuntimeError(f"executor returned the record of {rec['I'], rec['V']} for {key}")
+                    write(rec)
+            finally:
+                for fut in futs:
+                    fut.cancel()
+                if own:
+                    ex.shutdown(wait=not futs, cancel_futures=True)
+    if lost:
+        hint = ""
+        if executor is None and any("BrokenProcessPool" in err for _, err in lost):
+            hint = ("; a worker process died (crash, out of memory, killed) or could not start: with the 'spawn' "
+                    "start method a script that calls sweep() must do so under `if __name__ == '__main__':`")
+        raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: I={lost[0][0][0]}, "
+                           f"V={lost[0][0][1]}: {lost[0][1]}); {len(done)}/{total} points are in {rpath}; "
+                           "call sweep() again with the same arguments to compute the rest" + hint)
+    return SweepResult(I_vals, V_vals, measures, options, done.values(), manifest=m, out=out)

@@ -1,0 +1,413 @@
+"""(I, V) sweeps: the engine, crash safety and resume, executors, the CLI.
+
+The solvers are deterministic and the records hold no timings, so records
+from different executors, processes or runs are compared for *exact*
+equality throughout: any difference would be a bug in the engine (a lost,
+duplicated or mis-keyed point), not round-off.
+"""
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import _sweep_measures  # noqa: F401  (registers "slowprod" and "flaky")
+from peelapprox import PeelParams, estimate
+from peelapprox._sweep import MEASURES, SweepResult, _lock, load_sweep, parse_grid, register_measure, sweep
+from peelapprox.cli import main
+
+TESTS = str(Path(__file__).resolve().parent)
+I2, V2 = [1e-5, 1e-2], [1.0, 2.0]
+
+
+def _lines(out) -> list[str]:
+    p = Path(out) / "results.jsonl"
+    return p.read_text().splitlines() if p.exists() else []
+
+
+def _keys_once(out) -> list[tuple[float, float]]:
+    keys = [(r["I"], r["V"]) for r in map(json.loads, _lines(out))]
+    assert len(keys) == len(set(keys)), "a point was written twice"
+    return keys
+
+
+@pytest.fixture(scope="module")
+def pool_result(tmp_path_factory):
+    """2x2 sweep of regime and jumps on the default local process pool (2 spawned workers)."""
+    out = tmp_path_factory.mktemp("pool") / "sw"
+    t0 = time.perf_counter()
+    res = sweep(I2, V2, ("regime", "jumps"), out=out, max_workers=2, progress=False)
+    res.wall = time.perf_counter() - t0
+    return res
+
+
+def test_pool_values_match_direct_calls(pool_result):
+    """Hypothesis: a pool sweep stores, per point, exactly what the measures return when called directly.
+
+    Four records, one line each; ``values(key)[i, j]`` equals the direct call
+    at ``(I_values[i], V_values[j])``.  Tolerance: exact equality, since both
+    sides run the same deterministic code and JSON round-trips floats exactly.
+    """
+    res = pool_result
+    assert res.complete and len(res.records) == 4 and len(_lines(res.out)) == 4
+    assert sorted(_keys_once(res.out)) == sorted((I, V) for I in I2 for V in V2)
+    labels, ratio = res.values("regime_label"), res.values("regime_inertia_ratio")
+    count, drop = res.values("jumps_count"), res.values("jumps_mean_force_drop")
+    assert labels.dtype == object and ratio.dtype == float and ratio.shape == (2, 2)
+    for i, I in enumerate(I2):
+        for j, V in enumerate(V2):
+            p = PeelParams(V=V, I=I)
+            e = estimate(p)
+            assert labels[i, j] == e.label and ratio[i, j] == e.inertia_ratio
+            direct = MEASURES["jumps"](p, {})
+            assert direct["status"] == "ok"
+            assert count[i, j] == direct["count"] and drop[i, j] == direct["mean_force_drop"]
+            assert res.record(I, V)["status"] == "ok"
+    m = json.loads((Path(res.out) / "sweep.json").read_text())
+    assert m["I_values"] == I2 and m["V_values"] == V2 and m["measures"] == ["regime", "jumps"]
+    assert m["options"] == {} and m["versions"]["numba"] and m["created"]
+
+
+def test_jumps_measure_definitions():
+    """Hypothesis: the jumps measure implements its documented statistics on the exact solution's jumps.
+
+    Recomputed by a plain loop over the jump list of the same simulation
+    (V=1, I=1e-5, window [10, 20] s): count, AB->CD count, mean interval,
+    period between slips, mean force drop (F at AB->CD minus F at the next
+    CD->AB).  Tolerance 1e-12 relative: same numbers summed in a different
+    order.
+    """
+    from exact import simulate
+
+    p = PeelParams(V=1.0, I=1e-5)
+    got = MEASURES["jumps"](p, {"t_end": 20.0, "t_transient": 10.0})
+    j = simulate(p, 20.0, t_transient=10.0, save="jumps").jumps
+    jl = list(j)
+    assert jl and all(x.t >= 10.0 for x in jl)
+    drops, slips = [], []
+    for n, x in enumerate(jl):
+        if x.from_branch == "AB" and x.to_branch == "CD":
+            slips.append(x.t)
+            nxt = next((y for y in jl[n + 1:] if y.from_branch == "CD" and y.to_branch == "AB"), None)
+            if nxt is not None:
+                drops.append(x.F - nxt.F)
+    assert got["count"] == len(jl) and got["n_slips"] == len(slips) and len(drops) >= len(slips) - 1
+    assert math.isclose(got["mean_interval"], (jl[-1].t - jl[0].t) / (len(jl) - 1), rel_tol=1e-12)
+    assert math.isclose(got["mean_period"], (slips[-1] - slips[0]) / (len(slips) - 1), rel_tol=1e-12)
+    assert math.isclose(got["mean_force_drop"], sum(drops) / len(drops), rel_tol=1e-12)
+    assert got["mean_force_drop"] > 0
+
+
+def test_breakdown_is_a_result_not_an_error(tmp_path):
+    """Hypothesis: a ModelBreakdown (V=1, I=1e-4: v falls to v_floor on AB) is recorded as
+    ``jumps_status = "breakdown:v_floor"`` with the point's status ok, and ``values`` is NaN there only.
+
+    No tolerance: categorical outcome; V=1, I=1e-5 on the same sweep runs normally.
+    """
+    res = sweep([1e-5, 1e-4], [1.0], "jumps", out=tmp_path / "sw", executor="serial", progress=False)
+    bad, good = res.record(1e-4, 1.0), res.record(1e-5, 1.0)
+    assert bad["status"] == "ok" and bad["jumps_status"] == "breakdown:v_floor" and bad["jumps_t_breakdown"] > 0
+    assert good["jumps_status"] == "ok"
+    c = res.values("jumps_count")
+    assert np.isnan(c[1, 0]) and c[0, 0] == good["jumps_count"]
+    assert list(res.values("jumps_status")[:, 0]) == ["ok", "breakdown:v_floor"]
+
+
+def test_kill_and_resume(tmp_path):
+    """Hypothesis: SIGKILL of a running sweep loses no finished point, and resuming computes exactly the rest.
+
+    A subprocess sweeps 12 points with a measure that sleeps 0.25 s per point
+    (2 workers, ~1.5 s of work); it is killed (SIGKILL, the sweeping process
+    only) once >= 3 records are on disk.  Then: its orphaned workers exit
+    (they watch their parent), every record on disk survives, an in-process
+    resume writes each missing point once (each (I, V) exactly once in
+    results.jsonl) and the records equal those of a fresh uninterrupted sweep
+    (in-process, without the sleep, which changes no value).
+    Exact equality: deterministic measures.
+    """
+    I, V = [1e-5, 1e-4, 1e-3], [0.5, 1.0, 2.0, 4.0]
+    measures, opts = ("regime", "slowprod"), {"sleep": 0.25}
+    out = tmp_path / "killed"
+    code = (f"import sys; sys.path.insert(0, {TESTS!r})\n"
+            "import _sweep_measures\n"
+            "from peelapprox._sweep import sweep\n"
+            f"sweep({I!r}, {V!r}, {measures!r}, out={str(out)!r}, max_workers=2, options={opts!r}, progress=False)\n")
+    log = open(tmp_path / "child.log", "w")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 90
+        while len(_lines(out)) < 3:
+            assert proc.poll() is None, f"sweep subprocess exited early: {(tmp_path / 'child.log').read_text()}"
+            assert time.monotonic() < deadline, "no 3 records within 90 s"
+            time.sleep(0.01)
+        try:
+            import psutil
+
+            workers = psutil.Process(proc.pid).children(recursive=True)
+        except ImportError:  # pragma: no cover - psutil comes with the distributed extra
+            workers = []
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+        if workers:
+            gone, alive = psutil.wait_procs(workers, timeout=10)
+            assert not alive, f"orphaned workers still running: {alive}"
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)  # the session started above, in case anything is left
+        except (ProcessLookupError, PermissionError):
+            pass
+        log.close()
+    before = [json.loads(line) for line in _lines(out)]  # complete lines survived the kill
+    assert 3 <= len(before) < 12, f"kill did not interrupt the sweep ({len(before)} records)"
+
+    res = sweep(I, V, measures, out=out, max_workers=2, options=opts, progress=False)
+    keys = _keys_once(out)
+    assert len(keys) == 12 and res.complete
+    after = {(r["I"], r["V"]): r for r in map(json.loads, _lines(out))}
+    assert all(after[(r["I"], r["V"])] == r for r in before), "resume rewrote a finished point"
+    # the reference: uninterrupted, in-process, without the sleep (which changes no value)
+    fresh = sweep(I, V, measures, out=tmp_path / "fresh", executor="serial", options={"sleep": 0.0}, progress=False)
+    assert res.records == fresh.records
+
+
+def test_truncated_last_line_is_ignored_and_recomputed(tmp_path):
+    """Hypothesis: a last line cut off mid-write (no newline) is ignored by ``load_sweep`` and, on resume,
+    dropped from the file and recomputed; the earlier lines stay untouched.
+
+    Exact equality: the recomputed record is the same deterministic result.
+    """
+    out = tmp_path / "sw"
+    full = sweep(I2, V2, ("regime", "slowprod"), out=out, executor="serial", progress=False)
+    path = out / "results.jsonl"
+    text = path.read_text()
+    lines = text.splitlines(keepends=True)
+    cut = "".join(lines[:-1]) + lines[-1][: len(lines[-1]) // 2]  # killed while writing the 4th record
+    path.write_text(cut)
+    part = load_sweep(out)
+    assert len(part.records) == 3 and not part.complete and len(part.missing()) == 1
+    assert path.read_text() == cut  # load_sweep is read-only
+    res = sweep(I2, V2, ("regime", "slowprod"), out=out, executor="serial", progress=False)
+    assert path.read_text().startswith("".join(lines[:-1]))
+    assert len(_keys_once(out)) == 4 and res.records == full.records
+
+
+def test_malformed_middle_line_raises(tmp_path):
+    """Hypothesis: a corrupt *complete* line is not silently dropped: resume raises ValueError naming the line."""
+    out = tmp_path / "sw"
+    sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    lines = _lines(out)
+    (out / "results.jsonl").write_text(lines[0] + "\n" + "{not json\n" + "\n".join(lines[1:]) + "\n")
+    with pytest.raises(ValueError, match="line 2"):
+        sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+
+
+def test_manifest_mismatch_and_no_overwrite(tmp_path):
+    """Hypothesis: an out directory holding another sweep (grid, measures or options differ) is refused
+    with a ValueError naming what differs; resume=False never overwrites; a stranger's directory is refused.
+    """
+    out = tmp_path / "sw"
+    sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False, options={"sleep": 0.0})
+    kw = dict(out=out, executor="serial", progress=False)
+    with pytest.raises(ValueError, match="V_values: existing"):
+        sweep(I2, [1.0, 3.0], "slowprod", options={"sleep": 0.0}, **kw)
+    with pytest.raises(ValueError, match="I_values: existing"):
+        sweep([1e-5], V2, "slowprod", options={"sleep": 0.0}, **kw)
+    with pytest.raises(ValueError, match="measures: existing"):
+        sweep(I2, V2, ("slowprod", "regime"), options={"sleep": 0.0}, **kw)
+    with pytest.raises(ValueError, match="options differ in 'sleep'"):
+        sweep(I2, V2, "slowprod", options={"sleep": 0.1}, **kw)
+    with pytest.raises(ValueError, match="resume=False"):
+        sweep(I2, V2, "slowprod", options={"sleep": 0.0}, resume=False, **kw)
+    assert len(_lines(out)) == 4
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    with pytest.raises(ValueError, match="not empty"):
+        sweep(I2, V2, "slowprod", out=other, executor="serial", progress=False)
+
+
+def test_resume_tolerates_rebuilt_grid_roundoff(tmp_path):
+    """Hypothesis: a grid equal to the manifest's up to 1e-15 relative (a geomspace rebuilt on another
+    machine) resumes, and the manifest's exact values stay the record keys (no duplicates).
+    """
+    out = tmp_path / "sw"
+    sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    res = sweep([x * (1 + 1e-15) for x in I2], V2, "slowprod", out=out, executor="serial", progress=False)
+    assert list(res.I_values) == I2 and len(_keys_once(out)) == 4
+
+
+def test_validation_messages(tmp_path):
+    """Hypothesis: bad arguments raise ValueError naming the argument and its valid range (or the known measures)."""
+    out = tmp_path / "sw"
+    with pytest.raises(ValueError, match=r"I_values .*empty grid"):
+        sweep([], V2, out=out)
+    with pytest.raises(ValueError, match=r"V_values must hold finite values in \(0, inf\)"):
+        sweep(I2, [1.0, -2.0], out=out)
+    with pytest.raises(ValueError, match="duplicates"):
+        sweep(I2, [1.0, 1.0], out=out)
+    with pytest.raises(ValueError, match=r"unknown measure\(s\) \['nope'\]; known: \[.*'jumps'.*'regime'"):
+        sweep(I2, V2, "regime,nope", out=out)
+    with pytest.raises(ValueError, match=r"max_workers must be a positive integer \(valid range \[1, inf\)\)"):
+        sweep(I2, V2, out=out, max_workers=0)
+    with pytest.raises(ValueError, match="options must be JSON-serialisable"):
+        sweep(I2, V2, out=out, options={"x": object()})
+    with pytest.raises(ValueError, match="k must be finite"):
+        sweep(I2, V2, out=out, options={"k": -1.0})
+    with pytest.raises(ValueError, match="lambdas or local functions"):
+        register_measure("tmp_lambda", lambda p, o: {"x": 1}, replace=True)
+        try:
+            sweep(I2, V2, "tmp_lambda", out=out)
+        finally:
+            MEASURES.pop("tmp_lambda")
+    with pytest.raises(ValueError, match="already registered"):
+        register_measure("regime", _sweep_measures.slowprod)
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_failing_point_is_recorded_and_sweep_goes_on(tmp_path):
+    """Hypothesis: a measure raising at some points records ``status = "error: <Type>: <msg>"`` there,
+    the other measures still run at those points, and the remaining points are computed normally.
+    """
+    res = sweep(I2, [1.0, 2.0, 3.0], ("slowprod", "flaky"), out=tmp_path / "sw", executor="serial",
+                progress=False, options={"fail_at_V": 2.0})
+    assert res.complete
+    for r in res.records:
+        if r["V"] >= 2.0:
+            assert r["status"] == r["flaky_status"] == f"error: RuntimeError: boom at V={r['V']:g}"
+            assert "flaky_x" not in r and r["slowprod_value"] == r["I"] * r["V"]
+        else:
+            assert r["status"] == "ok" and r["flaky_x"] == 1.0
+    x = res.values("flaky_x")
+    assert np.all(np.isnan(x[:, 1:])) and np.all(x[:, 0] == 1.0)
+
+
+def test_progress_callable_and_stderr(tmp_path, capsys):
+    """Hypothesis: progress(done, total, record) is called once per computed point with done counting
+    resumed points; progress=True prints one line per point with an ETA on stderr.
+    """
+    calls = []
+    out = tmp_path / "sw"
+    sweep(I2, [1.0], "slowprod", out=out, executor="serial", progress=lambda d, t, r: calls.append((d, t, r["V"])))
+    assert calls == [(1, 2, 1.0), (2, 2, 1.0)]
+    sweep(I2, [1.0, 2.0], "slowprod", out=tmp_path / "sw2", executor="serial", progress=True)
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 4 and err[-1].startswith("sweep [4/4]") and "ETA" in err[-1]
+
+
+def test_locked_out_dir_is_refused(tmp_path):
+    """Hypothesis: a second sweep cannot write into a directory another sweep is writing (flock)."""
+    out = tmp_path / "sw"
+    out.mkdir()
+    held = _lock(str(out))
+    try:
+        with pytest.raises(RuntimeError, match="in use by another sweep"):
+            sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    finally:
+        held.close()
+    assert len(sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False).records) == 4
+
+
+def test_csv_and_load_roundtrip(pool_result, tmp_path):
+    """Hypothesis: load_sweep reproduces the SweepResult exactly and to_csv writes one full-precision row per
+    point with the columns of keys() (exact: floats are written with repr).
+    """
+    res = load_sweep(pool_result.out)
+    assert isinstance(res, SweepResult) and res.records == pool_result.records and res.rows() == res.records
+    path = tmp_path / "r.csv"
+    res.to_csv(path)
+    import csv
+
+    rows = list(csv.DictReader(open(path)))
+    assert list(rows[0]) == res.keys() and len(rows) == 4
+    assert [float(r["regime_inertia_ratio"]) for r in rows] == [r["regime_inertia_ratio"] for r in res.records]
+
+
+def test_parse_grid():
+    """Hypothesis: range specs give linspace / exact-endpoint geometric grids and comma lists; bad specs name the flag."""
+    assert list(parse_grid("0.4:4:10")) == list(np.linspace(0.4, 4, 10))
+    g = parse_grid("1e-5:1e-2:4:log")
+    assert g[0] == 1e-5 and g[-1] == 1e-2 and np.allclose(np.diff(np.log10(g)), 1.0, rtol=1e-12)
+    assert list(parse_grid("1, 2,3")) == [1.0, 2.0, 3.0]
+    with pytest.raises(ValueError, match="--I"):
+        parse_grid("1:2", name="--I")
+    with pytest.raises(ValueError, match="log range"):
+        parse_grid("0:1:3:log")
+
+
+def test_dask_executor_matches_pool(pool_result, tmp_path):
+    """Hypothesis: a dask executor (``Client(LocalCluster(...)).get_executor()``) gives the same records
+    as the local process pool: the engine is executor-agnostic.  Exact equality (deterministic measures).
+    """
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cl, \
+            distributed.Client(cl) as client:
+        res = sweep(I2, V2, ("regime", "jumps"), out=tmp_path / "dask", executor=client.get_executor(),
+                    progress=False)
+    assert res.records == pool_result.records
+    assert len(_keys_once(tmp_path / "dask")) == 4
+
+
+@pytest.mark.slow
+def test_dask_worker_processes_match_pool(pool_result, tmp_path):
+    """Hypothesis: with separate dask worker processes (tasks pickled, measures imported by the workers)
+    the records are still identical to the process pool's.  Exact equality.
+    """
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+            distributed.Client(cl) as client:
+        res = sweep(I2, V2, ("regime", "jumps"), out=tmp_path / "dask", executor=client.get_executor(),
+                    progress=False)
+    assert res.records == pool_result.records
+
+
+@pytest.mark.slow
+def test_pool_equals_serial_on_larger_grid(tmp_path):
+    """Hypothesis: on a 4x5 grid spanning all regimes (incl. model breakdowns) pool and in-process sweeps
+    give identical records.  Exact equality (deterministic solvers).
+    """
+    I, V = parse_grid("1e-5:1e-2:4:log"), parse_grid("0.4:4:5")
+    a = sweep(I, V, ("regime", "jumps"), out=tmp_path / "a", max_workers=2, progress=False)
+    b = sweep(I, V, ("regime", "jumps"), out=tmp_path / "b", executor="serial", progress=False)
+    assert a.records == b.records and a.complete
+    assert any(r["jumps_status"].startswith("breakdown:") for r in a.records)
+
+
+def test_cli_smoke(tmp_path, capsys):
+    """Hypothesis: ``peelapprox sweep`` on a 2x2 regime grid writes the manifest, one JSONL line per point,
+    results.csv and the phase-diagram PNG, prints the table, and a rerun resumes (computes nothing new).
+    """
+    out = tmp_path / "sw"
+    argv = ["sweep", "--I", "1e-5:1e-2:2:log", "--V", "1,2", "--measure", "regime", "--out", str(out),
+            "--workers", "0", "--format", "json"]
+    assert main(argv + ["--plot", "regime_label"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert len(rows) == 4 and {r["regime_label"] for r in rows} == {"low inertia, low V", "high inertia, low V"}
+    assert rows[0]["I"] == 1e-5 and rows[-1]["I"] == 1e-2
+    assert len(_lines(out)) == 4 and (out / "results.csv").exists() and (out / "sweep.json").exists()
+    assert (out / "regime_label.png").stat().st_size > 10_000
+    before = (out / "results.jsonl").read_text()
+    assert main(argv[:-1] + ["md", "--quiet"]) == 0
+    cap = capsys.readouterr()
+    assert cap.out.startswith("| I | V | status | regime_label") and len(cap.out.splitlines()) == 6
+    assert "holds a sweep with 4/4 points done" in cap.err
+    assert (out / "results.jsonl").read_text() == before
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", "--I", "1e-5", "--V", "1,3", "--out", str(out), "--workers", "0"])
+    assert exc.value.code == 2 and "V_values: existing" in capsys.readouterr().err
+
+
+def test_plot_phase_diagram_numeric(pool_result, tmp_path):
+    """Hypothesis: a numeric key draws a pcolormesh with a colour bar over (V, I) (file written, two axes)."""
+    from peelapprox.plotting import plot_phase_diagram
+
+    fig = plot_phase_diagram(pool_result, "jumps_mean_period", None)
+    assert len(fig.axes) == 2 and fig.axes[0].get_yscale() == "log"
+    fig.savefig(tmp_path / "p.png")
+    assert (tmp_path / "p.png").stat().st_size > 5_000
