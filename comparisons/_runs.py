@@ -32,7 +32,7 @@ from typing import List, Optional
 import numpy as np
 
 from exact import simulate
-from peelapprox import PeelParams
+from peelapprox import PeelParams, periodicity
 
 from ._segments import Segment, segments
 
@@ -96,13 +96,11 @@ def check_past_transient(trajectory, *, rtol: float = 1e-6, envelope_tol: float 
     if len(x) < 6:
         raise TransientNotPassed(f"only {len(x)} AB→CD jumps in the stored window: too short to judge",
                                  detail={"n_jumps": len(x)}, **ctx)
-    scale = float(np.max(np.abs(x)))
-    for n in range(1, len(x) // 2 + 1):
-        mis = float(np.max(np.abs(x[n:] - x[:-n]))) / scale
-        if mis <= rtol:
-            return TransientCheck("periodic", n, mis, len(x))
+    per = periodicity(x, rtol=rtol, max_period=len(x) // 2, min_repeats=1)
+    if per.kind == "periodic":
+        return TransientCheck("periodic", per.period, per.mismatch, len(x))
     h = len(x) // 2
-    rng = float(np.ptp(x)) or scale
+    rng = float(np.ptp(x)) or float(np.max(np.abs(x)))
     mis = max(abs(x[:h].min() - x[h:].min()), abs(x[:h].max() - x[h:].max())) / rng
     if mis <= envelope_tol:
         return TransientCheck("stationary", None, mis, len(x))
