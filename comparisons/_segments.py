@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import List, Optional
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 __all__ = ["Segment", "segments"]
 
@@ -153,10 +154,12 @@ def time_mean(t: np.ndarray, x: np.ndarray, t0: float, t1: float) -> float:
     interpolated linearly), independent of how densely the solver happened to store points."""
     if not t1 > t0:
         raise ValueError(f"time_mean needs t1 > t0, got [{t0}, {t1}]")
+    if t0 < t[0] or t1 > t[-1]:
+        raise ValueError(f"time_mean: [{t0}, {t1}] must lie inside the sampled range [{t[0]}, {t[-1]}]")
     m = (t > t0) & (t < t1)
     tt = np.concatenate(([t0], t[m], [t1]))
     xx = np.concatenate(([np.interp(t0, t, x)], x[m], [np.interp(t1, t, x)]))
-    return float(np.trapezoid(xx, tt) / (t1 - t0))
+    return float(trapezoid(xx, tt) / (t1 - t0))
 
 
 def segments(trajectory) -> List[Segment]:

@@ -141,7 +141,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
             n_jumps += 1
             if tj >= t_store:
                 jumps.append((tj, s_old, s_new, yj[0], yj[1], yj[2], v_mid, v_mid))
-            if n_jumps > max_jumps:
+            if len(jumps) > max_jumps:  # stored jumps, as the hybrid driver counts them
                 raise SolverBudgetExceeded(f"more than max_jumps={max_jumps} jumps before t_end={t_end}",
                                            budget="max_jumps", limit=max_jumps, t=float(tj), state=sdict(tj, yj),
                                            partial=build(False))

@@ -193,7 +193,9 @@ def simulate(
         states just before and after each jump; ``"jumps"`` stores only jumps
         (memory proportional to the number of jumps, not of steps).
     max_points, max_steps, max_jumps : int
-        Budgets.  Exceeding one raises :class:`SolverBudgetExceeded` (with the
+        Budgets: stored points, accepted steps (all, from t = 0) and stored
+        jumps (those at t >= t_transient: a memory budget, like max_points).
+        Needing more than one raises :class:`SolverBudgetExceeded` (with the
         partial trajectory); nothing is truncated silently.
     v_floor : float
         On AB, v falling to this value [m/s] means CONSTR is losing its root
@@ -371,7 +373,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
                 progress(t_end, t_end)
             return build()
         if status == H.OUT_FULL:
-            if n_stored + int(cnt[H.C_NOUT]) + 2 > max_points + 2:
+            if n_stored + int(cnt[H.C_NOUT]) > max_points:
                 raise over_budget("max_points", max_points)
             n = int(cnt[H.C_NOUT])
             n_stored += n
@@ -389,8 +391,6 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         if status == H.PAUSE:
             if int(cnt[H.C_STEPS]) >= max_steps:
                 raise over_budget("max_steps", max_steps)
-            if int(cnt[H.C_JUMPS]) > max_jumps:
-                raise over_budget("max_jumps", max_jumps)
             if progress:
                 progress(float(st[H.S_T0] + st[H.S_TAU]), t_end)
             continue
