@@ -51,11 +51,11 @@ def _f_curve(ax, V, vlo=1e-4, vhi=30.0, **kw):
     ax.plot(v, peel_force(v, V), "k-", lw=kw.pop("lw", 2), label=kw.pop("label", f"f(v, V={V:g})"), **kw)
 
 
-def _phase(ax, tr, V, title):
+def _phase(ax, v, F, branch, V, title):
     _f_curve(ax, V)
     for br, c in ((0, "C0"), (1, "C3")):
-        m = tr.branch == br
-        ax.plot(tr.v[m], tr.F[m], ".", ms=1.5, color=c, label="AB" if br == 0 else "CD")
+        m = branch == br
+        ax.plot(v[m], F[m], ".", ms=1.5, color=c, label="AB" if br == 0 else "CD")
     ax.set_xscale("log")
     ax.set_xlabel("v [m/s]")
     ax.set_ylabel("F [N]")
@@ -90,9 +90,9 @@ def _fig3(out):
     plt = _plt()
     fig, axs = plt.subplots(2, 2, figsize=(10, 7))
     tr = _sim(0.4, 1e-5, 2.0, t_transient=1.0, alpha0=0.2)
-    _phase(axs[0, 0], tr, 0.4, "(a) V=0.4, I=1e-5: v–F (start α0 = 0.2)")
+    _phase(axs[0, 0], tr.v, tr.F, tr.branch, 0.4, "(a) V=0.4, I=1e-5: v–F (start α0 = 0.2)")
     tr = _sim(1.0, 1e-5, 1.0, t_transient=0.5)
-    _phase(axs[0, 1], tr, 1.0, "(b) V=1, I=1e-5: v–F")
+    _phase(axs[0, 1], tr.v, tr.F, tr.branch, 1.0, "(b) V=1, I=1e-5: v–F")
     m = tr.t <= 0.7
     axs[1, 0].plot(tr.t[m], tr.alpha[m], lw=0.8)
     axs[1, 0].set_xlabel("t [s]")
@@ -109,16 +109,15 @@ def _fig3(out):
 
 def _fig4(out):
     plt = _plt()
-    from peelapprox._dynamics import return_map
+    from peelapprox._dynamics import periodicity, return_map
 
     tr = _sim(1.0, 1e-2, 40.0, t_transient=30.0)
-    J = tr.jumps
-    ab = np.flatnonzero(np.asarray(J.from_branch) == 0)
-    t0, t1 = J.t[ab[0]], J.t[ab[8]] if ab.size > 8 else tr.t[-1]  # one period-8 cycle
+    t_k, x = return_map(tr, with_times=True)
+    n = periodicity(x).period or 1  # one cycle of the return map (period 8 here)
+    t0, t1 = t_k[0], t_k[n] if t_k.size > n else tr.t[-1]
     m = (tr.t >= t0) & (tr.t <= t1)
     fig, axs = plt.subplots(2, 2, figsize=(10, 7))
-    sub = type("S", (), dict(v=tr.v[m], F=tr.F[m], branch=tr.branch[m]))
-    _phase(axs[0, 0], sub, 1.0, "(a) V=1, I=1e-2: v–F, one cycle")
+    _phase(axs[0, 0], tr.v[m], tr.F[m], tr.branch[m], 1.0, "(a) V=1, I=1e-2: v–F, one cycle")
     for ax, y, lab, name in ((axs[0, 1], tr.alpha, "α [rad]", "(b) α(t)"), (axs[1, 0], tr.F, "F [N]",
                              f"(c) F(t) (return map: {_period_label(return_map(tr))})"),
                              (axs[1, 1], tr.v, "v [m/s]", "(d) v(t)")):
@@ -146,7 +145,7 @@ def _fig5(out):
     axs[0, 1].plot(tr.t, tr.alpha, lw=0.6)
     axs[0, 1].set_ylabel("α [rad]")
     axs[0, 1].set_title("(b) α(t)", fontsize=9)
-    _phase(axs[1, 0], tr, 4.0, "(c) v–F")
+    _phase(axs[1, 0], tr.v, tr.F, tr.branch, 4.0, "(c) v–F")
     axs[1, 1].plot(tr.t, tr.v, lw=0.6)
     axs[1, 1].set_yscale("log")
     axs[1, 1].set_ylabel("v [m/s]")
@@ -156,7 +155,10 @@ def _fig5(out):
     return _save(fig, out, "fig5")
 
 
-def fig6_data(Vs=(0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5), Is=(1e-5, 1e-2), *, t_transient=20.0,
+_FIG6_V = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5)
+
+
+def fig6_data(Vs=_FIG6_V, Is=(1e-5, 1e-2), *, t_transient=20.0,
               window=20.0) -> Dict[float, np.ndarray]:
     """Mean force drop [N] per V for each I (NaN where a run breaks down or has no slip)."""
     from exact import ModelBreakdown
@@ -176,9 +178,6 @@ def fig6_data(Vs=(0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5), Is=(1e-5, 1e-2),
     return out
 
 
-_FIG6_V = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5)
-
-
 def _fig6(out):
     plt = _plt()
     data = fig6_data(_FIG6_V)
@@ -196,10 +195,9 @@ def _fig7(out):
     plt = _plt()
     tr = _sim(0.4, 1e-3, 22.0, t_transient=20.0, alpha0=0.2)
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
-    _phase(axs[0], tr, 0.4, "Fig. 7: V=0.4, I=1e-3 in the v–F plane (start α0 = 0.2)")
-    G = tr.F * (1 + np.sin(tr.alpha))
-    sub = type("S", (), dict(v=tr.v, F=G, branch=tr.branch))
-    _phase(axs[1], sub, 0.4, "the same orbit in the v–F(1+sin α) plane: on f's stable branches")
+    _phase(axs[0], tr.v, tr.F, tr.branch, 0.4, "Fig. 7: V=0.4, I=1e-3 in the v–F plane (start α0 = 0.2)")
+    G = tr.F * (1 + tr.closure_c)  # the pull side of CONSTR, F (1 - cos θ)
+    _phase(axs[1], tr.v, G, tr.branch, 0.4, "the same orbit in the v–F(1+sin α) plane: on f's stable branches")
     axs[1].set_ylabel("F (1 + sin α) [N]")
     for ax in axs:
         ax.set_xlim(1e-3, 30)

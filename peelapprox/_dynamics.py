@@ -18,6 +18,7 @@ Exact solutions come from :func:`exact.simulate` (imported lazily: ``exact`` dep
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -27,6 +28,7 @@ import numpy as np
 
 from ._params import PeelParams
 from ._peelforce import BRANCHES, branch_structure
+from ._sweep import register_measure
 from ._validate import positive
 
 __all__ = [
@@ -35,6 +37,8 @@ __all__ = [
     "periodicity",
     "force_drops",
     "settle_time",
+    "window_run",
+    "classify",
     "Attractor",
     "attractors",
     "BenettinResult",
@@ -46,13 +50,15 @@ __all__ = [
 _AB = BRANCHES.index("AB")
 
 
-def return_map(trajectory) -> np.ndarray:
+def return_map(trajectory, *, with_times: bool = False):
     """``x_k``: the pull force [N] at the AB→CD jumps of an exact trajectory (its stored window).
 
-    Signature: ``return_map(trajectory) -> ndarray``.
+    Signature: ``return_map(trajectory, *, with_times=False) -> ndarray`` (or ``(t_k, x_k)``).
     """
     J = trajectory.jumps
-    return np.asarray(J.F)[np.asarray(J.from_branch) == _AB]
+    m = np.asarray(J.from_branch) == _AB
+    x = np.asarray(J.F)[m]
+    return (np.asarray(J.t)[m], x) if with_times else x
 
 
 @dataclass(frozen=True)
@@ -60,8 +66,9 @@ class Periodicity:
     """Period of the return map ``x_k`` (see :func:`periodicity`).
 
     ``kind`` is ``"periodic"`` (``period`` = the smallest n that repeats), ``"aperiodic"`` (no n <=
-    ``max_period`` repeats; ``period`` None) or ``"too short"`` (fewer than ``2 max_period + 1`` returns
-    were given *and* no shorter period repeated).  ``mismatch`` = ``max_k |x_{k+n} − x_k| / max|x|`` for
+    ``max_period`` repeats; ``period`` None) or ``"too short"`` (fewer than
+    ``(min_repeats + 1) · max_period`` returns were given — 96 with the defaults — so not every n could be
+    tried, *and* no shorter period repeated).  ``mismatch`` = ``max_k |x_{k+n} − x_k| / max|x|`` for
     the period found, or the smallest over all n tried; ``n_returns`` = ``len(x)``.
     """
 
@@ -102,10 +109,9 @@ def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int
         x = return_map(x)
     x = np.asarray(x, dtype=float)
     rtol = positive("rtol", rtol)
-    if int(max_period) < 1:
-        raise ValueError(f"max_period must be an integer >= 1, got {max_period!r}")
-    if int(min_repeats) < 1:
-        raise ValueError(f"min_repeats must be an integer >= 1, got {min_repeats!r}")
+    for name, val in (("max_period", max_period), ("min_repeats", min_repeats)):
+        if isinstance(val, bool) or not isinstance(val, (int, np.integer)) or val < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {val!r}")
     if x.ndim != 1 or x.size < 2 or not np.all(np.isfinite(x)):
         raise ValueError(f"x must be a 1-D finite sequence of at least 2 returns, got shape {x.shape}")
     scale = float(np.max(np.abs(x)))
@@ -131,6 +137,8 @@ def force_drops(trajectory) -> np.ndarray:
     fb = np.asarray(J.from_branch)
     F = np.asarray(J.F)
     idx = np.flatnonzero(fb[:-1] == _AB)  # AB→CD followed by CD→AB (jumps alternate)
+    if np.any(fb[idx + 1] == _AB):
+        raise ValueError("force_drops: the jumps do not alternate AB→CD→AB (not an exact trajectory's jumps)")
     return F[idx] - F[idx + 1]
 
 
@@ -143,9 +151,8 @@ def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> Opti
     that of the earliest AB→CD jump from which ``|x_{k+n} − x_k| <= rtol·max|x|`` holds for every later k.
     None means no period was found in the last half (aperiodic, or still in the transient).
     """
-    J = trajectory.jumps
-    m = np.asarray(J.from_branch) == _AB
-    x, t = np.asarray(J.F)[m], np.asarray(J.t)[m]
+    rtol = positive("rtol", rtol)
+    t, x = return_map(trajectory, with_times=True)
     if x.size < 4:
         return None
     per = periodicity(x[x.size // 2:], rtol=rtol, max_period=max_period)
@@ -155,6 +162,40 @@ def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> Opti
     bad = np.abs(x[n:] - x[:-n]) > rtol * float(np.max(np.abs(x)))
     k = int(np.flatnonzero(bad)[-1]) + 1 if bad.any() else 0
     return float(t[k])
+
+
+# ---------------------------------------------------------------------------------------------- windows
+WINDOW_DEFAULTS = dict(t_transient=30.0, window=20.0, rtol=1e-10, alpha0=0.0)
+
+
+def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float = 20.0, rtol: float = 1e-10,
+               alpha0: float = 0.0):
+    """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
+
+    Signature: ``window_run(params, *, t_transient=30, window=20, rtol=1e-10, alpha0=0) -> Trajectory``.
+    The one windowed run behind :func:`attractors`, the sweep measures ``period`` and ``jumps`` and
+    ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so measures of one
+    sweep point share it.  Raises ``ModelBreakdown`` as :func:`exact.simulate` does.
+    """
+    t_transient = float(t_transient)
+    if not (math.isfinite(t_transient) and t_transient >= 0.0):
+        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
+    return _window_run(params, t_transient, positive("window", window), positive("rtol", rtol), float(alpha0))
+
+
+@functools.lru_cache(maxsize=2)
+def _window_run(params, t_transient, window, rtol, alpha0):
+    from exact import simulate
+
+    return simulate(params, t_transient + window, alpha0=alpha0, rtol=rtol, t_transient=t_transient, save="jumps")
+
+
+def classify(trajectory, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
+    """:func:`periodicity` of a window's return map, with ``kind = "no stick-slip"`` below 2 returns."""
+    x = return_map(trajectory)
+    if x.size < 2:
+        return Periodicity("no stick-slip", None, math.nan, int(x.size), period_rtol)
+    return periodicity(x, rtol=period_rtol, max_period=max_period)
 
 
 # ---------------------------------------------------------------------------------------------- attractors
@@ -179,7 +220,7 @@ def attractors(
     alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
     *,
     t_transient: float = 30.0,
-    window: float = 10.0,
+    window: float = 20.0,
     rtol: float = 1e-10,
     period_rtol: float = 1e-6,
     match_rtol: float = 1e-4,
@@ -187,36 +228,44 @@ def attractors(
 ) -> List[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
-    Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=10, rtol=1e-10,
+    Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=20, rtol=1e-10,
     period_rtol=1e-6, match_rtol=1e-4, progress=None) -> list[Attractor]``.
 
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
-    (discarded) and ``window`` s (stored jumps).  Two periodic orbits are the same attractor when their
+    (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same attractor when their
     periods agree and their sorted return-map cycles agree to ``match_rtol`` relative (a cycle is the same
     set of jump forces whatever its phase); aperiodic windows are grouped by their return range.  A start
     that breaks down (``ModelBreakdown``) or is infeasible (``ValueError``) is reported as its own entry.
     More than one entry means coexisting attractors — or a transient longer than ``t_transient``: the
     entries' settle times tell which.
     """
-    from exact import ModelBreakdown, simulate
+    from exact import ModelBreakdown, initial_state
 
+    # validate everything up front: inside the loop a ValueError can then only be an infeasible start
+    kw = dict(t_transient=float(t_transient), window=positive("window", window), rtol=positive("rtol", rtol))
+    if not (math.isfinite(kw["t_transient"]) and kw["t_transient"] >= 0.0):
+        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
+    positive("period_rtol", period_rtol)
+    positive("match_rtol", match_rtol)
+    if len(alpha0s) == 0:
+        raise ValueError("alpha0s must hold at least one initial peel angle")
     say = progress or (lambda msg: None)
     groups: List[dict] = []
     for a0 in alpha0s:
         say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
         try:
-            tr = simulate(params, t_transient + window, alpha0=a0, rtol=rtol, t_transient=t_transient,
-                          save="jumps")
+            initial_state(params, alpha0=a0)
+            tr = window_run(params, alpha0=a0, **kw)
         except (ModelBreakdown, ValueError) as exc:
             groups.append(dict(label=f"{type(exc).__name__}: {str(exc)[:80]}", period=None, signature=(),
                                F_range=(math.nan, math.nan), starts=[a0], settle=[None]))
             continue
+        per = classify(tr, period_rtol=period_rtol)
         x = return_map(tr)
-        if x.size < 2:
-            groups.append(dict(label="no stick-slip", period=None, signature=(), F_range=(math.nan, math.nan),
+        if per.kind == "no stick-slip":
+            groups.append(dict(label=per.kind, period=None, signature=(), F_range=(math.nan, math.nan),
                                starts=[a0], settle=[None]))
             continue
-        per = periodicity(x, rtol=period_rtol)
         if per.kind == "periodic":
             sig = tuple(float(v) for v in np.sort(x[: per.period]))
         else:
@@ -282,7 +331,8 @@ def benettin(
         ``distance(a, b) -> float``, any norm (the exponent does not depend on it).
     rescale : callable
         ``rescale(x_ref, x_pert, factor) -> x_pert`` putting the perturbation back to ``factor`` times its
-        size along its current direction.
+        size along its current direction (or shorter: the next interval's growth is measured from the
+        distance it returns).
     n : int
         Number of renormalisation intervals kept.
     n_discard : int
@@ -301,6 +351,7 @@ def benettin(
         raise ValueError(f"the initial perturbation must have a finite positive size, got {d0}")
     wall0 = time.perf_counter()
     logs, dts = [], []
+    d_start = d0
     for k in range(int(n_discard) + int(n)):
         x_ref, x_pert, dt = advance(x_ref, x_pert)
         d = float(distance(x_ref, x_pert))
@@ -308,9 +359,12 @@ def benettin(
             raise ValueError(f"the perturbation collapsed or diverged at interval {k} (distance {d}); choose a "
                              f"different d0 or interval")
         if k >= n_discard:
-            logs.append(math.log(d / d0))
+            logs.append(math.log(d / d_start))
             dts.append(dt)
         x_pert = rescale(x_ref, x_pert, d0 / d)
+        # the growth of the next interval is measured from the size rescale actually gave (it may shorten
+        # the perturbation further, e.g. to keep a state feasible)
+        d_start = float(distance(x_ref, x_pert))
     logs, dts = np.array(logs), np.array(dts)
     T = float(dts.sum())
     local = logs / dts
@@ -351,7 +405,7 @@ def lyapunov(
     """Largest Lyapunov exponent of the exact (hybrid) peeling dynamics, in bits/s.
 
     Signature: ``lyapunov(params, *, t_transient=30, tau=0.005, n=10000, n_discard=200, d0=1e-7, alpha0=0,
-    rtol=1e-12) -> LyapunovResult`` (50 s measured after 30 s of transient; ~4 s of wall time).
+    rtol=1e-12) -> LyapunovResult`` (50 s measured after 30 s of transient; 3-4 s of wall time).
 
     Method: :func:`benettin` on the hybrid solver.  The state is ``(α, ω, F, branch)`` — v follows from
     CONSTR — and the distance is measured in the continuous variables scaled by their natural sizes,
@@ -394,18 +448,31 @@ def lyapunov(
         return float(np.linalg.norm(vec(a) - vec(b)))
 
     def rescale(ref, pert, factor):
-        x = (vec(ref) + factor * (vec(pert) - vec(ref))) * scale
-        return (float(x[0]), float(x[1]), float(x[2]), ref[3])
+        # a state near a fold may leave its branch's level range when moved: halve the step until it does not
+        for _ in range(60):
+            x = (vec(ref) + factor * (vec(pert) - vec(ref))) * scale
+            G = x[2] * (1.0 + float(params.closure(x[0])[0]))
+            if bs.has_root(G, ref[3]):
+                return (float(x[0]), float(x[1]), float(x[2]), ref[3])
+            factor *= 0.5
+        return ref  # unreachable in practice: the reference itself lies on its branch
+
+    max_postpones = 64
 
     def advance(ref, pert):
         ref, nj = run(ref, tau)
         pert, _ = run(pert, tau)
         dt = tau
-        while ref[3] != pert[3]:
+        for _ in range(max_postpones):
+            if ref[3] == pert[3]:
+                break
             ref, nj2 = run(ref, tau / 8)
             pert, _ = run(pert, tau / 8)
             dt += tau / 8
             nj += nj2
+        else:
+            raise RuntimeError(f"lyapunov: the two orbits stayed on different branches for {max_postpones} "
+                               f"postponements of tau/8 = {tau / 8:g} s: d0 = {d0:g} is too large for this orbit")
         jumps[0] += nj
         return ref, pert, dt
 
@@ -414,31 +481,117 @@ def lyapunov(
     if t_transient > 0:
         ref, _ = run(ref, t_transient)
     # the perturbation: along F (the variable the constraint and the jumps act on), size d0
-    pert = (ref[0], ref[1], ref[2] + d0 * scale[2], ref[3])
+    pert = rescale(ref, (ref[0], ref[1], ref[2] + d0 * scale[2], ref[3]), 1.0)
     res = benettin(advance, ref, pert, distance, rescale, n, n_discard=n_discard)
     ln2 = math.log(2.0)
     return LyapunovResult(res.exponent, res.exponent / ln2, res.stderr / ln2, res, params, tau, jumps[0])
 
 
-# ---------------------------------------------------------------------------------------------- sweep measures
-def measure_period(params: PeelParams, options) -> dict:
-    """Sweep measure ``period``: the return map's period over ``[t_transient, t_end]`` (options
-    ``t_transient`` = 30 s, ``t_end`` = 50 s, ``rtol`` = 1e-10 of the solver, ``period_rtol`` = 1e-6,
-    ``alpha0`` = 0).  ``period`` is None when aperiodic (no n <= 32 repeats) or too short; a
-    ``ModelBreakdown`` is ``status = "breakdown:<reason>"``."""
-    from exact import ModelBreakdown, simulate
+def lyapunov_return_map(
+    params: PeelParams,
+    *,
+    t_transient: float = 30.0,
+    n_returns: int = 5000,
+    h: float = 1e-6,
+    rtol: float = 1e-12,
+) -> LyapunovResult:
+    """Largest Lyapunov exponent from the tangent map of the jump-to-jump (Poincaré) map, in bits/s.
 
-    t_tr = float(options.get("t_transient", 30.0))
+    Signature: ``lyapunov_return_map(params, *, t_transient=30, n_returns=5000, h=1e-6, rtol=1e-12)
+    -> LyapunovResult``.
+
+    The section is the AB→CD jump; the return map P takes the state (α, ω, F) just after one such jump to
+    the state at the next.  A tangent vector w is pushed through P's Jacobian by central differences,
+    ``DP w ≈ [P(x + h w) − P(x − h w)] / 2h`` in the scaled variables (α, ω/(V/R), F/f_max) — the jumps'
+    saltation is inside P, so nothing is linearised across them — and renormalised every return.  The
+    flow's exponent is ``Σ log|DP_k w_k| / Σ T_k`` over the return times T_k.  Unlike :func:`lyapunov`
+    there is no finite perturbation left to grow and no renormalisation noise; the result is independent
+    of h over 1e-8 … 1e-5 (docs/dynamics.md).  On a periodic orbit it gives the (negative) transverse
+    exponent, not the flow's 0.  A cross-check of :func:`lyapunov`, not a replacement: it needs a return
+    map with at least two returns per second of the run.
+    """
+    from exact import simulate
+
+    h = positive("h", h)
+    rtol = positive("rtol", rtol)
+    if isinstance(n_returns, bool) or int(n_returns) < 2:
+        raise ValueError(f"n_returns must be an integer >= 2, got {n_returns!r}")
+    bs = branch_structure(params.V)
+    scale = np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
+
+    def ret(x, horizon):
+        J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol,
+                     save="jumps").jumps
+        ab = np.flatnonzero(np.asarray(J.from_branch) == _AB)
+        if ab.size == 0:
+            return None, None
+        i = ab[0]
+        return np.array([J.alpha[i], J.omega[i], J.F[i]]), float(J.t[i])
+
+    J0 = window_run(params, t_transient=0.0, window=max(float(t_transient), 1e-3), rtol=rtol).jumps
+    ab = np.flatnonzero(np.asarray(J0.from_branch) == _AB)
+    if ab.size == 0:
+        raise ValueError(f"no AB→CD jump within t_transient = {t_transient} s: no return map to linearise")
+    k = int(ab[-1])  # start on the section, at the transient's last AB→CD jump
+    x = np.array([J0.alpha[k], J0.omega[k], J0.F[k]])
+    w = np.array([0.3, 0.3, 1.0]) / math.sqrt(1.18)
+    wall0 = time.perf_counter()
+    logs, dts, horizon, jumps = [], [], 1.0, 0
+    while len(logs) < int(n_returns):
+        y, dt = ret(x, horizon)
+        if y is None:
+            if horizon > 1e3:
+                raise ValueError("the orbit stopped returning to the AB→CD section (no stick-slip)")
+            horizon *= 2.0
+            continue
+        horizon = 3.0 * dt
+        yp, _ = ret(x + h * w * scale, horizon)
+        ym, _ = ret(x - h * w * scale, horizon)
+        if yp is None or ym is None:
+            raise ValueError("a perturbed orbit did not return within 3 return times: h is too large")
+        Dw = (yp - ym) / (2.0 * h) / scale
+        d = float(np.linalg.norm(Dw))
+        logs.append(math.log(d))
+        dts.append(dt)
+        w, x = Dw / d, y
+        jumps += 2
+    logs, dts = np.array(logs), np.array(dts)
+    T = float(dts.sum())
+    local = logs / dts
+    b = BenettinResult(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local,
+                       float(np.std(local, ddof=1) / math.sqrt(len(local))), T, len(logs), h,
+                       time.perf_counter() - wall0)
+    ln2 = math.log(2.0)
+    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, math.nan, jumps,
+                          method="tangent map of the AB→CD return map (central differences)")
+
+
+# ---------------------------------------------------------------------------------------------- sweep measures
+def _window_options(options) -> dict:
+    """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted)."""
+    kw = dict(WINDOW_DEFAULTS)
+    for key in ("t_transient", "window", "rtol", "alpha0"):
+        if options.get(key) is not None:
+            kw[key] = float(options[key])
+    if options.get("t_end") is not None:
+        kw["window"] = float(options["t_end"]) - kw["t_transient"]
+    return kw
+
+
+def measure_period(params: PeelParams, options) -> dict:
+    """Sweep measure ``period``: the return map's period over the window of :func:`window_run` (options
+    ``t_transient`` = 30 s, ``t_end`` = t_transient + 20 s, ``rtol`` = 1e-10, ``alpha0`` = 0,
+    ``period_rtol`` = 1e-6).  ``period`` is None when aperiodic (no n <= 32 repeats), too short or without
+    stick-slip; a ``ModelBreakdown`` is ``status = "breakdown:<reason>"``."""
+    from exact import ModelBreakdown
+
     try:
-        tr = simulate(params, float(options.get("t_end", t_tr + 20.0)), t_transient=t_tr, save="jumps",
-                      rtol=float(options.get("rtol", 1e-10)), alpha0=float(options.get("alpha0", 0.0)))
+        tr = window_run(params, **_window_options(options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
-    x = return_map(tr)
-    if x.size < 2:
-        return {"status": "ok", "label": "no stick-slip", "period": None, "mismatch": None, "n_returns": int(x.size)}
-    p = periodicity(x, rtol=float(options.get("period_rtol", 1e-6)))
-    return {"status": "ok", "label": p.label, "period": p.period, "mismatch": p.mismatch, "n_returns": p.n_returns}
+    p = classify(tr, period_rtol=float(options.get("period_rtol", 1e-6)))
+    return {"status": "ok", "label": p.label, "period": p.period,
+            "mismatch": p.mismatch if math.isfinite(p.mismatch) else None, "n_returns": p.n_returns}
 
 
 def measure_lyapunov(params: PeelParams, options) -> dict:
@@ -456,13 +609,5 @@ def measure_lyapunov(params: PeelParams, options) -> dict:
     return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}
 
 
-def _register_measures() -> None:
-    try:
-        from ._sweep import register_measure
-    except ImportError:  # pragma: no cover - the sweep engine is part of the package
-        return
-    register_measure("period", measure_period)
-    register_measure("lyapunov", measure_lyapunov)
-
-
-_register_measures()
+register_measure("period", measure_period)
+register_measure("lyapunov", measure_lyapunov)

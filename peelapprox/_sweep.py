@@ -15,17 +15,19 @@ flat dict of JSON scalars (``float, int, str, bool, None``; numpy scalars are
 converted).  Keys are prefixed ``"<name>_"`` by the engine unless they already
 equal ``name`` or start with ``"<name>_"``.  Register with
 :func:`register_measure`; the built-ins are ``"regime"`` (closed-form regime
-estimate, milliseconds) and ``"jumps"`` (statistics of the stick-slip jumps of
-the exact solution).  The engine imports :mod:`peelapprox._dynamics` lazily
-(if it exists) before resolving names, so measures registered there are
-available too.
+estimate, milliseconds), ``"jumps"`` (statistics of the stick-slip jumps of
+the exact solution) and, registered by :mod:`peelapprox._dynamics`,
+``"period"`` (period of the return map) and ``"lyapunov"`` (largest Lyapunov
+exponent, bits/s).
 
 Options
 -------
 ``options`` is one JSON-serialisable dict passed to every measure.  The engine
 itself reads ``k, R, l, geometry`` (the :class:`PeelParams` fields other than
-I and V; defaults as there); the built-in measures read ``t_end`` (20 s),
-``t_transient`` (10 s), ``rtol`` (1e-8) and ``alpha0`` (0).
+I and V; defaults as there); ``jumps`` and ``period`` share one windowed run
+(:func:`peelapprox._dynamics.window_run`) and read ``t_transient`` (30 s),
+``t_end`` (t_transient + 20 s), ``rtol`` (1e-10) and ``alpha0`` (0);
+``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).
 
 Output directory
 ----------------
@@ -93,8 +95,6 @@ Measure = Callable[[PeelParams, Mapping], dict]
 MEASURES: dict[str, Measure] = {}
 
 _NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-_PLUGIN_MODULES = ("peelapprox._dynamics",)
-_plugin_errors: dict[str, str] = {}
 
 
 def _ref(fn: Callable) -> str:
@@ -127,21 +127,6 @@ def register_measure(name: str, fn: Optional[Measure] = None, *, replace: bool =
     return fn
 
 
-def _load_plugins() -> None:
-    """Import the modules that register further measures (once; missing ones are skipped)."""
-    for mod in _PLUGIN_MODULES:
-        if mod in sys.modules or mod in _plugin_errors:
-            continue
-        try:
-            importlib.import_module(mod)
-        except ImportError as exc:  # not written yet / optional dependency missing
-            _plugin_errors[mod] = f"{type(exc).__name__}: {exc}"
-        except Exception as exc:  # a broken plugin must not break the other measures
-            _plugin_errors[mod] = f"{type(exc).__name__}: {exc}"
-            warnings.warn(f"importing {mod} failed, its measures are unavailable: {type(exc).__name__}: {exc}",
-                          RuntimeWarning, stacklevel=3)
-
-
 # --------------------------------------------------------------------------------------------- built-in measures
 
 def _measure_regime(params: PeelParams, options: Mapping) -> dict:
@@ -166,7 +151,8 @@ def _measure_regime(params: PeelParams, options: Mapping) -> dict:
 
 
 def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
-    """Stick-slip jump statistics of the exact solution in the window ``[t_transient, t_end]``.
+    """Stick-slip jump statistics of the exact solution in the window ``[t_transient, t_end]``
+    (:func:`peelapprox._dynamics.window_run`: t_transient 30 s, t_end t_transient + 20 s, rtol 1e-10).
 
     ``count`` jumps in the window, ``n_slips`` of them AB→CD; ``mean_interval``
     = mean time between consecutive jumps (either kind), ``mean_period`` =
@@ -176,18 +162,13 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     None.  A :class:`ModelBreakdown` gives ``status = "breakdown:<reason>"``
     and the breakdown time ``t_breakdown``.
     """
-    from exact import simulate
-
+    from ._dynamics import _window_options, force_drops, return_map, window_run
     from ._errors import ModelBreakdown
 
-    t_end = float(options.get("t_end", 20.0))
-    try:
-        traj = simulate(params, t_end, t_transient=float(options.get("t_transient", 10.0)), save="jumps",
-                        rtol=float(options.get("rtol", 1e-8)), alpha0=float(options.get("alpha0", 0.0)))
+    try:  # the same windowed run (and defaults) as the `period` measure: computed once per point
+        traj = window_run(params, **_window_options(options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}", "t_breakdown": float(exc.t)}
-    from ._dynamics import force_drops, return_map
-
     t = np.asarray(traj.jumps.t, dtype=float)
     t_slip = t[np.asarray(traj.jumps.from_branch) == 0]  # AB -> CD
     drops = force_drops(traj)
@@ -225,8 +206,6 @@ def _resolve(name: str, ref: Optional[str]) -> Measure:
             return _import_ref(ref)
         except Exception:
             pass
-    if name not in MEASURES:
-        _load_plugins()
     if name in MEASURES:
         return MEASURES[name]
     raise LookupError(f"measure {name!r} cannot be resolved in this process (import reference {ref!r}); "
@@ -710,13 +689,9 @@ def sweep(
         raise ValueError(f"measures must name at least one measure; known: {sorted(MEASURES)}")
     if len(set(measures)) != len(measures):
         raise ValueError(f"measures must not repeat a name, got {measures}")
-    _load_plugins()
     unknown = [m for m in measures if m not in MEASURES]
     if unknown:
-        hint = "".join(f"; {mod} could not be imported ({err})" for mod, err in _plugin_errors.items()
-                       if not err.startswith("ModuleNotFoundError: No module named 'peelapprox._")) \
-            if _plugin_errors else ""
-        raise ValueError(f"unknown measure(s) {unknown}; known: {sorted(MEASURES)}{hint}")
+        raise ValueError(f"unknown measure(s) {unknown}; known: {sorted(MEASURES)}")
     options = {} if options is None else options
     if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
         raise ValueError(f"options must be a mapping with str keys, got {options!r}")

@@ -375,11 +375,15 @@ def _dynamics(args: argparse.Namespace) -> int:
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
     try:
-        tr = simulate(p, args.t_transient + args.window, alpha0=args.alpha0, t_transient=args.t_transient,
-                      rtol=args.rtol, save="jumps")
-        x, d = return_map(tr), force_drops(tr)
-        per = periodicity(x, max_period=args.max_period) if x.size > 1 else None
+        # one run from t = 0: the window's jumps for the return map and force drops, all of them for the
+        # settle time
         full = simulate(p, args.t_transient + args.window, alpha0=args.alpha0, rtol=args.rtol, save="jumps")
+        t_k, x_all = return_map(full, with_times=True)
+        in_window = t_k >= args.t_transient
+        x = x_all[in_window]
+        per = periodicity(x, max_period=args.max_period) if x.size > 1 else None
+        d = force_drops(full)
+        d = d[in_window[: d.size]] if d.size else d
         row.update(returns=int(x.size), period=per.label if per else "no stick-slip",
                    period_mismatch=per.mismatch if per else None,
                    settle_time=settle_time(full, max_period=args.max_period),
@@ -519,10 +523,10 @@ def build_parser() -> argparse.ArgumentParser:
                        help="start a dask LocalCluster with N single-threaded worker processes")
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
                        help="connect to a running dask scheduler, e.g. tcp://host:8786")
-    sw.add_argument("--t-end", type=float, default=None, help="jumps: final time [s] (20)")
-    sw.add_argument("--t-transient", type=float, default=None, help="jumps: transient skipped [s] (10)")
-    sw.add_argument("--rtol", type=float, default=None, help="jumps: solver tolerance (1e-8)")
-    sw.add_argument("--alpha0", type=float, default=None, help="jumps: initial peel angle [rad] (0)")
+    sw.add_argument("--t-end", type=float, default=None, help="final time [s] (jumps, period: t_transient + 20)")
+    sw.add_argument("--t-transient", type=float, default=None, help="transient skipped [s] (30)")
+    sw.add_argument("--rtol", type=float, default=None, help="solver tolerance (jumps, period: 1e-10)")
+    sw.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (0)")
     sw.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (1000)")
     sw.add_argument("--R", type=float, default=None, help="roller radius [m] (0.1)")
     sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label")
@@ -545,7 +549,7 @@ def build_parser() -> argparse.ArgumentParser:
     dy.add_argument("--window", type=float, default=20.0, help="analysed [s] (20)")
     dy.add_argument("--rtol", type=float, default=1e-10)
     dy.add_argument("--max-period", type=int, default=32)
-    dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (~5 s)")
+    dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (a few s)")
     dy.add_argument("--attractors", metavar="A0,A0,...", help="sample these initial peel angles for coexisting "
                                                               "attractors")
     dy.add_argument("--format", choices=("table", "json"), default="table")

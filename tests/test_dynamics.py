@@ -112,3 +112,26 @@ def test_lyapunov_positive_in_the_chaotic_window_and_zero_on_a_periodic_orbit():
     assert 3.5 < chaotic.bits_per_s < 5.0
     periodic = lyapunov(PeelParams(V=1.0, I=1e-2))
     assert abs(periodic.bits_per_s) < 0.3
+
+
+def test_return_map_lyapunov_needs_a_return_map():
+    """Above the stick-slip window (V = 6: f has no folds) there is no AB→CD section to linearise: a
+    ValueError says so; a non-positive h is refused by name."""
+    from peelapprox._dynamics import lyapunov_return_map
+
+    with pytest.raises(ValueError, match="no AB→CD jump"):
+        lyapunov_return_map(PeelParams(V=6.0, I=1e-3), t_transient=1.0)
+    with pytest.raises(ValueError, match="h must be"):
+        lyapunov_return_map(PeelParams(V=2.0, I=1e-4), h=0.0)
+
+
+@pytest.mark.slow
+def test_two_lyapunov_methods_agree_where_the_chaos_is_strongest():
+    """Cross-check: at V = 2.5, I = 1e-4 the two-trajectory estimate (5.19 bits/s) and the tangent map of
+    the return map (5.38 bits/s) agree to 10 %.  (At V = 1.5 and 2 they differ by 25-30 %, an open
+    discrepancy recorded in docs/dynamics.md, so the test does not claim more.)"""
+    from peelapprox._dynamics import lyapunov, lyapunov_return_map
+
+    a = lyapunov(PeelParams(V=2.5, I=1e-4)).bits_per_s
+    b = lyapunov_return_map(PeelParams(V=2.5, I=1e-4)).bits_per_s
+    assert a > 3.0 and abs(a - b) / b < 0.10
