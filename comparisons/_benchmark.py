@@ -40,6 +40,7 @@ Outputs: ``work_precision.csv`` / ``.json``, ``eps_study.csv``, ``work_precision
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import os
 import sys
@@ -364,6 +365,19 @@ class EpsRow:
     status: str = "ok"
 
 
+@functools.lru_cache(maxsize=4)
+def _eps_reference(scene: BenchScene):
+    """The ε → 0 jumps (hybrid, rtol 1e-13) of a scene and the ε studies' horizon (halfway between the
+    second and third jump): one AB-fold and one CD-fold passage, in that order."""
+    full = simulate(scene.params, scene.horizon, alpha0=scene.alpha0, rtol=1e-13, save="jumps").jumps
+    if len(full) < 3:
+        raise ValueError(f"the ε study needs a scene with at least 3 jumps in its horizon, {scene.name} has "
+                         f"{len(full)}")
+    if full.from_branch[0] != 0:
+        raise ValueError(f"the ε study needs the scene's first jump to be AB→CD ({scene.name}'s is CD→AB)")
+    return full, 0.5 * (full.t[1] + full.t[2])
+
+
 def eps_study(
     scene: BenchScene,
     eps_values: Sequence[float] = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-15),
@@ -382,10 +396,7 @@ def eps_study(
     failing; ε = 1e-11 needs 35 000 steps) is a row with its status, not an exception.
     """
     say = progress or (lambda msg: None)
-    full = simulate(scene.params, scene.horizon, alpha0=scene.alpha0, rtol=1e-13, save="jumps").jumps
-    if len(full) < 3:
-        raise ValueError(f"eps_study needs a scene with at least 3 jumps in its horizon, {scene.name} has {len(full)}")
-    horizon = 0.5 * (full.t[1] + full.t[2])
+    full, horizon = _eps_reference(scene)
     ref = full[0], full[1]
     rows = []
     for eps in eps_values:
@@ -423,8 +434,7 @@ def small_eps_check(
     from ._peers import run_peer
 
     say = progress or (lambda msg: None)
-    full = simulate(scene.params, scene.horizon, alpha0=scene.alpha0, rtol=1e-13, save="jumps").jumps
-    horizon = 0.5 * (full.t[1] + full.t[2])
+    full, horizon = _eps_reference(scene)
     rows = []
     for eps in eps_values:
         say(f"small eps {eps:.0e}: Radau")

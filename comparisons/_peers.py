@@ -76,7 +76,8 @@ from typing import TYPE_CHECKING, Sequence, Union
 import numpy as np
 
 from exact._simulate import ATOL_SCALE, initial_state
-from peelapprox._peelforce import branch_structure, peel_force_coefficients
+from peelapprox import GEOMETRIES
+from peelapprox._peelforce import branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
     from peelapprox import PeelParams
@@ -212,7 +213,6 @@ def available_peers() -> tuple[str, ...]:
 #: inflection velocity, the initial state and the state scales (= atol).
 DIFFSL_INPUTS = ("V", "I", "k", "R", "l", "eps", "vm", "a0", "w0", "F0", "v0", "sa", "sw", "sF", "sv")
 
-_GEOMETRIES = ("paper", "exact")
 
 
 def _diffsl_expressions(geometry: str) -> dict:
@@ -251,8 +251,8 @@ def diffsl_code(geometry: str = "paper") -> str:
     -------
     str
     """
-    if geometry not in _GEOMETRIES:
-        raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {geometry!r}")
+    if geometry not in GEOMETRIES:
+        raise ValueError(f"geometry must be one of {GEOMETRIES}, got {geometry!r}")
     inputs = ", ".join(f"{n} = 1.0" for n in DIFFSL_INPUTS)
     e = _diffsl_expressions(geometry)
     return f"""
@@ -343,9 +343,9 @@ def _check(peer, params, t_end, eps, rtol, atol):
 
 
 def _qvec(params, eps):
-    b, A = peel_force_coefficients(params.V)
-    return np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
-                     0.0 if params.geometry == "paper" else 1.0])
+    from exact._regularized import param_vector
+
+    return param_vector(params, eps)
 
 
 def _run_sundials(peer, params, t_end, eps, rtol, atol, y0, vm):
@@ -414,7 +414,7 @@ def _run_sundials(peer, params, t_end, eps, rtol, atol, y0, vm):
 DIFFSOL_OPTIONS = dict(min_timestep=1e-18, update_jacobian_after_steps=1, update_rhs_jacobian_after_steps=1)
 
 
-def _run_diffsol(params, t_end, eps, rtol, atol, y0, vm):
+def _run_diffsol(params, t_end, eps, rtol, atol, y0):
     c0 = time.perf_counter()
     ode = diffsl_model(params.geometry)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0  # scalar atol 1 on y = X / atol
@@ -503,7 +503,7 @@ def run_peer(
     y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v])
     vm = branch_structure(params.V).v_inflection
     if peer == "diffsol":
-        out = _run_diffsol(params, t_end, eps, rtol, a, y0, vm)
+        out = _run_diffsol(params, t_end, eps, rtol, a, y0)
     else:
         out = _run_sundials(peer, params, t_end, eps, rtol, a, y0, vm)
     return PeerResult(peer=peer, eps=eps, rtol=rtol, atol=a, **out)

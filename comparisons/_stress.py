@@ -58,6 +58,7 @@ from typing import Any, Callable, Iterable, Optional, Sequence
 
 import numpy as np
 
+from peelapprox import GEOMETRIES
 from peelapprox._validate import positive
 
 __all__ = [
@@ -120,7 +121,6 @@ BUG_CLASSES: tuple[str, ...] = ("nan", "timeout", "crash", "unexpected:")
 DRIFT_FRACTION = 0.1
 
 _METHODS = ("hybrid", "regularized")
-_GEOMETRIES = ("paper", "exact")
 _SAVES = ("steps", "jumps")
 
 
@@ -198,8 +198,8 @@ class StressPoint:
         object.__setattr__(self, "rtol", rt)
         if self.method not in _METHODS:
             raise ValueError(f"method must be one of {_METHODS}, got {self.method!r}")
-        if self.geometry not in _GEOMETRIES:
-            raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {self.geometry!r}")
+        if self.geometry not in GEOMETRIES:
+            raise ValueError(f"geometry must be one of {GEOMETRIES}, got {self.geometry!r}")
         if self.save not in _SAVES:
             raise ValueError(f"save must be one of {_SAVES}, got {self.save!r}")
         if isinstance(self.n_eval, bool) or int(self.n_eval) != self.n_eval or self.n_eval < 0:

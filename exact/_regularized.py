@@ -66,13 +66,18 @@ def _jac(y, q):
     return out
 
 
+def param_vector(params, eps: float) -> np.ndarray:
+    """The parameter vector ``q`` of :func:`_fun` / :func:`_jac`: ``(V, I, k, R, l, b, A, eps, geometry)``."""
+    b, A = peel_force_coefficients(params.V)
+    return np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
+                     0.0 if params.geometry == "paper" else 1.0])
+
+
 def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, save, max_points, max_steps, max_jumps,
                     progress, v_floor):
     """Driver for ``simulate(method="regularized")`` (arguments already validated)."""
     bs = branch_structure(params.V)
-    b, A = peel_force_coefficients(params.V)
-    q = np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
-                  0.0 if params.geometry == "paper" else 1.0])
+    q = param_vector(params, eps)
     v_mid = bs.v_inflection
     fun = lambda t, y: _fun(y, q)  # noqa: E731
     jac = lambda t, y: _jac(y, q)  # noqa: E731

@@ -176,7 +176,6 @@ def _segment(args: argparse.Namespace) -> int:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    import os
 
     from comparisons import RUNS, SCENES, STAT_RUNS, TransientNotPassed, markdown, run_compare
 
@@ -227,7 +226,6 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _benchmark(args: argparse.Namespace) -> int:
-    import os
 
     from comparisons._benchmark import (markdown, plot_eps_study, plot_work_precision, rows_as_dicts,
                                         run_benchmark)
@@ -271,7 +269,6 @@ def _benchmark(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    import os
 
     from ._sweep import RESULTS, load_sweep, parse_grid, sweep
 
