@@ -44,9 +44,7 @@ times ever decrease or leave ``[0, t_end]``: a bug.
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
-import json
 import math
 import multiprocessing as mp
 import os
@@ -59,6 +57,7 @@ from typing import Any, Callable, Iterable, Optional, Sequence
 import numpy as np
 
 from peelapprox import GEOMETRIES
+from peelapprox._io import write_rows
 from peelapprox._validate import positive
 
 __all__ = [
@@ -1053,12 +1052,6 @@ def pair_long_runs(records: Sequence[dict]) -> None:
             r["jumps_match_save_jumps"] = bool(np.array_equal(np.asarray(r["_jump_t"]), np.asarray(mate["_jump_t"])))
 
 
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def write_records(records: Sequence[dict], out_dir: str) -> tuple[str, str]:
     """Write ``stress.csv`` and ``stress.json`` (one row per run; private ``_*`` keys dropped).
 
@@ -1077,14 +1070,8 @@ def write_records(records: Sequence[dict], out_dir: str) -> tuple[str, str]:
     os.makedirs(out_dir, exist_ok=True)
     rows = [{k: v for k, v in r.items() if not k.startswith("_")} for r in records]
     keys = list(dict.fromkeys(k for r in rows for k in r))
-    cp, jp = os.path.join(out_dir, "stress.csv"), os.path.join(out_dir, "stress.json")
-    with open(cp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys)
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
-    with open(jp, "w") as fh:
-        json.dump([{k: _jsonable(v) for k, v in r.items()} for r in rows], fh, indent=1, allow_nan=False)
+    cp = write_rows(os.path.join(out_dir, "stress.csv"), rows, fields=keys)
+    jp = write_rows(os.path.join(out_dir, "stress.json"), rows)
     return cp, jp
 
 

@@ -48,7 +48,6 @@ Output directory
 
 from __future__ import annotations
 
-import csv
 import datetime as _dt
 import importlib
 import json
@@ -487,13 +486,11 @@ class SweepResult:
 
     def to_csv(self, path) -> None:
         """One row per finished point; columns :meth:`keys`; None/absent as an empty cell; floats in full precision."""
-        cols = self.keys()
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(cols)
-            for rec in self.records:
-                w.writerow(["" if rec.get(c) is None else (repr(rec[c]) if isinstance(rec[c], float) else rec[c])
-                            for c in cols])
+        from ._io import write_rows
+
+        if not str(path).endswith(".csv"):
+            raise ValueError(f"path must end in .csv, got {str(path)!r}")
+        write_rows(path, self.records, fields=self.keys())
 
     def __repr__(self) -> str:
         n = self.I_values.size * self.V_values.size

@@ -98,19 +98,13 @@ def _folds(args: argparse.Namespace) -> int:
 
 
 def _write_rows(path: str, rows: list[dict]) -> None:
-    """Write rows as CSV or JSON, chosen by the file extension."""
-    import csv
+    """Write rows as CSV or JSON, chosen by the file extension (:func:`peelapprox._io.write_rows`)."""
+    from ._io import write_rows
 
-    if path.endswith(".json"):
-        with open(path, "w") as fh:
-            json.dump(rows, fh, indent=2)
-    elif path.endswith(".csv"):
-        with open(path, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
-    else:
-        raise ValueError(f"--out must end in .csv or .json, got {path!r}")
+    try:
+        write_rows(path, rows)
+    except ValueError:
+        raise ValueError(f"--out must end in .csv or .json, got {path!r}") from None
     print(f"wrote {path}", file=sys.stderr)
 
 
