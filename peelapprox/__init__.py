@@ -56,6 +56,8 @@ from ._dynamics import (
     benettin,
     force_drops,
     lyapunov,
+    lyapunov_return_map,
+    lyapunov_tangent,
     periodicity,
     return_map,
     settle_time,
@@ -116,6 +118,8 @@ __all__ = [
     "attractors",
     "Attractor",
     "lyapunov",
+    "lyapunov_tangent",
+    "lyapunov_return_map",
     "LyapunovResult",
     "benettin",
     # (I, V) sweeps

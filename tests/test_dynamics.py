@@ -135,3 +135,36 @@ def test_two_lyapunov_methods_agree_where_the_chaos_is_strongest():
     a = lyapunov(PeelParams(V=2.5, I=1e-4)).bits_per_s
     b = lyapunov_return_map(PeelParams(V=2.5, I=1e-4)).bits_per_s
     assert a > 3.0 and abs(a - b) / b < 0.10
+
+
+@pytest.mark.slow
+def test_saltation_tangent_dynamics_agrees_with_the_two_trajectory_estimate():
+    """The issue's primary method (variational equations with saltation matrices at the jumps) against the
+    two-trajectory estimate at V = 2.5, I = 1e-4: measured 5.05 bits/s over 20 s vs 5.19 over 50 s; the
+    10 % band covers the finite-time spread of a 20 s estimate."""
+    from peelapprox._dynamics import lyapunov, lyapunov_tangent
+
+    a = lyapunov(PeelParams(V=2.5, I=1e-4)).bits_per_s
+    c = lyapunov_tangent(PeelParams(V=2.5, I=1e-4), T=20.0).bits_per_s
+    assert abs(c - a) / a < 0.10
+
+
+def test_saltation_maps_the_flow_direction_onto_the_flow_direction():
+    """Defining property of a saltation matrix (analytic): S g⁻ = g⁺ — a perturbation along the flow before
+    the jump is the same orbit a little ahead, so after the jump it lies along the new flow.  And a tangent
+    with δv⁻ = 0 (on the event surface) is just reset: S δy = R δy.  Exact up to rounding (1e-12), at a real
+    fold state of V = 1, I = 1e-5."""
+    from exact import _hybrid as H
+    from exact import simulate
+    from exact._simulate import _param_vector
+    from exact._tangent import saltation
+
+    p = PeelParams(V=1.0, I=1e-5)
+    j = simulate(p, 0.01, save="jumps").jumps[0]
+    pv = _param_vector(p, 1e-9)
+    gm, gp = np.empty(4), np.empty(4)
+    H._rhs(np.array([0.0, j.alpha, j.omega, j.v_before]), pv, gm)
+    H._rhs(np.array([0.0, j.alpha, j.omega, j.v_after]), pv, gp)
+    assert np.allclose(saltation(gm, gm, gp), gp, rtol=1e-12, atol=0)
+    dy = np.array([1e-3, 0.2, -3.0, 0.0])
+    assert np.array_equal(saltation(dy, gm, gp), dy)

@@ -1,0 +1,179 @@
+"""Tangent (variational) dynamics of the hybrid solution with saltation matrices at the jumps.
+
+On a branch the hybrid solver integrates the desingularised field ``y' = g(y)``, ``y = (t, α, ω, v)``,
+in the parameter s (``exact._hybrid``); g is smooth through the folds.  A tangent vector δy obeys
+``δy' = Dg(y) δy``, integrated here together with y by the same compiled DOP853 (state + tangent, 8
+components); ``Dg δy`` is a central directional difference of g (two extra field evaluations, relative
+step 1e-7: accurate to ~1e-9 relative, far below the growth being measured).
+
+At the fold (the event ``h(y) = v − v_fold = 0``) the reset sets v to the landing root and keeps
+(t, α, ω).  The saltation matrix maps the tangent across it,
+
+    δy⁺ = S δy⁻,    S = R + (g⁺ − R g⁻) ∇hᵀ / (∇hᵀ g⁻),    R = diag(1, 1, 1, 0),
+
+i.e. ``δy⁺ = R δy⁻ + (g⁺ − R g⁻) δv⁻ / g_v⁻``: a perturbation that reaches the fold earlier by
+``δv⁻/g_v⁻`` in s has spent that long on the new branch.  (S maps the flow direction onto the flow
+direction, ``S g⁻ = g⁺``: tested.)  At the fold ``g⁻ = (0, 0, 0, v Ġ)`` (dt/ds, dα/ds and dω/ds vanish
+with f'), so ``R g⁻ = 0``.  Perturbations
+are compared at equal t at the measurement points: the (α, ω) part of ``δy − ẏ δt`` with
+``ẏ = (dy/ds)/(dt/ds)``, and the F part from CONSTR, ``δF = (∂F/∂α) δα + (∂F/∂v) δv``.
+
+This module owns only its small driver (integrate to the fold, no output); the step is the package's one
+DOP853 (:mod:`peelapprox._dop853`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
+from peelapprox._dop853 import interp, make_dop853, solve_theta, workspace
+
+from . import _hybrid as H
+
+_EPS_FD = 1e-7
+
+
+@njit(cache=True)
+def _rhs_tangent(y, p, out):
+    """d(y, δy)/ds: the hybrid field and its directional derivative along δy (central difference)."""
+    g = np.empty(4)
+    H._rhs(y[:4], p, g)
+    nrm = 0.0
+    ysz = 0.0
+    for i in range(4):
+        nrm += y[4 + i] * y[4 + i]
+        ysz += y[i] * y[i]
+    nrm = math.sqrt(nrm)
+    for i in range(4):
+        out[i] = g[i]
+    if nrm == 0.0:
+        for i in range(4):
+            out[4 + i] = 0.0
+        return
+    eta = _EPS_FD * max(1.0, math.sqrt(ysz) * 1e-3) / nrm
+    yp = np.empty(4)
+    ym = np.empty(4)
+    for i in range(4):
+        yp[i] = y[i] + eta * y[4 + i]
+        ym[i] = y[i] - eta * y[4 + i]
+    gp = np.empty(4)
+    gm = np.empty(4)
+    H._rhs(yp, p, gp)
+    H._rhs(ym, p, gm)
+    for i in range(4):
+        out[4 + i] = (gp[i] - gm[i]) / (2.0 * eta)
+
+
+_dop_t = make_dop853(_rhs_tangent)
+
+
+@njit(cache=True)
+def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
+    """Integrate (y, δy) from ``y`` on branch ``br`` to its fold or to t = t_max (whichever first).
+
+    Returns (status, steps); y holds the state there (v exactly at the fold for status 0).  status: 0 fold,
+    1 t_max, 2 step failure, 3 step budget.
+    """
+    K, y_new, f0, tmp, sc, work, Fc, ye = workspace(8)
+    _rhs_tangent(y, p, f0)
+    h = _dop_t.initial_step(y, f0, p, rtol, atol, work)
+    vf = p[H.P_VMAX] * (1.0 - H.FOLD_REL) if br == 0 else p[H.P_VMIN] * (1.0 + H.FOLD_REL)
+    for n in range(max_steps):
+        status, h, h_next, n_rej, n_rhs = _dop_t.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
+        if status == STEP_FAILED:
+            return 2, n
+        crossed = (y_new[3] >= vf) if br == 0 else (y_new[3] <= vf)
+        if crossed:
+            _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
+            x = solve_theta(y, Fc, 3, vf, y[3] - vf, 1.0, y_new[3] - vf)
+            interp(y, Fc, x, ye)
+            for i in range(8):
+                y[i] = ye[i]
+            y[3] = p[H.P_VMAX] if br == 0 else p[H.P_VMIN]
+            return 0, n + 1
+        for i in range(8):
+            y[i] = y_new[i]
+            f0[i] = K[_NS, i]
+        h = h_next
+        if y[0] >= t_max:
+            return 1, n + 1
+    return 3, max_steps
+
+
+def saltation(dy, g_minus, g_plus) -> np.ndarray:
+    """The tangent after a jump: ``S δy⁻`` with the fold event ``v = v_fold`` and the reset v := v_land
+    (module docstring); ``g_minus``, ``g_plus`` are the desingularised field before and after."""
+    R_dy = np.array([dy[0], dy[1], dy[2], 0.0])
+    R_g = np.array([g_minus[0], g_minus[1], g_minus[2], 0.0])
+    return R_dy + (np.asarray(g_plus) - R_g) * (dy[3] / g_minus[3])
+
+
+def _equal_time_vector(y, p, scale):
+    """(δα, δω, δF) at equal t (module docstring), scaled by (1, V/R, f_max)."""
+    g = np.empty(4)
+    H._rhs(y[:4], p, g)
+    dt = y[4]
+    if g[0] != 0.0:
+        da = y[5] - g[1] / g[0] * dt
+        dw = y[6] - g[2] / g[0] * dt
+        dv = y[7] - g[3] / g[0] * dt
+    else:  # exactly at a fold dα/dt and dω/dt stay finite but the quotient is 0/0: use δ at equal s
+        da, dw, dv = y[5], y[6], y[7]
+    eps = 1e-7
+    Fa = (H.pull_force(y[1] + eps, y[3], p) - H.pull_force(y[1] - eps, y[3], p)) / (2 * eps)
+    Fv = (H.pull_force(y[1], y[3] * (1 + eps), p) - H.pull_force(y[1], y[3] * (1 - eps), p)) / (2 * eps * y[3])
+    return np.array([da, dw, Fa * da + Fv * dv]) / scale
+
+
+def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rtol: float = 1e-10,
+                       alpha0: float = 0.0, max_steps: int = 10_000_000):
+    """Largest Lyapunov exponent [1/s] from the tangent dynamics with saltation matrices (module docstring).
+
+    Starts from the state at ``t_transient`` (exact.simulate from ``alpha0``), integrates the tangent for
+    ``T`` seconds, renormalising it after every jump, where its equal-time (α, ω, F) size is measured.
+    Returns ``(exponent_per_s, n_jumps, time)``.
+    """
+    from exact import simulate
+    from peelapprox import branch_structure
+
+    from ._simulate import ATOL_SCALE, _param_vector
+
+    s = simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state
+    p = _param_vector(params, 1e-9)
+    bs = branch_structure(params.V)
+    scale = np.array([1.0, params.V / params.R, bs.f_max])
+    # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
+    # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
+    atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])
+    br = 0 if s.branch == "AB" else 1
+    y = np.array([0.0, s.alpha, s.omega, s.v, 0.0, 0.0, 0.0, 1.0])
+    y[4:] /= np.linalg.norm(_equal_time_vector(y, p, scale))
+    t, logs, n_jumps, steps = 0.0, 0.0, 0, 0
+    g_minus, g_plus = np.empty(4), np.empty(4)
+    while t < T:
+        status, n = _to_fold(y, p, br, rtol, atol, T - t, max_steps - steps)
+        steps += n
+        if status == 1:
+            t += y[0]
+            logs += math.log(np.linalg.norm(_equal_time_vector(y, p, scale)))
+            break
+        if status != 0:
+            raise RuntimeError(f"tangent integration failed (status {status}) at t = {t + y[0]:.6g} s")
+        t += y[0]
+        H._rhs(y[:4], p, g_minus)
+        v_land = p[H.P_VLCD] if br == 0 else p[H.P_VLAB]
+        if not v_land > 0.0:
+            raise RuntimeError(f"no landing root at the fold at t = {t:.6g} s")
+        y[0], y[3] = 0.0, v_land
+        H._rhs(y[:4], p, g_plus)
+        y[4:] = saltation(y[4:], g_minus, g_plus)
+        br = 1 - br
+        n_jumps += 1
+        d = float(np.linalg.norm(_equal_time_vector(y, p, scale)))
+        logs += math.log(d)
+        y[4:] /= d
+    return logs / t, n_jumps, t
