@@ -75,8 +75,9 @@ from typing import TYPE_CHECKING, Sequence, Union
 
 import numpy as np
 
-from exact._simulate import ATOL_SCALE, initial_state
+from exact._simulate import _atol_vector, initial_state
 from peelapprox import GEOMETRIES
+from peelapprox._validate import positive
 from peelapprox._peelforce import branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -317,29 +318,14 @@ def _check(peer, params, t_end, eps, rtol, atol):
         raise ValueError(f"peer must be one of {PEERS}, got {peer!r}")
     if not isinstance(params, PeelParams):
         raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
-    vals = {}
-    for name, val in (("t_end", t_end), ("eps", eps), ("rtol", rtol)):
-        try:
-            vals[name] = float(val)
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a real number, got {val!r}") from None
-    if not (math.isfinite(vals["t_end"]) and vals["t_end"] > 0):
-        raise ValueError(f"t_end must be in (0, inf), got {t_end!r}")
-    if not (math.isfinite(vals["eps"]) and vals["eps"] > 0):
-        raise ValueError(f"eps must be in (0, inf), got {eps!r}")
-    if not (0.0 < vals["rtol"] < 1.0):
+    t_end, eps = positive("t_end", t_end), positive("eps", eps)
+    rt = positive("rtol", rtol)
+    if not rt < 1.0:
         raise ValueError(f"rtol must be in (0, 1), got {rtol!r}")
-    rt = vals["rtol"]
-    if atol is None:
-        a = rt * np.asarray(ATOL_SCALE["regularized"], dtype=float)
-    else:
-        a = np.asarray(atol, dtype=float)
-        if a.ndim == 0:
-            a = np.full(4, float(a))
-        if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a <= 0):
-            raise ValueError(f"atol must be None, a scalar or 4 values (alpha, omega, F, v), finite and in (0, inf), "
-                             f"got {atol!r}")
-    return vals["t_end"], vals["eps"], rt, a
+    a = _atol_vector("regularized", rt, atol)  # exact.simulate's default and checks
+    if np.any(a == 0.0):  # the DiffSL model divides by atol (it integrates X / atol)
+        raise ValueError(f"atol must be in (0, inf) for the peers, got {atol!r}")
+    return t_end, eps, rt, a
 
 
 def _qvec(params, eps):

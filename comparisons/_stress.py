@@ -58,7 +58,7 @@ import numpy as np
 
 from peelapprox import GEOMETRIES
 from peelapprox._io import write_rows
-from peelapprox._validate import positive
+from peelapprox._validate import finite, positive
 
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
@@ -184,13 +184,7 @@ class StressPoint:
     def __post_init__(self) -> None:
         for name in ("V", "I", "k", "t_end"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
-        try:
-            a0 = float(self.alpha0)
-        except (TypeError, ValueError):
-            raise ValueError(f"alpha0 must be a finite real number [rad], got {self.alpha0!r}") from None
-        if not math.isfinite(a0):
-            raise ValueError(f"alpha0 must be a finite real number [rad], got {self.alpha0!r}")
-        object.__setattr__(self, "alpha0", a0)
+        object.__setattr__(self, "alpha0", finite("alpha0", self.alpha0))
         rt = positive("rtol", self.rtol)
         if not (1e-14 <= rt <= 1e-2):
             raise ValueError(f"rtol must be in [1e-14, 1e-2], got {self.rtol!r}")
