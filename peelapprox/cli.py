@@ -361,7 +361,7 @@ def _figures(args: argparse.Namespace) -> int:
 def _dynamics(args: argparse.Namespace) -> int:
     from exact import ModelBreakdown, simulate
 
-    from ._dynamics import attractors, force_drops, lyapunov, periodicity, return_map, settle_time
+    from ._dynamics import attractors, force_drops, periodicity, return_map, settle_time
 
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
@@ -383,10 +383,15 @@ def _dynamics(args: argparse.Namespace) -> int:
                    F_min_at_jumps=float(x.min()) if x.size else None, F_max_at_jumps=float(x.max()) if x.size else None)
     except ModelBreakdown as exc:
         row.update(status=f"breakdown:{exc.reason} at t={exc.t:.6g}")
-    if args.lyapunov:
-        print("lyapunov: two-trajectory renormalisation ...", file=sys.stderr, flush=True)
-        ly = lyapunov(p, t_transient=args.t_transient, alpha0=args.alpha0)
-        row.update(lyapunov_bits_per_s=ly.bits_per_s, lyapunov_stderr=ly.stderr_bits)
+    if args.lyapunov or args.lyapunov_method:
+        method = args.lyapunov_method or "two-trajectory"
+        print(f"lyapunov ({method}, {args.lyapunov_time:g} s after {args.t_transient:g} s) ...", file=sys.stderr,
+              flush=True)
+        ly = _lyapunov_by_method(p, method, args, row.get("returns"))
+        row.update(lyapunov_method=method, lyapunov_time=args.lyapunov_time, lyapunov_bits_per_s=ly.bits_per_s,
+                   lyapunov_stderr=ly.stderr_bits, lyapunov_wall_time=ly.benettin.wall_time)
+        if method == "regularized":
+            row.update(eps=args.eps)
     _print_mapping(row, args.format)
     if args.attractors:
         a0s = [float(a) for a in args.attractors.split(",")]
@@ -404,6 +409,40 @@ def _dynamics(args: argparse.Namespace) -> int:
     if args.out:
         _write_rows(args.out, [row])
     return 0
+
+
+#: ``peelapprox dynamics --lyapunov-method`` choices.
+LYAPUNOV_METHODS = ("two-trajectory", "saltation", "return-map", "regularized")
+
+
+def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, returns):
+    """The largest Lyapunov exponent at ``p`` by one of :data:`LYAPUNOV_METHODS` over ``args.lyapunov_time`` s."""
+    from . import _dynamics as D
+
+    T, common = args.lyapunov_time, dict(t_transient=args.t_transient, alpha0=args.alpha0)
+    if method == "two-trajectory":
+        tau = 0.005
+        return D.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), **common)
+    if method == "saltation":
+        return D.lyapunov_tangent(p, T=T, **common)
+    if method == "return-map":
+        if args.alpha0 != 0.0:
+            raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
+        if not returns:
+            raise ValueError("--lyapunov-method return-map needs AB→CD returns in the window; there are none")
+        return D.lyapunov_return_map(p, t_transient=args.t_transient,
+                                     n_returns=max(2, int(round(returns / args.window * T))))
+    from comparisons._peers import lyapunov_regularized
+
+    step = max(args.t_transient + T, 1e-9) / 10.0
+    mark = [step]
+
+    def progress(t_done, t_total):
+        if t_done >= mark[0] - 1e-9 or t_done >= t_total:
+            print(f"  {t_done:g}/{t_total:g} s", file=sys.stderr, flush=True)
+            mark[0] += step
+
+    return lyapunov_regularized(p, eps=args.eps, T=T, progress=progress, **common)
 
 
 def _add_params(sp: argparse.ArgumentParser) -> None:
@@ -541,6 +580,12 @@ def build_parser() -> argparse.ArgumentParser:
     dy.add_argument("--rtol", type=float, default=1e-10)
     dy.add_argument("--max-period", type=int, default=32)
     dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (a few s)")
+    dy.add_argument("--lyapunov-method", choices=LYAPUNOV_METHODS,
+                    help="how (implies --lyapunov): two-trajectory renormalisation (the default), saltation "
+                         "(tangent dynamics with saltation matrices), return-map (tangent of the jump-to-jump "
+                         "map), regularized (variational equations of the ε-system; needs pydiffsol)")
+    dy.add_argument("--lyapunov-time", type=float, default=50.0, help="measured time [s] (50)")
+    dy.add_argument("--eps", type=float, default=1e-7, help="ε of --lyapunov-method regularized (1e-7)")
     dy.add_argument("--attractors", metavar="A0,A0,...", help="sample these initial peel angles for coexisting "
                                                               "attractors")
     dy.add_argument("--format", choices=("table", "json"), default="table")
@@ -552,9 +597,11 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = build_parser()
     args = ap.parse_args(argv)
+    from comparisons._peers import PeerUnavailableError
+
     try:
         return args.func(args)
-    except ValueError as exc:
+    except (ValueError, PeerUnavailableError) as exc:
         ap.exit(2, f"peelapprox {args.command}: error: {exc}\n")
 
 

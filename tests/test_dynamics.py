@@ -168,3 +168,19 @@ def test_saltation_maps_the_flow_direction_onto_the_flow_direction():
     assert np.allclose(saltation(gm, gm, gp), gp, rtol=1e-12, atol=0)
     dy = np.array([1e-3, 0.2, -3.0, 0.0])
     assert np.array_equal(saltation(dy, gm, gp), dy)
+
+
+def test_saltation_tangent_step_budget_raises_with_time_and_state():
+    """An exhausted step budget is a SolverBudgetExceeded naming ``max_steps`` with the time and state where
+    it stopped, never a truncated exponent; a non-positive budget is a ValueError naming it."""
+    from peelapprox import SolverBudgetExceeded
+    from peelapprox._dynamics import lyapunov_tangent
+
+    p = PeelParams(V=2.5, I=1e-4)
+    with pytest.raises(SolverBudgetExceeded, match="max_steps") as info:
+        lyapunov_tangent(p, t_transient=0.5, T=5.0, max_steps=200)
+    e = info.value
+    assert e.budget == "max_steps" and e.limit == 200 and 0.5 < e.t < 5.5
+    assert e.state["branch"] in ("AB", "CD") and np.isfinite(e.state["v"])
+    with pytest.raises(ValueError, match="max_steps"):
+        lyapunov_tangent(p, T=1.0, max_steps=0)
