@@ -77,7 +77,7 @@ import numpy as np
 
 from exact._simulate import _atol_vector, initial_state
 from peelapprox import GEOMETRIES, SolverFailure
-from peelapprox._validate import positive
+from peelapprox._validate import nonnegative, positive
 from peelapprox._peelforce import branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -564,6 +564,10 @@ def _slow_tangent(params, x, w, scale):
     return d
 
 
+def _state_dict(x) -> dict:
+    return dict(zip(("alpha", "omega", "F", "v"), map(float, x)))
+
+
 def tangent_solve(ode, params, eps: float, atol: np.ndarray, x, d, duration: float, *, t_start: float = 0.0):
     """One solve of the ``tangent=True`` model from state ``x`` and tangent ``d`` over ``duration`` seconds.
 
@@ -576,8 +580,7 @@ def tangent_solve(ode, params, eps: float, atol: np.ndarray, x, d, duration: flo
         sol = ode.solve(diffsl_inputs(params, eps, x, atol, d), duration)
     except RuntimeError as exc:
         raise SolverFailure(f"diffsol (tangent model) failed in the interval [{t_start:g}, {t_start + duration:g}] s: "
-                            f"{exc}", t=t_start, state=dict(zip(("alpha", "omega", "F", "v"), map(float, x)),
-                                                   tangent=[float(z) for z in d])) from exc
+                            f"{exc}", t=t_start, state=dict(_state_dict(x), tangent=[float(z) for z in d])) from exc
     ts = np.asarray(sol.ts, float)
     ys = np.asarray(sol.ys, float)[:, -1]
     n_cross = int(np.count_nonzero(np.diff(ts) == 0.0))
@@ -646,13 +649,9 @@ def lyapunov_regularized(
     peelapprox.SolverFailure
         diffsol gave up (its message, and the state at the start of the failing interval, are attached).
     """
-    from peelapprox._dynamics import BenettinResult, LyapunovResult
+    from peelapprox._dynamics import BenettinResult, LyapunovResult, natural_scales
 
-    T = positive("T", T)
-    tau = positive("tau", tau)
-    t_transient = float(t_transient)
-    if not (math.isfinite(t_transient) and t_transient >= 0):
-        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
+    T, tau, t_transient = positive("T", T), positive("tau", tau), nonnegative("t_transient", t_transient)
     _, eps, rtol, a = _check("diffsol", params, t_transient + T, eps, rtol, None)
     if progress is not None and not callable(progress):
         raise ValueError(f"progress must be callable or None, got {type(progress).__name__}")
@@ -661,8 +660,7 @@ def lyapunov_regularized(
     for name, val in TANGENT_OPTIONS.items():
         setattr(ode.options, name, val)
 
-    bs = branch_structure(params.V)
-    scale = np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
+    scale = natural_scales(params)
     s0 = initial_state(params, alpha0=alpha0)
     x = np.array([s0.alpha, s0.omega, s0.F, s0.v])
     d = _slow_tangent(params, x, np.array([0.3, 0.3, 1.0]) / math.sqrt(1.18), scale)
@@ -678,7 +676,7 @@ def lyapunov_regularized(
         size = float(np.linalg.norm(d[:3] / scale))
         if not (math.isfinite(size) and size > 0.0):
             raise SolverFailure(f"the tangent became {size!r} in the interval starting at t = {t_done:g} s",
-                                t=t_done, state=dict(zip(("alpha", "omega", "F", "v"), map(float, x))))
+                                t=t_done, state=_state_dict(x))
         d /= size
         steps += st
         crossings += nc

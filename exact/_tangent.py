@@ -148,14 +148,13 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     """
     from peelapprox import ModelBreakdown, SolverBudgetExceeded, SolverFailure
     from exact import simulate
-    from peelapprox import branch_structure
+    from peelapprox._dynamics import natural_scales
 
     from ._simulate import ATOL_SCALE, _param_vector
 
     s = simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state
     p = _param_vector(params, 1e-9)
-    bs = branch_structure(params.V)
-    scale = np.array([1.0, params.V / params.R, bs.f_max])
+    scale = natural_scales(params)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
     # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
     atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])

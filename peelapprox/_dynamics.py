@@ -31,7 +31,7 @@ import numpy as np
 from ._params import PeelParams
 from ._peelforce import BRANCHES, branch_structure
 from ._sweep import register_measure
-from ._validate import positive
+from ._validate import nonnegative, positive
 
 __all__ = [
     "return_map",
@@ -179,10 +179,7 @@ def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float =
     ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so measures of one
     sweep point share it.  Raises ``ModelBreakdown`` as :func:`exact.simulate` does.
     """
-    t_transient = float(t_transient)
-    if not (math.isfinite(t_transient) and t_transient >= 0.0):
-        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
-    return _window_run(params, t_transient, positive("window", window), positive("rtol", rtol), float(alpha0))
+    return _window_run(params, nonnegative("t_transient", t_transient), positive("window", window), positive("rtol", rtol), float(alpha0))
 
 
 @functools.lru_cache(maxsize=2)
@@ -244,9 +241,8 @@ def attractors(
     from exact import ModelBreakdown, initial_state
 
     # validate everything up front: inside the loop a ValueError can then only be an infeasible start
-    kw = dict(t_transient=float(t_transient), window=positive("window", window), rtol=positive("rtol", rtol))
-    if not (math.isfinite(kw["t_transient"]) and kw["t_transient"] >= 0.0):
-        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
+    kw = dict(t_transient=nonnegative("t_transient", t_transient), window=positive("window", window),
+              rtol=positive("rtol", rtol))
     positive("period_rtol", period_rtol)
     positive("match_rtol", match_rtol)
     if len(alpha0s) == 0:
@@ -287,6 +283,13 @@ def attractors(
 
 
 # ---------------------------------------------------------------------------------------------- Lyapunov
+def natural_scales(params: PeelParams) -> np.ndarray:
+    """The natural sizes ``(1 rad, V/R, f_max)`` of ``(α, ω, F)``: every Lyapunov estimate measures
+    perturbations in ``(δα, δω, δF)`` divided by these (``f_max`` is 1 N when f has no folds)."""
+    bs = branch_structure(params.V)
+    return np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
+
+
 @dataclass
 class BenettinResult:
     """Largest Lyapunov exponent by two-trajectory renormalisation.
@@ -430,11 +433,9 @@ def lyapunov(
 
     tau = positive("tau", tau)
     d0 = positive("d0", d0)
-    t_transient = float(t_transient)
-    if not (math.isfinite(t_transient) and t_transient >= 0):
-        raise ValueError(f"t_transient must be finite and >= 0, got {t_transient!r}")
+    t_transient = nonnegative("t_transient", t_transient)
     bs = branch_structure(params.V)
-    scale = np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
+    scale = natural_scales(params)
     jumps = [0]
 
     def run(state, dt):
@@ -556,8 +557,7 @@ def lyapunov_return_map(
     rtol = positive("rtol", rtol)
     if isinstance(n_returns, bool) or int(n_returns) < 2:
         raise ValueError(f"n_returns must be an integer >= 2, got {n_returns!r}")
-    bs = branch_structure(params.V)
-    scale = np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
+    scale = natural_scales(params)
 
     def ret(x, horizon):
         J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Optional
 
-__all__ = ["finite", "positive", "optional_finite"]
+__all__ = ["finite", "positive", "nonnegative", "optional_finite"]
 
 
 def finite(name: str, x) -> float:
@@ -27,6 +27,17 @@ def positive(name: str, x) -> float:
         raise ValueError(f"{name} must be a real number in (0, inf), got {x!r}") from None
     if not (math.isfinite(y) and y > 0.0):
         raise ValueError(f"{name} must be finite and in (0, inf), got {x!r}")
+    return y
+
+
+def nonnegative(name: str, x) -> float:
+    """``float(x)`` if it is a finite number in [0, inf), else ValueError naming ``name`` and the range."""
+    try:
+        y = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number in [0, inf), got {x!r}") from None
+    if not (math.isfinite(y) and y >= 0.0):
+        raise ValueError(f"{name} must be finite and in [0, inf), got {x!r}")
     return y
 
 
