@@ -686,14 +686,9 @@ def lyapunov_regularized(
         t_done += dt
         if progress is not None:
             progress(t_done, t_transient + T)
-    wall = time.perf_counter() - wall0
-    dts = np.full(n, T / n)
-    local = logs / dts
-    stderr = float(np.std(local, ddof=1) / math.sqrt(n)) if n > 1 else math.nan
-    lam = float(logs.sum() / T)
-    b = BenettinResult(lam, np.cumsum(logs) / np.cumsum(dts), local, stderr, T, n, math.nan, wall)
+    b = BenettinResult.from_logs(logs, np.full(n, T / n), math.nan, time.perf_counter() - wall0)
     ln2 = math.log(2.0)
-    return LyapunovResult(lam, lam / ln2, stderr / ln2, b, params, T / n, window_crossings,
+    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, T / n, window_crossings,
                           method=f"variational equations of the ε-regularised system (ε = {eps:g}, diffsol BDF)",
                           notes=[f"steps={steps}", f"crossings={crossings}", f"solves={len(chunks)}",
                                  f"rtol={rtol:g}"])

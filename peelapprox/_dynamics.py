@@ -309,6 +309,17 @@ class BenettinResult:
     d0: float
     wall_time: float
 
+    @classmethod
+    def from_logs(cls, logs, dts, d0: float, wall_time: float) -> "BenettinResult":
+        """The record of per-interval log growths ``logs`` over durations ``dts`` (the one place the
+        exponent, running estimate, local rates and standard error are computed from them)."""
+        logs, dts = np.asarray(logs, float), np.asarray(dts, float)
+        T = float(dts.sum())
+        local = logs / dts
+        stderr = float(np.std(local, ddof=1) / math.sqrt(local.size)) if local.size > 1 else math.nan
+        return cls(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local, stderr, T, int(logs.size),
+                   float(d0), float(wall_time))
+
 
 def benettin(
     advance: Callable,
@@ -370,12 +381,7 @@ def benettin(
         # the growth of the next interval is measured from the size rescale actually gave (it may shorten
         # the perturbation further, e.g. to keep a state feasible)
         d_start = float(distance(x_ref, x_pert))
-    logs, dts = np.array(logs), np.array(dts)
-    T = float(dts.sum())
-    local = logs / dts
-    return BenettinResult(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local,
-                          float(np.std(local, ddof=1) / math.sqrt(len(local))), T, len(logs), d0,
-                          time.perf_counter() - wall0)
+    return BenettinResult.from_logs(logs, dts, d0, time.perf_counter() - wall0)
 
 
 @dataclass
@@ -595,12 +601,7 @@ def lyapunov_return_map(
         dts.append(dt)
         w, x = Dw / d, y
         jumps += 2
-    logs, dts = np.array(logs), np.array(dts)
-    T = float(dts.sum())
-    local = logs / dts
-    b = BenettinResult(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local,
-                       float(np.std(local, ddof=1) / math.sqrt(len(local))), T, len(logs), h,
-                       time.perf_counter() - wall0)
+    b = BenettinResult.from_logs(logs, dts, h, time.perf_counter() - wall0)
     ln2 = math.log(2.0)
     return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, math.nan, jumps,
                           method="tangent map of the AB→CD return map (central differences)")
