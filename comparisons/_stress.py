@@ -58,12 +58,14 @@ import numpy as np
 
 from peelapprox import GEOMETRIES
 from peelapprox._io import write_rows
-from peelapprox._validate import finite, positive
+from peelapprox._validate import finite, nonnegative, positive
 
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
     "ALLOWED_PREFIXES", "BUG_CLASSES",
-    "StressPoint", "grid_points", "random_points", "tolerance_points", "budget_points", "variant_points", "long_points",
+    "LOOSE_V", "LOOSE_I", "LOOSE_ALPHA0", "LOOSE_TOLS",
+    "StressPoint", "grid_points", "random_points", "tolerance_points", "loose_points", "budget_points", "variant_points",
+    "long_points",
     "all_points", "run_point", "StressRunner", "run_points", "budget_edge_probes",
     "is_allowed", "is_bug", "tolerance_table", "pair_long_runs", "robustness_markdown", "write_records", "main",
 ]
@@ -104,6 +106,18 @@ TOL_POINTS: tuple[tuple[str, float, float, float, float], ...] = (
     ("irregular V=4", 4.0, 1e-2, 1000.0, 0.3),
     ("stiff near cusp", 5.0, 1e-3, 1e4, 0.5),
 )
+#: The loose-tolerance grid (issue 13): 6 V × 4 I × 3 α0 × 6 (rtol, atol) = 432 runs of 5 s, ``save="jumps"``.
+#: Before the kernel rejected steps whose dense output left the domain, 66 of 432 such runs ended with a NaN
+#: state (a false "geometry" breakdown) or a "successful" trajectory with v < 0.
+LOOSE_V: tuple[float, ...] = (0.5, 1.0, 2.0, 4.0, 6.0, 8.0)
+LOOSE_I: tuple[float, ...] = (1e-6, 1e-4, 1e-2, 1e-1)
+LOOSE_ALPHA0: tuple[float, ...] = (-0.5, 0.0, 0.5)
+#: (rtol, atol); atol None means simulate's default ``rtol * ATOL_SCALE``.
+LOOSE_TOLS: tuple[tuple[float, Optional[float]], ...] = (
+    (1e-2, None), (1e-2, 1e-3), (1e-2, 1.0), (1e-8, 1e-3), (1e-8, 1e-1), (1e-8, 1.0),
+)
+LOOSE_T_END = 5.0
+
 #: (label, V, I, k, α0, t_end, rtol) of the long runs (t_eval sampling).
 LONG_RUNS: tuple[tuple[str, float, float, float, float, float, float], ...] = (
     ("long V=4 I=1e-2", 4.0, 1e-2, 1000.0, 0.3, 300.0, 1e-8),
@@ -146,6 +160,8 @@ class StressPoint:
     geometry : {"paper", "exact"}
     rtol : float
         In [1e-14, 1e-2].
+    atol : float, optional
+        Scalar absolute tolerance (>= 0); None for simulate's default.
     t_end : float
         Simulated horizon [s], > 0.
     save : {"steps", "jumps"}
@@ -171,6 +187,7 @@ class StressPoint:
     method: str = "hybrid"
     geometry: str = "paper"
     rtol: float = 1e-8
+    atol: Optional[float] = None
     t_end: float = GRID_T_END
     save: str = "steps"
     n_eval: int = 0
@@ -189,6 +206,8 @@ class StressPoint:
         if not (1e-14 <= rt <= 1e-2):
             raise ValueError(f"rtol must be in [1e-14, 1e-2], got {self.rtol!r}")
         object.__setattr__(self, "rtol", rt)
+        if self.atol is not None:
+            object.__setattr__(self, "atol", nonnegative("atol", self.atol))
         if self.method not in _METHODS:
             raise ValueError(f"method must be one of {_METHODS}, got {self.method!r}")
         if self.geometry not in GEOMETRIES:
@@ -316,15 +335,28 @@ def random_points(n: int = N_RANDOM, seed: int = RANDOM_SEED, t_end: float = GRI
     return out
 
 
+def loose_points(quick: bool = False) -> list[StressPoint]:
+    """The loose-tolerance grid: :data:`LOOSE_V` × :data:`LOOSE_I` × :data:`LOOSE_ALPHA0` × :data:`LOOSE_TOLS`.
+
+    5 s runs storing jumps only.  With ``quick``, V in (1, 8) and I in (1e-6, 1e-1) only (72 runs).
+    """
+    Vs = (1.0, 8.0) if quick else LOOSE_V
+    Is = (1e-6, 1e-1) if quick else LOOSE_I
+    return [
+        StressPoint(V=V, I=I, alpha0=a0, rtol=rt, atol=at, t_end=LOOSE_T_END, save="jumps", group="loose")
+        for V in Vs for I in Is for a0 in LOOSE_ALPHA0 for rt, at in LOOSE_TOLS
+    ]
+
+
 def all_points(quick: bool = False, t_end: float = GRID_T_END, n_random: int = N_RANDOM) -> list[StressPoint]:
     """Everything :func:`main` runs apart from :func:`budget_edge_probes`.
 
     Grid (horizon ``t_end``), random sample (``n_random`` points, a quarter
-    with ``quick``), tolerance sweep, budget probes, variants, long runs.
+    with ``quick``), tolerance sweep, loose-tolerance grid, budget probes, variants, long runs.
     """
     nr = n_random // 4 if quick else n_random
-    return (grid_points(quick, t_end) + random_points(nr, t_end=t_end) + tolerance_points(quick) + budget_points()
-            + variant_points(quick) + long_points(quick))
+    return (grid_points(quick, t_end) + random_points(nr, t_end=t_end) + tolerance_points(quick) + loose_points(quick)
+            + budget_points() + variant_points(quick) + long_points(quick))
 
 
 # -------------------------------------------------------------- one point
@@ -367,8 +399,9 @@ def _inspect(tr: Any, t_end: float, rec: dict, keep_jump_times: bool) -> None:
     rec["n_points"] = int(len(tr.t))
     rec["n_jumps"] = int(tr.stats.n_jumps)
     rec["n_steps"] = int(tr.stats.n_steps)
-    rec["nonfinite"] = bool(
+    rec["nonfinite"] = bool(  # a non-finite value, or a stored v <= 0 (outside the model's domain)
         _nonfinite(tr.t, tr.alpha, tr.omega, tr.F, tr.v, J.t, J.alpha, J.omega, J.F, J.v_before, J.v_after)
+        or np.any(np.asarray(tr.v) <= 0.0)
     )
     ok_t = True
     for ts in (tr.t, J.t):
@@ -445,27 +478,28 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
         rec.update(outcome="invalid_initial_state", exception="ValueError", message=str(e)[:300], t_reached=0.0,
                    wall=time.perf_counter() - t0)
         return _finish(point, rec)
-    kw: dict[str, Any] = dict(alpha0=point.alpha0, method=point.method, rtol=point.rtol, max_steps=point.max_steps,
-                              max_jumps=point.max_jumps, max_points=point.max_points)
+    kw: dict[str, Any] = dict(alpha0=point.alpha0, method=point.method, rtol=point.rtol, atol=point.atol,
+                              max_steps=point.max_steps, max_jumps=point.max_jumps, max_points=point.max_points)
     if point.n_eval:
         kw["t_eval"] = np.linspace(0.0, point.t_end, point.n_eval)
     else:
         kw["save"] = point.save
     tr = None
+    exc: Any = None
     try:
         tr = exact.simulate(params, point.t_end, **kw)
         rec.update(outcome="ok", t_reached=float(tr.final_state.t))
     except ModelBreakdown as e:
         rec.update(outcome=f"breakdown:{e.reason}", exception="ModelBreakdown", reason=str(e.reason), t_reached=e.t)
-        tr = e.partial
+        tr, exc = e.partial, e
         rec["message"] = str(e)[:300]
     except SolverBudgetExceeded as e:
         rec.update(outcome=f"budget:{e.budget}", exception="SolverBudgetExceeded", reason=str(e.budget), t_reached=e.t)
-        tr = e.partial
+        tr, exc = e.partial, e
         rec["message"] = str(e)[:300]
     except SolverFailure as e:
         rec.update(outcome="solver_failure", exception="SolverFailure", t_reached=e.t, message=str(e)[:300])
-        tr = e.partial
+        tr, exc = e.partial, e
     except Exception as e:  # noqa: BLE001 - anything else is a finding, not a crash of the suite
         rec.update(outcome=f"unexpected:{type(e).__name__}", exception=type(e).__name__, message=str(e)[:300])
         tr = None
@@ -474,8 +508,12 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
         _inspect(tr, point.t_end, rec, keep_jump_times)
         if rec["outcome"] == "ok":
             fs = tr.final_state
-            rec["nonfinite"] |= _nonfinite([fs.t, fs.alpha, fs.omega, fs.F, fs.v])
+            rec["nonfinite"] |= _nonfinite([fs.t, fs.alpha, fs.omega, fs.F, fs.v]) or not fs.v > 0
             rec["t_monotone"] &= bool(abs(fs.t - point.t_end) <= 1e-12 * max(1.0, point.t_end))
+    if exc is not None:  # an exception reports a finite time and state with v > 0
+        sd = exc.state
+        rec["nonfinite"] |= _nonfinite([exc.t, sd["alpha"], sd["omega"], sd["F"], sd["v"]]) or not sd["v"] > 0
+    if tr is not None or exc is not None:
         if rec["nonfinite"]:
             rec["outcome"] = "nan"
     if isinstance(rec["t_reached"], float) and not math.isfinite(rec["t_reached"]) and rec["outcome"] != "nan":
@@ -881,7 +919,8 @@ def robustness_markdown(records: Sequence[dict], *, command: Optional[str] = Non
     for i, r in enumerate(records):
         if not isinstance(r, dict) or "outcome" not in r or "group" not in r:
             raise ValueError(f"records[{i}] must be a dict with 'outcome' and 'group' keys (a run_point record)")
-    by = {g: [r for r in records if r["group"] == g] for g in ("grid", "random", "tol", "budget", "variant", "long")}
+    by = {g: [r for r in records if r["group"] == g] for g in ("grid", "random", "tol", "loose", "budget", "variant",
+                                                                  "long")}
     L: list[str] = []
     if command:
         L += ["```", command, "```", ""]
@@ -966,6 +1005,19 @@ def robustness_markdown(records: Sequence[dict], *, command: Optional[str] = Non
         okj = [r["n_jumps"] for r in rnd if r["outcome"] == "ok"]
         L += [f"Max relative CONSTR residual over all stored steps: **{np.nanmax(res) if res.size else float('nan'):.2e}**;"
               f" jumps per ok run: max {max(okj) if okj else 0}, total {sum(okj)}.", ""]
+
+    loose = by["loose"]
+    if loose:
+        L += ["## Loose tolerances", ""]
+        L += [f"**{len(loose)} runs** of {loose[0]['t_end']:g} s (`save=\"jumps\"`): V ∈ "
+              f"{{{', '.join(f'{x:g}' for x in sorted({r['V'] for r in loose}))}}} m/s, I ∈ "
+              f"{{{', '.join(f'{x:g}' for x in sorted({r['I'] for r in loose}))}}} kg m², α0 ∈ "
+              f"{{{', '.join(f'{x:g}' for x in sorted({r['alpha0'] for r in loose}))}}} rad, (rtol, atol) ∈ "
+              f"{{{', '.join(f'({rt:g}, {at:g})' if at is not None else f'({rt:g}, None)' for rt, at in LOOSE_TOLS)}}} "
+              "(atol None: the default).  At such tolerances the dense output of a step can leave the model's "
+              "domain (v ≤ 0) although the step's stages did not; the kernel rejects such steps, so no run "
+              "may end with a non-finite or v ≤ 0 state (`nan` counts both).", ""]
+        L += _count_table(loose, "outcome (loose tolerances)") + [""]
 
     if any(by[x] for x in by) and records:
         L += ["## Non-ok outcome classes", ""]

@@ -72,7 +72,7 @@ import numpy as np
 from numba import njit
 
 from peelapprox import _generated as _g
-from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
+from peelapprox._dop853 import MAX_REJECTIONS, STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from peelapprox._peelforce import peel_force_fp_jit
 
@@ -112,7 +112,6 @@ PAUSE = 3  # per-call step quota reached (progress / budget checks)
 BREAK_VFLOOR = 10  # v -> 0 on AB: constraint loses its root
 BREAK_NOLAND = 11  # CD fold reached but f_min <= f(0+): no AB root to land on
 BREAK_ALPHA = 12  # 1 + c(alpha) <= 0: the peel geometry degenerates
-BREAK_NONFINITE = 13  # state became non-finite
 BREAK_VCEIL = 14  # v ran away on CD
 STEP_FAIL = 20  # step size underflow / repeated rejection
 
@@ -136,12 +135,12 @@ def pull_force(alpha, v, p):
 def _rhs(y, p, out):
     """Desingularised vector field d(τ, α, ω, v)/ds, dt/ds = v f'(v) (module docstring)."""
     v = y[3]
-    if not (v > 0.0):  # trial stage left the domain: poison the step
+    c, dc = _closure(y[1], p)
+    if not (v > 0.0 and 1.0 + c > 0.0):  # trial stage left the model's domain: poison the step
         for i in range(4):
             out[i] = np.nan
         return
     f, fp = peel_force_fp_jit(v, p[P_B], p[P_A])
-    c, dc = _closure(y[1], p)
     F = f / (1.0 + c)
     ad, wd, Fd = slow_rates(y[1], y[2], F, v, c, p[P_V], p[P_I], p[P_K], p[P_R])
     (Gd,) = constraint_rate(F, Fd, c, dc, ad)
@@ -163,6 +162,28 @@ def _store(out, nrow, t, y, F, br_arr, br):
     out[nrow, O_F] = F
     out[nrow, O_V] = y[3]
     br_arr[nrow] = br
+
+
+@njit(cache=True)
+def _in_domain(y, p):
+    """A state the driver may use: finite, v > 0 and 1 + c(α) > 0 (where the field is defined)."""
+    for i in range(4):
+        if not np.isfinite(y[i]):
+            return False
+    if not y[3] > 0.0:
+        return False
+    c, _ = _closure(y[1], p)
+    return 1.0 + c > 0.0
+
+
+@njit(cache=True)
+def _finite_rows(Fc):
+    """All dense-output coefficients finite (the extra stages stayed in the domain)."""
+    for r in range(Fc.shape[0]):
+        for i in range(Fc.shape[1]):
+            if not np.isfinite(Fc[r, i]):
+                return False
+    return True
 
 
 @njit(cache=True)
@@ -213,6 +234,7 @@ def run(
     h = st[S_H]
     has_folds = p[P_FOLDS] != 0.0
     calls = 0
+    n_bad = 0  # successive steps rejected for their dense output
 
     _rhs(y, p, f0)
     cnt[C_RHS] += 1
@@ -239,8 +261,14 @@ def run(
         if status == STEP_FAILED:
             _save(st, y, h)
             return STEP_FAIL
-        cnt[C_STEPS] += 1
-        calls += 1
+        # The step's own stages and end point lie in the domain (a stage outside poisons the error
+        # estimate), but its dense output (three more stages) and the states interpolated from it
+        # need not: at loose tolerances the interpolant can leave v > 0.  Any such state rejects the
+        # step like a failed error test (``ok`` below), so no non-finite state or v <= 0 is stored,
+        # reported or continued from.
+        nout0 = cnt[C_NOUT]
+        nte0 = cnt[C_TEVAL]
+        ok = True
 
         # ---- events inside [y, y_new]
         dense = False
@@ -259,10 +287,13 @@ def run(
                 crossed = gB <= 0.0
             if crossed:
                 dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
-                x_fold = solve_theta(y, Fc, 3, vf, gA, 1.0, gB)
+                ok = _finite_rows(Fc)
+                if ok:
+                    x_fold = solve_theta(y, Fc, 3, vf, gA, 1.0, gB)
         # breakdown on AB: v -> 0 (checked at step end; the kernel never
         # accepts a step whose stages left v > 0)
-        if br == 0 and y_new[3] <= p[P_VFLOOR] and x_fold > 1.0:
+        if ok and br == 0 and y_new[3] <= p[P_VFLOOR] and x_fold > 1.0:
+            cnt[C_STEPS] += 1
             for i in range(4):
                 y[i] = y_new[i]
             _save(st, y, h_next)
@@ -270,22 +301,24 @@ def run(
         # end time: τ increases up to the fold (f' > 0 on the branch) and falls
         # again beyond it, so t_end is looked for in [0, min(x_fold, 1)]
         x_end = 2.0
-        tau_end = t_end - t0
-        if x_fold <= 1.0:
-            x_b = x_fold
-            tau_b = interp1(y, Fc, x_fold, 0)
-        else:
-            x_b = 1.0
-            tau_b = y_new[0]
-        if tau_b >= tau_end:
-            dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
-            x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
-        x_stop = min(x_fold, x_end)
-        if x_stop > 1.0:
-            x_stop = 1.0
+        x_stop = 1.0
+        if ok:
+            tau_end = t_end - t0
+            if x_fold <= 1.0:
+                x_b = x_fold
+                tau_b = interp1(y, Fc, x_fold, 0)
+            else:
+                x_b = 1.0
+                tau_b = y_new[0]
+            if tau_b >= tau_end:
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                ok = _finite_rows(Fc)
+                if ok:
+                    x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
+            x_stop = min(x_fold, x_end, 1.0)
 
         # ---- t_eval output strictly before the stop point of this step
-        if save_mode == SAVE_TEVAL:
+        if ok and save_mode == SAVE_TEVAL:
             if x_stop < 1.0:
                 tau_stop = interp1(y, Fc, x_stop, 0)
             else:
@@ -294,15 +327,35 @@ def run(
                 te = t_eval[cnt[C_TEVAL]]
                 dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
                 state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
+                if not _in_domain(ye, p):
+                    ok = False
+                    break
                 _store(out, cnt[C_NOUT], te, ye, pull_force(ye[1], ye[3], p), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
-        if x_fold <= 1.0 or x_end <= 1.0:
-            interp(y, Fc, x_stop, ye)
-        else:
-            for i in range(4):
-                ye[i] = y_new[i]
+        if ok:
+            if x_fold <= 1.0 or x_end <= 1.0:
+                interp(y, Fc, x_stop, ye)
+                ok = _in_domain(ye, p)
+            else:
+                for i in range(4):
+                    ye[i] = y_new[i]
+
+        if not ok:
+            # reject the step: forget its output, retry from y with a quarter of the step
+            cnt[C_NOUT] = nout0
+            cnt[C_TEVAL] = nte0
+            cnt[C_REJ] += 1
+            h *= 0.25
+            n_bad += 1
+            if n_bad > MAX_REJECTIONS or h <= 1e-300:
+                _save(st, y, h)
+                return STEP_FAIL
+            continue
+        n_bad = 0
+        cnt[C_STEPS] += 1
+        calls += 1
 
         c_e, _ = _closure(ye[1], p)
         if not (1.0 + c_e > 1e-12):
@@ -310,10 +363,6 @@ def run(
                 y[i] = ye[i]
             _save(st, y, h)
             return BREAK_ALPHA
-        for i in range(4):
-            if not np.isfinite(ye[i]):
-                _save(st, y, h)
-                return BREAK_NONFINITE
         if br == 1 and ye[3] > p[P_VCEIL]:
             for i in range(4):
                 y[i] = ye[i]

@@ -407,7 +407,6 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             H.BREAK_NOLAND: ("no_landing", f"CD fold reached but f_min={bs.f_min} <= f(0+, V)={bs.f_zero:.6g}: "
                              "no AB root to land on"),
             H.BREAK_ALPHA: ("geometry", "1 - cos(theta) reached 0: the peel geometry degenerates (alpha -> -pi/2)"),
-            H.BREAK_NONFINITE: ("nonfinite", "the state became non-finite"),
             H.BREAK_VCEIL: ("v_ceiling", "v exceeded 1000 m/s on CD: the pull force is running away"),
         }
         reason, text = reasons.get(status, ("unknown", f"kernel status {status}"))
