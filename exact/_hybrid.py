@@ -69,7 +69,7 @@ when an output buffer fills or the run ends.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from peelapprox._jit import kernel
 
 from peelapprox import _generated as _g
 from peelapprox._dop853 import MAX_REJECTIONS, STEP_FAILED, N_STAGES as _NS
@@ -79,10 +79,10 @@ from peelapprox._peelforce import peel_force_fp_jit
 # the model's equations, compiled from the one generated source
 # (inline="always": numba then inlines them at the IR level; as separately compiled functions their calls
 # cost half of a field evaluation, 72 -> 35 ns measured)
-closure_paper = njit(cache=True, inline="always")(_g.closure_paper)
-closure_exact = njit(cache=True, inline="always")(_g.closure_exact)
-slow_rates = njit(cache=True, inline="always")(_g.slow_rates)
-constraint_rate = njit(cache=True, inline="always")(_g.constraint_rate)
+closure_paper = kernel(inline="always")(_g.closure_paper)
+closure_exact = kernel(inline="always")(_g.closure_exact)
+slow_rates = kernel(inline="always")(_g.slow_rates)
+constraint_rate = kernel(inline="always")(_g.constraint_rate)
 
 # ---------------------------------------------------------------- layouts
 # parameter vector
@@ -116,14 +116,14 @@ BREAK_VCEIL = 14  # v ran away on CD
 STEP_FAIL = 20  # step size underflow / repeated rejection
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _closure(alpha, p):
     if p[P_GEOM] == 0.0:
         return closure_paper(alpha, p[P_R], p[P_L])
     return closure_exact(alpha, p[P_R], p[P_L])
 
 
-@njit(cache=True)
+@kernel
 def pull_force(alpha, v, p):
     """F = f(v, V) / (1 + c(α))  (CONSTR solved for F)."""
     f, _ = peel_force_fp_jit(v, p[P_B], p[P_A])
@@ -131,7 +131,7 @@ def pull_force(alpha, v, p):
     return f / (1.0 + c)
 
 
-@njit(cache=True)
+@kernel
 def _rhs(y, p, out):
     """Desingularised vector field d(τ, α, ω, v)/ds, dt/ds = v f'(v) (module docstring)."""
     v = y[3]
@@ -154,7 +154,7 @@ def _rhs(y, p, out):
 _dop = make_dop853(_rhs)
 
 
-@njit(cache=True)
+@kernel
 def _store(out, nrow, t, y, F, br_arr, br):
     out[nrow, O_T] = t
     out[nrow, O_AL] = y[1]
@@ -164,7 +164,7 @@ def _store(out, nrow, t, y, F, br_arr, br):
     br_arr[nrow] = br
 
 
-@njit(cache=True)
+@kernel
 def _in_domain(y, p):
     """A state the driver may use: finite, v > 0 and 1 + c(α) > 0 (where the field is defined)."""
     for i in range(4):
@@ -176,7 +176,7 @@ def _in_domain(y, p):
     return 1.0 + c > 0.0
 
 
-@njit(cache=True)
+@kernel
 def _finite_rows(Fc):
     """All dense-output coefficients finite (the extra stages stayed in the domain)."""
     for r in range(Fc.shape[0]):
@@ -186,7 +186,7 @@ def _finite_rows(Fc):
     return True
 
 
-@njit(cache=True)
+@kernel
 def _save(st, y, h):
     """Write the resumable solver state (y and the next step size) into st."""
     st[S_TAU] = y[0]
@@ -196,7 +196,7 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-@njit(cache=True)
+@kernel
 def run(
     st,
     p,

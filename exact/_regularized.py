@@ -20,7 +20,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import njit
+from peelapprox._jit import kernel
 from scipy import integrate
 from scipy.optimize import brentq
 
@@ -30,15 +30,15 @@ from peelapprox._peelforce import BRANCHES, branch_structure, peel_force_coeffic
 
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
-_rhs_g = njit(cache=True, inline="always")(_g.regularized_rhs)
-_jac_g = njit(cache=True, inline="always")(_g.regularized_jacobian)
-_cl_paper = njit(cache=True, inline="always")(_g.closure_paper)
-_cl_exact = njit(cache=True, inline="always")(_g.closure_exact)
+_rhs_g = kernel(inline="always")(_g.regularized_rhs)
+_jac_g = kernel(inline="always")(_g.regularized_jacobian)
+_cl_paper = kernel(inline="always")(_g.closure_paper)
+_cl_exact = kernel(inline="always")(_g.closure_exact)
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 
 
-@njit(cache=True)
+@kernel
 def _fun(y, q):
     # q = V, I, k, R, l, b, A, eps, geom
     v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
@@ -51,7 +51,7 @@ def _fun(y, q):
     return np.array([r[0], r[1], r[2], r[3]])
 
 
-@njit(cache=True)
+@kernel
 def _jac(y, q):
     v = max(y[3], 1e-300)
     _, fp = peel_force_fp_jit(v, q[5], q[6])

@@ -28,7 +28,7 @@ import math
 from typing import Optional
 
 import numpy as np
-from numba import njit
+from peelapprox._jit import kernel
 
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import interp, make_dop853, solve_theta, workspace
@@ -38,7 +38,7 @@ from . import _hybrid as H
 _EPS_FD = 1e-7
 
 
-@njit(cache=True)
+@kernel
 def _rhs_tangent(y, p, out):
     """d(y, δy)/ds: the hybrid field and its directional derivative along δy (central difference)."""
     g = np.empty(4)
@@ -72,7 +72,7 @@ def _rhs_tangent(y, p, out):
 _dop_t = make_dop853(_rhs_tangent)
 
 
-@njit(cache=True)
+@kernel
 def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
     """Integrate (y, δy) from ``y`` on branch ``br`` to its fold or to t = t_max (whichever first).
 

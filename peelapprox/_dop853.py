@@ -23,9 +23,11 @@ returns them as a :class:`Dop853` tuple.  The field is bound as a closure
 variable, not passed as an argument: numba caches closures over jitted
 functions across processes, but not functions taking a dispatcher argument
 (numba issue #2956); each field's pieces are renamed after the field so
-that their cache files are distinct.  numba does not invalidate a cached
-function when a function it calls changes in *another* file: after editing
-a vector field or ``_generated.py``, delete the ``__pycache__/*.nb*`` files.
+that their cache files are distinct.  numba alone would not invalidate a
+cached function when a function it calls changes in *another* file; every
+kernel is compiled by :func:`peelapprox._jit.kernel`, whose cache names carry
+a hash of all kernel sources, so a changed field or ``_generated.py`` is
+always recompiled.
 The pieces that do not call the field (``combine``,
 ``interp1``, ``interp``, ``solve_theta``) are module-level.
 """
@@ -35,7 +37,7 @@ from __future__ import annotations
 from typing import Callable, NamedTuple
 
 import numpy as np
-from numba import njit
+from ._jit import kernel
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
 __all__ = [
@@ -105,7 +107,7 @@ class Dop853(NamedTuple):
     ensure_dense: Callable
 
 
-@njit(cache=True)
+@kernel
 def workspace(n):
     """Scratch arrays for a driver on an n-dimensional state:
     ``(K, y_new, f0, tmp, sc, work, Fc, ye)`` with K of shape (16, n), work (3, n), Fc (7, n)."""
@@ -113,7 +115,7 @@ def workspace(n):
             np.empty((7, n)), np.empty(n))
 
 
-@njit(cache=True)
+@kernel
 def _norm(x):
     n = x.shape[0]
     s = 0.0
@@ -122,7 +124,7 @@ def _norm(x):
     return np.sqrt(s / n)
 
 
-@njit(cache=True)
+@kernel
 def combine(y, h, K, coef, n, out):
     """out = y + h * sum_{j<n} coef[j] K[j]  (an RK stage argument or the step result)."""
     for i in range(y.shape[0]):
@@ -132,7 +134,7 @@ def combine(y, h, K, coef, n, out):
         out[i] = y[i] + h * acc
 
 
-@njit(cache=True)
+@kernel
 def interp1(y_old, Fc, x, i):
     """Component i of the dense output at fraction x ∈ [0, 1] of the step."""
     yv = 0.0
@@ -145,14 +147,14 @@ def interp1(y_old, Fc, x, i):
     return yv + y_old[i]
 
 
-@njit(cache=True)
+@kernel
 def interp(y_old, Fc, x, out):
     """The whole dense-output state at fraction x of the step."""
     for i in range(y_old.shape[0]):
         out[i] = interp1(y_old, Fc, x, i)
 
 
-@njit(cache=True)
+@kernel
 def solve_theta(y_old, Fc, i, target, g0, xb, g1):
     """x in [0, xb] with interp1(x, i) = target.
 
@@ -186,7 +188,7 @@ def solve_theta(y_old, Fc, i, target, g0, xb, g1):
     return b if abs(gb) < abs(ga) else a
 
 
-@njit(cache=True)
+@kernel
 def crossing(y_old, Fc, i, target, xb, value_b):
     """Fraction x in [0, xb] of the step where the increasing component i reaches
     ``target`` (0 if it is already there); ``value_b`` is its value at xb."""
@@ -195,7 +197,7 @@ def crossing(y_old, Fc, i, target, xb, value_b):
     return solve_theta(y_old, Fc, i, target, y_old[i] - target, xb, value_b - target)
 
 
-@njit(cache=True)
+@kernel
 def state_at(y_old, Fc, i, target, xb, value_b, out):
     """Dense-output state where the increasing component i equals ``target``
     (a ``t_eval`` point); component i is set to ``target`` exactly."""
@@ -222,8 +224,7 @@ def make_dop853(rhs) -> Dop853:
     tag = _cache_tag(rhs)
 
     def jit(fn):
-        fn.__qualname__ = fn.__name__ = f"{fn.__name__}__{tag}"
-        return njit(cache=True)(fn)
+        return kernel(fn, name=f"{fn.__name__}__{tag}")
 
     def initial_step(y0, f0, p, rtol, atol, work):
         n = y0.shape[0]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-__all__ = ["ModelBreakdown", "SolverBudgetExceeded", "SolverFailure"]
+__all__ = ["ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "KernelCacheWarning"]
 
 
 class ModelBreakdown(RuntimeError):
@@ -62,3 +62,7 @@ class SolverFailure(RuntimeError):
         self.t = t
         self.state = state
         self.partial = partial
+
+
+class KernelCacheWarning(RuntimeWarning):
+    """No writable numba cache location: kernels are compiled without on-disk caching (see ``peelapprox._jit``)."""

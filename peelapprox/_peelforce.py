@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
-from numba import njit
+from ._jit import kernel
 from scipy.optimize import brentq
 
 from . import _generated as _g
@@ -49,9 +49,9 @@ BRANCHES = ("AB", "CD")
 peel_force_coefficients = _g.peel_force_coefficients
 
 #: numba-compiled scalar ``(f, f')`` at ``v`` given ``(b, A) = peel_force_coefficients(V)``.
-peel_force_fp_jit = njit(cache=True, fastmath=False, inline="always")(_g.peel_force_fp)
+peel_force_fp_jit = kernel(inline="always")(_g.peel_force_fp)
 #: numba-compiled scalar ``(f, f', f'')``.
-peel_force_fpp_jit = njit(cache=True, fastmath=False)(_g.peel_force_fpp)
+peel_force_fpp_jit = kernel(_g.peel_force_fpp)
 
 # Bracket used to search for folds and roots: f' -> +inf as v -> 0 and the
 # exponential term dominates for large v, so every sign change lies inside.

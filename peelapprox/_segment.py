@@ -63,7 +63,7 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-from numba import njit
+from ._jit import kernel
 
 from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
@@ -96,12 +96,12 @@ SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = range(3)
 # status codes
 EXIT, OUT_FULL, T_MAX, MAX_STEPS, BREAK_VFLOOR, BREAK_VCEIL, BREAK_F, BREAK_NONFINITE, STEP_FAIL = range(9)
 
-_sinusoid_jit = njit(cache=True, inline="always")(_sinusoid)
-_harmonic_jit = njit(cache=True, inline="always")(_harmonic)
-_decay_jit = njit(cache=True, inline="always")(_decay)
+_sinusoid_jit = kernel(inline="always")(_sinusoid)
+_harmonic_jit = kernel(inline="always")(_harmonic)
+_decay_jit = kernel(inline="always")(_decay)
 
 
-@njit(cache=True, inline="always")  # inlined into the field (numba does not inline separate dispatchers)
+@kernel(inline="always")  # inlined into the field (numba does not inline separate dispatchers)
 def _alpha_of(y, q):
     """(α, α̇) at state y: closed forms evaluated at t, else the state's own."""
     am = int(q[Q_AM])
@@ -117,7 +117,7 @@ def _alpha_of(y, q):
     return y[3], y[4]
 
 
-@njit(cache=True)
+@kernel
 def _field(y, q, out):
     """d(t, ln v, F, α, α̇)/ds with dt/ds = v f'(v) (module docstring)."""
     v = np.exp(y[1])
@@ -162,7 +162,7 @@ def _field(y, q, out):
 _dop = make_dop853(_field)
 
 
-@njit(cache=True)
+@kernel
 def _store(out, row, y, q):
     al, ad = _alpha_of(y, q)
     out[row, 0] = y[0]
@@ -172,7 +172,7 @@ def _store(out, row, y, q):
     out[row, 4] = ad
 
 
-@njit(cache=True)
+@kernel
 def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
     """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state."""
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(5)

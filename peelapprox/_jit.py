@@ -1,0 +1,155 @@
+"""The one way the package compiles numba kernels: cached, with cache keys that follow the model source.
+
+numba caches a compiled function on disk keyed on *its own* source file (time
+stamp and size) and bytecode.  A kernel that inlines or calls functions from
+other files (the generated model in ``_generated.py``, the peel force, the
+DOP853 step) embeds their machine code, so after one of those files changes
+(a regenerated model, a package upgrade) numba would load the old kernel: the
+stale-kernel bug of issue 13 (a changed fvV coefficient gave CONSTR residuals
+of 37 N).  :func:`kernel` therefore names every compiled function after a hash
+of **all** the files compiled into kernels (:data:`KERNEL_SOURCES`): a change
+to any of them gives new cache file names, so the kernels are compiled anew,
+and a cache written by other sources is never read.  Files left behind by an
+old source stay on disk unused (numba's own cache files; deleting
+``__pycache__/*.nbi, *.nbc`` is always safe).
+
+Where no cache location is writable (read-only install, HOME, XDG cache and
+``NUMBA_CACHE_DIR``: containers, HPC nodes) the kernels are compiled without
+caching, with one :class:`~peelapprox._errors.KernelCacheWarning`: the
+package works, and every new process compiles again.
+
+Every function compiled by the package goes through :func:`kernel`; it
+refuses a function whose source file is not in :data:`KERNEL_SOURCES`, so a
+new kernel module cannot silently escape the hash.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import types
+import warnings
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+from numba import njit
+
+from ._errors import KernelCacheWarning
+
+__all__ = ["kernel", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
+
+_ROOT = Path(__file__).resolve().parent.parent
+
+#: Files (relative to the directory holding the packages) whose code is compiled into kernels.
+KERNEL_SOURCES: tuple[str, ...] = (
+    "peelapprox/_jit.py",
+    "peelapprox/_generated.py",
+    "peelapprox/_peelforce.py",
+    "peelapprox/_dop853.py",
+    "peelapprox/_alpha.py",
+    "peelapprox/_segment.py",
+    "exact/_hybrid.py",
+    "exact/_regularized.py",
+    "exact/_tangent.py",
+)
+
+
+def source_tag(root: Path = _ROOT, sources: tuple[str, ...] = KERNEL_SOURCES) -> str:
+    """First 16 hex digits of the SHA-256 of the kernel sources (path and bytes of each, in order).
+
+    A missing file hashes as empty (a partial install still gets a consistent, distinct tag).
+    """
+    h = hashlib.sha256()
+    for rel in sources:
+        h.update(rel.encode())
+        h.update(b"\0")
+        try:
+            h.update((root / rel).read_bytes())
+        except OSError:
+            pass
+        h.update(b"\0")
+    return h.hexdigest()[:16]
+
+
+#: The tag every compiled function's cache name carries (see the module docstring).
+SOURCE_TAG = source_tag()
+
+_state = {"cache": True}
+
+
+def caching_enabled() -> bool:
+    """False once a kernel had to be compiled without a writable cache location."""
+    return bool(_state["cache"])
+
+
+def _renamed(fn: Callable, name: str) -> Callable:
+    """A copy of the plain function ``fn`` named ``name`` (numba names cache files after the qualname)."""
+    g = types.FunctionType(fn.__code__, fn.__globals__, name, fn.__defaults__, fn.__closure__)
+    g.__qualname__ = name
+    g.__module__ = fn.__module__
+    g.__doc__ = fn.__doc__
+    g.__kwdefaults__ = fn.__kwdefaults__
+    return g
+
+
+def _check_source(fn: Callable) -> None:
+    try:
+        src = Path(inspect.getfile(fn)).resolve()
+        rel = src.relative_to(_ROOT).as_posix()
+    except (TypeError, ValueError):
+        rel = None
+    if rel not in KERNEL_SOURCES:
+        raise RuntimeError(
+            f"peelapprox._jit.kernel: {fn.__qualname__} is defined in {rel or inspect.getfile(fn)!r}, which is not "
+            "in KERNEL_SOURCES; add the file there so that its changes invalidate the cached kernels"
+        )
+
+
+def kernel(fn: Optional[Callable] = None, *, inline: str = "never", fastmath: bool = False,
+           name: Optional[str] = None) -> Any:
+    """Compile ``fn`` with numba (``njit``), cached under a name that carries :data:`SOURCE_TAG`.
+
+    Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.
+
+    Parameters
+    ----------
+    fn : function
+        Plain Python function defined in one of :data:`KERNEL_SOURCES`.
+    inline : {"never", "always"}
+        numba's IR-level inlining into the callers.
+    fastmath : bool
+        numba's fastmath flag (default False: IEEE semantics, as the tests assume).
+    name : str, optional
+        Base name of the cache files (default: the function's qualname); the
+        DOP853 pieces of :func:`peelapprox._dop853.make_dop853` are named after
+        their vector field.
+
+    Returns
+    -------
+    numba dispatcher
+
+    Raises
+    ------
+    RuntimeError
+        If ``fn``'s source file is not in :data:`KERNEL_SOURCES` (a developer error).
+    """
+    if fn is None:
+        return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name)
+    _check_source(fn)
+    base = (name or fn.__qualname__).replace("<locals>.", "").replace(".", "_")
+    g = _renamed(fn, f"{base}__src{SOURCE_TAG}")
+    if _state["cache"]:
+        try:
+            return njit(cache=True, inline=inline, fastmath=fastmath)(g)
+        except RuntimeError as e:  # numba: "cannot cache function ...: no locator available"
+            if "no locator available" not in str(e):
+                raise
+            _state["cache"] = False
+            warnings.warn(
+                "peelapprox: no writable numba cache location (NUMBA_CACHE_DIR, the package's __pycache__, "
+                "the user cache directory); kernels are compiled without caching, so every new process "
+                "compiles them again (~20 s). Set NUMBA_CACHE_DIR to a writable directory to cache them.",
+                KernelCacheWarning,
+                stacklevel=2,
+            )
+    return njit(cache=False, inline=inline, fastmath=fastmath)(g)

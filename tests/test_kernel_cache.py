@@ -1,0 +1,133 @@
+"""Compiled kernels are never stale and never need a writable cache (issue 13, items 3-4).
+
+Both tests run the package from a temporary copy in a subprocess, so the
+repository's own numba cache is neither used nor touched.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import peelapprox._jit as J
+
+ROOT = Path(__file__).resolve().parent.parent
+
+#: Kernel pull force vs the numpy peel force and closure, for V = 1 at v = 0.1 m/s, alpha = 0.2.
+PROBE = """
+import json, warnings
+import numpy as np
+warnings.simplefilter("always")
+with warnings.catch_warnings(record=True) as w:
+    import peelapprox, exact
+    from peelapprox import PeelParams
+    from peelapprox._peelforce import peel_force
+    from exact._hybrid import pull_force
+    from exact._simulate import _param_vector
+    p = PeelParams(V=1.0, I=1e-5)
+    kern = float(pull_force(0.2, 0.1, _param_vector(p, 1e-9)))
+    ref = float(peel_force(0.1, 1.0)) / (1.0 + float(p.closure(0.2)[0]))
+    extra = {}
+    if {simulate}:
+        tr = exact.simulate(p, 0.01)
+        extra = dict(res=float(np.max(np.abs(tr.constraint_residual(relative=True)))), n=len(tr.t))
+print(json.dumps(dict(file=peelapprox.__file__, kern=kern, ref=ref,
+                      warnings=[type(x.message).__name__ for x in w], **extra)))
+"""
+
+
+def _copy_packages(dst: Path, keep_cache: bool = False) -> None:
+    ignore = None if keep_cache else shutil.ignore_patterns("__pycache__")
+    for pkg in ("peelapprox", "exact"):
+        shutil.copytree(ROOT / pkg, dst / pkg, ignore=ignore)
+
+
+def _probe(cwd: Path, env_extra: dict | None = None, simulate: bool = False) -> dict:
+    import json
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(PYTHONDONTWRITEBYTECODE="1", **(env_extra or {}))
+    code = PROBE.replace("{simulate}", "True" if simulate else "False")
+    r = subprocess.run([sys.executable, "-c", code], cwd=cwd, env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert Path(out["file"]).resolve().is_relative_to(cwd.resolve()), out["file"]  # the copy, not the checkout
+    return out
+
+
+def test_every_kernel_source_is_hashed():
+    """The tag covers every file compiled into kernels: a file of peelapprox/ or exact/ that calls the compiler
+    (``kernel``/``njit``) or whose functions are wrapped by it must be listed.  Exact: a set comparison."""
+    users = set()
+    for pkg in ("peelapprox", "exact"):
+        for f in (ROOT / pkg).glob("*.py"):
+            text = f.read_text()
+            if re.search(r"\bkernel\(|@kernel\b|\bnjit\b", text) and f.name != "_jit.py":
+                users.add(f"{pkg}/{f.name}")
+    assert users <= set(J.KERNEL_SOURCES), users - set(J.KERNEL_SOURCES)
+    assert {"peelapprox/_generated.py", "peelapprox/_alpha.py"} <= set(J.KERNEL_SOURCES)
+
+
+def test_source_tag_changes_with_any_kernel_source(tmp_path):
+    """Hypothesis: one changed byte in any kernel source changes the tag (SHA-256; a collision in 64 bits is
+    not a tolerance but an impossibility for this test)."""
+    _copy_packages(tmp_path)
+    t0 = J.source_tag(tmp_path)
+    assert t0 == J.SOURCE_TAG
+    for rel in J.KERNEL_SOURCES:
+        f = tmp_path / rel
+        b = f.read_bytes()
+        f.write_bytes(b + b"\n")
+        assert J.source_tag(tmp_path) != t0, rel
+        f.write_bytes(b)
+    assert J.source_tag(tmp_path) == t0
+
+
+def test_changed_model_source_recompiles_the_kernel(tmp_path):
+    """Issue 13 item 3: after a change of one fvV coefficient in ``_generated.py`` the cached kernels used to be
+    loaded unchanged (the pull force of the kernel then disagreed with the numpy law by ~37 N).  Hypothesis:
+    the kernel follows the changed source.  The kernel and numpy evaluate the same expression, so they agree
+    to rounding (1e-12 relative); the change of 400 v^0.35 -> 401 v^0.35 at v = 0.1 moves f by 0.447 N (F by 0.373 N),
+    10^9 times that tolerance."""
+    _copy_packages(tmp_path)
+    before = _probe(tmp_path)  # compiles and caches in the copy's __pycache__
+    assert abs(before["kern"] - before["ref"]) <= 1e-12 * abs(before["ref"])
+    assert list((tmp_path / "exact" / "__pycache__").glob("*pull_force*.nbi")), "the first run did not cache"
+    gen = tmp_path / "peelapprox" / "_generated.py"
+    src = gen.read_text()
+    assert src.count("400*x2") == 2
+    gen.write_text(src.replace("400*x2", "401*x2"))
+    after = _probe(tmp_path)
+    assert abs(after["ref"] - before["ref"]) > 0.3  # the numpy law did change ...
+    assert abs(after["kern"] - after["ref"]) <= 1e-12 * abs(after["ref"])  # ... and so did the kernel
+
+
+def test_import_and_simulate_without_writable_cache(tmp_path):
+    """Issue 13 item 4: with no writable cache location (NUMBA_CACHE_DIR, HOME and XDG_CACHE_HOME unwritable,
+    the packages' __pycache__ unusable) ``import peelapprox`` raised 'cannot cache function ...: no locator
+    available'.  Hypothesis: import and a first simulate work, uncached, with exactly one KernelCacheWarning,
+    and the result is right (CONSTR residual at rounding level, 1e-13 relative as in tests/test_exact.py).
+    As root every directory is writable, so unwritability is made by paths that cannot be created: under
+    /proc (procfs) and where a regular file stands in for ``__pycache__``."""
+    _copy_packages(tmp_path)
+    for pkg in ("peelapprox", "exact"):
+        (tmp_path / pkg / "__pycache__").write_text("not a directory\n")
+    nowhere = "/proc/peelapprox-no-such-dir"
+    out = _probe(tmp_path, dict(NUMBA_CACHE_DIR=nowhere, HOME=nowhere, XDG_CACHE_HOME=nowhere), simulate=True)
+    assert out["warnings"].count("KernelCacheWarning") == 1, out["warnings"]
+    assert abs(out["kern"] - out["ref"]) <= 1e-12 * abs(out["ref"])
+    assert out["n"] > 10 and out["res"] <= 1e-13
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs procfs for an uncreatable path")
+def test_no_locator_is_really_unwritable():
+    """Guard of the test above: numba cannot create a cache directory under /proc (else the test proves
+    nothing).  Exact: the creation must raise OSError."""
+    with pytest.raises(OSError):
+        os.makedirs("/proc/peelapprox-no-such-dir/x", exist_ok=True)
