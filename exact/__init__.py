@@ -8,7 +8,7 @@ with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
 
 from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._simulate import ATOL_SCALE, compile_kernels, initial_state, simulate
+from ._simulate import ATOL_SCALE, STEP_BUDGET, compile_kernels, default_max_steps, initial_state, simulate
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 
 __all__ = [
@@ -16,6 +16,8 @@ __all__ = [
     "initial_state",
     "compile_kernels",
     "ATOL_SCALE",
+    "STEP_BUDGET",
+    "default_max_steps",
     "Trajectory",
     "Jumps",
     "Jump",

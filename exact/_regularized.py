@@ -20,13 +20,18 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from peelapprox._jit import kernel
 from scipy import integrate
 from scipy.optimize import brentq
 
 from peelapprox import _generated as _g
-from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from peelapprox._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_fp_jit
+from peelapprox._errors import ModelBreakdown, SolverFailure, budget_exceeded
+from peelapprox._jit import kernel
+from peelapprox._peelforce import (
+    BRANCHES,
+    branch_structure,
+    peel_force_coefficients,
+    peel_force_fp_jit,
+)
 
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
@@ -74,7 +79,7 @@ def param_vector(params, eps: float) -> np.ndarray:
 
 
 def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, save, max_points, max_steps, max_jumps,
-                    progress, v_floor):
+                    progress, v_floor, max_wall=None):
     """Driver for ``simulate(method="regularized")`` (arguments already validated)."""
     bs = branch_structure(params.V)
     q = param_vector(params, eps)
@@ -93,9 +98,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
 
     def store(t, y):
         if len(rows) >= max_points:
-            raise SolverBudgetExceeded(
-                f"more than max_points={max_points} stored points before t_end={t_end}; pass t_eval or save='jumps'",
-                budget="max_points", limit=max_points, t=t, state=sdict(t, y), partial=build(False))
+            raise budget_exceeded("max_points", max_points, t_end, sdict(t, y), build(False))
         rows.append((t, y[0], y[1], y[2], y[3]))
         brs.append(side(y[3]))
 
@@ -129,14 +132,15 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
                                 state=sdict(ode.t, ode.y), partial=build(False))
         n_steps += 1
         y = ode.y
-        if not np.all(np.isfinite(y)):
-            raise ModelBreakdown(f"state became non-finite at t={ode.t:.9g}", t=float(ode.t),
-                                 state=sdict(t_old, y_old), reason="nonfinite", partial=build(False))
+        if not np.all(np.isfinite(y)):  # a numerical failure, reported at the last finite state
+            raise SolverFailure(f"regularized {solver}: the state became non-finite after t={t_old:.9g}",
+                                t=float(t_old), state=sdict(t_old, y_old), partial=build(False))
         if y[3] <= v_floor:
+            tb, yb = (ode.t, y) if y[3] > 0 else (t_old, y_old)  # never report v <= 0
             raise ModelBreakdown(
-                f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
+                f"model breakdown at t={tb:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
                 f"(F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)",
-                t=float(ode.t), state=sdict(ode.t, y), reason="v_floor", partial=build(False))
+                t=float(tb), state=sdict(tb, yb), reason="v_floor", partial=build(False))
         dense = None
         s_old, s_new = side(y_old[3]), side(y[3])
         if s_old != s_new:
@@ -147,9 +151,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
             if tj >= t_store:
                 jumps.append((tj, s_old, s_new, yj[0], yj[1], yj[2], v_mid, v_mid))
             if len(jumps) > max_jumps:  # stored jumps, as the hybrid driver counts them
-                raise SolverBudgetExceeded(f"more than max_jumps={max_jumps} jumps before t_end={t_end}",
-                                           budget="max_jumps", limit=max_jumps, t=float(tj), state=sdict(tj, yj),
-                                           partial=build(False))
+                raise budget_exceeded("max_jumps", max_jumps, t_end, sdict(tj, yj), build(False))
         if te is not None:
             while t_eval_i < te.size and te[t_eval_i] <= ode.t:
                 dense = dense or ode.dense_output()
@@ -158,9 +160,9 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         elif save == "steps" and ode.t >= t_store:
             store(ode.t, y)
         if n_steps >= max_steps and ode.status == "running":
-            raise SolverBudgetExceeded(f"more than max_steps={max_steps} steps before t_end={t_end}",
-                                       budget="max_steps", limit=max_steps, t=float(ode.t), state=sdict(ode.t, y),
-                                       partial=build(False))
+            raise budget_exceeded("max_steps", max_steps, t_end, sdict(ode.t, y), build(False))
+        if max_wall is not None and time.perf_counter() - wall0 > max_wall and ode.status == "running":
+            raise budget_exceeded("max_wall", max_wall, t_end, sdict(ode.t, y), build(False))
         if progress and time.perf_counter() - last_report > 0.5:
             last_report = time.perf_counter()
             progress(float(ode.t), t_end)

@@ -10,8 +10,12 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from peelapprox import PeelParams
-from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from peelapprox._validate import finite as _finite
+from peelapprox._errors import (
+    ModelBreakdown,
+    SolverBudgetExceeded,
+    SolverFailure,
+    budget_exceeded,
+)
 from peelapprox._peelforce import (
     BRANCHES,
     branch_inverse,
@@ -19,11 +23,12 @@ from peelapprox._peelforce import (
     peel_force,
     peel_force_coefficients,
 )
+from peelapprox._validate import finite as _finite
 
 from . import _hybrid as H
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
-__all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE"]
+__all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE", "STEP_BUDGET", "default_max_steps"]
 
 METHODS = ("hybrid", "regularized")
 SOLVERS = ("Radau", "BDF", "LSODA")
@@ -37,6 +42,20 @@ SAVES = ("steps", "jumps")
 ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1e-6), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
 
 _COMPILE_TIME = {"hybrid": None}
+
+#: Default step budget per simulated second, floor and cap, by method (``max_steps=None``).  The
+#: physical grid of the stress suite needs at most ~1.5e4 hybrid steps per simulated second (I = 1e-6,
+#: rtol 1e-8; 1.3-1.8 us each) and the regularised scheme ~1e3 (~150 us each), so the rate leaves a
+#: margin of ~50x, while the cap bounds a default call: hybrid <= 2e7 steps (~35 s measured on
+#: t_end = 1e300), regularised <= 5e5 (~80 s).  A run that needs more raises SolverBudgetExceeded
+#: naming max_steps.
+STEP_BUDGET = {"hybrid": (1e6, 1e6, 2e7), "regularized": (1e5, 1e5, 5e5)}
+
+
+def default_max_steps(method: str, t_end: float) -> int:
+    """The step budget ``simulate`` uses when ``max_steps=None``: ``clip(rate * t_end, floor, cap)``."""
+    rate, lo, hi = STEP_BUDGET[method]
+    return int(min(hi, max(lo, rate * t_end)))
 
 
 def initial_state(
@@ -150,8 +169,9 @@ def simulate(
     t_eval: Optional[Sequence[float]] = None,
     save: str = "steps",
     max_points: int = 5_000_000,
-    max_steps: int = 200_000_000,
+    max_steps: Optional[int] = None,
     max_jumps: int = 20_000_000,
+    max_wall: Optional[float] = None,
     v_floor: float = 1e-9,
     progress: Union[None, bool, Callable[[float, float], None]] = None,
 ) -> Trajectory:
@@ -196,7 +216,16 @@ def simulate(
         Budgets: stored points, accepted steps (all, from t = 0) and stored
         jumps (those at t >= t_transient: a memory budget, like max_points).
         Needing more than one raises :class:`SolverBudgetExceeded` (with the
-        partial trajectory); nothing is truncated silently.
+        partial trajectory); nothing is truncated silently.  ``max_steps=None``
+        scales the step budget with the horizon (:func:`default_max_steps`:
+        1e6 steps per simulated second within [1e6, 2e7] for the hybrid
+        method, ~35 s of work at most; 1e5/s within [1e5, 5e5] for the
+        regularised one, ~80 s).
+    max_wall : float, optional
+        Wall-clock budget [s] of the integration (checked every ~0.3 s in
+        the hybrid kernel and at every step of the regularised scheme);
+        exceeding it raises :class:`SolverBudgetExceeded` with
+        ``budget="max_wall"``.  None (default): bounded by ``max_steps`` only.
     v_floor : float
         On AB, v falling to this value [m/s] means CONSTR is losing its root
         (``F(1 - cos θ) → f(0+, V)``): :class:`ModelBreakdown`.
@@ -247,9 +276,15 @@ def simulate(
             raise ValueError(f"t_eval must lie within [t_transient, t_end] = [{t_transient}, {t_end}]")
         if te.size > max_points:
             raise ValueError(f"t_eval has {te.size} points, more than max_points={max_points}")
+    if max_steps is None:
+        max_steps = default_max_steps(method, t_end)
     for name, val in (("max_points", max_points), ("max_steps", max_steps), ("max_jumps", max_jumps)):
         if int(val) != val or val < 1:
             raise ValueError(f"{name} must be a positive integer, got {val!r}")
+    if max_wall is not None:
+        max_wall = _finite("max_wall", max_wall)
+        if not max_wall > 0:
+            raise ValueError(f"max_wall must be in (0, inf) seconds or None, got {max_wall!r}")
     v_floor = _finite("v_floor", v_floor)
     if not v_floor > 0:
         raise ValueError(f"v_floor must be in (0, inf), got {v_floor}")
@@ -264,7 +299,8 @@ def simulate(
     if method == "hybrid":
         ct = compile_kernels()
         traj = _run_hybrid(
-            params, t_end, st0, rtol, atol_v, t_transient, te, save, max_points, max_steps, max_jumps, progress, v_floor
+            params, t_end, st0, rtol, atol_v, t_transient, te, save, max_points, max_steps, max_jumps, progress, v_floor,
+            max_wall,
         )
         if ct:
             traj.stats = SolverStats(**{**traj.stats.__dict__, "compile_time": ct})
@@ -272,7 +308,8 @@ def simulate(
     from ._regularized import run_regularized
 
     return run_regularized(
-        params, t_end, st0, solver, rtol, atol_v, eps, t_transient, te, save, max_points, max_steps, max_jumps, progress, v_floor
+        params, t_end, st0, solver, rtol, atol_v, eps, t_transient, te, save, max_points, max_steps, max_jumps, progress,
+        v_floor, max_wall,
     )
 
 
@@ -293,10 +330,11 @@ def _param_vector(params: PeelParams, v_floor: float) -> np.ndarray:
     return p
 
 
-_PAUSE_STEPS = 250_000  # steps per kernel call between progress/budget checks
+_PAUSE_STEPS = 250_000  # steps per kernel call between progress/budget checks (~0.3 s)
 
 
-def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, max_steps, max_jumps, progress, v_floor):
+def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, max_steps, max_jumps, progress, v_floor,
+                max_wall=None):
     p = _param_vector(params, v_floor)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, s0.v, 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
@@ -348,13 +386,8 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             message="reached t_end" if final else "stopped early",
         )
 
-    def over_budget(name: str, limit: int) -> SolverBudgetExceeded:
-        sd = state_dict()
-        hint = "; pass t_eval, save='jumps' or a larger max_points" if name == "max_points" else ""
-        return SolverBudgetExceeded(
-            f"more than {name}={limit} {name[4:]} before t_end={t_end} (stopped at t={sd['t']:.6g}){hint}",
-            budget=name, limit=limit, t=sd["t"], state=sd, partial=build(False),
-        )
+    def over_budget(name: str, limit: float) -> SolverBudgetExceeded:
+        return budget_exceeded(name, limit, t_end, state_dict(), build(False))
 
     n_jstored = 0
     while True:
@@ -391,6 +424,8 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         if status == H.PAUSE:
             if int(cnt[H.C_STEPS]) >= max_steps:
                 raise over_budget("max_steps", max_steps)
+            if max_wall is not None and time.perf_counter() - wall0 > max_wall:
+                raise over_budget("max_wall", max_wall)
             if progress:
                 progress(float(st[H.S_T0] + st[H.S_TAU]), t_end)
             continue

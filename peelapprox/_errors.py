@@ -36,19 +36,31 @@ class ModelBreakdown(RuntimeError):
 
 
 class SolverBudgetExceeded(RuntimeError):
-    """A step, jump or stored-point budget was used up before ``t_end``.
+    """A step, jump, stored-point or wall-time budget was used up before ``t_end``.
 
     Attributes: ``budget`` (name of the keyword), ``limit``, ``t`` and
     ``state`` where the run stopped, ``partial`` trajectory.
     """
 
-    def __init__(self, message: str, *, budget: str, limit: int, t: float, state: dict, partial: Optional[Any] = None):
+    def __init__(self, message: str, *, budget: str, limit: float, t: float, state: dict, partial: Optional[Any] = None):
         super().__init__(message)
         self.budget = budget
         self.limit = limit
         self.t = t
         self.state = state
         self.partial = partial
+
+
+def budget_exceeded(name: str, limit: float, t_end: float, state: dict, partial: Optional[Any]) -> "SolverBudgetExceeded":
+    """The exception for a used-up budget, with the message both drivers give."""
+    hints = {"max_points": "; pass t_eval, save='jumps' or a larger max_points",
+             "max_steps": "; pass a larger max_steps (the default scales with t_end)",
+             "max_wall": "; pass a larger max_wall, or None"}
+    what = f"{limit:g} s of wall time" if name == "max_wall" else f"{name}={limit} {name[4:]}"
+    return SolverBudgetExceeded(
+        f"more than {what} before t_end={t_end} (stopped at t={state['t']:.6g}){hints.get(name, '')}",
+        budget=name, limit=limit, t=state["t"], state=state, partial=partial,
+    )
 
 
 class SolverFailure(RuntimeError):

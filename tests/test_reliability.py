@@ -74,3 +74,41 @@ def test_loose_tolerance_grid_has_no_nan():
     assert c["nan"] == 0, [r for r in recs if r["outcome"] == "nan"][:3]
     assert all(r["expect_met"] for r in recs), c
     assert not any(r["outcome"].startswith("unexpected") for r in recs)
+
+
+def test_max_wall_bounds_a_huge_horizon():
+    """Issue 13 item 5: ``simulate(p, 1e300, save="jumps")`` ran ~4 min before its step budget raised.
+    Hypothesis: with ``max_wall=1`` it raises SolverBudgetExceeded(budget="max_wall") with a finite state,
+    after at least 1 s of wall time (the check runs between kernel calls of <= 250k steps, so it cannot
+    fire early; an upper bound on wall time is a benchmark matter, not asserted here)."""
+    with pytest.raises(SolverBudgetExceeded) as ei:
+        simulate(PeelParams(V=1, I=1e-5), 1e300, save="jumps", max_wall=1.0)
+    e = ei.value
+    assert e.budget == "max_wall" and e.limit == 1.0
+    assert _finite_state(e.t, e.state) and 0 < e.t < 1e300
+    assert e.partial.stats.wall_time >= 1.0
+    assert "max_wall" in str(e)
+
+
+def test_max_wall_regularized():
+    """Issue 13 item 5 for the regularised scheme (~11 h before its budget raised): the wall budget is checked
+    at every step, so 0.5 s suffices to stop it; same contract as the hybrid method."""
+    with pytest.raises(SolverBudgetExceeded) as ei:
+        simulate(PeelParams(V=1, I=1e-5), 1e300, method="regularized", save="jumps", max_wall=0.5)
+    assert ei.value.budget == "max_wall" and _finite_state(ei.value.t, ei.value.state)
+
+
+def test_default_step_budget_scales_with_horizon():
+    """Issue 13 item 5: ``simulate(PeelParams(V=100, I=1e-12), 0.5)`` took over a minute (1.6e8 steps per
+    simulated second).  The default budget is now 1e6 steps per simulated second with a floor of 1e6, so this
+    run stops at exactly 1e6 steps (an integer budget: exact)."""
+    from exact import default_max_steps
+
+    assert default_max_steps("hybrid", 0.5) == 1_000_000
+    assert default_max_steps("hybrid", 3.0) == 3_000_000
+    assert default_max_steps("hybrid", 1e300) == 20_000_000
+    assert default_max_steps("regularized", 1e300) == 500_000
+    with pytest.raises(SolverBudgetExceeded) as ei:
+        simulate(PeelParams(V=100, I=1e-12), 0.5, save="jumps")
+    assert ei.value.budget == "max_steps" and ei.value.limit == 1_000_000
+    assert ei.value.partial.stats.n_steps == 1_000_000
