@@ -251,9 +251,10 @@ def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_
     x_far = float(np.max(np.abs(a * (t + F_in / s))))
     if not x_far <= AIRY_X_MAX:
         raise ValueError(
-            f"t and F_rate put the Airy argument x = -cbrt(R s/I) (t + F_in/s) at |x| = {x_far:.3g}, beyond "
-            f"{AIRY_X_MAX:g} where scipy's Ai/Bi are NaN (s = F_rate = {s:g} N/s too small or t too large): "
-            f"use wkb_alpha there (its error, wkb_error_bound, is ~|x|^-1.5)")
+            f"F_rate = {s:g} N/s with t up to {float(np.max(t)):g} s puts the Airy argument "
+            f"x = -cbrt(R s/I) (t + F_in/s) at |x| = {x_far:.3g}, beyond {AIRY_X_MAX:g} where scipy's Ai/Bi are "
+            f"NaN (|F_rate| too small or t too large): use wkb_alpha there (its error, wkb_error_bound, is "
+            f"~|x|^-1.5)")
     ai0, aip0, bi0, bip0 = special.airy(x0)
     c1 = np.pi * (a_in * bip0 + ad_in / a * bi0)
     c2 = -np.pi * (a_in * aip0 + ad_in / a * ai0)

@@ -14,6 +14,9 @@ __all__ = ["EPS_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RAN
 #: is the full geometry ``cos θ = -l sin α / L``, ``L² = l² + R² - 2 l R cos α``.
 GEOMETRIES = ("paper", "exact")
 
+#: Smallest ``l/R``: closer, the exact closure's ``L(α) = l - R + O(α²)`` cancels (see :class:`PeelParams`).
+L_OVER_R_MIN = 1.001
+
 #: Valid range ``(lo, hi)`` of each numeric field, closed at both ends (``l`` also needs
 #: ``l >= L_OVER_R_MIN * R``).  Chosen so that every function of the package returns or raises a
 #: documented exception (no overflow, no division by zero, no bracket failure) with room to spare;
@@ -23,7 +26,7 @@ PARAM_RANGES = {
     "I": (1e-12, 1e6),
     "k": (1e-3, 1e7),
     "R": (1e-4, 10.0),
-    "l": (1e-4, 1e3),
+    "l": (L_OVER_R_MIN * 1e-4, 1e3),
 }
 #: Valid range ``(lo, hi)`` of the state variables wherever they are given as arguments (initial and
 #: entry states; forces, velocities and angles of the closed forms), closed unless noted:
@@ -56,8 +59,6 @@ TIME_MAX = 1e6
 #: the slow dynamics (the paper uses 1e-7): no longer a regularisation of the jumps.
 EPS_RANGE = (1e-15, 1e-2)
 
-#: Smallest ``l/R``: closer, the exact closure's ``L(α) = l - R + O(α²)`` cancels (see :class:`PeelParams`).
-L_OVER_R_MIN = 1.001
 
 
 @dataclass(frozen=True)
