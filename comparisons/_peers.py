@@ -77,7 +77,9 @@ import numpy as np
 
 from exact._simulate import _atol_vector, initial_state
 from peelapprox import GEOMETRIES, SolverFailure
-from peelapprox._validate import nonnegative, positive
+from peelapprox._params import EPS_RANGE
+from peelapprox._validate import choice, duration, function, in_range, optional, reals, state
+from peelapprox._validate import params as _params
 from peelapprox._peelforce import branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -357,16 +359,12 @@ def diffsl_inputs(params: "PeelParams", eps: float, state, scale, tangent=None, 
 
 
 def _check(peer, params, t_end, eps, rtol, atol):
-    from peelapprox import PeelParams
-
-    if peer not in PEERS:
-        raise ValueError(f"peer must be one of {PEERS}, got {peer!r}")
-    if not isinstance(params, PeelParams):
-        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
-    t_end, eps = positive("t_end", t_end), positive("eps", eps)
-    rt = positive("rtol", rtol)
-    if not rt < 1.0:
-        raise ValueError(f"rtol must be in (0, 1), got {rtol!r}")
+    choice("peer", peer, PEERS)
+    _params("params", params)
+    t_end, eps = duration("t_end", t_end), in_range("eps", eps, *EPS_RANGE)
+    rt = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
+    if atol is not None:
+        reals("atol", atol, 0.0)  # kind and sign; exact.simulate's parser checks the shape
     a = _atol_vector("regularized", rt, atol)  # exact.simulate's default and checks
     if np.any(a == 0.0):  # the DiffSL model divides by atol (it integrates X / atol)
         raise ValueError(f"atol must be in (0, inf) for the peers, got {atol!r}")
@@ -651,10 +649,11 @@ def lyapunov_regularized(
     """
     from peelapprox._dynamics import BenettinResult, LyapunovResult, natural_scales
 
-    T, tau, t_transient = positive("T", T), positive("tau", tau), nonnegative("t_transient", t_transient)
+    T, tau = duration("T", T), duration("tau", tau)
+    t_transient = duration("t_transient", t_transient, zero=True)
     _, eps, rtol, a = _check("diffsol", params, t_transient + T, eps, rtol, None)
-    if progress is not None and not callable(progress):
-        raise ValueError(f"progress must be callable or None, got {type(progress).__name__}")
+    alpha0 = state("alpha0", alpha0, "alpha")
+    progress = optional(function, "progress", progress)
     ode = diffsl_model(params.geometry, tangent=True)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0
     for name, val in TANGENT_OPTIONS.items():

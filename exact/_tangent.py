@@ -32,6 +32,7 @@ from peelapprox._jit import kernel
 
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import interp, make_dop853, solve_theta, workspace
+from peelapprox._validate import MAX_COUNT, duration, integer, optional
 
 from . import _hybrid as H
 
@@ -141,8 +142,9 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
 
     Starts from the state at ``t_transient`` (exact.simulate from ``alpha0``), integrates the tangent for
     ``T`` seconds, renormalising it after every jump, where its equal-time (α, ω, F) size is measured.
-    Returns ``(exponent_per_s, n_jumps, time, steps)``.  ``max_steps`` (default
-    ``STEPS_PER_SECOND * (T + 1)``) bounds the accepted steps; exceeding it raises
+    Returns ``(exponent_per_s, n_jumps, time, steps)``.  ``T`` must lie in (0, 1e6] s and ``t_transient`` in
+    [0, 1e6] s.  ``max_steps`` (an integer in [1, 1e15]; default ``STEPS_PER_SECOND * (T + 1)``, at most
+    1e15 so that it fits the compiled driver's int64) bounds the accepted steps; exceeding it raises
     :class:`peelapprox.SolverBudgetExceeded`, a step-size failure :class:`peelapprox.SolverFailure` and a
     fold with no landing root :class:`peelapprox.ModelBreakdown`, each with the time and state.
     """
@@ -152,6 +154,9 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
 
     from ._simulate import ATOL_SCALE, _param_vector
 
+    T = duration("T", T)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    max_steps = optional(integer, "max_steps", max_steps)
     s = simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state
     p = _param_vector(params, 1e-9)
     scale = natural_scales(params)
@@ -160,7 +165,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])
     br = 0 if s.branch == "AB" else 1
     if max_steps is None:
-        max_steps = int(STEPS_PER_SECOND * (T + 1.0))
+        max_steps = min(int(STEPS_PER_SECOND * (T + 1.0)), MAX_COUNT)
 
     def where(t_now):
         return dict(alpha=float(y[1]), omega=float(y[2]), v=float(y[3]), branch="AB" if br == 0 else "CD",

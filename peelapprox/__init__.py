@@ -24,7 +24,7 @@ from ._alpha import (
     wkb_error_bound,
 )
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from ._params import GEOMETRIES, PeelParams
+from ._params import GEOMETRIES, PARAM_RANGES, PeelParams
 from ._estimate import (
     INERTIA_RULE,
     VELOCITY_RULE,
@@ -68,6 +68,7 @@ __version__ = "0.1.0"
 __all__ = [
     "PeelParams",
     "GEOMETRIES",
+    "PARAM_RANGES",
     "peel_force",
     "peel_force_derivative",
     "branch_structure",

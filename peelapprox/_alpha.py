@@ -37,10 +37,12 @@ from typing import NamedTuple, Optional
 import numpy as np
 from scipy import integrate, special
 
-from ._params import PeelParams
+from ._errors import SolverFailure
+from ._params import TIME_MAX, PeelParams
 from ._peelforce import branch_structure, peel_force_derivative
+from ._validate import choice, in_range, optional, state, states, times
 from ._validate import finite as _finite
-from ._validate import positive as _positive
+from ._validate import params as _params
 
 __all__ = [
     "inertial_frequency",
@@ -61,6 +63,9 @@ __all__ = [
 
 #: equations accepted by :func:`alpha_numerical`
 ALPHA_FORMS = ("airy", "airy1", "airy2")
+#: Largest |x| at which :func:`airy_alpha` evaluates Ai(x), Bi(x): scipy returns finite values at x = -1e6
+#: and NaN at x = -1e8.
+AIRY_X_MAX = 1e6
 
 
 # ------------------------------------------------------------ shared closed forms
@@ -98,16 +103,14 @@ def _decay(t, alpha_in, tau):
 
 
 def _times(t) -> np.ndarray:
-    a = np.asarray(t, dtype=float)
-    if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise ValueError("t must be a non-empty array of finite times in [0, inf) measured from the branch entry")
-    return a
+    """Times since the branch entry, any shape, each in [0, TIME_MAX]."""
+    return times("t", t, hi=TIME_MAX, increasing=False, ndim=None)
 
 
 def _force_ramp(params: PeelParams, t: np.ndarray, F_in, F_rate) -> tuple[float, float]:
     """Validate ``F = F_in + F_rate t`` (default rate ``k V``) and keep it positive over t."""
-    F_in = _positive("F_in", F_in)
-    s = params.k * params.V if F_rate is None else _finite("F_rate", F_rate)
+    F_in = state("F_in", F_in, "F")
+    s = params.k * params.V if F_rate is None else state("F_rate", F_rate, "F_rate")
     F_end = F_in + s * float(np.max(t))
     if not F_end > 0.0:
         raise ValueError(
@@ -136,9 +139,8 @@ def inertial_frequency(params: PeelParams, F):
         ``sqrt(F R / I)`` [rad/s].  Valid on AB, where ``v/R`` is small in
         FLOW1 so that ``v̇/R`` drops out of genalpha (paper Sec. V, Case I).
     """
-    Fa = np.asarray(F, dtype=float)
-    if not np.all(np.isfinite(Fa)) or np.any(Fa <= 0):
-        raise ValueError("F must be finite and in (0, inf)")
+    params = _params("params", params)
+    Fa = states("F", F, "F")
     out = np.sqrt(Fa * params.R / params.I)
     return float(out) if out.ndim == 0 else out
 
@@ -174,10 +176,11 @@ def inertial_periods(params: PeelParams, F_mean: Optional[float] = None) -> Iner
         If ``f(v, V)`` has no folds (no stick-slip window for this V) and no
         ``F_mean`` is given.
     """
-    bs = branch_structure(params.V)
+    bs = branch_structure(_params("params", params).V)
+    F_mean = optional(state, "F_mean", F_mean, "F")
     if not bs.has_folds:
         raise ValueError(f"V={params.V} is outside the stick-slip window (f(v, V) has no folds): f_min/f_max undefined")
-    Fm = 0.5 * (bs.f_min + bs.f_max) if F_mean is None else _positive("F_mean", F_mean)
+    Fm = 0.5 * (bs.f_min + bs.f_max) if F_mean is None else F_mean
     return InertialPeriods(
         inertial_period(params, bs.f_min), inertial_period(params, bs.f_max), inertial_period(params, Fm),
         bs.f_min, bs.f_max, Fm,
@@ -192,9 +195,10 @@ def harmonic_alpha(params: PeelParams, t, *, F: float, alpha_in: float, alphadot
     Returns ``α(t) = α_in cos Ωt + (α̇_in/Ω) sin Ωt`` and its derivative,
     ``Ω = sqrt(F R/I)``; arrays shaped like ``t`` (time since branch entry, s).
     """
+    params = _params("params", params)
     t = _times(t)
-    return _harmonic(t, _finite("alpha_in", alpha_in), _finite("alphadot_in", alphadot_in), _positive("F", F),
-                     params.R, params.I)
+    return _harmonic(t, state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega"),
+                     state("F", F, "F"), params.R, params.I)
 
 
 # ------------------------------------------------------------ Airy
@@ -236,13 +240,21 @@ def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_
     alpha, alphadot : ndarray
         Shaped like ``t``.
     """
+    params = _params("params", params)
     t = _times(t)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
-    a_in, ad_in = _finite("alpha_in", alpha_in), _finite("alphadot_in", alphadot_in)
+    a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
     if s == 0.0:
         return _harmonic(t, a_in, ad_in, F_in, params.R, params.I)
     a = np.cbrt(params.R * s / params.I)
     x0 = -a * F_in / s
+    x_far = float(np.max(np.abs(a * (t + F_in / s))))
+    if not x_far <= AIRY_X_MAX:
+        raise ValueError(
+            f"F_rate = {s:g} N/s with t up to {float(np.max(t)):g} s puts the Airy argument "
+            f"x = -cbrt(R s/I) (t + F_in/s) at |x| = {x_far:.3g}, beyond {AIRY_X_MAX:g} where scipy's Ai/Bi are "
+            f"NaN (|F_rate| too small or t too large): use wkb_alpha there (its error, wkb_error_bound, is "
+            f"~|x|^-1.5)")
     ai0, aip0, bi0, bip0 = special.airy(x0)
     c1 = np.pi * (a_in * bip0 + ad_in / a * bi0)
     c2 = -np.pi * (a_in * aip0 + ad_in / a * ai0)
@@ -269,6 +281,7 @@ def sinusoid_alpha(params: PeelParams, t, *, F_in: float, amplitude: float, phas
         ``A`` [rad] (the paper's ``α_in``) and ``φ`` [rad] at t = 0.
     Other parameters as in :func:`airy_alpha`.
     """
+    params = _params("params", params)
     t = _times(t)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
     return _sinusoid(t, _finite("amplitude", amplitude), _finite("phase", phase), F_in, s, params.R, params.I)
@@ -280,8 +293,8 @@ def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alp
 
     Solves ``A sin φ = α_in`` and ``A (Ω_in cos φ - s/(4 F_in) sin φ) = α̇_in``.
     """
-    F_in, s = _force_ramp(params, np.zeros(1), F_in, F_rate)
-    a_in, ad_in = _finite("alpha_in", alpha_in), _finite("alphadot_in", alphadot_in)
+    F_in, s = _force_ramp(_params("params", params), np.zeros(1), F_in, F_rate)
+    a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
     Om = math.sqrt(params.R * F_in / params.I)
     c = (ad_in + s * a_in / (4.0 * F_in)) / Om
     return math.hypot(a_in, c), math.atan2(a_in, c)
@@ -319,6 +332,7 @@ def wkb_error_bound(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
     ``A(t) = A (F_in/F)^(1/4)``.  𝒱 is first order in the adiabatic
     parameter ``s/(F·sqrt(FR/I))``.
     """
+    params = _params("params", params)
     t = _times(t)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
     A, _ = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in, F_rate=F_rate)
@@ -350,11 +364,14 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
     ``R f'/F`` (:func:`cd_damping_time`).  The default rate is ``k (V - v)``
     when ``v`` is given, else ``k V``.
     """
-    if form not in ALPHA_FORMS:
-        raise ValueError(f"form must be one of {ALPHA_FORMS}, got {form!r}")
+    params = _params("params", params)
+    form = choice("form", form, ALPHA_FORMS)
     t = _times(t)
+    rtol = in_range("rtol", rtol, 1e-14, 1e-2)
+    atol = in_range("atol", atol, 1e-100, 1e3)
+    a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
     if v is not None:
-        v = _positive("v", v)
+        v = state("v", v, "v")
         if F_rate is None:
             F_rate = params.k * (params.V - v)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
@@ -375,11 +392,13 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
 
     order = np.argsort(t.ravel(), kind="stable")
     tv = t.ravel()[order]
-    sol = integrate.solve_ivp(rhs, (0.0, float(tv[-1])), [_finite("alpha_in", alpha_in),
-                              _finite("alphadot_in", alphadot_in)], method="DOP853", t_eval=tv,
+    if tv[-1] == 0.0:  # every time is the entry: nothing to integrate (solve_ivp needs a non-empty span)
+        return np.full(t.shape, a_in), np.full(t.shape, ad_in)
+    sol = integrate.solve_ivp(rhs, (0.0, float(tv[-1])), [a_in, ad_in], method="DOP853", t_eval=tv,
                               rtol=rtol, atol=atol)
     if sol.status != 0:
-        raise RuntimeError(f"solve_ivp failed: {sol.message}")
+        raise SolverFailure(f"solve_ivp failed at t = {sol.t[-1]:.6g} s: {sol.message}", t=float(sol.t[-1]),
+                            state={"alpha": float(sol.y[0, -1]), "alphadot": float(sol.y[1, -1])})
     al = np.empty(t.size)
     ad = np.empty(t.size)
     al[order] = sol.y[0]
@@ -394,12 +413,11 @@ def cd_damping_time(params: PeelParams, F, v):
     ``2π sqrt(I/(FR))`` exceeds it, the damping term of Airy1 controls α on CD
     (high inertia).  ``v`` must be on a stable branch.
     """
-    fp = np.asarray(peel_force_derivative(v, params.V), dtype=float)
-    Fa = np.asarray(F, dtype=float)
+    params = _params("params", params)
+    Fa = states("F", F, "F")
+    fp = np.asarray(peel_force_derivative(states("v", v, "v"), params.V), dtype=float)
     if np.any(fp <= 0):
         raise ValueError(f"v must be on a stable branch of f(., V={params.V}) (f'(v) > 0)")
-    if not np.all(np.isfinite(Fa)) or np.any(Fa <= 0):
-        raise ValueError("F must be finite and in (0, inf)")
     out = params.R * fp / Fa
     return float(out) if out.ndim == 0 else out
 
@@ -415,5 +433,6 @@ def cd_decay_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, v_in:
     implied, not free.
     """
     t = _times(t)
-    tau = cd_damping_time(params, _positive("F_in", F_in), _positive("v_in", v_in))
-    return _decay(t, _finite("alpha_in", alpha_in), tau)
+    a_in = state("alpha_in", alpha_in, "alpha")
+    tau = cd_damping_time(params, state("F_in", F_in, "F"), state("v_in", v_in, "v"))
+    return _decay(t, a_in, tau)

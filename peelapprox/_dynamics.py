@@ -31,7 +31,8 @@ import numpy as np
 from ._params import PeelParams
 from ._peelforce import BRANCHES, branch_structure
 from ._sweep import register_measure
-from ._validate import nonnegative, positive
+from ._validate import ArgumentTypeError, duration, function, in_range, integer, optional, positive, reals, state
+from ._validate import params as _params
 
 __all__ = [
     "return_map",
@@ -50,6 +51,20 @@ __all__ = [
 ]
 
 _AB = BRANCHES.index("AB")
+#: Valid ``rtol`` of the exact runs behind the dynamics functions (exact.simulate's range).
+RTOL_RANGE = (1e-14, 1e-2)
+
+
+def _rtol(name: str, x) -> float:
+    return in_range(name, x, *RTOL_RANGE)
+
+
+def _trajectory(name: str, x):
+    """x if it looks like an :class:`exact.Trajectory` (has ``jumps`` with ``t``, ``F``, ``from_branch``)."""
+    J = getattr(x, "jumps", None)
+    if not all(hasattr(J, a) for a in ("t", "F", "from_branch")):
+        raise ArgumentTypeError(f"{name} must be an exact.Trajectory (with jumps), got {type(x).__name__}")
+    return x
 
 
 def return_map(trajectory, *, with_times: bool = False):
@@ -57,7 +72,7 @@ def return_map(trajectory, *, with_times: bool = False):
 
     Signature: ``return_map(trajectory, *, with_times=False) -> ndarray`` (or ``(t_k, x_k)``).
     """
-    J = trajectory.jumps
+    J = _trajectory("trajectory", trajectory).jumps
     m = np.asarray(J.from_branch) == _AB
     x = np.asarray(J.F)[m]
     return (np.asarray(J.t)[m], x) if with_times else x
@@ -109,12 +124,10 @@ def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int
     """
     if hasattr(x, "jumps"):
         x = return_map(x)
-    x = np.asarray(x, dtype=float)
+    x = reals("x", x)
     rtol = positive("rtol", rtol)
-    for name, val in (("max_period", max_period), ("min_repeats", min_repeats)):
-        if isinstance(val, bool) or not isinstance(val, (int, np.integer)) or val < 1:
-            raise ValueError(f"{name} must be an integer >= 1, got {val!r}")
-    if x.ndim != 1 or x.size < 2 or not np.all(np.isfinite(x)):
+    max_period, min_repeats = integer("max_period", max_period), integer("min_repeats", min_repeats)
+    if x.ndim != 1 or x.size < 2:
         raise ValueError(f"x must be a 1-D finite sequence of at least 2 returns, got shape {x.shape}")
     scale = float(np.max(np.abs(x)))
     best = math.inf
@@ -135,7 +148,7 @@ def force_drops(trajectory) -> np.ndarray:
     Signature: ``force_drops(trajectory) -> ndarray`` (one value per completed slip in the stored window).
     The paper's Fig. 6 plots their mean against V.
     """
-    J = trajectory.jumps
+    J = _trajectory("trajectory", trajectory).jumps
     fb = np.asarray(J.from_branch)
     F = np.asarray(J.F)
     idx = np.flatnonzero(fb[:-1] == _AB)  # AB→CD followed by CD→AB (jumps alternate)
@@ -154,6 +167,7 @@ def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> Opti
     None means no period was found in the last half (aperiodic, or still in the transient).
     """
     rtol = positive("rtol", rtol)
+    max_period = integer("max_period", max_period)
     t, x = return_map(trajectory, with_times=True)
     if x.size < 4:
         return None
@@ -179,7 +193,8 @@ def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float =
     ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so measures of one
     sweep point share it.  Raises ``ModelBreakdown`` as :func:`exact.simulate` does.
     """
-    return _window_run(params, nonnegative("t_transient", t_transient), positive("window", window), positive("rtol", rtol), float(alpha0))
+    return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
+                       duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"))
 
 
 @functools.lru_cache(maxsize=2)
@@ -241,13 +256,13 @@ def attractors(
     from exact import ModelBreakdown, initial_state
 
     # validate everything up front: inside the loop a ValueError can then only be an infeasible start
-    kw = dict(t_transient=nonnegative("t_transient", t_transient), window=positive("window", window),
-              rtol=positive("rtol", rtol))
-    positive("period_rtol", period_rtol)
-    positive("match_rtol", match_rtol)
-    if len(alpha0s) == 0:
-        raise ValueError("alpha0s must hold at least one initial peel angle")
-    say = progress or (lambda msg: None)
+    params = _params("params", params)
+    kw = dict(t_transient=duration("t_transient", t_transient, zero=True), window=duration("window", window),
+              rtol=_rtol("rtol", rtol))
+    period_rtol = positive("period_rtol", period_rtol)
+    match_rtol = positive("match_rtol", match_rtol)
+    alpha0s = [float(a) for a in np.atleast_1d(states_alpha("alpha0s", alpha0s))]
+    say = optional(function, "progress", progress) or (lambda msg: None)
     groups: List[dict] = []
     for a0 in alpha0s:
         say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
@@ -283,6 +298,16 @@ def attractors(
 
 
 # ---------------------------------------------------------------------------------------------- Lyapunov
+def states_alpha(name: str, x) -> np.ndarray:
+    """A non-empty 1-D array of initial peel angles, each in ``STATE_RANGES["alpha"]``."""
+    from ._validate import states
+
+    a = states(name, x, "alpha")
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D sequence of initial peel angles, got shape {a.shape}")
+    return a
+
+
 def natural_scales(params: PeelParams) -> np.ndarray:
     """The natural sizes ``(1 rad, V/R, f_max)`` of ``(α, ω, F)``: every Lyapunov estimate measures
     perturbations in ``(δα, δω, δF)`` divided by these (``f_max`` is 1 N when f has no folds)."""
@@ -358,10 +383,9 @@ def benettin(
     -------
     BenettinResult
     """
-    if int(n) < 2:
-        raise ValueError(f"n must be an integer >= 2, got {n!r}")
-    if int(n_discard) < 0:
-        raise ValueError(f"n_discard must be an integer >= 0, got {n_discard!r}")
+    advance, distance, rescale = (function(nm, f) for nm, f in
+                                  (("advance", advance), ("distance", distance), ("rescale", rescale)))
+    n, n_discard = integer("n", n, lo=2), integer("n_discard", n_discard, lo=0)
     d0 = float(distance(x_ref, x_pert))
     if not (d0 > 0.0 and math.isfinite(d0)):
         raise ValueError(f"the initial perturbation must have a finite positive size, got {d0}")
@@ -437,9 +461,13 @@ def lyapunov(
     """
     from exact import initial_state, simulate
 
-    tau = positive("tau", tau)
-    d0 = positive("d0", d0)
-    t_transient = nonnegative("t_transient", t_transient)
+    params = _params("params", params)
+    tau = duration("tau", tau)
+    d0 = positive("d0", d0, hi=1.0)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    n, n_discard = integer("n", n, lo=2), integer("n_discard", n_discard, lo=0)
+    alpha0 = state("alpha0", alpha0, "alpha")
+    rtol = _rtol("rtol", rtol)
     bs = branch_structure(params.V)
     scale = natural_scales(params)
     jumps = [0]
@@ -520,12 +548,14 @@ def lyapunov_tangent(
     """
     from exact._tangent import lyapunov_saltation
 
-    T = positive("T", T)
-    rtol = positive("rtol", rtol)
+    params = _params("params", params)
+    T = duration("T", T)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    rtol = _rtol("rtol", rtol)
+    alpha0 = state("alpha0", alpha0, "alpha")
+    max_steps = optional(integer, "max_steps", max_steps)
     t0 = time.perf_counter()
-    if max_steps is not None and (isinstance(max_steps, bool) or int(max_steps) < 1):
-        raise ValueError(f"max_steps must be a positive integer or None, got {max_steps!r}")
-    lam, n_jumps, t, steps = lyapunov_saltation(params, t_transient=float(t_transient), T=T, rtol=rtol,
+    lam, n_jumps, t, steps = lyapunov_saltation(params, t_transient=t_transient, T=T, rtol=rtol,
                                                 alpha0=alpha0, max_steps=max_steps)
     b = BenettinResult(lam, np.array([lam]), np.array([lam]), math.nan, t, n_jumps, math.nan,
                        time.perf_counter() - t0)
@@ -559,10 +589,11 @@ def lyapunov_return_map(
     """
     from exact import simulate
 
-    h = positive("h", h)
-    rtol = positive("rtol", rtol)
-    if isinstance(n_returns, bool) or int(n_returns) < 2:
-        raise ValueError(f"n_returns must be an integer >= 2, got {n_returns!r}")
+    params = _params("params", params)
+    h = positive("h", h, hi=1.0)
+    rtol = _rtol("rtol", rtol)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    n_returns = integer("n_returns", n_returns, lo=2)
     scale = natural_scales(params)
 
     def ret(x, horizon):

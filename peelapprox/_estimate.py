@@ -20,6 +20,8 @@ from scipy import integrate
 from ._alpha import cd_damping_time, inertial_frequency, inertial_periods
 from ._params import PeelParams
 from ._peelforce import BranchStructure, FixedPoint, branch_structure, fixed_point, peel_force_derivative
+from ._validate import choice, flag, function, in_range, nonnegative, optional, state
+from ._validate import params as _params
 
 __all__ = [
     "crude_branch_time",
@@ -48,7 +50,7 @@ VELOCITY_RULE = (
 
 
 def _folds(params: PeelParams) -> BranchStructure:
-    bs = branch_structure(params.V)
+    bs = branch_structure(_params("params", params).V)
     if not bs.has_folds:
         raise ValueError(f"V={params.V} is outside the stick-slip window: f(v, V) has no folds")
     return bs
@@ -101,21 +103,18 @@ def quasi_static_branch_time(
         Δt [s] (positive for a forward passage along the branch).
     """
     bs = _folds(params)
-    if branch not in ("AB", "CD"):
-        raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
-    if rate not in ("k(V-v)", "kV"):
-        raise ValueError(f"rate must be 'k(V-v)' or 'kV', got {rate!r}")
+    branch = choice("branch", branch, ("AB", "CD"))
+    rate = choice("rate", rate, ("k(V-v)", "kV"))
+    v_in, v_f = optional(state, "v_in", v_in, "v"), optional(state, "v_f", v_f, "v")
+    fprime = optional(function, "fprime", fprime)
     if branch == "AB":
-        v_in = bs.v_land_ab if v_in is None else float(v_in)
-        v_f = bs.v_max if v_f is None else float(v_f)
+        v_in = bs.v_land_ab if v_in is None else v_in
+        v_f = bs.v_max if v_f is None else v_f
         if v_in is None:
             raise ValueError(f"no AB landing velocity for V={params.V}; give v_in")
     else:
-        v_in = bs.v_land_cd if v_in is None else float(v_in)
-        v_f = bs.v_min if v_f is None else float(v_f)
-    for name, x in (("v_in", v_in), ("v_f", v_f)):
-        if not (math.isfinite(x) and x > 0):
-            raise ValueError(f"{name} must be finite and in (0, inf), got {x}")
+        v_in = bs.v_land_cd if v_in is None else v_in
+        v_f = bs.v_min if v_f is None else v_f
     fpr = (lambda v: peel_force_derivative(v, params.V)) if fprime is None else fprime
     k, V = params.k, params.V
     if rate == "kV":
@@ -141,9 +140,9 @@ def force_bounds(params: PeelParams, alpha_min: float, alpha_max: float, *, line
     uses the paper's ``1 + α`` (its quoted 438 N and 181 N at V=4, I=1e-2).
     """
     bs = _folds(params)
-    for name, a in (("alpha_min", alpha_min), ("alpha_max", alpha_max)):
-        if not (math.isfinite(a) and -math.pi / 2 < a < math.pi / 2):
-            raise ValueError(f"{name} must be in (-pi/2, pi/2), got {a}")
+    alpha_min, alpha_max = (in_range(name, a, -math.pi / 2, math.pi / 2, lo_open=True, hi_open=True)
+                            for name, a in (("alpha_min", alpha_min), ("alpha_max", alpha_max)))
+    linear = flag("linear", linear)
     if alpha_min > alpha_max:
         raise ValueError(f"alpha_min must be <= alpha_max, got {alpha_min} > {alpha_max}")
     g = (lambda a: 1.0 + a) if linear else (lambda a: 1.0 + math.sin(a))
@@ -182,12 +181,15 @@ def slope_criterion(params: PeelParams, *, F_in: float, alphadot_in: float, alph
     the asymmetry from ``v/R`` in FLOW1 that the argument neglects; 0.25 puts
     the paper's two points on either side.
     """
-    if not (math.isfinite(alpha0) and alpha0 != 0.0):
+    params = _params("params", params)
+    F_in = state("F_in", F_in, "F")
+    alphadot_in = state("alphadot_in", alphadot_in, "omega")
+    alpha0 = state("alpha0", alpha0, "alpha")
+    if alpha0 == 0.0:
         raise ValueError(f"alpha0 must be finite and non-zero (signed amplitude), got {alpha0}")
-    if not (math.isfinite(tol) and tol >= 0):
-        raise ValueError(f"tol must be finite and >= 0, got {tol}")
+    tol = nonnegative("tol", tol)
     nat = float(inertial_frequency(params, F_in)) * alpha0
-    ratio = float(alphadot_in) / nat
+    ratio = alphadot_in / nat
     return SlopeCriterion(nat, ratio, bool(0.0 < ratio <= 1.0 + tol), tol)
 
 
@@ -262,8 +264,10 @@ def estimate(params: PeelParams, *, alpha_min: Optional[float] = None, alpha_max
     A few milliseconds per call after the first for a given V (the fold
     search is cached).
     """
-    if not isinstance(params, PeelParams):
-        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
+    params = _params("params", params)
+    angle = dict(lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True)
+    alpha_min = optional(in_range, "alpha_min", alpha_min, **angle)
+    alpha_max = optional(in_range, "alpha_max", alpha_max, **angle)
     bs = branch_structure(params.V)
     fp: FixedPoint = fixed_point(params.V, params.R)
     velocity = "stable" if fp.stable else None
@@ -291,7 +295,7 @@ def estimate(params: PeelParams, *, alpha_min: Optional[float] = None, alpha_max
     if alpha_min is not None or alpha_max is not None:
         if alpha_min is None or alpha_max is None:
             raise ValueError("give both alpha_min and alpha_max for the force bounds")
-        Fmax_b, Fmin_b = force_bounds(params, float(alpha_min), float(alpha_max))
+        Fmax_b, Fmin_b = force_bounds(params, alpha_min, alpha_max)
     return RegimeEstimate(
         V=params.V, I=params.I, k=params.k, R=params.R, has_folds=True, v_max=bs.v_max, f_max=bs.f_max,
         v_min=bs.v_min, f_min=bs.f_min, v_land_ab=bs.v_land_ab, v_land_cd=bs.v_land_cd, fixed_point_v=fp.v,

@@ -2,16 +2,62 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
-from ._validate import positive
+from ._validate import choice, in_range
 
-__all__ = ["PeelParams", "GEOMETRIES"]
+__all__ = ["EPS_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
 #: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
 #: is the full geometry ``cos θ = -l sin α / L``, ``L² = l² + R² - 2 l R cos α``.
 GEOMETRIES = ("paper", "exact")
+
+#: Smallest ``l/R``: closer, the exact closure's ``L(α) = l - R + O(α²)`` cancels (see :class:`PeelParams`).
+L_OVER_R_MIN = 1.001
+
+#: Valid range ``(lo, hi)`` of each numeric field, closed at both ends (``l`` also needs
+#: ``l >= L_OVER_R_MIN * R``).  Chosen so that every function of the package returns or raises a
+#: documented exception (no overflow, no division by zero, no bracket failure) with room to spare;
+#: the reasons and the measurements behind each bound are in :class:`PeelParams`.
+PARAM_RANGES = {
+    "V": (1e-6, 100.0),
+    "I": (1e-12, 1e6),
+    "k": (1e-3, 1e7),
+    "R": (1e-4, 10.0),
+    "l": (L_OVER_R_MIN * 1e-4, 1e3),
+}
+#: Valid range ``(lo, hi)`` of the state variables wherever they are given as arguments (initial and
+#: entry states; forces, velocities and angles of the closed forms), closed unless noted:
+#:
+#: * ``"alpha"`` [rad], ``[-π, π]``: one turn (the closures are 2π-periodic; the reduced equations,
+#:   linear in α, are meant for |α| of order 0.1).
+#: * ``"omega"`` [rad/s], for ω and α̇: ``|ω| <= 1e9``, above every natural rate of the model within
+#:   :data:`PARAM_RANGES` (``V/R <= 1e6``; the inertial frequency ``sqrt(F R/I)`` on the branches,
+#:   F <= 1e3 N, is <= 1e8).  Measured: α̇_in = 1e9 still returns (or fails with a documented
+#:   SolverFailure) in :func:`reduced_segment`; 1e300 divided by zero.
+#: * ``"F"`` [N]: ``[1e-3, 1e7]``: the pull force; the peel force is 100-400 N in the stick-slip window and
+#:   ``f(V, V) <= 1.3e6 N`` at the fastest V.  ``F_in = 1e-300`` divided by zero, ``1e300`` did not finish.
+#: * ``"v"`` [m/s]: ``(0, 1e3]``: every branch velocity the model reaches is below 30 m/s; f(1e3, V) ~ 4e41 N
+#:   is still finite (its e^(v/11) overflows at v ~ 7800).  v = 0 is excluded: f has a v^0.15 branch point.
+#: * ``"F_rate"`` [N/s], ``|dF/dt| <= 1e12``: ``k V <= 1e9``.
+STATE_RANGES = {
+    "alpha": (-math.pi, math.pi),
+    "omega": (-1e9, 1e9),
+    "F": (1e-3, 1e7),
+    "v": (0.0, 1e3),
+    "F_rate": (-1e12, 1e12),
+}
+#: Largest time [s] accepted as a horizon or a time since a branch entry by the closed forms and the reduced
+#: segment: 1e6 s (12 days of peeling) keeps ``F_in + F_rate t`` and the phases finite.
+TIME_MAX = 1e6
+
+#: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons._benchmark) goes
+#: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding
+#: of t); at 1e-300 the rates (F(1 + c) - f)/ε overflow.  Above 1e-2 the "fast" transits last as long as
+#: the slow dynamics (the paper uses 1e-7): no longer a regularisation of the jumps.
+EPS_RANGE = (1e-15, 1e-2)
 
 
 
@@ -39,10 +85,50 @@ class PeelParams:
 
     Raises
     ------
+    TypeError
+        (:class:`peelapprox._validate.ArgumentTypeError`, also a
+        ValueError) If a field is not a real number (None, a string, a
+        bool) or ``geometry`` is not a string.
     ValueError
-        If a field is not finite and positive, if ``l <= R``, or if
-        ``geometry`` is unknown.  The message names the field and its valid
-        range.
+        If a field is not finite, lies outside its range
+        (:data:`PARAM_RANGES`), if ``l < 1.001 R``, or if ``geometry`` is
+        unknown.  The message names the field and its valid range.
+
+    Notes
+    -----
+    Valid ranges (:data:`PARAM_RANGES`; the paper's values are V = 0.05-8
+    m/s, I = 1e-6-1e-1 kg m², k = 1000 N/m, R = 0.1 m).  Each bound keeps the
+    numerics of every function in the package valid, with margin; beyond
+    them the runs fail with ZeroDivisionError, OverflowError or bracket
+    errors, or take unbounded time.  Measured with ``estimate``,
+    ``reduced_segment`` and a 0.2 s ``exact.simulate(..., save="jumps")``
+    in both geometries, around V = 2, I = 1e-4:
+
+    * ``V`` in [1e-6, 100] m/s.  The law fvV is fitted to the paper's
+      V <= 10; its ``f(0+, V) = 130 - 2 V^1.5`` is negative above 16 m/s.
+      Numerically, the fixed point ``f(V, V) ~ 130 e^(V/11)`` overflows at
+      V ~ 7800, and the solvers' root bracket (v <= 300 m/s) fails already
+      at V = 300 (exact.simulate: "f(a) and f(b) must have different
+      signs"); V = 100 and 200 work.  Below 1e-6 m/s nothing fails (V =
+      1e-300 ends in a documented breakdown) but the stick phase lasts
+      ``(f_max - f_min)/(k V)`` > 1e5 s: not a pull speed.
+    * ``I`` in [1e-12, 1e6] kg m².  The inertial period ``2π sqrt(I/(F R))``
+      is 1.2e-6 s at I = 1e-12 (a 0.2 s run: 2 s of wall time); at 1e-15 it
+      does not finish in 20 s.  1e6 kg m² (a 10 t flywheel) is used by the
+      tests as the inertia-free limit; 1e9 also works.
+    * ``k`` in [1e-3, 1e7] N/m.  The stiff time ``sqrt(I/(k R²))`` sets the
+      step: 0.2 s take 1.1 s at k = 1e7, 16 s at 1e8, over 20 s at 1e9;
+      ``k = 1e300`` divides by zero (the default absolute tolerances).  Down to
+      k = 1e-6 every run returns (the reduced segment then exhausts its step
+      budget, a documented SolverBudgetExceeded).
+    * ``R`` in [1e-4, 10] m.  ``V/R`` and ``F R/I`` set the fast scales:
+      R = 1e-4 takes 0.3 s, 1e-5 5 s, 1e-6 over 20 s; ``R = 1e-300`` divides
+      by zero.  R = 100 (with l = 1000) still works; 10 m is a generous roller.
+    * ``l`` in [1.001 R, 1e3] m (``l`` is read only by ``geometry="exact"``).
+      At ``l = R (1 + 1e-12)`` the closure is NaN at α = 0 and at
+      ``R (1 + 1e-6)`` a 0.2 s run does not finish in 20 s; from 1.001 R
+      (closure slope ``l/(l - R)`` <= 1001) runs are ordinary.  l = 1e6 works;
+      beyond 1 km the exact geometry is the paper's to 1e-4.
 
     Examples
     --------
@@ -59,14 +145,14 @@ class PeelParams:
     geometry: str = field(default="paper")
 
     def __post_init__(self) -> None:
-        for name in ("V", "I", "k", "R", "l"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        if self.l <= self.R:
+        for name, (lo, hi) in PARAM_RANGES.items():
+            object.__setattr__(self, name, in_range(name, getattr(self, name), lo, hi))
+        if self.l < L_OVER_R_MIN * self.R:
             raise ValueError(
-                f"l must be greater than R (valid range: l in (R, inf) = ({self.R}, inf)), got l={self.l}"
+                f"l must be greater than R: l must be finite and in [{L_OVER_R_MIN} R, {PARAM_RANGES['l'][1]:g}] = "
+                f"[{L_OVER_R_MIN * self.R:g}, {PARAM_RANGES['l'][1]:g}], got l={self.l!r} with R={self.R!r}"
             )
-        if self.geometry not in GEOMETRIES:
-            raise ValueError(f"geometry must be one of {GEOMETRIES}, got {self.geometry!r}")
+        object.__setattr__(self, "geometry", choice("geometry", self.geometry, GEOMETRIES))
 
     def closure(self, alpha):
         """``(c, dc/dα)`` with ``c = -cos θ`` for this geometry; scalar or array ``alpha``."""

@@ -28,6 +28,8 @@ from ._jit import kernel
 from scipy.optimize import brentq
 
 from . import _generated as _g
+from ._params import PARAM_RANGES, STATE_RANGES
+from ._validate import choice, in_range, reals
 
 __all__ = [
     "peel_force",
@@ -60,17 +62,13 @@ _V_HI = 300.0  # exp(300/11) ~ 7e11: f is astronomically large there
 
 
 def _check_V(V) -> float:
-    x = float(V)
-    if not math.isfinite(x) or x <= 0:
-        raise ValueError(f"V must be finite and in (0, inf), got {V!r}")
-    return x
+    """The pull speed V in :data:`peelapprox.PARAM_RANGES` (the law's valid range, one bound for all)."""
+    return in_range("V", V, *PARAM_RANGES["V"])
 
 
 def _check_v(v) -> np.ndarray:
-    a = np.asarray(v, dtype=float)
-    if not np.all(np.isfinite(a)) or np.any(a <= 0):
-        raise ValueError("v must be finite and in (0, inf) (f(v, V) has a v^0.15 branch point at v = 0)")
-    return a
+    """Peel velocities in ``STATE_RANGES["v"]`` = (0, 1e3] m/s (f has a v^0.15 branch point at 0)."""
+    return reals("v", v, *STATE_RANGES["v"], lo_open=True)
 
 
 def peel_force(v, V):
@@ -98,8 +96,7 @@ def peel_force(v, V):
 
 def peel_force_derivative(v, V, order: int = 1):
     """``∂ᵏf/∂vᵏ (v, V)`` for ``order`` k in {0, 1, 2} [N s^k/m^k]."""
-    if order not in (0, 1, 2):
-        raise ValueError(f"order must be 0, 1 or 2, got {order!r}")
+    order = choice("order", order, (0, 1, 2))
     b, A = peel_force_coefficients(_check_V(V))
     out = _g.peel_force_fpp(_check_v(v), b, A)[order]
     return out[()] if np.ndim(out) == 0 else out
@@ -174,7 +171,6 @@ class BranchStructure:
         return (self.f_min, math.inf)
 
 
-@functools.lru_cache(maxsize=512)
 def branch_structure(V: float) -> BranchStructure:
     """Folds, inflection and landing velocities of ``f(·, V)``; cached per V.
 
@@ -191,8 +187,17 @@ def branch_structure(V: float) -> BranchStructure:
     Returns
     -------
     BranchStructure
+
+    Raises
+    ------
+    ValueError
+        If V is outside ``PARAM_RANGES["V"]`` (TypeError if not a number).
     """
-    V = _check_V(V)
+    return _branch_structure(_check_V(V))
+
+
+@functools.lru_cache(maxsize=512)
+def _branch_structure(V: float) -> BranchStructure:
     b, A = peel_force_coefficients(V)
     # f'' < 0 for small v (the -v^-1.85 term) and > 0 for large v (exp term):
     # locate its sign changes on a log grid and require exactly one.
@@ -267,12 +272,10 @@ def branch_inverse(G, V: float, branch: str):
         If ``G`` is outside the branch's level range
         (AB: ``(f(0+), f_max]``, CD: ``[f_min, inf)``), naming the range.
     """
-    bs = branch_structure(_check_V(V))
-    bs.branch_range(branch)
+    bs = branch_structure(V)
+    bs.branch_range(choice("branch", branch, BRANCHES))
     b, A = peel_force_coefficients(bs.V)
-    Ga = np.asarray(G, dtype=float)
-    if not np.all(np.isfinite(Ga)):
-        raise ValueError("G must be finite")
+    Ga = reals("G", G)
     out = np.array([_invert(float(x), bs, branch, b, A) for x in Ga.ravel()]).reshape(Ga.shape)
     return float(out) if out.ndim == 0 else out
 
@@ -293,7 +296,11 @@ class FixedPoint:
 
 
 def fixed_point(V: float, R: float = 0.1) -> FixedPoint:
-    """Fixed point of FLOW1–flow3 with CONSTR and its stability (``f'(V,V) > 0``)."""
+    """Fixed point of FLOW1–flow3 with CONSTR and its stability (``f'(V,V) > 0``).
+
+    ``V`` and ``R`` must lie in :data:`peelapprox.PARAM_RANGES`.
+    """
     V = _check_V(V)
+    R = in_range("R", R, *PARAM_RANGES["R"])
     f, fp = _g.peel_force_fp(V, *peel_force_coefficients(V))
     return FixedPoint(0.0, V / R, float(f), V, float(fp), bool(fp > 0))

@@ -70,7 +70,10 @@ from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import PeelParams
-from ._validate import optional_finite as _opt_finite
+from ._params import TIME_MAX
+from ._validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
+from ._validate import state as _state
+from ._validate import params as _params
 from ._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_derivative, peel_force_fp_jit
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
@@ -81,6 +84,12 @@ ALPHA_MODELS = (
 )
 #: velocity equations accepted by :func:`reduced_segment`
 V_EQUATIONS = ("approxvdot", "fullvdot")
+#: Valid ``rtol`` of :func:`reduced_segment`: below 1e-14 the DOP853 error test asks for less than rounding.
+RTOL_RANGE = (1e-14, 1e-2)
+#: Valid ``atol`` components: below 1e-100 the squared scaled errors of the step-size control underflow
+#: (``atol = 1e-200`` divided by zero); above 1e3 the error test accepts any step (every component's
+#: natural scale on a branch is smaller, except F in N, whose default atol is ``rtol F_in``).
+ATOL_RANGE = (1e-100, 1e3)
 
 AM_SIN, AM_HARM, AM_APPROX, AM_AIRY2, AM_AIRY2F, AM_AIRY1, AM_GEN, AM_EXP, AM_STATIC = range(9)
 VE_APPROX, VE_FULL = range(2)
@@ -364,10 +373,12 @@ def reduced_segment(
         Slope ``s`` of ``F_lin = F_in + s t`` used by ``"sinusoid"``;
         default ``k (V - v_in)``.
     rtol : float, default 1e-10
+        In [1e-14, 1e-2] (:data:`RTOL_RANGE`).
     atol : float or array_like of 5, optional
-        Tolerances (module docstring for the semantics and the default).
+        Tolerances (module docstring for the semantics and the default), each in [1e-100, 1e3]
+        (:data:`ATOL_RANGE`).
     t_max : float, optional
-        Horizon [s]; default ``20 (f_max - f_min)/(k V) + 20 × 2π/Ω_in``.
+        Horizon [s] in (0, 1e6]; default ``20 (f_max - f_min)/(k V) + 20 × 2π/Ω_in``.
     save : {"steps", "none"}
         Store the curves at accepted steps, or only entry and exit.
         Ignored when ``t_eval`` is given.
@@ -375,7 +386,11 @@ def reduced_segment(
         Increasing times [s, from entry] at which to store the curves (dense
         output); times after the exit are not filled.
     max_steps : int
-        Step budget.
+        Step budget, an integer in [1, 1e15] (a float such as ``1e6`` is refused: write ``10**6``).
+
+    Entry states must lie in :data:`peelapprox._params.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
+    ``alpha_in`` and ``amplitude`` in [-π, π], ``alphadot_in`` in [-1e9, 1e9] rad/s, ``v_in``, ``v_f`` in
+    (0, 1e3] m/s, ``F_rate`` in [-1e12, 1e12] N/s).
 
     Returns
     -------
@@ -383,8 +398,12 @@ def reduced_segment(
 
     Raises
     ------
+    TypeError
+        (``ArgumentTypeError``, also a ValueError) For an argument of the wrong kind: a string, bool or
+        None for a number, a float for ``max_steps``, anything but a PeelParams for ``params``.
     ValueError
-        For an unknown model, a velocity off the branch, or missing inputs.
+        For an unknown model, a value out of its range, a velocity off the branch, or missing inputs;
+        the message names the argument.
     ModelBreakdown
         If v → 0 on AB, v runs away on CD, or F reaches 0 (reason in the
         exception, with the time and state).
@@ -392,25 +411,29 @@ def reduced_segment(
         If v does not reach ``v_f`` before ``t_max`` or within ``max_steps``.
     """
     t_wall = time.perf_counter()
-    if not isinstance(params, PeelParams):
-        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
-    if branch not in BRANCHES:
-        raise ValueError(f"branch must be one of {BRANCHES}, got {branch!r}")
-    if alpha_model not in ALPHA_MODELS:
-        raise ValueError(f"alpha_model must be one of {ALPHA_MODELS}, got {alpha_model!r}")
-    if v_equation not in V_EQUATIONS:
-        raise ValueError(f"v_equation must be one of {V_EQUATIONS}, got {v_equation!r}")
-    if save not in ("steps", "none"):
-        raise ValueError(f"save must be 'steps' or 'none', got {save!r}")
-    rtol = _opt_finite("rtol", rtol)
-    if not 1e-14 <= rtol <= 1e-2:
-        raise ValueError(f"rtol must be in [1e-14, 1e-2], got {rtol}")
-    if int(max_steps) < 1:
-        raise ValueError(f"max_steps must be >= 1, got {max_steps}")
+    params = _params("params", params)
+    branch = choice("branch", branch, BRANCHES)
+    alpha_model = choice("alpha_model", alpha_model, ALPHA_MODELS)
+    v_equation = choice("v_equation", v_equation, V_EQUATIONS)
+    save = choice("save", save, ("steps", "none"))
+    rtol = in_range("rtol", rtol, *RTOL_RANGE)
+    max_steps = integer("max_steps", max_steps)
+    F_in = _state("F_in", F_in, "F")
+    v_in, v_f = optional(_state, "v_in", v_in, "v"), optional(_state, "v_f", v_f, "v")
+    alpha_in = optional(_state, "alpha_in", alpha_in, "alpha")
+    alphadot_in = optional(_state, "alphadot_in", alphadot_in, "omega")
+    amplitude = optional(_state, "amplitude", amplitude, "alpha")
+    phase = optional_finite("phase", phase)
+    F_rate = optional(_state, "F_rate", F_rate, "F_rate")
+    if atol is not None:
+        atol_v = reals("atol", atol, *ATOL_RANGE)
+        if atol_v.shape not in ((), (5,)):
+            raise ValueError(f"atol must be a scalar or one value per (t, ln v, F, alpha, alphadot), got shape "
+                             f"{atol_v.shape}")
+        atol_v = np.broadcast_to(atol_v, (5,)).copy()
+    t_max = optional(duration, "t_max", t_max)
+    te = None if t_eval is None else times("t_eval", t_eval, hi=TIME_MAX)
     bs = branch_structure(params.V)
-    F_in = _opt_finite("F_in", F_in)
-    if F_in is None or F_in <= 0:
-        raise ValueError(f"F_in must be finite and in (0, inf), got {F_in!r}")
 
     # ---- velocities
     if branch == "CD" and not bs.has_folds:
@@ -419,7 +442,6 @@ def reduced_segment(
         v_in = bs.v_land_ab if branch == "AB" else bs.v_land_cd
         if v_in is None:
             raise ValueError(f"no AB landing velocity for V={params.V} (f_min <= f(0+)); give v_in explicitly")
-    v_in = _opt_finite("v_in", v_in)
     lo, hi = bs.branch_range(branch)
     if not (lo < v_in < hi):
         raise ValueError(f"v_in must be on branch {branch}, i.e. in ({lo}, {hi}) for V={params.V}; got {v_in}")
@@ -427,7 +449,6 @@ def reduced_segment(
         if not bs.has_folds:
             raise ValueError(f"V={params.V} has no fold; give v_f explicitly")
         v_f = bs.v_max if branch == "AB" else bs.v_min
-    v_f = _opt_finite("v_f", v_f)
     if branch == "AB" and not (v_in < v_f <= hi):
         raise ValueError(f"v_f must be in (v_in, v_max] = ({v_in}, {hi}] on AB, got {v_f}")
     if branch == "CD" and not (lo <= v_f < v_in):
@@ -435,11 +456,7 @@ def reduced_segment(
 
     # ---- α inputs
     am = ALPHA_MODELS.index(alpha_model)
-    alpha_in = _opt_finite("alpha_in", alpha_in)
-    alphadot_in = _opt_finite("alphadot_in", alphadot_in)
-    amplitude = _opt_finite("amplitude", amplitude)
-    phase = _opt_finite("phase", phase)
-    s = params.k * (params.V - v_in) if F_rate is None else _opt_finite("F_rate", F_rate)
+    s = params.k * (params.V - v_in) if F_rate is None else F_rate
     fp_in = float(peel_force_derivative(v_in, params.V))
     tau = params.R * fp_in / F_in
     if am == AM_SIN:
@@ -472,21 +489,11 @@ def reduced_segment(
     a_scale = max(abs(alpha_in), abs(alphadot_in) / Om, 1e-8)
     if atol is None:
         atol_v = rtol * np.array([1e-3, 1.0, F_in, a_scale, Om * a_scale])
-    else:
-        atol_v = np.broadcast_to(np.asarray(atol, dtype=float), (5,)).copy()
-        if not np.all(np.isfinite(atol_v)) or np.any(atol_v <= 0):
-            raise ValueError("atol must be finite and > 0 (a scalar or one value per (t, ln v, F, alpha, alphadot))")
     if t_max is None:
         gap = (bs.f_max - bs.f_min) if bs.has_folds else F_in
         t_max = 20.0 * gap / (params.k * params.V) + 20.0 * 2.0 * math.pi / Om
-    t_max = _opt_finite("t_max", t_max)
-    if t_max <= 0:
-        raise ValueError(f"t_max must be > 0, got {t_max}")
 
-    if t_eval is not None:
-        te = np.asarray(t_eval, dtype=float).ravel()
-        if te.size == 0 or not np.all(np.isfinite(te)) or np.any(te < 0) or np.any(np.diff(te) <= 0):
-            raise ValueError("t_eval must be a non-empty, strictly increasing array of finite times >= 0")
+    if te is not None:
         mode, cap = SAVE_TEVAL, te.size
     else:
         te = np.empty(0)

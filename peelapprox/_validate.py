@@ -1,46 +1,328 @@
-"""Small named validators shared by the public functions (clear ``ValueError`` messages)."""
+"""The named argument validators shared by every public function.
+
+One rule for every public argument, so that a bad argument is reported as what it is, by name, before
+any computation:
+
+* a value of the wrong *kind* — ``None``, a string, a bool, a sequence where a number is expected, a
+  float where an integer count is expected, anything but a :class:`PeelParams` where parameters are
+  expected — raises :class:`ArgumentTypeError` (a ``TypeError``);
+* a value of the right kind outside its valid range — NaN, ±inf, a negative time, an unknown choice —
+  raises ``ValueError``.
+
+Both messages name the argument and the valid range, in the one pattern
+``"<name> must be <kind> in <range>, got <value>"``, e.g.
+``"rtol must be finite and in (0, 1), got nan"`` or ``"alpha0 must be a real number in (-inf, inf), got 'abc'
+(str)"``.
+
+:class:`ArgumentTypeError` subclasses both ``TypeError`` and ``ValueError`` (as numpy's ``AxisError``
+subclasses ``ValueError`` and ``IndexError``), so callers written against the earlier rule "bad arguments
+raise ValueError" (the CLI's error report, ``except ValueError`` around a run) still catch it.
+
+Decisions recorded here once:
+
+* **bool and str are not numbers**: ``True`` is not 1.0 and ``"1e-3"`` is not 1e-3.
+* **integer counts are integers**: :func:`integer` accepts ``int`` and numpy integers and rejects every
+  float, integral or not (``max_points=100.0`` is refused rather than rounded: a float count is usually
+  a unit mix-up, and numpy refuses ``np.zeros(3.0)`` for the same reason).  Counts are bounded above by
+  :data:`MAX_COUNT` so that no budget overflows numba's int64 or means "forever".
+* ranges are closed unless stated open; bounds are printed with ``[``/``]`` or ``(``/``)`` accordingly.
+"""
 
 from __future__ import annotations
 
 import math
-from typing import Optional
+import numbers
+from typing import Any, Callable, Optional, Sequence, TypeVar
 
-__all__ = ["finite", "positive", "nonnegative", "optional_finite"]
+import numpy as np
+
+__all__ = [
+    "ArgumentTypeError",
+    "MAX_COUNT",
+    "real",
+    "in_range",
+    "finite",
+    "positive",
+    "nonnegative",
+    "optional",
+    "optional_finite",
+    "integer",
+    "choice",
+    "flag",
+    "function",
+    "params",
+    "reals",
+    "times",
+    "interval",
+    "state",
+    "states",
+    "duration",
+]
+
+T = TypeVar("T")
+
+#: Upper bound of every integer count (steps, points, jumps, periods): 1e15 is beyond any run that can
+#: finish (a year of wall time at 30 ns per step) and far inside numba's int64 (9.2e18).
+MAX_COUNT = 10**15
 
 
-def finite(name: str, x) -> float:
-    """``float(x)``, or ValueError naming ``name`` if x is not a finite real number."""
-    try:
-        y = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite real number, got {x!r}") from None
-    if not math.isfinite(y):
-        raise ValueError(f"{name} must be finite, got {x!r}")
+class ArgumentTypeError(TypeError, ValueError):
+    """An argument of the wrong kind (a string or bool for a number, a float for a count, ...).
+
+    A ``TypeError``; also a ``ValueError`` so that handlers of the library's earlier "bad arguments raise
+    ValueError" rule still catch it (module docstring).
+    """
+
+
+def _fmt(x: float) -> str:
+    """A bound as people write it: ``0``, ``1e-14``, ``0.01``, ``1e+300`` -> ``1e300``, ``inf``."""
+    if isinstance(x, numbers.Integral):
+        return str(x) if abs(x) < 10**6 else f"{float(x):.0e}".replace("e+0", "e").replace("e+", "e")
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    s = f"{x:.6g}"
+    if "e" in s:
+        m, e = s.split("e")
+        s = f"{m}e{int(e)}"
+    return s
+
+
+def interval(lo: float = -math.inf, hi: float = math.inf, *, lo_open: bool = False, hi_open: bool = False) -> str:
+    """The text of a range, ``"[lo, hi]"`` with ``(``/``)`` for open or infinite ends (``"(0, inf)"``)."""
+    left = "(" if lo_open or math.isinf(lo) else "["
+    right = ")" if hi_open or math.isinf(hi) else "]"
+    return f"{left}{_fmt(lo)}, {_fmt(hi)}{right}"
+
+
+def _got(x: Any) -> str:
+    """``repr(x)``, shortened, with the type for values whose repr hides it (``'abc' (str)``)."""
+    r = repr(x)
+    if len(r) > 60:
+        r = r[:57] + "..."
+    if isinstance(x, (str, bytes, bool, np.bool_)) or x is None:
+        return r if x is None else f"{r} ({type(x).__name__})"
+    return r
+
+
+def real(name: str, x: Any, *, rng: str = "(-inf, inf)") -> float:
+    """``float(x)`` if x is a real number of any value (NaN and ±inf included), else ArgumentTypeError.
+
+    Accepts Python and numpy real scalars, 0-d real arrays and other ``float()``-convertible numbers
+    (``Fraction``); rejects None, ``bool``/``numpy.bool_``, ``str``/``bytes``, complex numbers, and
+    arrays or sequences with any dimension.  ``rng`` is the range printed in the message.
+    """
+    bad = (x is None or isinstance(x, (bool, np.bool_, str, bytes, complex, np.complexfloating))
+           or np.ndim(x) != 0)
+    if not bad:
+        if isinstance(x, np.ndarray) and x.dtype.kind not in "iuf":
+            bad = True
+        else:
+            try:
+                return float(x)
+            except (TypeError, ValueError, OverflowError):
+                # OverflowError: an int beyond the float range; it is a number, but not a usable one
+                if isinstance(x, numbers.Integral):
+                    raise ValueError(f"{name} must be finite and in {rng}, got {_got(x)}") from None
+                bad = True
+    raise ArgumentTypeError(f"{name} must be a real number in {rng}, got {_got(x)}")
+
+
+def in_range(name: str, x: Any, lo: float = -math.inf, hi: float = math.inf, *, lo_open: bool = False,
+             hi_open: bool = False) -> float:
+    """``float(x)`` if x is a finite real number in the range from ``lo`` to ``hi``.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the caller spells it.
+    x : object
+        The value given.
+    lo, hi : float
+        Bounds; infinite bounds are always open (the value must be finite).
+    lo_open, hi_open : bool
+        Exclude the bound itself.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ArgumentTypeError
+        If x is not a real number (see :func:`real`).
+    ValueError
+        If x is NaN, infinite or outside the range: ``"<name> must be finite and in [lo, hi], got x"``.
+    """
+    rng = interval(lo, hi, lo_open=lo_open, hi_open=hi_open)
+    y = real(name, x, rng=rng)
+    ok = math.isfinite(y) and (y > lo if lo_open else y >= lo) and (y < hi if hi_open else y <= hi)
+    if not ok:
+        raise ValueError(f"{name} must be finite and in {rng}, got {_got(x)}")
     return y
 
 
-def positive(name: str, x) -> float:
-    """``float(x)`` if it is a finite number in (0, inf), else ValueError naming ``name`` and the range."""
-    try:
-        y = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number in (0, inf), got {x!r}") from None
-    if not (math.isfinite(y) and y > 0.0):
-        raise ValueError(f"{name} must be finite and in (0, inf), got {x!r}")
-    return y
+def finite(name: str, x: Any) -> float:
+    """``float(x)`` if x is a finite real number, else an error naming ``name`` (:func:`in_range`)."""
+    return in_range(name, x)
 
 
-def nonnegative(name: str, x) -> float:
-    """``float(x)`` if it is a finite number in [0, inf), else ValueError naming ``name`` and the range."""
-    try:
-        y = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number in [0, inf), got {x!r}") from None
-    if not (math.isfinite(y) and y >= 0.0):
-        raise ValueError(f"{name} must be finite and in [0, inf), got {x!r}")
-    return y
+def positive(name: str, x: Any, hi: float = math.inf) -> float:
+    """``float(x)`` if x is a finite real number in ``(0, hi]`` (``(0, inf)`` by default)."""
+    return in_range(name, x, 0.0, hi, lo_open=True)
 
 
-def optional_finite(name: str, x) -> Optional[float]:
+def nonnegative(name: str, x: Any, hi: float = math.inf) -> float:
+    """``float(x)`` if x is a finite real number in ``[0, hi]`` (``[0, inf)`` by default)."""
+    return in_range(name, x, 0.0, hi)
+
+
+def optional(check: Callable[..., T], name: str, x: Any, *args: Any, **kwargs: Any) -> Optional[T]:
+    """None stays None; anything else goes through ``check(name, x, *args, **kwargs)``."""
+    return None if x is None else check(name, x, *args, **kwargs)
+
+
+def optional_finite(name: str, x: Any) -> Optional[float]:
     """None stays None; anything else goes through :func:`finite`."""
-    return None if x is None else finite(name, x)
+    return optional(finite, name, x)
+
+
+def integer(name: str, x: Any, lo: int = 1, hi: int = MAX_COUNT) -> int:
+    """``int(x)`` if x is an integer (``int`` or a numpy integer, not bool, not float) in ``[lo, hi]``.
+
+    Raises
+    ------
+    ArgumentTypeError
+        For floats (``100.0`` included: pass ``100``), bools, strings, None.
+    ValueError
+        Outside ``[lo, hi]`` (``hi`` defaults to :data:`MAX_COUNT`).
+    """
+    rng = interval(lo, hi)
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (numbers.Integral, np.integer)):
+        hint = f"; write {int(x)} for a whole number" if isinstance(x, float) and x.is_integer() else ""
+        raise ArgumentTypeError(f"{name} must be an integer in {rng}, got {_got(x)}{hint}")
+    y = int(x)
+    if not lo <= y <= hi:
+        raise ValueError(f"{name} must be an integer in {rng}, got {_got(x)}")
+    return y
+
+
+def _same_kind(x: Any, c: Any) -> bool:
+    """x could equal the choice c: strings with strings, integers (not bools) with integers, bools with bools."""
+    if isinstance(c, (bool, np.bool_)) or isinstance(x, (bool, np.bool_)):
+        return isinstance(x, (bool, np.bool_)) and isinstance(c, (bool, np.bool_))
+    if isinstance(c, str):
+        return isinstance(x, str)
+    if isinstance(c, numbers.Integral):
+        return isinstance(x, (numbers.Integral, np.integer))
+    return isinstance(x, type(c))
+
+
+def choice(name: str, x: Any, choices: Sequence[T]) -> T:
+    """The element of ``choices`` equal to x (same type), else an error listing the choices.
+
+    ArgumentTypeError if x is of none of the choices' types (``None`` for a string choice), ValueError
+    otherwise; both read ``"<name> must be one of (...), got x"``.
+    """
+    for c in choices:
+        if _same_kind(x, c) and x == c:
+            return c
+    msg = f"{name} must be one of {tuple(choices)!r}, got {_got(x)}"
+    if not any(_same_kind(x, c) for c in choices):
+        raise ArgumentTypeError(msg)
+    raise ValueError(msg)
+
+
+def flag(name: str, x: Any) -> bool:
+    """x if it is a bool (or ``numpy.bool_``), else ArgumentTypeError: 0, 1, "yes" are not flags."""
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    raise ArgumentTypeError(f"{name} must be True or False, got {_got(x)}")
+
+
+def function(name: str, x: Any) -> Callable:
+    """x if it is callable, else ArgumentTypeError."""
+    if not callable(x):
+        raise ArgumentTypeError(f"{name} must be callable, got {_got(x)}")
+    return x
+
+
+def params(name: str, x: Any):
+    """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError."""
+    from ._params import PeelParams
+
+    if not isinstance(x, PeelParams):
+        raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
+    return x
+
+
+def reals(name: str, x: Any, lo: float = -math.inf, hi: float = math.inf, *, lo_open: bool = False,
+          hi_open: bool = False, nonempty: bool = True) -> np.ndarray:
+    """x as a float array (any shape, scalars as 0-d) with every element finite and in the range.
+
+    ArgumentTypeError for None, strings, bools or boolean/object/complex arrays; ValueError for an empty
+    array (with ``nonempty``), a non-finite element or one out of range (the first offender is shown).
+    """
+    rng = interval(lo, hi, lo_open=lo_open, hi_open=hi_open)
+    kind = "an array of real numbers"
+    if x is None or isinstance(x, (str, bytes, bool, np.bool_)):
+        raise ArgumentTypeError(f"{name} must be {kind} in {rng}, got {_got(x)}")
+    try:
+        a = np.asarray(x)
+    except (TypeError, ValueError):  # ragged nesting
+        raise ArgumentTypeError(f"{name} must be {kind} in {rng}, got {_got(x)}") from None
+    if a.dtype.kind not in "iuf":
+        raise ArgumentTypeError(f"{name} must be {kind} in {rng}, got {_got(x)} (dtype {a.dtype})")
+    a = a.astype(float)
+    if nonempty and a.size == 0:
+        raise ValueError(f"{name} must be a non-empty array of finite values in {rng}, got an empty array")
+    ok = np.isfinite(a) & ((a > lo) if lo_open else (a >= lo)) & ((a < hi) if hi_open else (a <= hi))
+    if not np.all(ok):
+        bad = a.ravel()[np.flatnonzero(~ok.ravel())[0]]
+        raise ValueError(f"{name} must be finite and in {rng} (every element), got {_got(float(bad))}")
+    return a
+
+
+def times(name: str, x: Any, *, lo: float = 0.0, hi: float = math.inf, increasing: bool = True,
+          ndim: Optional[int] = 1) -> np.ndarray:
+    """x as a non-empty float array of finite times in ``[lo, hi]``, strictly increasing if ``increasing``.
+
+    ``ndim=1`` requires a 1-D array (``None``: any shape, used where times are broadcast elementwise).
+    Errors as :func:`reals`; ``ValueError`` names the first non-increasing position.
+    """
+    a = reals(name, x, lo, hi)
+    if ndim is not None and a.ndim != ndim:
+        raise ValueError(f"{name} must be a {ndim}-D array of times in {interval(lo, hi)}, got shape {a.shape}")
+    if increasing and a.ndim == 1 and a.size > 1:
+        bad = np.flatnonzero(np.diff(a) <= 0)
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"{name} must be strictly increasing, got {name}[{i}] = {float(a[i])!r} >= "
+                             f"{name}[{i + 1}] = {float(a[i + 1])!r}")
+    return a
+
+
+def state(name: str, x: Any, quantity: str) -> float:
+    """A scalar state variable in its range :data:`peelapprox._params.STATE_RANGES` [quantity].
+
+    ``quantity`` is ``"alpha"`` (rad), ``"omega"`` (rad/s, also for α̇), ``"F"`` (N), ``"v"`` (m/s, open at
+    0) or ``"F_rate"`` (N/s); e.g. ``state("F0", F0, "F")``.
+    """
+    from ._params import STATE_RANGES
+
+    lo, hi = STATE_RANGES[quantity]
+    return in_range(name, x, lo, hi, lo_open=quantity == "v")
+
+
+def states(name: str, x: Any, quantity: str) -> np.ndarray:
+    """:func:`state` for an array (any shape, scalars as 0-d), every element checked (:func:`reals`)."""
+    from ._params import STATE_RANGES
+
+    lo, hi = STATE_RANGES[quantity]
+    return reals(name, x, lo, hi, lo_open=quantity == "v")
+
+
+def duration(name: str, x: Any, *, zero: bool = False) -> float:
+    """A time span [s] in ``(0, TIME_MAX]`` (``[0, TIME_MAX]`` with ``zero``), TIME_MAX = 1e6 s."""
+    from ._params import TIME_MAX
+
+    return in_range(name, x, 0.0, TIME_MAX, lo_open=not zero)

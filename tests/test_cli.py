@@ -28,7 +28,7 @@ def test_bad_argument_exit_code(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["simulate", "--V", "1", "--I", "-1", "--t-end", "1"])
     assert exc.value.code == 2
-    assert "I must be finite and in (0, inf)" in capsys.readouterr().err
+    assert "I must be finite and in [1e-12, 1e6], got -1.0" in capsys.readouterr().err
 
 
 def test_folds_json(capsys):

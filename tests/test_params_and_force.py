@@ -1,6 +1,7 @@
 """PeelParams validation and the peel-force module (fvV, folds, branch inverses)."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -17,10 +18,15 @@ from peelapprox import (
 
 @pytest.mark.parametrize("field,value", [("V", 0), ("V", -1), ("I", float("nan")), ("k", float("inf")), ("R", 0.0)])
 def test_params_reject_nonpositive_or_nonfinite(field, value):
-    """Every field must be finite and positive; the message names the field and the range."""
+    """Every field must be finite and inside its range (PARAM_RANGES); the message names the field and the
+    range."""
+    from peelapprox._validate import interval
+    from peelapprox import PARAM_RANGES
+
     kw = dict(V=1.0, I=1e-5)
     kw[field] = value
-    with pytest.raises(ValueError, match=rf"{field} must be finite and in \(0, inf\)"):
+    rng = re.escape(interval(*PARAM_RANGES[field]))
+    with pytest.raises(ValueError, match=rf"{field} must be finite and in {rng}"):
         PeelParams(**kw)
 
 
