@@ -33,6 +33,8 @@ __all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE", "STEP_B
 METHODS = ("hybrid", "regularized")
 SOLVERS = ("Radau", "BDF", "LSODA")
 SAVES = ("steps", "jumps")
+#: The relative tolerances :func:`simulate` accepts (closed interval).
+RTOL_RANGE = (1e-14, 1e-2)
 
 #: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
 #: components.  Hybrid: (τ [s], α [rad], ω [rad/s], v [m/s]); regularised:
@@ -256,8 +258,8 @@ def simulate(
     if t_end <= 0:
         raise ValueError(f"t_end must be in (0, inf), got {t_end}")
     rtol = _finite("rtol", rtol)
-    if not (1e-14 <= rtol <= 1e-2):
-        raise ValueError(f"rtol must be in [1e-14, 1e-2], got {rtol}")
+    if not (RTOL_RANGE[0] <= rtol <= RTOL_RANGE[1]):
+        raise ValueError(f"rtol must be in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}], got {rtol}")
     atol_v = _atol_vector(method, rtol, atol)
     eps = _finite("eps", eps)
     if not eps > 0:

@@ -31,7 +31,7 @@ import numpy as np
 from ._params import PeelParams
 from ._peelforce import BRANCHES, branch_structure
 from ._sweep import register_measure
-from ._validate import ArgumentTypeError, duration, function, in_range, integer, optional, positive, reals, state
+from ._validate import ArgumentTypeError, duration, finite, function, in_range, integer, nonnegative, optional, positive, reals, state
 from ._validate import params as _params
 
 __all__ = [
@@ -640,14 +640,38 @@ def lyapunov_return_map(
 
 # ---------------------------------------------------------------------------------------------- sweep measures
 def _window_options(options) -> dict:
-    """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted)."""
+    """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted),
+    checked: ValueError naming the option and its valid range (the sweep calls this before the first point)."""
+    from exact._simulate import RTOL_RANGE
+
     kw = dict(WINDOW_DEFAULTS)
-    for key in ("t_transient", "window", "rtol", "alpha0"):
-        if options.get(key) is not None:
-            kw[key] = float(options[key])
+    kw.update({key: options[key] for key in kw if options.get(key) is not None})
+    kw["t_transient"] = nonnegative("t_transient", kw["t_transient"])
+    kw["alpha0"] = finite("alpha0", kw["alpha0"])
+    rtol = kw["rtol"] = positive("rtol", kw["rtol"])
+    if not RTOL_RANGE[0] <= rtol <= RTOL_RANGE[1]:
+        raise ValueError(f"rtol must be in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}], got {options['rtol']!r}")
     if options.get("t_end") is not None:
-        kw["window"] = float(options["t_end"]) - kw["t_transient"]
+        t_end = finite("t_end", options["t_end"])
+        if not t_end > kw["t_transient"]:
+            raise ValueError(f"t_end must be greater than t_transient = {kw['t_transient']:g} (the measured window "
+                             f"is [t_transient, t_end]), got {options['t_end']!r}")
+        kw["window"] = t_end - kw["t_transient"]
+    kw["window"] = positive("window", kw["window"])
     return kw
+
+
+def _period_options(options) -> dict:
+    """The checked options of the ``period`` measure: :func:`_window_options` and ``period_rtol`` (1e-6)."""
+    return {**_window_options(options), "period_rtol": positive("period_rtol", options.get("period_rtol", 1e-6))}
+
+
+def _lyapunov_options(options) -> dict:
+    """The checked options of the ``lyapunov`` measure: ``t_transient`` (30 s), ``lyapunov_time`` (50 s) and
+    ``alpha0`` (0)."""
+    return {"t_transient": nonnegative("t_transient", options.get("t_transient", 30.0)),
+            "lyapunov_time": positive("lyapunov_time", options.get("lyapunov_time", 50.0)),
+            "alpha0": finite("alpha0", options.get("alpha0", 0.0))}
 
 
 def measure_period(params: PeelParams, options) -> dict:
@@ -657,11 +681,13 @@ def measure_period(params: PeelParams, options) -> dict:
     stick-slip; a ``ModelBreakdown`` is ``status = "breakdown:<reason>"``."""
     from exact import ModelBreakdown
 
+    kw = _period_options(options)
+    period_rtol = kw.pop("period_rtol")
     try:
-        tr = window_run(params, **_window_options(options))
+        tr = window_run(params, **kw)
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
-    p = classify(tr, period_rtol=float(options.get("period_rtol", 1e-6)))
+    p = classify(tr, period_rtol=period_rtol)
     return {"status": "ok", "label": p.label, "period": p.period,
             "mismatch": p.mismatch if math.isfinite(p.mismatch) else None, "n_returns": p.n_returns}
 
@@ -672,14 +698,14 @@ def measure_lyapunov(params: PeelParams, options) -> dict:
     from exact import ModelBreakdown
 
     tau = 0.005
+    kw = _lyapunov_options(options)
     try:
-        r = lyapunov(params, t_transient=float(options.get("t_transient", 30.0)), tau=tau,
-                     n=max(2, int(float(options.get("lyapunov_time", 50.0)) / tau)),
-                     alpha0=float(options.get("alpha0", 0.0)))
+        r = lyapunov(params, t_transient=kw["t_transient"], tau=tau, n=max(2, int(kw["lyapunov_time"] / tau)),
+                     alpha0=kw["alpha0"])
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
     return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}
 
 
-register_measure("period", measure_period)
-register_measure("lyapunov", measure_lyapunov)
+register_measure("period", measure_period, check_options=_period_options)
+register_measure("lyapunov", measure_lyapunov, check_options=_lyapunov_options)

@@ -5,11 +5,11 @@ from __future__ import annotations
 import csv
 import json
 import math
-from typing import Any, Iterable, Mapping, Optional, Sequence
+from typing import IO, Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["write_rows", "jsonable"]
+__all__ = ["write_rows", "write_csv", "jsonable"]
 
 
 def jsonable(v: Any) -> Any:
@@ -38,13 +38,21 @@ def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequ
         with open(p, "w") as fh:
             json.dump([{k: jsonable(v) for k, v in r.items()} for r in rows], fh, indent=1, allow_nan=False)
     elif p.endswith(".csv"):
-        cols = list(fields) if fields is not None else list(dict.fromkeys(k for r in rows for k in r))
         with open(p, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(cols)
-            for r in rows:
-                w.writerow(["" if r.get(c) is None else (repr(float(r[c])) if isinstance(r[c], (float, np.floating))
-                                                         else r[c]) for c in cols])
+            write_csv(fh, rows, fields=fields)
     else:
         raise ValueError(f"path must end in .csv or .json, got {p!r}")
     return p
+
+
+def write_csv(fh: IO[str], rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequence[str]] = None) -> None:
+    """Write ``rows`` as CSV to the open text stream ``fh`` (e.g. ``sys.stdout``), as :func:`write_rows` does
+    to a ``.csv`` file: columns ``fields`` (default: every key, first-seen order), None or absent as an empty
+    cell, floats in full precision."""
+    rows = [dict(r) for r in rows]
+    cols = list(fields) if fields is not None else list(dict.fromkeys(k for r in rows for k in r))
+    w = csv.writer(fh)
+    w.writerow(cols)
+    for r in rows:
+        w.writerow(["" if r.get(c) is None else (repr(float(r[c])) if isinstance(r[c], (float, np.floating))
+                                                 else r[c]) for c in cols])

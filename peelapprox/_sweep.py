@@ -27,7 +27,18 @@ itself reads ``k, R, l, geometry`` (the :class:`PeelParams` fields other than
 I and V; defaults as there); ``jumps`` and ``period`` share one windowed run
 (:func:`peelapprox._dynamics.window_run`) and read ``t_transient`` (30 s),
 ``t_end`` (t_transient + 20 s), ``rtol`` (1e-10) and ``alpha0`` (0);
-``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).
+``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).  Every option
+the chosen measures read is checked before the first point (a measure
+registered with ``check_options`` checks its own), so invalid options raise
+ValueError naming the option and nothing is written.
+
+Workers
+-------
+Pool and cluster workers import each measure by ``module:qualname``.  A
+measure they cannot import (defined in a notebook or ``__main__``, a lambda, a
+local function) is shipped by value with cloudpickle when it is installed;
+without it, such a measure is a ValueError before the first point.
+``max_workers=0`` (``--workers 0``) runs every point in this process.
 
 Output directory
 ----------------
@@ -36,21 +47,32 @@ Output directory
     package versions, creation time.  Written once, atomically.
 ``out/results.jsonl``
     One JSON object per finished point, in completion order: ``I``, ``V``,
-    ``status`` (``"ok"`` or ``"error: <Type>: <message>"``, the first failing
-    measure), then the measures' keys; a failing measure records
-    ``"<name>_status": "error: ..."`` and the others still run.  Non-finite
-    floats are written as ``NaN``/``Infinity`` (Python's JSON extension).
-    Records hold no timings or host names, so the same inputs give the same
-    records.
+    ``status``, then the measures' keys.  ``status`` is ``"ok"`` when every
+    measure is; else ``"error: <Type>: <message>"`` of the first measure that
+    raised, or else the first non-ok status a measure reported (e.g.
+    ``"breakdown:v_floor"``, a result, not a failure).  A failing measure
+    records ``"<name>_status": "error: ..."`` and the others still run.
+    Error points count as finished on resume; ``retry_failed=True``
+    (``--retry-failed``) drops their records (the file is rewritten
+    atomically) and computes them again.  Non-finite floats are written as
+    ``NaN``/``Infinity`` (Python's JSON extension).  Records hold no timings
+    or host names, so the same inputs give the same records.
 ``out/.lock``
     Held (``flock``) while a sweep writes, so two sweeps cannot share ``out``.
+
+Files are opened without following symbolic links (``os.O_NOFOLLOW``) and
+must be regular files; a manifest or record that is not what the engine
+writes (wrong types, missing keys, non-finite ``I``/``V``) is a ValueError
+naming the file (and line) as malformed.  A directory this process cannot
+write is read only: a complete sweep there is returned (and reported by the
+CLI); computing anything there is a ValueError.  The format itself lives in
+:mod:`peelapprox._sweep_store`.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
 import importlib
-import json
 import math
 import numbers
 import os
@@ -58,14 +80,32 @@ import re
 import sys
 import threading
 import time
-import warnings
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
-from types import MappingProxyType
+from types import MappingProxyType, ModuleType
 from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
 from ._params import PeelParams
+from ._sweep_store import (
+    FORMAT,
+    RESERVED,
+    RESULTS,
+    Plan,
+    append_records,
+    check_axis,
+    failed,
+    is_read_only,
+    json_norm,
+    read_manifest,
+    read_records,
+    rewrite_records,
+    truncate_records,
+    versions,
+    write_manifest,
+    write_record,
+)
+from ._sweep_store import lock as _lock
 
 __all__ = [
     "MEASURES",
@@ -76,22 +116,16 @@ __all__ = [
     "parse_grid",
 ]
 
-MANIFEST = "sweep.json"
-RESULTS = "results.jsonl"
-LOCK = ".lock"
-FORMAT = "peelapprox.sweep/1"
-#: Reserved record keys (set by the engine, not by measures).
-RESERVED = ("I", "V", "status")
 #: Options the engine turns into :class:`PeelParams` fields.
 PARAM_OPTIONS = ("k", "R", "l", "geometry")
-#: Grid values of a resumed sweep may differ from the manifest's by this relative amount (a grid rebuilt by
-#: ``geomspace`` on another machine); the manifest's values are then used, so record keys stay exact.
-GRID_RTOL = 1e-12
 
 Measure = Callable[[PeelParams, Mapping], dict]
+OptionCheck = Callable[[Mapping], Any]
 
 #: name -> measure function.  Add entries with :func:`register_measure`.
 MEASURES: dict[str, Measure] = {}
+#: name -> its options check (``check_options`` of :func:`register_measure`).
+_OPTION_CHECKS: dict[str, OptionCheck] = {}
 
 _NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
@@ -100,29 +134,53 @@ def _ref(fn: Callable) -> str:
     return f"{getattr(fn, '__module__', '?')}:{getattr(fn, '__qualname__', '?')}"
 
 
-def register_measure(name: str, fn: Optional[Measure] = None, *, replace: bool = False):
+def register_measure(name: str, fn: Optional[Measure] = None, *, replace: bool = False,
+                     check_options: Optional[OptionCheck] = None):
     """Register ``fn(params, options) -> dict`` under ``name``.
 
-    Signature: ``register_measure(name, fn=None, *, replace=False)``; without
-    ``fn`` it returns a decorator.  Registering another function under a taken
-    name raises ValueError unless ``replace=True`` (registering the same
-    function again, e.g. on re-import, is allowed).  For process pools and
-    clusters the function must be module level in an importable module: the
-    workers import it by ``module:qualname``.
+    Signature: ``register_measure(name, fn=None, *, replace=False, check_options=None)``;
+    without ``fn`` it returns a decorator.
 
-    Returns the function.
+    Parameters
+    ----------
+    name : str
+        ``[A-Za-z][A-Za-z0-9_]*``, not one of ``I, V, status``.
+    fn : callable
+        The measure.  Pool and cluster workers import it by ``module:qualname``;
+        one they cannot import (a notebook's, ``__main__``'s, a lambda) is
+        shipped by value with cloudpickle if installed, else :func:`sweep`
+        refuses it before the first point.
+    replace : bool
+        Registering another function under a taken name raises ValueError
+        unless True (registering the same function again, e.g. on re-import,
+        is allowed).
+    check_options : callable, optional
+        ``check_options(options)`` raises ValueError naming an option this
+        measure reads that is invalid; :func:`sweep` calls it before the first
+        point, so a bad option never turns every point into an error record.
+
+    Returns
+    -------
+    callable
+        ``fn``.
     """
     if fn is None:
-        return lambda f: register_measure(name, f, replace=replace)
+        return lambda f: register_measure(name, f, replace=replace, check_options=check_options)
     if not isinstance(name, str) or not _NAME_RE.match(name) or name in RESERVED:
         raise ValueError(
             f"measure name must match [A-Za-z][A-Za-z0-9_]* and not be one of {RESERVED}, got {name!r}")
     if not callable(fn):
         raise ValueError(f"measure {name!r}: fn must be callable (params, options) -> dict, got {fn!r}")
+    if check_options is not None and not callable(check_options):
+        raise ValueError(f"measure {name!r}: check_options must be callable (options) or None, got {check_options!r}")
     old = MEASURES.get(name)
     if old is not None and old is not fn and _ref(old) != _ref(fn) and not replace:
         raise ValueError(f"measure {name!r} is already registered as {_ref(old)}; pass replace=True to replace it")
     MEASURES[name] = fn
+    if check_options is None:
+        _OPTION_CHECKS.pop(name, None)
+    else:
+        _OPTION_CHECKS[name] = check_options
     return fn
 
 
@@ -181,8 +239,15 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     }
 
 
+def _check_window_options(options: Mapping) -> None:
+    """The options of the windowed run (:func:`peelapprox._dynamics._window_options` checks them)."""
+    from ._dynamics import _window_options
+
+    _window_options(options)
+
+
 register_measure("regime", _measure_regime)
-register_measure("jumps", _measure_jumps)
+register_measure("jumps", _measure_jumps, check_options=_check_window_options)
 
 
 # --------------------------------------------------------------------------------------------- the task
@@ -195,8 +260,18 @@ def _import_ref(ref: str) -> Callable:
     return obj
 
 
-def _resolve(name: str, ref: Optional[str]) -> Measure:
-    """The measure function in this (worker) process: by import reference, else by registry name."""
+def _resolve(name: str, ref: Union[None, str, bytes]) -> Measure:
+    """The measure function in this (worker) process: unpickled if shipped by value (bytes), else by import
+    reference, else by registry name."""
+    if isinstance(ref, bytes):
+        import pickle
+
+        try:
+            return pickle.loads(ref)
+        except Exception as exc:
+            raise LookupError(f"measure {name!r} was shipped by value (cloudpickle) but cannot be unpickled in this "
+                              f"process ({type(exc).__name__}: {exc}); install cloudpickle where the workers run, "
+                              "or define the measure in an importable module") from None
     if ref is not None:
         fn = MEASURES.get(name)
         if fn is not None and _ref(fn) == ref:
@@ -251,15 +326,17 @@ def _make_params(I: float, V: float, options: Mapping) -> PeelParams:
 
 
 def _run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
-               refs: Optional[Mapping[str, str]] = None) -> dict:
+               refs: Optional[Mapping[str, Union[str, bytes]]] = None) -> dict:
     """Evaluate ``measures`` at one grid point; never raises for a measure's failure.
 
-    Module level and plain-data in/out, so any executor can ship it.  Returns
-    the record ``{"I", "V", "status", <measure keys>...}``.
+    Module level and plain-data in/out, so any executor can ship it.  ``refs``
+    maps a measure's name to its import reference, or to its cloudpickle bytes.
+    Returns the record ``{"I", "V", "status", <measure keys>...}``; ``status``
+    as in the module docstring.
     """
     refs = refs or {}
     body: dict = {}
-    status = "ok"
+    error = reported = None
     try:
         params = _make_params(I, V, options)
     except Exception as exc:
@@ -272,12 +349,57 @@ def _run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
             if clash:
                 raise ValueError(f"measure {name!r} returned keys that are already taken: {sorted(clash)}")
             body.update(out)
+            own = out.get(f"{name}_status")
+            if reported is None and isinstance(own, str) and own != "ok":
+                reported = own
         except Exception as exc:
             err = _error(exc)
             body[f"{name}_status"] = err
-            if status == "ok":
-                status = err
-    return {"I": I, "V": V, "status": status, **body}
+            error = error or err
+    return {"I": I, "V": V, "status": error or reported or "ok", **body}
+
+
+def _cloudpickle() -> Optional[ModuleType]:
+    """The cloudpickle module, or None if it is not installed."""
+    try:
+        import cloudpickle
+    except ImportError:
+        return None
+    return cloudpickle
+
+
+def _importable(fn: Callable) -> bool:
+    """Whether a worker process can import ``fn`` by its ``module:qualname`` (as this process resolves it)."""
+    mod, _, qual = _ref(fn).partition(":")
+    if mod in ("__main__", "__mp_main__", "?") or "<" in qual:
+        return False
+    try:
+        return _import_ref(_ref(fn)) is fn
+    except Exception:
+        return False
+
+
+def _worker_refs(measures: Sequence[str]) -> dict[str, Union[str, bytes]]:
+    """What the workers get for each measure: its import reference, or its cloudpickle bytes if they could not
+    import it.  ValueError (before any point runs) if such a measure cannot be shipped."""
+    refs: dict[str, Union[str, bytes]] = {name: _ref(MEASURES[name]) for name in measures}
+    lone = [name for name in measures if not _importable(MEASURES[name])]
+    if not lone:
+        return refs
+    cp = _cloudpickle()
+    if cp is None:
+        raise ValueError(f"measure(s) {lone} ({[refs[n] for n in lone]}) cannot be imported by worker processes "
+                         "(defined in a notebook or __main__, a lambda or a local function) and cloudpickle, which "
+                         "would ship them, is not installed: define them in an importable module, "
+                         "pip install cloudpickle, or run in this process with max_workers=0 (--workers 0)")
+    for name in lone:
+        try:
+            refs[name] = cp.dumps(MEASURES[name])
+        except Exception as exc:
+            raise ValueError(f"measure {name!r} ({refs[name]}) cannot be pickled to ship it to the workers "
+                             f"({type(exc).__name__}: {exc}): define it in an importable module, or run in this "
+                             "process with max_workers=0 (--workers 0)") from None
+    return refs
 
 
 def _worker_init(parent_pid: int) -> None:  # pragma: no cover - runs in the workers
@@ -290,101 +412,6 @@ def _worker_init(parent_pid: int) -> None:  # pragma: no cover - runs in the wor
                 os._exit(1)
 
     threading.Thread(target=watch, name="peelapprox-sweep-orphan-watch", daemon=True).start()
-
-
-# --------------------------------------------------------------------------------------------- files
-
-def _json_norm(x: Any) -> Any:
-    return json.loads(json.dumps(x))
-
-
-def _versions() -> dict:
-    from importlib import metadata
-
-    v = {"python": sys.version.split()[0]}
-    for pkg in ("peelapprox", "numpy", "scipy", "numba"):
-        try:
-            v[pkg] = metadata.version(pkg)
-        except Exception:
-            v[pkg] = None
-    return v
-
-
-def _fsync_dir(path: str) -> None:
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:  # pragma: no cover - e.g. Windows
-        return
-    try:
-        os.fsync(fd)
-    except OSError:  # pragma: no cover
-        pass
-    finally:
-        os.close(fd)
-
-
-def _write_manifest(out: str, manifest: dict) -> None:
-    tmp = os.path.join(out, MANIFEST + ".tmp")
-    with open(tmp, "w") as fh:
-        json.dump(manifest, fh, indent=2)
-        fh.write("\n")
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, os.path.join(out, MANIFEST))
-    _fsync_dir(out)
-
-
-def _read_manifest(out: str) -> dict:
-    path = os.path.join(out, MANIFEST)
-    try:
-        with open(path) as fh:
-            m = json.load(fh)
-    except (OSError, json.JSONDecodeError) as exc:
-        raise ValueError(f"out={out!r}: cannot read the manifest {path}: {exc}") from None
-    if not isinstance(m, dict) or m.get("format") != FORMAT:
-        raise ValueError(f"out={out!r}: {path} is not a {FORMAT} manifest")
-    return m
-
-
-def _read_records(path: str) -> tuple[list[dict], int, bool]:
-    """Complete records of ``results.jsonl``, the byte length they span, and whether a partial tail follows.
-
-    A last line without its newline (the process died while writing it) is
-    ignored.  A malformed complete line raises ValueError.
-    """
-    if not os.path.exists(path):
-        return [], 0, False
-    with open(path, "rb") as fh:
-        data = fh.read()
-    end = data.rfind(b"\n") + 1
-    recs = []
-    for n, line in enumerate(data[:end].splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            rec = json.loads(line)
-            if not isinstance(rec, dict) or "I" not in rec or "V" not in rec:
-                raise ValueError("not a record with I and V")
-        except ValueError as exc:
-            raise ValueError(f"{path}, line {n}: malformed record ({exc}); repair or remove the line to resume") \
-                from None
-        recs.append(rec)
-    return recs, end, end < len(data)
-
-
-def _lock(out: str):
-    fh = open(os.path.join(out, LOCK), "a+")
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - Windows: no protection against two writers
-        return fh
-    try:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        fh.close()
-        raise RuntimeError(f"out={out!r} is in use by another sweep (lock {os.path.join(out, LOCK)} is held)") \
-            from None
-    return fh
 
 
 # --------------------------------------------------------------------------------------------- result
@@ -439,6 +466,11 @@ class SweepResult:
     def missing(self) -> list[tuple[float, float]]:
         """(I, V) of the points without a record, in grid order."""
         return [k for k in self._index if k not in self._by_key]
+
+    def failed(self) -> list[tuple[float, float]]:
+        """(I, V) of the points whose record is an error (a measure raised), in grid order; see ``retry_failed``
+        of :func:`sweep`."""
+        return [(float(r["I"]), float(r["V"])) for r in self.records if failed(r)]
 
     def record(self, I: float, V: float) -> Optional[dict]:
         """The record at exactly (I, V), or None."""
@@ -503,10 +535,17 @@ def load_sweep(out) -> SweepResult:
 
     A truncated last line of ``results.jsonl`` is ignored; if a point occurs
     twice (only possible if the file was edited) the first record is used.
+    Works in a directory this process cannot write.
+
+    Raises
+    ------
+    ValueError
+        No manifest, a file that is a symbolic link, or a malformed manifest
+        or record (the message names the file and line).
     """
     out = os.fspath(out)
-    m = _read_manifest(out)
-    recs, _, _ = _read_records(os.path.join(out, RESULTS))
+    m = read_manifest(out)
+    recs, _, _ = read_records(out)
     return SweepResult(m["I_values"], m["V_values"], m["measures"], m["options"], recs, manifest=m, out=out)
 
 
@@ -540,50 +579,6 @@ def parse_grid(spec: str, *, name: str = "values") -> np.ndarray:
     except ValueError as exc:
         raise ValueError(f"{name}: cannot parse {spec!r} ({exc}); use start:stop:num[:log] or a comma list") \
             from None
-
-
-def _check_axis(name: str, values) -> list[float]:
-    try:
-        arr = np.asarray(values, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a non-empty sequence of finite values in (0, inf), got {values!r}") \
-            from None
-    if arr.size == 0:
-        raise ValueError(f"{name} must be a non-empty sequence of finite values in (0, inf), got an empty grid")
-    bad = arr[~(np.isfinite(arr) & (arr > 0))]
-    if bad.size:
-        raise ValueError(f"{name} must hold finite values in (0, inf), got {bad.tolist()}")
-    vals = [float(x) for x in arr]
-    if len(set(vals)) != len(vals):
-        dup = sorted({x for x in vals if vals.count(x) > 1})
-        raise ValueError(f"{name} must not repeat a value, got duplicates {dup}")
-    return vals
-
-
-def _close(a: Sequence[float], b: Sequence[float]) -> bool:
-    return len(a) == len(b) and all(abs(x - y) <= GRID_RTOL * max(abs(x), abs(y)) for x, y in zip(a, b))
-
-
-def _describe(vals: Sequence[float]) -> str:
-    return f"{len(vals)} values [{vals[0]:.6g} .. {vals[-1]:.6g}]" if len(vals) > 3 else str(list(vals))
-
-
-def _compare_manifest(m: dict, I_vals, V_vals, measures, options, out: str) -> None:
-    diffs = []
-    for name, old, new in (("I_values", m.get("I_values"), I_vals), ("V_values", m.get("V_values"), V_vals)):
-        if not _close(old or [], new):
-            diffs.append(f"{name}: existing {_describe(old or [])}, requested {_describe(new)}")
-    if list(m.get("measures", [])) != list(measures):
-        diffs.append(f"measures: existing {list(m.get('measures', []))}, requested {list(measures)}")
-    old_o, new_o = m.get("options", {}), _json_norm(options)
-    if old_o != new_o:
-        keys = sorted(set(old_o) | set(new_o))
-        parts = [f"{k!r}: existing {old_o.get(k, '<unset>')!r}, requested {new_o.get(k, '<unset>')!r}"
-                 for k in keys if old_o.get(k, "<unset>") != new_o.get(k, "<unset>")]
-        diffs.append("options differ in " + "; ".join(parts))
-    if diffs:
-        raise ValueError(f"out={out!r} holds a different sweep, cannot resume: " + "; ".join(diffs)
-                         + ". Use another out directory (or delete this one).")
 
 
 # --------------------------------------------------------------------------------------------- the sweep
@@ -622,11 +617,12 @@ def sweep(
     options: Optional[Mapping[str, Any]] = None,
     progress: Union[bool, Callable[[int, int, dict], None], None] = True,
     resume: bool = True,
+    retry_failed: bool = False,
 ) -> SweepResult:
     """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
 
     Signature: ``sweep(I_values, V_values, measures=("regime",), *, out, executor=None, max_workers=None,
-    options=None, progress=True, resume=True) -> SweepResult``.
+    options=None, progress=True, resume=True, retry_failed=False) -> SweepResult``.
 
     Parameters
     ----------
@@ -644,9 +640,12 @@ def sweep(
         ``distributed.Client(...).get_executor()`` for a dask cluster.
     max_workers : int, optional
         Processes of the local pool (default: CPUs available, at most the
-        number of points to compute).  Only with ``executor=None``.
+        number of points to compute); 0 runs in this process, as
+        ``executor="serial"`` (the CLI's ``--workers 0``).  Only with
+        ``executor=None``.
     options : mapping, optional
-        JSON-serialisable settings passed to every measure (module docstring).
+        JSON-serialisable settings passed to every measure (module
+        docstring), checked before the first point.
     progress : bool or callable
         ``True``: one line per finished point on stderr, with an ETA.  A
         callable receives ``(done, total, record)`` (``done`` counts resumed
@@ -656,6 +655,9 @@ def sweep(
         else ValueError naming what differs): skip its finished points.
         ``resume=False`` refuses a non-empty ``out`` (ValueError) rather than
         overwrite it.
+    retry_failed : bool
+        Also compute again the points of ``out`` whose status is an error
+        (their records are dropped first); by default they count as finished.
 
     Returns
     -------
@@ -665,8 +667,11 @@ def sweep(
     Raises
     ------
     ValueError
-        Invalid arguments (naming the argument and its valid range), unknown
-        measures (listing the known ones), an ``out`` holding another sweep.
+        Invalid arguments or options (naming the argument or option and its
+        valid range), unknown measures (listing the known ones), a measure
+        the workers can neither import nor be sent, an ``out`` holding
+        another sweep, a malformed or symbolically linked file in ``out``, an
+        ``out`` this process cannot write while points remain to compute.
     RuntimeError
         ``out`` is locked by another sweep; or tasks were lost to the
         executor (a worker died): the records written stay, and calling
@@ -675,10 +680,12 @@ def sweep(
     Notes
     -----
     A point whose measure raises is recorded with ``status = "error: ..."``
-    and the sweep goes on; such points count as finished on resume.
+    and the sweep goes on; such points count as finished on resume unless
+    ``retry_failed=True``.  Nothing is written before every argument and
+    option has been checked.
     """
-    I_vals = _check_axis("I_values", I_values)
-    V_vals = _check_axis("V_values", V_values)
+    I_vals = check_axis("I_values", I_values)
+    V_vals = check_axis("V_values", V_values)
     if isinstance(measures, str):
         measures = [m.strip() for m in measures.split(",") if m.strip()]
     measures = list(measures)
@@ -693,13 +700,14 @@ def sweep(
     if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
         raise ValueError(f"options must be a mapping with str keys, got {options!r}")
     try:
-        options = _json_norm(dict(options))
+        options = json_norm(dict(options))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
             from None
+    _check_options(measures, options)
     if max_workers is not None:
-        if isinstance(max_workers, bool) or not isinstance(max_workers, numbers.Integral) or max_workers < 1:
-            raise ValueError(f"max_workers must be a positive integer (valid range [1, inf)) or None, "
+        if isinstance(max_workers, bool) or not isinstance(max_workers, numbers.Integral) or max_workers < 0:
+            raise ValueError(f"max_workers must be an integer in [0, inf) (0: in this process) or None, "
                              f"got {max_workers!r}")
         if executor is not None:
             raise ValueError("max_workers applies only to the local process pool (executor=None); "
@@ -708,92 +716,94 @@ def sweep(
         raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
     if not (isinstance(progress, bool) or progress is None or callable(progress)):
         raise ValueError("progress must be a bool, None or a callable (done, total, record)")
+    for name, flag in (("resume", resume), ("retry_failed", retry_failed)):
+        if not isinstance(flag, bool):
+            raise ValueError(f"{name} must be True or False, got {flag!r}")
+    if max_workers == 0:
+        executor = "serial"
     refs = {name: _ref(MEASURES[name]) for name in measures}
-    if executor != "serial":
-        bad = [n for n in measures if "<" in refs[n]]
-        if bad:
-            raise ValueError(f"measure(s) {bad} are lambdas or local functions ({[refs[n] for n in bad]}): "
-                             "worker processes cannot import them; define them at module level or use "
-                             "executor='serial'")
-    try:
-        _make_params(I_vals[0], V_vals[0], options)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"options: invalid PeelParams fields {[k for k in PARAM_OPTIONS if k in options]}: {exc}") \
-            from None
+    task_refs = refs if executor == "serial" else _worker_refs(measures)
 
     out = os.fspath(out)
     if os.path.exists(out) and not os.path.isdir(out):
         raise ValueError(f"out={out!r} exists and is not a directory")
-    os.makedirs(out, exist_ok=True)
-    lock = _lock(out)
     try:
-        return _sweep_locked(I_vals, V_vals, measures, options, refs, out, executor, max_workers, progress, resume)
+        os.makedirs(out, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"out={out!r}: cannot create the directory ({exc})") from None
+    plan = dict(out=out, I_vals=I_vals, V_vals=V_vals, measures=measures, options=options, resume=resume,
+                retry_failed=retry_failed)
+    try:
+        lock = _lock(out)
+    except OSError as exc:
+        if not is_read_only(exc):
+            raise
+        return _sweep_read_only(exc, **plan)
+    try:
+        return _sweep_locked(Plan(**plan), refs, task_refs, executor, max_workers, progress)
     finally:
         lock.close()
 
 
-def _sweep_locked(I_vals, V_vals, measures, options, refs, out, executor, max_workers, progress, resume):
-    mpath, rpath = os.path.join(out, MANIFEST), os.path.join(out, RESULTS)
-    others = [f for f in os.listdir(out) if f not in (LOCK, MANIFEST + ".tmp")]
-    if os.path.exists(mpath):
-        if not resume:
-            raise ValueError(f"out={out!r} already holds a sweep and resume=False: refusing to overwrite it; "
-                             "pass resume=True to continue it, or use another directory")
-        m = _read_manifest(out)
-        _compare_manifest(m, I_vals, V_vals, measures, options, out)
-        I_vals, V_vals = [float(x) for x in m["I_values"]], [float(x) for x in m["V_values"]]
-        mine = {k: v for k, v in _versions().items() if k != "python"}
-        theirs = {k: v for k, v in (m.get("versions") or {}).items() if k in mine}
-        if theirs and theirs != mine:
-            warnings.warn(f"resuming a sweep made with {theirs} under {mine}: records may mix versions",
-                          RuntimeWarning, stacklevel=3)
-    elif others:
-        raise ValueError(f"out={out!r} is not empty and holds no sweep manifest ({MANIFEST}): "
-                         f"refusing to write into it (found {sorted(others)[:5]})")
-    else:
-        m = {
+def _check_options(measures: Sequence[str], options: Mapping) -> None:
+    """Every option the engine and ``measures`` read, checked before any point (ValueError naming it)."""
+    try:
+        _make_params(1.0, 1.0, options)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"options: invalid PeelParams fields {[k for k in PARAM_OPTIONS if k in options]}: {exc}") \
+            from None
+    frozen = MappingProxyType(options)
+    for name in measures:
+        check = _OPTION_CHECKS.get(name)
+        if check is not None:
+            try:
+                check(frozen)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"options (read by measure {name!r}): {exc}") from None
+
+
+def _sweep_read_only(exc: OSError, **plan) -> SweepResult:
+    """``out`` cannot be written: return its sweep if nothing is left to compute, else ValueError."""
+    p = Plan(**plan)
+    if p.manifest is not None and not p.todo:
+        return _result(p)
+    left = f"{len(p.todo)} of {p.total} points are still to compute" if p.manifest else "it holds no sweep yet"
+    raise ValueError(f"out={p.out!r} is not writable ({exc}) and {left}: make it writable or use another directory")
+
+
+def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress) -> SweepResult:
+    out = p.out
+    if p.manifest is None:
+        p.manifest = {
             "format": FORMAT,
-            "I_values": I_vals,
-            "V_values": V_vals,
-            "measures": measures,
-            "options": options,
+            "I_values": p.I_vals,
+            "V_values": p.V_vals,
+            "measures": p.measures,
+            "options": p.options,
             "measure_refs": refs,
             "grid_order": "I major: results arrays are [i, j] for I_values[i], V_values[j]",
-            "versions": _versions(),
+            "versions": versions(),
             "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
-        _write_manifest(out, m)
-
-    recs, end, partial = _read_records(rpath)
-    if partial:  # the last write was cut off: drop it so appends start on a clean line
-        with open(rpath, "r+b") as fh:
-            fh.truncate(end)
-            fh.flush()
-            os.fsync(fh.fileno())
-    grid = [(I, V) for I in I_vals for V in V_vals]
-    on_grid = set(grid)
-    done = {}
-    for rec in recs:
-        key = (float(rec["I"]), float(rec["V"]))
-        if key in on_grid and key not in done:
-            done[key] = rec
-    todo = [k for k in grid if k not in done]
-    total = len(grid)
+        write_manifest(out, p.manifest)
+    if p.retry:  # drop the failed points' records (and any partial tail) before computing them again
+        rewrite_records(out, [r for r in p.records if (float(r["I"]), float(r["V"])) not in p.retry])
+    elif p.partial:  # the last write was cut off: drop it so appends start on a clean line
+        truncate_records(out, p.end)
+    done, todo, total = p.done, p.todo, p.total
     report = _Stderr(total, len(done)) if progress is True else (progress or None)
 
     lost: list[tuple[tuple[float, float], str]] = []
-    with open(rpath, "a") as fh:
+    with append_records(out) as fh:
         def write(rec: dict) -> None:
-            fh.write(json.dumps(rec, separators=(",", ":")) + "\n")
-            fh.flush()
-            os.fsync(fh.fileno())
+            write_record(fh, rec)
             done[(rec["I"], rec["V"])] = rec
             if report:
                 report(len(done), total, rec)
 
         if executor == "serial":
             for I, V in todo:
-                write(_run_point(I, V, measures, options, refs))
+                write(_run_point(I, V, p.measures, p.options, task_refs))
         elif todo:
             own = executor is None
             if own:
@@ -809,7 +819,7 @@ def _sweep_locked(I_vals, V_vals, measures, options, refs, out, executor, max_wo
             futs: dict[Future, tuple[float, float]] = {}
             try:
                 for I, V in todo:
-                    futs[ex.submit(_run_point, I, V, measures, options, refs)] = (I, V)
+                    futs[ex.submit(_run_point, I, V, p.measures, p.options, task_refs)] = (I, V)
                 for fut in as_completed(futs):
                     key = futs.pop(fut)
                     try:
@@ -831,6 +841,11 @@ def _sweep_locked(I_vals, V_vals, measures, options, refs, out, executor, max_wo
             hint = ("; a worker process died (crash, out of memory, killed) or could not start: with the 'spawn' "
                     "start method a script that calls sweep() must do so under `if __name__ == '__main__':`")
         raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: I={lost[0][0][0]}, "
-                           f"V={lost[0][0][1]}: {lost[0][1]}); {len(done)}/{total} points are in {rpath}; "
-                           "call sweep() again with the same arguments to compute the rest" + hint)
-    return SweepResult(I_vals, V_vals, measures, options, done.values(), manifest=m, out=out)
+                           f"V={lost[0][0][1]}: {lost[0][1]}); {len(done)}/{total} points are in "
+                           f"{os.path.join(out, RESULTS)}; call sweep() again with the same arguments to compute "
+                           "the rest" + hint)
+    return _result(p)
+
+
+def _result(p: Plan) -> SweepResult:
+    return SweepResult(p.I_vals, p.V_vals, p.measures, p.options, p.done.values(), manifest=p.manifest, out=p.out)

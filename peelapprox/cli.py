@@ -295,14 +295,12 @@ def _sweep(args: argparse.Namespace) -> int:
             client = Client(args.dask_scheduler)
         print(f"dask: {client}", file=sys.stderr)
         executor = client.get_executor()
-    elif args.workers == 0:
-        executor = "serial"
     else:
-        max_workers = args.workers
+        max_workers = args.workers  # 0: in this process
     t0 = time.perf_counter()
     try:
         result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor, max_workers=max_workers,
-                       options=options, progress=not args.quiet)
+                       options=options, progress=not args.quiet, retry_failed=args.retry_failed)
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3
@@ -314,15 +312,19 @@ def _sweep(args: argparse.Namespace) -> int:
     print(f"sweep: {len(result.records)} points in {args.out}/{RESULTS} ({time.perf_counter() - t0:.1f} s)",
           file=sys.stderr)
     csv_path = os.path.join(args.out, "results.csv")
-    result.to_csv(csv_path)
-    print(f"wrote {csv_path}", file=sys.stderr)
+    try:
+        result.to_csv(csv_path)
+        print(f"wrote {csv_path}", file=sys.stderr)
+    except OSError as exc:  # e.g. a complete sweep in a read-only directory: still report it
+        print(f"note: cannot write {csv_path} ({exc}); the table is printed only", file=sys.stderr)
     rows = result.rows()
     cols = result.keys()
     if args.format == "json":
         print(json.dumps(rows, indent=2))
     elif args.format == "csv":
-        with open(csv_path) as fh:
-            sys.stdout.write(fh.read())
+        from ._io import write_csv
+
+        write_csv(sys.stdout, rows, fields=cols)
     else:
         def cell(v) -> str:
             return "" if v is None else (f"{v:.6g}" if isinstance(v, float) else str(v))
@@ -337,7 +339,7 @@ def _sweep(args: argparse.Namespace) -> int:
         png = os.path.join(args.out, f"{args.plot}.png")
         plot_phase_diagram(result, args.plot, png)
         print(f"wrote {png}", file=sys.stderr)
-    return 0 if all(r.get("status") == "ok" for r in rows) else 1
+    return 1 if result.failed() else 0
 
 
 def _figures(args: argparse.Namespace) -> int:
@@ -559,6 +561,8 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (0)")
     sw.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (1000)")
     sw.add_argument("--R", type=float, default=None, help="roller radius [m] (0.1)")
+    sw.add_argument("--retry-failed", action="store_true",
+                    help="compute again the points of DIR whose status is an error (else they count as done)")
     sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label")
     sw.add_argument("--format", choices=("md", "csv", "json"), default="md", help="table printed at the end (md)")
     sw.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")

@@ -6,6 +6,7 @@ holds ``tests/`` under pytest and in the kill-and-resume subprocess.
 """
 
 import math
+import os
 import time
 
 from peelapprox._sweep import register_measure
@@ -24,5 +25,14 @@ def flaky(params, options):
     return {"x": params.V}
 
 
+def envfail(params, options):
+    """Raises while the environment variable ``PEELAPPROX_TEST_FAIL`` is set (a transient failure that the same
+    options do not reproduce once it is unset); otherwise returns one number."""
+    if os.environ.get("PEELAPPROX_TEST_FAIL"):
+        raise OSError(f"transient failure at V={params.V:g}")
+    return {"x": params.I + params.V}
+
+
 register_measure("slowprod", slowprod)
 register_measure("flaky", flaky)
+register_measure("envfail", envfail)

@@ -15,12 +15,20 @@ import sys
 import time
 from pathlib import Path
 
+import _sweep_measures  # noqa: F401  (registers "slowprod" and "flaky")
 import numpy as np
 import pytest
 
-import _sweep_measures  # noqa: F401  (registers "slowprod" and "flaky")
 from peelapprox import PeelParams, estimate
-from peelapprox._sweep import MEASURES, SweepResult, _lock, load_sweep, parse_grid, register_measure, sweep
+from peelapprox._sweep import (
+    MEASURES,
+    SweepResult,
+    _lock,
+    load_sweep,
+    parse_grid,
+    register_measure,
+    sweep,
+)
 from peelapprox.cli import main
 
 TESTS = str(Path(__file__).resolve().parent)
@@ -107,13 +115,14 @@ def test_jumps_measure_definitions():
 
 def test_breakdown_is_a_result_not_an_error(tmp_path):
     """Hypothesis: a ModelBreakdown (V=1, I=1e-4: v falls to v_floor on AB) is recorded as
-    ``jumps_status = "breakdown:v_floor"`` with the point's status ok, and ``values`` is NaN there only.
+    ``jumps_status = "breakdown:v_floor"`` (and so the point's status), not as an error, and ``values`` is
+    NaN there only.
 
     No tolerance: categorical outcome; V=1, I=1e-5 on the same sweep runs normally.
     """
     res = sweep([1e-5, 1e-4], [1.0], "jumps", out=tmp_path / "sw", executor="serial", progress=False)
     bad, good = res.record(1e-4, 1.0), res.record(1e-5, 1.0)
-    assert bad["status"] == "ok" and bad["jumps_status"] == "breakdown:v_floor" and bad["jumps_t_breakdown"] > 0
+    assert bad["status"] == bad["jumps_status"] == "breakdown:v_floor" and bad["jumps_t_breakdown"] > 0
     assert good["jumps_status"] == "ok"
     c = res.values("jumps_count")
     assert np.isnan(c[1, 0]) and c[0, 0] == good["jumps_count"]
@@ -254,18 +263,19 @@ def test_validation_messages(tmp_path):
         sweep(I2, [1.0, 1.0], out=out)
     with pytest.raises(ValueError, match=r"unknown measure\(s\) \['nope'\]; known: \[.*'jumps'.*'regime'"):
         sweep(I2, V2, "regime,nope", out=out)
-    with pytest.raises(ValueError, match=r"max_workers must be a positive integer \(valid range \[1, inf\)\)"):
-        sweep(I2, V2, out=out, max_workers=0)
+    with pytest.raises(ValueError, match=r"max_workers must be an integer in \[0, inf\) \(0: in this process\)"):
+        sweep(I2, V2, out=out, max_workers=-1)
     with pytest.raises(ValueError, match="options must be JSON-serialisable"):
         sweep(I2, V2, out=out, options={"x": object()})
     with pytest.raises(ValueError, match="k must be finite"):
         sweep(I2, V2, out=out, options={"k": -1.0})
-    with pytest.raises(ValueError, match="lambdas or local functions"):
-        register_measure("tmp_lambda", lambda p, o: {"x": 1}, replace=True)
+    with pytest.raises(ValueError, match=r"tmp_closure.*(cannot be pickled|importable module)"):
+        lock = __import__("threading").Lock()
+        register_measure("tmp_closure", lambda p, o: {"x": int(lock.locked())}, replace=True)
         try:
-            sweep(I2, V2, "tmp_lambda", out=out)
+            sweep(I2, V2, "tmp_closure", out=out)
         finally:
-            MEASURES.pop("tmp_lambda")
+            MEASURES.pop("tmp_closure")
     with pytest.raises(ValueError, match="already registered"):
         register_measure("regime", _sweep_measures.slowprod)
     assert not out.exists() or not any(out.iterdir())
@@ -411,3 +421,297 @@ def test_plot_phase_diagram_numeric(pool_result, tmp_path):
     assert len(fig.axes) == 2 and fig.axes[0].get_yscale() == "log"
     fig.savefig(tmp_path / "p.png")
     assert (tmp_path / "p.png").stat().st_size > 5_000
+
+
+# --------------------------------------------------------------------------------------------- issue 13, item 7
+
+@pytest.mark.parametrize("measures, options, match", [
+    ("jumps", {"t_end": 1.0, "t_transient": 5.0}, r"t_end must be greater than t_transient = 5"),
+    ("jumps", {"rtol": 1.0}, r"rtol must be in \[1e-14, 0\.01\]"),
+    ("period", {"rtol": 1e-16}, r"rtol must be in \[1e-14, 0\.01\]"),
+    ("jumps", {"t_transient": -1.0}, r"t_transient must be finite and in \[0, inf\)"),
+    ("period", {"alpha0": float("nan")}, r"alpha0 must be finite"),
+    ("period", {"period_rtol": 0.0}, r"period_rtol must be finite and in \(0, inf\)"),
+    ("lyapunov", {"lyapunov_time": -1.0}, r"lyapunov_time must be finite and in \(0, inf\)"),
+    ("lyapunov", {"t_transient": "soon"}, r"t_transient must be a real number"),
+    ("regime", {"geometry": "flat"}, r"geometry must be one of"),
+    ("regime", {"R": 0.0}, r"R must be finite and in \[0.0001, 10\]"),
+])
+def test_invalid_options_rejected_before_any_point(tmp_path, measures, options, match):
+    """Hypothesis: every option a built-in measure reads is checked before the first point, so an invalid
+    one raises ValueError naming it and its valid range, and nothing is written (no manifest to pin the
+    bad options, no error records that a resume would keep).
+
+    Reproducer of issue 13 item 7: ``t_end=1, t_transient=5`` or ``rtol=1`` used to compute every point
+    as an error record.  No tolerance: categorical outcome.
+    """
+    out = tmp_path / "sw"
+    with pytest.raises(ValueError, match=match):
+        sweep(I2, V2, measures, out=out, executor="serial", options=options, progress=False)
+    assert not out.exists()
+
+
+def test_cli_invalid_options_exit_2_and_write_nothing(tmp_path, capsys):
+    """Hypothesis: ``peelapprox sweep --t-end 1 --t-transient 5`` stops with exit status 2 and a message
+    naming t_end before any point, leaving no directory behind (it used to exit 1 with every point an error
+    record, poisoning the directory)."""
+    out = tmp_path / "sw"
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", "--I", "1e-5", "--V", "1", "--measure", "jumps", "--out", str(out), "--workers", "0",
+              "--t-end", "1", "--t-transient", "5", "--quiet"])
+    assert exc.value.code == 2 and "t_end must be greater than t_transient" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_point_status_reflects_its_measures(tmp_path):
+    """Hypothesis: a point's status is the first non-ok status among its measures: a ModelBreakdown of every
+    measure (V=1, I=1e-4, v reaches v_floor) is ``status = "breakdown:v_floor"``, not ``"ok"``; a raising
+    measure outranks a breakdown; a point whose measures all succeed is ``"ok"``.
+
+    Reproducer of issue 13 item 7.  No tolerance: categorical outcome.
+    """
+    res = sweep([1e-5, 1e-4], [1.0], ("regime", "jumps", "flaky"), out=tmp_path / "sw", executor="serial",
+                progress=False, options={"fail_at_V": 2.0})
+    assert res.record(1e-4, 1.0)["status"] == "breakdown:v_floor"
+    assert res.record(1e-5, 1.0)["status"] == "ok"
+    res = sweep([1e-4], [1.0], ("jumps", "flaky"), out=tmp_path / "sw2", executor="serial", progress=False,
+                options={"fail_at_V": 1.0})
+    rec = res.record(1e-4, 1.0)
+    assert rec["status"] == "error: RuntimeError: boom at V=1" and rec["jumps_status"] == "breakdown:v_floor"
+
+
+def test_retry_failed(tmp_path, monkeypatch):
+    """Hypothesis: error records count as finished on a plain resume (nothing recomputed, the file
+    unchanged), and ``retry_failed=True`` recomputes exactly those points, leaving one record per point
+    and the ok records byte for byte as they were.
+
+    Reproducer of issue 13 item 7 (failed points could never be retried).  Exact equality: deterministic.
+    """
+    out = tmp_path / "sw"
+    monkeypatch.setenv("PEELAPPROX_TEST_FAIL", "1")
+    res = sweep(I2, V2, "envfail", out=out, executor="serial", progress=False)
+    assert [r["status"] for r in res.records] == ["error: OSError: transient failure at V=1",
+                                                   "error: OSError: transient failure at V=2"] * 2
+    monkeypatch.delenv("PEELAPPROX_TEST_FAIL")
+    before = (out / "results.jsonl").read_text()
+    assert sweep(I2, V2, "envfail", out=out, executor="serial", progress=False).records == res.records
+    assert (out / "results.jsonl").read_text() == before
+    res = sweep(I2, V2, "envfail", out=out, executor="serial", progress=False, retry_failed=True)
+    assert res.complete and all(r["status"] == "ok" and r["envfail_x"] == r["I"] + r["V"] for r in res.records)
+    assert len(_keys_once(out)) == 4
+
+
+def test_cli_retry_failed(tmp_path, capsys, monkeypatch):
+    """Hypothesis: ``--retry-failed`` recomputes the error points of a CLI sweep (exit 1 while a point failed,
+    0 once all are ok) and a plain rerun does not."""
+    argv = ["sweep", "--I", "1e-5", "--V", "1,2", "--measure", "envfail", "--out", str(tmp_path / "sw"),
+            "--workers", "0", "--quiet", "--format", "json"]
+    monkeypatch.setenv("PEELAPPROX_TEST_FAIL", "1")
+    assert main(argv) == 1
+    monkeypatch.delenv("PEELAPPROX_TEST_FAIL")
+    assert main(argv) == 1
+    capsys.readouterr()
+    assert main(argv + ["--retry-failed"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["envfail_x"] for r in rows] == [1.00001, 2.00001]
+
+
+def test_max_workers_0_runs_in_process(tmp_path):
+    """Hypothesis: ``max_workers=0`` means "in this process", as the CLI's ``--workers 0`` does, so even a
+    lambda (which no worker could import) is evaluated; it used to raise ValueError."""
+    register_measure("tmp_inproc", lambda p, o: {"x": p.V * 2}, replace=True)
+    try:
+        res = sweep(I2, V2, "tmp_inproc", out=tmp_path / "sw", max_workers=0, progress=False)
+    finally:
+        MEASURES.pop("tmp_inproc")
+    assert res.complete and [r["tmp_inproc_x"] for r in res.records] == [2.0, 4.0, 2.0, 4.0]
+
+
+def test_notebook_measure_on_process_pool(tmp_path):
+    """Hypothesis: a measure defined in ``__main__`` without a file (a notebook, ``python -c``) works on the
+    default process pool: the engine ships it by value (cloudpickle), since no worker can import it.
+
+    Reproducer of issue 13 item 7: it used to fail at every point with LookupError.  Exact equality of
+    I*V: the same float product in the worker.
+    """
+    pytest.importorskip("cloudpickle")
+    code = ("import json, sys\n"
+            "from peelapprox import register_measure, sweep\n"
+            "def nb(params, options):\n"
+            "    return {'x': params.I * params.V}\n"
+            "register_measure('nb', nb)\n"
+            f"res = sweep([1e-5, 1e-3], [2.0], 'nb', out={str(tmp_path / 'sw')!r}, max_workers=1, progress=False)\n"
+            "print(json.dumps(res.records))\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    recs = json.loads(proc.stdout)
+    assert [(r["status"], r["nb_x"]) for r in recs] == [("ok", 1e-5 * 2.0), ("ok", 1e-3 * 2.0)]
+
+
+def test_unshippable_measure_fails_before_any_point(tmp_path, monkeypatch):
+    """Hypothesis: without cloudpickle, a measure from ``__main__`` (or a lambda) on a process pool is a
+    ValueError before any point, saying to define it in an importable module or use max_workers=0; nothing
+    is written.  (It used to run every point on the pool as an error record.)"""
+    from peelapprox import _sweep as sw
+
+    monkeypatch.setattr(sw, "_cloudpickle", lambda: None)
+
+    def nb(params, options):
+        return {"x": 1.0}
+
+    nb.__module__, nb.__qualname__ = "__main__", "nb"
+    register_measure("tmp_main", nb, replace=True)
+    try:
+        with pytest.raises(ValueError, match=r"tmp_main.*importable module.*max_workers=0"):
+            sweep(I2, V2, "tmp_main", out=tmp_path / "sw", max_workers=1, progress=False)
+    finally:
+        MEASURES.pop("tmp_main")
+    assert not (tmp_path / "sw").exists()
+
+
+def _partial_sweep(out):
+    """A 2x2 slowprod sweep with its last record removed (one point left to compute)."""
+    sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    lines = _lines(out)
+    (out / "results.jsonl").write_text("\n".join(lines[:-1]) + "\n")
+    return lines
+
+
+@pytest.mark.parametrize("name", ["results.jsonl", "sweep.json", ".lock"])
+def test_symlinks_are_not_followed(tmp_path, name):
+    """Hypothesis: a sweep file that is a symbolic link (here to a file outside ``out``) is refused with a
+    ValueError naming it, and the file it points to is not changed; load_sweep refuses it too.
+
+    Reproducer of issue 13 item 7: a resume appended to whatever ``results.jsonl`` pointed to.
+    """
+    out = tmp_path / "sw"
+    _partial_sweep(out)
+    outside = tmp_path / f"outside-{name}"
+    (out / name).rename(outside)
+    (out / name).symlink_to(outside)
+    before = outside.read_bytes()
+    with pytest.raises(ValueError, match=f"{name}.*symbolic link"):
+        sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    if name != ".lock":
+        with pytest.raises(ValueError, match=f"{name}.*symbolic link"):
+            load_sweep(out)
+    assert outside.read_bytes() == before
+
+
+_MANIFEST_DAMAGE = {
+    "not an object": lambda m: [m],
+    "I_values a string": lambda m: {**m, "I_values": "1e-5"},
+    "I_values 1e400": lambda m: {**m, "I_values": [float("inf"), 1e-2]},
+    "I_values holding bools": lambda m: {**m, "I_values": [True, 1e-2]},
+    "V_values missing": lambda m: {k: v for k, v in m.items() if k != "V_values"},
+    "measures a number": lambda m: {**m, "measures": 3},
+    "measures missing": lambda m: {k: v for k, v in m.items() if k != "measures"},
+    "options a list": lambda m: {**m, "options": [1]},
+    "versions a string": lambda m: {**m, "versions": "new"},
+}
+
+
+@pytest.mark.parametrize("damage", sorted(_MANIFEST_DAMAGE))
+def test_malformed_manifest_gives_the_clear_error(tmp_path, damage):
+    """Hypothesis: a crafted or corrupted manifest (wrong types, missing keys, non-finite grid values) makes
+    load_sweep and a resume raise ValueError saying the manifest is malformed, never another exception.
+
+    Reproducer of issue 13 item 7 (these gave TypeError/KeyError/AttributeError tracebacks).
+    """
+    out = tmp_path / "sw"
+    _partial_sweep(out)
+    path = out / "sweep.json"
+    path.write_text(json.dumps(_MANIFEST_DAMAGE[damage](json.loads(path.read_text()))))
+    with pytest.raises(ValueError, match="malformed manifest"):
+        load_sweep(out)
+    with pytest.raises(ValueError, match="malformed manifest"):
+        sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+
+
+@pytest.mark.parametrize("line", [
+    '{"I":1e400,"V":1.0,"status":"ok"}',
+    '{"I":1e-05,"V":Infinity,"status":"ok"}',
+    '{"I":"1e-05","V":1.0,"status":"ok"}',
+    '{"I":true,"V":1.0,"status":"ok"}',
+    '{"I":1e-05,"V":1.0}',
+    '{"I":1e-05,"V":1.0,"status":5}',
+    '{"I":1e-05,"V":1.0,"status":"ok","slowprod_value":[1,2]}',
+    '{"I":1e-05,"V":1.0,"status":"ok","slowprod_value":1' + "0" * 400 + '}',
+    '[1, 2]',
+    '[' * 100000,
+], ids=["I 1e400", "V Infinity", "I a string", "I a bool", "status missing", "status a number", "a list value",
+        "a 401-digit int", "not an object", "deep nesting"])
+def test_malformed_record_gives_the_clear_error(tmp_path, line):
+    """Hypothesis: a crafted or corrupted complete line of results.jsonl (non-finite or non-numeric I/V,
+    missing status, non-scalar values, an int no float can hold, deep nesting) makes load_sweep and a resume
+    raise ValueError naming the line as malformed, never another exception.
+
+    Reproducer of issue 13 item 7 (``I=1e400`` and wrong types gave tracebacks).
+    """
+    out = tmp_path / "sw"
+    lines = _partial_sweep(out)
+    (out / "results.jsonl").write_text(lines[0] + "\n" + line + "\n")
+    with pytest.raises(ValueError, match="line 2: malformed record"):
+        load_sweep(out)
+    with pytest.raises(ValueError, match="line 2: malformed record"):
+        sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+
+
+@pytest.fixture
+def read_only(monkeypatch):
+    """Make ``out`` (the returned callable's argument) read-only for this process.
+
+    Every open for writing of a path under it fails with EACCES, through ``open`` and ``os.open`` alike:
+    ``chmod`` cannot do this here, since the tests may run as root, whom permissions do not stop.
+    """
+    import builtins
+    import errno
+
+    roots: list[str] = []
+    real_open, real_os_open = builtins.open, os.open
+    write_flags = os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_APPEND | os.O_TRUNC
+
+    def denied(path) -> bool:
+        p = os.path.abspath(os.fspath(path)) if isinstance(path, (str, bytes, os.PathLike)) else ""
+        return any(p == r or p.startswith(r + os.sep) for r in roots)
+
+    def fake_open(file, mode="r", *a, **k):
+        if denied(file) and any(c in mode for c in "wax+"):
+            raise PermissionError(errno.EACCES, "Permission denied", os.fspath(file))
+        return real_open(file, mode, *a, **k)
+
+    def fake_os_open(path, flags, *a, **k):
+        if denied(path) and flags & write_flags:
+            raise PermissionError(errno.EACCES, "Permission denied", os.fspath(path))
+        return real_os_open(path, flags, *a, **k)
+
+    def make(out):
+        roots.append(os.path.abspath(os.fspath(out)))
+        monkeypatch.setattr(builtins, "open", fake_open)
+        monkeypatch.setattr(os, "open", fake_os_open)
+
+    return make
+
+
+def test_read_only_complete_sweep_loads_and_reports(tmp_path, capsys, read_only):
+    """Hypothesis: a complete sweep in a directory this process cannot write is returned by ``sweep`` (nothing
+    to compute, so nothing to write) and reported by the CLI (exit 0, the table printed, results.csv skipped
+    with a note); an incomplete one is a ValueError saying how many points remain and that out is not
+    writable.  Exact equality of the records: they are read back unchanged.
+
+    Reproducer of issue 13 item 7 (it failed even to report a complete sweep).
+    """
+    out = tmp_path / "sw"
+    full = sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    part = tmp_path / "part"
+    _partial_sweep(part)
+    read_only(out)
+    read_only(part)
+    res = sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)
+    assert res.complete and res.records == full.records
+    assert main(["sweep", "--I", "1e-5,1e-2", "--V", "1,2", "--measure", "slowprod", "--out", str(out),
+                 "--workers", "0", "--quiet", "--format", "json"]) == 0
+    cap = capsys.readouterr()
+    assert json.loads(cap.out) == full.records and "cannot write" in cap.err
+    with pytest.raises(ValueError, match=r"not writable.*1 of 4 points"):
+        sweep(I2, V2, "slowprod", out=part, executor="serial", progress=False)
