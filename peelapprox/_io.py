@@ -9,7 +9,10 @@ from typing import Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["write_rows", "jsonable"]
+__all__ = ["TABLE_EXTENSIONS", "jsonable", "write_rows"]
+
+#: The file name endings :func:`write_rows` accepts.
+TABLE_EXTENSIONS = (".csv", ".json")
 
 
 def jsonable(v: Any) -> Any:
@@ -46,5 +49,5 @@ def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequ
                 w.writerow(["" if r.get(c) is None else (repr(float(r[c])) if isinstance(r[c], (float, np.floating))
                                                          else r[c]) for c in cols])
     else:
-        raise ValueError(f"path must end in .csv or .json, got {p!r}")
+        raise ValueError(f"path must end in {' or '.join(TABLE_EXTENSIONS)}, got {p!r}")
     return p
