@@ -28,6 +28,7 @@ from ._cli_checks import (
     nonnegative_float,
     one_line,
     positive_float,
+    positive_int,
 )
 from ._params import GEOMETRIES, PeelParams
 
@@ -599,7 +600,7 @@ def build_parser() -> argparse.ArgumentParser:
     dy.add_argument("--t-transient", type=nonnegative_float, default=30.0, help="discarded [s] (30)")
     dy.add_argument("--window", type=positive_float, default=20.0, help="analysed [s] (20)")
     dy.add_argument("--rtol", type=float, default=1e-10)
-    dy.add_argument("--max-period", type=int, default=32)
+    dy.add_argument("--max-period", type=positive_int, default=32)
     dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (a few s)")
     dy.add_argument("--lyapunov-method", choices=LYAPUNOV_METHODS,
                     help="how (implies --lyapunov): two-trajectory renormalisation (the default), saltation "

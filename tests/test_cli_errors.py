@@ -69,6 +69,7 @@ CASES = [
      ["argument --lyapunov-time", "(0, inf)", "'-1'"]),
     ("dynamics-window-negative", DYN + ["--window", "-5"], 2, ["argument --window", "(0, inf)", "'-5'"]),
     ("dynamics-t-transient-negative", DYN + ["--t-transient", "-1"], 2, ["argument --t-transient", "[0, inf)"]),
+    ("dynamics-max-period-zero", DYN + ["--max-period", "0"], 2, ["argument --max-period", "integer >= 1"]),
     ("dynamics-attractors-nan", DYN + ["--attractors=nan"], 2, ["argument --attractors", "finite", "'nan'"]),
     ("dynamics-attractors-empty-item", DYN + ["--attractors=0.1,,0.2"], 2, ["argument --attractors", "comma list"]),
     ("dynamics-return-map-alpha0", DYN + ["--alpha0", "0.1", "--lyapunov-method", "return-map"], 2,
