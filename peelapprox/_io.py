@@ -9,7 +9,10 @@ from typing import IO, Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["write_rows", "write_csv", "jsonable"]
+__all__ = ["TABLE_EXTENSIONS", "jsonable", "write_csv", "write_rows"]
+
+#: The file name endings :func:`write_rows` accepts.
+TABLE_EXTENSIONS = (".csv", ".json")
 
 
 def jsonable(v: Any) -> Any:
@@ -41,7 +44,7 @@ def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequ
         with open(p, "w", newline="") as fh:
             write_csv(fh, rows, fields=fields)
     else:
-        raise ValueError(f"path must end in .csv or .json, got {p!r}")
+        raise ValueError(f"path must end in {' or '.join(TABLE_EXTENSIONS)}, got {p!r}")
     return p
 
 

@@ -2,6 +2,13 @@
 
 The CLI is the only place that ties the three packages (peelapprox, exact,
 comparisons) together; it imports the solvers lazily per subcommand.
+
+Output paths are checked before any computation and reported exactly as
+written (:mod:`peelapprox._cli_checks`).  A user error is one line on stderr,
+``peelapprox <command>: error: <message>``, never a traceback; exit status 2
+for a usage error (a bad argument or output path), 3 when the model or solver
+stops (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed),
+1 when writing fails (OSError) or, for ``sweep``, when a point failed.
 """
 
 from __future__ import annotations
@@ -9,39 +16,50 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import time
 import sys
+import time
 from typing import Optional, Sequence
 
+from ._cli_checks import (
+    check_output_path,
+    check_sweep_plot_key,
+    connect_dask_scheduler,
+    finite_float_list,
+    nonnegative_float,
+    one_line,
+    positive_float,
+    positive_int,
+)
 from ._params import GEOMETRIES, PeelParams
 
 __all__ = ["main"]
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from exact import ModelBreakdown, SolverBudgetExceeded, simulate
+    from exact import simulate
 
+    if args.plot and args.jumps_only:
+        raise ValueError("--plot needs stored steps; drop --jumps-only")
+    out = check_output_path(args.out, "npz", "--out") if args.out else None
+    jumps_csv = check_output_path(args.jumps_csv, "file", "--jumps-csv") if args.jumps_csv else None
+    plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, l=args.l, geometry=args.geometry)
     save = "jumps" if args.jumps_only else "steps"
-    try:
-        traj = simulate(
-            params,
-            args.t_end,
-            alpha0=args.alpha0,
-            omega0=args.omega0,
-            F0=args.F0,
-            branch0=args.branch0,
-            method=args.method,
-            solver=args.solver,
-            rtol=args.rtol,
-            eps=args.eps,
-            t_transient=args.t_transient,
-            save=save,
-            progress=not args.quiet,
-        )
-    except (ModelBreakdown, SolverBudgetExceeded) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 3
+    traj = simulate(
+        params,
+        args.t_end,
+        alpha0=args.alpha0,
+        omega0=args.omega0,
+        F0=args.F0,
+        branch0=args.branch0,
+        method=args.method,
+        solver=args.solver,
+        rtol=args.rtol,
+        eps=args.eps,
+        t_transient=args.t_transient,
+        save=save,
+        progress=not args.quiet,
+    )
     s = traj.stats
     summary = {
         "V": params.V,
@@ -66,20 +84,17 @@ def _simulate(args: argparse.Namespace) -> int:
     else:
         for key, val in summary.items():
             print(f"{key:>18}: {val}")
-    if args.out:
-        traj.to_npz(args.out)
-        print(f"wrote {args.out}", file=sys.stderr)
-    if args.jumps_csv:
-        traj.jumps.to_csv(args.jumps_csv)
-        print(f"wrote {args.jumps_csv}", file=sys.stderr)
-    if args.plot:
-        if args.jumps_only:
-            print("error: --plot needs stored steps; drop --jumps-only", file=sys.stderr)
-            return 2
+    if out:
+        traj.to_npz(out)
+        print(f"wrote {out}", file=sys.stderr)
+    if jumps_csv:
+        traj.jumps.to_csv(jumps_csv)
+        print(f"wrote {jumps_csv}", file=sys.stderr)
+    if plot:
         from .plotting import plot_trajectory
 
-        plot_trajectory(traj, args.plot)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        plot_trajectory(traj, plot)
+        print(f"wrote {plot}", file=sys.stderr)
     return 0
 
 
@@ -98,13 +113,13 @@ def _folds(args: argparse.Namespace) -> int:
 
 
 def _write_rows(path: str, rows: list[dict]) -> None:
-    """Write rows as CSV or JSON, chosen by the file extension (:func:`peelapprox._io.write_rows`)."""
+    """Write rows as CSV or JSON, chosen by the file extension (:func:`peelapprox._io.write_rows`).
+
+    ``path`` was checked by :func:`check_output_path` (kind ``"table"``) before the run.
+    """
     from ._io import write_rows
 
-    try:
-        write_rows(path, rows)
-    except ValueError:
-        raise ValueError(f"--out must end in .csv or .json, got {path!r}") from None
+    write_rows(path, rows)
     print(f"wrote {path}", file=sys.stderr)
 
 
@@ -122,32 +137,31 @@ def _print_mapping(row: dict, fmt: str) -> None:
 def _estimate(args: argparse.Namespace) -> int:
     from ._estimate import estimate
 
+    out = check_output_path(args.out, "table", "--out") if args.out else None
     params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     row = estimate(params, alpha_min=args.alpha_min, alpha_max=args.alpha_max).as_dict()
     _print_mapping(row, args.format)
-    if args.out:
-        _write_rows(args.out, [row])
+    if out:
+        _write_rows(out, [row])
     return 0
 
 
 def _segment(args: argparse.Namespace) -> int:
-    from ._errors import ModelBreakdown, SolverBudgetExceeded
     from ._segment import reduced_segment
 
+    out = check_output_path(args.out, "table", "--out") if args.out else None
+    curves = check_output_path(args.curves, "table", "--curves") if args.curves else None
+    plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
-    try:
-        seg = reduced_segment(
-            params, args.branch, F_in=args.F_in, alpha_in=args.alpha_in, alphadot_in=args.alphadot_in,
-            amplitude=args.amplitude, phase=args.phase, v_in=args.v_in, v_f=args.v_f,
-            alpha_model=args.alpha_model, v_equation=args.v_equation, rtol=args.rtol,
-        )
-    except (ModelBreakdown, SolverBudgetExceeded) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 3
+    seg = reduced_segment(
+        params, args.branch, F_in=args.F_in, alpha_in=args.alpha_in, alphadot_in=args.alphadot_in,
+        amplitude=args.amplitude, phase=args.phase, v_in=args.v_in, v_f=args.v_f,
+        alpha_model=args.alpha_model, v_equation=args.v_equation, rtol=args.rtol,
+    )
     _print_mapping(seg.as_dict(), args.format)
-    if args.out:
-        _write_rows(args.out, [seg.as_dict()])
-    if args.curves or args.plot:
+    if out:
+        _write_rows(out, [seg.as_dict()])
+    if curves or plot:
         # smooth curves: the same integration again, sampled by dense output
         import numpy as np
 
@@ -157,21 +171,21 @@ def _segment(args: argparse.Namespace) -> int:
             alpha_model=args.alpha_model, v_equation=args.v_equation, rtol=args.rtol,
             t_eval=np.linspace(0.0, seg.dt, 801)[:-1],
         )
-    if args.curves:
+    if curves:
         rows = [dict(t=float(a), v=float(b), F=float(c), alpha=float(d), alphadot=float(e))
                 for a, b, c, d, e in zip(seg.t, seg.v, seg.F, seg.alpha, seg.alphadot)]
-        _write_rows(args.curves, rows)
-    if args.plot:
+        _write_rows(curves, rows)
+    if plot:
         from .plotting import plot_segment
 
-        plot_segment(seg, args.plot)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        plot_segment(seg, plot)
+        print(f"wrote {plot}", file=sys.stderr)
     return 0
 
 
 def _compare(args: argparse.Namespace) -> int:
 
-    from comparisons import RUNS, SCENES, STAT_RUNS, TransientNotPassed, markdown, run_compare
+    from comparisons import RUNS, SCENES, STAT_RUNS, markdown, run_compare
 
     if args.list:
         for name, sc in SCENES.items():
@@ -181,15 +195,12 @@ def _compare(args: argparse.Namespace) -> int:
         return 0
     figdir = None
     if args.out:
+        check_output_path(args.out, "dir", "--out")
         figdir = os.path.join(args.out, "figures")
         os.makedirs(figdir, exist_ok=True)
-    try:
-        report = run_compare(args.scene, statistics_runs=() if args.no_stats else STAT_RUNS,
-                             figures_dir=None if args.no_figures else figdir,
-                             progress=lambda msg: print(msg, file=sys.stderr, flush=True))
-    except TransientNotPassed as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 3
+    report = run_compare(args.scene, statistics_runs=() if args.no_stats else STAT_RUNS,
+                         figures_dir=None if args.no_figures else figdir,
+                         progress=lambda msg: print(msg, file=sys.stderr, flush=True))
     rows, stats = report.row_dicts(), report.stat_dicts()
     if args.format == "md":
         print(markdown(report, figures_rel="figures" if figdir else None), end="")
@@ -224,6 +235,8 @@ def _benchmark(args: argparse.Namespace) -> int:
     from comparisons._benchmark import (markdown, plot_eps_study, plot_work_precision, rows_as_dicts,
                                         run_benchmark)
 
+    if args.out:
+        check_output_path(args.out, "dir", "--out")
     t0 = time.perf_counter()
 
     def say(msg: str) -> None:
@@ -275,6 +288,9 @@ def _sweep(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 0 (0: in this process), got {args.workers}")
     if args.dask_local is not None and args.dask_local < 1:
         raise ValueError(f"--dask-local must be >= 1 workers, got {args.dask_local}")
+    check_output_path(args.out, "dir", "--out", read_only_ok=True)  # a complete sweep is only read
+    if args.plot:
+        check_sweep_plot_key(args.plot, [m.strip() for m in args.measure.split(",") if m.strip()])
     if os.path.exists(os.path.join(args.out, "sweep.json")):
         prev = load_sweep(args.out)
         print(f"{args.out} holds a sweep with {len(prev.records)}/{prev.I_values.size * prev.V_values.size} points "
@@ -292,7 +308,7 @@ def _sweep(args: argparse.Namespace) -> int:
             cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
             client = Client(cluster)
         else:
-            client = Client(args.dask_scheduler)
+            client = connect_dask_scheduler(args.dask_scheduler)
         print(f"dask: {client}", file=sys.stderr)
         executor = client.get_executor()
     else:
@@ -336,6 +352,9 @@ def _sweep(args: argparse.Namespace) -> int:
     if args.plot:
         from .plotting import plot_phase_diagram
 
+        if args.plot not in cols:
+            raise ValueError(f"--plot {args.plot!r}: no record has this key (the sweep is saved in {args.out}); "
+                             f"keys: {', '.join(cols)}")
         png = os.path.join(args.out, f"{args.plot}.png")
         plot_phase_diagram(result, args.plot, png)
         print(f"wrote {png}", file=sys.stderr)
@@ -349,14 +368,16 @@ def _figures(args: argparse.Namespace) -> int:
         for name, fig in FIGURES.items():
             print(f"{name}: {fig.caption}  [{fig.params}]")
         return 0
+    check_output_path(args.out, "dir", "--out")
+    markdown = check_output_path(args.markdown, "file", "--markdown") if args.markdown else None
     files = make_figures(args.only, args.out, progress=lambda msg: print(msg, file=sys.stderr, flush=True))
     for name, paths in files.items():
         print(f"{name}: {', '.join(paths)}")
-    if args.markdown:
-        rel = os.path.relpath(args.out, os.path.dirname(os.path.abspath(args.markdown)) or ".")
-        with open(args.markdown, "w") as fh:
+    if markdown:
+        rel = os.path.relpath(args.out, os.path.dirname(os.path.abspath(markdown)) or ".")
+        with open(markdown, "w") as fh:
             fh.write(figures_markdown(files, rel=rel))
-        print(f"wrote {args.markdown}", file=sys.stderr)
+        print(f"wrote {markdown}", file=sys.stderr)
     return 0
 
 
@@ -365,6 +386,9 @@ def _dynamics(args: argparse.Namespace) -> int:
 
     from ._dynamics import attractors, force_drops, periodicity, return_map, settle_time
 
+    out = check_output_path(args.out, "table", "--out") if args.out else None
+    if args.lyapunov_method == "return-map" and args.alpha0 != 0.0:
+        raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
     try:
@@ -396,7 +420,7 @@ def _dynamics(args: argparse.Namespace) -> int:
             row.update(eps=args.eps)
     _print_mapping(row, args.format)
     if args.attractors:
-        a0s = [float(a) for a in args.attractors.split(",")]
+        a0s = args.attractors
         res = attractors(p, a0s, t_transient=args.t_transient, window=args.window,
                          progress=lambda msg: print(msg, file=sys.stderr, flush=True))
         rows = [dict(attractor=a.label, starts=" ".join(f"{s:g}" for s in a.starts), F_min=a.F_range[0],
@@ -408,8 +432,8 @@ def _dynamics(args: argparse.Namespace) -> int:
             for r in rows:
                 print(f"  {r['attractor']:>14}  F at AB→CD jumps {r['F_min']:.4g}…{r['F_max']:.4g} N  "
                       f"from alpha0 = {r['starts']}")
-    if args.out:
-        _write_rows(args.out, [row])
+    if out:
+        _write_rows(out, [row])
     return 0
 
 
@@ -427,9 +451,7 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
         return D.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), **common)
     if method == "saltation":
         return D.lyapunov_tangent(p, T=T, **common)
-    if method == "return-map":
-        if args.alpha0 != 0.0:
-            raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
+    if method == "return-map":  # alpha0 = 0: checked by the subcommand before the run
         if not returns:
             raise ValueError("--lyapunov-method return-map needs AB→CD returns in the window; there are none")
         return D.lyapunov_return_map(p, t_transient=args.t_transient,
@@ -579,19 +601,19 @@ def build_parser() -> argparse.ArgumentParser:
                                          "Lyapunov exponent at one (V, I)")
     _add_params(dy)
     dy.add_argument("--alpha0", type=float, default=0.0)
-    dy.add_argument("--t-transient", type=float, default=30.0, help="discarded [s] (30)")
-    dy.add_argument("--window", type=float, default=20.0, help="analysed [s] (20)")
+    dy.add_argument("--t-transient", type=nonnegative_float, default=30.0, help="discarded [s] (30)")
+    dy.add_argument("--window", type=positive_float, default=20.0, help="analysed [s] (20)")
     dy.add_argument("--rtol", type=float, default=1e-10)
-    dy.add_argument("--max-period", type=int, default=32)
+    dy.add_argument("--max-period", type=positive_int, default=32)
     dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (a few s)")
     dy.add_argument("--lyapunov-method", choices=LYAPUNOV_METHODS,
                     help="how (implies --lyapunov): two-trajectory renormalisation (the default), saltation "
                          "(tangent dynamics with saltation matrices), return-map (tangent of the jump-to-jump "
                          "map), regularized (variational equations of the ε-system; needs pydiffsol)")
-    dy.add_argument("--lyapunov-time", type=float, default=50.0, help="measured time [s] (50)")
+    dy.add_argument("--lyapunov-time", type=positive_float, default=50.0, help="measured time [s] (50)")
     dy.add_argument("--eps", type=float, default=1e-7, help="ε of --lyapunov-method regularized (1e-7)")
-    dy.add_argument("--attractors", metavar="A0,A0,...", help="sample these initial peel angles for coexisting "
-                                                              "attractors")
+    dy.add_argument("--attractors", type=finite_float_list, metavar="A0,A0,...",
+                    help="sample these initial peel angles for coexisting attractors")
     dy.add_argument("--format", choices=("table", "json"), default="table")
     dy.add_argument("--out", help="also write the summary row to this .csv or .json")
     dy.set_defaults(func=_dynamics)
@@ -599,14 +621,28 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
+
+    User errors end in ``SystemExit`` with one line on stderr (module docstring
+    for the statuses); any other exception is a bug and propagates with its
+    traceback.
+    """
     ap = build_parser()
     args = ap.parse_args(argv)
+    from comparisons import TransientNotPassed
     from comparisons._peers import PeerUnavailableError
+
+    from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
     try:
         return args.func(args)
-    except (ValueError, PeerUnavailableError) as exc:
-        ap.exit(2, f"peelapprox {args.command}: error: {exc}\n")
+    except (ValueError, PeerUnavailableError) as exc:  # a bad argument, output path or missing optional package
+        status, err = 2, exc
+    except (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed) as exc:  # the model stopped
+        status, err = 3, exc
+    except OSError as exc:  # writing failed after the checks (disk full, a path changed meanwhile)
+        status, err = 1, exc
+    ap.exit(status, f"peelapprox {args.command}: error: {one_line(err)}\n")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,223 @@
+"""Checks the command line (:mod:`peelapprox.cli`) runs before any computation.
+
+Argument types for :mod:`argparse` that reject out-of-range numbers with the
+argument's name (exit status 2, no traceback), and :func:`check_output_path`,
+which decides the exact file name an output option writes and fails *before*
+the run, not after it, when that name cannot be written.  The ranges come from
+:mod:`peelapprox._validate`, so the CLI and the Python API say the same thing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from collections.abc import Callable, Sequence
+
+from . import _validate
+
+__all__ = [
+    "DASK_CONNECT_TIMEOUT_S",
+    "OUTPUT_KINDS",
+    "check_output_path",
+    "check_sweep_plot_key",
+    "connect_dask_scheduler",
+    "finite_float_list",
+    "nonnegative_float",
+    "one_line",
+    "positive_float",
+    "positive_int",
+]
+
+
+# --------------------------------------------------------------------------------------------- argument types
+
+def _argtype(check: Callable[[str, str], object], text: str):
+    """``check("value", text)``, its ValueError turned into argparse's "argument --x: <message>" (exit 2)."""
+    try:
+        return check("value", text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def positive_float(text: str) -> float:
+    """Argparse type: a finite float in (0, inf) (:func:`peelapprox._validate.positive`)."""
+    return _argtype(_validate.positive, text)
+
+
+def nonnegative_float(text: str) -> float:
+    """Argparse type: a finite float in [0, inf) (:func:`peelapprox._validate.nonnegative`)."""
+    return _argtype(_validate.nonnegative, text)
+
+
+def positive_int(text: str) -> int:
+    """Argparse type: an integer >= 1, written as one (``"3"``, not ``"3.0"`` or ``"inf"``)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"value must be an integer >= 1, got {text!r}") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"value must be an integer >= 1, got {text!r}")
+    return n
+
+
+def finite_float_list(text: str) -> list[float]:
+    """Argparse type: a comma list of finite floats, at least one (:func:`peelapprox._validate.finite`)."""
+    items = [s.strip() for s in text.split(",")]
+    if not text.strip() or any(not s for s in items):
+        raise argparse.ArgumentTypeError(f"value must be a comma list of numbers, got {text!r}")
+    return [_argtype(_validate.finite, s) for s in items]
+
+
+# --------------------------------------------------------------------------------------------- output paths
+
+#: What an output option writes: ``"file"`` (any name), ``"table"`` (``.csv``/``.json``, by
+#: :func:`peelapprox._io.write_rows`), ``"npz"`` (numpy's ``.npz``, appended when missing, as numpy
+#: does), ``"image"`` (a matplotlib format by extension, ``.png`` appended when there is none, as
+#: matplotlib does) or ``"dir"`` (a directory, created with its parents).
+OUTPUT_KINDS = ("file", "table", "npz", "image", "dir")
+
+
+def _image_formats() -> list[str]:
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return sorted(FigureCanvasBase.get_supported_filetypes())
+
+
+def _file_name(path: str, kind: str, option: str) -> str:
+    """The name a ``kind`` writer really writes for ``path`` (or ValueError for a name it refuses)."""
+    if kind == "npz":
+        return path if path.endswith(".npz") else path + ".npz"
+    if kind == "table":
+        from ._io import TABLE_EXTENSIONS
+
+        if not path.endswith(TABLE_EXTENSIONS):
+            raise ValueError(f"{option} must end in {' or '.join(TABLE_EXTENSIONS)}, got {path!r}")
+        return path
+    if kind == "image":
+        ext = os.path.splitext(path)[1][1:].lower()
+        if not ext:
+            return path.rstrip(".") + ".png"
+        formats = _image_formats()
+        if ext not in formats:
+            raise ValueError(f"{option} {path!r}: unknown image format {ext!r}; known: {', '.join(formats)}")
+        return path
+    return path
+
+
+def _writable_dir(d: str) -> bool:
+    return os.access(d, os.W_OK | os.X_OK)
+
+
+def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool = False) -> str:
+    """The exact path an output option will write, checked before any computation.
+
+    Signature: ``check_output_path(path, kind, option, *, read_only_ok=False) -> str``.
+
+    Parameters
+    ----------
+    path : str
+        As the user gave it.
+    kind : str
+        One of :data:`OUTPUT_KINDS`.
+    option : str
+        The option's name for messages, e.g. ``"--out"``.
+    read_only_ok : bool
+        ``kind="dir"`` only: an existing directory need not be writable (a
+        complete sweep is only read).
+
+    Returns
+    -------
+    str
+        The name written: ``path``, or ``path`` with the extension the writer
+        appends (``.npz``, ``.png``).  Print this one.
+
+    Raises
+    ------
+    ValueError
+        Naming ``option`` and the path: an empty path; a file output that is
+        an existing directory, or whose directory is missing, not a directory
+        or not writable; a name the writer refuses (extension); a directory
+        output that is an existing file, or that cannot be created.
+    """
+    if kind not in OUTPUT_KINDS:
+        raise ValueError(f"kind must be one of {OUTPUT_KINDS}, got {kind!r}")
+    if not path:
+        raise ValueError(f"{option} must not be empty")
+    if kind == "dir":
+        if os.path.exists(path):
+            if not os.path.isdir(path):
+                raise ValueError(f"{option} {path!r} exists and is not a directory")
+            if not read_only_ok and not _writable_dir(path):
+                raise ValueError(f"{option} {path!r}: directory is not writable")
+            return path
+        parent = os.path.dirname(os.path.normpath(path))
+        while parent and not os.path.exists(parent):  # the nearest existing ancestor: makedirs creates the rest
+            parent = os.path.dirname(parent)
+        parent = parent or "."
+        if not os.path.isdir(parent):
+            raise ValueError(f"{option} {path!r}: cannot create it, {parent!r} is not a directory")
+        if not _writable_dir(parent):
+            raise ValueError(f"{option} {path!r}: cannot create it, directory {parent!r} is not writable")
+        return path
+    if os.path.isdir(path):
+        raise ValueError(f"{option} {path!r} is a directory, expected a file name")
+    name = _file_name(path, kind, option)
+    if os.path.isdir(name):
+        raise ValueError(f"{option} {path!r} would write {name!r}, which is a directory")
+    parent = os.path.dirname(name) or "."
+    if not os.path.exists(parent):
+        raise ValueError(f"{option} {path!r}: directory {parent!r} does not exist")
+    if not os.path.isdir(parent):
+        raise ValueError(f"{option} {path!r}: {parent!r} is not a directory")
+    if not _writable_dir(parent) or (os.path.exists(name) and not os.access(name, os.W_OK)):
+        raise ValueError(f"{option} {path!r}: not writable")
+    return name
+
+
+def check_sweep_plot_key(key: str, measures: Sequence[str]) -> None:
+    """Before a sweep: ValueError unless ``key`` can be a record key of ``measures``.
+
+    Record keys are the engine's (``I``, ``V``, ``status``) and the measures'
+    keys, which the engine prefixes ``"<measure>_"`` (:func:`peelapprox._sweep._prefixed`,
+    reused here so the rule stays in one place).  Which suffixes a measure
+    returns is known only after it ran; the CLI checks the exact key again then.
+    """
+    from ._sweep import RESERVED, _prefixed
+
+    if os.sep in key or (os.altsep and os.altsep in key):
+        raise ValueError(f"--plot {key!r}: a record key has no path separator (the plot goes to DIR/KEY.png)")
+    if key in RESERVED or any(key in _prefixed(m, {key: None}) for m in measures):
+        return
+    raise ValueError(f"--plot {key!r} is not a key of the measures {list(measures)}: keys are "
+                     f"{', '.join(RESERVED)} or start with {', '.join(m + '_' for m in measures)}")
+
+
+#: Seconds ``sweep --dask-scheduler`` waits for the scheduler before giving up.
+DASK_CONNECT_TIMEOUT_S = 10.0
+
+
+def connect_dask_scheduler(address: str):
+    """A ``distributed.Client`` on the scheduler at ``address``, or OSError within :data:`DASK_CONNECT_TIMEOUT_S`.
+
+    Raises
+    ------
+    ValueError
+        A malformed address (dask's message, e.g. a missing port).
+    OSError
+        Naming ``--dask-scheduler`` and the address: nothing answered in
+        time, or what answered is not a dask scheduler.
+    """
+    from distributed import Client
+
+    try:
+        return Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
+    except ValueError as exc:
+        raise ValueError(f"--dask-scheduler {address!r}: {one_line(exc)}") from None
+    except Exception as exc:  # noqa: BLE001 - whatever a wrong address provokes in dask (timeout, garbage reply)
+        raise OSError(f"--dask-scheduler {address!r}: cannot connect to a dask scheduler "
+                      f"({type(exc).__name__}: {one_line(exc)})") from None
+
+
+def one_line(exc: BaseException) -> str:
+    """The exception's message on one line (whitespace runs, newlines included, become one space)."""
+    return " ".join(str(exc).split()) or type(exc).__name__
