@@ -23,7 +23,8 @@ from peelapprox._peelforce import (
     peel_force,
     peel_force_coefficients,
 )
-from peelapprox._validate import finite as _finite
+from peelapprox._params import EPS_RANGE, TIME_MAX
+from peelapprox._validate import choice, duration, in_range, integer, optional, params as _params, positive, reals, state
 
 from . import _hybrid as H
 from ._trajectory import Jumps, SolverStats, State, Trajectory
@@ -83,11 +84,12 @@ def initial_state(
         ``F0 (1 - cos θ(α0))`` has no root on the requested branch (or on
         any branch), or if ``1 - cos θ(α0) <= 0``.
     """
-    if not isinstance(params, PeelParams):
-        raise ValueError(f"params must be a PeelParams, got {type(params).__name__}")
-    a0 = _finite("alpha0", alpha0)
-    w0 = params.V / params.R if omega0 is None else _finite("omega0", omega0)
-    F = 1.01 * float(peel_force(params.V, params.V)) if F0 is None else _finite("F0", F0)
+    _params("params", params)
+    a0 = state("alpha0", alpha0, "alpha")
+    w0 = params.V / params.R if omega0 is None else state("omega0", omega0, "omega")
+    F = 1.01 * float(peel_force(params.V, params.V)) if F0 is None else state("F0", F0, "F")
+    t0 = in_range("t0", t0, 0.0, TIME_MAX)
+    branch0 = optional(choice, "branch0", branch0, BRANCHES)
     c = float(params.closure(a0)[0])
     if not (1.0 + c > 0.0):
         raise ValueError(f"alpha0={a0} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
@@ -115,12 +117,20 @@ def initial_state(
     return State(float(t0), a0, w0, F, float(v), branch0)
 
 
+#: Valid absolute tolerances, every component: 0 is excluded (τ starts every branch segment at 0, so pure
+#: relative control has no scale there), above 1 (1 s, 1 rad, 1 rad/s, 1 m/s or 1 N) no error is
+#: controlled at all; below 1e-100 the scaled field overflows the error norm.
+ATOL_RANGE = (1e-100, 1.0)
+
+
 def _atol_vector(method: str, rtol: float, atol) -> np.ndarray:
     if atol is None:
         return rtol * np.asarray(ATOL_SCALE[method], dtype=float)
-    a = np.broadcast_to(np.asarray(atol, dtype=float), (4,)).copy() if np.ndim(atol) == 0 else np.asarray(atol, float)
-    if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise ValueError(f"atol must be a scalar or 4 values, finite and >= 0, got {atol!r}")
+    a = reals("atol", atol, *ATOL_RANGE)
+    if a.ndim == 0:
+        a = np.full(4, float(a))
+    if a.shape != (4,):
+        raise ValueError(f"atol must be a scalar or 4 values (one per integrated component), got shape {a.shape}")
     return a
 
 
@@ -163,10 +173,10 @@ def simulate(
     F0: Optional[float] = None,
     branch0: Optional[str] = None,
     method: str = "hybrid",
-    solver: str = "Radau",
+    solver: Optional[str] = None,
     rtol: float = 1e-8,
     atol: Union[None, float, Sequence[float]] = None,
-    eps: float = 1e-7,
+    eps: Optional[float] = None,
     t_transient: float = 0.0,
     t_eval: Optional[Sequence[float]] = None,
     save: str = "steps",
@@ -184,7 +194,7 @@ def simulate(
     params : PeelParams
         Physical parameters and the ``cos θ`` closure (``geometry``).
     t_end : float
-        Final time [s], > 0.
+        Final time [s], in (0, TIME_MAX] = (0, 1e6].
     alpha0, omega0, F0, branch0 : optional
         Initial state; defaults ``α = 0``, ``ω = V/R``, ``F = 1.01 f(V, V)``,
         ``branch0=None`` meaning the lowest-velocity stable root of CONSTR
@@ -195,15 +205,19 @@ def simulate(
         on the desingularised branch dynamics with exact fold jumps (see
         :mod:`exact._hybrid`).  ``"regularized"``: the paper's scheme, mass
         matrix ``diag(1, 1, 1, ε)``, integrated by scipy's stiff ``solver``.
-    solver : {"Radau", "BDF", "LSODA"}
-        scipy solver for ``method="regularized"`` (analytic Jacobian).
+    solver : {"Radau", "BDF", "LSODA"}, optional
+        scipy solver for ``method="regularized"`` (analytic Jacobian);
+        default "Radau".  Passing it with the hybrid method is an error.
     rtol, atol : float, float or 4 floats
         Local error control per step: RMS over components of
         ``err_i / (atol_i + rtol |y_i|) <= 1``.  Hybrid components are
         ``(τ, α, ω, v)`` (τ = time since the last jump), regularised ones are
-        ``(α, ω, F, v)``.  ``atol=None`` uses ``rtol * ATOL_SCALE[method]``.
-    eps : float
-        Regularisation ε (``method="regularized"`` only), default 1e-7 as in
+        ``(α, ω, F, v)``.  ``rtol`` in ``RTOL_RANGE`` = [1e-14, 1e-2];
+        ``atol`` (each component) in ``ATOL_RANGE`` = [1e-100, 1];
+        ``atol=None`` uses ``rtol * ATOL_SCALE[method]``.
+    eps : float, optional
+        Regularisation ε (``method="regularized"`` only; an error with the
+        hybrid method), in ``EPS_RANGE`` = [1e-15, 1e-2], default 1e-7 as in
         the paper.
     t_transient : float
         Integrate from 0 but store nothing (points or jumps) before this time.
@@ -250,52 +264,40 @@ def simulate(
     SolverBudgetExceeded, SolverFailure
         Budget used up / the integrator cannot proceed.
     """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if method == "regularized" and solver not in SOLVERS:
-        raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
-    t_end = _finite("t_end", t_end)
-    if t_end <= 0:
-        raise ValueError(f"t_end must be in (0, inf), got {t_end}")
-    rtol = _finite("rtol", rtol)
-    if not (RTOL_RANGE[0] <= rtol <= RTOL_RANGE[1]):
-        raise ValueError(f"rtol must be in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}], got {rtol}")
+    _params("params", params)
+    method = choice("method", method, METHODS)
+    if method == "hybrid":
+        for name, val in (("solver", solver), ("eps", eps)):
+            if val is not None:
+                raise ValueError(f"{name} applies only to method='regularized' (the hybrid method is the eps -> 0 "
+                                 f"limit, integrated by its own DOP853), got {name}={val!r} with method='hybrid'")
+    else:
+        solver = choice("solver", "Radau" if solver is None else solver, SOLVERS)
+        eps = in_range("eps", 1e-7 if eps is None else eps, *EPS_RANGE)
+    t_end = duration("t_end", t_end)
+    rtol = in_range("rtol", rtol, *RTOL_RANGE)
     atol_v = _atol_vector(method, rtol, atol)
-    eps = _finite("eps", eps)
-    if not eps > 0:
-        raise ValueError(f"eps must be in (0, inf), got {eps}")
-    t_transient = _finite("t_transient", t_transient)
-    if not (0 <= t_transient <= t_end):
-        raise ValueError(f"t_transient must be in [0, t_end] = [0, {t_end}], got {t_transient}")
-    if save not in SAVES:
-        raise ValueError(f"save must be one of {SAVES}, got {save!r}")
+    t_transient = in_range("t_transient", t_transient, 0.0, t_end)
+    save = choice("save", save, SAVES)
+    max_points = integer("max_points", max_points)
+    max_jumps = integer("max_jumps", max_jumps)
+    max_steps = default_max_steps(method, t_end) if max_steps is None else integer("max_steps", max_steps)
+    max_wall = optional(positive, "max_wall", max_wall)
     te = None
     if t_eval is not None:
-        te = np.asarray(t_eval, dtype=float).ravel()
-        if te.size == 0 or not np.all(np.isfinite(te)) or np.any(np.diff(te) < 0):
-            raise ValueError("t_eval must be a non-empty, finite, sorted sequence of times")
-        if te[0] < t_transient or te[-1] > t_end:
-            raise ValueError(f"t_eval must lie within [t_transient, t_end] = [{t_transient}, {t_end}]")
+        te = reals("t_eval", t_eval, t_transient, t_end).ravel()
+        if te.size == 0 or np.any(np.diff(te) < 0):
+            raise ValueError(f"t_eval must be a non-empty, sorted sequence of times in [t_transient, t_end] = "
+                             f"[{t_transient:g}, {t_end:g}]")
         if te.size > max_points:
             raise ValueError(f"t_eval has {te.size} points, more than max_points={max_points}")
-    if max_steps is None:
-        max_steps = default_max_steps(method, t_end)
-    for name, val in (("max_points", max_points), ("max_steps", max_steps), ("max_jumps", max_jumps)):
-        if int(val) != val or val < 1:
-            raise ValueError(f"{name} must be a positive integer, got {val!r}")
-    if max_wall is not None:
-        max_wall = _finite("max_wall", max_wall)
-        if not max_wall > 0:
-            raise ValueError(f"max_wall must be in (0, inf) seconds or None, got {max_wall!r}")
-    v_floor = _finite("v_floor", v_floor)
-    if not v_floor > 0:
-        raise ValueError(f"v_floor must be in (0, inf), got {v_floor}")
+    v_floor = positive("v_floor", v_floor)
     if progress is True:
         progress = _progress_printer(f"simulate V={params.V} I={params.I}")
     elif progress is False:
         progress = None
     elif progress is not None and not callable(progress):
-        raise ValueError("progress must be None, a bool or a callable (t, t_end)")
+        raise TypeError(f"progress must be None, a bool or a callable (t, t_end), got {type(progress).__name__}")
 
     st0 = initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
     if method == "hybrid":

@@ -34,7 +34,11 @@ __all__ = [
 def _argtype(check: Callable[[str, str], object], text: str):
     """``check("value", text)``, its ValueError turned into argparse's "argument --x: <message>" (exit 2)."""
     try:
-        return check("value", text)
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"value must be a real number, got {text!r}") from None
+    try:
+        return check("value", x)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 

@@ -58,6 +58,7 @@ def _simulate(args: argparse.Namespace) -> int:
         eps=args.eps,
         t_transient=args.t_transient,
         save=save,
+        max_wall=args.max_wall,
         progress=not args.quiet,
     )
     s = traj.stats
@@ -493,9 +494,12 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--F0", type=float, default=None, help="default 1.01 f(V, V)")
     sp.add_argument("--branch0", choices=("AB", "CD"), default=None, help="default: lowest-velocity stable root")
     sp.add_argument("--method", choices=("hybrid", "regularized"), default="hybrid")
-    sp.add_argument("--solver", choices=("Radau", "BDF", "LSODA"), default="Radau", help="for --method regularized")
+    sp.add_argument("--solver", choices=("Radau", "BDF", "LSODA"), default=None,
+                    help="for --method regularized (Radau)")
     sp.add_argument("--rtol", type=float, default=1e-8)
-    sp.add_argument("--eps", type=float, default=1e-7, help="regularisation epsilon (regularized only)")
+    sp.add_argument("--eps", type=float, default=None, help="regularisation epsilon (regularized only; 1e-7)")
+    sp.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
+                    help="wall-clock budget of the integration [s] (600)")
     sp.add_argument("--t-transient", type=float, default=0.0, help="store nothing before this time [s]")
     sp.add_argument("--jumps-only", action="store_true", help="store only the jumps (long runs)")
     sp.add_argument("--out", help="write the trajectory to this .npz")

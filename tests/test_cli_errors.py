@@ -40,8 +40,8 @@ CASES = [
     ("simulate-plot-unknown-format", SIM + ["--plot", "p.xyz"], 2, ["--plot", "unknown image format 'xyz'", "png"]),
     ("simulate-plot-jumps-only", SIM + ["--jumps-only", "--plot", "p.png"], 2, ["--plot", "--jumps-only"]),
     # the solver stops: the model's exception, exit 3
-    ("simulate-lsoda-eps-1e-30", SIM + ["--method", "regularized", "--solver", "LSODA", "--eps", "1e-30"], 3,
-     ["LSODA", "failed"]),
+    ("simulate-lsoda-eps-1e-30", SIM + ["--method", "regularized", "--solver", "LSODA", "--eps", "1e-30"], 2,
+     ["eps", "1e-15"]),
     # table outputs of estimate, segment, dynamics
     ("estimate-out-missing-dir", ["estimate", "--V", "1", "--I", "1e-2", "--out", "nodir/e.csv"], 2,
      ["--out", "'nodir' does not exist"]),
@@ -66,11 +66,11 @@ CASES = [
      ["--markdown", "'nodir' does not exist"]),
     # nonsense that was accepted (item 6): argparse types, exit 2
     ("dynamics-lyapunov-time-negative", DYN + ["--lyapunov", "--lyapunov-time", "-1"], 2,
-     ["argument --lyapunov-time", "(0, inf)", "'-1'"]),
-    ("dynamics-window-negative", DYN + ["--window", "-5"], 2, ["argument --window", "(0, inf)", "'-5'"]),
+     ["argument --lyapunov-time", "(0, inf)", "got -1.0"]),
+    ("dynamics-window-negative", DYN + ["--window", "-5"], 2, ["argument --window", "(0, inf)", "got -5.0"]),
     ("dynamics-t-transient-negative", DYN + ["--t-transient", "-1"], 2, ["argument --t-transient", "[0, inf)"]),
     ("dynamics-max-period-zero", DYN + ["--max-period", "0"], 2, ["argument --max-period", "integer >= 1"]),
-    ("dynamics-attractors-nan", DYN + ["--attractors=nan"], 2, ["argument --attractors", "finite", "'nan'"]),
+    ("dynamics-attractors-nan", DYN + ["--attractors=nan"], 2, ["argument --attractors", "finite", "got nan"]),
     ("dynamics-attractors-empty-item", DYN + ["--attractors=0.1,,0.2"], 2, ["argument --attractors", "comma list"]),
     ("dynamics-return-map-alpha0", DYN + ["--alpha0", "0.1", "--lyapunov-method", "return-map"], 2,
      ["return-map", "alpha0"]),
@@ -152,7 +152,7 @@ def test_dask_scheduler_malformed_address_is_a_usage_error(workdir, capsys):
 
 
 @pytest.mark.parametrize("argv,status,fragment", [
-    (SIM + ["--method", "regularized", "--solver", "LSODA", "--eps", "1e-30"], 3, "LSODA"),
+    (SIM + ["--method", "regularized", "--solver", "LSODA", "--eps", "1e-30"], 2, "eps"),
     (DYN + ["--window", "-5"], 2, "argument --window"),
 ], ids=["solver-failure", "argparse-type"])
 def test_subprocess_has_no_traceback(workdir, argv, status, fragment):

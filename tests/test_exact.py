@@ -144,12 +144,12 @@ def test_continuation_from_final_state(p_low):
 @pytest.mark.parametrize(
     "kw,match",
     [
-        (dict(rtol=0.5), "rtol must be in"),
+        (dict(rtol=0.5), "rtol must be finite and in"),
         (dict(method="rk4"), "method must be one of"),
         (dict(branch0="XY"), "branch0 must be"),
         (dict(F0=290.0, branch0="AB"), "no root on branch0='AB'"),
         (dict(F0=100.0), "below f\\(0\\+, V\\)"),
-        (dict(t_transient=5.0), "t_transient must be in"),
+        (dict(t_transient=5.0), "t_transient must be finite and in"),
         (dict(t_eval=[0.3, 0.1]), "t_eval must be"),
         (dict(save="all"), "save must be one of"),
         (dict(atol=[1, 2]), "atol must be"),
