@@ -10,18 +10,19 @@ Instead CONSTR is solved for the pull force, which is always well posed
 
     F = f(v, V) / (1 + c(α))                                     (CONSTR)
 
-and v is carried as a state obeying the differentiated constraint Eq. (vdot),
-``f'(v) v̇ = Ġ`` with ``G = F (1 + c)``.  Time is then reparametrised by
-``dt/ds = v f'(v) = ∂f/∂(ln v)`` (a desingularisation of the impasse point)::
+and ``u = ln v`` is carried as a state obeying the differentiated constraint
+Eq. (vdot), ``f'(v) v̇ = Ġ`` with ``G = F (1 + c)``.  Time is then
+reparametrised by ``dt/ds = v f'(v) = ∂f/∂(ln v)`` (a desingularisation of the
+impasse point)::
 
     dt/ds = v f'(v)
     dα/ds = v f'(v) (ω - v/R)                                     (FLOW1)
     dω/ds = v f'(v) (-F R c(α) / I)                               (FLOW2)
-    dv/ds = v Ġ,   Ġ = Ḟ (1 + c) + F c'(α) α̇,  Ḟ from flow3      (vdot)
+    du/ds = Ġ,   Ġ = Ḟ (1 + c) + F c'(α) α̇,  Ḟ from flow3        (vdot)
 
 This vector field is smooth through the folds: the fold is simply the
 transversal event ``v = v_max`` (on AB) or ``v = v_min`` (on CD), where
-``dv/ds = v Ġ ≠ 0``.  At the fold ``dt/ds = dα/ds = dω/ds = 0``, so the event
+``du/ds = Ġ ≠ 0``.  At the fold ``dt/ds = dα/ds = dω/ds = 0``, so the event
 time, α, ω and F are *stationary* in s: an error δs in locating the event
 costs only O(δs²) in the jump time and jump state.  Along the branch f' > 0
 and ``t(s)`` is increasing, so the branch solution is the DAE solution, with
@@ -30,7 +31,18 @@ the constraint satisfied to rounding by construction.
 Why ``v f'`` rather than ``f'``: on AB ``f' ∝ v^-0.85`` swings by a factor ~3
 within one inertial α-oscillation (v oscillates), while ``v f' ≈ 16.5 v^0.15``
 barely moves; measured at V=1, I=1e-5 this saves 35 % of the steps at equal
-jump-time error.  It also keeps v > 0 automatically (``d ln v/ds = Ġ``).
+jump-time error.
+
+Why ``u = ln v`` rather than v: v > 0 by construction, and v is controlled
+relatively (the error test sees ``δv/v``) down to the model's breakdown.  On
+AB the level ``G = f(v)`` approaches ``f(0+, V)`` as ``110 v^0.15``, so v must
+be followed over some 60 decades before G is within rounding of f(0+): with v
+as the state (absolute tolerance ~1e-14 m/s) the run had to stop at a floor
+``v = 1e-9`` m/s where G was still ~5 N above f(0+) — a numerical stop
+reported as a breakdown (issue 13).  In u, ``du/ds = Ġ`` is smooth and
+bounded there, and the breakdown is declared by the model's criterion:
+``G - f(0+) <= BREAKDOWN_LEVEL`` (1e-10 relative), i.e. ``v <= v_breakdown``
+(~1e-67 m/s, :class:`peelapprox.BranchStructure`).
 
 At the fold v jumps to the landing root on the other branch (``f = f_max`` on
 CD, or ``f = f_min`` on AB) with (α, ω, F) continuous: this is the ε → 0 limit
@@ -57,7 +69,7 @@ Integrator
 ----------
 The one compiled integrator of the package, :mod:`peelapprox._dop853`
 (Dormand–Prince 8(5,3), scipy's coefficients and controller, scipy's
-tolerance semantics), on the state ``y = (τ, α, ω, v)`` where ``τ = t - t_seg``
+tolerance semantics), on the state ``y = (τ, α, ω, ln v)`` where ``τ = t - t_seg``
 is the time since the segment started (so the error control of the time is
 relative to the segment duration, not to the absolute time).  This module is
 its event driver: folds, jumps, t_end, output and breakdown checks.
@@ -69,9 +81,9 @@ when an output buffer fills or the run ends.
 from __future__ import annotations
 
 import numpy as np
-from peelapprox._jit import kernel
 
 from peelapprox import _generated as _g
+from peelapprox._jit import kernel
 from peelapprox._dop853 import MAX_REJECTIONS, STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from peelapprox._peelforce import peel_force_fp_jit
@@ -86,10 +98,12 @@ constraint_rate = kernel(inline="always")(_g.constraint_rate)
 
 # ---------------------------------------------------------------- layouts
 # parameter vector
-P_V, P_I, P_K, P_R, P_L, P_B, P_A, P_GEOM, P_VMAX, P_VMIN, P_VLCD, P_VLAB, P_VFLOOR, P_VCEIL, P_FOLDS = range(15)
-N_P = 15
-# solver state vector
-S_T0, S_TAU, S_AL, S_OM, S_V, S_H, S_BR = range(7)
+# (v-valued entries are velocities [m/s]; the U entries their logarithms, the state's variable)
+(P_V, P_I, P_K, P_R, P_L, P_B, P_A, P_GEOM, P_VMAX, P_VMIN, P_VLCD, P_VLAB, P_UFLOOR, P_UCEIL, P_FOLDS,
+ P_UEV_AB, P_UEV_CD) = range(17)
+N_P = 17
+# solver state vector (S_U holds u = ln v)
+S_T0, S_TAU, S_AL, S_OM, S_U, S_H, S_BR = range(7)
 N_S = 7
 # counters
 C_STEPS, C_REJ, C_RHS, C_JUMPS, C_NOUT, C_NJOUT, C_TEVAL = range(7)
@@ -109,7 +123,7 @@ DONE = 0
 OUT_FULL = 1
 JUMPS_FULL = 2
 PAUSE = 3  # per-call step quota reached (progress / budget checks)
-BREAK_VFLOOR = 10  # v -> 0 on AB: constraint loses its root
+BREAK_VFLOOR = 10  # v -> v_breakdown (or v_floor) on AB: the constraint loses its root
 BREAK_NOLAND = 11  # CD fold reached but f_min <= f(0+): no AB root to land on
 BREAK_ALPHA = 12  # 1 + c(alpha) <= 0: the peel geometry degenerates
 BREAK_VCEIL = 14  # v ran away on CD
@@ -133,10 +147,10 @@ def pull_force(alpha, v, p):
 
 @kernel
 def _rhs(y, p, out):
-    """Desingularised vector field d(τ, α, ω, v)/ds, dt/ds = v f'(v) (module docstring)."""
-    v = y[3]
+    """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring)."""
+    v = np.exp(y[3])
     c, dc = _closure(y[1], p)
-    if not (v > 0.0 and 1.0 + c > 0.0):  # trial stage left the model's domain: poison the step
+    if not (0.0 < v < np.inf and 1.0 + c > 0.0):  # trial stage left the model's domain (v under/overflowed)
         for i in range(4):
             out[i] = np.nan
         return
@@ -148,29 +162,29 @@ def _rhs(y, p, out):
     out[0] = g
     out[1] = g * ad
     out[2] = g * wd
-    out[3] = v * Gd
+    out[3] = Gd  # d(ln v)/ds = (dv/ds)/v = Ġ
 
 
 _dop = make_dop853(_rhs)
 
 
 @kernel
-def _store(out, nrow, t, y, F, br_arr, br):
+def _store(out, nrow, t, y, v, F, br_arr, br):
     out[nrow, O_T] = t
     out[nrow, O_AL] = y[1]
     out[nrow, O_OM] = y[2]
     out[nrow, O_F] = F
-    out[nrow, O_V] = y[3]
+    out[nrow, O_V] = v
     br_arr[nrow] = br
 
 
 @kernel
 def _in_domain(y, p):
-    """A state the driver may use: finite, v > 0 and 1 + c(α) > 0 (where the field is defined)."""
+    """A state the driver may use: finite, v = exp(u) > 0 and 1 + c(α) > 0 (where the field is defined)."""
     for i in range(4):
         if not np.isfinite(y[i]):
             return False
-    if not y[3] > 0.0:
+    if not 0.0 < np.exp(y[3]) < np.inf:
         return False
     c, _ = _closure(y[1], p)
     return 1.0 + c > 0.0
@@ -192,7 +206,7 @@ def _save(st, y, h):
     st[S_TAU] = y[0]
     st[S_AL] = y[1]
     st[S_OM] = y[2]
-    st[S_V] = y[3]
+    st[S_U] = y[3]
     st[S_H] = h
 
 
@@ -228,7 +242,7 @@ def run(
     y[0] = st[S_TAU]
     y[1] = st[S_AL]
     y[2] = st[S_OM]
-    y[3] = st[S_V]
+    y[3] = st[S_U]
     t0 = st[S_T0]
     br = int(st[S_BR])
     h = st[S_H]
@@ -275,24 +289,18 @@ def run(
         # fold (AB: v reaches v_max from below; CD: v reaches v_min from above)
         x_fold = 2.0
         if has_folds:
-            if br == 0:
-                vf = p[P_VMAX] * (1.0 - FOLD_REL)
-                gA = y[3] - vf
-                gB = y_new[3] - vf
-                crossed = gB >= 0.0
-            else:
-                vf = p[P_VMIN] * (1.0 + FOLD_REL)
-                gA = y[3] - vf
-                gB = y_new[3] - vf
-                crossed = gB <= 0.0
+            uf = p[P_UEV_AB] if br == 0 else p[P_UEV_CD]
+            gA = y[3] - uf
+            gB = y_new[3] - uf
+            crossed = gB >= 0.0 if br == 0 else gB <= 0.0
             if crossed:
                 dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
                 ok = _finite_rows(Fc)
                 if ok:
-                    x_fold = solve_theta(y, Fc, 3, vf, gA, 1.0, gB)
-        # breakdown on AB: v -> 0 (checked at step end; the kernel never
-        # accepts a step whose stages left v > 0)
-        if ok and br == 0 and y_new[3] <= p[P_VFLOOR] and x_fold > 1.0:
+                    x_fold = solve_theta(y, Fc, 3, uf, gA, 1.0, gB)
+        # breakdown on AB: the level F(1 + c) = f(v) reached f(0+) + BREAKDOWN_LEVEL, i.e. u <= ln v_breakdown
+        # (or a user's v_floor), checked at step end
+        if ok and br == 0 and y_new[3] <= p[P_UFLOOR] and x_fold > 1.0:
             cnt[C_STEPS] += 1
             for i in range(4):
                 y[i] = y_new[i]
@@ -330,7 +338,8 @@ def run(
                 if not _in_domain(ye, p):
                     ok = False
                     break
-                _store(out, cnt[C_NOUT], te, ye, pull_force(ye[1], ye[3], p), out_br, br)
+                ve = np.exp(ye[3])
+                _store(out, cnt[C_NOUT], te, ye, ve, pull_force(ye[1], ve, p), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
@@ -363,7 +372,7 @@ def run(
                 y[i] = ye[i]
             _save(st, y, h)
             return BREAK_ALPHA
-        if br == 1 and ye[3] > p[P_VCEIL]:
+        if br == 1 and ye[3] > p[P_UCEIL]:
             for i in range(4):
                 y[i] = ye[i]
             _save(st, y, h)
@@ -373,7 +382,8 @@ def run(
             # reached t_end (a fold exactly at t_end is left for a later call)
             ye[0] = t_end - t0
             if save_mode == SAVE_STEPS and t_end >= t_store:
-                _store(out, cnt[C_NOUT], t_end, ye, pull_force(ye[1], ye[3], p), out_br, br)
+                ve = np.exp(ye[3])
+                _store(out, cnt[C_NOUT], t_end, ye, ve, pull_force(ye[1], ve, p), out_br, br)
                 cnt[C_NOUT] += 1
             for i in range(4):
                 y[i] = ye[i]
@@ -382,10 +392,11 @@ def run(
 
         if x_fold <= 1.0:
             # ---- jump at the fold: v exactly at the fold value, (α, ω, F) continuous
-            ye[3] = p[P_VMAX] if br == 0 else p[P_VMIN]
+            v_fold = p[P_VMAX] if br == 0 else p[P_VMIN]
+            ye[3] = np.log(v_fold)
             ye[0] = max(ye[0], y[0])  # as for a plain step (below)
             tj = t0 + ye[0]
-            Fj = pull_force(ye[1], ye[3], p)
+            Fj = pull_force(ye[1], v_fold, p)
             if br == 0:
                 v_after = p[P_VLCD]
             else:
@@ -397,7 +408,7 @@ def run(
                     return BREAK_NOLAND
             if tj >= t_store:
                 if save_mode == SAVE_STEPS:
-                    _store(out, cnt[C_NOUT], tj, ye, Fj, out_br, br)
+                    _store(out, cnt[C_NOUT], tj, ye, v_fold, Fj, out_br, br)
                     cnt[C_NOUT] += 1
                 k = cnt[C_NJOUT]
                 jbuf[k, 0] = tj
@@ -406,7 +417,7 @@ def run(
                 jbuf[k, 3] = ye[1]
                 jbuf[k, 4] = ye[2]
                 jbuf[k, 5] = Fj
-                jbuf[k, 6] = ye[3]
+                jbuf[k, 6] = v_fold
                 jbuf[k, 7] = v_after
                 cnt[C_NJOUT] += 1
             cnt[C_JUMPS] += 1
@@ -415,11 +426,11 @@ def run(
             y[0] = 0.0
             y[1] = ye[1]
             y[2] = ye[2]
-            y[3] = v_after
+            y[3] = np.log(v_after)
             st[S_T0] = t0
             st[S_BR] = br
             if tj >= t_store and save_mode == SAVE_STEPS:
-                _store(out, cnt[C_NOUT], tj, y, Fj, out_br, br)
+                _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
                 cnt[C_NOUT] += 1
             _rhs(y, p, f0)
             h = _dop.initial_step(y, f0, p, rtol, atol, work)
@@ -437,5 +448,6 @@ def run(
             f0[i] = K[_NS, i]
         h = h_next
         if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
-            _store(out, cnt[C_NOUT], t0 + y[0], y, pull_force(y[1], y[3], p), out_br, br)
+            v = np.exp(y[3])
+            _store(out, cnt[C_NOUT], t0 + y[0], y, v, pull_force(y[1], v, p), out_br, br)
             cnt[C_NOUT] += 1

@@ -28,6 +28,7 @@ from peelapprox._errors import ModelBreakdown, SolverFailure, budget_exceeded
 from peelapprox._jit import kernel
 from peelapprox._peelforce import (
     BRANCHES,
+    BREAKDOWN_LEVEL,
     branch_structure,
     peel_force_coefficients,
     peel_force_fp_jit,
@@ -82,6 +83,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
                     progress, v_floor, max_wall=None):
     """Driver for ``simulate(method="regularized")`` (arguments already validated)."""
     bs = branch_structure(params.V)
+    no_root_margin = BREAKDOWN_LEVEL * max(abs(bs.f_zero), 1.0)  # the hybrid solver's criterion (v_breakdown)
     q = param_vector(params, eps)
     v_mid = bs.v_inflection
     fun = lambda t, y: _fun(y, q)  # noqa: E731
@@ -135,12 +137,17 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         if not np.all(np.isfinite(y)):  # a numerical failure, reported at the last finite state
             raise SolverFailure(f"regularized {solver}: the state became non-finite after t={t_old:.9g}",
                                 t=float(t_old), state=sdict(t_old, y_old), partial=build(False))
-        if y[3] <= v_floor:
+        if v_floor is not None and y[3] <= v_floor:
             tb, yb = (ode.t, y) if y[3] > 0 else (t_old, y_old)  # never report v <= 0
             raise ModelBreakdown(
                 f"model breakdown at t={tb:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
                 f"(F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)",
                 t=float(tb), state=sdict(tb, yb), reason="v_floor", partial=build(False))
+        if side(y[3]) == 0 and y[2] * (1.0 + float(params.closure(y[0])[0])) - bs.f_zero <= no_root_margin:
+            raise ModelBreakdown(
+                f"model breakdown at t={ode.t:.9g}: F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB "
+                "(within 1e-10): CONSTR has no root left, the peel front would have to stop",
+                t=float(ode.t), state=sdict(ode.t, y), reason="no_root", partial=build(False))
         dense = None
         s_old, s_new = side(y_old[3]), side(y[3])
         if s_old != s_new:

@@ -38,11 +38,12 @@ SAVES = ("steps", "jumps")
 RTOL_RANGE = (1e-14, 1e-2)
 
 #: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
-#: components.  Hybrid: (τ [s], α [rad], ω [rad/s], v [m/s]); regularised:
-#: (α, ω, F [N], v).  The scales are the smallest magnitudes that matter on the
-#: orbits of the paper: α oscillates with amplitude ≥ ~1e-3 rad, v on AB is
-#: ≥ ~1e-3 m/s, segment durations are ≥ ~1e-4 s.
-ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1e-6), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
+#: components.  Hybrid: (τ [s], α [rad], ω [rad/s], ln v [-]); regularised:
+#: (α, ω, F [N], v [m/s]).  The scales are the smallest magnitudes that matter on
+#: the orbits of the paper: α oscillates with amplitude ≥ ~1e-3 rad, segment
+#: durations are ≥ ~1e-4 s; ln v is controlled to ``rtol (1 + |ln v|)``, a
+#: relative accuracy of v at every speed (the regularised v ≥ ~1e-3 m/s on AB).
+ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1.0), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
 
 _COMPILE_TIME = {"hybrid": None}
 
@@ -144,7 +145,7 @@ def compile_kernels() -> float:
     t0 = time.perf_counter()
     p = PeelParams(V=1.0, I=1e-5)
     st = initial_state(p)
-    _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None, 1e-9)
+    _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None, None)
     _COMPILE_TIME["hybrid"] = time.perf_counter() - t0
     return _COMPILE_TIME["hybrid"]
 
@@ -184,7 +185,7 @@ def simulate(
     max_steps: Optional[int] = None,
     max_jumps: int = 20_000_000,
     max_wall: Optional[float] = None,
-    v_floor: float = 1e-9,
+    v_floor: Optional[float] = None,
     progress: Union[None, bool, Callable[[float, float], None]] = None,
 ) -> Trajectory:
     """Integrate the peeling model (FLOW1, FLOW2, flow3, CONSTR) from t = 0 to t_end.
@@ -211,7 +212,7 @@ def simulate(
     rtol, atol : float, float or 4 floats
         Local error control per step: RMS over components of
         ``err_i / (atol_i + rtol |y_i|) <= 1``.  Hybrid components are
-        ``(τ, α, ω, v)`` (τ = time since the last jump), regularised ones are
+        ``(τ, α, ω, ln v)`` (τ = time since the last jump), regularised ones are
         ``(α, ω, F, v)``.  ``rtol`` in ``RTOL_RANGE`` = [1e-14, 1e-2];
         ``atol`` (each component) in ``ATOL_RANGE`` = [1e-100, 1];
         ``atol=None`` uses ``rtol * ATOL_SCALE[method]``.
@@ -242,9 +243,15 @@ def simulate(
         the hybrid kernel and at every step of the regularised scheme);
         exceeding it raises :class:`SolverBudgetExceeded` with
         ``budget="max_wall"``.  None (default): bounded by ``max_steps`` only.
-    v_floor : float
-        On AB, v falling to this value [m/s] means CONSTR is losing its root
-        (``F(1 - cos θ) → f(0+, V)``): :class:`ModelBreakdown`.
+    v_floor : float, optional
+        None (default): the model's criterion.  On AB the level
+        ``G = F(1 - cos θ)`` falling to ``f(0+, V)`` leaves CONSTR without a
+        root (the peel front would have to stop): :class:`ModelBreakdown`
+        with ``reason="no_root"`` once ``G - f(0+) <= 1e-10 max(|f(0+)|, 1 N)``,
+        i.e. v below ``BranchStructure.v_breakdown`` (~1e-67 m/s; the hybrid
+        method integrates ln v, so it follows v that far).  A number [m/s]:
+        stop earlier, at that velocity, with ``reason="v_floor"`` (a
+        threshold of the user's, not of the model).
     progress : bool or callable, optional
         ``True`` prints progress to stderr; a callable receives ``(t, t_end)``
         between chunks of work.
@@ -291,7 +298,7 @@ def simulate(
                              f"[{t_transient:g}, {t_end:g}]")
         if te.size > max_points:
             raise ValueError(f"t_eval has {te.size} points, more than max_points={max_points}")
-    v_floor = positive("v_floor", v_floor)
+    v_floor = optional(positive, "v_floor", v_floor)
     if progress is True:
         progress = _progress_printer(f"simulate V={params.V} I={params.I}")
     elif progress is False:
@@ -317,7 +324,13 @@ def simulate(
     )
 
 
-def _param_vector(params: PeelParams, v_floor: float) -> np.ndarray:
+#: On CD, v above this [m/s] is a runaway of the pull force (ModelBreakdown "v_ceiling").
+V_CEILING = 1e3
+
+
+def _param_vector(params: PeelParams, v_floor: Optional[float] = None) -> np.ndarray:
+    """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
+    criterion, ``BranchStructure.v_breakdown``."""
     bs = branch_structure(params.V)
     b, A = peel_force_coefficients(params.V)
     p = np.zeros(H.N_P)
@@ -329,8 +342,10 @@ def _param_vector(params: PeelParams, v_floor: float) -> np.ndarray:
     p[H.P_VMIN] = bs.v_min if bs.has_folds else 0.0
     p[H.P_VLCD] = bs.v_land_cd if bs.has_folds else 0.0
     p[H.P_VLAB] = bs.v_land_ab if (bs.has_folds and bs.v_land_ab is not None) else -1.0
-    p[H.P_VFLOOR] = v_floor
-    p[H.P_VCEIL] = 1e3
+    p[H.P_UFLOOR] = math.log(bs.v_breakdown if v_floor is None else v_floor)
+    p[H.P_UCEIL] = math.log(V_CEILING)
+    p[H.P_UEV_AB] = math.log(bs.v_max * (1.0 - H.FOLD_REL)) if bs.has_folds else math.inf
+    p[H.P_UEV_CD] = math.log(bs.v_min * (1.0 + H.FOLD_REL)) if bs.has_folds else -math.inf
     return p
 
 
@@ -340,7 +355,7 @@ _PAUSE_STEPS = 250_000  # steps per kernel call between progress/budget checks (
 def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, max_steps, max_jumps, progress, v_floor,
                 max_wall=None):
     p = _param_vector(params, v_floor)
-    st = np.array([s0.t, 0.0, s0.alpha, s0.omega, s0.v, 0.0, BRANCHES.index(s0.branch)], dtype=float)
+    st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
     if te is not None:
         mode, cap = H.SAVE_TEVAL, te.size
@@ -363,7 +378,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         cnt[H.C_NOUT] = 1
 
     def state_dict():
-        a, v = st[H.S_AL], st[H.S_V]
+        a, v = st[H.S_AL], math.exp(st[H.S_U])
         F = float(H.pull_force(a, v, p)) if v > 0 else float("nan")
         return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
                     branch=BRANCHES[int(st[H.S_BR])])
@@ -441,8 +456,11 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             )
         bs = branch_structure(params.V)
         reasons = {
-            H.BREAK_VFLOOR: ("v_floor", f"v fell to v_floor={v_floor} m/s on AB: F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N, "
-                             "CONSTR loses its stable root (the peel front would have to stop)"),
+            H.BREAK_VFLOOR: (
+                ("no_root", f"F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB (within 1e-10, v = "
+                            f"{sd['v']:.3g} m/s): CONSTR has no root left, the peel front would have to stop")
+                if v_floor is None else
+                ("v_floor", f"v fell to v_floor={v_floor} m/s on AB (F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)")),
             H.BREAK_NOLAND: ("no_landing", f"CD fold reached but f_min={bs.f_min} <= f(0+, V)={bs.f_zero:.6g}: "
                              "no AB root to land on"),
             H.BREAK_ALPHA: ("geometry", "1 - cos(theta) reached 0: the peel geometry degenerates (alpha -> -pi/2)"),

@@ -1,22 +1,22 @@
 """Tangent (variational) dynamics of the hybrid solution with saltation matrices at the jumps.
 
-On a branch the hybrid solver integrates the desingularised field ``y' = g(y)``, ``y = (t, α, ω, v)``,
+On a branch the hybrid solver integrates the desingularised field ``y' = g(y)``, ``y = (t, α, ω, u = ln v)``,
 in the parameter s (``exact._hybrid``); g is smooth through the folds.  A tangent vector δy obeys
 ``δy' = Dg(y) δy``, integrated here together with y by the same compiled DOP853 (state + tangent, 8
 components); ``Dg δy`` is a central directional difference of g (two extra field evaluations, relative
 step 1e-7: accurate to ~1e-9 relative, far below the growth being measured).
 
-At the fold (the event ``h(y) = v − v_fold = 0``) the reset sets v to the landing root and keeps
+At the fold (the event ``h(y) = u − ln v_fold = 0``) the reset sets v to the landing root and keeps
 (t, α, ω).  The saltation matrix maps the tangent across it,
 
     δy⁺ = S δy⁻,    S = R + (g⁺ − R g⁻) ∇hᵀ / (∇hᵀ g⁻),    R = diag(1, 1, 1, 0),
 
-i.e. ``δy⁺ = R δy⁻ + (g⁺ − R g⁻) δv⁻ / g_v⁻``: a perturbation that reaches the fold earlier by
-``δv⁻/g_v⁻`` in s has spent that long on the new branch.  (S maps the flow direction onto the flow
-direction, ``S g⁻ = g⁺``: tested.)  At the fold ``g⁻ = (0, 0, 0, v Ġ)`` (dt/ds, dα/ds and dω/ds vanish
+i.e. ``δy⁺ = R δy⁻ + (g⁺ − R g⁻) δu⁻ / g_u⁻``: a perturbation that reaches the fold earlier by
+``δu⁻/g_u⁻`` in s has spent that long on the new branch.  (S maps the flow direction onto the flow
+direction, ``S g⁻ = g⁺``: tested.)  At the fold ``g⁻ = (0, 0, 0, Ġ)`` (dt/ds, dα/ds and dω/ds vanish
 with f'), so ``R g⁻ = 0``.  Perturbations
 are compared at equal t at the measurement points: the (α, ω) part of ``δy − ẏ δt`` with
-``ẏ = (dy/ds)/(dt/ds)``, and the F part from CONSTR, ``δF = (∂F/∂α) δα + (∂F/∂v) δv``.
+``ẏ = (dy/ds)/(dt/ds)``, and the F part from CONSTR, ``δF = (∂F/∂α) δα + (∂F/∂u) δu``.
 
 This module owns only its small driver (integrate to the fold, no output); the step is the package's one
 DOP853 (:mod:`peelapprox._dop853`).
@@ -83,19 +83,19 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(8)
     _rhs_tangent(y, p, f0)
     h = _dop_t.initial_step(y, f0, p, rtol, atol, work)
-    vf = p[H.P_VMAX] * (1.0 - H.FOLD_REL) if br == 0 else p[H.P_VMIN] * (1.0 + H.FOLD_REL)
+    uf = p[H.P_UEV_AB] if br == 0 else p[H.P_UEV_CD]
     for n in range(max_steps):
         status, h, h_next, n_rej, n_rhs = _dop_t.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
         if status == STEP_FAILED:
             return 2, n
-        crossed = (y_new[3] >= vf) if br == 0 else (y_new[3] <= vf)
+        crossed = (y_new[3] >= uf) if br == 0 else (y_new[3] <= uf)
         if crossed:
             _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
-            x = solve_theta(y, Fc, 3, vf, y[3] - vf, 1.0, y_new[3] - vf)
+            x = solve_theta(y, Fc, 3, uf, y[3] - uf, 1.0, y_new[3] - uf)
             interp(y, Fc, x, ye)
             for i in range(8):
                 y[i] = ye[i]
-            y[3] = p[H.P_VMAX] if br == 0 else p[H.P_VMIN]
+            y[3] = np.log(p[H.P_VMAX] if br == 0 else p[H.P_VMIN])
             return 0, n + 1
         for i in range(8):
             y[i] = y_new[i]
@@ -126,9 +126,10 @@ def _equal_time_vector(y, p, scale):
     else:  # exactly at a fold dα/dt and dω/dt stay finite but the quotient is 0/0: use δ at equal s
         da, dw, dv = y[5], y[6], y[7]
     eps = 1e-7
-    Fa = (H.pull_force(y[1] + eps, y[3], p) - H.pull_force(y[1] - eps, y[3], p)) / (2 * eps)
-    Fv = (H.pull_force(y[1], y[3] * (1 + eps), p) - H.pull_force(y[1], y[3] * (1 - eps), p)) / (2 * eps * y[3])
-    return np.array([da, dw, Fa * da + Fv * dv]) / scale
+    v = math.exp(y[3])
+    Fa = (H.pull_force(y[1] + eps, v, p) - H.pull_force(y[1] - eps, v, p)) / (2 * eps)
+    Fu = (H.pull_force(y[1], math.exp(y[3] + eps), p) - H.pull_force(y[1], math.exp(y[3] - eps), p)) / (2 * eps)
+    return np.array([da, dw, Fa * da + Fu * dv]) / scale
 
 
 #: Default step budget of :func:`lyapunov_saltation` per simulated second (measured: ~1.2e6 steps/s at
@@ -158,7 +159,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     t_transient = duration("t_transient", t_transient, zero=True)
     max_steps = optional(integer, "max_steps", max_steps)
     s = simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state
-    p = _param_vector(params, 1e-9)
+    p = _param_vector(params)
     scale = natural_scales(params)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
     # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
@@ -168,10 +169,10 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
         max_steps = min(int(STEPS_PER_SECOND * (T + 1.0)), MAX_COUNT)
 
     def where(t_now):
-        return dict(alpha=float(y[1]), omega=float(y[2]), v=float(y[3]), branch="AB" if br == 0 else "CD",
+        return dict(alpha=float(y[1]), omega=float(y[2]), v=math.exp(y[3]), branch="AB" if br == 0 else "CD",
                     t=t_transient + t_now)
 
-    y = np.array([0.0, s.alpha, s.omega, s.v, 0.0, 0.0, 0.0, 1.0])
+    y = np.array([0.0, s.alpha, s.omega, math.log(s.v), 0.0, 0.0, 0.0, 1.0])
     y[4:] /= np.linalg.norm(_equal_time_vector(y, p, scale))
     t, logs, n_jumps, steps = 0.0, 0.0, 0, 0
     g_minus, g_plus = np.empty(4), np.empty(4)
@@ -195,7 +196,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
         if not v_land > 0.0:
             raise ModelBreakdown(f"no landing root at the fold at t = {t_transient + t:.6g} s",
                                  t=t_transient + t, state=where(t), reason="no_landing")
-        y[0], y[3] = 0.0, v_land
+        y[0], y[3] = 0.0, math.log(v_land)
         H._rhs(y[:4], p, g_plus)
         y[4:] = saltation(y[4:], g_minus, g_plus)
         br = 1 - br

@@ -18,6 +18,7 @@ are generated from the sympy source (:mod:`peelapprox._symbolic`) into
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -135,6 +136,14 @@ class BranchStructure:
     v_land_ab : float or None
         Where a CD→AB jump lands: the AB root of ``f = f_min``; None if
         ``f_min <= f_zero`` (the orbit would have nowhere to land).
+    v_breakdown : float
+        The AB velocity where ``f(v, V) - f(0+, V) = BREAKDOWN_LEVEL``
+        (1e-10 max(|f(0+)|, 1 N)): a level this close to ``f(0+)`` is
+        f(0+) to within the rounding of the solvers' arithmetic, so CONSTR
+        has no resolvable root above it (the model's breakdown criterion,
+        used by ``exact.simulate``).  Since ``f - f(0+) ≈ 110 v^0.15`` at
+        small v, it is ~1e-67 m/s for every V: far below any physical
+        speed, reached only where the level really falls to f(0+).
     """
 
     V: float
@@ -147,6 +156,7 @@ class BranchStructure:
     f_zero: float
     v_land_cd: Optional[float]
     v_land_ab: Optional[float]
+    v_breakdown: float = 0.0
 
     def branch_range(self, branch: str) -> tuple[float, float]:
         """Range ``(v_lo, v_hi)`` of v on a stable branch."""
@@ -196,8 +206,23 @@ def branch_structure(V: float) -> BranchStructure:
     return _branch_structure(_check_V(V))
 
 
+#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times max(|f(0+)|, 1 N)) at which the
+#: model breaks down (BranchStructure.v_breakdown).
+BREAKDOWN_LEVEL = 1e-10
+
+
 @functools.lru_cache(maxsize=512)
 def _branch_structure(V: float) -> BranchStructure:
+    bs = _folds_and_landings(V)
+    b, A = peel_force_coefficients(V)
+    margin = BREAKDOWN_LEVEL * max(abs(bs.f_zero), 1.0)
+    w_hi = math.log(bs.v_max) if bs.has_folds else math.log(_V_HI)
+    g = lambda w: _g.peel_force_fp(math.exp(w), b, A)[0] - bs.f_zero - margin  # noqa: E731
+    v_br = math.exp(brentq(g, -690.0, w_hi, xtol=1e-12, rtol=4 * np.finfo(float).eps))
+    return dataclasses.replace(bs, v_breakdown=v_br)
+
+
+def _folds_and_landings(V: float) -> BranchStructure:
     b, A = peel_force_coefficients(V)
     # f'' < 0 for small v (the -v^-1.85 term) and > 0 for large v (exp term):
     # locate its sign changes on a log grid and require exactly one.

@@ -163,8 +163,8 @@ def test_saltation_maps_the_flow_direction_onto_the_flow_direction():
     j = simulate(p, 0.01, save="jumps").jumps[0]
     pv = _param_vector(p, 1e-9)
     gm, gp = np.empty(4), np.empty(4)
-    H._rhs(np.array([0.0, j.alpha, j.omega, j.v_before]), pv, gm)
-    H._rhs(np.array([0.0, j.alpha, j.omega, j.v_after]), pv, gp)
+    H._rhs(np.array([0.0, j.alpha, j.omega, np.log(j.v_before)]), pv, gm)
+    H._rhs(np.array([0.0, j.alpha, j.omega, np.log(j.v_after)]), pv, gp)
     assert np.allclose(saltation(gm, gm, gp), gp, rtol=1e-12, atol=0)
     dy = np.array([1e-3, 0.2, -3.0, 0.0])
     assert np.array_equal(saltation(dy, gm, gp), dy)

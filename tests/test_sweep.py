@@ -114,19 +114,19 @@ def test_jumps_measure_definitions():
 
 
 def test_breakdown_is_a_result_not_an_error(tmp_path):
-    """Hypothesis: a ModelBreakdown (V=1, I=1e-4: v falls to v_floor on AB) is recorded as
-    ``jumps_status = "breakdown:v_floor"`` (and so the point's status), not as an error, and ``values`` is
+    """Hypothesis: a ModelBreakdown (V=0.5, I=1e-4: F(1 + sin a) falls to f(0+) on AB) is recorded as
+    ``jumps_status = "breakdown:no_root"`` (and so the point's status), not as an error, and ``values`` is
     NaN there only.
 
-    No tolerance: categorical outcome; V=1, I=1e-5 on the same sweep runs normally.
+    No tolerance: categorical outcome; V=0.5, I=1e-5 on the same sweep runs normally.
     """
-    res = sweep([1e-5, 1e-4], [1.0], "jumps", out=tmp_path / "sw", executor="serial", progress=False)
-    bad, good = res.record(1e-4, 1.0), res.record(1e-5, 1.0)
-    assert bad["status"] == bad["jumps_status"] == "breakdown:v_floor" and bad["jumps_t_breakdown"] > 0
+    res = sweep([1e-5, 1e-4], [0.5], "jumps", out=tmp_path / "sw", executor="serial", progress=False)
+    bad, good = res.record(1e-4, 0.5), res.record(1e-5, 0.5)
+    assert bad["status"] == bad["jumps_status"] == "breakdown:no_root" and bad["jumps_t_breakdown"] > 0
     assert good["jumps_status"] == "ok"
     c = res.values("jumps_count")
     assert np.isnan(c[1, 0]) and c[0, 0] == good["jumps_count"]
-    assert list(res.values("jumps_status")[:, 0]) == ["ok", "breakdown:v_floor"]
+    assert list(res.values("jumps_status")[:, 0]) == ["ok", "breakdown:no_root"]
 
 
 def test_kill_and_resume(tmp_path):
@@ -465,19 +465,19 @@ def test_cli_invalid_options_exit_2_and_write_nothing(tmp_path, capsys):
 
 def test_point_status_reflects_its_measures(tmp_path):
     """Hypothesis: a point's status is the first non-ok status among its measures: a ModelBreakdown of every
-    measure (V=1, I=1e-4, v reaches v_floor) is ``status = "breakdown:v_floor"``, not ``"ok"``; a raising
+    measure (V=0.5, I=1e-4, the level reaches f(0+)) is ``status = "breakdown:no_root"``, not ``"ok"``; a raising
     measure outranks a breakdown; a point whose measures all succeed is ``"ok"``.
 
     Reproducer of issue 13 item 7.  No tolerance: categorical outcome.
     """
-    res = sweep([1e-5, 1e-4], [1.0], ("regime", "jumps", "flaky"), out=tmp_path / "sw", executor="serial",
+    res = sweep([1e-5, 1e-4], [0.5], ("regime", "jumps", "flaky"), out=tmp_path / "sw", executor="serial",
                 progress=False, options={"fail_at_V": 2.0})
-    assert res.record(1e-4, 1.0)["status"] == "breakdown:v_floor"
-    assert res.record(1e-5, 1.0)["status"] == "ok"
-    res = sweep([1e-4], [1.0], ("jumps", "flaky"), out=tmp_path / "sw2", executor="serial", progress=False,
-                options={"fail_at_V": 1.0})
-    rec = res.record(1e-4, 1.0)
-    assert rec["status"] == "error: RuntimeError: boom at V=1" and rec["jumps_status"] == "breakdown:v_floor"
+    assert res.record(1e-4, 0.5)["status"] == "breakdown:no_root"
+    assert res.record(1e-5, 0.5)["status"] == "ok"
+    res = sweep([1e-4], [0.5], ("jumps", "flaky"), out=tmp_path / "sw2", executor="serial", progress=False,
+                options={"fail_at_V": 0.5})
+    rec = res.record(1e-4, 0.5)
+    assert rec["status"] == "error: RuntimeError: boom at V=0.5" and rec["jumps_status"] == "breakdown:no_root"
 
 
 def test_retry_failed(tmp_path, monkeypatch):
