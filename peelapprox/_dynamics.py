@@ -28,6 +28,7 @@ from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ._errors import WallBudget
 from ._params import PeelParams
 from ._peelforce import BRANCHES, branch_structure
 from ._sweep import register_measure
@@ -185,23 +186,35 @@ WINDOW_DEFAULTS = dict(t_transient=30.0, window=20.0, rtol=1e-10, alpha0=0.0)
 
 
 def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float = 20.0, rtol: float = 1e-10,
-               alpha0: float = 0.0):
+               alpha0: float = 0.0, max_wall: Optional[float] = None):
     """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
 
-    Signature: ``window_run(params, *, t_transient=30, window=20, rtol=1e-10, alpha0=0) -> Trajectory``.
-    The one windowed run behind :func:`attractors`, the sweep measures ``period`` and ``jumps`` and
-    ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so measures of one
-    sweep point share it.  Raises ``ModelBreakdown`` as :func:`exact.simulate` does.
+    Signature: ``window_run(params, *, t_transient=30, window=20, rtol=1e-10, alpha0=0, max_wall=None)
+    -> Trajectory``.  The one windowed run behind :func:`attractors`, the sweep measures ``period`` and
+    ``jumps`` and ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so
+    measures of one sweep point share it.  Raises ``ModelBreakdown`` and ``SolverBudgetExceeded`` (also
+    for ``max_wall`` seconds of wall time) as :func:`exact.simulate` does.
     """
     return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
-                       duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"))
+                       duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
+                       optional(positive, "max_wall", max_wall))
 
 
 @functools.lru_cache(maxsize=2)
-def _window_run(params, t_transient, window, rtol, alpha0):
+def _window_run(params, t_transient, window, rtol, alpha0, max_wall=None):
     from exact import simulate
 
-    return simulate(params, t_transient + window, alpha0=alpha0, rtol=rtol, t_transient=t_transient, save="jumps")
+    return simulate(params, t_transient + window, alpha0=alpha0, rtol=rtol, t_transient=t_transient, save="jumps",
+                    max_wall=max_wall)
+
+
+def _state_dict(params: PeelParams, t: float, alpha: float, omega: float, F: float, branch: str) -> dict:
+    """A state as the model exceptions carry it (v from CONSTR on ``branch``)."""
+    from ._peelforce import branch_inverse
+
+    G = F * (1.0 + float(params.closure(alpha)[0]))
+    return dict(t=float(t), alpha=float(alpha), omega=float(omega), F=float(F),
+                v=float(branch_inverse(G, params.V, branch)), branch=branch)
 
 
 def classify(trajectory, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
@@ -239,11 +252,13 @@ def attractors(
     period_rtol: float = 1e-6,
     match_rtol: float = 1e-4,
     progress: Optional[Callable[[str], None]] = None,
+    max_wall: Optional[float] = None,
 ) -> List[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
     Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=20, rtol=1e-10,
-    period_rtol=1e-6, match_rtol=1e-4, progress=None) -> list[Attractor]``.
+    period_rtol=1e-6, match_rtol=1e-4, progress=None, max_wall=None) -> list[Attractor]``.  ``max_wall``
+    [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``).
 
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
     (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same attractor when their
@@ -253,7 +268,7 @@ def attractors(
     More than one entry means coexisting attractors — or a transient longer than ``t_transient``: the
     entries' settle times tell which.
     """
-    from exact import ModelBreakdown, initial_state
+    from exact import ModelBreakdown, SolverBudgetExceeded, initial_state
 
     # validate everything up front: inside the loop a ValueError can then only be an infeasible start
     params = _params("params", params)
@@ -263,12 +278,16 @@ def attractors(
     match_rtol = positive("match_rtol", match_rtol)
     alpha0s = [float(a) for a in np.atleast_1d(states_alpha("alpha0s", alpha0s))]
     say = optional(function, "progress", progress) or (lambda msg: None)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     groups: List[dict] = []
     for a0 in alpha0s:
         say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
         try:
-            initial_state(params, alpha0=a0)
-            tr = window_run(params, alpha0=a0, **kw)
+            s0 = initial_state(params, alpha0=a0)
+            tr = window_run(params, alpha0=a0, max_wall=wall.left(0.0, s0.__dict__, kw["t_transient"] + kw["window"]),
+                            **kw)
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
         except (ModelBreakdown, ValueError) as exc:
             groups.append(dict(label=f"{type(exc).__name__}: {str(exc)[:80]}", period=None, signature=(),
                                F_range=(math.nan, math.nan), starts=[a0], settle=[None]))
@@ -436,11 +455,14 @@ def lyapunov(
     d0: float = 1e-7,
     alpha0: float = 0.0,
     rtol: float = 1e-12,
+    max_wall: Optional[float] = None,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the exact (hybrid) peeling dynamics, in bits/s.
 
     Signature: ``lyapunov(params, *, t_transient=30, tau=0.005, n=10000, n_discard=200, d0=1e-7, alpha0=0,
-    rtol=1e-12) -> LyapunovResult`` (50 s measured after 30 s of transient; 3-4 s of wall time).
+    rtol=1e-12, max_wall=None) -> LyapunovResult`` (50 s measured after 30 s of transient; 3-4 s of wall
+    time).  ``max_wall`` [s] bounds the wall time of the whole computation (``SolverBudgetExceeded`` with
+    ``budget="max_wall"``).
 
     Method: :func:`benettin` on the hybrid solver.  The state is ``(α, ω, F, branch)`` — v follows from
     CONSTR — and the distance is measured in the continuous variables scaled by their natural sizes,
@@ -459,9 +481,10 @@ def lyapunov(
     The running estimate and ``stderr_bits`` show the convergence.  Cross-checks: :func:`lyapunov_tangent`
     (variational equations with saltation matrices at the jumps) and :func:`lyapunov_return_map`.
     """
-    from exact import initial_state, simulate
+    from exact import SolverBudgetExceeded, initial_state, simulate
 
     params = _params("params", params)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     tau = duration("tau", tau)
     d0 = positive("d0", d0, hi=1.0)
     t_transient = duration("t_transient", t_transient, zero=True)
@@ -471,10 +494,15 @@ def lyapunov(
     bs = branch_structure(params.V)
     scale = natural_scales(params)
     jumps = [0]
+    t_total = t_transient + (n + n_discard) * tau
 
     def run(state, dt):
         a, w, F, br = state
-        tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps")
+        try:
+            tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps",
+                          max_wall=wall.left(0.0, _state_dict(params, 0.0, a, w, F, br), t_total))
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
         s = tr.final_state
         return (s.alpha, s.omega, s.F, s.branch), len(tr.jumps)
 

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import time
 from typing import Any, Optional
 
-__all__ = ["ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "KernelCacheWarning"]
+__all__ = ["ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "KernelCacheWarning", "WallBudget", "budget_exceeded"]
 
 
 class ModelBreakdown(RuntimeError):
@@ -61,6 +62,35 @@ def budget_exceeded(name: str, limit: float, t_end: float, state: dict, partial:
         f"more than {what} before t_end={t_end} (stopped at t={state['t']:.6g}){hints.get(name, '')}",
         budget=name, limit=limit, t=state["t"], state=state, partial=partial,
     )
+
+
+class WallBudget:
+    """The wall-clock budget ``max_wall`` [s] of one public call made of many solver runs (None: unbounded).
+
+    ``left(t, state, t_end)`` is the time left for the next run, to pass on as its ``max_wall``; it raises
+    :class:`SolverBudgetExceeded` (``budget="max_wall"``, with the caller's ``t`` and ``state``) once the
+    budget is spent.  ``reraise(exc)`` turns an inner run's ``max_wall`` exception into one naming this
+    budget.
+    """
+
+    def __init__(self, max_wall: Optional[float]):
+        self.limit = max_wall
+        self.t0 = time.perf_counter()
+
+    def left(self, t: float, state: dict, t_end: float) -> Optional[float]:
+        if self.limit is None:
+            return None
+        rest = self.limit - (time.perf_counter() - self.t0)
+        if rest <= 0.0:
+            raise budget_exceeded("max_wall", self.limit, t_end, state, None)
+        return rest
+
+    def reraise(self, exc: "SolverBudgetExceeded") -> "SolverBudgetExceeded":
+        if exc.budget != "max_wall" or self.limit is None:
+            return exc
+        return SolverBudgetExceeded(f"more than {self.limit:g} s of wall time (max_wall) at t={exc.t:.6g}; pass a "
+                                    "larger max_wall, or None", budget="max_wall", limit=self.limit, t=exc.t,
+                                    state=exc.state, partial=exc.partial)
 
 
 class SolverFailure(RuntimeError):

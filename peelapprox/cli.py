@@ -395,7 +395,8 @@ def _dynamics(args: argparse.Namespace) -> int:
     try:
         # one run from t = 0: the window's jumps for the return map and force drops, all of them for the
         # settle time
-        full = simulate(p, args.t_transient + args.window, alpha0=args.alpha0, rtol=args.rtol, save="jumps")
+        full = simulate(p, args.t_transient + args.window, alpha0=args.alpha0, rtol=args.rtol, save="jumps",
+                        max_wall=args.max_wall)
         t_k, x_all = return_map(full, with_times=True)
         in_window = t_k >= args.t_transient
         x = x_all[in_window]
@@ -422,7 +423,7 @@ def _dynamics(args: argparse.Namespace) -> int:
     _print_mapping(row, args.format)
     if args.attractors:
         a0s = args.attractors
-        res = attractors(p, a0s, t_transient=args.t_transient, window=args.window,
+        res = attractors(p, a0s, t_transient=args.t_transient, window=args.window, max_wall=args.max_wall,
                          progress=lambda msg: print(msg, file=sys.stderr, flush=True))
         rows = [dict(attractor=a.label, starts=" ".join(f"{s:g}" for s in a.starts), F_min=a.F_range[0],
                      F_max=a.F_range[1]) for a in res]
@@ -449,7 +450,7 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
     T, common = args.lyapunov_time, dict(t_transient=args.t_transient, alpha0=args.alpha0)
     if method == "two-trajectory":
         tau = 0.005
-        return D.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), **common)
+        return D.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), max_wall=args.max_wall, **common)
     if method == "saltation":
         return D.lyapunov_tangent(p, T=T, **common)
     if method == "return-map":  # alpha0 = 0: checked by the subcommand before the run
@@ -620,6 +621,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="sample these initial peel angles for coexisting attractors")
     dy.add_argument("--format", choices=("table", "json"), default="table")
     dy.add_argument("--out", help="also write the summary row to this .csv or .json")
+    dy.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
+                    help="wall-clock budget of each computation (run, two-trajectory λ, attractors) [s] (600)")
     dy.set_defaults(func=_dynamics)
     return ap
 

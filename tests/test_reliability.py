@@ -112,3 +112,21 @@ def test_default_step_budget_scales_with_horizon():
         simulate(PeelParams(V=100, I=1e-12), 0.5, save="jumps")
     assert ei.value.budget == "max_steps" and ei.value.limit == 1_000_000
     assert ei.value.partial.stats.n_steps == 1_000_000
+
+
+@pytest.mark.parametrize("fn, kw", [
+    ("lyapunov", dict(t_transient=1.0, max_wall=0.3)),
+    ("attractors", dict(t_transient=1e5, max_wall=0.5)),
+], ids=["lyapunov", "attractors"])
+def test_dynamics_max_wall(fn, kw):
+    """Issue 13 item 5: lyapunov and attractors are made of many solver runs (lyapunov: 2 per 5 ms interval,
+    20,000 by default), so a per-run budget does not bound the call.  Hypothesis: ``max_wall`` bounds the
+    whole call: SolverBudgetExceeded(budget="max_wall", limit=max_wall) with a finite state (v > 0) from the
+    orbit.  Categorical outcome; no wall time asserted (benchmarks measure time)."""
+    import peelapprox._dynamics as D
+
+    with pytest.raises(SolverBudgetExceeded) as ei:
+        getattr(D, fn)(PeelParams(V=2.0, I=1e-4), **kw)
+    e = ei.value
+    assert e.budget == "max_wall" and e.limit == kw["max_wall"]
+    assert all(math.isfinite(e.state[k]) for k in ("t", "alpha", "omega", "F", "v")) and e.state["v"] > 0
