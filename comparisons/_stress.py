@@ -16,8 +16,8 @@ Outcome classes (``record["outcome"]``)
 ``ok``
     Reached ``t_end``.
 ``breakdown:<reason>``
-    :class:`~exact.ModelBreakdown` with ``reason`` (``v_floor``,
-    ``no_landing``, ``geometry``, ``v_ceiling``, ``nonfinite``, ...).
+    :class:`~exact.ModelBreakdown` with ``reason`` (``no_root``,
+    ``no_landing``, ``geometry``, ``v_ceiling``, ...).
 ``budget:<which>``
     :class:`~exact.SolverBudgetExceeded` for ``max_steps``, ``max_jumps`` or
     ``max_points``.
@@ -827,19 +827,21 @@ EXPLANATIONS: dict[str, str] = {
         "No consistent start: with the default F0 = 1.01 f(V, V) the level F0 (1 - cos θ) = F0 (1 + sin α0) lies "
         "below f(0+, V) = 130 - 2 V^1.5 (α0 = -1 gives 1 + sin α0 = 0.16), so CONSTR has no root; initial_state "
         "raises ValueError naming F0's valid range."),
-    "breakdown:v_floor": (
-        "On AB the pull side F (1 - cos θ) falls to f(0+, V), so v → 0: the peel front would have to stop, a regime "
-        "the model does not contain.  Seen (i) at small I with α0 = 1, where FLOW2's angular acceleration "
+    "breakdown:no_root": (
+        "On AB the pull side F (1 - cos θ) falls to f(0+, V) (within 1e-10, the model's criterion; v is followed "
+        "in ln v down to ~1e-67 m/s), so the peel front would have to stop, a regime the model does not contain.  "
+        "Seen (i) at small I with α0 = 1, where FLOW2's angular acceleration "
         "-F R c(α)/I swings α from 1 to ≈ -0.59 within ~0.5 ms and 1 + sin α collapses; (ii) at small V "
         "(0.2-0.5), where the CD→AB jump lands at v = 2e-9 (V=0.2) to 8e-5 m/s (V=0.5), barely above 0; "
         "(iii) for soft tapes (k = 100) after a few s of growing oscillation; (iv) for starts whose level is "
-        "barely above f(0+, V) (α0 = -0.5 at V = 0.05)."),
+        "barely above f(0+, V) (α0 = -0.5 at V = 0.05); (v) at loose tolerances (atol up to 1), on the "
+        "inaccurate orbits such tolerances give."),
+    "breakdown:v_floor": "v fell to a v_floor the caller passed (not used by the suite).",
     "breakdown:no_landing": (
         "V below ≈ 0.163, where f_min <= f(0+, V): at the CD fold there is no AB root to jump to (the peel "
         "front would have to stop)."),
     "breakdown:geometry": "1 - cos θ reached 0 (α → -π/2): the peel geometry degenerates.",
     "breakdown:v_ceiling": "v exceeded 1000 m/s on CD: the pull force runs away.",
-    "breakdown:nonfinite": "The integrated state became non-finite (guarded in the kernel; would hint at a bug).",
     "budget:max_steps": "The step budget was used up (budget probes: deliberately tiny budgets).",
     "budget:max_jumps": "The jump budget was used up (budget probes: deliberately tiny budgets).",
     "budget:max_points": "The stored-point budget was used up (budget probes: deliberately tiny budgets).",
@@ -873,8 +875,8 @@ def _example(r: dict) -> str:
     return s
 
 
-_ABBR = {"ok": "ok", "invalid_initial_state": "inv", "breakdown:v_floor": "vf", "breakdown:no_landing": "nl",
-         "breakdown:geometry": "geo", "breakdown:v_ceiling": "vc", "breakdown:nonfinite": "nf",
+_ABBR = {"ok": "ok", "invalid_initial_state": "inv", "breakdown:no_root": "nr", "breakdown:v_floor": "vf",
+         "breakdown:no_landing": "nl", "breakdown:geometry": "geo", "breakdown:v_ceiling": "vc",
          "solver_failure": "sf", "nan": "NAN", "timeout": "TIMEOUT", "crash": "CRASH"}
 
 
@@ -964,7 +966,7 @@ def robustness_markdown(records: Sequence[dict], *, command: Optional[str] = Non
         L += _count_table(g, "outcome (grid)") + [""]
         L += ["Outcomes by I (rows) × V (columns), each cell over k × α0 "
               f"({len(ks) * len(a0s)} runs).  Abbreviations: ok, inv = invalid_initial_state, "
-              "vf = breakdown:v_floor, nl = breakdown:no_landing, geo = breakdown:geometry, "
+              "nr = breakdown:no_root, nl = breakdown:no_landing, geo = breakdown:geometry, "
               "vc = breakdown:v_ceiling, sf = solver_failure.", ""]
         L += ["| I \\ V | " + " | ".join(f"{v:g}" for v in Vs) + " |", "|---|" + "---|" * len(Vs)]
         for I in Is:
