@@ -137,12 +137,15 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         if not np.all(np.isfinite(y)):  # a numerical failure, reported at the last finite state
             raise SolverFailure(f"regularized {solver}: the state became non-finite after t={t_old:.9g}",
                                 t=float(t_old), state=sdict(t_old, y_old), partial=build(False))
+        if not y[3] > 0.0:  # the scheme left the model's domain (f is defined for v > 0): numerical, not physical
+            raise SolverFailure(f"regularized {solver}: v = {y[3]:.3g} <= 0 after t={t_old:.9g} (the regularised "
+                                "scheme left the model's domain; tighten rtol)", t=float(t_old),
+                                state=sdict(t_old, y_old), partial=build(False))
         if v_floor is not None and y[3] <= v_floor:
-            tb, yb = (ode.t, y) if y[3] > 0 else (t_old, y_old)  # never report v <= 0
             raise ModelBreakdown(
-                f"model breakdown at t={tb:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
+                f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
                 f"(F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)",
-                t=float(tb), state=sdict(tb, yb), reason="v_floor", partial=build(False))
+                t=float(ode.t), state=sdict(ode.t, y), reason="v_floor", partial=build(False))
         if side(y[3]) == 0 and y[2] * (1.0 + float(params.closure(y[0])[0])) - bs.f_zero <= no_root_margin:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB "
