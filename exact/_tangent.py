@@ -150,7 +150,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     fold with no landing root :class:`peelapprox.ModelBreakdown`, each with the time and state.
     """
     from peelapprox import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-    from exact import simulate
+    from exact import initial_state, simulate
     from peelapprox._dynamics import natural_scales
 
     from ._simulate import ATOL_SCALE, _param_vector
@@ -158,7 +158,9 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     max_steps = optional(integer, "max_steps", max_steps)
-    s = simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state
+    # no transient: the initial state itself (simulate needs t_end > 0)
+    s = (simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state if t_transient > 0
+         else initial_state(params, alpha0=alpha0))
     p = _param_vector(params)
     scale = natural_scales(params)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries

@@ -54,6 +54,10 @@ __all__ = [
 _AB = BRANCHES.index("AB")
 #: Valid ``rtol`` of the exact runs behind the dynamics functions (exact.simulate's range).
 RTOL_RANGE = (1e-14, 1e-2)
+#: Valid initial perturbation ``d0`` of :func:`lyapunov` (scaled units): below 1e-12 the perturbation of F,
+#: ``d0 f_max``, nears the rounding of F itself (``2e-16 F``) and the two orbits can start at distance 0;
+#: above 1 it is not a perturbation.
+D0_RANGE = (1e-12, 1.0)
 
 
 def _rtol(name: str, x) -> float:
@@ -87,7 +91,8 @@ class Periodicity:
     ``max_period`` repeats; ``period`` None) or ``"too short"`` (fewer than
     ``(min_repeats + 1) · max_period`` returns were given — 96 with the defaults — so not every n could be
     tried, *and* no shorter period repeated).  ``mismatch`` = ``max_k |x_{k+n} − x_k| / max|x|`` for
-    the period found, or the smallest over all n tried; ``n_returns`` = ``len(x)``.
+    the period found, or the smallest over all n tried (``inf`` when too few returns to try any n; NaN only
+    for "no stick-slip" from :func:`classify`); ``n_returns`` = ``len(x)``.
     """
 
     kind: str
@@ -131,11 +136,14 @@ def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int
     if x.ndim != 1 or x.size < 2:
         raise ValueError(f"x must be a 1-D finite sequence of at least 2 returns, got shape {x.shape}")
     scale = float(np.max(np.abs(x)))
+    # differences of x / max|x| (in [-1, 1]): no overflow for |x| near the float maximum, and all-zero
+    # returns (scale 0) are the constant sequence, mismatch 0
+    xs = x / scale if scale > 0 else x
     best = math.inf
     for n in range(1, int(max_period) + 1):
         if x.size - n < int(min_repeats) * n:
             break
-        mis = float(np.max(np.abs(x[n:] - x[:-n]))) / scale
+        mis = float(np.max(np.abs(xs[n:] - xs[:-n])))
         if mis <= rtol:
             return Periodicity("periodic", n, mis, x.size, rtol)
         best = min(best, mis)
@@ -476,7 +484,7 @@ def lyapunov(
     perturbations every ``tau``, and the jumps amplify them.  Unless ``d0/rtol >= 1e5`` this noise inflates
     the exponent: at V = 2, I = 1e-4 we measured 9.5-13.5 bits/s with d0/rtol = 10-100, and 4.06-4.15 bits/s
     for every d0/rtol >= 1e5 (d0 from 1e-8 to 1e-6, rtol 1e-12 or 1e-13, tau = 0.005; docs/dynamics.md).
-    Hence the defaults d0 = 1e-7, rtol = 1e-12.
+    Hence the defaults d0 = 1e-7, rtol = 1e-12.  ``d0`` must lie in :data:`D0_RANGE` = [1e-12, 1].
 
     The running estimate and ``stderr_bits`` show the convergence.  Cross-checks: :func:`lyapunov_tangent`
     (variational equations with saltation matrices at the jumps) and :func:`lyapunov_return_map`.
@@ -486,7 +494,7 @@ def lyapunov(
     params = _params("params", params)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
     tau = duration("tau", tau)
-    d0 = positive("d0", d0, hi=1.0)
+    d0 = in_range("d0", d0, *D0_RANGE)
     t_transient = duration("t_transient", t_transient, zero=True)
     n, n_discard = integer("n", n, lo=2), integer("n_discard", n_discard, lo=0)
     alpha0 = state("alpha0", alpha0, "alpha")

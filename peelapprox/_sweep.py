@@ -86,7 +86,7 @@ from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
-from ._params import PeelParams
+from ._params import PARAM_RANGES, PeelParams
 from ._sweep_store import (
     FORMAT,
     RESERVED,
@@ -106,6 +106,8 @@ from ._sweep_store import (
     write_record,
 )
 from ._sweep_store import lock as _lock
+from ._validate import ArgumentTypeError
+from ._validate import path as _path
 
 __all__ = [
     "MEASURES",
@@ -543,7 +545,7 @@ def load_sweep(out) -> SweepResult:
         No manifest, a file that is a symbolic link, or a malformed manifest
         or record (the message names the file and line).
     """
-    out = os.fspath(out)
+    out = _path("out", out)
     m = read_manifest(out)
     recs, _, _ = read_records(out)
     return SweepResult(m["I_values"], m["V_values"], m["measures"], m["options"], recs, manifest=m, out=out)
@@ -684,10 +686,12 @@ def sweep(
     ``retry_failed=True``.  Nothing is written before every argument and
     option has been checked.
     """
-    I_vals = check_axis("I_values", I_values)
-    V_vals = check_axis("V_values", V_values)
+    I_vals = check_axis("I_values", I_values, *PARAM_RANGES["I"])
+    V_vals = check_axis("V_values", V_values, *PARAM_RANGES["V"])
     if isinstance(measures, str):
         measures = [m.strip() for m in measures.split(",") if m.strip()]
+    if not isinstance(measures, (list, tuple)) or not all(isinstance(m, str) for m in measures):
+        raise ArgumentTypeError(f"measures must be a str or a sequence of str (names in MEASURES), got {measures!r}")
     measures = list(measures)
     if not measures:
         raise ValueError(f"measures must name at least one measure; known: {sorted(MEASURES)}")
@@ -695,7 +699,7 @@ def sweep(
         raise ValueError(f"measures must not repeat a name, got {measures}")
     unknown = [m for m in measures if m not in MEASURES]
     if unknown:
-        raise ValueError(f"unknown measure(s) {unknown}; known: {sorted(MEASURES)}")
+        raise ValueError(f"measures: unknown measure(s) {unknown}; known: {sorted(MEASURES)}")
     options = {} if options is None else options
     if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
         raise ValueError(f"options must be a mapping with str keys, got {options!r}")
@@ -712,7 +716,8 @@ def sweep(
         if executor is not None:
             raise ValueError("max_workers applies only to the local process pool (executor=None); "
                              "size your executor instead")
-    if executor is not None and executor != "serial" and not callable(getattr(executor, "submit", None)):
+    if executor is not None and not (isinstance(executor, str) and executor == "serial") \
+            and not callable(getattr(executor, "submit", None)):
         raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
     if not (isinstance(progress, bool) or progress is None or callable(progress)):
         raise ValueError("progress must be a bool, None or a callable (done, total, record)")
@@ -724,7 +729,7 @@ def sweep(
     refs = {name: _ref(MEASURES[name]) for name in measures}
     task_refs = refs if executor == "serial" else _worker_refs(measures)
 
-    out = os.fspath(out)
+    out = _path("out", out)
     if os.path.exists(out) and not os.path.isdir(out):
         raise ValueError(f"out={out!r} exists and is not a directory")
     try:

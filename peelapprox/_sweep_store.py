@@ -17,7 +17,7 @@ import sys
 import warnings
 from typing import IO, Any, Iterable, Optional, Sequence
 
-import numpy as np
+from ._validate import reals
 
 __all__ = [
     "MANIFEST", "RESULTS", "LOCK", "FORMAT", "RESERVED", "TEMPORARY", "GRID_RTOL",
@@ -141,18 +141,14 @@ def lock(out: str) -> IO:
 
 # --------------------------------------------------------------------------------------------- the grid
 
-def check_axis(name: str, values) -> list[float]:
-    """A grid axis as a list of floats: non-empty, finite, in (0, inf), no repeats; else ValueError naming it."""
-    try:
-        arr = np.asarray(values, dtype=float).ravel()
-    except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{name} must be a non-empty sequence of finite values in (0, inf), got {values!r}") \
-            from None
-    if arr.size == 0:
-        raise ValueError(f"{name} must be a non-empty sequence of finite values in (0, inf), got an empty grid")
-    bad = arr[~(np.isfinite(arr) & (arr > 0))]
-    if bad.size:
-        raise ValueError(f"{name} must hold finite values in (0, inf), got {bad.tolist()}")
+def check_axis(name: str, values, lo: float = 0.0, hi: float = math.inf) -> list[float]:
+    """A grid axis as a list of floats: non-empty, finite, in ``(lo, hi]`` (``(0, inf)`` by default), no repeats.
+
+    Raises ArgumentTypeError (a TypeError and ValueError) for values that are not real numbers (None,
+    strings, bools), ValueError naming ``name`` otherwise (:func:`peelapprox._validate.reals`).
+    """
+    lo_open = lo == 0.0
+    arr = reals(name, values, lo, hi, lo_open=lo_open).ravel()
     vals = [float(x) for x in arr]
     if len(set(vals)) != len(vals):
         dup = sorted({x for x in vals if vals.count(x) > 1})

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from typing import Any, Callable, Optional, Sequence, TypeVar
 
 import numpy as np
@@ -57,6 +58,7 @@ __all__ = [
     "state",
     "states",
     "duration",
+    "path",
 ]
 
 T = TypeVar("T")
@@ -326,3 +328,19 @@ def duration(name: str, x: Any, *, zero: bool = False) -> float:
     from ._params import TIME_MAX
 
     return in_range(name, x, 0.0, TIME_MAX, lo_open=not zero)
+
+
+def path(name: str, x: Any) -> str:
+    """x as a ``str`` file-system path if it is a ``str`` or an ``os.PathLike`` giving one, else ArgumentTypeError.
+
+    Bytes paths are refused (the package joins paths with ``str`` file names), and so (ValueError) is a
+    NUL character, which no file name can hold; whether the path exists or can be written is for the caller
+    to check.
+    """
+    if isinstance(x, (str, os.PathLike)):
+        p = os.fspath(x)
+        if isinstance(p, str):
+            if "\0" in p:
+                raise ValueError(f"{name} must be a path without NUL characters, got {_got(p)}")
+            return p
+    raise ArgumentTypeError(f"{name} must be a path (str or os.PathLike), got {_got(x)}")

@@ -391,6 +391,10 @@ def _dynamics(args: argparse.Namespace) -> int:
     if args.lyapunov_method == "return-map" and args.alpha0 != 0.0:
         raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    if args.attractors:  # checked before the run, named as the user wrote it
+        from ._dynamics import states_alpha
+
+        states_alpha("--attractors", args.attractors)
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
     try:
         # one run from t = 0: the window's jumps for the return map and force drops, all of them for the

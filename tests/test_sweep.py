@@ -255,9 +255,9 @@ def test_resume_tolerates_rebuilt_grid_roundoff(tmp_path):
 def test_validation_messages(tmp_path):
     """Hypothesis: bad arguments raise ValueError naming the argument and its valid range (or the known measures)."""
     out = tmp_path / "sw"
-    with pytest.raises(ValueError, match=r"I_values .*empty grid"):
+    with pytest.raises(ValueError, match=r"I_values .*empty array"):
         sweep([], V2, out=out)
-    with pytest.raises(ValueError, match=r"V_values must hold finite values in \(0, inf\)"):
+    with pytest.raises(ValueError, match=r"V_values must be finite and in \[1e-6, 100\] \(every element\), got -2.0"):
         sweep(I2, [1.0, -2.0], out=out)
     with pytest.raises(ValueError, match="duplicates"):
         sweep(I2, [1.0, 1.0], out=out)
