@@ -32,7 +32,7 @@ from peelapprox._jit import kernel
 
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import interp, make_dop853, solve_theta, workspace
-from peelapprox._validate import MAX_COUNT, duration, integer, optional
+from peelapprox._validate import duration, integer, optional
 
 from . import _hybrid as H
 
@@ -135,6 +135,9 @@ def _equal_time_vector(y, p, scale):
 #: Default step budget of :func:`lyapunov_saltation` per simulated second (measured: ~1.2e6 steps/s at
 #: V = 2, I = 1e-4, rtol 1e-10).
 STEPS_PER_SECOND = 5_000_000
+#: Cap of that default: 1e9 steps, ~35 min of work at ~2 us per (state + tangent) step, so that a default call
+#: is bounded in wall time whatever T (the driver is one compiled loop and cannot watch a clock).
+MAX_DEFAULT_STEPS = 1_000_000_000
 
 
 def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rtol: float = 1e-10,
@@ -145,7 +148,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     ``T`` seconds, renormalising it after every jump, where its equal-time (α, ω, F) size is measured.
     Returns ``(exponent_per_s, n_jumps, time, steps)``.  ``T`` must lie in (0, 1e6] s and ``t_transient`` in
     [0, 1e6] s.  ``max_steps`` (an integer in [1, 1e15]; default ``STEPS_PER_SECOND * (T + 1)``, at most
-    1e15 so that it fits the compiled driver's int64) bounds the accepted steps; exceeding it raises
+    ``MAX_DEFAULT_STEPS`` = 1e9, ~35 min) bounds the accepted steps; exceeding it raises
     :class:`peelapprox.SolverBudgetExceeded`, a step-size failure :class:`peelapprox.SolverFailure` and a
     fold with no landing root :class:`peelapprox.ModelBreakdown`, each with the time and state.
     """
@@ -168,7 +171,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])
     br = 0 if s.branch == "AB" else 1
     if max_steps is None:
-        max_steps = min(int(STEPS_PER_SECOND * (T + 1.0)), MAX_COUNT)
+        max_steps = min(int(STEPS_PER_SECOND * (T + 1.0)), MAX_DEFAULT_STEPS)
 
     def where(t_now):
         return dict(alpha=float(y[1]), omega=float(y[2]), v=math.exp(y[3]), branch="AB" if br == 0 else "CD",

@@ -35,7 +35,12 @@ from ._sweep import register_measure
 from ._validate import ArgumentTypeError, duration, finite, function, in_range, integer, nonnegative, optional, positive, reals, state
 from ._validate import params as _params
 
+#: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
+#: attractors): their work grows with counts (n, n_returns, starts) that no step budget bounds.
+DEFAULT_MAX_WALL = 3600.0
+
 __all__ = [
+    "DEFAULT_MAX_WALL",
     "return_map",
     "Periodicity",
     "periodicity",
@@ -260,13 +265,14 @@ def attractors(
     period_rtol: float = 1e-6,
     match_rtol: float = 1e-4,
     progress: Optional[Callable[[str], None]] = None,
-    max_wall: Optional[float] = None,
+    max_wall: Optional[float] = DEFAULT_MAX_WALL,
 ) -> List[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
     Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=20, rtol=1e-10,
-    period_rtol=1e-6, match_rtol=1e-4, progress=None, max_wall=None) -> list[Attractor]``.  ``max_wall``
-    [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``).
+    period_rtol=1e-6, match_rtol=1e-4, progress=None, max_wall=3600) -> list[Attractor]``.  ``max_wall``
+    [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``;
+    None: unbounded).
 
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
     (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same attractor when their
@@ -463,14 +469,14 @@ def lyapunov(
     d0: float = 1e-7,
     alpha0: float = 0.0,
     rtol: float = 1e-12,
-    max_wall: Optional[float] = None,
+    max_wall: Optional[float] = DEFAULT_MAX_WALL,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the exact (hybrid) peeling dynamics, in bits/s.
 
     Signature: ``lyapunov(params, *, t_transient=30, tau=0.005, n=10000, n_discard=200, d0=1e-7, alpha0=0,
-    rtol=1e-12, max_wall=None) -> LyapunovResult`` (50 s measured after 30 s of transient; 3-4 s of wall
+    rtol=1e-12, max_wall=3600) -> LyapunovResult`` (50 s measured after 30 s of transient; 3-4 s of wall
     time).  ``max_wall`` [s] bounds the wall time of the whole computation (``SolverBudgetExceeded`` with
-    ``budget="max_wall"``).
+    ``budget="max_wall"``; None: unbounded).
 
     Method: :func:`benettin` on the hybrid solver.  The state is ``(α, ω, F, branch)`` — v follows from
     CONSTR — and the distance is measured in the continuous variables scaled by their natural sizes,
@@ -607,11 +613,13 @@ def lyapunov_return_map(
     n_returns: int = 5000,
     h: float = 1e-6,
     rtol: float = 1e-12,
+    max_wall: Optional[float] = DEFAULT_MAX_WALL,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent map of the jump-to-jump (Poincaré) map, in bits/s.
 
-    Signature: ``lyapunov_return_map(params, *, t_transient=30, n_returns=5000, h=1e-6, rtol=1e-12)
-    -> LyapunovResult``.
+    Signature: ``lyapunov_return_map(params, *, t_transient=30, n_returns=5000, h=1e-6, rtol=1e-12,
+    max_wall=3600) -> LyapunovResult``.  ``max_wall`` [s] bounds the whole computation
+    (``SolverBudgetExceeded``, ``budget="max_wall"``; None: unbounded).
 
     The section is the AB→CD jump; the return map P takes the state (α, ω, F) just after one such jump to
     the state at the next.  A tangent vector w is pushed through P's Jacobian by central differences,
@@ -623,25 +631,33 @@ def lyapunov_return_map(
     exponent, not the flow's 0.  A cross-check of :func:`lyapunov`, not a replacement: it needs a return
     map with at least two returns per second of the run.
     """
-    from exact import simulate
+    from exact import SolverBudgetExceeded, simulate
 
     params = _params("params", params)
     h = positive("h", h, hi=1.0)
     rtol = _rtol("rtol", rtol)
     t_transient = duration("t_transient", t_transient, zero=True)
     n_returns = integer("n_returns", n_returns, lo=2)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     scale = natural_scales(params)
 
     def ret(x, horizon):
-        J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol,
-                     save="jumps").jumps
+        try:
+            J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol, save="jumps",
+                         max_wall=wall.left(0.0, _state_dict(params, 0.0, x[0], x[1], x[2], "CD"), horizon)).jumps
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
         ab = np.flatnonzero(np.asarray(J.from_branch) == _AB)
         if ab.size == 0:
             return None, None
         i = ab[0]
         return np.array([J.alpha[i], J.omega[i], J.F[i]]), float(J.t[i])
 
-    J0 = window_run(params, t_transient=0.0, window=max(float(t_transient), 1e-3), rtol=rtol).jumps
+    try:
+        J0 = window_run(params, t_transient=0.0, window=max(float(t_transient), 1e-3), rtol=rtol,
+                        max_wall=wall.limit).jumps
+    except SolverBudgetExceeded as exc:
+        raise wall.reraise(exc) from None
     ab = np.flatnonzero(np.asarray(J0.from_branch) == _AB)
     if ab.size == 0:
         raise ValueError(f"no AB→CD jump within t_transient = {t_transient} s: no return map to linearise")

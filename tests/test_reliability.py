@@ -130,3 +130,30 @@ def test_dynamics_max_wall(fn, kw):
     e = ei.value
     assert e.budget == "max_wall" and e.limit == kw["max_wall"]
     assert all(math.isfinite(e.state[k]) for k in ("t", "alpha", "omega", "F", "v")) and e.state["v"] > 0
+
+
+def test_composite_calls_have_a_default_wall_budget():
+    """Issue 13 item 5: lyapunov(n=1e15) or lyapunov_return_map(n_returns=1e15) are valid counts that no step
+    budget bounds.  Hypothesis: their default max_wall (DEFAULT_MAX_WALL = 3600 s) and the saltation
+    tangent's default step cap (1e9) state a bound for every default call.  Exact: defaults read from the
+    signatures."""
+    import inspect
+
+    import peelapprox._dynamics as D
+    from exact._tangent import MAX_DEFAULT_STEPS
+
+    for fn in (D.lyapunov, D.lyapunov_return_map, D.attractors):
+        assert inspect.signature(fn).parameters["max_wall"].default == D.DEFAULT_MAX_WALL == 3600.0
+    assert MAX_DEFAULT_STEPS == 10**9
+
+
+def test_return_map_lyapunov_max_wall():
+    """lyapunov_return_map shares one wall budget across its runs: with max_wall = 0.3 s and 10^6 returns it
+    raises SolverBudgetExceeded(budget="max_wall") with a finite state (categorical; no time asserted)."""
+    import peelapprox._dynamics as D
+
+    with pytest.raises(SolverBudgetExceeded) as ei:
+        D.lyapunov_return_map(PeelParams(V=2.0, I=1e-4), t_transient=0.5, n_returns=10**6, max_wall=0.3)
+    e = ei.value
+    assert e.budget == "max_wall" and e.limit == 0.3 and e.state["v"] > 0
+    assert all(math.isfinite(e.state[k]) for k in ("t", "alpha", "omega", "F", "v"))
