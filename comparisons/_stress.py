@@ -58,7 +58,8 @@ import numpy as np
 
 from peelapprox import GEOMETRIES
 from peelapprox._io import write_rows
-from peelapprox._validate import finite, nonnegative, positive
+from peelapprox._params import RTOL_RANGE
+from peelapprox._validate import finite, in_range, nonnegative, positive
 
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
@@ -202,10 +203,7 @@ class StressPoint:
         for name in ("V", "I", "k", "t_end"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "alpha0", finite("alpha0", self.alpha0))
-        rt = positive("rtol", self.rtol)
-        if not (1e-14 <= rt <= 1e-2):
-            raise ValueError(f"rtol must be in [1e-14, 1e-2], got {self.rtol!r}")
-        object.__setattr__(self, "rtol", rt)
+        object.__setattr__(self, "rtol", in_range("rtol", self.rtol, *RTOL_RANGE))
         if self.atol is not None:
             object.__setattr__(self, "atol", nonnegative("atol", self.atol))
         if self.method not in _METHODS:

@@ -362,7 +362,9 @@ def run(
                 _save(st, y, h)
                 return STEP_FAIL
             continue
-        n_bad = 0
+        if n_bad > 0:  # the step after a dense-output rejection does not grow (as after an error rejection)
+            h_next = min(h_next, h)
+            n_bad = 0
         cnt[C_STEPS] += 1
         calls += 1
 

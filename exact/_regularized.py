@@ -108,7 +108,9 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         return dict(t=float(t), alpha=float(y[0]), omega=float(y[1]), F=float(y[2]), v=float(y[3]),
                     branch=BRANCHES[side(y[3])])
 
-    def build(final=True):
+    def build(final=True, last=None):
+        """The trajectory so far; ``last = (t, y)``: the final state to report (default the solver's)."""
+        t_last, y_last = last if last is not None else (ode.t, ode.y)
         arr = np.array(rows, dtype=float).reshape(-1, 5)
         njac = getattr(ode, "njev", 0)
         nlu = getattr(ode, "nlu", 0)
@@ -118,7 +120,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
             t=arr[:, 0], alpha=arr[:, 1], omega=arr[:, 2], F=arr[:, 3], v=arr[:, 4], branch=np.array(brs, np.int8),
             jumps=Jumps.from_buffer(np.array(jumps, dtype=float).reshape(-1, 8)), stats=stats, params=params,
             method="regularized", solver=solver, rtol=rtol, atol=atol, eps=eps, initial_state=s0,
-            final_state=State(**sdict(ode.t, ode.y)), t_end=t_end, t_transient=t_store, status=0 if final else 1,
+            final_state=State(**sdict(t_last, y_last)), t_end=t_end, t_transient=t_store, status=0 if final else 1,
             message="reached t_end" if final else "stopped early")
 
     n_steps = 0
@@ -130,17 +132,21 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         t_old, y_old = ode.t, ode.y.copy()
         msg = ode.step()
         if ode.status == "failed":
-            raise SolverFailure(f"regularized {solver} failed at t={ode.t:.9g}: {msg}", t=float(ode.t),
-                                state=sdict(ode.t, ode.y), partial=build(False))
+            gap = y_old[2] * (1.0 + float(params.closure(y_old[0])[0])) - bs.f_zero
+            raise SolverFailure(f"regularized {solver} failed after t={t_old:.9g} (v = {y_old[3]:.3g} m/s, "
+                                f"F(1 - cos theta) - f(0+, V) = {gap:.3g} N): {msg}", t=float(t_old),
+                                state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         n_steps += 1
         y = ode.y
         if not np.all(np.isfinite(y)):  # a numerical failure, reported at the last finite state
             raise SolverFailure(f"regularized {solver}: the state became non-finite after t={t_old:.9g}",
-                                t=float(t_old), state=sdict(t_old, y_old), partial=build(False))
+                                t=float(t_old), state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         if not y[3] > 0.0:  # the scheme left the model's domain (f is defined for v > 0): numerical, not physical
-            raise SolverFailure(f"regularized {solver}: v = {y[3]:.3g} <= 0 after t={t_old:.9g} (the regularised "
-                                "scheme left the model's domain; tighten rtol)", t=float(t_old),
-                                state=sdict(t_old, y_old), partial=build(False))
+            gap = y_old[2] * (1.0 + float(params.closure(y_old[0])[0])) - bs.f_zero
+            raise SolverFailure(f"regularized {solver}: v = {y[3]:.3g} <= 0 after t={t_old:.9g}: the regularised "
+                                f"scheme left the model's domain (F(1 - cos theta) - f(0+, V) = {gap:.3g} N there; "
+                                "near 0 the orbit is approaching the no_root breakdown, else tighten rtol)",
+                                t=float(t_old), state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         if v_floor is not None and y[3] <= v_floor:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
@@ -149,7 +155,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         if side(y[3]) == 0 and y[2] * (1.0 + float(params.closure(y[0])[0])) - bs.f_zero <= no_root_margin:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB "
-                "(within 1e-10): CONSTR has no root left, the peel front would have to stop",
+                f"(within {BREAKDOWN_LEVEL:g}): CONSTR has no root left, the peel front would have to stop",
                 t=float(ode.t), state=sdict(ode.t, y), reason="no_root", partial=build(False))
         dense = None
         s_old, s_new = side(y_old[3]), side(y[3])
@@ -165,7 +171,12 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         if te is not None:
             while t_eval_i < te.size and te[t_eval_i] <= ode.t:
                 dense = dense or ode.dense_output()
-                store(te[t_eval_i], dense(te[t_eval_i]))
+                ye = dense(te[t_eval_i])
+                if not (np.all(np.isfinite(ye)) and ye[3] > 0.0):  # the interpolant left the domain
+                    raise SolverFailure(f"regularized {solver}: the dense output at t={te[t_eval_i]:.9g} left the "
+                                        "model's domain (v <= 0 or non-finite); tighten rtol", t=float(t_old),
+                                        state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
+                store(te[t_eval_i], ye)
                 t_eval_i += 1
         elif save == "steps" and ode.t >= t_store:
             store(ode.t, y)

@@ -18,12 +18,13 @@ from peelapprox._errors import (
 )
 from peelapprox._peelforce import (
     BRANCHES,
+    BREAKDOWN_LEVEL,
     branch_inverse,
     branch_structure,
     peel_force,
     peel_force_coefficients,
 )
-from peelapprox._params import EPS_RANGE, TIME_MAX
+from peelapprox._params import EPS_RANGE, RTOL_RANGE, TIME_MAX
 from peelapprox._validate import choice, duration, in_range, integer, optional, params as _params, positive, reals, state
 
 from . import _hybrid as H
@@ -34,8 +35,6 @@ __all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE", "STEP_B
 METHODS = ("hybrid", "regularized")
 SOLVERS = ("Radau", "BDF", "LSODA")
 SAVES = ("steps", "jumps")
-#: The relative tolerances :func:`simulate` accepts (closed interval).
-RTOL_RANGE = (1e-14, 1e-2)
 
 #: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
 #: components.  Hybrid: (τ [s], α [rad], ω [rad/s], ln v [-]); regularised:
@@ -119,8 +118,9 @@ def initial_state(
 
 
 #: Valid absolute tolerances, every component: 0 is excluded (τ starts every branch segment at 0, so pure
-#: relative control has no scale there), above 1 (1 s, 1 rad, 1 rad/s, 1 m/s or 1 N) no error is
-#: controlled at all; below 1e-100 the scaled field overflows the error norm.
+#: relative control has no scale there), above 1 (1 s, 1 rad, 1 rad/s, a factor e in v (hybrid, ln v),
+#: 1 m/s or 1 N (regularised)) no error is controlled at all; below 1e-100 the scaled field overflows the
+#: error norm.
 ATOL_RANGE = (1e-100, 1.0)
 
 
@@ -239,8 +239,9 @@ def simulate(
         method, ~35 s of work at most; 1e5/s within [1e5, 5e5] for the
         regularised one, ~80 s).
     max_wall : float, optional
-        Wall-clock budget [s] of the integration (checked every ~0.3 s in
-        the hybrid kernel and at every step of the regularised scheme);
+        Wall-clock budget [s] of the integration (checked between hybrid
+        kernel calls, at most 250,000 steps (~0.4 s) apart, and at every step
+        of the regularised scheme);
         exceeding it raises :class:`SolverBudgetExceeded` with
         ``budget="max_wall"``.  None (default): bounded by ``max_steps`` only.
     v_floor : float, optional
@@ -342,7 +343,7 @@ def _param_vector(params: PeelParams, v_floor: Optional[float] = None) -> np.nda
     p[H.P_VMIN] = bs.v_min if bs.has_folds else 0.0
     p[H.P_VLCD] = bs.v_land_cd if bs.has_folds else 0.0
     p[H.P_VLAB] = bs.v_land_ab if (bs.has_folds and bs.v_land_ab is not None) else -1.0
-    p[H.P_UFLOOR] = math.log(bs.v_breakdown if v_floor is None else v_floor)
+    p[H.P_UFLOOR] = math.log(bs.v_breakdown if v_floor is None else max(v_floor, bs.v_breakdown))
     p[H.P_UCEIL] = math.log(V_CEILING)
     p[H.P_UEV_AB] = math.log(bs.v_max * (1.0 - H.FOLD_REL)) if bs.has_folds else math.inf
     p[H.P_UEV_CD] = math.log(bs.v_min * (1.0 + H.FOLD_REL)) if bs.has_folds else -math.inf
@@ -409,8 +410,17 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         return budget_exceeded(name, limit, t_end, state_dict(), build(False))
 
     n_jstored = 0
+    next_pause = _PAUSE_STEPS  # step count of the next PAUSE, counted over calls (buffer returns interleave)
+
+    def checkpoint() -> None:
+        """Between kernel calls: the wall budget and progress (every return, whatever stopped the call)."""
+        if max_wall is not None and time.perf_counter() - wall0 > max_wall:
+            raise over_budget("max_wall", max_wall)
+        if progress:
+            progress(float(st[H.S_T0] + st[H.S_TAU]), t_end)
+
     while True:
-        quota = min(_PAUSE_STEPS, max_steps - int(cnt[H.C_STEPS]))
+        quota = max(1, min(next_pause, max_steps) - int(cnt[H.C_STEPS]))
         # buffer views never reach past the budgets (+ slack), so a full buffer that ends at the budget
         # means the run needs more than the budget
         nv = cap if mode != H.SAVE_STEPS else min(cap, max_points + 2 - n_stored)
@@ -432,6 +442,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             chunks.append(out[:n].copy())
             bchunks.append(out_br[:n].copy())
             cnt[H.C_NOUT] = 0
+            checkpoint()
             continue
         if status == H.JUMPS_FULL:
             if n_jstored + int(cnt[H.C_NJOUT]) > max_jumps:
@@ -439,14 +450,13 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             n_jstored += int(cnt[H.C_NJOUT])
             jchunks.append(jbuf[: cnt[H.C_NJOUT]].copy())
             cnt[H.C_NJOUT] = 0
+            checkpoint()
             continue
         if status == H.PAUSE:
             if int(cnt[H.C_STEPS]) >= max_steps:
                 raise over_budget("max_steps", max_steps)
-            if max_wall is not None and time.perf_counter() - wall0 > max_wall:
-                raise over_budget("max_wall", max_wall)
-            if progress:
-                progress(float(st[H.S_T0] + st[H.S_TAU]), t_end)
+            next_pause = int(cnt[H.C_STEPS]) + _PAUSE_STEPS
+            checkpoint()
             continue
         sd = state_dict()
         if status == H.STEP_FAIL:
@@ -457,9 +467,9 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         bs = branch_structure(params.V)
         reasons = {
             H.BREAK_VFLOOR: (
-                ("no_root", f"F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB (within 1e-10, v = "
+                ("no_root", f"F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB (within {BREAKDOWN_LEVEL:g}, v = "
                             f"{sd['v']:.3g} m/s): CONSTR has no root left, the peel front would have to stop")
-                if v_floor is None else
+                if v_floor is None or v_floor <= bs.v_breakdown else
                 ("v_floor", f"v fell to v_floor={v_floor} m/s on AB (F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)")),
             H.BREAK_NOLAND: ("no_landing", f"CD fold reached but f_min={bs.f_min} <= f(0+, V)={bs.f_zero:.6g}: "
                              "no AB root to land on"),

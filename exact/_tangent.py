@@ -78,7 +78,7 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
     """Integrate (y, δy) from ``y`` on branch ``br`` to its fold or to t = t_max (whichever first).
 
     Returns (status, steps); y holds the state there (v exactly at the fold for status 0).  status: 0 fold,
-    1 t_max, 2 step failure, 3 step budget.
+    1 t_max, 2 step failure, 3 step budget, 4 breakdown on AB (u <= ln v_breakdown, the model's criterion).
     """
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(8)
     _rhs_tangent(y, p, f0)
@@ -88,6 +88,10 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
         status, h, h_next, n_rej, n_rhs = _dop_t.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
         if status == STEP_FAILED:
             return 2, n
+        if br == 0 and y_new[3] <= p[H.P_UFLOOR]:
+            for i in range(8):
+                y[i] = y_new[i]
+            return 4, n + 1
         crossed = (y_new[3] >= uf) if br == 0 else (y_new[3] <= uf)
         if crossed:
             _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
@@ -107,7 +111,7 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
 
 
 def saltation(dy, g_minus, g_plus) -> np.ndarray:
-    """The tangent after a jump: ``S δy⁻`` with the fold event ``v = v_fold`` and the reset v := v_land
+    """The tangent after a jump: ``S δy⁻`` with the fold event ``u = ln v_fold`` and the reset v := v_land
     (module docstring); ``g_minus``, ``g_plus`` are the desingularised field before and after."""
     R_dy = np.array([dy[0], dy[1], dy[2], 0.0])
     R_g = np.array([g_minus[0], g_minus[1], g_minus[2], 0.0])
@@ -122,14 +126,14 @@ def _equal_time_vector(y, p, scale):
     if g[0] != 0.0:
         da = y[5] - g[1] / g[0] * dt
         dw = y[6] - g[2] / g[0] * dt
-        dv = y[7] - g[3] / g[0] * dt
+        du = y[7] - g[3] / g[0] * dt
     else:  # exactly at a fold dα/dt and dω/dt stay finite but the quotient is 0/0: use δ at equal s
-        da, dw, dv = y[5], y[6], y[7]
+        da, dw, du = y[5], y[6], y[7]
     eps = 1e-7
     v = math.exp(y[3])
     Fa = (H.pull_force(y[1] + eps, v, p) - H.pull_force(y[1] - eps, v, p)) / (2 * eps)
     Fu = (H.pull_force(y[1], math.exp(y[3] + eps), p) - H.pull_force(y[1], math.exp(y[3] - eps), p)) / (2 * eps)
-    return np.array([da, dw, Fa * da + Fu * dv]) / scale
+    return np.array([da, dw, Fa * da + Fu * du]) / scale
 
 
 #: Default step budget of :func:`lyapunov_saltation` per simulated second (measured: ~1.2e6 steps/s at
@@ -174,8 +178,9 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
         max_steps = min(int(STEPS_PER_SECOND * (T + 1.0)), MAX_DEFAULT_STEPS)
 
     def where(t_now):
-        return dict(alpha=float(y[1]), omega=float(y[2]), v=math.exp(y[3]), branch="AB" if br == 0 else "CD",
-                    t=t_transient + t_now)
+        v = math.exp(y[3])
+        return dict(t=t_transient + t_now, alpha=float(y[1]), omega=float(y[2]), F=float(H.pull_force(y[1], v, p)),
+                    v=v, branch="AB" if br == 0 else "CD")
 
     y = np.array([0.0, s.alpha, s.omega, math.log(s.v), 0.0, 0.0, 0.0, 1.0])
     y[4:] /= np.linalg.norm(_equal_time_vector(y, p, scale))
@@ -192,6 +197,10 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
             raise SolverBudgetExceeded(f"tangent integration used its max_steps = {max_steps} steps by "
                                        f"t = {t_transient + t + y[0]:.6g} s", budget="max_steps",
                                        limit=int(max_steps), t=t_transient + t + y[0], state=where(t + y[0]))
+        if status == 4:
+            raise ModelBreakdown(f"model breakdown at t = {t_transient + t + y[0]:.6g} s: F(1 - cos theta) fell to "
+                                 "f(0+, V) on AB (the model's no_root criterion)", t=t_transient + t + y[0],
+                                 state=where(t + y[0]), reason="no_root")
         if status != 0:
             raise SolverFailure(f"tangent integration: step-size failure at t = {t_transient + t + y[0]:.6g} s",
                                 t=t_transient + t + y[0], state=where(t + y[0]))

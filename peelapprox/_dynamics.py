@@ -29,10 +29,10 @@ from typing import Callable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ._errors import WallBudget
-from ._params import PeelParams
+from ._params import RTOL_RANGE, TIME_MAX, PeelParams
 from ._peelforce import BRANCHES, branch_structure
 from ._sweep import register_measure
-from ._validate import ArgumentTypeError, duration, finite, function, in_range, integer, nonnegative, optional, positive, reals, state
+from ._validate import ArgumentTypeError, duration, function, in_range, integer, optional, positive, reals, state
 from ._validate import params as _params
 
 #: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
@@ -57,8 +57,6 @@ __all__ = [
 ]
 
 _AB = BRANCHES.index("AB")
-#: Valid ``rtol`` of the exact runs behind the dynamics functions (exact.simulate's range).
-RTOL_RANGE = (1e-14, 1e-2)
 #: Valid initial perturbation ``d0`` of :func:`lyapunov` (scaled units): below 1e-12 the perturbation of F,
 #: ``d0 f_max``, nears the rounding of F itself (``2e-16 F``) and the two orbits can start at distance 0;
 #: above 1 it is not a perturbation.
@@ -514,7 +512,7 @@ def lyapunov(
         a, w, F, br = state
         try:
             tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps",
-                          max_wall=wall.left(0.0, _state_dict(params, 0.0, a, w, F, br), t_total))
+                          max_wall=wall.left(0.0, lambda: _state_dict(params, 0.0, a, w, F, br), t_total))
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         s = tr.final_state
@@ -644,7 +642,8 @@ def lyapunov_return_map(
     def ret(x, horizon):
         try:
             J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol, save="jumps",
-                         max_wall=wall.left(0.0, _state_dict(params, 0.0, x[0], x[1], x[2], "CD"), horizon)).jumps
+                         max_wall=wall.left(0.0, lambda: _state_dict(params, 0.0, x[0], x[1], x[2], "CD"),
+                                            horizon)).jumps
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         ab = np.flatnonzero(np.asarray(J.from_branch) == _AB)
@@ -693,23 +692,23 @@ def lyapunov_return_map(
 # ---------------------------------------------------------------------------------------------- sweep measures
 def _window_options(options) -> dict:
     """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted),
-    checked: ValueError naming the option and its valid range (the sweep calls this before the first point)."""
-    from exact._simulate import RTOL_RANGE
-
+    checked by the same validators as :func:`window_run` (ValueError/TypeError naming the option and its valid
+    range; the sweep calls this before the first point)."""
     kw = dict(WINDOW_DEFAULTS)
     kw.update({key: options[key] for key in kw if options.get(key) is not None})
-    kw["t_transient"] = nonnegative("t_transient", kw["t_transient"])
-    kw["alpha0"] = finite("alpha0", kw["alpha0"])
-    rtol = kw["rtol"] = positive("rtol", kw["rtol"])
-    if not RTOL_RANGE[0] <= rtol <= RTOL_RANGE[1]:
-        raise ValueError(f"rtol must be in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}], got {options['rtol']!r}")
+    kw["t_transient"] = duration("t_transient", kw["t_transient"], zero=True)
+    kw["alpha0"] = state("alpha0", kw["alpha0"], "alpha")
+    kw["rtol"] = _rtol("rtol", kw["rtol"])
     if options.get("t_end") is not None:
-        t_end = finite("t_end", options["t_end"])
+        t_end = duration("t_end", options["t_end"])
         if not t_end > kw["t_transient"]:
             raise ValueError(f"t_end must be greater than t_transient = {kw['t_transient']:g} (the measured window "
                              f"is [t_transient, t_end]), got {options['t_end']!r}")
         kw["window"] = t_end - kw["t_transient"]
-    kw["window"] = positive("window", kw["window"])
+    kw["window"] = duration("window", kw["window"])
+    if kw["t_transient"] + kw["window"] > TIME_MAX:
+        raise ValueError(f"t_transient + window must be at most {TIME_MAX:g} s (simulate's t_end), got "
+                         f"{kw['t_transient']:g} + {kw['window']:g}")
     return kw
 
 
@@ -718,12 +717,17 @@ def _period_options(options) -> dict:
     return {**_window_options(options), "period_rtol": positive("period_rtol", options.get("period_rtol", 1e-6))}
 
 
+#: Renormalisation interval [s] of the sweep's ``lyapunov`` measure.
+LYAPUNOV_TAU = 0.005
+
+
 def _lyapunov_options(options) -> dict:
-    """The checked options of the ``lyapunov`` measure: ``t_transient`` (30 s), ``lyapunov_time`` (50 s) and
-    ``alpha0`` (0)."""
-    return {"t_transient": nonnegative("t_transient", options.get("t_transient", 30.0)),
-            "lyapunov_time": positive("lyapunov_time", options.get("lyapunov_time", 50.0)),
-            "alpha0": finite("alpha0", options.get("alpha0", 0.0))}
+    """The checked options of the ``lyapunov`` measure: ``t_transient`` (30 s), ``lyapunov_time`` (50 s, at most
+    1e6 s) and ``alpha0`` (0), with :func:`lyapunov`'s validators."""
+    return {"t_transient": duration("t_transient", options.get("t_transient", 30.0), zero=True),
+            "lyapunov_time": in_range("lyapunov_time", options.get("lyapunov_time", 50.0), 2 * LYAPUNOV_TAU,
+                                      TIME_MAX),
+            "alpha0": state("alpha0", options.get("alpha0", 0.0), "alpha")}
 
 
 def measure_period(params: PeelParams, options) -> dict:
@@ -749,7 +753,7 @@ def measure_lyapunov(params: PeelParams, options) -> dict:
     and ``lyapunov_time`` (50 s of renormalisation intervals of 0.005 s)."""
     from exact import ModelBreakdown
 
-    tau = 0.005
+    tau = LYAPUNOV_TAU
     kw = _lyapunov_options(options)
     try:
         r = lyapunov(params, t_transient=kw["t_transient"], tau=tau, n=max(2, int(kw["lyapunov_time"] / tau)),

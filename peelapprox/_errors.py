@@ -23,7 +23,8 @@ class ModelBreakdown(RuntimeError):
     state : dict
         ``alpha, omega, F, v, branch`` at ``t``.
     reason : str
-        Short machine-readable cause (``"v_floor"``, ``"no_landing"``, ...).
+        Short machine-readable cause (``"no_root"``, ``"no_landing"``, ``"geometry"``, ``"v_ceiling"``, or
+        ``"v_floor"`` for a floor the caller passed).
     partial : object or None
         The trajectory computed up to the breakdown, when available.
     """
@@ -77,12 +78,13 @@ class WallBudget:
         self.limit = max_wall
         self.t0 = time.perf_counter()
 
-    def left(self, t: float, state: dict, t_end: float) -> Optional[float]:
+    def left(self, t: float, state: Any, t_end: float) -> Optional[float]:
+        """Seconds left (None: unbounded); ``state`` is the dict, or a callable building it only if needed."""
         if self.limit is None:
             return None
         rest = self.limit - (time.perf_counter() - self.t0)
         if rest <= 0.0:
-            raise budget_exceeded("max_wall", self.limit, t_end, state, None)
+            raise budget_exceeded("max_wall", self.limit, t_end, state() if callable(state) else state, None)
         return rest
 
     def reraise(self, exc: "SolverBudgetExceeded") -> "SolverBudgetExceeded":

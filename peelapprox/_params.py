@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 from ._validate import choice, in_range
 
-__all__ = ["EPS_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
+__all__ = ["EPS_RANGE", "RTOL_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
 #: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
@@ -52,6 +52,11 @@ STATE_RANGES = {
 #: Largest time [s] accepted as a horizon or a time since a branch entry by the closed forms and the reduced
 #: segment: 1e6 s (12 days of peeling) keeps ``F_in + F_rate t`` and the phases finite.
 TIME_MAX = 1e6
+
+#: Valid relative tolerance of every DOP853 run of the package (exact.simulate, the reduced segments, the
+#: dynamics functions) and of the regularised scheme: below 1e-14 the error test asks for less than rounding,
+#: above 1e-2 it controls nothing a user could mean.
+RTOL_RANGE = (1e-14, 1e-2)
 
 #: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons._benchmark) goes
 #: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding

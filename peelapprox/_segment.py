@@ -69,8 +69,7 @@ from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from ._params import PeelParams
-from ._params import TIME_MAX
+from ._params import RTOL_RANGE, TIME_MAX, PeelParams
 from ._validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
 from ._validate import state as _state
 from ._validate import params as _params
@@ -84,8 +83,6 @@ ALPHA_MODELS = (
 )
 #: velocity equations accepted by :func:`reduced_segment`
 V_EQUATIONS = ("approxvdot", "fullvdot")
-#: Valid ``rtol`` of :func:`reduced_segment`: below 1e-14 the DOP853 error test asks for less than rounding.
-RTOL_RANGE = (1e-14, 1e-2)
 #: Valid ``atol`` components: below 1e-100 the squared scaled errors of the step-size control underflow
 #: (``atol = 1e-200`` divided by zero); above 1e3 the error test accepts any step (every component's
 #: natural scale on a branch is smaller, except F in N, whose default atol is ``rtol F_in``).

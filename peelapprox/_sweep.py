@@ -50,7 +50,7 @@ Output directory
     ``status``, then the measures' keys.  ``status`` is ``"ok"`` when every
     measure is; else ``"error: <Type>: <message>"`` of the first measure that
     raised, or else the first non-ok status a measure reported (e.g.
-    ``"breakdown:v_floor"``, a result, not a failure).  A failing measure
+    ``"breakdown:no_root"``, a result, not a failure).  A failing measure
     records ``"<name>_status": "error: ..."`` and the others still run.
     Error points count as finished on resume; ``retry_failed=True``
     (``--retry-failed``) drops their records (the file is rewritten

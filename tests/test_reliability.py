@@ -157,3 +157,43 @@ def test_return_map_lyapunov_max_wall():
     e = ei.value
     assert e.budget == "max_wall" and e.limit == 0.3 and e.state["v"] > 0
     assert all(math.isfinite(e.state[k]) for k in ("t", "alpha", "omega", "F", "v"))
+
+
+@pytest.mark.parametrize("save", ["jumps", "steps"])
+def test_max_wall_at_a_high_jump_rate(save):
+    """Review of issue 13: the wall budget was checked only when the kernel paused after 250k steps in one
+    call, but at V=4, I=1e-2 (~480 jumps/s) the jump or point buffer fills first, every call: a 600 s run
+    with max_wall=0.3 completed (3.4 s).  Hypothesis: the budget is checked after every kernel return, so the
+    run raises SolverBudgetExceeded("max_wall") long before t_end (it reaches t < 300 s; categorical)."""
+    with pytest.raises(SolverBudgetExceeded) as ei:
+        simulate(PeelParams(V=4, I=1e-2), 600.0, save=save, max_wall=0.3, max_points=10**8)
+    assert ei.value.budget == "max_wall" and ei.value.t < 300.0
+
+
+def test_regularized_failure_reports_last_state_in_domain():
+    """Issue 13, regularised scheme: at V=0.5, I=1e-4 the orbit approaches the no_root breakdown, which the
+    ε-scheme cannot follow to the hybrid solver's 1e-67 m/s; Radau fails (step size below spacing).
+    Hypothesis: the SolverFailure carries a finite state with v > 0 both as ``state`` and as the partial
+    trajectory's final state (it used to be the solver's last, rejected state), and the message gives the
+    level's distance to f(0+) (0.25 N here: the orbit is near the breakdown)."""
+    with pytest.raises(SolverFailure) as ei:
+        simulate(PeelParams(V=0.5, I=1e-4), 0.05, method="regularized")
+    e = ei.value
+    assert _finite_state(e.t, e.state)
+    fs = e.partial.final_state
+    assert _finite_state(fs.t, fs.__dict__) and fs.t == e.t
+    assert "f(0+, V) = " in str(e)
+
+
+def test_saltation_tangent_reports_no_root_breakdown():
+    """Review of issue 13: the saltation tangent's driver ignored the breakdown criterion and integrated ln v
+    to underflow, ending in a step-size SolverFailure.  Hypothesis: at V=0.5, I=1e-4 (the hybrid solver's
+    no_root breakdown at t = 0.0183 s) it raises ModelBreakdown('no_root') near that time (within 1e-3 s:
+    both integrate the same field; the tangent's tolerances differ) with a finite state."""
+    from exact import ModelBreakdown
+    from peelapprox._dynamics import lyapunov_tangent
+
+    with pytest.raises(ModelBreakdown) as ei:
+        lyapunov_tangent(PeelParams(V=0.5, I=1e-4), t_transient=0.0, T=0.05)
+    e = ei.value
+    assert e.reason == "no_root" and abs(e.t - 0.0183) < 1e-3 and _finite_state(e.t, e.state)

@@ -162,7 +162,7 @@ def test_bad_inputs_raise_value_error():
     """
     with pytest.raises(ValueError, match="V must be"):
         StressPoint(V=-1.0, I=1e-3)
-    with pytest.raises(ValueError, match=r"rtol must be in \[1e-14, 1e-2\]"):
+    with pytest.raises(ValueError, match=r"rtol must be finite and in \[1e-14, 0.01\]"):
         StressPoint(V=1.0, I=1e-3, rtol=0.1)
     with pytest.raises(ValueError, match="save must be"):
         StressPoint(V=1.0, I=1e-3, save="all")
