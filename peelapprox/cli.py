@@ -460,7 +460,7 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
     if method == "return-map":  # alpha0 = 0: checked by the subcommand before the run
         if not returns:
             raise ValueError("--lyapunov-method return-map needs AB→CD returns in the window; there are none")
-        return D.lyapunov_return_map(p, t_transient=args.t_transient,
+        return D.lyapunov_return_map(p, t_transient=args.t_transient, max_wall=args.max_wall,
                                      n_returns=max(2, int(round(returns / args.window * T))))
     from comparisons._peers import lyapunov_regularized
 
