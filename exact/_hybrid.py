@@ -86,7 +86,7 @@ from peelapprox import _generated as _g
 from peelapprox._jit import kernel
 from peelapprox._dop853 import MAX_REJECTIONS, STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
-from peelapprox._peelforce import peel_force_fp_jit
+from peelapprox._peelforce import peel_force_fp_jit, peel_force_lnv_jit
 
 # the model's equations, compiled from the one generated source
 # (inline="always": numba then inlines them at the IR level; as separately compiled functions their calls
@@ -148,17 +148,19 @@ def pull_force(alpha, v, p):
 @kernel
 def _rhs(y, p, out):
     """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring)."""
-    v = np.exp(y[3])
-    c, dc = _closure(y[1], p)
-    if not (0.0 < v < np.inf and 1.0 + c > 0.0):  # trial stage left the model's domain (v under/overflowed)
+    v, f, g = peel_force_lnv_jit(y[3], p[P_B], p[P_A])  # g = v f'(v) = df/d(ln v) = dt/ds
+    if not (v > 0.0):  # trial stage left the model's domain (v underflowed): poison the step
         for i in range(4):
             out[i] = np.nan
         return
-    f, fp = peel_force_fp_jit(v, p[P_B], p[P_A])
+    c, dc = _closure(y[1], p)
+    if not (1.0 + c > 0.0):  # the peel geometry degenerates (alpha -> -pi/2): outside the domain as well
+        for i in range(4):
+            out[i] = np.nan
+        return
     F = f / (1.0 + c)
     ad, wd, Fd = slow_rates(y[1], y[2], F, v, c, p[P_V], p[P_I], p[P_K], p[P_R])
     (Gd,) = constraint_rate(F, Fd, c, dc, ad)
-    g = v * fp  # dt/ds = v f'(v) = df/d(ln v)
     out[0] = g
     out[1] = g * ad
     out[2] = g * wd

@@ -31,7 +31,7 @@ import numpy as np
 from peelapprox._jit import kernel
 
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
-from peelapprox._dop853 import interp, make_dop853, solve_theta, workspace
+from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, workspace
 from peelapprox._validate import duration, integer, optional
 
 from . import _hybrid as H
@@ -93,10 +93,23 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
                 y[i] = y_new[i]
             return 4, n + 1
         crossed = (y_new[3] >= uf) if br == 0 else (y_new[3] <= uf)
+        x_fold = 2.0
         if crossed:
             _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
-            x = solve_theta(y, Fc, 3, uf, y[3] - uf, 1.0, y_new[3] - uf)
-            interp(y, Fc, x, ye)
+            x_fold = solve_theta(y, Fc, 3, uf, y[3] - uf, 1.0, y_new[3] - uf)
+        # t_max inside the step (tau increases up to the fold): stop exactly there, as simulate does at t_end
+        x_b = min(x_fold, 1.0)
+        tau_b = interp1(y, Fc, x_b, 0) if crossed else y_new[0]
+        if tau_b >= t_max:
+            if not crossed:
+                _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
+            interp(y, Fc, crossing(y, Fc, 0, t_max, x_b, tau_b), ye)
+            for i in range(8):
+                y[i] = ye[i]
+            y[0] = t_max
+            return 1, n + 1
+        if crossed:
+            interp(y, Fc, x_fold, ye)
             for i in range(8):
                 y[i] = ye[i]
             y[3] = np.log(p[H.P_VMAX] if br == 0 else p[H.P_VMIN])
@@ -105,8 +118,6 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
             y[i] = y_new[i]
             f0[i] = K[_NS, i]
         h = h_next
-        if y[0] >= t_max:
-            return 1, n + 1
     return 3, max_steps
 
 

@@ -42,6 +42,18 @@ def peel_force_fpp(v, b, A):
     return f, fp, fpp
 
 
+def peel_force_lnv(lv, b, A):
+    """v = exp(lv), f(v, V) (fvV) and df/d(ln v) = v df/dv, given lv = ln v and (b, A)."""
+    v = numpy.exp(lv)
+    x0 = A*numpy.sqrt(v)
+    x1 = numpy.exp((3/20)*lv)
+    x2 = numpy.exp((7/20)*lv)
+    x3 = numpy.exp((1/11)*v)
+    f = b - x0 + 110*x1 + 400*x2 + 130*x3
+    f_lnv = (130/11)*v*x3 - 1/2*x0 + (33/2)*x1 + 140*x2
+    return v, f, f_lnv
+
+
 def closure_paper(alpha, R, l):
     """Closure 'paper': c = -cos(theta) as a function of alpha, and dc/dalpha."""
     c = numpy.sin(alpha)

@@ -6,12 +6,14 @@ other files (the generated model in ``_generated.py``, the peel force, the
 DOP853 step) embeds their machine code, so after one of those files changes
 (a regenerated model, a package upgrade) numba would load the old kernel: the
 stale-kernel bug of issue 13 (a changed fvV coefficient gave CONSTR residuals
-of 37 N).  :func:`kernel` therefore names every compiled function after a hash
-of **all** the files compiled into kernels (:data:`KERNEL_SOURCES`): a change
-to any of them gives new cache file names, so the kernels are compiled anew,
-and a cache written by other sources is never read.  Files left behind by an
-old source stay on disk unused (numba's own cache files; deleting
-``__pycache__/*.nbi, *.nbc`` is always safe).
+of 37 N).  :func:`kernel` therefore stamps every compiled function's cache
+index with a hash of **all** the files compiled into kernels
+(:data:`KERNEL_SOURCES`, :data:`SOURCE_TAG`) next to numba's own stamp: numba
+discards an index whose stamp differs, so after a change to any of them the
+kernels are compiled anew (the cache files keep their names and are
+overwritten), and a cache written by other sources is never read.  On a numba
+without the private stamp attribute the tag goes into the cache file names
+instead.
 
 Where no cache location is writable (read-only install, HOME, XDG cache and
 ``NUMBA_CACHE_DIR``: containers, HPC nodes) the kernels are compiled without
@@ -82,6 +84,21 @@ def caching_enabled() -> bool:
     return bool(_state["cache"])
 
 
+def _stamp_with_tag(dispatcher: Any) -> bool:
+    """Make the dispatcher's on-disk cache index carry :data:`SOURCE_TAG` in its source stamp.
+
+    numba stores the stamp of the function's own file in the index and discards the index when it differs
+    on load; adding the tag discards it also when any other kernel source changed.  The cache files keep
+    their names (overwritten, not accumulated).  Uses numba's private ``_cache._cache_file._source_stamp``
+    (numba 0.58-0.68); returns False where that is not there.
+    """
+    cf = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    if cf is None or not hasattr(cf, "_source_stamp"):
+        return False
+    cf._source_stamp = (cf._source_stamp, SOURCE_TAG)
+    return True
+
+
 def _renamed(fn: Callable, name: str) -> Callable:
     """A copy of the plain function ``fn`` named ``name`` (numba names cache files after the qualname)."""
     g = types.FunctionType(fn.__code__, fn.__globals__, name, fn.__defaults__, fn.__closure__)
@@ -107,7 +124,7 @@ def _check_source(fn: Callable) -> None:
 
 def kernel(fn: Optional[Callable] = None, *, inline: str = "never", fastmath: bool = False,
            name: Optional[str] = None) -> Any:
-    """Compile ``fn`` with numba (``njit``), cached under a name that carries :data:`SOURCE_TAG`.
+    """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 
     Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.
 
@@ -136,11 +153,16 @@ def kernel(fn: Optional[Callable] = None, *, inline: str = "never", fastmath: bo
     if fn is None:
         return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name)
     _check_source(fn)
-    base = (name or fn.__qualname__).replace("<locals>.", "").replace(".", "_")
-    g = _renamed(fn, f"{base}__src{SOURCE_TAG}")
+    if name is not None:  # distinct cache files for the pieces of each vector field (make_dop853)
+        fn = _renamed(fn, name.replace("<locals>.", "").replace(".", "_"))
     if _state["cache"]:
         try:
-            return njit(cache=True, inline=inline, fastmath=fastmath)(g)
+            d = njit(cache=True, inline=inline, fastmath=fastmath)(fn)
+            if not _stamp_with_tag(d):  # a numba without the private stamp: tag the cache file names instead
+                # (old files then accumulate in __pycache__)
+                base = fn.__qualname__.replace("<locals>.", "").replace(".", "_")
+                d = njit(cache=True, inline=inline, fastmath=fastmath)(_renamed(fn, f"{base}__src{SOURCE_TAG}"))
+            return d
         except RuntimeError as e:  # numba: "cannot cache function ...: no locator available"
             if "no locator available" not in str(e):
                 raise
@@ -152,4 +174,4 @@ def kernel(fn: Optional[Callable] = None, *, inline: str = "never", fastmath: bo
                 KernelCacheWarning,
                 stacklevel=2,
             )
-    return njit(cache=False, inline=inline, fastmath=fastmath)(g)
+    return njit(cache=False, inline=inline, fastmath=fastmath)(fn)

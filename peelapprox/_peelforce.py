@@ -38,6 +38,7 @@ __all__ = [
     "peel_force_coefficients",
     "peel_force_fp_jit",
     "peel_force_fpp_jit",
+    "peel_force_lnv_jit",
     "BranchStructure",
     "branch_structure",
     "branch_inverse",
@@ -55,6 +56,8 @@ peel_force_coefficients = _g.peel_force_coefficients
 peel_force_fp_jit = kernel(inline="always")(_g.peel_force_fp)
 #: numba-compiled scalar ``(f, f', f'')``.
 peel_force_fpp_jit = kernel(_g.peel_force_fpp)
+#: numba-compiled scalar ``(v, f, v f')`` at ``ln v`` (the hybrid solver's state variable; no log needed).
+peel_force_lnv_jit = kernel(inline="always")(_g.peel_force_lnv)
 
 # Bracket used to search for folds and roots: f' -> +inf as v -> 0 and the
 # exponential term dominates for large v, so every sign change lies inside.

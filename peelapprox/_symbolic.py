@@ -176,7 +176,7 @@ import numpy
 '''
 
 
-def _render_function(name, args, exprs, doc, out_names=None, prelude=()):
+def _render_function(name, args, exprs, doc, out_names=None, prelude=(), extra_outs=()):
     from sympy.printing.numpy import NumPyPrinter
 
     printer = NumPyPrinter({"fully_qualified_modules": True, "inline": True})
@@ -189,8 +189,8 @@ def _render_function(name, args, exprs, doc, out_names=None, prelude=()):
     for o, e in zip(outs, red):
         e = sp.Float(e) if e.is_Number else e  # homogeneous float tuples for numba
         lines.append(f"    {o} = {printer.doprint(e)}")
-    ret = ", ".join(outs)
-    lines.append(f"    return {ret}" + ("," if len(outs) == 1 else ""))
+    ret = ", ".join(list(extra_outs) + list(outs))
+    lines.append(f"    return {ret}" + ("," if len(outs) + len(extra_outs) == 1 else ""))
     return "\n".join(lines) + "\n"
 
 
@@ -243,6 +243,21 @@ def render_module() -> str:
                 prelude,
             )
         )
+
+    # The hybrid solver's state is ln v: f and df/d(ln v) = v f' from ln v directly (no log; v = e^(ln v)).
+    g0 = fw.subs(sub).xreplace(frac)
+    g1 = f_w.subs(sub).xreplace(frac)
+    parts.append(
+        _render_function(
+            "peel_force_lnv",
+            ["lv", "b", "A"],
+            [g0, g1],
+            "v = exp(lv), f(v, V) (fvV) and df/d(ln v) = v df/dv, given lv = ln v and (b, A).",
+            ["f", "f_lnv"],
+            [(vv, sp.exp(lv))],
+            extra_outs=["v"],
+        )
+    )
 
     for geom in ("paper", "exact"):
         c = -cos_theta_expr(geom, alpha)

@@ -101,7 +101,7 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     assert list((tmp_path / "exact" / "__pycache__").glob("*pull_force*.nbi")), "the first run did not cache"
     gen = tmp_path / "peelapprox" / "_generated.py"
     src = gen.read_text()
-    assert src.count("400*x2") == 2
+    assert src.count("400*x2") == 3  # f in peel_force_fp, peel_force_fpp, peel_force_lnv
     gen.write_text(src.replace("400*x2", "401*x2"))
     after = _probe(tmp_path)
     assert abs(after["ref"] - before["ref"]) > 0.3  # the numpy law did change ...
