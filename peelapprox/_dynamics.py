@@ -220,12 +220,10 @@ def _window_run(params, t_transient, window, rtol, alpha0, max_wall=None):
 
 
 def _state_dict(params: PeelParams, t: float, alpha: float, omega: float, F: float, branch: str) -> dict:
-    """A state as the model exceptions carry it (v from CONSTR on ``branch``)."""
-    from ._peelforce import branch_inverse
+    """A state as the model exceptions carry it (v from CONSTR on ``branch``, as :func:`exact.initial_state`)."""
+    from exact import initial_state
 
-    G = F * (1.0 + float(params.closure(alpha)[0]))
-    return dict(t=float(t), alpha=float(alpha), omega=float(omega), F=float(F),
-                v=float(branch_inverse(G, params.V, branch)), branch=branch)
+    return dict(initial_state(params, alpha0=alpha, omega0=omega, F0=F, branch0=branch, t0=t).__dict__)
 
 
 def classify(trajectory, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
