@@ -380,7 +380,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
 
     def state_dict():
         a, v = st[H.S_AL], math.exp(st[H.S_U])
-        F = float(H.pull_force(a, v, p)) if v > 0 else float("nan")
+        F = float(H.pull_force(a, v, p))  # the kernel keeps the state in the domain (v = e^u > 0)
         return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
                     branch=BRANCHES[int(st[H.S_BR])])
 
