@@ -39,14 +39,15 @@ PARAM_RANGES = {
 #:   SolverFailure) in :func:`reduced_segment`; 1e300 divided by zero.
 #: * ``"F"`` [N]: ``[1e-3, 1e7]``: the pull force; the peel force is 100-400 N in the stick-slip window and
 #:   ``f(V, V) <= 1.3e6 N`` at the fastest V.  ``F_in = 1e-300`` divided by zero, ``1e300`` did not finish.
-#: * ``"v"`` [m/s]: ``(0, 1e3]``: every branch velocity the model reaches is below 30 m/s; f(1e3, V) ~ 4e41 N
-#:   is still finite (its e^(v/11) overflows at v ~ 7800).  v = 0 is excluded: f has a v^0.15 branch point.
+#: * ``"v"`` [m/s]: ``(1e-150, 1e3]``: every branch velocity the model reaches is below 30 m/s; f(1e3, V) ~ 4e41 N
+#:   is still finite (its e^(v/11) overflows at v ~ 7800).  Below 1e-150, v² underflows in f'' (the reduced
+#:   equations' fullvdot); the model's own breakdown velocity (``BranchStructure.v_breakdown``) is ~1e-67.
 #: * ``"F_rate"`` [N/s], ``|dF/dt| <= 1e12``: ``k V <= 1e9``.
 STATE_RANGES = {
     "alpha": (-math.pi, math.pi),
     "omega": (-1e9, 1e9),
     "F": (1e-3, 1e7),
-    "v": (0.0, 1e3),
+    "v": (1e-150, 1e3),
     "F_rate": (-1e12, 1e12),
 }
 #: Largest time [s] accepted as a horizon or a time since a branch entry by the closed forms and the reduced

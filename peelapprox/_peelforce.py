@@ -71,7 +71,7 @@ def _check_V(V) -> float:
 
 
 def _check_v(v) -> np.ndarray:
-    """Peel velocities in ``STATE_RANGES["v"]`` = (0, 1e3] m/s (f has a v^0.15 branch point at 0)."""
+    """Peel velocities in ``STATE_RANGES["v"]`` = (1e-150, 1e3] m/s (f has a v^0.15 branch point at 0)."""
     return reals("v", v, *STATE_RANGES["v"], lo_open=True)
 
 

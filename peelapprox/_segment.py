@@ -387,7 +387,7 @@ def reduced_segment(
 
     Entry states must lie in :data:`peelapprox._params.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
     ``alpha_in`` and ``amplitude`` in [-π, π], ``alphadot_in`` in [-1e9, 1e9] rad/s, ``v_in``, ``v_f`` in
-    (0, 1e3] m/s, ``F_rate`` in [-1e12, 1e12] N/s).
+    (1e-150, 1e3] m/s, ``F_rate`` in [-1e12, 1e12] N/s).
 
     Returns
     -------

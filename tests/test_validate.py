@@ -138,7 +138,7 @@ def test_state_and_duration_ranges():
     assert v.state("F0", 250, "F") == 250.0
     with pytest.raises(ValueError, match=r"^F0 must be finite and in \[0.001, 1e7\], got 1e\+300"):
         v.state("F0", 1e300, "F")
-    with pytest.raises(ValueError, match=r"^v_in must be finite and in \(0, 1000\], got 0.0"):
+    with pytest.raises(ValueError, match=r"^v_in must be finite and in \(1e-150, 1000\], got 0.0"):
         v.state("v_in", 0.0, "v")
     assert v.duration("t_transient", 0, zero=True) == 0.0
     with pytest.raises(ValueError, match=r"^window must be finite and in \(0, 1e6\], got 1e\+300"):
