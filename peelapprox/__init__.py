@@ -23,7 +23,7 @@ from ._alpha import (
     wkb_amplitude_phase,
     wkb_error_bound,
 )
-from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from ._errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import GEOMETRIES, PARAM_RANGES, PeelParams
 from ._estimate import (
     INERTIA_RULE,
@@ -63,7 +63,7 @@ from ._dynamics import (
     settle_time,
 )
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 __all__ = [
     "PeelParams",
@@ -80,6 +80,7 @@ __all__ = [
     "ModelBreakdown",
     "SolverBudgetExceeded",
     "SolverFailure",
+    "KernelCacheWarning",
     # reduced α equations (Sec. V)
     "inertial_frequency",
     "inertial_period",

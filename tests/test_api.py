@@ -1,0 +1,75 @@
+"""The public API of each package (issue 14: names that move between rooms must keep working).
+
+Each set below is the package's public API as of 0.2.0.dev0.  A name may be added to a package (then add it
+here), but one listed here may not disappear: the test fails if it is missing from ``__all__`` or does not
+resolve.  Moves record themselves in CHANGELOG.md.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import pytest
+
+API = {
+    "peelapprox": {
+        "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BranchStructure", "FixedPoint", "GEOMETRIES",
+        "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
+        "PARAM_RANGES", "PeelParams", "Periodicity", "ReducedSegment", "RegimeEstimate", "SlopeCriterion",
+        "SolverBudgetExceeded", "SolverFailure", "SweepResult", "VELOCITY_RULE", "V_EQUATIONS", "airy_alpha",
+        "alpha_numerical", "attractors", "benettin", "branch_inverse", "branch_structure", "cd_damping_time",
+        "cd_decay_alpha", "crude_branch_time", "estimate", "fixed_point", "force_bounds", "force_drops",
+        "harmonic_alpha", "inertial_frequency", "inertial_period", "inertial_periods", "load_sweep", "lyapunov",
+        "lyapunov_return_map", "lyapunov_tangent", "parse_grid", "peel_force", "peel_force_derivative",
+        "periodicity", "quasi_static_branch_time", "reduced_segment", "register_measure", "return_map",
+        "settle_time", "sinusoid_alpha", "slope_criterion", "sweep", "wkb_alpha", "wkb_amplitude_phase",
+        "wkb_error_bound",
+    },
+    "exact": {
+        "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
+        "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state", "simulate",
+    },
+    "comparisons": {
+        "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
+        "STAT_RUNS", "Scene", "Segment", "StatRow", "TransientCheck", "TransientNotPassed", "check_past_transient",
+        "compare", "exact_run", "local_period", "markdown", "run_compare", "run_reduction", "scene_rows",
+        "segments", "statistics",
+    },
+}
+
+
+@pytest.mark.parametrize("package", sorted(API))
+def test_public_names_stay_offered(package):
+    """Hypothesis: every listed name is in the package's ``__all__`` and resolves to an object (exact set
+    inclusion; a name that disappears is an API break)."""
+    mod = importlib.import_module(package)
+    missing = API[package] - set(mod.__all__)
+    assert not missing, f"{package} no longer offers {sorted(missing)}"
+    for name in mod.__all__:
+        assert getattr(mod, name) is not None, name
+
+
+@pytest.mark.parametrize("package", sorted(API))
+def test_all_lists_no_unknown_name(package):
+    """``__all__`` holds no name this test does not know: a new public name is a decision, recorded here
+    (exact set comparison)."""
+    mod = importlib.import_module(package)
+    assert set(mod.__all__) == API[package], sorted(set(mod.__all__) ^ API[package])
+
+
+def test_the_errors_are_one_class_each():
+    """The model exceptions offered by both packages are the same classes (one place: peelapprox._errors)."""
+    import exact
+    import peelapprox
+
+    for name in ("ModelBreakdown", "SolverBudgetExceeded", "SolverFailure"):
+        assert getattr(exact, name) is getattr(peelapprox, name)
+
+
+def test_version_single_sourced():
+    """The installed distribution's version is the package's (pyproject reads peelapprox._version)."""
+    from importlib.metadata import version
+
+    import peelapprox
+
+    assert version("peelapprox") == peelapprox.__version__
