@@ -84,6 +84,7 @@ import numpy as np
 
 from peelapprox import _generated as _g
 from peelapprox._jit import kernel
+from peelapprox._status import DONE, GEOMETRY, JUMPS_FULL, NO_LANDING, NO_ROOT, OUT_FULL, PAUSE, STEP_FAIL, V_CEILING
 from peelapprox._dop853 import MAX_REJECTIONS, STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from peelapprox._peelforce import peel_force_fp_jit, peel_force_lnv_jit
@@ -118,16 +119,6 @@ N_J = 8
 FOLD_REL = 1e-9
 # save modes
 SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = 0, 1, 2
-# status codes returned by the kernel
-DONE = 0
-OUT_FULL = 1
-JUMPS_FULL = 2
-PAUSE = 3  # per-call step quota reached (progress / budget checks)
-BREAK_VFLOOR = 10  # v -> v_breakdown (or v_floor) on AB: the constraint loses its root
-BREAK_NOLAND = 11  # CD fold reached but f_min <= f(0+): no AB root to land on
-BREAK_ALPHA = 12  # 1 + c(alpha) <= 0: the peel geometry degenerates
-BREAK_VCEIL = 14  # v ran away on CD
-STEP_FAIL = 20  # step size underflow / repeated rejection
 
 
 @kernel(inline="always")
@@ -307,7 +298,7 @@ def run(
             for i in range(4):
                 y[i] = y_new[i]
             _save(st, y, h_next)
-            return BREAK_VFLOOR
+            return NO_ROOT
         # end time: τ increases up to the fold (f' > 0 on the branch) and falls
         # again beyond it, so t_end is looked for in [0, min(x_fold, 1)]
         x_end = 2.0
@@ -375,12 +366,12 @@ def run(
             for i in range(4):
                 y[i] = ye[i]
             _save(st, y, h)
-            return BREAK_ALPHA
+            return GEOMETRY
         if br == 1 and ye[3] > p[P_UCEIL]:
             for i in range(4):
                 y[i] = ye[i]
             _save(st, y, h)
-            return BREAK_VCEIL
+            return V_CEILING
 
         if x_end <= 1.0 and x_end <= x_fold:
             # reached t_end (a fold exactly at t_end is left for a later call)
@@ -409,7 +400,7 @@ def run(
                     for i in range(4):
                         y[i] = ye[i]
                     _save(st, y, h)
-                    return BREAK_NOLAND
+                    return NO_LANDING
             if tj >= t_store:
                 if save_mode == SAVE_STEPS:
                     _store(out, cnt[C_NOUT], tj, ye, v_fold, Fj, out_br, br)

@@ -10,12 +10,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from peelapprox import PeelParams
-from peelapprox._errors import (
-    ModelBreakdown,
-    SolverBudgetExceeded,
-    SolverFailure,
-    budget_exceeded,
-)
+from peelapprox._errors import SolverBudgetExceeded, budget_exceeded
 from peelapprox._peelforce import (
     BRANCHES,
     BREAKDOWN_LEVEL,
@@ -24,6 +19,8 @@ from peelapprox._peelforce import (
     peel_force,
     peel_force_coefficients,
 )
+from peelapprox import _status as S
+from peelapprox._status import status_error
 from peelapprox._params import EPS_RANGE, RTOL_RANGE, TIME_MAX
 from peelapprox._validate import choice, duration, in_range, integer, optional, params as _params, positive, reals, state
 
@@ -426,7 +423,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
         nv = cap if mode != H.SAVE_STEPS else min(cap, max_points + 2 - n_stored)
         jv = min(jcap, max_jumps + 1 - n_jstored)
         status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv], cnt, quota)
-        if status == H.DONE:
+        if status == S.DONE:
             if n_stored + int(cnt[H.C_NOUT]) > max_points:
                 raise over_budget("max_points", max_points)
             if n_jstored + int(cnt[H.C_NJOUT]) > max_jumps:
@@ -434,7 +431,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             if progress:
                 progress(t_end, t_end)
             return build()
-        if status == H.OUT_FULL:
+        if status == S.OUT_FULL:
             if n_stored + int(cnt[H.C_NOUT]) > max_points:
                 raise over_budget("max_points", max_points)
             n = int(cnt[H.C_NOUT])
@@ -444,7 +441,7 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             cnt[H.C_NOUT] = 0
             checkpoint()
             continue
-        if status == H.JUMPS_FULL:
+        if status == S.JUMPS_FULL:
             if n_jstored + int(cnt[H.C_NJOUT]) > max_jumps:
                 raise over_budget("max_jumps", max_jumps)
             n_jstored += int(cnt[H.C_NJOUT])
@@ -452,30 +449,21 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
             cnt[H.C_NJOUT] = 0
             checkpoint()
             continue
-        if status == H.PAUSE:
+        if status == S.PAUSE:
             if int(cnt[H.C_STEPS]) >= max_steps:
                 raise over_budget("max_steps", max_steps)
             next_pause = int(cnt[H.C_STEPS]) + _PAUSE_STEPS
             checkpoint()
             continue
         sd = state_dict()
-        if status == H.STEP_FAIL:
-            raise SolverFailure(
-                f"hybrid solver: step size collapsed at t={sd['t']:.9g} on {sd['branch']} (v={sd['v']:.6g})",
-                t=sd["t"], state=sd, partial=build(False),
-            )
         bs = branch_structure(params.V)
-        reasons = {
-            H.BREAK_VFLOOR: (
-                ("no_root", f"F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB (within {BREAKDOWN_LEVEL:g}, v = "
-                            f"{sd['v']:.3g} m/s): CONSTR has no root left, the peel front would have to stop")
-                if v_floor is None or v_floor <= bs.v_breakdown else
-                ("v_floor", f"v fell to v_floor={v_floor} m/s on AB (F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)")),
-            H.BREAK_NOLAND: ("no_landing", f"CD fold reached but f_min={bs.f_min} <= f(0+, V)={bs.f_zero:.6g}: "
-                             "no AB root to land on"),
-            H.BREAK_ALPHA: ("geometry", "1 - cos(theta) reached 0: the peel geometry degenerates (alpha -> -pi/2)"),
-            H.BREAK_VCEIL: ("v_ceiling", "v exceeded 1000 m/s on CD: the pull force is running away"),
-        }
-        reason, text = reasons.get(status, ("unknown", f"kernel status {status}"))
-        raise ModelBreakdown(f"model breakdown at t={sd['t']:.9g}: {text}", t=sd["t"], state=sd, reason=reason,
-                             partial=build(False))
+        if status == S.NO_ROOT and v_floor is not None and v_floor > bs.v_breakdown:
+            status, why = S.V_FLOOR, f"the caller's v_floor; F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N"
+        else:
+            why = ""
+        raise status_error(
+            status, t=sd["t"], state=sd, partial=build(False),
+            prefix=f"hybrid solver at t={sd['t']:.9g} on {sd['branch']}: ",
+            f_zero=bs.f_zero, f_min=bs.f_min, level=BREAKDOWN_LEVEL, v=sd["v"], v_ceiling=V_CEILING,
+            v_floor=v_floor, why=why,
+        )

@@ -29,6 +29,8 @@ from typing import Optional
 
 import numpy as np
 from peelapprox._jit import kernel
+from peelapprox._peelforce import BREAKDOWN_LEVEL, branch_structure
+from peelapprox._status import DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, status_error
 
 from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
 from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, workspace
@@ -77,8 +79,9 @@ _dop_t = make_dop853(_rhs_tangent)
 def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
     """Integrate (y, δy) from ``y`` on branch ``br`` to its fold or to t = t_max (whichever first).
 
-    Returns (status, steps); y holds the state there (v exactly at the fold for status 0).  status: 0 fold,
-    1 t_max, 2 step failure, 3 step budget, 4 breakdown on AB (u <= ln v_breakdown, the model's criterion).
+    Returns (status, steps) with a code of :mod:`peelapprox._status`; y holds the state there: FOLD (v
+    exactly at the fold), DONE (t = t_max), STEP_FAIL, MAX_STEPS, NO_ROOT (u <= ln v_breakdown on AB, the
+    model's criterion).
     """
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(8)
     _rhs_tangent(y, p, f0)
@@ -87,11 +90,11 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
     for n in range(max_steps):
         status, h, h_next, n_rej, n_rhs = _dop_t.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
         if status == STEP_FAILED:
-            return 2, n
+            return STEP_FAIL, n
         if br == 0 and y_new[3] <= p[H.P_UFLOOR]:
             for i in range(8):
                 y[i] = y_new[i]
-            return 4, n + 1
+            return NO_ROOT, n + 1
         crossed = (y_new[3] >= uf) if br == 0 else (y_new[3] <= uf)
         x_fold = 2.0
         if crossed:
@@ -107,18 +110,18 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
             for i in range(8):
                 y[i] = ye[i]
             y[0] = t_max
-            return 1, n + 1
+            return DONE, n + 1
         if crossed:
             interp(y, Fc, x_fold, ye)
             for i in range(8):
                 y[i] = ye[i]
             y[3] = np.log(p[H.P_VMAX] if br == 0 else p[H.P_VMIN])
-            return 0, n + 1
+            return FOLD, n + 1
         for i in range(8):
             y[i] = y_new[i]
             f0[i] = K[_NS, i]
         h = h_next
-    return 3, max_steps
+    return MAX_STEPS, max_steps
 
 
 def saltation(dy, g_minus, g_plus) -> np.ndarray:
@@ -167,7 +170,6 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     :class:`peelapprox.SolverBudgetExceeded`, a step-size failure :class:`peelapprox.SolverFailure` and a
     fold with no landing root :class:`peelapprox.ModelBreakdown`, each with the time and state.
     """
-    from peelapprox import ModelBreakdown, SolverBudgetExceeded, SolverFailure
     from exact import initial_state, simulate
     from peelapprox._dynamics import natural_scales
 
@@ -181,6 +183,7 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
          else initial_state(params, alpha0=alpha0))
     p = _param_vector(params)
     scale = natural_scales(params)
+    bs = branch_structure(params.V)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
     # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
     atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])
@@ -200,27 +203,20 @@ def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rt
     while t < T:
         status, n = _to_fold(y, p, br, rtol, atol, T - t, max_steps - steps)
         steps += n
-        if status == 1:
+        if status == DONE:
             t += y[0]
             logs += math.log(np.linalg.norm(_equal_time_vector(y, p, scale)))
             break
-        if status == 3:
-            raise SolverBudgetExceeded(f"tangent integration used its max_steps = {max_steps} steps by "
-                                       f"t = {t_transient + t + y[0]:.6g} s", budget="max_steps",
-                                       limit=int(max_steps), t=t_transient + t + y[0], state=where(t + y[0]))
-        if status == 4:
-            raise ModelBreakdown(f"model breakdown at t = {t_transient + t + y[0]:.6g} s: F(1 - cos theta) fell to "
-                                 "f(0+, V) on AB (the model's no_root criterion)", t=t_transient + t + y[0],
-                                 state=where(t + y[0]), reason="no_root")
-        if status != 0:
-            raise SolverFailure(f"tangent integration: step-size failure at t = {t_transient + t + y[0]:.6g} s",
-                                t=t_transient + t + y[0], state=where(t + y[0]))
+        if status != FOLD:
+            raise status_error(status, t=t_transient + t + y[0], state=where(t + y[0]), prefix="tangent integration: ",
+                               where=f"at t = {t_transient + t + y[0]:.6g} s", limit=int(max_steps),
+                               f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]))
         t += y[0]
         H._rhs(y[:4], p, g_minus)
         v_land = p[H.P_VLCD] if br == 0 else p[H.P_VLAB]
         if not v_land > 0.0:
-            raise ModelBreakdown(f"no landing root at the fold at t = {t_transient + t:.6g} s",
-                                 t=t_transient + t, state=where(t), reason="no_landing")
+            raise status_error(NO_LANDING, t=t_transient + t, state=where(t), prefix="tangent integration: ",
+                               where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero)
         y[0], y[3] = 0.0, math.log(v_land)
         H._rhs(y[:4], p, g_plus)
         y[4:] = saltation(y[4:], g_minus, g_plus)

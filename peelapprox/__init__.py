@@ -63,7 +63,7 @@ from ._dynamics import (
     settle_time,
 )
 
-from ._version import __version__
+from ._version import __version__ as __version__
 
 __all__ = [
     "PeelParams",

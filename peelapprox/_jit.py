@@ -50,6 +50,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_dop853.py",
     "peelapprox/_alpha.py",
     "peelapprox/_segment.py",
+    "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "exact/_hybrid.py",
     "exact/_regularized.py",
     "exact/_tangent.py",

@@ -68,8 +68,19 @@ from ._jit import kernel
 from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
-from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._params import RTOL_RANGE, TIME_MAX, PeelParams
+from ._status import (
+    DONE,
+    F_NONPOSITIVE,
+    MAX_STEPS,
+    NONFINITE,
+    OUT_FULL,
+    STEP_FAIL,
+    T_MAX,
+    V_CEILING,
+    V_FLOOR,
+    status_error,
+)
 from ._validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
 from ._validate import state as _state
 from ._validate import params as _params
@@ -99,8 +110,6 @@ N_Q = 17
 C_STEPS, C_REJ, C_RHS, C_NOUT, C_TEVAL = range(5)
 # save modes
 SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = range(3)
-# status codes
-EXIT, OUT_FULL, T_MAX, MAX_STEPS, BREAK_VFLOOR, BREAK_VCEIL, BREAK_F, BREAK_NONFINITE, STEP_FAIL = range(9)
 
 _sinusoid_jit = kernel(inline="always")(_sinusoid)
 _harmonic_jit = kernel(inline="always")(_harmonic)
@@ -229,7 +238,7 @@ def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode,
                 y[i] = ye[i]
             if x_exit <= x_tmax:
                 y[1] = x_f
-                code = EXIT
+                code = DONE
             else:
                 y[0] = t_max
                 code = T_MAX
@@ -239,7 +248,7 @@ def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode,
             return code
         for i in range(5):
             if not np.isfinite(y_new[i]):
-                return BREAK_NONFINITE
+                return NONFINITE
         for i in range(5):
             y[i] = y_new[i]
             f0[i] = K[_NS, i]
@@ -248,11 +257,11 @@ def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode,
             _store(out, cnt[C_NOUT], y, q)
             cnt[C_NOUT] += 1
         if y[1] <= x_lo:
-            return BREAK_VFLOOR
+            return V_FLOOR
         if y[1] >= x_hi:
-            return BREAK_VCEIL
+            return V_CEILING
         if y[2] <= 0.0:
-            return BREAK_F
+            return F_NONPOSITIVE
 
 
 @dataclass(frozen=True)
@@ -521,22 +530,10 @@ def reduced_segment(
         alphadot=rows[:, 4].copy(), n_steps=int(cnt[C_STEPS]), n_rejected=int(cnt[C_REJ]), n_rhs=int(cnt[C_RHS]),
         wall_time=time.perf_counter() - t_wall, rtol=rtol, atol=atol_v,
     )
-    if code == EXIT:
+    if code == DONE:
         return res
-    where = f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})"
-    if code == T_MAX:
-        raise SolverBudgetExceeded(
-            f"{alpha_model}+{v_equation} on {branch}: v did not reach v_f={v_f} before t_max={t_max} s",
-            budget="t_max", limit=t_max, t=state["t"], state=state, partial=res)
-    if code == MAX_STEPS:
-        raise SolverBudgetExceeded(f"{alpha_model}+{v_equation} on {branch}: max_steps={max_steps} reached {where}",
-                                   budget="max_steps", limit=int(max_steps), t=state["t"], state=state, partial=res)
-    if code == STEP_FAIL:
-        raise SolverFailure(f"step size underflow {where}", t=state["t"], state=state, partial=res)
-    reason = {BREAK_VFLOOR: "v_floor", BREAK_VCEIL: "v_ceiling", BREAK_F: "F_nonpositive",
-              BREAK_NONFINITE: "nonfinite"}[code]
-    text = {BREAK_VFLOOR: "v -> 0 on AB (fell by a factor e^60 below v_in)",
-            BREAK_VCEIL: "v ran away on CD (1000 x v_in)", BREAK_F: "the pull force reached 0",
-            BREAK_NONFINITE: "the state became non-finite"}[code]
-    raise ModelBreakdown(f"{alpha_model}+{v_equation} on {branch}: {text} {where}", t=state["t"], state=state,
-                         reason=reason, partial=res)
+    limit = {T_MAX: t_max, MAX_STEPS: int(max_steps)}.get(code)
+    raise status_error(code, t=state["t"], state=state, partial=res, prefix=f"{alpha_model}+{v_equation} on {branch}: ",
+                       where=f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})",
+                       limit=limit, v_f=v_f, v_floor=math.exp(x_lo) if branch == "AB" else 0.0,
+                       why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * v_in)
