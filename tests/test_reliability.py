@@ -11,7 +11,7 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from comparisons._stress import loose_points, run_point
+from comparisons.stress import loose_points, run_point
 from exact import ModelBreakdown, SolverBudgetExceeded, SolverFailure, simulate
 from peelapprox import PeelParams
 

@@ -1,4 +1,4 @@
-"""Stress tests of the exact solver (``comparisons._stress``).
+"""Stress tests of the exact solver (``comparisons.stress``).
 
 Default run: a dozen corner points of the grid in a worker process with a
 timeout, the budget probes, the timeout/crash machinery and one 20 s drift
@@ -14,7 +14,7 @@ import time
 import numpy as np
 import pytest
 
-from comparisons._stress import (
+from comparisons.stress import (
     StressPoint,
     StressRunner,
     budget_points,
