@@ -45,8 +45,8 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
-from typing import Callable, List, Optional, Sequence
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -211,7 +211,7 @@ class WPRow:
     status: str = "ok"
 
 
-def _timed(fn: Callable, repeats: int, warm: Optional[Callable] = None):
+def _timed(fn: Callable, repeats: int, warm: Callable | None = None):
     (warm or fn)()  # warm-up, untimed (``warm``: a shorter run, for the multi-second scipy stiff runs)
     best, out = math.inf, None
     for _ in range(repeats):
@@ -223,7 +223,8 @@ def _timed(fn: Callable, repeats: int, warm: Optional[Callable] = None):
 
 def _row(scene, method, solver, eps, rtol, ref, t, F, wall, steps, n_rhs, status="ok"):
     et, eF = jump_errors(t, F, *ref) if status == "ok" else (math.nan, math.nan)
-    return WPRow(scene.name, method, solver, eps, rtol, et, eF, max(et, eF), wall, int(steps), int(n_rhs), len(t), status)
+    return WPRow(scene.name, method, solver, eps, rtol, et, eF, max(et, eF), wall, int(steps), int(n_rhs), len(t),
+                 status)
 
 
 def _simulate_row(scene, ref, repeats, method, solver, eps, rtol):
@@ -286,8 +287,8 @@ def work_precision(
     reg_rtols: Sequence[float] = (1e-5, 1e-7, 1e-9),
     repeats: int = 5,
     slow_repeats: int = 1,
-    progress: Optional[Callable[[str], None]] = None,
-) -> tuple[List[WPRow], dict]:
+    progress: Callable[[str], None] | None = None,
+) -> tuple[list[WPRow], dict]:
     """Work-precision rows for one scene (module docstring for the methodology).
 
     Returns
@@ -305,7 +306,7 @@ def work_precision(
     ct, cF = jump_errors(bt, bF, *ref)
     reference = dict(scene=scene.name, n_jumps=len(ref[0]), check_t=ct, check_F=cF, t=ref[0], F=ref[1],
                      horizon=scene.horizon)
-    rows: List[WPRow] = []
+    rows: list[WPRow] = []
     for rt in hybrid_rtols:
         say(f"{scene.name}: hybrid rtol {rt:.0e}")
         rows.append(_simulate_row(scene, ref, repeats, "hybrid", "DOP853 (compiled)", 0.0, rt))
@@ -322,7 +323,7 @@ def work_precision(
     return rows, reference
 
 
-def matched_ratios(rows: Sequence[WPRow]) -> List[dict]:
+def matched_ratios(rows: Sequence[WPRow]) -> list[dict]:
     """For each non-hybrid run of a scene with a finite error: the fastest hybrid run of that scene whose
     error is at most the run's error, and the time ratio (their time / hybrid time)."""
     out = []
@@ -385,8 +386,8 @@ def eps_study(
     solver: str = "Radau",
     rtol: float = 1e-10,
     max_steps: int = 60_000,
-    progress: Optional[Callable[[str], None]] = None,
-) -> List[EpsRow]:
+    progress: Callable[[str], None] | None = None,
+) -> list[EpsRow]:
     """Fold-passage delay of the regularised scheme vs ε, against the ε → 0 (hybrid, rtol 1e-13) jumps.
 
     The horizon ends halfway between the reference's second and third jump, so one passage of each fold
@@ -425,8 +426,8 @@ def small_eps_check(
     *,
     rtol: float = 1e-8,
     peers: Sequence[str] = (),
-    progress: Optional[Callable[[str], None]] = None,
-) -> List[EpsRow]:
+    progress: Callable[[str], None] | None = None,
+) -> list[EpsRow]:
     """Which solvers of the regularised system get through both folds at tiny ε in double precision (the
     paper: results do not depend on ε for 1e-7 … 1e-15).  The horizon and delays are as in :func:`eps_study`;
     scipy Radau in the ODE form ``v̇ = φ_v/ε`` and every installed peer (IDA integrates the DAE residual
@@ -494,7 +495,7 @@ def _rhs_cost_ns(n: int = 200_000) -> float:
 
 
 def speed_targets(*, repeats: int = 5, long_run: float = 200.0,
-                  progress: Optional[Callable[[str], None]] = None) -> List[dict]:
+                  progress: Callable[[str], None] | None = None) -> list[dict]:
     """The exact-model issue's speed targets, measured: per-step cost on each scene (rtol 1e-8, 1 s, or the
     long run), the long V=4 run, and the share of the time spent in field evaluations."""
     say = progress or (lambda msg: None)
@@ -530,13 +531,13 @@ def compile_costs() -> tuple[float, float]:
 class BenchmarkReport:
     """Everything one ``peelapprox benchmark`` run measured."""
 
-    rows: List[WPRow]
-    references: List[dict]
-    ratios: List[dict]
-    eps_rows: List[EpsRow]
+    rows: list[WPRow]
+    references: list[dict]
+    ratios: list[dict]
+    eps_rows: list[EpsRow]
     eps_fit: dict
-    small_eps: List[EpsRow]
-    targets: List[dict]
+    small_eps: list[EpsRow]
+    targets: list[dict]
     peers: tuple
     quick: bool
     wall_time: float
@@ -544,8 +545,8 @@ class BenchmarkReport:
     compile: tuple = (math.nan, math.nan)
 
 
-def run_benchmark(*, quick: bool = False, peers: Optional[Sequence[str]] = None,
-                  progress: Optional[Callable[[str], None]] = None) -> BenchmarkReport:
+def run_benchmark(*, quick: bool = False, peers: Sequence[str] | None = None,
+                  progress: Callable[[str], None] | None = None) -> BenchmarkReport:
     """Run the whole benchmark (module docstring).  ``quick`` thins the tolerance grids, uses 3 repeats,
     only ε = 1e-7 for the scipy sweep and a 20 s long run; it is meant to finish in well under 5 minutes.
     ``peers=None`` uses every installed peer (:func:`comparisons._peers.available_peers`)."""
@@ -586,7 +587,8 @@ def run_benchmark(*, quick: bool = False, peers: Optional[Sequence[str]] = None,
     if progress:
         progress("compile costs (fresh processes, cold and cached)")
     compile_ = compile_costs()
-    machine = f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
+    machine = (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+               f"Python {platform.python_version()}")
     return BenchmarkReport(rows, refs, matched_ratios(rows), eps_rows, eps_fit, small_eps, targets, peers, quick,
                            time.perf_counter() - t_start, machine, compile_)
 
@@ -604,7 +606,8 @@ def markdown(rep: BenchmarkReport) -> str:
     for r in rep.references:
         L.append(f"| {r['scene']} | {r['horizon']:g} | {r['n_jumps']} | {_g3(r['check_t'])} | {_g3(r['check_F'])} |")
     L += ["", "### Work precision", "",
-          "| scene | method | solver | ε | rtol | error (max of the two) | Δt/T̄ | ΔF/F | time [s] | steps | RHS | status |",
+          "| scene | method | solver | ε | rtol | error (max of the two) | Δt/T̄ | ΔF/F | time [s] | steps | RHS "
+          "| status |",
           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rep.rows:
         eps = "0" if r.method == "hybrid" else f"{r.eps:.0e}"
@@ -640,11 +643,13 @@ def markdown(rep: BenchmarkReport) -> str:
     for e in rep.small_eps:
         L.append(f"| {e.eps:.0e} | {e.solver} | {_g3(e.delay_ab)} | {_g3(e.delay_cd)} | {_g3(e.time)} | {e.status} |")
     L += ["", "### Speed targets", "",
-          "| scene | simulated [s] | wall [s] | steps | jumps | µs/step | RHS/step | ns/RHS | RHS share of time | steps/jump |",
+          "| scene | simulated [s] | wall [s] | steps | jumps | µs/step | RHS/step | ns/RHS | RHS share of time "
+          "| steps/jump |",
           "|---|---|---|---|---|---|---|---|---|---|"]
     for t in rep.targets:
         L.append(f"| {t['scene']} | {t['t_end']:g} | {t['wall']:.3g} | {t['steps']} | {t['jumps']} | "
-                 f"{t['us_per_step']:.2f} | {t['rhs_per_step']:.1f} | {t['rhs_ns']:.0f} | {100 * t['rhs_share']:.0f} % | "
+                 f"{t['us_per_step']:.2f} | {t['rhs_per_step']:.1f} | {t['rhs_ns']:.0f} | "
+                 f"{100 * t['rhs_share']:.0f} % | "
                  f"{t['steps_per_jump']:.1f} |")
     L += ["", f"Kernel compilation in a fresh process with an empty numba cache: {rep.compile[0]:.1f} s; loading "
               f"the on-disk cache in a fresh process: {rep.compile[1]:.2f} s (never included in the times above)."]
@@ -704,6 +709,6 @@ def plot_eps_study(rep: BenchmarkReport, path) -> None:
     plt.close(fig)
 
 
-def rows_as_dicts(rep: BenchmarkReport) -> tuple[List[dict], List[dict]]:
+def rows_as_dicts(rep: BenchmarkReport) -> tuple[list[dict], list[dict]]:
     """(work-precision rows, ε rows including the tiny-ε check) as plain dicts for CSV/JSON."""
     return [asdict(r) for r in rep.rows], [asdict(e) for e in rep.eps_rows + rep.small_eps]

@@ -10,8 +10,8 @@ fold is reported as a failed row with its reason, never silently dropped.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from typing import Dict, List, Optional, Sequence, Tuple
 
 from peelapprox import ModelBreakdown, SolverBudgetExceeded, reduced_segment
 
@@ -20,7 +20,7 @@ from ._segments import Segment, _crossings, _extrema, local_period, segments
 __all__ = ["DEFAULT_MODELS", "ComparisonRow", "compare", "run_reduction"]
 
 #: reductions tried on each branch by default: (alpha_model, v_equation)
-DEFAULT_MODELS: Dict[str, Tuple[Tuple[str, str], ...]] = {
+DEFAULT_MODELS: dict[str, tuple[tuple[str, str], ...]] = {
     "AB": (("approxalpha", "approxvdot"), ("sinusoid", "approxvdot"), ("genalpha", "approxvdot"),
            ("genalpha", "fullvdot")),
     "CD": (("airy2", "approxvdot"), ("airy2_frozen", "approxvdot"), ("exponential", "approxvdot"),
@@ -39,16 +39,16 @@ class ComparisonRow:
     v_equation: str
     status: str
     dt_exact: float
-    dt_approx: Optional[float]
-    dt_abs_error: Optional[float]
-    dt_rel_error: Optional[float]
+    dt_approx: float | None
+    dt_abs_error: float | None
+    dt_rel_error: float | None
     dF_exact: float
-    dF_approx: Optional[float]
-    dF_abs_error: Optional[float]
-    dF_rel_error: Optional[float]
-    period_exact: Optional[float]
-    period_approx: Optional[float]
-    period_rel_error: Optional[float]
+    dF_approx: float | None
+    dF_abs_error: float | None
+    dF_rel_error: float | None
+    period_exact: float | None
+    period_approx: float | None
+    period_rel_error: float | None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -73,14 +73,14 @@ def run_reduction(params, branch: str, alpha_model: str, v_equation: str, **seed
         return None, f"no exit: {exc.budget}"
 
 
-def _err(a: Optional[float], e: Optional[float]):
+def _err(a: float | None, e: float | None):
     if a is None or e is None:
         return None, None
     return a - e, (a - e) / abs(e) if e != 0 else None
 
 
-def compare(trajectory, models: Optional[Dict[str, Sequence[Tuple[str, str]]]] = None, *,
-            segs: Optional[List[Segment]] = None, rtol: float = 1e-10) -> List[ComparisonRow]:
+def compare(trajectory, models: dict[str, Sequence[tuple[str, str]]] | None = None, *,
+            segs: list[Segment] | None = None, rtol: float = 1e-10) -> list[ComparisonRow]:
     """Every reduction on every segment of an exact trajectory, seeded from exact entry states.
 
     Signature: ``compare(trajectory, models=None, *, segs=None, rtol=1e-10) -> list[ComparisonRow]``.
@@ -104,7 +104,7 @@ def compare(trajectory, models: Optional[Dict[str, Sequence[Tuple[str, str]]]] =
     """
     models = DEFAULT_MODELS if models is None else models
     params = trajectory.params
-    rows: List[ComparisonRow] = []
+    rows: list[ComparisonRow] = []
     for s in (segments(trajectory) if segs is None else segs):
         p_ex = s.local_period()
         for am, ve in models.get(s.branch, ()):

@@ -70,17 +70,18 @@ import functools
 import importlib
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Sequence, Union
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from exact._simulate import _atol_vector, initial_state
 from peelapprox import GEOMETRIES, SolverFailure
 from peelapprox._params import EPS_RANGE
+from peelapprox._peelforce import branch_structure
 from peelapprox._validate import choice, duration, function, in_range, optional, reals, state
 from peelapprox._validate import params as _params
-from peelapprox._peelforce import branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
     from peelapprox import PeelParams
@@ -180,7 +181,7 @@ def _import(peer: str):
         ) from exc
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _works(peer: str) -> bool:
     try:
         mod = _import(peer)
@@ -329,7 +330,7 @@ def diffsl_model(geometry: str = "paper", *, tangent: bool = False):
     return ds.Ode(diffsl_code(geometry, tangent=tangent), matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
 
 
-def diffsl_inputs(params: "PeelParams", eps: float, state, scale, tangent=None, tangent_scale=None) -> np.ndarray:
+def diffsl_inputs(params: PeelParams, eps: float, state, scale, tangent=None, tangent_scale=None) -> np.ndarray:
     """The ``in_i`` vector of :func:`diffsl_code` (order :data:`DIFFSL_INPUTS`, then
     :data:`DIFFSL_TANGENT_INPUTS` when ``tangent`` is given).
 
@@ -470,12 +471,12 @@ def _run_diffsol(params, t_end, eps, rtol, atol, y0):
 
 def run_peer(
     peer: str,
-    params: "PeelParams",
+    params: PeelParams,
     t_end: float,
     *,
     eps: float,
     rtol: float,
-    atol: Union[None, float, Sequence[float]] = None,
+    atol: None | float | Sequence[float] = None,
     alpha0: float = 0.0,
 ) -> PeerResult:
     """Integrate the ε-regularised system from 0 to ``t_end`` with an external peer.
@@ -586,7 +587,7 @@ def tangent_solve(ode, params, eps: float, atol: np.ndarray, x, d, duration: flo
 
 
 def lyapunov_regularized(
-    params: "PeelParams",
+    params: PeelParams,
     *,
     eps: float = 1e-7,
     t_transient: float = 30.0,

@@ -7,8 +7,8 @@ This is what ``peelapprox compare`` runs.  Signature:
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
-from typing import Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -38,22 +38,22 @@ class StatRow:
     n: int
     n_failed: int
     n_defined: int
-    median: Optional[float]
-    p90: Optional[float]
-    max: Optional[float]
+    median: float | None
+    p90: float | None
+    max: float | None
 
     def as_dict(self) -> dict:
         return asdict(self)
 
 
-def statistics(runs: Sequence[str] = STAT_RUNS, models=None) -> List[StatRow]:
+def statistics(runs: Sequence[str] = STAT_RUNS, models=None) -> list[StatRow]:
     """Median, 90th percentile and max of |relative error| of Δt, ΔF and the α period, per run, branch and
     reduction, over every complete segment of each run's window (seeded from the exact entries).
 
     Signature: ``statistics(runs=STAT_RUNS, models=None) -> list[StatRow]``; ``models`` as in
     :func:`compare` (default :data:`DEFAULT_MODELS`).
     """
-    out: List[StatRow] = []
+    out: list[StatRow] = []
     for name in runs:
         run = exact_run(name)
         rows = compare(run.trajectory, models, segs=run.segments)
@@ -77,22 +77,22 @@ def statistics(runs: Sequence[str] = STAT_RUNS, models=None) -> List[StatRow]:
 class CompareReport:
     """Rows of every scene, the statistics, the transient checks and the timings [s]."""
 
-    rows: List[Row]
-    stats: List[StatRow]
-    transients: Dict[str, str]
-    timings: Dict[str, float]
-    figures: List[str] = field(default_factory=list)
+    rows: list[Row]
+    stats: list[StatRow]
+    transients: dict[str, str]
+    timings: dict[str, float]
+    figures: list[str] = field(default_factory=list)
 
-    def row_dicts(self) -> List[dict]:
+    def row_dicts(self) -> list[dict]:
         return [r.as_dict() for r in self.rows]
 
-    def stat_dicts(self) -> List[dict]:
+    def stat_dicts(self) -> list[dict]:
         return [s.as_dict() for s in self.stats]
 
 
-def run_compare(scenes: Optional[Sequence[str]] = None, *, statistics_runs: Optional[Sequence[str]] = STAT_RUNS,
-                figures_dir: Optional[str] = None,
-                progress: Optional[Callable[[str], None]] = None) -> CompareReport:
+def run_compare(scenes: Sequence[str] | None = None, *, statistics_runs: Sequence[str] | None = STAT_RUNS,
+                figures_dir: str | None = None,
+                progress: Callable[[str], None] | None = None) -> CompareReport:
     """Run the scenes (default: all of :data:`SCENES`, in order), then the statistics.
 
     Parameters
@@ -121,8 +121,8 @@ def run_compare(scenes: Optional[Sequence[str]] = None, *, statistics_runs: Opti
             raise ValueError(f"statistics run must be one of {list(RUNS)}, got {n!r}")
     say = progress or (lambda msg: None)
     t_all = time.perf_counter()
-    timings: Dict[str, float] = {}
-    transients: Dict[str, str] = {}
+    timings: dict[str, float] = {}
+    transients: dict[str, str] = {}
 
     def ensure_run(name):
         if name not in transients:
@@ -132,8 +132,8 @@ def run_compare(scenes: Optional[Sequence[str]] = None, *, statistics_runs: Opti
             say(f"exact run {name}: {r.wall_time:.2f} s, {len(r.segments)} segments; {transients[name]}")
         return exact_run(name)
 
-    rows: List[Row] = []
-    figures: List[str] = []
+    rows: list[Row] = []
+    figures: list[str] = []
     for i, n in enumerate(names, 1):
         sc = SCENES[n]
         run = ensure_run(sc.run)
@@ -143,7 +143,7 @@ def run_compare(scenes: Optional[Sequence[str]] = None, *, statistics_runs: Opti
             figures.extend(sc.figures(run, figures_dir))
         timings[f"scene {n}"] = time.perf_counter() - t0
         say(f"[{i}/{len(names)}] {n}: {timings[f'scene {n}']:.2f} s")
-    stats: List[StatRow] = []
+    stats: list[StatRow] = []
     if statistics_runs:
         for n in statistics_runs:
             ensure_run(n)
@@ -175,10 +175,10 @@ def _pct(x, signed: bool = True) -> str:
     return f"{100 * x:{'+' if signed else ''}{digits}} %"
 
 
-def markdown(report: CompareReport, *, figures_rel: Optional[str] = None) -> str:
+def markdown(report: CompareReport, *, figures_rel: str | None = None) -> str:
     """The report as markdown: one table per scene, then the statistics, transients and timings."""
     out = []
-    by_scene: Dict[str, List[Row]] = {}
+    by_scene: dict[str, list[Row]] = {}
     for r in report.rows:
         by_scene.setdefault(r.scene, []).append(r)
     for name, rows in by_scene.items():

@@ -27,7 +27,6 @@ from __future__ import annotations
 import functools
 import time
 from dataclasses import dataclass
-from typing import List, Optional
 
 import numpy as np
 
@@ -60,7 +59,7 @@ class TransientCheck:
     envelope difference relative to the range)."""
 
     kind: str
-    period: Optional[int]
+    period: int | None
     mismatch: float
     n_jumps: int
 
@@ -150,12 +149,12 @@ class ExactRun:
 
     spec: RunSpec
     trajectory: object
-    segments: List[Segment]
+    segments: list[Segment]
     transient: TransientCheck
     wall_time: float
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def exact_run(name: str) -> ExactRun:
     """The exact run ``RUNS[name]``, integrated once per process and checked past its transient.
 

@@ -21,9 +21,9 @@ progress=None) -> SceneReport``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from types import SimpleNamespace
-from typing import Callable, Dict, List, Optional
 
 import numpy as np
 
@@ -53,12 +53,12 @@ class Row:
     quantity: str
     seed: str
     method: str
-    paper_approx: Optional[float]
-    paper_exact: Optional[float]
-    ours_approx: Optional[float]
-    ours_exact: Optional[float]
-    rel_error: Optional[float]
-    claim: Optional[float] = None
+    paper_approx: float | None
+    paper_exact: float | None
+    ours_approx: float | None
+    ours_exact: float | None
+    rel_error: float | None
+    claim: float | None = None
     status: str = "ok"
     note: str = ""
 
@@ -77,7 +77,7 @@ class Row:
         return d
 
 
-def _rel(a: Optional[float], e: Optional[float]) -> Optional[float]:
+def _rel(a: float | None, e: float | None) -> float | None:
     return None if a is None or e is None or e == 0 else (a - e) / abs(e)
 
 
@@ -95,14 +95,14 @@ class Scene:
     title: str
     run: str
     selector: str
-    rows: Callable[[ExactRun], List[Row]]
-    figures: Optional[Callable[[ExactRun, str], List[str]]] = field(default=None, repr=False)
+    rows: Callable[[ExactRun], list[Row]]
+    figures: Callable[[ExactRun, str], list[str]] | None = field(default=None, repr=False)
 
 
 # --------------------------------------------------------------------------------------------
 # segment selectors (each returns one exact Segment of the run's window)
 
-def _ab(run: ExactRun) -> List[Segment]:
+def _ab(run: ExactRun) -> list[Segment]:
     return [s for s in run.segments if s.branch == "AB"]
 
 
@@ -110,7 +110,7 @@ def _nearest_F_in(run: ExactRun, branch: str, F: float) -> Segment:
     return min((s for s in run.segments if s.branch == branch), key=lambda s: abs(s.F_in - F))
 
 
-def _first_max(segs: List[Segment], key) -> Segment:
+def _first_max(segs: list[Segment], key) -> Segment:
     """The first segment whose ``key`` is within 1e-6 (relative, the transient check's recurrence
     tolerance) of the window's maximum: the same stay of the first cycle in a periodic window."""
     top = max(key(s) for s in segs)
@@ -153,7 +153,7 @@ def _window(run: ExactRun, seg: Segment):
 # reductions from the two kinds of seed
 
 def _reduce_rows(scene: str, run: ExactRun, seg: Segment, models, *, quantities, paper_seeds=(),
-                 claim_models=None) -> List[Row]:
+                 claim_models=None) -> list[Row]:
     """Δt / ΔF / exit-F rows of reductions of one segment, from paper seeds and from the exact entry.
 
     ``quantities`` maps "dt"/"dF"/"F_exit" to ``(label, paper_approx, paper_exact, claimed)``, with
@@ -180,7 +180,7 @@ def _reduce_rows(scene: str, run: ExactRun, seg: Segment, models, *, quantities,
 # --------------------------------------------------------------------------------------------
 # Case I (I = 1e-5, V = 1)
 
-def _case_i_periods(run: ExactRun) -> List[Row]:
+def _case_i_periods(run: ExactRun) -> list[Row]:
     p = run.spec.params
     ab = [s for s in _ab(run) if len(s.periods) >= 2]
     rows = []
@@ -191,14 +191,15 @@ def _case_i_periods(run: ExactRun) -> List[Row]:
         rows.append(_row("case-I-periods", label, "paper", f"approxalpha T = 2π√(I/FR), F = {F_paper:g}", pa, pe,
                          float(inertial_period(p, F_paper)), T_ex, claim=CLAIM,
                          note="paper's 3.69e-3 is a misprint for 3.73e-3 (paper-notes 11)" if k else ""))
-        rows.append(_row("case-I-periods", label, "exact", "approxalpha T = 2π√(I/FR), F = exact mean F over the period",
+        rows.append(_row("case-I-periods", label, "exact",
+                         "approxalpha T = 2π√(I/FR), F = exact mean F over the period",
                          pa, pe, float(inertial_period(p, F_ex)), T_ex, claim=CLAIM,
                          note=f"median over {len(ab)} AB stays of the {'first' if k == 0 else 'last'} α period "
                               f"(mean F {F_ex:.1f} N)"))
     return rows
 
 
-def _case_i_times(run: ExactRun) -> List[Row]:
+def _case_i_times(run: ExactRun) -> list[Row]:
     ab = _nearest_F_in(run, "AB", 211.5)
     cd = _after(run, ab)
     fmax = branch_structure(run.spec.V).f_max
@@ -218,7 +219,7 @@ def _case_i_times(run: ExactRun) -> List[Row]:
     return rows
 
 
-def _fig8(run: ExactRun, outdir: str) -> List[str]:
+def _fig8(run: ExactRun, outdir: str) -> list[str]:
     ab = _nearest_F_in(run, "AB", 211.5)
     return [_plot_pair(run, ab, ("approxalpha", "approxvdot"), f"{outdir}/fig8_ab.png",
                        "Fig. 8: AB, I = 1e-5, V = 1 (approxalpha + approxvdot vs exact)"),
@@ -244,7 +245,7 @@ def _plot_pair(run: ExactRun, seg: Segment, model, path: str, title: str) -> str
 _CASCADE_PAPER_SEED = dict(F_in=295.6, alpha_in=-0.0304, alphadot_in=-160.0, v_in=15.54, v_f=8.7)
 
 
-def _case_ii_cascade(run: ExactRun) -> List[Row]:
+def _case_ii_cascade(run: ExactRun) -> list[Row]:
     top = _top_cd(run)
     rows = _reduce_rows(
         "case-II-cascade", run, top,
@@ -266,7 +267,7 @@ def _case_ii_cascade(run: ExactRun) -> List[Row]:
     return rows
 
 
-def _case_ii_point_e(run: ExactRun) -> List[Row]:
+def _case_ii_point_e(run: ExactRun) -> list[Row]:
     e = _after(run, _top_cd(run))
     seed = dict(F_in=276.53, alphadot_in=11.9, v_f=0.4)
     return _reduce_rows(
@@ -277,7 +278,7 @@ def _case_ii_point_e(run: ExactRun) -> List[Row]:
                       "α_in = -0.239 (paper-notes 7), v_in = 0.00188 (paper-notes 1)")])
 
 
-def _case_ii_point_a(run: ExactRun) -> List[Row]:
+def _case_ii_point_a(run: ExactRun) -> list[Row]:
     a = _point_a(run)
     seed = dict(F_in=186.95, alpha_in=0.0599, alphadot_in=9.7, v_f=0.4)
     return _reduce_rows(
@@ -290,7 +291,7 @@ def _case_ii_point_a(run: ExactRun) -> List[Row]:
         claim_models={("approxalpha", "approxvdot"), ("sinusoid", "approxvdot")})
 
 
-def _fig9(run: ExactRun, outdir: str) -> List[str]:
+def _fig9(run: ExactRun, outdir: str) -> list[str]:
     return [_plot_pair(run, _point_a(run), ("approxalpha", "approxvdot"), f"{outdir}/fig9.png",
                        "Fig. 9: AB a→b, I = 1e-2, V = 1 (approxalpha + approxvdot vs exact)")]
 
@@ -300,7 +301,7 @@ def _max_alpha(run: ExactRun, seg: Segment) -> float:
     return float(np.max(c.alpha))
 
 
-def _case_ii_slope(run: ExactRun) -> List[Row]:
+def _case_ii_slope(run: ExactRun) -> list[Row]:
     """The slope criterion 2πν α₀ (natural slope of the a→b sinusoid) vs the entry slope α̇_in at a and k."""
     p = run.spec.params
     a, k = _point_a(run), _point_k(run)
@@ -326,7 +327,7 @@ def _case_ii_slope(run: ExactRun) -> List[Row]:
 # --------------------------------------------------------------------------------------------
 # Case III (I = 1e-2, V = 4) and the high-inertia period estimates
 
-def _case_iii_coupled(run: ExactRun) -> List[Row]:
+def _case_iii_coupled(run: ExactRun) -> list[Row]:
     """Coupled genalpha + approxvdot (the paper's) and + fullvdot on every rapid-jump stay of the window."""
     models = (("genalpha", "approxvdot"), ("genalpha", "fullvdot"))
     rapid = [s for s in run.segments if s.dt < 0.01]
@@ -347,7 +348,7 @@ def _case_iii_coupled(run: ExactRun) -> List[Row]:
     return rows
 
 
-def _case_iii_bounds(run: ExactRun) -> List[Row]:
+def _case_iii_bounds(run: ExactRun) -> list[Row]:
     p = run.spec.params
     tr = run.trajectory
     a_min, a_max = float(tr.alpha.min()), float(tr.alpha.max())
@@ -381,7 +382,7 @@ def _up_crossings(run: ExactRun):
     return _crossings(tr.t, tr.alpha, tr.omega - tr.v / run.spec.params.R)
 
 
-def _periods_high_inertia_v1(run: ExactRun) -> List[Row]:
+def _periods_high_inertia_v1(run: ExactRun) -> list[Row]:
     p = run.spec.params
     a = _point_a(run)
     T_ex = a.local_period()
@@ -397,7 +398,7 @@ def _periods_high_inertia_v1(run: ExactRun) -> List[Row]:
     ]
 
 
-def _periods_high_inertia_v4(run: ExactRun) -> List[Row]:
+def _periods_high_inertia_v4(run: ExactRun) -> list[Row]:
     p = run.spec.params
     t_hi, t_lo, T_cycle, F_mean = _alpha_cycle(run)
     T300 = float(inertial_period(p, 300.0))
@@ -415,7 +416,7 @@ def _periods_high_inertia_v4(run: ExactRun) -> List[Row]:
     ]
 
 
-SCENES: Dict[str, Scene] = {s.name: s for s in (
+SCENES: dict[str, Scene] = {s.name: s for s in (
     Scene("case-I-periods", "Case I a: α periods on AB at F_min and F_max (I=1e-5, V=1)", "V1-I1e-5",
           "every AB stay with ≥ 2 α periods: its first (lowest F) and last (highest F) period",
           _case_i_periods),
@@ -444,7 +445,7 @@ SCENES: Dict[str, Scene] = {s.name: s for s in (
 )}
 
 
-def scene_rows(name: str) -> List[Row]:
+def scene_rows(name: str) -> list[Row]:
     """The rows of one scene (running, or reusing, its exact run).
 
     Raises

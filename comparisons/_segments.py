@@ -15,7 +15,6 @@ derivative) give the half periods instead.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import List, Optional
 
 import numpy as np
 from scipy.integrate import trapezoid
@@ -78,7 +77,7 @@ class Segment:
     def dF(self) -> float:
         return self.F_out - self.F_in
 
-    def local_period(self) -> Optional[float]:
+    def local_period(self) -> float | None:
         """The α period inside this stay [s], or None if it cannot be measured.
 
         The median of :attr:`periods` (successive upward zero crossings) when
@@ -124,7 +123,7 @@ def _crossings(t, a, d):
     return np.array(sorted(set(out)))
 
 
-def local_period(crossings, extrema) -> Optional[float]:
+def local_period(crossings, extrema) -> float | None:
     """Median spacing of upward zero crossings, else twice the median spacing of extrema, else None [s]."""
     if len(crossings) >= 2:
         return float(np.median(np.diff(crossings)))
@@ -162,7 +161,7 @@ def time_mean(t: np.ndarray, x: np.ndarray, t0: float, t1: float) -> float:
     return float(trapezoid(xx, tt) / (t1 - t0))
 
 
-def segments(trajectory) -> List[Segment]:
+def segments(trajectory) -> list[Segment]:
     """Complete branch segments of an exact trajectory, in time order.
 
     Signature: ``segments(trajectory) -> list[Segment]``.
@@ -187,7 +186,7 @@ def segments(trajectory) -> List[Segment]:
     al = np.asarray(trajectory.alpha)
     ad = np.asarray(trajectory.omega) - np.asarray(trajectory.v) / R
     F = np.asarray(trajectory.F)
-    out: List[Segment] = []
+    out: list[Segment] = []
     for i in range(len(J) - 1):
         a, b = J[i], J[i + 1]
         if a.to_branch != b.from_branch:  # pragma: no cover - the solver guarantees alternation

@@ -83,11 +83,21 @@ from __future__ import annotations
 import numpy as np
 
 from peelapprox import _generated as _g
+from peelapprox._dop853 import (
+    MAX_REJECTIONS,
+    STEP_FAILED,
+    crossing,
+    interp,
+    interp1,
+    make_dop853,
+    solve_theta,
+    state_at,
+    workspace,
+)
+from peelapprox._dop853 import N_STAGES as _NS
 from peelapprox._jit import kernel
-from peelapprox._status import DONE, GEOMETRY, JUMPS_FULL, NO_LANDING, NO_ROOT, OUT_FULL, PAUSE, STEP_FAIL, V_CEILING
-from peelapprox._dop853 import MAX_REJECTIONS, STEP_FAILED, N_STAGES as _NS
-from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from peelapprox._peelforce import peel_force_fp_jit, peel_force_lnv_jit
+from peelapprox._status import DONE, GEOMETRY, JUMPS_FULL, NO_LANDING, NO_ROOT, OUT_FULL, PAUSE, STEP_FAIL, V_CEILING
 
 # the model's equations, compiled from the one generated source
 # (inline="always": numba then inlines them at the IR level; as separately compiled functions their calls

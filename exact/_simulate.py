@@ -5,12 +5,14 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import Callable, Optional, Sequence, Union
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from peelapprox import PeelParams
+from peelapprox import _status as S
 from peelapprox._errors import SolverBudgetExceeded, budget_exceeded
+from peelapprox._params import EPS_RANGE, RTOL_RANGE, TIME_MAX
 from peelapprox._peelforce import (
     BRANCHES,
     BREAKDOWN_LEVEL,
@@ -19,10 +21,9 @@ from peelapprox._peelforce import (
     peel_force,
     peel_force_coefficients,
 )
-from peelapprox import _status as S
 from peelapprox._status import status_error
-from peelapprox._params import EPS_RANGE, RTOL_RANGE, TIME_MAX
-from peelapprox._validate import choice, duration, in_range, integer, optional, params as _params, positive, reals, state
+from peelapprox._validate import choice, duration, in_range, integer, optional, positive, reals, state
+from peelapprox._validate import params as _params
 
 from . import _hybrid as H
 from ._trajectory import Jumps, SolverStats, State, Trajectory
@@ -62,9 +63,9 @@ def initial_state(
     params: PeelParams,
     *,
     alpha0: float = 0.0,
-    omega0: Optional[float] = None,
-    F0: Optional[float] = None,
-    branch0: Optional[str] = None,
+    omega0: float | None = None,
+    F0: float | None = None,
+    branch0: str | None = None,
     t0: float = 0.0,
 ) -> State:
     """The consistent initial state used by :func:`simulate`.
@@ -142,7 +143,8 @@ def compile_kernels() -> float:
     t0 = time.perf_counter()
     p = PeelParams(V=1.0, I=1e-5)
     st = initial_state(p)
-    _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None, None)
+    _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None,
+                None)
     _COMPILE_TIME["hybrid"] = time.perf_counter() - t0
     return _COMPILE_TIME["hybrid"]
 
@@ -167,23 +169,23 @@ def simulate(
     t_end: float,
     *,
     alpha0: float = 0.0,
-    omega0: Optional[float] = None,
-    F0: Optional[float] = None,
-    branch0: Optional[str] = None,
+    omega0: float | None = None,
+    F0: float | None = None,
+    branch0: str | None = None,
     method: str = "hybrid",
-    solver: Optional[str] = None,
+    solver: str | None = None,
     rtol: float = 1e-8,
-    atol: Union[None, float, Sequence[float]] = None,
-    eps: Optional[float] = None,
+    atol: None | float | Sequence[float] = None,
+    eps: float | None = None,
     t_transient: float = 0.0,
-    t_eval: Optional[Sequence[float]] = None,
+    t_eval: Sequence[float] | None = None,
     save: str = "steps",
     max_points: int = 5_000_000,
-    max_steps: Optional[int] = None,
+    max_steps: int | None = None,
     max_jumps: int = 20_000_000,
-    max_wall: Optional[float] = None,
-    v_floor: Optional[float] = None,
-    progress: Union[None, bool, Callable[[float, float], None]] = None,
+    max_wall: float | None = None,
+    v_floor: float | None = None,
+    progress: None | bool | Callable[[float, float], None] = None,
 ) -> Trajectory:
     """Integrate the peeling model (FLOW1, FLOW2, flow3, CONSTR) from t = 0 to t_end.
 
@@ -308,7 +310,8 @@ def simulate(
     if method == "hybrid":
         ct = compile_kernels()
         traj = _run_hybrid(
-            params, t_end, st0, rtol, atol_v, t_transient, te, save, max_points, max_steps, max_jumps, progress, v_floor,
+            params, t_end, st0, rtol, atol_v, t_transient, te, save, max_points, max_steps, max_jumps, progress,
+            v_floor,
             max_wall,
         )
         if ct:
@@ -317,7 +320,8 @@ def simulate(
     from ._regularized import run_regularized
 
     return run_regularized(
-        params, t_end, st0, solver, rtol, atol_v, eps, t_transient, te, save, max_points, max_steps, max_jumps, progress,
+        params, t_end, st0, solver, rtol, atol_v, eps, t_transient, te, save, max_points, max_steps, max_jumps,
+        progress,
         v_floor, max_wall,
     )
 
@@ -326,7 +330,7 @@ def simulate(
 V_CEILING = 1e3
 
 
-def _param_vector(params: PeelParams, v_floor: Optional[float] = None) -> np.ndarray:
+def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``."""
     bs = branch_structure(params.V)

@@ -25,15 +25,14 @@ DOP853 (:mod:`peelapprox._dop853`).
 from __future__ import annotations
 
 import math
-from typing import Optional
 
 import numpy as np
+
+from peelapprox._dop853 import N_STAGES as _NS
+from peelapprox._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, workspace
 from peelapprox._jit import kernel
 from peelapprox._peelforce import BREAKDOWN_LEVEL, branch_structure
 from peelapprox._status import DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, status_error
-
-from peelapprox._dop853 import STEP_FAILED, N_STAGES as _NS
-from peelapprox._dop853 import crossing, interp, interp1, make_dop853, solve_theta, workspace
 from peelapprox._validate import duration, integer, optional
 
 from . import _hybrid as H
@@ -159,7 +158,7 @@ MAX_DEFAULT_STEPS = 1_000_000_000
 
 
 def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rtol: float = 1e-10,
-                       alpha0: float = 0.0, max_steps: Optional[int] = None):
+                       alpha0: float = 0.0, max_steps: int | None = None):
     """Largest Lyapunov exponent [1/s] from the tangent dynamics with saltation matrices (module docstring).
 
     Starts from the state at ``t_transient`` (exact.simulate from ``alpha0``), integrates the tangent for

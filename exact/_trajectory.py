@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import json
 from dataclasses import dataclass
-from typing import Optional
 
 import numpy as np
 
@@ -64,7 +63,7 @@ class Jumps:
     FIELDS = ("t", "from_branch", "to_branch", "alpha", "omega", "F", "v_before", "v_after")
 
     @classmethod
-    def from_buffer(cls, buf: np.ndarray) -> "Jumps":
+    def from_buffer(cls, buf: np.ndarray) -> Jumps:
         buf = np.asarray(buf, dtype=float).reshape(-1, 8)
         return cls(
             t=buf[:, 0].copy(),
@@ -172,7 +171,7 @@ class Trajectory:
         solver: str,
         rtol: float,
         atol,
-        eps: Optional[float],
+        eps: float | None,
         initial_state: State,
         final_state: State,
         t_end: float,
@@ -264,7 +263,7 @@ class Trajectory:
         )
 
     @classmethod
-    def from_npz(cls, path) -> "Trajectory":
+    def from_npz(cls, path) -> Trajectory:
         """Load a trajectory written by :meth:`to_npz`."""
         with np.load(path, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"]))

@@ -23,31 +23,6 @@ from ._alpha import (
     wkb_amplitude_phase,
     wkb_error_bound,
 )
-from ._errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from ._params import GEOMETRIES, PARAM_RANGES, PeelParams
-from ._estimate import (
-    INERTIA_RULE,
-    VELOCITY_RULE,
-    RegimeEstimate,
-    SlopeCriterion,
-    crude_branch_time,
-    estimate,
-    force_bounds,
-    quasi_static_branch_time,
-    slope_criterion,
-)
-from ._peelforce import (
-    BRANCHES,
-    BranchStructure,
-    FixedPoint,
-    branch_inverse,
-    branch_structure,
-    fixed_point,
-    peel_force,
-    peel_force_derivative,
-)
-from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
-from ._sweep import MEASURES, SweepResult, load_sweep, parse_grid, register_measure, sweep
 from ._dynamics import (
     Attractor,
     LyapunovResult,
@@ -62,7 +37,31 @@ from ._dynamics import (
     return_map,
     settle_time,
 )
-
+from ._errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from ._estimate import (
+    INERTIA_RULE,
+    VELOCITY_RULE,
+    RegimeEstimate,
+    SlopeCriterion,
+    crude_branch_time,
+    estimate,
+    force_bounds,
+    quasi_static_branch_time,
+    slope_criterion,
+)
+from ._params import GEOMETRIES, PARAM_RANGES, PeelParams
+from ._peelforce import (
+    BRANCHES,
+    BranchStructure,
+    FixedPoint,
+    branch_inverse,
+    branch_structure,
+    fixed_point,
+    peel_force,
+    peel_force_derivative,
+)
+from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
+from ._sweep import MEASURES, SweepResult, load_sweep, parse_grid, register_measure, sweep
 from ._version import __version__ as __version__
 
 __all__ = [

@@ -32,7 +32,7 @@ compiled segment solver uses the same functions.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple, Optional
+from typing import NamedTuple
 
 import numpy as np
 from scipy import integrate, special
@@ -161,7 +161,7 @@ class InertialPeriods(NamedTuple):
     F_mean: float
 
 
-def inertial_periods(params: PeelParams, F_mean: Optional[float] = None) -> InertialPeriods:
+def inertial_periods(params: PeelParams, F_mean: float | None = None) -> InertialPeriods:
     """Periods of approxalpha at ``F = f_min``, ``f_max`` and a mean force.
 
     Signature: ``inertial_periods(params, F_mean=None) -> InertialPeriods``.
@@ -205,7 +205,7 @@ def harmonic_alpha(params: PeelParams, t, *, F: float, alpha_in: float, alphadot
 
 
 def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
-               F_rate: Optional[float] = None):
+               F_rate: float | None = None):
     """Exact solution of the Airy-type equation ``I α̈ = -(F_in + s t) R α`` (Airy).
 
     Signature: ``airy_alpha(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> (alpha, alphadot)``.
@@ -263,7 +263,7 @@ def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_
 
 
 def sinusoid_alpha(params: PeelParams, t, *, F_in: float, amplitude: float, phase: float,
-                   F_rate: Optional[float] = None):
+                   F_rate: float | None = None):
     """The paper's slowly varying sinusoid for α on AB, as the WKB form of Airy.
 
     Signature: ``sinusoid_alpha(params, t, *, F_in, amplitude, phase, F_rate=None) -> (alpha, alphadot)``.
@@ -288,7 +288,7 @@ def sinusoid_alpha(params: PeelParams, t, *, F_in: float, amplitude: float, phas
 
 
 def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alphadot_in: float,
-                        F_rate: Optional[float] = None) -> tuple[float, float]:
+                        F_rate: float | None = None) -> tuple[float, float]:
     """``(A, φ)`` of :func:`sinusoid_alpha` matching ``(α_in, α̇_in)`` at t = 0.
 
     Solves ``A sin φ = α_in`` and ``A (Ω_in cos φ - s/(4 F_in) sin φ) = α̇_in``.
@@ -301,7 +301,7 @@ def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alp
 
 
 def wkb_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
-              F_rate: Optional[float] = None):
+              F_rate: float | None = None):
     """:func:`sinusoid_alpha` matched to ``(α_in, α̇_in)`` (see :func:`wkb_amplitude_phase`).
 
     Signature: ``wkb_alpha(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> (alpha, alphadot)``.
@@ -311,7 +311,7 @@ def wkb_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_i
 
 
 def wkb_error_bound(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
-                    F_rate: Optional[float] = None):
+                    F_rate: float | None = None):
     """Rigorous bound on ``|α_Airy(t) - α_WKB(t)|`` [rad].
 
     Signature: ``wkb_error_bound(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> ndarray``.
@@ -345,7 +345,7 @@ def wkb_error_bound(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
 
 
 def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
-                    form: str = "airy", F_rate: Optional[float] = None, v: Optional[float] = None,
+                    form: str = "airy", F_rate: float | None = None, v: float | None = None,
                     rtol: float = 1e-12, atol: float = 1e-15):
     """Integrate an α equation of Sec. V numerically with v frozen.
 

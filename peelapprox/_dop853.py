@@ -34,11 +34,13 @@ The pieces that do not call the field (``combine``,
 
 from __future__ import annotations
 
-from typing import Callable, NamedTuple
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
-from ._jit import kernel
 from scipy.integrate._ivp import dop853_coefficients as _dop
+
+from ._jit import kernel
 
 __all__ = [
     "Dop853",

@@ -23,8 +23,8 @@ from __future__ import annotations
 import functools
 import math
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -99,7 +99,7 @@ class Periodicity:
     """
 
     kind: str
-    period: Optional[int]
+    period: int | None
     mismatch: float
     n_returns: int
     rtol: float
@@ -169,7 +169,7 @@ def force_drops(trajectory) -> np.ndarray:
     return F[idx] - F[idx + 1]
 
 
-def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> Optional[float]:
+def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> float | None:
     """The time from which the return map is periodic to the end of the stored window, or None.
 
     Signature: ``settle_time(trajectory, *, rtol=1e-6, max_period=32) -> float | None``.
@@ -197,7 +197,7 @@ WINDOW_DEFAULTS = dict(t_transient=30.0, window=20.0, rtol=1e-10, alpha0=0.0)
 
 
 def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float = 20.0, rtol: float = 1e-10,
-               alpha0: float = 0.0, max_wall: Optional[float] = None):
+               alpha0: float = 0.0, max_wall: float | None = None):
     """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
 
     Signature: ``window_run(params, *, t_transient=30, window=20, rtol=1e-10, alpha0=0, max_wall=None)
@@ -244,11 +244,11 @@ class Attractor:
     """
 
     label: str
-    period: Optional[int]
-    signature: Tuple[float, ...]
-    F_range: Tuple[float, float]
-    starts: Tuple[float, ...]
-    settle_times: Tuple[Optional[float], ...]
+    period: int | None
+    signature: tuple[float, ...]
+    F_range: tuple[float, float]
+    starts: tuple[float, ...]
+    settle_times: tuple[float | None, ...]
 
 
 def attractors(
@@ -260,9 +260,9 @@ def attractors(
     rtol: float = 1e-10,
     period_rtol: float = 1e-6,
     match_rtol: float = 1e-4,
-    progress: Optional[Callable[[str], None]] = None,
-    max_wall: Optional[float] = DEFAULT_MAX_WALL,
-) -> List[Attractor]:
+    progress: Callable[[str], None] | None = None,
+    max_wall: float | None = DEFAULT_MAX_WALL,
+) -> list[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
     Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=20, rtol=1e-10,
@@ -271,7 +271,8 @@ def attractors(
     None: unbounded).
 
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
-    (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same attractor when their
+    (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same
+    attractor when their
     periods agree and their sorted return-map cycles agree to ``match_rtol`` relative (a cycle is the same
     set of jump forces whatever its phase); aperiodic windows are grouped by their return range.  A start
     that breaks down (``ModelBreakdown``) or is infeasible (``ValueError``) is reported as its own entry.
@@ -289,7 +290,7 @@ def attractors(
     alpha0s = [float(a) for a in np.atleast_1d(states_alpha("alpha0s", alpha0s))]
     say = optional(function, "progress", progress) or (lambda msg: None)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
-    groups: List[dict] = []
+    groups: list[dict] = []
     for a0 in alpha0s:
         say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
         try:
@@ -364,7 +365,7 @@ class BenettinResult:
     wall_time: float
 
     @classmethod
-    def from_logs(cls, logs, dts, d0: float, wall_time: float) -> "BenettinResult":
+    def from_logs(cls, logs, dts, d0: float, wall_time: float) -> BenettinResult:
         """The record of per-interval log growths ``logs`` over durations ``dts`` (the one place the
         exponent, running estimate, local rates and standard error are computed from them)."""
         logs, dts = np.asarray(logs, float), np.asarray(dts, float)
@@ -452,7 +453,7 @@ class LyapunovResult:
     tau: float
     n_jumps: int
     method: str = "hybrid two-trajectory (Benettin)"
-    notes: List[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
 
 def lyapunov(
@@ -465,7 +466,7 @@ def lyapunov(
     d0: float = 1e-7,
     alpha0: float = 0.0,
     rtol: float = 1e-12,
-    max_wall: Optional[float] = DEFAULT_MAX_WALL,
+    max_wall: float | None = DEFAULT_MAX_WALL,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the exact (hybrid) peeling dynamics, in bits/s.
 
@@ -569,7 +570,7 @@ def lyapunov_tangent(
     T: float = 50.0,
     rtol: float = 1e-10,
     alpha0: float = 0.0,
-    max_steps: Optional[int] = None,
+    max_steps: int | None = None,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent (variational) dynamics with saltation matrices, in bits/s.
 
@@ -609,7 +610,7 @@ def lyapunov_return_map(
     n_returns: int = 5000,
     h: float = 1e-6,
     rtol: float = 1e-12,
-    max_wall: Optional[float] = DEFAULT_MAX_WALL,
+    max_wall: float | None = DEFAULT_MAX_WALL,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent map of the jump-to-jump (Poincaré) map, in bits/s.
 

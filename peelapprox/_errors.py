@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import time
-from typing import Any, Optional
+from typing import Any
 
-__all__ = ["ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "KernelCacheWarning", "WallBudget", "budget_exceeded"]
+__all__ = ["ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "KernelCacheWarning", "WallBudget",
+           "budget_exceeded"]
 
 
 class ModelBreakdown(RuntimeError):
@@ -29,7 +30,7 @@ class ModelBreakdown(RuntimeError):
         The trajectory computed up to the breakdown, when available.
     """
 
-    def __init__(self, message: str, *, t: float, state: dict, reason: str, partial: Optional[Any] = None):
+    def __init__(self, message: str, *, t: float, state: dict, reason: str, partial: Any | None = None):
         super().__init__(message)
         self.t = t
         self.state = state
@@ -44,7 +45,7 @@ class SolverBudgetExceeded(RuntimeError):
     ``state`` where the run stopped, ``partial`` trajectory.
     """
 
-    def __init__(self, message: str, *, budget: str, limit: float, t: float, state: dict, partial: Optional[Any] = None):
+    def __init__(self, message: str, *, budget: str, limit: float, t: float, state: dict, partial: Any | None = None):
         super().__init__(message)
         self.budget = budget
         self.limit = limit
@@ -53,7 +54,7 @@ class SolverBudgetExceeded(RuntimeError):
         self.partial = partial
 
 
-def budget_exceeded(name: str, limit: float, t_end: float, state: dict, partial: Optional[Any]) -> "SolverBudgetExceeded":
+def budget_exceeded(name: str, limit: float, t_end: float, state: dict, partial: Any | None) -> SolverBudgetExceeded:
     """The exception for a used-up budget, with the message both drivers give."""
     hints = {"max_points": "; pass t_eval, save='jumps' or a larger max_points",
              "max_steps": "; pass a larger max_steps (the default scales with t_end)",
@@ -74,11 +75,11 @@ class WallBudget:
     budget.
     """
 
-    def __init__(self, max_wall: Optional[float]):
+    def __init__(self, max_wall: float | None):
         self.limit = max_wall
         self.t0 = time.perf_counter()
 
-    def left(self, t: float, state: Any, t_end: float) -> Optional[float]:
+    def left(self, t: float, state: Any, t_end: float) -> float | None:
         """Seconds left (None: unbounded); ``state`` is the dict, or a callable building it only if needed."""
         if self.limit is None:
             return None
@@ -87,7 +88,7 @@ class WallBudget:
             raise budget_exceeded("max_wall", self.limit, t_end, state() if callable(state) else state, None)
         return rest
 
-    def reraise(self, exc: "SolverBudgetExceeded") -> "SolverBudgetExceeded":
+    def reraise(self, exc: SolverBudgetExceeded) -> SolverBudgetExceeded:
         if exc.budget != "max_wall" or self.limit is None:
             return exc
         return SolverBudgetExceeded(f"more than {self.limit:g} s of wall time (max_wall) at t={exc.t:.6g}; pass a "
@@ -101,7 +102,7 @@ class SolverFailure(RuntimeError):
     Attributes: ``t``, ``state``, ``partial``.
     """
 
-    def __init__(self, message: str, *, t: float, state: dict, partial: Optional[Any] = None):
+    def __init__(self, message: str, *, t: float, state: dict, partial: Any | None = None):
         super().__init__(message)
         self.t = t
         self.state = state

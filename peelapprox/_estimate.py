@@ -11,8 +11,8 @@ mode to a monotonic rise.  :func:`estimate` collects them with a regime label.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Callable, Optional
 
 import numpy as np
 from scipy import integrate
@@ -70,9 +70,9 @@ def quasi_static_branch_time(
     params: PeelParams,
     branch: str = "AB",
     *,
-    v_in: Optional[float] = None,
-    v_f: Optional[float] = None,
-    fprime: Optional[Callable[[np.ndarray], np.ndarray]] = None,
+    v_in: float | None = None,
+    v_f: float | None = None,
+    fprime: Callable[[np.ndarray], np.ndarray] | None = None,
     rate: str = "k(V-v)",
 ) -> float:
     """Branch time of approxvdot with α̇ = 0: ``Δt = ∫ f'(v) / Ḟ dv`` [s].
@@ -206,33 +206,33 @@ class RegimeEstimate:
     k: float
     R: float
     has_folds: bool
-    v_max: Optional[float]
-    f_max: Optional[float]
-    v_min: Optional[float]
-    f_min: Optional[float]
-    v_land_ab: Optional[float]
-    v_land_cd: Optional[float]
+    v_max: float | None
+    f_max: float | None
+    v_min: float | None
+    f_min: float | None
+    v_land_ab: float | None
+    v_land_cd: float | None
     fixed_point_v: float
     fixed_point_F: float
     fixed_point_fprime: float
     fixed_point_stable: bool
-    F_mean: Optional[float]
-    period_at_f_min: Optional[float]
-    period_at_f_max: Optional[float]
-    period_at_mean: Optional[float]
-    cd_damping_time: Optional[float]
-    inertia_ratio: Optional[float]
-    t_ab_crude: Optional[float]
-    t_ab_quasi_static: Optional[float]
-    t_cd_quasi_static: Optional[float]
-    dF_ab_quasi_static: Optional[float]
-    dF_cd_quasi_static: Optional[float]
-    oscillations_per_ab: Optional[float]
-    force_gap: Optional[float]
+    F_mean: float | None
+    period_at_f_min: float | None
+    period_at_f_max: float | None
+    period_at_mean: float | None
+    cd_damping_time: float | None
+    inertia_ratio: float | None
+    t_ab_crude: float | None
+    t_ab_quasi_static: float | None
+    t_cd_quasi_static: float | None
+    dF_ab_quasi_static: float | None
+    dF_cd_quasi_static: float | None
+    oscillations_per_ab: float | None
+    force_gap: float | None
     inertia: str
     velocity: str
-    F_max_bound: Optional[float] = None
-    F_min_bound: Optional[float] = None
+    F_max_bound: float | None = None
+    F_min_bound: float | None = None
     inertia_rule: str = INERTIA_RULE
     velocity_rule: str = VELOCITY_RULE
 
@@ -249,7 +249,7 @@ class RegimeEstimate:
         return d
 
 
-def estimate(params: PeelParams, *, alpha_min: Optional[float] = None, alpha_max: Optional[float] = None
+def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: float | None = None
              ) -> RegimeEstimate:
     """Regime estimate for one parameter point, without running the DAE.
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 import csv
 import json
 import math
-from typing import IO, Any, Iterable, Mapping, Optional, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from typing import IO, Any
 
 import numpy as np
 
@@ -24,7 +25,7 @@ def jsonable(v: Any) -> Any:
     return v
 
 
-def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequence[str]] = None) -> str:
+def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Sequence[str] | None = None) -> str:
     """Write ``rows`` to ``path`` (``.csv`` or ``.json``); returns the path.
 
     CSV: columns ``fields`` (default: every key, in first-seen order), None or absent as an empty cell,
@@ -48,7 +49,7 @@ def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequ
     return p
 
 
-def write_csv(fh: IO[str], rows: Iterable[Mapping[str, Any]], *, fields: Optional[Sequence[str]] = None) -> None:
+def write_csv(fh: IO[str], rows: Iterable[Mapping[str, Any]], *, fields: Sequence[str] | None = None) -> None:
     """Write ``rows`` as CSV to the open text stream ``fh`` (e.g. ``sys.stdout``), as :func:`write_rows` does
     to a ``.csv`` file: columns ``fields`` (default: every key, first-seen order), None or absent as an empty
     cell, floats in full precision."""

@@ -31,8 +31,9 @@ import hashlib
 import inspect
 import types
 import warnings
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any
 
 from numba import njit
 
@@ -123,8 +124,8 @@ def _check_source(fn: Callable) -> None:
         )
 
 
-def kernel(fn: Optional[Callable] = None, *, inline: str = "never", fastmath: bool = False,
-           name: Optional[str] = None) -> Any:
+def kernel(fn: Callable | None = None, *, inline: str = "never", fastmath: bool = False,
+           name: str | None = None) -> Any:
     """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 
     Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.

@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 
 from ._validate import choice, in_range
 
-__all__ = ["EPS_RANGE", "RTOL_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
+__all__ = ["EPS_RANGE", "RTOL_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX",
+           "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
 #: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
@@ -167,7 +168,7 @@ class PeelParams:
         fun = _generated.closure_paper if self.geometry == "paper" else _generated.closure_exact
         return fun(alpha, self.R, self.l)
 
-    def replace(self, **changes) -> "PeelParams":
+    def replace(self, **changes) -> PeelParams:
         """Return a copy with some fields changed (validated again)."""
         import dataclasses
 

@@ -22,13 +22,12 @@ import dataclasses
 import functools
 import math
 from dataclasses import dataclass
-from typing import Optional
 
 import numpy as np
-from ._jit import kernel
 from scipy.optimize import brentq
 
 from . import _generated as _g
+from ._jit import kernel
 from ._params import PARAM_RANGES, STATE_RANGES
 from ._validate import choice, in_range, reals
 
@@ -151,14 +150,14 @@ class BranchStructure:
 
     V: float
     has_folds: bool
-    v_max: Optional[float]
-    f_max: Optional[float]
-    v_min: Optional[float]
-    f_min: Optional[float]
+    v_max: float | None
+    f_max: float | None
+    v_min: float | None
+    f_min: float | None
     v_inflection: float
     f_zero: float
-    v_land_cd: Optional[float]
-    v_land_ab: Optional[float]
+    v_land_cd: float | None
+    v_land_ab: float | None
     v_breakdown: float = 0.0
 
     def branch_range(self, branch: str) -> tuple[float, float]:
@@ -167,7 +166,8 @@ class BranchStructure:
             return (0.0, self.v_max if self.has_folds else math.inf)
         if branch == "CD":
             if not self.has_folds:
-                raise ValueError(f"branch 'CD' does not exist for V={self.V}: f(v, V) has no fold (no stick-slip window)")
+                raise ValueError(f"branch 'CD' does not exist for V={self.V}: f(v, V) has no fold "
+                                 "(no stick-slip window)")
             return (self.v_min, math.inf)
         raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
 

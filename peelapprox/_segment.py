@@ -60,15 +60,15 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
-from ._jit import kernel
 
 from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
+from ._jit import kernel
 from ._params import RTOL_RANGE, TIME_MAX, PeelParams
+from ._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_derivative, peel_force_fp_jit
 from ._status import (
     DONE,
     F_NONPOSITIVE,
@@ -82,9 +82,8 @@ from ._status import (
     status_error,
 )
 from ._validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
-from ._validate import state as _state
 from ._validate import params as _params
-from ._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_derivative, peel_force_fp_jit
+from ._validate import state as _state
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
 
@@ -327,18 +326,18 @@ def reduced_segment(
     branch: str,
     *,
     F_in: float,
-    alpha_in: Optional[float] = None,
-    alphadot_in: Optional[float] = None,
-    amplitude: Optional[float] = None,
-    phase: Optional[float] = None,
-    v_in: Optional[float] = None,
-    v_f: Optional[float] = None,
+    alpha_in: float | None = None,
+    alphadot_in: float | None = None,
+    amplitude: float | None = None,
+    phase: float | None = None,
+    v_in: float | None = None,
+    v_f: float | None = None,
     alpha_model: str = "approxalpha",
     v_equation: str = "approxvdot",
-    F_rate: Optional[float] = None,
+    F_rate: float | None = None,
     rtol: float = 1e-10,
     atol=None,
-    t_max: Optional[float] = None,
+    t_max: float | None = None,
     save: str = "steps",
     t_eval=None,
     max_steps: int = 1_000_000,

@@ -11,7 +11,7 @@ table's), 20-29 numerical failures and exhausted budgets.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any
 
 from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
@@ -42,7 +42,7 @@ class Status:
 
     code: int
     reason: str
-    exception: Optional[type]
+    exception: type | None
     message: str
 
 

@@ -80,9 +80,10 @@ import re
 import sys
 import threading
 import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from types import MappingProxyType, ModuleType
-from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Union
+from typing import Any
 
 import numpy as np
 
@@ -136,8 +137,8 @@ def _ref(fn: Callable) -> str:
     return f"{getattr(fn, '__module__', '?')}:{getattr(fn, '__qualname__', '?')}"
 
 
-def register_measure(name: str, fn: Optional[Measure] = None, *, replace: bool = False,
-                     check_options: Optional[OptionCheck] = None):
+def register_measure(name: str, fn: Measure | None = None, *, replace: bool = False,
+                     check_options: OptionCheck | None = None):
     """Register ``fn(params, options) -> dict`` under ``name``.
 
     Signature: ``register_measure(name, fn=None, *, replace=False, check_options=None)``;
@@ -262,7 +263,7 @@ def _import_ref(ref: str) -> Callable:
     return obj
 
 
-def _resolve(name: str, ref: Union[None, str, bytes]) -> Measure:
+def _resolve(name: str, ref: None | str | bytes) -> Measure:
     """The measure function in this (worker) process: unpickled if shipped by value (bytes), else by import
     reference, else by registry name."""
     if isinstance(ref, bytes):
@@ -328,7 +329,7 @@ def _make_params(I: float, V: float, options: Mapping) -> PeelParams:
 
 
 def _run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
-               refs: Optional[Mapping[str, Union[str, bytes]]] = None) -> dict:
+               refs: Mapping[str, str | bytes] | None = None) -> dict:
     """Evaluate ``measures`` at one grid point; never raises for a measure's failure.
 
     Module level and plain-data in/out, so any executor can ship it.  ``refs``
@@ -361,7 +362,7 @@ def _run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
     return {"I": I, "V": V, "status": error or reported or "ok", **body}
 
 
-def _cloudpickle() -> Optional[ModuleType]:
+def _cloudpickle() -> ModuleType | None:
     """The cloudpickle module, or None if it is not installed."""
     try:
         import cloudpickle
@@ -381,10 +382,10 @@ def _importable(fn: Callable) -> bool:
         return False
 
 
-def _worker_refs(measures: Sequence[str]) -> dict[str, Union[str, bytes]]:
+def _worker_refs(measures: Sequence[str]) -> dict[str, str | bytes]:
     """What the workers get for each measure: its import reference, or its cloudpickle bytes if they could not
     import it.  ValueError (before any point runs) if such a measure cannot be shipped."""
-    refs: dict[str, Union[str, bytes]] = {name: _ref(MEASURES[name]) for name in measures}
+    refs: dict[str, str | bytes] = {name: _ref(MEASURES[name]) for name in measures}
     lone = [name for name in measures if not _importable(MEASURES[name])]
     if not lone:
         return refs
@@ -439,7 +440,7 @@ class SweepResult:
     """
 
     def __init__(self, I_values, V_values, measures, options, records: Iterable[dict], *,
-                 manifest: Optional[dict] = None, out: Optional[str] = None):
+                 manifest: dict | None = None, out: str | None = None):
         self.I_values = np.asarray(I_values, dtype=float)
         self.V_values = np.asarray(V_values, dtype=float)
         self.measures = tuple(measures)
@@ -474,7 +475,7 @@ class SweepResult:
         of :func:`sweep`."""
         return [(float(r["I"]), float(r["V"])) for r in self.records if failed(r)]
 
-    def record(self, I: float, V: float) -> Optional[dict]:
+    def record(self, I: float, V: float) -> dict | None:
         """The record at exactly (I, V), or None."""
         return self._by_key.get((float(I), float(V)))
 
@@ -611,13 +612,13 @@ def _hms(s: float) -> str:
 def sweep(
     I_values: Sequence[float],
     V_values: Sequence[float],
-    measures: Union[str, Sequence[str]] = ("regime",),
+    measures: str | Sequence[str] = ("regime",),
     *,
     out,
-    executor: Union[None, str, Executor] = None,
-    max_workers: Optional[int] = None,
-    options: Optional[Mapping[str, Any]] = None,
-    progress: Union[bool, Callable[[int, int, dict], None], None] = True,
+    executor: None | str | Executor = None,
+    max_workers: int | None = None,
+    options: Mapping[str, Any] | None = None,
+    progress: bool | Callable[[int, int, dict], None] | None = True,
     resume: bool = True,
     retry_failed: bool = False,
 ) -> SweepResult:

@@ -15,7 +15,8 @@ import os
 import stat
 import sys
 import warnings
-from typing import IO, Any, Iterable, Optional, Sequence
+from collections.abc import Iterable, Sequence
+from typing import IO, Any
 
 from ._validate import reals
 
@@ -194,7 +195,7 @@ def _is_number(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
-def _manifest_problem(m: Any) -> Optional[str]:
+def _manifest_problem(m: Any) -> str | None:
     """Why ``m`` is not a manifest this version can use, or None."""
     if not isinstance(m, dict):
         return f"not a JSON object but {type(m).__name__}"
@@ -231,7 +232,7 @@ def read_manifest(out: str) -> dict:
     try:
         m = json.loads(data)
     except (ValueError, RecursionError) as exc:
-        why: Optional[str] = f"not JSON ({exc})"
+        why: str | None = f"not JSON ({exc})"
     else:
         why = _manifest_problem(m)
     if why:
@@ -246,7 +247,7 @@ def write_manifest(out: str, manifest: dict) -> None:
 
 # --------------------------------------------------------------------------------------------- records
 
-def _record_problem(rec: Any) -> Optional[str]:
+def _record_problem(rec: Any) -> str | None:
     """Why ``rec`` is not a record, or None.  Values must be JSON scalars that a float array can hold."""
     if not isinstance(rec, dict):
         return f"not a JSON object but {type(rec).__name__}"
@@ -294,7 +295,7 @@ def read_records(out: str) -> tuple[list[dict], int, bool]:
         try:
             rec = json.loads(line)
         except (ValueError, RecursionError) as exc:
-            why: Optional[str] = f"not JSON: {exc}"
+            why: str | None = f"not JSON: {exc}"
         else:
             why = _record_problem(rec)
         if why:
@@ -366,7 +367,7 @@ class Plan:
             if theirs and theirs != mine:
                 warnings.warn(f"resuming a sweep made with {theirs} under {mine}: records may mix versions",
                               RuntimeWarning, stacklevel=3)
-            self.manifest: Optional[dict] = m
+            self.manifest: dict | None = m
         elif others:
             raise ValueError(f"out={out!r} is not empty and holds no sweep manifest ({MANIFEST}): "
                              f"refusing to write into it (found {sorted(others)[:5]})")

@@ -33,7 +33,8 @@ from __future__ import annotations
 import math
 import numbers
 import os
-from typing import Any, Callable, Optional, Sequence, TypeVar
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -178,12 +179,12 @@ def nonnegative(name: str, x: Any, hi: float = math.inf) -> float:
     return in_range(name, x, 0.0, hi)
 
 
-def optional(check: Callable[..., T], name: str, x: Any, *args: Any, **kwargs: Any) -> Optional[T]:
+def optional(check: Callable[..., T], name: str, x: Any, *args: Any, **kwargs: Any) -> T | None:
     """None stays None; anything else goes through ``check(name, x, *args, **kwargs)``."""
     return None if x is None else check(name, x, *args, **kwargs)
 
 
-def optional_finite(name: str, x: Any) -> Optional[float]:
+def optional_finite(name: str, x: Any) -> float | None:
     """None stays None; anything else goes through :func:`finite`."""
     return optional(finite, name, x)
 
@@ -285,7 +286,7 @@ def reals(name: str, x: Any, lo: float = -math.inf, hi: float = math.inf, *, lo_
 
 
 def times(name: str, x: Any, *, lo: float = 0.0, hi: float = math.inf, increasing: bool = True,
-          ndim: Optional[int] = 1) -> np.ndarray:
+          ndim: int | None = 1) -> np.ndarray:
     """x as a non-empty float array of finite times in ``[lo, hi]``, strictly increasing if ``increasing``.
 
     ``ndim=1`` requires a 1-D array (``None``: any shape, used where times are broadcast elementwise).

@@ -18,7 +18,7 @@ import json
 import os
 import sys
 import time
-from typing import Optional, Sequence
+from collections.abc import Sequence
 
 from ._cli_checks import (
     check_output_path,
@@ -233,8 +233,7 @@ def _compare(args: argparse.Namespace) -> int:
 
 def _benchmark(args: argparse.Namespace) -> int:
 
-    from comparisons._benchmark import (markdown, plot_eps_study, plot_work_precision, rows_as_dicts,
-                                        run_benchmark)
+    from comparisons._benchmark import markdown, plot_eps_study, plot_work_precision, rows_as_dicts, run_benchmark
 
     if args.out:
         check_output_path(args.out, "dir", "--out")
@@ -631,7 +630,7 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
     User errors end in ``SystemExit`` with one line on stderr (module docstring

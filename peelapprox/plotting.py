@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +24,7 @@ def _pyplot():
     return plt
 
 
-def plot_trajectory(traj: Any, path: Optional[str] = None, *, title: Optional[str] = None):
+def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = None):
     """F(t), α(t), v(t) and the v–F phase plane with f(v, V) (as the paper's Fig. 3).
 
     Parameters
@@ -60,7 +60,8 @@ def plot_trajectory(traj: Any, path: Optional[str] = None, *, title: Optional[st
     if len(traj.F):
         lo, hi = float(np.min(traj.F)), float(np.max(traj.F))
         pad = 0.08 * (hi - lo + 1.0)
-        ax[1, 1].set_ylim(min(lo, bs.f_min if bs.has_folds else lo) - pad, max(hi, bs.f_max if bs.has_folds else hi) + pad)
+        ax[1, 1].set_ylim(min(lo, bs.f_min if bs.has_folds else lo) - pad,
+                          max(hi, bs.f_max if bs.has_folds else hi) + pad)
     ax[1, 1].set(xlabel="v [m/s]", ylabel="F [N]", title="v–F phase plane")
     ax[1, 1].legend(loc="best", fontsize=8)
     ttl = title or f"V = {p.V} m/s, I = {p.I:g} kg m², k = {p.k:g} N/m, method = {traj.method}"
@@ -71,7 +72,7 @@ def plot_trajectory(traj: Any, path: Optional[str] = None, *, title: Optional[st
     return fig
 
 
-def plot_segment(seg: Any, path: Optional[str] = None, *, exact: Any = None, title: Optional[str] = None):
+def plot_segment(seg: Any, path: str | None = None, *, exact: Any = None, title: str | None = None):
     """v(t), α(t) and F(t) of a reduced branch solution (as the paper's Figs. 8 and 9).
 
     Parameters
@@ -109,8 +110,8 @@ def plot_segment(seg: Any, path: Optional[str] = None, *, exact: Any = None, tit
     return fig
 
 
-def plot_phase_diagram(result: Any, key: str, path: Optional[str] = None, *, log_I: bool = True,
-                       log_V: bool = False, title: Optional[str] = None):
+def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I: bool = True,
+                       log_V: bool = False, title: str | None = None):
     """A sweep quantity over the (V, I) plane, one cell per grid point (pcolormesh).
 
     Parameters

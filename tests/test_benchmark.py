@@ -107,5 +107,6 @@ def test_benchmark_quick_cli_writes_its_outputs(tmp_path):
         hyb = sorted((r for r in rows if r["scene"] == sc.name and r["method"] == "hybrid"), key=lambda r: -r["rtol"])
         errs = [r["error"] for r in hyb]
         assert all(a > b for a, b in zip(errs, errs[1:])) and errs[0] / errs[-1] > 1e4
-        reg = [r["error"] for r in rows if r["scene"] == sc.name and r["method"] == "regularized" and r["status"] == "ok"]
+        reg = [r["error"] for r in rows
+               if r["scene"] == sc.name and r["method"] == "regularized" and r["status"] == "ok"]
         assert reg and min(reg) > 1e-4

@@ -3,7 +3,6 @@ Benettin Lyapunov exponent (first on systems with known exponents, then on the p
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp

@@ -39,7 +39,8 @@ import os
 import shutil
 import tempfile
 from collections import Counter
-from typing import Any, Callable, Dict, Iterable, Mapping, Sequence, Tuple
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pytest
@@ -55,7 +56,7 @@ from peelapprox.cli import main as cli_main
 
 #: Cases per entry point and tier: (default, slow).  Sums: 565 default, 5650 slow (the issue asks >= 500
 #: and >= 5000); the split favours the cheap entry points with many arguments.
-CASES: Dict[str, Tuple[int, int]] = {
+CASES: dict[str, tuple[int, int]] = {
     "PeelParams": (80, 800),
     "PeelParams+simulate (random valid)": (40, 400),
     "simulate": (80, 800),

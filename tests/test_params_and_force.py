@@ -1,5 +1,6 @@
 """PeelParams validation and the peel-force module (fvV, folds, branch inverses)."""
 
+import dataclasses
 import math
 import re
 
@@ -20,8 +21,8 @@ from peelapprox import (
 def test_params_reject_nonpositive_or_nonfinite(field, value):
     """Every field must be finite and inside its range (PARAM_RANGES); the message names the field and the
     range."""
-    from peelapprox._validate import interval
     from peelapprox import PARAM_RANGES
+    from peelapprox._validate import interval
 
     kw = dict(V=1.0, I=1e-5)
     kw[field] = value
@@ -38,7 +39,7 @@ def test_params_l_must_exceed_R():
 
 def test_params_are_frozen():
     p = PeelParams(V=1, I=1e-5)
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         p.V = 2.0
 
 
@@ -55,7 +56,8 @@ def test_derivatives_match_finite_differences():
     V = 1.0
     for v in (2e-3, 0.05, 0.5, 3.0, 12.0):
         h = 1e-4 * v
-        fd1 = (-peel_force(v + 2 * h, V) + 8 * peel_force(v + h, V) - 8 * peel_force(v - h, V) + peel_force(v - 2 * h, V)) / (12 * h)
+        fd1 = (-peel_force(v + 2 * h, V) + 8 * peel_force(v + h, V) - 8 * peel_force(v - h, V)
+               + peel_force(v - 2 * h, V)) / (12 * h)
         assert peel_force_derivative(v, V, 1) == pytest.approx(fd1, rel=1e-7, abs=1e-7)
         d1 = lambda x: peel_force_derivative(x, V, 1)  # noqa: E731
         fd2 = (-d1(v + 2 * h) + 8 * d1(v + h) - 8 * d1(v - h) + d1(v - 2 * h)) / (12 * h)

@@ -78,7 +78,8 @@ def test_loose_tolerance_grid_has_no_nan():
 
 def test_max_wall_bounds_a_huge_horizon():
     """Issue 13 item 5: ``simulate(p, 1e300, save="jumps")`` ran ~4 min before its step budget raised (t_end is
-    now at most TIME_MAX = 1e6 s, ``test_validate``).  Hypothesis: with ``max_wall=1`` a 1e6 s run raises SolverBudgetExceeded(budget="max_wall") with a finite state,
+    now at most TIME_MAX = 1e6 s, ``test_validate``).  Hypothesis: with ``max_wall=1`` a 1e6 s run raises
+    SolverBudgetExceeded(budget="max_wall") with a finite state,
     after at least 1 s of wall time (the check runs between kernel calls of <= 250k steps, so it cannot
     fire early; an upper bound on wall time is a benchmark matter, not asserted here)."""
     with pytest.raises(SolverBudgetExceeded) as ei:

@@ -340,7 +340,8 @@ def test_csv_and_load_roundtrip(pool_result, tmp_path):
 
 
 def test_parse_grid():
-    """Hypothesis: range specs give linspace / exact-endpoint geometric grids and comma lists; bad specs name the flag."""
+    """Hypothesis: range specs give linspace / exact-endpoint geometric grids and comma lists; bad specs name the
+    flag."""
     assert list(parse_grid("0.4:4:10")) == list(np.linspace(0.4, 4, 10))
     g = parse_grid("1e-5:1e-2:4:log")
     assert g[0] == 1e-5 and g[-1] == 1e-2 and np.allclose(np.diff(np.log10(g)), 1.0, rtol=1e-12)

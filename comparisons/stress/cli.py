@@ -14,7 +14,7 @@ import math
 import os
 import sys
 import time
-from typing import Optional, Sequence
+from collections.abc import Sequence
 
 from .points import GRID_T_END, N_RANDOM, all_points
 from .report import _count_table, pair_long_runs, robustness_markdown, write_records
@@ -34,7 +34,7 @@ def _package_doc() -> str:
     return comparisons.stress.__doc__ or ""
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns 0 if no run shows a bug, 1 otherwise."""
     ap = argparse.ArgumentParser(prog=PROG, description=_package_doc().splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="corner subset of the grid, shorter long run")
@@ -57,7 +57,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         cmd += f" --n-random {a.n_random}"
     t0 = time.perf_counter()
     with StressRunner(timeout=a.timeout) as runner:
-        recs = run_points(all_points(a.quick, a.t_end, a.n_random), timeout=a.timeout, progress=not a.no_progress, runner=runner)
+        recs = run_points(all_points(a.quick, a.t_end, a.n_random), timeout=a.timeout, progress=not a.no_progress,
+                          runner=runner)
         recs += budget_edge_probes(runner, timeout=a.timeout)
     pair_long_runs(recs)
     wall = time.perf_counter() - t0

@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +24,8 @@ from peelapprox._validate import finite, in_range, nonnegative, positive
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
     "LOOSE_V", "LOOSE_I", "LOOSE_ALPHA0", "LOOSE_TOLS",
-    "StressPoint", "grid_points", "random_points", "tolerance_points", "loose_points", "budget_points", "variant_points",
+    "StressPoint", "grid_points", "random_points", "tolerance_points", "loose_points", "budget_points",
+    "variant_points",
     "long_points", "all_points",
 ]
 
@@ -71,7 +72,7 @@ LOOSE_V: tuple[float, ...] = (0.5, 1.0, 2.0, 4.0, 6.0, 8.0)
 LOOSE_I: tuple[float, ...] = (1e-6, 1e-4, 1e-2, 1e-1)
 LOOSE_ALPHA0: tuple[float, ...] = (-0.5, 0.0, 0.5)
 #: (rtol, atol); atol None means simulate's default ``rtol * ATOL_SCALE``.
-LOOSE_TOLS: tuple[tuple[float, Optional[float]], ...] = (
+LOOSE_TOLS: tuple[tuple[float, float | None], ...] = (
     (1e-2, None), (1e-2, 1e-3), (1e-2, 1.0), (1e-8, 1e-3), (1e-8, 1e-1), (1e-8, 1.0),
 )
 LOOSE_T_END = 5.0
@@ -136,7 +137,7 @@ class StressPoint:
     method: str = "hybrid"
     geometry: str = "paper"
     rtol: float = 1e-8
-    atol: Optional[float] = None
+    atol: float | None = None
     t_end: float = GRID_T_END
     save: str = "steps"
     n_eval: int = 0

@@ -12,7 +12,8 @@ from __future__ import annotations
 import math
 import os
 from collections import Counter
-from typing import Any, Iterable, Optional, Sequence
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -123,8 +124,8 @@ def _count_table(records: list[dict], title: str) -> list[str]:
     return lines
 
 
-def robustness_markdown(records: Sequence[dict], *, command: Optional[str] = None,
-                        wall_time: Optional[float] = None) -> str:
+def robustness_markdown(records: Sequence[dict], *, command: str | None = None,
+                        wall_time: float | None = None) -> str:
     """Render the stress-test report (markdown) from run records.
 
     Parameters
@@ -235,7 +236,8 @@ def robustness_markdown(records: Sequence[dict], *, command: Optional[str] = Non
         L += _count_table(rnd, "outcome (random)") + [""]
         res = np.array([r["res_max"] for r in rnd if r["n_points"]], dtype=float)
         okj = [r["n_jumps"] for r in rnd if r["outcome"] == "ok"]
-        L += [f"Max relative CONSTR residual over all stored steps: **{np.nanmax(res) if res.size else float('nan'):.2e}**;"
+        worst = np.nanmax(res) if res.size else float("nan")
+        L += [f"Max relative CONSTR residual over all stored steps: **{worst:.2e}**;"
               f" jumps per ok run: max {max(okj) if okj else 0}, total {sum(okj)}.", ""]
 
     loose = by["loose"]

@@ -126,7 +126,8 @@ def _empty_record(point: StressPoint) -> dict:
     rec = point.as_dict()
     rec.update(
         outcome="", exception="", reason="", message="", t_reached=float("nan"), wall=float("nan"),
-        n_steps=0, n_jumps=0, n_points=0, res_max=float("nan"), res_median=float("nan"), res_early=float("nan"), res_late=float("nan"),
+        n_steps=0, n_jumps=0, n_points=0, res_max=float("nan"), res_median=float("nan"), res_early=float("nan"),
+        res_late=float("nan"),
         jres_max=float("nan"), jres_early=float("nan"), jres_late=float("nan"), t_monotone=True, nonfinite=False,
         expect_met=True,
     )

@@ -12,7 +12,8 @@ from __future__ import annotations
 import multiprocessing as mp
 import sys
 import time
-from typing import Any, Callable, Optional, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from peelapprox._validate import positive
 
@@ -76,7 +77,7 @@ class StressRunner:
         first task's wall time does not include it.
     """
 
-    def __init__(self, timeout: float = 60.0, func: Optional[Callable[[Any], Any]] = None, start_timeout: float = 300.0,
+    def __init__(self, timeout: float = 60.0, func: Callable[[Any], Any] | None = None, start_timeout: float = 300.0,
                  warm: bool = True):
         self.timeout = positive("timeout", timeout)
         self.start_timeout = positive("start_timeout", start_timeout)
@@ -113,7 +114,7 @@ class StressRunner:
             self._conn.close()
         self._proc = self._conn = None
 
-    def run(self, task: Any, timeout: Optional[float] = None) -> dict:
+    def run(self, task: Any, timeout: float | None = None) -> dict:
         """Run one task in the worker; returns its record (or a timeout/crash record).
 
         Parameters
@@ -170,7 +171,7 @@ class StressRunner:
             self._proc.join(5.0)
         self._kill()
 
-    def __enter__(self) -> "StressRunner":
+    def __enter__(self) -> StressRunner:
         return self
 
     def __exit__(self, *exc: Any) -> None:
@@ -189,7 +190,7 @@ def _fmt_point(p: StressPoint) -> str:
 
 
 def run_points(points: Sequence[StressPoint], timeout: float = 60.0, progress: bool = True,
-               runner: Optional[StressRunner] = None, keep_jump_times: Optional[Callable[[StressPoint], bool]] = None
+               runner: StressRunner | None = None, keep_jump_times: Callable[[StressPoint], bool] | None = None
                ) -> list[dict]:
     """Run points one after the other in a worker process, each with a timeout.
 
@@ -238,7 +239,7 @@ def run_points(points: Sequence[StressPoint], timeout: float = 60.0, progress: b
     return recs
 
 
-def budget_edge_probes(runner: Optional[StressRunner] = None, timeout: float = 60.0) -> list[dict]:
+def budget_edge_probes(runner: StressRunner | None = None, timeout: float = 60.0) -> list[dict]:
     """Budgets set exactly to what a run needs must not raise.
 
     ``simulate``'s contract: *exceeding* a budget raises.  Runs V=4, I=1e-2,
