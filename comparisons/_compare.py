@@ -57,8 +57,6 @@ class ComparisonRow:
 def run_reduction(params, branch: str, alpha_model: str, v_equation: str, **seed):
     """One reduced solve that reports a physical breakdown as a status instead of raising.
 
-    Signature: ``run_reduction(params, branch, alpha_model, v_equation, **seed) -> (ReducedSegment | None, status)``.
-
     ``seed`` goes to :func:`peelapprox.reduced_segment`.  ``status`` is ``"ok"``,
     ``"breakdown: <reason>"`` (:class:`~peelapprox.ModelBreakdown`) or
     ``"no exit: <budget>"`` (:class:`~peelapprox.SolverBudgetExceeded`); the
@@ -82,8 +80,6 @@ def _err(a: float | None, e: float | None):
 def compare(trajectory, models: dict[str, Sequence[tuple[str, str]]] | None = None, *,
             segs: list[Segment] | None = None, rtol: float = 1e-10) -> list[ComparisonRow]:
     """Every reduction on every segment of an exact trajectory, seeded from exact entry states.
-
-    Signature: ``compare(trajectory, models=None, *, segs=None, rtol=1e-10) -> list[ComparisonRow]``.
 
     Parameters
     ----------

@@ -254,7 +254,6 @@ def make_figures(only=None, out: str = "docs/figures", *, progress: Callable[[st
                  ) -> dict[str, list[str]]:
     """Draw the paper's figures (all, or the names in ``only``) into ``out``; returns the files per figure.
 
-    Signature: ``make_figures(only=None, out="docs/figures", *, progress=None) -> dict[str, list[str]]``.
     """
     names = list(FIGURES) if not only else list(only)
     bad = [n for n in names if n not in FIGURES]

@@ -599,9 +599,8 @@ def lyapunov_regularized(
 ):
     """Largest Lyapunov exponent of the ε-regularised system (XDAE) from its variational equations, in bits/s.
 
-    Signature: ``lyapunov_regularized(params, *, eps=1e-7, t_transient=30, T=50, tau=0.5, rtol=1e-8,
-    alpha0=0, progress=None) -> peelapprox.LyapunovResult`` (about 0.35 s of wall time per simulated second
-    at V = 2.5, I = 1e-4, rtol 1e-8; needs pydiffsol, the ``bench`` extra).
+    About 0.35 s of wall time per simulated second at V = 2.5, I = 1e-4, rtol 1e-8; needs pydiffsol (the
+    ``bench`` extra).
 
     The state ``X = (α, ω, F, v)`` of ``M Ẋ = φ(X)`` and a tangent vector obeying
     ``M δẊ = (∂φ/∂X) δX`` are integrated together by diffsol's BDF (the ``tangent=True`` model of

@@ -1,7 +1,6 @@
 """``run_compare``: all scenes, the per-regime error statistics, timings, and their markdown/CSV/JSON.
 
-This is what ``peelapprox compare`` runs.  Signature:
-``run_compare(scenes=None, *, statistics=True, figures_dir=None, progress=None) -> CompareReport``.
+This is what ``peelapprox compare`` runs.
 """
 
 from __future__ import annotations
@@ -50,8 +49,7 @@ def statistics(runs: Sequence[str] = STAT_RUNS, models=None) -> list[StatRow]:
     """Median, 90th percentile and max of |relative error| of Δt, ΔF and the α period, per run, branch and
     reduction, over every complete segment of each run's window (seeded from the exact entries).
 
-    Signature: ``statistics(runs=STAT_RUNS, models=None) -> list[StatRow]``; ``models`` as in
-    :func:`compare` (default :data:`DEFAULT_MODELS`).
+    ``models`` as in :func:`compare` (default :data:`DEFAULT_MODELS`).
     """
     out: list[StatRow] = []
     for name in runs:

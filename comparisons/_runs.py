@@ -74,8 +74,6 @@ class TransientCheck:
 def check_past_transient(trajectory, *, rtol: float = 1e-6, envelope_tol: float = 0.02) -> TransientCheck:
     """Check that an exact trajectory's stored window is past the transient.
 
-    Signature: ``check_past_transient(trajectory, *, rtol=1e-6, envelope_tol=0.02) -> TransientCheck``.
-
     Parameters
     ----------
     trajectory : exact.Trajectory

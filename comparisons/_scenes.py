@@ -14,9 +14,6 @@ seeded in one of two ways:
 ``claim`` is the relative agreement the paper claims for the row (0.10, "within 10 %", unless
 stated); ``verdict`` says whether our numbers meet it.  A failed reduction stays in the table with
 its status (for example ``breakdown: v_floor``).
-
-Signature of the entry points: ``scene_rows(name) -> list[Row]``, ``run_scenes(names=None,
-progress=None) -> SceneReport``.
 """
 
 from __future__ import annotations

@@ -164,8 +164,6 @@ def time_mean(t: np.ndarray, x: np.ndarray, t0: float, t1: float) -> float:
 def segments(trajectory) -> list[Segment]:
     """Complete branch segments of an exact trajectory, in time order.
 
-    Signature: ``segments(trajectory) -> list[Segment]``.
-
     Parameters
     ----------
     trajectory : exact.Trajectory

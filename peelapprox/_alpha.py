@@ -164,8 +164,6 @@ class InertialPeriods(NamedTuple):
 def inertial_periods(params: PeelParams, F_mean: float | None = None) -> InertialPeriods:
     """Periods of approxalpha at ``F = f_min``, ``f_max`` and a mean force.
 
-    Signature: ``inertial_periods(params, F_mean=None) -> InertialPeriods``.
-
     The paper (Case I a) estimates the high-frequency α oscillation on AB at
     the lowest force ``F_min ≈ f_min`` and the highest ``F_max ≈ f_max``, and
     for high inertia at a mean ``F`` (default ``(f_min + f_max)/2``).
@@ -190,8 +188,6 @@ def inertial_periods(params: PeelParams, F_mean: float | None = None) -> Inertia
 def harmonic_alpha(params: PeelParams, t, *, F: float, alpha_in: float, alphadot_in: float):
     """Exact solution of approxalpha, ``I α̈ = -F R α`` with constant F.
 
-    Signature: ``harmonic_alpha(params, t, *, F, alpha_in, alphadot_in) -> (alpha, alphadot)``.
-
     Returns ``α(t) = α_in cos Ωt + (α̇_in/Ω) sin Ωt`` and its derivative,
     ``Ω = sqrt(F R/I)``; arrays shaped like ``t`` (time since branch entry, s).
     """
@@ -207,8 +203,6 @@ def harmonic_alpha(params: PeelParams, t, *, F: float, alpha_in: float, alphadot
 def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
                F_rate: float | None = None):
     """Exact solution of the Airy-type equation ``I α̈ = -(F_in + s t) R α`` (Airy).
-
-    Signature: ``airy_alpha(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> (alpha, alphadot)``.
 
     The paper says this equation "does not have an exact solution"; it does.
     With ``a = cbrt(R s / I)`` and ``x = -a (t + F_in/s)`` it becomes Airy's
@@ -266,8 +260,6 @@ def sinusoid_alpha(params: PeelParams, t, *, F_in: float, amplitude: float, phas
                    F_rate: float | None = None):
     """The paper's slowly varying sinusoid for α on AB, as the WKB form of Airy.
 
-    Signature: ``sinusoid_alpha(params, t, *, F_in, amplitude, phase, F_rate=None) -> (alpha, alphadot)``.
-
     ``α = A (F_in/F)^(1/4) sin(Φ(t) + φ)``, ``Φ = ∫0^t sqrt(F R/I) dt'``,
     ``F = F_in + s t``.  The paper writes ``α = α_in sin(2πνt + φ)`` with
     ``2πν = sqrt(F R/I)`` and "F treated as a slowly increasing parameter";
@@ -304,7 +296,6 @@ def wkb_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_i
               F_rate: float | None = None):
     """:func:`sinusoid_alpha` matched to ``(α_in, α̇_in)`` (see :func:`wkb_amplitude_phase`).
 
-    Signature: ``wkb_alpha(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> (alpha, alphadot)``.
     """
     A, phi = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in, F_rate=F_rate)
     return sinusoid_alpha(params, t, F_in=F_in, amplitude=A, phase=phi, F_rate=F_rate)
@@ -313,8 +304,6 @@ def wkb_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_i
 def wkb_error_bound(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,
                     F_rate: float | None = None):
     """Rigorous bound on ``|α_Airy(t) - α_WKB(t)|`` [rad].
-
-    Signature: ``wkb_error_bound(params, t, *, F_in, alpha_in, alphadot_in, F_rate=None) -> ndarray``.
 
     Liouville–Green theorem (Olver, *Asymptotics and Special Functions*,
     Ch. 6, Thm 2.2 and §2.4) for ``α̈ = -Q α``, ``Q = R F(t)/I``: the exact
@@ -348,9 +337,6 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
                     form: str = "airy", F_rate: float | None = None, v: float | None = None,
                     rtol: float = 1e-12, atol: float = 1e-15):
     """Integrate an α equation of Sec. V numerically with v frozen.
-
-    Signature: ``alpha_numerical(params, t, *, F_in, alpha_in, alphadot_in, form="airy",
-    F_rate=None, v=None, rtol=1e-12, atol=1e-15) -> (alpha, alphadot)``.
 
     ``form`` selects (``F = F_in + s t``, ``s = F_rate``, ``f' = f'(v, V)`` frozen):
 
@@ -424,8 +410,6 @@ def cd_damping_time(params: PeelParams, F, v):
 
 def cd_decay_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, v_in: float):
     """CD limit of Airy2: ``α̇ = -F α/(R f')`` with f', F frozen at entry (exponential decay).
-
-    Signature: ``cd_decay_alpha(params, t, *, F_in, alpha_in, v_in) -> (alpha, alphadot)``.
 
     Returns ``α = α_in exp(-t/τ)``, ``τ = R f'(v_in)/F_in``.  The paper uses
     it on CD at high inertia, where ``FRα/I`` is small against the damping

@@ -115,8 +115,6 @@ def _writable_dir(d: str) -> bool:
 def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool = False) -> str:
     """The exact path an output option will write, checked before any computation.
 
-    Signature: ``check_output_path(path, kind, option, *, read_only_ok=False) -> str``.
-
     Parameters
     ----------
     path : str

@@ -78,7 +78,7 @@ def _trajectory(name: str, x):
 def return_map(trajectory, *, with_times: bool = False):
     """``x_k``: the pull force [N] at the AB→CD jumps of an exact trajectory (its stored window).
 
-    Signature: ``return_map(trajectory, *, with_times=False) -> ndarray`` (or ``(t_k, x_k)``).
+    With ``with_times=True``, the pair ``(t_k, x_k)`` of jump times and forces.
     """
     J = _trajectory("trajectory", trajectory).jumps
     m = np.asarray(J.from_branch) == _AB
@@ -111,8 +111,6 @@ class Periodicity:
 
 def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int = 2) -> Periodicity:
     """Classify the return map as period-n or aperiodic.
-
-    Signature: ``periodicity(x, *, rtol=1e-6, max_period=32, min_repeats=2) -> Periodicity``.
 
     Parameters
     ----------
@@ -157,7 +155,7 @@ def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int
 def force_drops(trajectory) -> np.ndarray:
     """Force drop of each slip [N]: ``F`` at an AB→CD jump minus ``F`` at the next CD→AB jump.
 
-    Signature: ``force_drops(trajectory) -> ndarray`` (one value per completed slip in the stored window).
+    One value per completed slip in the stored window.
     The paper's Fig. 6 plots their mean against V.
     """
     J = _trajectory("trajectory", trajectory).jumps
@@ -171,8 +169,6 @@ def force_drops(trajectory) -> np.ndarray:
 
 def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> float | None:
     """The time from which the return map is periodic to the end of the stored window, or None.
-
-    Signature: ``settle_time(trajectory, *, rtol=1e-6, max_period=32) -> float | None``.
 
     The orbit's period n is found on the last half of the returns (:func:`periodicity`); the settle time is
     that of the earliest AB→CD jump from which ``|x_{k+n} − x_k| <= rtol·max|x|`` holds for every later k.
@@ -200,8 +196,7 @@ def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float =
                alpha0: float = 0.0, max_wall: float | None = None):
     """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
 
-    Signature: ``window_run(params, *, t_transient=30, window=20, rtol=1e-10, alpha0=0, max_wall=None)
-    -> Trajectory``.  The one windowed run behind :func:`attractors`, the sweep measures ``period`` and
+    The one windowed run behind :func:`attractors`, the sweep measures ``period`` and
     ``jumps`` and ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so
     measures of one sweep point share it.  Raises ``ModelBreakdown`` and ``SolverBudgetExceeded`` (also
     for ``max_wall`` seconds of wall time) as :func:`exact.simulate` does.
@@ -265,9 +260,7 @@ def attractors(
 ) -> list[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
-    Signature: ``attractors(params, alpha0s=(-0.3, ..., 0.3), *, t_transient=30, window=20, rtol=1e-10,
-    period_rtol=1e-6, match_rtol=1e-4, progress=None, max_wall=3600) -> list[Attractor]``.  ``max_wall``
-    [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``;
+    ``max_wall`` [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``;
     None: unbounded).
 
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
@@ -388,8 +381,6 @@ def benettin(
 ) -> BenettinResult:
     """The largest Lyapunov exponent of a flow by the two-trajectory (Benettin) method.
 
-    Signature: ``benettin(advance, x_ref, x_pert, distance, rescale, n, *, n_discard=0) -> BenettinResult``.
-
     Parameters
     ----------
     advance : callable
@@ -470,9 +461,8 @@ def lyapunov(
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the exact (hybrid) peeling dynamics, in bits/s.
 
-    Signature: ``lyapunov(params, *, t_transient=30, tau=0.005, n=10000, n_discard=200, d0=1e-7, alpha0=0,
-    rtol=1e-12, max_wall=3600) -> LyapunovResult`` (50 s measured after 30 s of transient; 3-4 s of wall
-    time).  ``max_wall`` [s] bounds the wall time of the whole computation (``SolverBudgetExceeded`` with
+    With the defaults, 50 s are measured after 30 s of transient (3-4 s of wall time).  ``max_wall`` [s]
+    bounds the wall time of the whole computation (``SolverBudgetExceeded`` with
     ``budget="max_wall"``; None: unbounded).
 
     Method: :func:`benettin` on the hybrid solver.  The state is ``(α, ω, F, branch)`` — v follows from
@@ -574,8 +564,7 @@ def lyapunov_tangent(
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent (variational) dynamics with saltation matrices, in bits/s.
 
-    Signature: ``lyapunov_tangent(params, *, t_transient=30, T=50, rtol=1e-10, alpha0=0, max_steps=None)
-    -> LyapunovResult``.  ``max_steps`` bounds the accepted steps (default 5e6 per simulated second;
+    ``max_steps`` bounds the accepted steps (default 5e6 per simulated second;
     ~1.2e6 are used at V = 2, I = 1e-4); ``notes`` reports the steps taken.
 
     The variational equation of the hybrid solver's desingularised field is integrated with the state by
@@ -614,8 +603,7 @@ def lyapunov_return_map(
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent map of the jump-to-jump (Poincaré) map, in bits/s.
 
-    Signature: ``lyapunov_return_map(params, *, t_transient=30, n_returns=5000, h=1e-6, rtol=1e-12,
-    max_wall=3600) -> LyapunovResult``.  ``max_wall`` [s] bounds the whole computation
+    ``max_wall`` [s] bounds the whole computation
     (``SolverBudgetExceeded``, ``budget="max_wall"``; None: unbounded).
 
     The section is the AB→CD jump; the return map P takes the state (α, ω, F) just after one such jump to

@@ -77,9 +77,6 @@ def quasi_static_branch_time(
 ) -> float:
     """Branch time of approxvdot with α̇ = 0: ``Δt = ∫ f'(v) / Ḟ dv`` [s].
 
-    Signature: ``quasi_static_branch_time(params, branch="AB", *, v_in=None, v_f=None,
-    fprime=None, rate="k(V-v)") -> float``.
-
     With α̇ = 0, approxvdot reads ``f'(v) v̇ = k(V - v)``, so the time from
     ``v_in`` to ``v_f`` is the quadrature above (:func:`scipy.integrate.quad`,
     relative accuracy ~1e-10).  This is the inertia-free limit and equals
@@ -133,8 +130,6 @@ def force_bounds(params: PeelParams, alpha_min: float, alpha_max: float, *, line
                  ) -> tuple[float, float]:
     """``F_max ≈ f_max/(1 + sin α_min)`` and ``F_min ≈ f_min/(1 + sin α_max)`` [N].
 
-    Signature: ``force_bounds(params, alpha_min, alpha_max, *, linear=False) -> (F_max, F_min)``.
-
     From CONSTR, ``F = f(v, V)/(1 + sin α)``: the pull force overshoots the
     folds by the peel-angle factor (paper Sec. V, Case III).  ``linear=True``
     uses the paper's ``1 + α`` (its quoted 438 N and 181 N at V=4, I=1e-2).
@@ -169,8 +164,6 @@ class SlopeCriterion:
 def slope_criterion(params: PeelParams, *, F_in: float, alphadot_in: float, alpha0: float, tol: float = 0.25
                     ) -> SlopeCriterion:
     """The paper's test for leaving the jumping mode on AB (Case II points a vs k).
-
-    Signature: ``slope_criterion(params, *, F_in, alphadot_in, alpha0, tol=0.25) -> SlopeCriterion``.
 
     A sinusoid ``α₀ sin 2πνt`` has its largest slope ``2πν α₀`` at α ≈ 0,
     with ``2πν = sqrt(F_in R/I)`` (approxalpha).  An AB entry whose α̇ has
@@ -252,8 +245,6 @@ class RegimeEstimate:
 def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: float | None = None
              ) -> RegimeEstimate:
     """Regime estimate for one parameter point, without running the DAE.
-
-    Signature: ``estimate(params, *, alpha_min=None, alpha_max=None) -> RegimeEstimate``.
 
     Returns the folds, the fixed point and its Hopf stability, the inertial
     periods of approxalpha at ``f_min``, ``f_max`` and ``F_mean = (f_min +

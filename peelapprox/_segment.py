@@ -344,8 +344,6 @@ def reduced_segment(
 ) -> ReducedSegment:
     """Time and force change on one branch from the paper's reduced equations.
 
-    Signature: ``reduced_segment(params, branch, *, F_in, alpha_in, alphadot_in, ...) -> ReducedSegment``.
-
     Integrates approxvdot or fullvdot (module docstring) coupled to an α
     model from ``v_in`` until v reaches ``v_f`` and returns Δt, ΔF, the exit
     state and the v(t), α(t) curves (the paper's Figs. 8 and 9).

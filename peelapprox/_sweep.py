@@ -141,7 +141,6 @@ def register_measure(name: str, fn: Measure | None = None, *, replace: bool = Fa
                      check_options: OptionCheck | None = None):
     """Register ``fn(params, options) -> dict`` under ``name``.
 
-    Signature: ``register_measure(name, fn=None, *, replace=False, check_options=None)``;
     without ``fn`` it returns a decorator.
 
     Parameters
@@ -623,9 +622,6 @@ def sweep(
     retry_failed: bool = False,
 ) -> SweepResult:
     """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
-
-    Signature: ``sweep(I_values, V_values, measures=("regime",), *, out, executor=None, max_workers=None,
-    options=None, progress=True, resume=True, retry_failed=False) -> SweepResult``.
 
     Parameters
     ----------
