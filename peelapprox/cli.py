@@ -639,20 +639,35 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     ap = build_parser()
     args = ap.parse_args(argv)
-    from comparisons import TransientNotPassed
-    from comparisons._peers import PeerUnavailableError
-
-    from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-
     try:
         return args.func(args)
-    except (ValueError, PeerUnavailableError) as exc:  # a bad argument, output path or missing optional package
-        status, err = 2, exc
-    except (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed) as exc:  # the model stopped
-        status, err = 3, exc
-    except OSError as exc:  # writing failed after the checks (disk full, a path changed meanwhile)
-        status, err = 1, exc
-    ap.exit(status, f"peelapprox {args.command}: error: {one_line(err)}\n")
+    except Exception as exc:
+        status = _exit_status(exc)
+        if status is None:  # not a user error or a documented stop: a bug, with its traceback
+            raise
+        ap.exit(status, f"peelapprox {args.command}: error: {one_line(exc)}\n")
+
+
+def _loaded(module: str, name: str) -> tuple[type, ...]:
+    """``module.name`` if the subcommand imported that module, else nothing (the CLI loads no package it does
+    not use: ``peelapprox folds`` never imports the harness)."""
+    mod = sys.modules.get(module)
+    return (getattr(mod, name),) if mod is not None else ()
+
+
+def _exit_status(exc: BaseException) -> int | None:
+    """2 for a bad argument, output path or missing optional package; 3 when the model or solver stopped; 1
+    when writing failed after the checks (disk full, a path changed meanwhile); None for anything else."""
+    from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+
+    if isinstance(exc, (ValueError, *_loaded("comparisons._peers", "PeerUnavailableError"))):
+        return 2
+    if isinstance(exc, (ModelBreakdown, SolverBudgetExceeded, SolverFailure,
+                        *_loaded("comparisons._runs", "TransientNotPassed"))):
+        return 3
+    if isinstance(exc, OSError):
+        return 1
+    return None
 
 
 if __name__ == "__main__":  # pragma: no cover

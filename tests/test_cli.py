@@ -82,3 +82,17 @@ def test_cli_figures_list_and_bad_name(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["figures", "--only", "fig1", "--out", "/tmp/unused-figs"])
     assert exc.value.code == 2
+
+
+def test_folds_loads_neither_solvers_nor_harness():
+    """Issue 14: the CLI crosses the doors lazily per subcommand; ``peelapprox folds`` needs only the peel-force
+    law.  Hypothesis: after it runs, neither ``exact`` nor ``comparisons`` is imported (exact: module set)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, contextlib, io\nfrom peelapprox.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n    main(['folds', '--V', '1'])\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('exact', 'comparisons')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "[]"
