@@ -644,6 +644,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
+    err: Exception
     try:
         return args.func(args)
     except (ValueError, PeerUnavailableError) as exc:  # a bad argument, output path or missing optional package
