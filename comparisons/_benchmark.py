@@ -47,6 +47,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
+from typing import Any, cast
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -161,7 +162,8 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
         return rhs, fold
 
     t, y, br = s0.t, np.array([s0.alpha, s0.omega, s0.F]), s0.branch
-    scale = np.array([1.0, params.V / params.R, float(bs.f_max)])
+    # the benchmark scenes are stick-slip orbits: the folds exist and f_max is a float (BranchStructure)
+    scale = np.array([1.0, params.V / params.R, float(cast(float, bs.f_max))])
     jt, jF = [], []
     while t < t_end:
         rhs, fold = make(br)
@@ -562,6 +564,7 @@ def run_benchmark(*, quick: bool = False, peers: Sequence[str] | None = None,
         except ImportError:
             peers = ()
     peers = tuple(peers)
+    kw: dict[str, Any]
     if quick:
         kw = dict(hybrid_rtols=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12), eps_values=(1e-7,), reg_rtols=(1e-5, 1e-8),
                   repeats=3)
@@ -603,8 +606,9 @@ def markdown(rep: BenchmarkReport) -> str:
          f"Peers installed: {', '.join(rep.peers) or 'none'}.", ""]
     L += ["### References", "",
           "| scene | horizon [s] | jumps | branch-wise check: Δt/T̄ | ΔF/F |", "|---|---|---|---|---|"]
-    for r in rep.references:
-        L.append(f"| {r['scene']} | {r['horizon']:g} | {r['n_jumps']} | {_g3(r['check_t'])} | {_g3(r['check_F'])} |")
+    for ref in rep.references:
+        L.append(f"| {ref['scene']} | {ref['horizon']:g} | {ref['n_jumps']} | {_g3(ref['check_t'])} | "
+                 f"{_g3(ref['check_F'])} |")
     L += ["", "### Work precision", "",
           "| scene | method | solver | ε | rtol | error (max of the two) | Δt/T̄ | ΔF/F | time [s] | steps | RHS "
           "| status |",

@@ -10,7 +10,7 @@ fold is reported as a failed row with its reason, never silently dropped.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 
 from peelapprox import ModelBreakdown, SolverBudgetExceeded, reduced_segment
@@ -77,7 +77,7 @@ def _err(a: float | None, e: float | None):
     return a - e, (a - e) / abs(e) if e != 0 else None
 
 
-def compare(trajectory, models: dict[str, Sequence[tuple[str, str]]] | None = None, *,
+def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None = None, *,
             segs: list[Segment] | None = None, rtol: float = 1e-10) -> list[ComparisonRow]:
     """Every reduction on every segment of an exact trajectory, seeded from exact entry states.
 

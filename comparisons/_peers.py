@@ -407,14 +407,14 @@ def _run_sundials(peer, params, t_end, eps, rtol, atol, y0, vm):
         def res(t, y, yp, out):
             out[:] = mass * yp - _fun(y, q1)
 
-        def jac(t, y, yp, r, cj, JJ):
+        def jac_dae(t, y, yp, r, cj, JJ):  # IDA's signatures differ from CVODE's: own names (mypy [misc])
             JJ[:, :] = cj * mass_m - _jac(y, q1)
 
-        def events(t, y, yp, ev):
+        def events_dae(t, y, yp, ev):
             ev[0] = y[3] - vm
 
-        events.terminal, events.direction = [False], [0]
-        solver = sun.ida.IDA(res, jacfn=jac, eventsfn=events, **common)
+        events_dae.terminal, events_dae.direction = [False], [0]
+        solver = sun.ida.IDA(res, jacfn=jac_dae, eventsfn=events_dae, **common)
         args = ([0.0, t_end], y0, _fun(y0, q))  # consistent yp0 = M^-1 phi(y0)
     compile_time = time.perf_counter() - c0
     w0 = time.perf_counter()

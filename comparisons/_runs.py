@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from exact import simulate
+from exact import Trajectory, simulate
 from peelapprox import PeelParams, periodicity
 
 from ._segments import Segment, segments
@@ -146,7 +146,7 @@ class ExactRun:
     """A finished run: its spec, trajectory, complete segments, transient check and wall time [s]."""
 
     spec: RunSpec
-    trajectory: object
+    trajectory: Trajectory
     segments: list[Segment]
     transient: TransientCheck
     wall_time: float

@@ -6,6 +6,7 @@ import math
 import sys
 import time
 from collections.abc import Callable, Sequence
+from typing import cast
 
 import numpy as np
 
@@ -42,7 +43,7 @@ SAVES = ("steps", "jumps")
 #: relative accuracy of v at every speed (the regularised v ≥ ~1e-3 m/s on AB).
 ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1.0), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
 
-_COMPILE_TIME = {"hybrid": None}
+_COMPILE_TIME: dict[str, float | None] = {"hybrid": None}
 
 #: Default step budget per simulated second, floor and cap, by method (``max_steps=None``).  The
 #: physical grid of the stress suite needs at most ~1.5e4 hybrid steps per simulated second (I = 1e-6,
@@ -145,8 +146,9 @@ def compile_kernels() -> float:
     st = initial_state(p)
     _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None,
                 None)
-    _COMPILE_TIME["hybrid"] = time.perf_counter() - t0
-    return _COMPILE_TIME["hybrid"]
+    dt = time.perf_counter() - t0
+    _COMPILE_TIME["hybrid"] = dt
+    return dt
 
 
 def _progress_printer(label: str) -> Callable[[float, float], None]:
@@ -346,8 +348,9 @@ def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarra
     p[H.P_VLAB] = bs.v_land_ab if (bs.has_folds and bs.v_land_ab is not None) else -1.0
     p[H.P_UFLOOR] = math.log(bs.v_breakdown if v_floor is None else max(v_floor, bs.v_breakdown))
     p[H.P_UCEIL] = math.log(V_CEILING)
-    p[H.P_UEV_AB] = math.log(bs.v_max * (1.0 - H.FOLD_REL)) if bs.has_folds else math.inf
-    p[H.P_UEV_CD] = math.log(bs.v_min * (1.0 + H.FOLD_REL)) if bs.has_folds else -math.inf
+    # the fold fields are floats when has_folds (peelapprox.BranchStructure)
+    p[H.P_UEV_AB] = math.log(cast(float, bs.v_max) * (1.0 - H.FOLD_REL)) if bs.has_folds else math.inf
+    p[H.P_UEV_CD] = math.log(cast(float, bs.v_min) * (1.0 + H.FOLD_REL)) if bs.has_folds else -math.inf
     return p
 
 

@@ -178,6 +178,7 @@ def inertial_periods(params: PeelParams, F_mean: float | None = None) -> Inertia
     F_mean = optional(state, "F_mean", F_mean, "F")
     if not bs.has_folds:
         raise ValueError(f"V={params.V} is outside the stick-slip window (f(v, V) has no folds): f_min/f_max undefined")
+    assert bs.f_min is not None and bs.f_max is not None  # has_folds
     Fm = 0.5 * (bs.f_min + bs.f_max) if F_mean is None else F_mean
     return InertialPeriods(
         inertial_period(params, bs.f_min), inertial_period(params, bs.f_max), inertial_period(params, Fm),

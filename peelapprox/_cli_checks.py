@@ -31,7 +31,7 @@ __all__ = [
 
 # --------------------------------------------------------------------------------------------- argument types
 
-def _argtype(check: Callable[[str, str], object], text: str):
+def _argtype(check: Callable[[str, float], object], text: str):
     """``check("value", text)``, its ValueError turned into argparse's "argument --x: <message>" (exit 2)."""
     try:
         x = float(text)

@@ -183,6 +183,7 @@ def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> floa
     if per.kind != "periodic":
         return None
     n = per.period
+    assert n is not None  # kind "periodic" comes with its period
     bad = np.abs(x[n:] - x[:-n]) > rtol * float(np.max(np.abs(x)))
     k = int(np.flatnonzero(bad)[-1]) + 1 if bad.any() else 0
     return float(t[k])
@@ -651,7 +652,9 @@ def lyapunov_return_map(
     x = np.array([J0.alpha[k], J0.omega[k], J0.F[k]])
     w = np.array([0.3, 0.3, 1.0]) / math.sqrt(1.18)
     wall0 = time.perf_counter()
-    logs, dts, horizon, jumps = [], [], 1.0, 0
+    logs: list[float] = []
+    dts: list[float] = []
+    horizon, jumps = 1.0, 0
     while len(logs) < int(n_returns):
         y, dt = ret(x, horizon)
         if y is None:

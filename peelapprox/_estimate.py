@@ -63,6 +63,7 @@ def crude_branch_time(params: PeelParams) -> float:
     ignored.  V=1: 0.0862 s (the paper, reading 284 and 200 off a figure: 0.084).
     """
     bs = _folds(params)
+    assert bs.f_max is not None and bs.f_min is not None  # _folds: has_folds
     return (bs.f_max - bs.f_min) / (params.k * params.V)
 
 
@@ -100,6 +101,7 @@ def quasi_static_branch_time(
         Δt [s] (positive for a forward passage along the branch).
     """
     bs = _folds(params)
+    assert bs.v_max is not None and bs.v_min is not None and bs.v_land_cd is not None  # _folds: has_folds
     branch = choice("branch", branch, ("AB", "CD"))
     rate = choice("rate", rate, ("k(V-v)", "kV"))
     v_in, v_f = optional(state, "v_in", v_in, "v"), optional(state, "v_f", v_f, "v")
@@ -135,6 +137,7 @@ def force_bounds(params: PeelParams, alpha_min: float, alpha_max: float, *, line
     uses the paper's ``1 + α`` (its quoted 438 N and 181 N at V=4, I=1e-2).
     """
     bs = _folds(params)
+    assert bs.f_max is not None and bs.f_min is not None  # _folds: has_folds
     alpha_min, alpha_max = (in_range(name, a, -math.pi / 2, math.pi / 2, lo_open=True, hi_open=True)
                             for name, a in (("alpha_min", alpha_min), ("alpha_max", alpha_max)))
     linear = flag("linear", linear)
@@ -267,6 +270,7 @@ def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: f
             params.V, params.I, params.k, params.R, False, None, None, None, None, None, None, fp.v, fp.F,
             fp.fprime, fp.stable, None, None, None, None, None, None, None, None, None, None, None, None, None,
             "n/a", "stable")
+    assert bs.v_max is not None and bs.f_max is not None and bs.v_min is not None and bs.f_min is not None
     per = inertial_periods(params)
     tau_cd = cd_damping_time(params, per.F_mean, bs.v_land_cd)
     ratio = per.at_mean / tau_cd

@@ -33,7 +33,7 @@ import types
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from numba import njit
 
@@ -124,7 +124,7 @@ def _check_source(fn: Callable) -> None:
         )
 
 
-def kernel(fn: Callable | None = None, *, inline: str = "never", fastmath: bool = False,
+def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "never", fastmath: bool = False,
            name: str | None = None) -> Any:
     """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 

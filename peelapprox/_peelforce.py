@@ -22,6 +22,7 @@ import dataclasses
 import functools
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from scipy.optimize import brentq
@@ -159,15 +160,19 @@ class BranchStructure:
     v_land_cd: float | None
     v_land_ab: float | None
     v_breakdown: float = 0.0
+    # The fold fields (v_max, f_max, v_min, f_min, v_land_cd) are floats exactly when has_folds
+    # (_folds_and_landings sets them together; v_land_ab may stay None): below, the casts in
+    # ``... if has_folds else ...`` and the asserts after a has_folds guard state that for the type checker.
 
     def branch_range(self, branch: str) -> tuple[float, float]:
         """Range ``(v_lo, v_hi)`` of v on a stable branch."""
         if branch == "AB":
-            return (0.0, self.v_max if self.has_folds else math.inf)
+            return (0.0, cast(float, self.v_max) if self.has_folds else math.inf)
         if branch == "CD":
             if not self.has_folds:
                 raise ValueError(f"branch 'CD' does not exist for V={self.V}: f(v, V) has no fold "
                                  "(no stick-slip window)")
+            assert self.v_min is not None  # has_folds
             return (self.v_min, math.inf)
         raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
 
@@ -179,8 +184,9 @@ class BranchStructure:
     def level_range(self, branch: str) -> tuple[float, float]:
         """Range of levels ``G = F(1 - cos θ)`` for which the branch has a root."""
         if branch == "AB":
-            return (self.f_zero, self.f_max if self.has_folds else math.inf)
-        self.branch_range(branch)
+            return (self.f_zero, cast(float, self.f_max) if self.has_folds else math.inf)
+        self.branch_range(branch)  # raises unless branch is CD and the folds exist
+        assert self.f_min is not None
         return (self.f_min, math.inf)
 
 
@@ -219,7 +225,7 @@ def _branch_structure(V: float) -> BranchStructure:
     bs = _folds_and_landings(V)
     b, A = peel_force_coefficients(V)
     margin = BREAKDOWN_LEVEL * max(abs(bs.f_zero), 1.0)
-    w_hi = math.log(bs.v_max) if bs.has_folds else math.log(_V_HI)
+    w_hi = math.log(cast(float, bs.v_max)) if bs.has_folds else math.log(_V_HI)
     g = lambda w: _g.peel_force_fp(math.exp(w), b, A)[0] - bs.f_zero - margin  # noqa: E731
     v_br = math.exp(brentq(g, -690.0, w_hi, xtol=1e-12, rtol=4 * np.finfo(float).eps))
     return dataclasses.replace(bs, v_breakdown=v_br)
@@ -259,14 +265,16 @@ def _invert(G: float, bs: BranchStructure, branch: str, b: float, A: float) -> f
         )
     if branch == "AB":
         if bs.has_folds and G == bs.f_max:
+            assert bs.v_max is not None
             return bs.v_max
         # solve in w = ln v: f is monotone and smooth in w down to v ~ 1e-300
-        w_hi = math.log(bs.v_max) if bs.has_folds else math.log(_V_HI)
+        w_hi = math.log(cast(float, bs.v_max)) if bs.has_folds else math.log(_V_HI)
         w_lo = -690.0
         g = lambda w: _g.peel_force_fp(math.exp(w), b, A)[0] - G  # noqa: E731
         if g(w_lo) >= 0:
             raise ValueError(f"level G={G!r} is within rounding of f(0+, V)={bs.f_zero}: v on AB underflows")
         return math.exp(brentq(g, w_lo, w_hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
+    assert bs.v_min is not None  # CD: has_root above raised unless the folds exist
     if G == bs.f_min:
         return bs.v_min
     g = lambda x: _g.peel_force_fp(x, b, A)[0] - G  # noqa: E731

@@ -60,6 +60,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -312,7 +313,7 @@ class ReducedSegment:
     n_rhs: int = 0
     wall_time: float = 0.0
     rtol: float = 0.0
-    atol: np.ndarray = field(default=None, repr=False)
+    atol: np.ndarray | None = field(default=None, repr=False)
 
     def as_dict(self) -> dict:
         """Scalars only (no curves), for tables and JSON."""
@@ -451,6 +452,7 @@ def reduced_segment(
     if v_f is None:
         if not bs.has_folds:
             raise ValueError(f"V={params.V} has no fold; give v_f explicitly")
+        assert bs.v_max is not None and bs.v_min is not None  # has_folds
         v_f = bs.v_max if branch == "AB" else bs.v_min
     if branch == "AB" and not (v_in < v_f <= hi):
         raise ValueError(f"v_f must be in (v_in, v_max] = ({v_in}, {hi}] on AB, got {v_f}")
@@ -493,7 +495,7 @@ def reduced_segment(
     if atol is None:
         atol_v = rtol * np.array([1e-3, 1.0, F_in, a_scale, Om * a_scale])
     if t_max is None:
-        gap = (bs.f_max - bs.f_min) if bs.has_folds else F_in
+        gap = (cast(float, bs.f_max) - cast(float, bs.f_min)) if bs.has_folds else F_in
         t_max = 20.0 * gap / (params.k * params.V) + 20.0 * 2.0 * math.pi / Om
 
     if te is not None:

@@ -83,7 +83,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from types import MappingProxyType, ModuleType
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -398,7 +398,8 @@ def _worker_refs(measures: Sequence[str]) -> dict[str, str | bytes]:
         try:
             refs[name] = cp.dumps(MEASURES[name])
         except Exception as exc:
-            raise ValueError(f"measure {name!r} ({refs[name]}) cannot be pickled to ship it to the workers "
+            ref = cast(str, refs[name])  # still its import reference: dumps raised before the assignment
+            raise ValueError(f"measure {name!r} ({ref}) cannot be pickled to ship it to the workers "
                              f"({type(exc).__name__}: {exc}): define it in an importable module, or run in this "
                              "process with max_workers=0 (--workers 0)") from None
     return refs
@@ -609,8 +610,8 @@ def _hms(s: float) -> str:
 
 
 def sweep(
-    I_values: Sequence[float],
-    V_values: Sequence[float],
+    I_values: Sequence[float] | np.ndarray,
+    V_values: Sequence[float] | np.ndarray,
     measures: str | Sequence[str] = ("regime",),
     *,
     out,

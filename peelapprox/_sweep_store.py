@@ -53,7 +53,7 @@ def versions() -> dict:
     """Versions of Python and the packages whose changes could change a record."""
     from importlib import metadata
 
-    v = {"python": sys.version.split()[0]}
+    v: dict[str, str | None] = {"python": sys.version.split()[0]}
     for pkg in ("peelapprox", "numpy", "scipy", "numba"):
         try:
             v[pkg] = metadata.version(pkg)

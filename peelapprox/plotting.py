@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -60,8 +60,8 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     if len(traj.F):
         lo, hi = float(np.min(traj.F)), float(np.max(traj.F))
         pad = 0.08 * (hi - lo + 1.0)
-        ax[1, 1].set_ylim(min(lo, bs.f_min if bs.has_folds else lo) - pad,
-                          max(hi, bs.f_max if bs.has_folds else hi) + pad)
+        ax[1, 1].set_ylim(min(lo, cast(float, bs.f_min) if bs.has_folds else lo) - pad,
+                          max(hi, cast(float, bs.f_max) if bs.has_folds else hi) + pad)
     ax[1, 1].set(xlabel="v [m/s]", ylabel="F [N]", title="v–F phase plane")
     ax[1, 1].legend(loc="best", fontsize=8)
     ttl = title or f"V = {p.V} m/s, I = {p.I:g} kg m², k = {p.k:g} N/m, method = {traj.method}"
