@@ -78,7 +78,7 @@ import numpy as np
 
 from exact._simulate import _atol_vector, initial_state
 from peelapprox import GEOMETRIES, SolverFailure
-from peelapprox._params import EPS_RANGE
+from peelapprox._params import EPS_RANGE, T_TRANSIENT
 from peelapprox._peelforce import branch_structure
 from peelapprox._validate import choice, duration, function, in_range, optional, reals, state
 from peelapprox._validate import params as _params
@@ -590,7 +590,7 @@ def lyapunov_regularized(
     params: PeelParams,
     *,
     eps: float = 1e-7,
-    t_transient: float = 30.0,
+    t_transient: float = T_TRANSIENT,
     T: float = 50.0,
     tau: float = 0.5,
     rtol: float = 1e-8,

@@ -31,6 +31,7 @@ import numpy as np
 from peelapprox._dop853 import N_STAGES as _NS
 from peelapprox._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, workspace
 from peelapprox._jit import kernel
+from peelapprox._params import T_TRANSIENT
 from peelapprox._peelforce import BREAKDOWN_LEVEL, branch_structure
 from peelapprox._status import DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, status_error
 from peelapprox._validate import duration, integer, optional
@@ -157,7 +158,7 @@ STEPS_PER_SECOND = 5_000_000
 MAX_DEFAULT_STEPS = 1_000_000_000
 
 
-def lyapunov_saltation(params, *, t_transient: float = 30.0, T: float = 50.0, rtol: float = 1e-10,
+def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 50.0, rtol: float = 1e-10,
                        alpha0: float = 0.0, max_steps: int | None = None):
     """Largest Lyapunov exponent [1/s] from the tangent dynamics with saltation matrices (module docstring).
 

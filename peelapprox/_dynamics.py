@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._errors import WallBudget
-from ._params import RTOL_RANGE, TIME_MAX, PeelParams
+from ._params import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT, TIME_MAX, PeelParams
 from ._peelforce import BRANCHES, branch_structure
 from ._sweep import register_measure
 from ._validate import ArgumentTypeError, duration, function, in_range, integer, optional, positive, reals, state
@@ -190,10 +190,10 @@ def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> floa
 
 
 # ---------------------------------------------------------------------------------------------- windows
-WINDOW_DEFAULTS = dict(t_transient=30.0, window=20.0, rtol=1e-10, alpha0=0.0)
+WINDOW_DEFAULTS = dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0)
 
 
-def window_run(params: PeelParams, *, t_transient: float = 30.0, window: float = 20.0, rtol: float = 1e-10,
+def window_run(params: PeelParams, *, t_transient: float = T_TRANSIENT, window: float = 20.0, rtol: float = 1e-10,
                alpha0: float = 0.0, max_wall: float | None = None):
     """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
 
@@ -251,7 +251,7 @@ def attractors(
     params: PeelParams,
     alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
     *,
-    t_transient: float = 30.0,
+    t_transient: float = T_TRANSIENT,
     window: float = 20.0,
     rtol: float = 1e-10,
     period_rtol: float = 1e-6,
@@ -451,8 +451,8 @@ class LyapunovResult:
 def lyapunov(
     params: PeelParams,
     *,
-    t_transient: float = 30.0,
-    tau: float = 0.005,
+    t_transient: float = T_TRANSIENT,
+    tau: float = LYAPUNOV_TAU,
     n: int = 10000,
     n_discard: int = 200,
     d0: float = 1e-7,
@@ -557,7 +557,7 @@ def lyapunov(
 def lyapunov_tangent(
     params: PeelParams,
     *,
-    t_transient: float = 30.0,
+    t_transient: float = T_TRANSIENT,
     T: float = 50.0,
     rtol: float = 1e-10,
     alpha0: float = 0.0,
@@ -596,7 +596,7 @@ def lyapunov_tangent(
 def lyapunov_return_map(
     params: PeelParams,
     *,
-    t_transient: float = 30.0,
+    t_transient: float = T_TRANSIENT,
     n_returns: int = 5000,
     h: float = 1e-6,
     rtol: float = 1e-12,
@@ -707,14 +707,12 @@ def _period_options(options) -> dict:
     return {**_window_options(options), "period_rtol": positive("period_rtol", options.get("period_rtol", 1e-6))}
 
 
-#: Renormalisation interval [s] of the sweep's ``lyapunov`` measure.
-LYAPUNOV_TAU = 0.005
 
 
 def _lyapunov_options(options) -> dict:
     """The checked options of the ``lyapunov`` measure: ``t_transient`` (30 s), ``lyapunov_time`` (50 s, at most
     1e6 s) and ``alpha0`` (0), with :func:`lyapunov`'s validators."""
-    return {"t_transient": duration("t_transient", options.get("t_transient", 30.0), zero=True),
+    return {"t_transient": duration("t_transient", options.get("t_transient", T_TRANSIENT), zero=True),
             "lyapunov_time": in_range("lyapunov_time", options.get("lyapunov_time", 50.0), 2 * LYAPUNOV_TAU,
                                       TIME_MAX),
             "alpha0": state("alpha0", options.get("alpha0", 0.0), "alpha")}

@@ -7,8 +7,8 @@ from dataclasses import dataclass, field
 
 from ._validate import choice, in_range
 
-__all__ = ["EPS_RANGE", "RTOL_RANGE", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX",
-           "PeelParams"]
+__all__ = ["EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES",
+           "STATE_RANGES", "TIME_MAX", "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
 #: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
@@ -59,6 +59,12 @@ TIME_MAX = 1e6
 #: dynamics functions) and of the regularised scheme: below 1e-14 the error test asks for less than rounding,
 #: above 1e-2 it controls nothing a user could mean.
 RTOL_RANGE = (1e-14, 1e-2)
+
+#: Default transient [s] discarded by the dynamics functions (windowed runs, attractors, the Lyapunov family,
+#: the sweep measures): the paper's orbits settle within it (docs/dynamics.md, "Transients").
+T_TRANSIENT = 30.0
+#: Default renormalisation interval [s] of the two-trajectory Lyapunov exponent (docs/dynamics.md).
+LYAPUNOV_TAU = 0.005
 
 #: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons._benchmark) goes
 #: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding

@@ -30,7 +30,7 @@ from ._cli_checks import (
     positive_float,
     positive_int,
 )
-from ._params import GEOMETRIES, PeelParams
+from ._params import GEOMETRIES, LYAPUNOV_TAU, T_TRANSIENT, PeelParams
 
 __all__ = ["main"]
 
@@ -452,7 +452,7 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
 
     T, common = args.lyapunov_time, dict(t_transient=args.t_transient, alpha0=args.alpha0)
     if method == "two-trajectory":
-        tau = 0.005
+        tau = LYAPUNOV_TAU
         return D.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), max_wall=args.max_wall, **common)
     if method == "saltation":
         return D.lyapunov_tangent(p, T=T, **common)
@@ -609,7 +609,8 @@ def build_parser() -> argparse.ArgumentParser:
                                          "Lyapunov exponent at one (V, I)")
     _add_params(dy)
     dy.add_argument("--alpha0", type=float, default=0.0)
-    dy.add_argument("--t-transient", type=nonnegative_float, default=30.0, help="discarded [s] (30)")
+    dy.add_argument("--t-transient", type=nonnegative_float, default=T_TRANSIENT,
+                    help=f"discarded [s] ({T_TRANSIENT:g})")
     dy.add_argument("--window", type=positive_float, default=20.0, help="analysed [s] (20)")
     dy.add_argument("--rtol", type=float, default=1e-10)
     dy.add_argument("--max-period", type=positive_int, default=32)
