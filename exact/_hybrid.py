@@ -82,30 +82,28 @@ from __future__ import annotations
 
 import numpy as np
 
-from peelapprox import _generated as _g
-from peelapprox._dop853 import (
+from peelapprox.kernels import (
     MAX_REJECTIONS,
     STEP_FAILED,
+    closure,
+    constraint_rate,
     crossing,
     interp,
     interp1,
+    kernel,
     make_dop853,
+    peel_force_fp_jit,
+    peel_force_lnv_jit,
+    slow_rates,
     solve_theta,
     state_at,
     workspace,
 )
-from peelapprox._dop853 import N_STAGES as _NS
-from peelapprox._jit import kernel
-from peelapprox._peelforce import peel_force_fp_jit, peel_force_lnv_jit
-from peelapprox._status import DONE, GEOMETRY, JUMPS_FULL, NO_LANDING, NO_ROOT, OUT_FULL, PAUSE, STEP_FAIL, V_CEILING
+from peelapprox.kernels import N_STAGES as _NS
+from peelapprox.kernels import status as _st
 
-# the model's equations, compiled from the one generated source
-# (inline="always": numba then inlines them at the IR level; as separately compiled functions their calls
-# cost half of a field evaluation, 72 -> 35 ns measured)
-closure_paper = kernel(inline="always")(_g.closure_paper)
-closure_exact = kernel(inline="always")(_g.closure_exact)
-slow_rates = kernel(inline="always")(_g.slow_rates)
-constraint_rate = kernel(inline="always")(_g.constraint_rate)
+DONE, OUT_FULL, JUMPS_FULL, PAUSE, STEP_FAIL = _st.DONE, _st.OUT_FULL, _st.JUMPS_FULL, _st.PAUSE, _st.STEP_FAIL
+NO_ROOT, NO_LANDING, GEOMETRY, V_CEILING = _st.NO_ROOT, _st.NO_LANDING, _st.GEOMETRY, _st.V_CEILING
 
 # ---------------------------------------------------------------- layouts
 # parameter vector
@@ -133,9 +131,7 @@ SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = 0, 1, 2
 
 @kernel(inline="always")
 def _closure(alpha, p):
-    if p[P_GEOM] == 0.0:
-        return closure_paper(alpha, p[P_R], p[P_L])
-    return closure_exact(alpha, p[P_R], p[P_L])
+    return closure(alpha, p[P_GEOM], p[P_R], p[P_L])
 
 
 @kernel

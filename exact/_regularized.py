@@ -23,23 +23,16 @@ import numpy as np
 from scipy import integrate
 from scipy.optimize import brentq
 
-from peelapprox import _generated as _g
 from peelapprox._errors import ModelBreakdown, SolverFailure, budget_exceeded
-from peelapprox._jit import kernel
 from peelapprox._peelforce import (
     BRANCHES,
     BREAKDOWN_LEVEL,
     branch_structure,
     peel_force_coefficients,
-    peel_force_fp_jit,
 )
+from peelapprox.kernels import closure, kernel, peel_force_fp_jit, regularized_jacobian, regularized_rhs
 
 from ._trajectory import Jumps, SolverStats, State, Trajectory
-
-_rhs_g = kernel(inline="always")(_g.regularized_rhs)
-_jac_g = kernel(inline="always")(_g.regularized_jacobian)
-_cl_paper = kernel(inline="always")(_g.closure_paper)
-_cl_exact = kernel(inline="always")(_g.closure_exact)
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 
@@ -49,11 +42,8 @@ def _fun(y, q):
     # q = V, I, k, R, l, b, A, eps, geom
     v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
     f, _ = peel_force_fp_jit(v, q[5], q[6])
-    if q[8] == 0.0:
-        c, _ = _cl_paper(y[0], q[3], q[4])
-    else:
-        c, _ = _cl_exact(y[0], q[3], q[4])
-    r = _rhs_g(y[0], y[1], y[2], v, c, f, q[7], q[0], q[1], q[2], q[3])
+    c, _ = closure(y[0], q[8], q[3], q[4])
+    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[7], q[0], q[1], q[2], q[3])
     return np.array([r[0], r[1], r[2], r[3]])
 
 
@@ -61,11 +51,8 @@ def _fun(y, q):
 def _jac(y, q):
     v = max(y[3], 1e-300)
     _, fp = peel_force_fp_jit(v, q[5], q[6])
-    if q[8] == 0.0:
-        c, dc = _cl_paper(y[0], q[3], q[4])
-    else:
-        c, dc = _cl_exact(y[0], q[3], q[4])
-    j = _jac_g(y[0], y[1], y[2], v, c, dc, fp, q[7], q[0], q[1], q[2], q[3])
+    c, dc = closure(y[0], q[8], q[3], q[4])
+    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[7], q[0], q[1], q[2], q[3])
     out = np.empty((4, 4))
     for i in range(16):
         out[i // 4, i % 4] = j[i]

@@ -28,13 +28,12 @@ import math
 
 import numpy as np
 
-from peelapprox._dop853 import N_STAGES as _NS
-from peelapprox._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, workspace
-from peelapprox._jit import kernel
 from peelapprox._params import T_TRANSIENT
 from peelapprox._peelforce import BREAKDOWN_LEVEL, branch_structure
 from peelapprox._status import DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, status_error
 from peelapprox._validate import duration, integer, optional
+from peelapprox.kernels import N_STAGES as _NS
+from peelapprox.kernels import STEP_FAILED, crossing, interp, interp1, kernel, make_dop853, solve_theta, workspace
 
 from . import _hybrid as H
 

@@ -52,6 +52,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_alpha.py",
     "peelapprox/_segment.py",
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
+    "peelapprox/kernels.py",
     "exact/_hybrid.py",
     "exact/_regularized.py",
     "exact/_tangent.py",
