@@ -91,6 +91,10 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         rows.append((t, y[0], y[1], y[2], y[3]))
         brs.append(side(y[3]))
 
+    def level_gap(y):
+        """How far the level F (1 - cos θ) of state y lies above f(0+, V) [N] (the no_root criterion's measure)."""
+        return y[2] * (1.0 + float(params.closure(y[0])[0])) - bs.f_zero
+
     def sdict(t, y):
         return dict(t=float(t), alpha=float(y[0]), omega=float(y[1]), F=float(y[2]), v=float(y[3]),
                     branch=BRANCHES[side(y[3])])
@@ -119,9 +123,8 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
         t_old, y_old = ode.t, ode.y.copy()
         msg = ode.step()
         if ode.status == "failed":
-            gap = y_old[2] * (1.0 + float(params.closure(y_old[0])[0])) - bs.f_zero
             raise SolverFailure(f"regularized {solver} failed after t={t_old:.9g} (v = {y_old[3]:.3g} m/s, "
-                                f"F(1 - cos theta) - f(0+, V) = {gap:.3g} N): {msg}", t=float(t_old),
+                                f"F(1 - cos theta) - f(0+, V) = {level_gap(y_old):.3g} N): {msg}", t=float(t_old),
                                 state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         n_steps += 1
         y = ode.y
@@ -129,17 +132,17 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
             raise SolverFailure(f"regularized {solver}: the state became non-finite after t={t_old:.9g}",
                                 t=float(t_old), state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         if not y[3] > 0.0:  # the scheme left the model's domain (f is defined for v > 0): numerical, not physical
-            gap = y_old[2] * (1.0 + float(params.closure(y_old[0])[0])) - bs.f_zero
             raise SolverFailure(f"regularized {solver}: v = {y[3]:.3g} <= 0 after t={t_old:.9g}: the regularised "
-                                f"scheme left the model's domain (F(1 - cos theta) - f(0+, V) = {gap:.3g} N there; "
-                                "near 0 the orbit is approaching the no_root breakdown, else tighten rtol)",
+                                "scheme left the model's domain (F(1 - cos theta) - f(0+, V) = "
+                                f"{level_gap(y_old):.3g} N there; near 0 the orbit is approaching the no_root "
+                                "breakdown, else tighten rtol)",
                                 t=float(t_old), state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         if v_floor is not None and y[3] <= v_floor:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
                 f"(F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)",
                 t=float(ode.t), state=sdict(ode.t, y), reason="v_floor", partial=build(False))
-        if side(y[3]) == 0 and y[2] * (1.0 + float(params.closure(y[0])[0])) - bs.f_zero <= no_root_margin:
+        if side(y[3]) == 0 and level_gap(y) <= no_root_margin:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB "
                 f"(within {BREAKDOWN_LEVEL:g}): CONSTR has no root left, the peel front would have to stop",
