@@ -215,13 +215,6 @@ def _window_run(params, t_transient, window, rtol, alpha0, max_wall=None):
                     max_wall=max_wall)
 
 
-def _state_dict(params: PeelParams, t: float, alpha: float, omega: float, F: float, branch: str) -> dict:
-    """A state as the model exceptions carry it (v from CONSTR on ``branch``, as :func:`exact.initial_state`)."""
-    from exact import initial_state
-
-    return dict(initial_state(params, alpha0=alpha, omega0=omega, F0=F, branch0=branch, t0=t).__dict__)
-
-
 def classify(trajectory, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
     """:func:`periodicity` of a window's return map, with ``kind = "no stick-slip"`` below 2 returns."""
     x = return_map(trajectory)
@@ -502,7 +495,8 @@ def lyapunov(
         a, w, F, br = state
         try:
             tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps",
-                          max_wall=wall.left(0.0, lambda: _state_dict(params, 0.0, a, w, F, br), t_total))
+                          max_wall=wall.left(0.0, lambda: initial_state(params, alpha0=a, omega0=w, F0=F,
+                                                                        branch0=br).__dict__, t_total))
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         s = tr.final_state
@@ -617,7 +611,7 @@ def lyapunov_return_map(
     exponent, not the flow's 0.  A cross-check of :func:`lyapunov`, not a replacement: it needs a return
     map with at least two returns per second of the run.
     """
-    from exact import SolverBudgetExceeded, simulate
+    from exact import SolverBudgetExceeded, initial_state, simulate
 
     params = _params("params", params)
     h = positive("h", h, hi=1.0)
@@ -630,8 +624,8 @@ def lyapunov_return_map(
     def ret(x, horizon):
         try:
             J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol, save="jumps",
-                         max_wall=wall.left(0.0, lambda: _state_dict(params, 0.0, x[0], x[1], x[2], "CD"),
-                                            horizon)).jumps
+                         max_wall=wall.left(0.0, lambda: initial_state(params, alpha0=x[0], omega0=x[1], F0=x[2],
+                                                                           branch0="CD").__dict__, horizon)).jumps
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         ab = np.flatnonzero(np.asarray(J.from_branch) == _AB)
