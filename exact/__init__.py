@@ -10,6 +10,7 @@ from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailu
 
 from ._simulate import ATOL_SCALE, STEP_BUDGET, compile_kernels, default_max_steps, initial_state, simulate
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
+from ._variational import lyapunov_variational
 
 __all__ = [
     "simulate",
@@ -18,6 +19,7 @@ __all__ = [
     "ATOL_SCALE",
     "STEP_BUDGET",
     "default_max_steps",
+    "lyapunov_variational",
     "Trajectory",
     "Jumps",
     "Jump",

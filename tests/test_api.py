@@ -27,7 +27,8 @@ API = {
     },
     "exact": {
         "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
-        "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state", "simulate",
+        "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state",
+        "lyapunov_variational", "simulate",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
