@@ -26,7 +26,8 @@ API = {
         "wkb_error_bound",
     },
     "exact": {
-        "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
+        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "STEP_BUDGET", "SaveAt",
+        "SolverBudgetExceeded", "SolverFailure",
         "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state", "simulate",
     },
     "comparisons": {
