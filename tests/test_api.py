@@ -26,9 +26,9 @@ API = {
         "wkb_error_bound",
     },
     "exact": {
-        "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
-        "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state",
-        "lyapunov_variational", "simulate",
+        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "STEP_BUDGET", "SaveAt",
+        "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
+        "default_max_steps", "initial_state", "lyapunov_variational", "simulate",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
