@@ -51,6 +51,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_dop853.py",
     "peelapprox/_alpha.py",
     "peelapprox/_segment.py",
+    "peelapprox/_packing.py",  # the parameter-vector layouts, frozen into the kernels
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "peelapprox/kernels.py",
     "exact/_hybrid.py",
