@@ -5,6 +5,10 @@ stick-slip in peeling of an adhesive tape".  The core package holds the model
 parameters, the peel-force function, the paper's reduced branch-wise
 equations (Sec. V) and regime estimates; the exact DAE solvers live in the
 ``exact`` package and the approximate-vs-exact harness in ``comparisons``.
+
+The (I, V) sweep (``sweep``, ``load_sweep``, ``SweepResult``, ``register_measure``, ``MEASURES``,
+``parse_grid``) is an experiment and lives in :mod:`comparisons.sweep`; these names are offered here too,
+imported from there on first use (``import peelapprox`` imports no sibling package).
 """
 
 from ._alpha import (
@@ -61,7 +65,6 @@ from ._peelforce import (
     peel_force_derivative,
 )
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
-from ._sweep import MEASURES, SweepResult, load_sweep, parse_grid, register_measure, sweep
 from ._version import __version__ as __version__
 
 __all__ = [
@@ -131,3 +134,22 @@ __all__ = [
     "MEASURES",
     "parse_grid",
 ]
+
+#: Names offered here that live in another package: name -> module, imported on first access (a module
+#: ``__getattr__``), so that ``import peelapprox`` imports no sibling package.  The object is the module's
+#: own (``peelapprox.MEASURES is comparisons.sweep.MEASURES``: one registry).
+_LAZY = {name: "comparisons.sweep" for name in
+         ("sweep", "load_sweep", "SweepResult", "register_measure", "MEASURES", "parse_grid")}
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    return getattr(importlib.import_module(module), name)
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
