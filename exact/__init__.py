@@ -8,7 +8,16 @@ with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
 
 from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._simulate import ATOL_SCALE, STEP_BUDGET, compile_kernels, default_max_steps, initial_state, simulate
+from ._simulate import (
+    ATOL_SCALE,
+    STEP_BUDGET,
+    compile_kernels,
+    default_atol,
+    default_max_steps,
+    hybrid_field,
+    initial_state,
+    simulate,
+)
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import lyapunov_variational
 
@@ -19,6 +28,8 @@ __all__ = [
     "ATOL_SCALE",
     "STEP_BUDGET",
     "default_max_steps",
+    "default_atol",
+    "hybrid_field",
     "lyapunov_variational",
     "Trajectory",
     "Jumps",

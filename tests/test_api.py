@@ -27,8 +27,8 @@ API = {
     },
     "exact": {
         "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
-        "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state",
-        "lyapunov_variational", "simulate",
+        "SolverStats", "State", "Trajectory", "compile_kernels", "default_atol", "default_max_steps",
+        "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
