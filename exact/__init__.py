@@ -12,7 +12,16 @@ limits) are the validated forms of ``simulate``'s keywords.
 from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._options import Budget, Hybrid, Regularized, SaveAt
-from ._simulate import ATOL_SCALE, STEP_BUDGET, compile_kernels, default_max_steps, initial_state, simulate
+from ._simulate import (
+    ATOL_SCALE,
+    STEP_BUDGET,
+    compile_kernels,
+    default_atol,
+    default_max_steps,
+    hybrid_field,
+    initial_state,
+    simulate,
+)
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import lyapunov_variational
 
@@ -27,6 +36,8 @@ __all__ = [
     "ATOL_SCALE",
     "STEP_BUDGET",
     "default_max_steps",
+    "default_atol",
+    "hybrid_field",
     "lyapunov_variational",
     "Trajectory",
     "Jumps",

@@ -26,13 +26,10 @@ from scipy import integrate
 from scipy.optimize import brentq
 
 from peelapprox._errors import ModelBreakdown, SolverFailure, budget_exceeded
-from peelapprox._peelforce import (
-    BRANCHES,
-    BREAKDOWN_LEVEL,
-    branch_structure,
-    peel_force_coefficients,
-)
-from peelapprox.kernels import closure, kernel, peel_force_fp_jit, regularized_jacobian, regularized_rhs
+from peelapprox._peelforce import BRANCHES, BREAKDOWN_LEVEL, branch_structure
+from peelapprox.kernels import regularized_field as _fun  # the compiled field, Jacobian and parameter vector
+from peelapprox.kernels import regularized_field_jacobian as _jac
+from peelapprox.kernels import regularized_parameters as param_vector
 
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
@@ -42,35 +39,6 @@ if TYPE_CHECKING:
     from ._options import Budget, Regularized, SaveAt
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
-
-
-@kernel
-def _fun(y, q):
-    # q = V, I, k, R, l, b, A, eps, geom
-    v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
-    f, _ = peel_force_fp_jit(v, q[5], q[6])
-    c, _ = closure(y[0], q[8], q[3], q[4])
-    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[7], q[0], q[1], q[2], q[3])
-    return np.array([r[0], r[1], r[2], r[3]])
-
-
-@kernel
-def _jac(y, q):
-    v = max(y[3], 1e-300)
-    _, fp = peel_force_fp_jit(v, q[5], q[6])
-    c, dc = closure(y[0], q[8], q[3], q[4])
-    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[7], q[0], q[1], q[2], q[3])
-    out = np.empty((4, 4))
-    for i in range(16):
-        out[i // 4, i % 4] = j[i]
-    return out
-
-
-def param_vector(params, eps: float) -> np.ndarray:
-    """The parameter vector ``q`` of :func:`_fun` / :func:`_jac`: ``(V, I, k, R, l, b, A, eps, geometry)``."""
-    b, A = peel_force_coefficients(params.V)
-    return np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
-                     0.0 if params.geometry == "paper" else 1.0])
 
 
 def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regularized, saveat: SaveAt,

@@ -426,3 +426,19 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
             f_zero=bs.f_zero, f_min=bs.f_min, level=BREAKDOWN_LEVEL, v=sd["v"], v_ceiling=V_CEILING,
             v_floor=v_floor, why=why,
         )
+
+
+def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] = None) -> np.ndarray:
+    """The absolute tolerances ``simulate(method=method, rtol=rtol, atol=atol)`` uses, one per integrated component.
+
+    ``atol=None``: ``rtol * ATOL_SCALE[method]``; else ``atol`` checked (every component in
+    ``[1e-100, 1]``) and broadcast to 4 values.  Raises ValueError naming ``atol`` otherwise.
+    """
+    return _atol_vector(method, rtol, atol)
+
+
+def hybrid_field(params: PeelParams, v_floor: float | None = None) -> tuple[Callable, np.ndarray]:
+    """The hybrid solver's compiled field ``rhs(y, p, out)`` and its parameter vector ``p`` for ``params``
+    (``v_floor`` as in :func:`simulate`), e.g. to time one field evaluation in a compiled loop."""
+    return H._rhs, _param_vector(params, v_floor)
+

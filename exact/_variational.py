@@ -19,13 +19,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from peelapprox._errors import SolverFailure
+from peelapprox import SolverFailure
 from peelapprox._params import EPS_RANGE, T_TRANSIENT
 from peelapprox._validate import duration, function, in_range, optional, state
 from peelapprox._validate import params as _params
-from peelapprox.kernels import DIFFSOL_OPTIONS, diffsl_inputs, diffsl_model
+from peelapprox.kernels import (
+    DIFFSOL_OPTIONS,
+    diffsl_inputs,
+    diffsl_model,
+    regularized_field_jacobian,
+    regularized_parameters,
+)
 
-from ._regularized import _jac, param_vector
 from ._simulate import _atol_vector, initial_state
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -44,7 +49,7 @@ TANGENT_OPTIONS = dict(DIFFSOL_OPTIONS, max_error_test_failures=100_000)
 def _slow_tangent(params, x, w, scale):
     """A tangent vector with (α, ω, F) part ``w * scale`` and δv on the tangent of the slow manifold
     ``φ_v = 0`` (``∂φ_v/∂X · δX = 0``), so the first step needs no fast relaxation of δv."""
-    Jx = _jac(np.asarray(x, float), param_vector(params, 1.0))  # eps = 1: ∂φ/∂X itself
+    Jx = regularized_field_jacobian(np.asarray(x, float), regularized_parameters(params, 1.0))  # eps = 1: ∂φ/∂X
     d = np.zeros(4)
     d[:3] = np.asarray(w, float) * scale
     d[3] = -float(Jx[3, :3] @ d[:3]) / float(Jx[3, 3])
@@ -136,7 +141,8 @@ def lyapunov_variational(
     peelapprox.SolverFailure
         diffsol gave up (its message, and the state at the start of the failing interval, are attached).
     """
-    from peelapprox._dynamics import BenettinResult, LyapunovResult, natural_scales
+    from peelapprox import LyapunovResult
+    from peelapprox._dynamics import BenettinResult, natural_scales
 
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)

@@ -4,18 +4,21 @@ Everything here is compiled by :func:`peelapprox._jit.kernel` from the one gener
 (:mod:`peelapprox._generated`, written by :mod:`peelapprox._symbolic`), compiled once, and shared by every
 driver: the peel force (fvV) in the velocity and in the ln v form, the ``cos θ`` closures with the
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
-system XDAE and its Jacobian.  The model block every driver's parameter vector starts with
-(:mod:`peelapprox._packing`: the index constants ``M_*``, its length ``N_M``, :func:`model_block`), the DOP853
-pieces (:mod:`peelapprox._dop853`), the kernel compiler and the status codes (:mod:`peelapprox._status`) are
-offered here too, so ``exact`` needs no private module of ``peelapprox`` for its kernels.  The same system
-written in DiffSL and JIT-compiled by pydiffsol (optional, the ``bench`` extra; :mod:`peelapprox._diffsl`) is
-offered here for the ε-variational Lyapunov exponent of ``exact`` and the peers of ``comparisons``.
+system XDAE and its Jacobian (also as whole fields of the state and a packed parameter vector, the form the
+stiff solvers call).  The model block every driver's parameter vector starts with (:mod:`peelapprox._packing`:
+the index constants ``M_*``, its length ``N_M``, :func:`model_block`), the DOP853 pieces
+(:mod:`peelapprox._dop853`), the kernel compiler and the status codes (:mod:`peelapprox._status`) are offered
+here too, so ``exact`` needs no private module of ``peelapprox`` for its kernels.  The same system written in
+DiffSL and JIT-compiled by pydiffsol (optional, the ``bench`` extra; :mod:`peelapprox._diffsl`) is offered here
+for the ε-variational Lyapunov exponent of ``exact`` and the peers of ``comparisons``.
 
 The model functions are ``inline="always"``: numba inlines them into the fields at the IR level (as separate
 compiled functions their calls cost half of a field evaluation, 72 -> 35 ns measured).
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from . import _generated as _g
 from . import _status as status
@@ -43,13 +46,15 @@ from ._dop853 import (
 )
 from ._jit import kernel
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
-from ._peelforce import peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
+from ._peelforce import _invert as branch_inverse_at
+from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
 
 __all__ = [
     "kernel", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
-    "regularized_rhs", "regularized_jacobian",
+    "regularized_rhs", "regularized_jacobian", "regularized_parameters", "regularized_field",
+    "regularized_field_jacobian", "peel_force_coefficients", "branch_inverse_at",
     "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
@@ -77,3 +82,36 @@ def closure(alpha, exact_geometry, R, l):
     if exact_geometry == 0.0:
         return closure_paper(alpha, R, l)
     return closure_exact(alpha, R, l)
+
+
+def regularized_parameters(params, eps: float) -> np.ndarray:
+    """The parameter vector ``q`` of :func:`regularized_field` / :func:`regularized_field_jacobian`:
+    ``(V, I, k, R, l, b, A, eps, geometry)`` with ``(b, A)`` the coefficients of fvV and ``geometry`` 0 for the
+    paper's closure, 1 for the full one."""
+    b, A = peel_force_coefficients(params.V)
+    return np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
+                     0.0 if params.geometry == "paper" else 1.0])
+
+
+@kernel
+def regularized_field(y, q):
+    """XDAE's ``M⁻¹ φ(X)`` at ``y = (α, ω, F, v)`` as a new array (``q``: :func:`regularized_parameters`)."""
+    # q = V, I, k, R, l, b, A, eps, geom
+    v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
+    f, _ = peel_force_fp_jit(v, q[5], q[6])
+    c, _ = closure(y[0], q[8], q[3], q[4])
+    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[7], q[0], q[1], q[2], q[3])
+    return np.array([r[0], r[1], r[2], r[3]])
+
+
+@kernel
+def regularized_field_jacobian(y, q):
+    """The Jacobian of :func:`regularized_field`, a (4, 4) array (with ``eps = 1`` in ``q``: ∂φ/∂X itself)."""
+    v = max(y[3], 1e-300)
+    _, fp = peel_force_fp_jit(v, q[5], q[6])
+    c, dc = closure(y[0], q[8], q[3], q[4])
+    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[7], q[0], q[1], q[2], q[3])
+    out = np.empty((4, 4))
+    for i in range(16):
+        out[i // 4, i % 4] = j[i]
+    return out

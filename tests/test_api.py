@@ -30,7 +30,7 @@ API = {
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "STEP_BUDGET", "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
-        "default_max_steps", "initial_state", "lyapunov_variational", "simulate",
+        "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from comparisons._benchmark import (
+from comparisons.benchmark import (
     BENCH_SCENES,
     BenchScene,
     WPRow,

@@ -1,4 +1,4 @@
-"""External peer solvers (comparisons._peers) on the ε-regularised system, and its ε-variational Lyapunov
+"""External peer solvers (comparisons.benchmark.peers) on the ε-regularised system, and its ε-variational Lyapunov
 exponent (exact.lyapunov_variational, on the diffsol peer's tangent model).
 
 Each peer is skipped when its package is missing.  The shared Radau
@@ -9,10 +9,13 @@ import numpy as np
 import pytest
 
 import exact
-from comparisons import _peers as P
+from comparisons.benchmark import peers as P
+from comparisons.benchmark.peers import common as PC
+from comparisons.benchmark.peers import diffsol as PD
 from exact import _variational as LV
 from exact._regularized import _fun
-from peelapprox import PeelParams
+from peelapprox import PeelParams, branch_structure
+from peelapprox import kernels as K
 
 PACKAGES = {"ida": "sksundae", "cvode": "sksundae", "diffsol": "pydiffsol"}
 EPS = 1e-7
@@ -41,15 +44,15 @@ def test_diffsl_rhs_matches_generated_kernel(geometry):
     """
     pytest.importorskip("pydiffsol")
     params = PeelParams(V=1.3, I=2e-5, k=900.0, R=0.12, l=1.1, geometry=geometry)
-    ode = P.diffsl_model(geometry)
+    ode = K.diffsl_model(geometry)
     rng = np.random.default_rng(7)
     scale = np.array([3e-5, 2e-4, 5e-3, 7e-7])
-    q = P._qvec(params, EPS)
+    q = K.regularized_parameters(params, EPS)
     for _ in range(8):
         X = np.array([rng.uniform(-0.6, 0.6), rng.uniform(-80, 80), rng.uniform(120, 320), 10 ** rng.uniform(-3, 1.3)])
         y = X / scale
         Xs = y * scale  # what the DiffSL model sees: alpha = ya * sa, ...
-        inp = P.diffsl_inputs(params, EPS, X, scale)
+        inp = K.diffsl_inputs(params, EPS, X, scale)
         rhs = np.asarray(ode.rhs(inp, 0.0, y), dtype=float) * scale / np.array([1.0, 1.0, 1.0, EPS])
         np.testing.assert_allclose(rhs, _fun(Xs, q), rtol=1e-12, atol=0)
         assert np.allclose(ode.y0(inp) * scale, X, rtol=1e-15, atol=0)
@@ -109,7 +112,7 @@ def test_run_peer_rejects_bad_arguments(kwargs, name, p_low):
 
 def test_missing_package_raises_import_error(monkeypatch, p_low):
     """A missing peer package is an ImportError subclass naming the pip package (no tolerance involved)."""
-    monkeypatch.setitem(P._PACKAGES, "diffsol", ("no_such_module_for_peelapprox", "pydiffsol"))
+    monkeypatch.setitem(PC._PACKAGES, "diffsol", ("no_such_module_for_peelapprox", "pydiffsol"))
     with pytest.raises(ImportError, match="pydiffsol"):
         P.run_peer("diffsol", p_low, 0.01, eps=EPS, rtol=1e-6)
 
@@ -127,7 +130,7 @@ def test_solver_failure_is_reported_not_raised(monkeypatch, p_low):
         def solve(self, params, t_end):
             raise RuntimeError("ODE solver error: Step size is too small")
 
-    monkeypatch.setattr(P, "diffsl_model", lambda geometry: Broken())
+    monkeypatch.setattr(PD, "diffsl_model", lambda geometry: Broken())
     r = P.run_peer("diffsol", p_low, 0.01, eps=EPS, rtol=1e-6)
     assert r.status.startswith("failed: ") and "Step size is too small" in r.status
     assert r.jump_t.size == 0 and r.n_steps == -1
@@ -148,16 +151,16 @@ def test_diffsl_tangent_rhs_is_the_generated_jacobian_times_the_tangent(geometry
     from exact._regularized import _jac
 
     params = PeelParams(V=1.3, I=2e-5, k=900.0, R=0.12, l=1.1, geometry=geometry)
-    ode = P.diffsl_model(geometry, tangent=True)
+    ode = K.diffsl_model(geometry, tangent=True)
     rng = np.random.default_rng(11)
     scale = np.array([3e-5, 2e-4, 5e-3, 7e-7])
     tscale = np.array([1e-3, 2e-2, 1e-1, 3e-4])
-    q = P._qvec(params, EPS)
+    q = K.regularized_parameters(params, EPS)
     for _ in range(20):
         X = np.array([rng.uniform(-0.6, 0.6), rng.uniform(-80, 80), rng.uniform(120, 320), 10 ** rng.uniform(-3, 1.3)])
         d = rng.normal(size=4) * np.array([0.1, 10.0, 10.0, 1.0])
         y = np.concatenate([X / scale, d / tscale])
-        inp = P.diffsl_inputs(params, EPS, X, scale, d, tscale)
+        inp = K.diffsl_inputs(params, EPS, X, scale, d, tscale)
         rhs = np.asarray(ode.rhs(inp, 0.0, y), dtype=float)
         Xs, ds = y[:4] * scale, y[4:] * tscale
         mass = np.array([1.0, 1.0, 1.0, EPS])
@@ -181,14 +184,14 @@ def test_tangent_follows_finite_differences_across_the_jumps():
     p = PeelParams(V=2.0, I=1e-4)
     rtol, h = 1e-11, 1e-6
     a = exact._simulate._atol_vector("regularized", rtol, None)
-    ode = P.diffsl_model("paper", tangent=True)
+    ode = K.diffsl_model("paper", tangent=True)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0
     for name, val in LV.TANGENT_OPTIONS.items():
         setattr(ode.options, name, val)
     s0 = exact.initial_state(p)
     x = np.array([s0.alpha, s0.omega, s0.F, s0.v])
     x, _, _, _ = LV.tangent_solve(ode, p, EPS, a, x, np.zeros(4), 0.9)
-    scale = np.array([1.0, p.V / p.R, P.branch_structure(p.V).f_max])
+    scale = np.array([1.0, p.V / p.R, branch_structure(p.V).f_max])
     d = LV._slow_tangent(p, x, np.array([0.3, 0.3, 1.0]), scale)
     _, d1, steps, crossings = LV.tangent_solve(ode, p, EPS, a, x, d, 0.4)
     xp = LV.tangent_solve(ode, p, EPS, a, x + h * d, np.zeros(4), 0.4)
@@ -240,7 +243,7 @@ def test_lyapunov_regularized_reports_a_diffsol_failure_with_time_and_state(monk
     pytest.importorskip("pydiffsol")
     from peelapprox import SolverFailure
 
-    real = P.diffsl_model
+    real = K.diffsl_model
 
     class FailsLater:
         def __init__(self):
@@ -310,3 +313,17 @@ def test_lyapunov_variational_without_pydiffsol_names_the_bench_extra(monkeypatc
     with pytest.raises(PeerUnavailableError, match=r"pydiffsol.*peelapprox\[bench\]"):
         exact.lyapunov_variational(PeelParams(V=2.0, I=1e-4), T=1.0)
     assert issubclass(PeerUnavailableError, ImportError) and P.PeerUnavailableError is PeerUnavailableError
+
+
+def test_the_old_module_names_still_resolve_to_the_moved_objects():
+    """``comparisons._peers`` and ``comparisons._benchmark`` stay compatibility aliases: every name they export
+    resolves, to the very object of its new home (identity checks)."""
+    from comparisons import _benchmark, _peers, benchmark
+
+    for mod in (_peers, _benchmark):
+        for name in mod.__all__:
+            assert getattr(mod, name) is not None, (mod.__name__, name)
+    assert _peers.lyapunov_regularized is exact.lyapunov_variational
+    assert _peers.run_peer is P.run_peer and _peers.diffsl_code is K.diffsl_code
+    assert _peers.tangent_solve is LV.tangent_solve and _peers.TANGENT_OPTIONS is LV.TANGENT_OPTIONS
+    assert _benchmark.run_benchmark is benchmark.run_benchmark and _benchmark.BENCH_SCENES is benchmark.BENCH_SCENES
