@@ -7,6 +7,7 @@ equations (Sec. V) and regime estimates; the exact DAE solvers live in the
 ``exact`` package and the approximate-vs-exact harness in ``comparisons``.
 """
 
+from . import _dynamics  # noqa: F401  (registers the sweep measures "period" and "lyapunov")
 from ._alpha import (
     ALPHA_FORMS,
     InertialPeriods,
@@ -22,20 +23,6 @@ from ._alpha import (
     wkb_alpha,
     wkb_amplitude_phase,
     wkb_error_bound,
-)
-from ._dynamics import (
-    Attractor,
-    LyapunovResult,
-    Periodicity,
-    attractors,
-    benettin,
-    force_drops,
-    lyapunov,
-    lyapunov_return_map,
-    lyapunov_tangent,
-    periodicity,
-    return_map,
-    settle_time,
 )
 from ._errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._estimate import (
@@ -60,9 +47,15 @@ from ._peelforce import (
     peel_force,
     peel_force_derivative,
 )
+from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._sweep import MEASURES, SweepResult, load_sweep, parse_grid, register_measure, sweep
 from ._version import __version__ as __version__
+
+#: Names offered here that live in the ``exact`` package (they run its solver): imported from it on first
+#: access (module ``__getattr__``), so that ``import peelapprox`` does not import ``exact``.
+_FROM_EXACT = ("attractors", "Attractor", "lyapunov", "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult",
+               "benettin")
 
 __all__ = [
     "PeelParams",
@@ -110,12 +103,14 @@ __all__ = [
     "force_bounds",
     "slope_criterion",
     "SlopeCriterion",
-    # dynamics of the exact solution (need the exact package at call time)
+    # the return map of an exact trajectory
     "return_map",
     "periodicity",
     "Periodicity",
+    "classify",
     "force_drops",
     "settle_time",
+    # dynamics of the exact solution: they live in exact, imported from it on first access
     "attractors",
     "Attractor",
     "lyapunov",
@@ -131,3 +126,18 @@ __all__ = [
     "MEASURES",
     "parse_grid",
 ]
+
+
+def __getattr__(name: str):
+    """The names of :data:`_FROM_EXACT`, imported from ``exact`` when first asked for (PEP 562)."""
+    if name in _FROM_EXACT:
+        import exact
+
+        value = getattr(exact, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_FROM_EXACT))
