@@ -20,6 +20,7 @@ from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._lyapunov import lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._simulate import ATOL_SCALE, STEP_BUDGET, compile_kernels, default_max_steps, initial_state, simulate
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
+from ._variational import lyapunov_variational
 
 __all__ = [
     "simulate",
@@ -28,6 +29,7 @@ __all__ = [
     "ATOL_SCALE",
     "STEP_BUDGET",
     "default_max_steps",
+    "lyapunov_variational",
     "Trajectory",
     "Jumps",
     "Jump",

@@ -151,8 +151,7 @@ def lyapunov(
         return _tangent(params, max_wall=max_wall, **common, **options)
     if method == "return-map":
         return _return_map(params, max_wall=max_wall, **common, **options)
-    # the ε-variational method moves into exact on a parallel branch (issue 14): until it lands, import error
-    from ._variational import lyapunov_variational  # type: ignore[import-not-found,unused-ignore]
+    from ._variational import lyapunov_variational
 
     progress = optional(function, "progress", options.pop("progress", None))
     wall = WallBudget(optional(positive, "max_wall", max_wall))

@@ -4,10 +4,9 @@ Temporary home (issue 14): the return-map analysis moved to :mod:`peelapprox._re
 that run the exact solver to :mod:`exact` (``exact._attractors``, ``exact._lyapunov``); these measures move
 with the sweep engine to ``comparisons``.  They import ``exact`` lazily, inside their bodies.
 
-For the modules not yet moved that import the dynamics from here (``peelapprox._sweep``,
-``comparisons._peers``), ``force_drops`` and ``return_map`` are imported here and the names that moved to
-:mod:`exact` still resolve here, lazily (module ``__getattr__``): ``window_run``, ``BenettinResult``,
-``LyapunovResult``, ``natural_scales``.
+For ``peelapprox._sweep`` (not yet moved), which imports the dynamics from here, ``force_drops`` and
+``return_map`` are imported here and ``window_run``, now in :mod:`exact`, still resolves here lazily (module
+``__getattr__``).
 """
 
 from __future__ import annotations
@@ -21,16 +20,12 @@ from ._validate import duration, in_range, positive, state
 
 __all__ = ["measure_period", "measure_lyapunov"]
 
-#: Names that moved to ``exact`` and are still imported from here by modules not yet moved (module docstring).
-_MOVED = {"window_run": "exact._attractors", "BenettinResult": "exact._benettin",
-          "LyapunovResult": "exact._benettin", "natural_scales": "exact._benettin"}
-
 
 def __getattr__(name: str):
-    if name in _MOVED:
-        import importlib
+    if name == "window_run":
+        import exact
 
-        return getattr(importlib.import_module(_MOVED[name]), name)
+        return exact.window_run
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

@@ -461,7 +461,6 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
             raise ValueError("--lyapunov-method return-map needs AB→CD returns in the window; there are none")
         return exact.lyapunov_return_map(p, t_transient=args.t_transient, max_wall=args.max_wall,
                                          n_returns=max(2, int(round(returns / args.window * T))))
-    from comparisons._peers import lyapunov_regularized
 
     step = max(args.t_transient + T, 1e-9) / 10.0
     mark = [step]
@@ -471,7 +470,7 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
             print(f"  {t_done:g}/{t_total:g} s", file=sys.stderr, flush=True)
             mark[0] += step
 
-    return lyapunov_regularized(p, eps=args.eps, T=T, progress=progress, **common)
+    return exact.lyapunov_variational(p, eps=args.eps, T=T, progress=progress, **common)
 
 
 def _add_params(sp: argparse.ArgumentParser) -> None:
@@ -659,9 +658,10 @@ def _loaded(module: str, name: str) -> tuple[type, ...]:
 def _exit_status(exc: BaseException) -> int | None:
     """2 for a bad argument, output path or missing optional package; 3 when the model or solver stopped; 1
     when writing failed after the checks (disk full, a path changed meanwhile); None for anything else."""
+    from ._diffsl import PeerUnavailableError
     from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-    if isinstance(exc, (ValueError, *_loaded("comparisons._peers", "PeerUnavailableError"))):
+    if isinstance(exc, (ValueError, PeerUnavailableError)):
         return 2
     if isinstance(exc, (ModelBreakdown, SolverBudgetExceeded, SolverFailure,
                         *_loaded("comparisons._runs", "TransientNotPassed"))):

@@ -6,7 +6,9 @@ driver: the peel force (fvV) in the velocity and in the ln v form, the ``cos θ`
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
 system XDAE and its Jacobian; the DOP853 pieces (:mod:`peelapprox._dop853`), the kernel compiler and the
 status codes (:mod:`peelapprox._status`) are offered here too, so ``exact`` needs no private module of
-``peelapprox`` for its kernels.
+``peelapprox`` for its kernels.  The same system written in DiffSL and JIT-compiled by pydiffsol (optional,
+the ``bench`` extra; :mod:`peelapprox._diffsl`) is offered here for the ε-variational Lyapunov exponent of
+``exact`` and the peers of ``comparisons``.
 
 The model functions are ``inline="always"``: numba inlines them into the fields at the IR level (as separate
 compiled functions their calls cost half of a field evaluation, 72 -> 35 ns measured).
@@ -16,6 +18,16 @@ from __future__ import annotations
 
 from . import _generated as _g
 from . import _status as status
+from ._diffsl import (
+    DIFFSL_INPUTS,
+    DIFFSL_TANGENT_INPUTS,
+    DIFFSOL_OPTIONS,
+    PeerUnavailableError,
+    diffsl_code,
+    diffsl_inputs,
+    diffsl_model,
+    import_optional,
+)
 from ._dop853 import (
     MAX_REJECTIONS,
     N_STAGES,
@@ -38,6 +50,8 @@ __all__ = [
     "regularized_rhs", "regularized_jacobian",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
+    "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
+    "diffsl_inputs", "diffsl_model", "import_optional",
 ]
 
 #: ``(c, dc/dα)`` of the paper's closure ``cos θ = -sin α`` at ``(alpha, R, l)``.

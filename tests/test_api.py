@@ -29,7 +29,7 @@ API = {
         "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
         "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state", "simulate",
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
-        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult",
+        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "lyapunov_variational",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",

@@ -1,4 +1,5 @@
-"""External peer solvers (comparisons._peers) on the ε-regularised system.
+"""External peer solvers (comparisons._peers) on the ε-regularised system, and its ε-variational Lyapunov
+exponent (exact.lyapunov_variational, on the diffsol peer's tangent model).
 
 Each peer is skipped when its package is missing.  The shared Radau
 reference (rtol 1e-10, ~6 s) is computed once per module.
@@ -9,6 +10,7 @@ import pytest
 
 import exact
 from comparisons import _peers as P
+from exact import _variational as LV
 from exact._regularized import _fun
 from peelapprox import PeelParams
 
@@ -181,16 +183,16 @@ def test_tangent_follows_finite_differences_across_the_jumps():
     a = exact._simulate._atol_vector("regularized", rtol, None)
     ode = P.diffsl_model("paper", tangent=True)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0
-    for name, val in P.TANGENT_OPTIONS.items():
+    for name, val in LV.TANGENT_OPTIONS.items():
         setattr(ode.options, name, val)
     s0 = exact.initial_state(p)
     x = np.array([s0.alpha, s0.omega, s0.F, s0.v])
-    x, _, _, _ = P.tangent_solve(ode, p, EPS, a, x, np.zeros(4), 0.9)
+    x, _, _, _ = LV.tangent_solve(ode, p, EPS, a, x, np.zeros(4), 0.9)
     scale = np.array([1.0, p.V / p.R, P.branch_structure(p.V).f_max])
-    d = P._slow_tangent(p, x, np.array([0.3, 0.3, 1.0]), scale)
-    _, d1, steps, crossings = P.tangent_solve(ode, p, EPS, a, x, d, 0.4)
-    xp = P.tangent_solve(ode, p, EPS, a, x + h * d, np.zeros(4), 0.4)
-    xm = P.tangent_solve(ode, p, EPS, a, x - h * d, np.zeros(4), 0.4)
+    d = LV._slow_tangent(p, x, np.array([0.3, 0.3, 1.0]), scale)
+    _, d1, steps, crossings = LV.tangent_solve(ode, p, EPS, a, x, d, 0.4)
+    xp = LV.tangent_solve(ode, p, EPS, a, x + h * d, np.zeros(4), 0.4)
+    xm = LV.tangent_solve(ode, p, EPS, a, x - h * d, np.zeros(4), 0.4)
     assert crossings == xp[3] == xm[3] >= 40 and steps > 0
     fd = (xp[0] - xm[0]) / (2 * h)
     assert np.linalg.norm((fd - d1)[:3] / scale) <= 3e-3 * np.linalg.norm(d1[:3] / scale)
@@ -215,7 +217,7 @@ def test_lyapunov_regularized_at_a_stable_fixed_point_is_the_leading_eigenvalue(
     lead = sorted(ev, key=lambda z: -z.real)
     assert lead[0].imag == 0.0 and lead[0].real - lead[1].real > 0.8
     expected = lead[0].real / np.log(2.0)
-    r = P.lyapunov_regularized(p, eps=EPS, t_transient=15.0, T=10.0, rtol=1e-8)
+    r = LV.lyapunov_variational(p, eps=EPS, t_transient=15.0, T=10.0, rtol=1e-8)
     assert r.bits_per_s == pytest.approx(expected, rel=1e-5)
     assert r.n_jumps == 0 and r.benettin.n == 20 and r.benettin.wall_time > 0
     assert any(n.startswith("steps=") and int(n[6:]) > 0 for n in r.notes)
@@ -229,7 +231,7 @@ def test_lyapunov_regularized_at_a_stable_fixed_point_is_the_leading_eigenvalue(
 def test_lyapunov_regularized_rejects_bad_arguments(kwargs, name):
     """Bad arguments raise ValueError naming the argument, before any compilation or solve."""
     with pytest.raises(ValueError, match=name):
-        P.lyapunov_regularized(PeelParams(V=2.0, I=1e-4), **kwargs)
+        LV.lyapunov_variational(PeelParams(V=2.0, I=1e-4), **kwargs)
 
 
 def test_lyapunov_regularized_reports_a_diffsol_failure_with_time_and_state(monkeypatch):
@@ -256,9 +258,9 @@ def test_lyapunov_regularized_reports_a_diffsol_failure_with_time_and_state(monk
                 raise RuntimeError("ODE solver error: Exceeded maximum number of error test failures (41)")
             return self.ode.solve(inp, t)
 
-    monkeypatch.setattr(P, "diffsl_model", lambda geometry, tangent=False: FailsLater())
+    monkeypatch.setattr(LV, "diffsl_model", lambda geometry, tangent=False: FailsLater())
     with pytest.raises(SolverFailure, match="error test failures") as info:
-        P.lyapunov_regularized(PeelParams(V=2.0, I=1e-4), t_transient=0.0, T=1.0, tau=0.25)
+        LV.lyapunov_variational(PeelParams(V=2.0, I=1e-4), t_transient=0.0, T=1.0, tau=0.25)
     assert info.value.t == pytest.approx(0.5, abs=1e-12)
     assert set(info.value.state) == {"alpha", "omega", "F", "v", "tangent"}
 
@@ -274,7 +276,7 @@ def test_regularized_variational_lyapunov_agrees_with_the_hybrid_two_trajectory_
     from peelapprox import lyapunov
 
     p = PeelParams(V=2.5, I=1e-4)
-    reg = P.lyapunov_regularized(p, eps=1e-8, T=200.0).bits_per_s
+    reg = LV.lyapunov_variational(p, eps=1e-8, T=200.0).bits_per_s
     hyb = lyapunov(p, n=40000).bits_per_s
     assert abs(reg - hyb) / hyb < 0.10
 
@@ -295,3 +297,16 @@ def test_paper_eps_turns_the_chaotic_point_V2_I1e4_into_a_period_42_orbit():
     x = F[k::2][t[k::2] > 30.0]
     per = periodicity(x, max_period=64)
     assert per.period == 42 and x.size > 3000
+
+
+def test_lyapunov_variational_without_pydiffsol_names_the_bench_extra(monkeypatch):
+    """Without pydiffsol, exact.lyapunov_variational raises an ImportError subclass naming the package and the
+    ``bench`` extra, after the argument checks (no tolerance involved)."""
+    import sys
+
+    from peelapprox.kernels import PeerUnavailableError
+
+    monkeypatch.setitem(sys.modules, "pydiffsol", None)  # makes ``import pydiffsol`` raise ImportError
+    with pytest.raises(PeerUnavailableError, match=r"pydiffsol.*peelapprox\[bench\]"):
+        exact.lyapunov_variational(PeelParams(V=2.0, I=1e-4), T=1.0)
+    assert issubclass(PeerUnavailableError, ImportError) and P.PeerUnavailableError is PeerUnavailableError
