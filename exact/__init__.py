@@ -4,6 +4,9 @@
 FLOW1, FLOW2, flow3 with the constraint CONSTR of De, Maybhate and
 Ananthakrishna, either in the ε → 0 limit (``method="hybrid"``, default) or
 with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
+The option objects :class:`Hybrid`, :class:`Regularized` (the method and its
+error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the
+limits) are the validated forms of ``simulate``'s keywords.
 
 The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
 (sampled starts grouped by the attractor they reach) and the largest Lyapunov exponent,
@@ -18,12 +21,17 @@ from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailu
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._lyapunov import lyapunov, lyapunov_return_map, lyapunov_tangent
+from ._options import Budget, Hybrid, Regularized, SaveAt
 from ._simulate import ATOL_SCALE, STEP_BUDGET, compile_kernels, default_max_steps, initial_state, simulate
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import lyapunov_variational
 
 __all__ = [
     "simulate",
+    "Hybrid",
+    "Regularized",
+    "SaveAt",
+    "Budget",
     "initial_state",
     "compile_kernels",
     "ATOL_SCALE",

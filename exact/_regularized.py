@@ -18,6 +18,8 @@ delay ~ ε^(2/3) (see docs/theory.md).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from scipy import integrate
@@ -33,6 +35,11 @@ from peelapprox._peelforce import (
 from peelapprox.kernels import closure, kernel, peel_force_fp_jit, regularized_jacobian, regularized_rhs
 
 from ._trajectory import Jumps, SolverStats, State, Trajectory
+
+if TYPE_CHECKING:
+    from peelapprox import PeelParams
+
+    from ._options import Budget, Regularized, SaveAt
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 
@@ -66,9 +73,12 @@ def param_vector(params, eps: float) -> np.ndarray:
                      0.0 if params.geometry == "paper" else 1.0])
 
 
-def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, save, max_points, max_steps, max_jumps,
-                    progress, v_floor, max_wall=None):
-    """Driver for ``simulate(method="regularized")`` (arguments already validated)."""
+def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regularized, saveat: SaveAt,
+                    budget: Budget, progress: Callable[[float, float], None] | None) -> Trajectory:
+    """Driver for ``simulate(method="regularized")``: the options validated, the budget resolved."""
+    solver, eps, rtol, atol, v_floor = method.solver, method.eps, method.rtol, method.atol_vector(), method.v_floor
+    t_store, te, max_wall = saveat.t_transient, saveat.ts, budget.max_wall
+    max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
     bs = branch_structure(params.V)
     no_root_margin = BREAKDOWN_LEVEL * max(abs(bs.f_zero), 1.0)  # the hybrid solver's criterion (v_breakdown)
     q = param_vector(params, eps)
@@ -79,7 +89,9 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
     wall0 = time.perf_counter()
     ode = _SOLVERS[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, jac=jac)
 
-    rows, brs, jumps = [], [], []
+    rows: list[tuple] = []
+    brs: list[int] = []
+    jumps: list[tuple] = []
     t_eval_i = 0
 
     def side(v):
@@ -116,7 +128,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
 
     n_steps = 0
     n_jumps = 0
-    if te is None and save == "steps" and s0.t >= t_store:
+    if saveat.steps and s0.t >= t_store:
         store(s0.t, y0)
     last_report = time.perf_counter()
     while ode.status == "running":
@@ -168,7 +180,7 @@ def run_regularized(params, t_end, s0, solver, rtol, atol, eps, t_store, te, sav
                                         state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
                 store(te[t_eval_i], ye)
                 t_eval_i += 1
-        elif save == "steps" and ode.t >= t_store:
+        elif saveat.steps and ode.t >= t_store:
             store(ode.t, y)
         if n_steps >= max_steps and ode.status == "running":
             raise budget_exceeded("max_steps", max_steps, t_end, sdict(ode.t, y), build(False))

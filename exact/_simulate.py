@@ -13,7 +13,7 @@ import numpy as np
 from peelapprox import PeelParams
 from peelapprox import _status as S
 from peelapprox._errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox._params import EPS_RANGE, RTOL_RANGE, TIME_MAX
+from peelapprox._params import TIME_MAX
 from peelapprox._peelforce import (
     BRANCHES,
     BREAKDOWN_LEVEL,
@@ -23,41 +23,27 @@ from peelapprox._peelforce import (
     peel_force_coefficients,
 )
 from peelapprox._status import status_error
-from peelapprox._validate import choice, duration, in_range, integer, optional, positive, reals, state
+from peelapprox._validate import choice, duration, in_range, optional, state
 from peelapprox._validate import params as _params
 
 from . import _hybrid as H
+from ._options import (
+    ATOL_SCALE,
+    STEP_BUDGET,
+    Budget,
+    Hybrid,
+    Regularized,
+    SaveAt,
+    default_max_steps,
+    method_option,
+    output_options,
+)
+from ._options import _atol_vector as _atol_vector  # read by comparisons._peers (exact.simulate's atol rule)
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 __all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE", "STEP_BUDGET", "default_max_steps"]
 
-METHODS = ("hybrid", "regularized")
-SOLVERS = ("Radau", "BDF", "LSODA")
-SAVES = ("steps", "jumps")
-
-#: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
-#: components.  Hybrid: (τ [s], α [rad], ω [rad/s], ln v [-]); regularised:
-#: (α, ω, F [N], v [m/s]).  The scales are the smallest magnitudes that matter on
-#: the orbits of the paper: α oscillates with amplitude ≥ ~1e-3 rad, segment
-#: durations are ≥ ~1e-4 s; ln v is controlled to ``rtol (1 + |ln v|)``, a
-#: relative accuracy of v at every speed (the regularised v ≥ ~1e-3 m/s on AB).
-ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1.0), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
-
 _COMPILE_TIME: dict[str, float | None] = {"hybrid": None}
-
-#: Default step budget per simulated second, floor and cap, by method (``max_steps=None``).  The
-#: physical grid of the stress suite needs at most ~1.5e4 hybrid steps per simulated second (I = 1e-6,
-#: rtol 1e-8; 1.3-1.8 us each) and the regularised scheme ~1e3 (~150 us each), so the rate leaves a
-#: margin of ~50x, while the cap bounds a default call: hybrid <= 2e7 steps (~35 s measured on
-#: t_end = 1e300), regularised <= 5e5 (~80 s).  A run that needs more raises SolverBudgetExceeded
-#: naming max_steps.
-STEP_BUDGET = {"hybrid": (1e6, 1e6, 2e7), "regularized": (1e5, 1e5, 5e5)}
-
-
-def default_max_steps(method: str, t_end: float) -> int:
-    """The step budget ``simulate`` uses when ``max_steps=None``: ``clip(rate * t_end, floor, cap)``."""
-    rate, lo, hi = STEP_BUDGET[method]
-    return int(min(hi, max(lo, rate * t_end)))
 
 
 def initial_state(
@@ -116,24 +102,6 @@ def initial_state(
     return State(float(t0), a0, w0, F, float(v), branch0)
 
 
-#: Valid absolute tolerances, every component: 0 is excluded (τ starts every branch segment at 0, so pure
-#: relative control has no scale there), above 1 (1 s, 1 rad, 1 rad/s, a factor e in v (hybrid, ln v),
-#: 1 m/s or 1 N (regularised)) no error is controlled at all; below 1e-100 the scaled field overflows the
-#: error norm.
-ATOL_RANGE = (1e-100, 1.0)
-
-
-def _atol_vector(method: str, rtol: float, atol) -> np.ndarray:
-    if atol is None:
-        return rtol * np.asarray(ATOL_SCALE[method], dtype=float)
-    a = reals("atol", atol, *ATOL_RANGE)
-    if a.ndim == 0:
-        a = np.full(4, float(a))
-    if a.shape != (4,):
-        raise ValueError(f"atol must be a scalar or 4 values (one per integrated component), got shape {a.shape}")
-    return a
-
-
 def compile_kernels() -> float:
     """Compile (or load from numba's on-disk cache) the hybrid kernel.
 
@@ -144,8 +112,8 @@ def compile_kernels() -> float:
     t0 = time.perf_counter()
     p = PeelParams(V=1.0, I=1e-5)
     st = initial_state(p)
-    _run_hybrid(p, 1e-4, st, 1e-6, _atol_vector("hybrid", 1e-6, None), 0.0, None, "steps", 10**4, 10**3, 10**4, None,
-                None)
+    _run_hybrid(p, 1e-4, st, Hybrid(rtol=1e-6), SaveAt(steps=True),
+                Budget(max_points=10**4, max_steps=10**3, max_jumps=10**4), None)
     dt = time.perf_counter() - t0
     _COMPILE_TIME["hybrid"] = dt
     return dt
@@ -174,7 +142,7 @@ def simulate(
     omega0: float | None = None,
     F0: float | None = None,
     branch0: str | None = None,
-    method: str = "hybrid",
+    method: str | Hybrid | Regularized = "hybrid",
     solver: str | None = None,
     rtol: float = 1e-8,
     atol: None | float | Sequence[float] = None,
@@ -188,6 +156,8 @@ def simulate(
     max_wall: float | None = None,
     v_floor: float | None = None,
     progress: None | bool | Callable[[float, float], None] = None,
+    saveat: SaveAt | None = None,
+    budget: Budget | None = None,
 ) -> Trajectory:
     """Integrate the peeling model (FLOW1, FLOW2, flow3, CONSTR) from t = 0 to t_end.
 
@@ -202,11 +172,14 @@ def simulate(
         ``branch0=None`` meaning the lowest-velocity stable root of CONSTR
         (see :func:`initial_state`).  v is always the root of CONSTR on
         ``branch0``, so the start is consistent.
-    method : {"hybrid", "regularized"}
+    method : {"hybrid", "regularized"} or Hybrid or Regularized
         ``"hybrid"`` (default): the ε → 0 limit, event-driven, compiled DOP853
         on the desingularised branch dynamics with exact fold jumps (see
         :mod:`exact._hybrid`).  ``"regularized"``: the paper's scheme, mass
         matrix ``diag(1, 1, 1, ε)``, integrated by scipy's stiff ``solver``.
+        A method object (:class:`Hybrid`, :class:`Regularized`) holds
+        ``solver``, ``eps``, ``rtol``, ``atol`` and ``v_floor`` itself: those
+        keywords must then stay at their defaults (ValueError naming both).
     solver : {"Radau", "BDF", "LSODA"}, optional
         scipy solver for ``method="regularized"`` (analytic Jacobian);
         default "Radau".  Passing it with the hybrid method is an error.
@@ -257,6 +230,13 @@ def simulate(
     progress : bool or callable, optional
         ``True`` prints progress to stderr; a callable receives ``(t, t_end)``
         between chunks of work.
+    saveat : SaveAt, optional
+        ``save``, ``t_eval`` and ``t_transient`` as one object; those
+        keywords must then stay at their defaults (a keyword at its default
+        value counts as not given; otherwise ValueError naming both).
+    budget : Budget, optional
+        ``max_points``, ``max_steps``, ``max_jumps`` and ``max_wall`` as one
+        object, on the same rule.
 
     Returns
     -------
@@ -274,33 +254,10 @@ def simulate(
         Budget used up / the integrator cannot proceed.
     """
     _params("params", params)
-    method = choice("method", method, METHODS)
-    if method == "hybrid":
-        for name, val in (("solver", solver), ("eps", eps)):
-            if val is not None:
-                raise ValueError(f"{name} applies only to method='regularized' (the hybrid method is the eps -> 0 "
-                                 f"limit, integrated by its own DOP853), got {name}={val!r} with method='hybrid'")
-    else:
-        solver = choice("solver", "Radau" if solver is None else solver, SOLVERS)
-        eps = in_range("eps", 1e-7 if eps is None else eps, *EPS_RANGE)
+    opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor)
     t_end = duration("t_end", t_end)
-    rtol = in_range("rtol", rtol, *RTOL_RANGE)
-    atol_v = _atol_vector(method, rtol, atol)
-    t_transient = in_range("t_transient", t_transient, 0.0, t_end)
-    save = choice("save", save, SAVES)
-    max_points = integer("max_points", max_points)
-    max_jumps = integer("max_jumps", max_jumps)
-    max_steps = default_max_steps(method, t_end) if max_steps is None else integer("max_steps", max_steps)
-    max_wall = optional(positive, "max_wall", max_wall)
-    te = None
-    if t_eval is not None:
-        te = reals("t_eval", t_eval, t_transient, t_end).ravel()
-        if te.size == 0 or np.any(np.diff(te) < 0):
-            raise ValueError(f"t_eval must be a non-empty, sorted sequence of times in [t_transient, t_end] = "
-                             f"[{t_transient:g}, {t_end:g}]")
-        if te.size > max_points:
-            raise ValueError(f"t_eval has {te.size} points, more than max_points={max_points}")
-    v_floor = optional(positive, "v_floor", v_floor)
+    out, lim = output_options(opts.name, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
+                              max_points=max_points, max_steps=max_steps, max_jumps=max_jumps, max_wall=max_wall)
     if progress is True:
         progress = _progress_printer(f"simulate V={params.V} I={params.I}")
     elif progress is False:
@@ -309,23 +266,15 @@ def simulate(
         raise TypeError(f"progress must be None, a bool or a callable (t, t_end), got {type(progress).__name__}")
 
     st0 = initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
-    if method == "hybrid":
+    if isinstance(opts, Hybrid):
         ct = compile_kernels()
-        traj = _run_hybrid(
-            params, t_end, st0, rtol, atol_v, t_transient, te, save, max_points, max_steps, max_jumps, progress,
-            v_floor,
-            max_wall,
-        )
+        traj = _run_hybrid(params, t_end, st0, opts, out, lim, progress)
         if ct:
             traj.stats = SolverStats(**{**traj.stats.__dict__, "compile_time": ct})
         return traj
     from ._regularized import run_regularized
 
-    return run_regularized(
-        params, t_end, st0, solver, rtol, atol_v, eps, t_transient, te, save, max_points, max_steps, max_jumps,
-        progress,
-        v_floor, max_wall,
-    )
+    return run_regularized(params, t_end, st0, opts, out, lim, progress)
 
 
 #: On CD, v above this [m/s] is a runaway of the pull force (ModelBreakdown "v_ceiling").
@@ -357,16 +306,20 @@ def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarra
 _PAUSE_STEPS = 250_000  # steps per kernel call between progress/budget checks (~0.3 s)
 
 
-def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, max_steps, max_jumps, progress, v_floor,
-                max_wall=None):
+def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, saveat: SaveAt, budget: Budget,
+                progress: Callable[[float, float], None] | None) -> Trajectory:
+    """Driver for ``simulate(method="hybrid")``: the options validated, the budget resolved."""
+    rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
+    t_store, max_wall = saveat.t_transient, budget.max_wall
+    max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
     p = _param_vector(params, v_floor)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
-    if te is not None:
-        mode, cap = H.SAVE_TEVAL, te.size
-        t_eval = te
+    if saveat.ts is not None:
+        mode, cap = H.SAVE_TEVAL, saveat.ts.size
+        t_eval = saveat.ts.copy()  # writeable, as the compiled kernel is typed for
     else:
-        mode = H.SAVE_STEPS if save == "steps" else H.SAVE_NONE
+        mode = H.SAVE_STEPS if saveat.steps else H.SAVE_NONE
         # two rows of slack: a step may store two (at a jump), and the budget raises only when *more*
         # than max_points rows are needed (the kernel returns OUT_FULL before a step without room for two)
         cap = min(max_points + 2, 1 << 16) if mode == H.SAVE_STEPS else 1
@@ -375,7 +328,9 @@ def _run_hybrid(params, t_end, s0, rtol, atol, t_store, te, save, max_points, ma
     out_br = np.empty(cap, dtype=np.int8)
     jcap = min(max_jumps + 1, 1 << 14)  # one slot of slack: JUMPS_FULL in the last view means > max_jumps
     jbuf = np.empty((jcap, H.N_J))
-    chunks, bchunks, jchunks = [], [], []
+    chunks: list[np.ndarray] = []
+    bchunks: list[np.ndarray] = []
+    jchunks: list[np.ndarray] = []
     n_stored = 0
     if mode == H.SAVE_STEPS and s0.t >= t_store:
         out[0] = (s0.t, s0.alpha, s0.omega, s0.F, s0.v)

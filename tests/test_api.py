@@ -26,10 +26,11 @@ API = {
         "wkb_error_bound",
     },
     "exact": {
-        "ATOL_SCALE", "Jump", "Jumps", "ModelBreakdown", "STEP_BUDGET", "SolverBudgetExceeded", "SolverFailure",
-        "SolverStats", "State", "Trajectory", "compile_kernels", "default_max_steps", "initial_state", "simulate",
+        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "STEP_BUDGET", "SaveAt",
+        "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
+        "default_max_steps", "initial_state", "lyapunov_variational", "simulate",
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
-        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "lyapunov_variational",
+        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
