@@ -83,7 +83,16 @@ from __future__ import annotations
 import numpy as np
 
 from peelapprox.kernels import (
+    M_A,
+    M_B,
+    M_GEOM,
+    M_I,
+    M_K,
+    M_L,
+    M_R,
+    M_V,
     MAX_REJECTIONS,
+    N_M,
     STEP_FAILED,
     closure,
     constraint_rate,
@@ -106,11 +115,10 @@ DONE, OUT_FULL, JUMPS_FULL, PAUSE, STEP_FAIL = _st.DONE, _st.OUT_FULL, _st.JUMPS
 NO_ROOT, NO_LANDING, GEOMETRY, V_CEILING = _st.NO_ROOT, _st.NO_LANDING, _st.GEOMETRY, _st.V_CEILING
 
 # ---------------------------------------------------------------- layouts
-# parameter vector
+# parameter vector: the model block of peelapprox.kernels (M_V ... M_GEOM), then this driver's fields
 # (v-valued entries are velocities [m/s]; the U entries their logarithms, the state's variable)
-(P_V, P_I, P_K, P_R, P_L, P_B, P_A, P_GEOM, P_VMAX, P_VMIN, P_VLCD, P_VLAB, P_UFLOOR, P_UCEIL, P_FOLDS,
- P_UEV_AB, P_UEV_CD) = range(17)
-N_P = 17
+(P_VMAX, P_VMIN, P_VLCD, P_VLAB, P_UFLOOR, P_UCEIL, P_FOLDS, P_UEV_AB, P_UEV_CD) = range(N_M, N_M + 9)
+N_P = N_M + 9
 # solver state vector (S_U holds u = ln v)
 S_T0, S_TAU, S_AL, S_OM, S_U, S_H, S_BR = range(7)
 N_S = 7
@@ -131,13 +139,13 @@ SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = 0, 1, 2
 
 @kernel(inline="always")
 def _closure(alpha, p):
-    return closure(alpha, p[P_GEOM], p[P_R], p[P_L])
+    return closure(alpha, p[M_GEOM], p[M_R], p[M_L])
 
 
 @kernel
 def pull_force(alpha, v, p):
     """F = f(v, V) / (1 + c(α))  (CONSTR solved for F)."""
-    f, _ = peel_force_fp_jit(v, p[P_B], p[P_A])
+    f, _ = peel_force_fp_jit(v, p[M_B], p[M_A])
     c, _ = _closure(alpha, p)
     return f / (1.0 + c)
 
@@ -145,7 +153,7 @@ def pull_force(alpha, v, p):
 @kernel
 def _rhs(y, p, out):
     """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring)."""
-    v, f, g = peel_force_lnv_jit(y[3], p[P_B], p[P_A])  # g = v f'(v) = df/d(ln v) = dt/ds
+    v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
     if not (v > 0.0):  # trial stage left the model's domain (v underflowed): poison the step
         for i in range(4):
             out[i] = np.nan
@@ -156,7 +164,7 @@ def _rhs(y, p, out):
             out[i] = np.nan
         return
     F = f / (1.0 + c)
-    ad, wd, Fd = slow_rates(y[1], y[2], F, v, c, p[P_V], p[P_I], p[P_K], p[P_R])
+    ad, wd, Fd = slow_rates(y[1], y[2], F, v, c, p[M_V], p[M_I], p[M_K], p[M_R])
     (Gd,) = constraint_rate(F, Fd, c, dc, ad)
     out[0] = g
     out[1] = g * ad

@@ -20,7 +20,6 @@ from peelapprox._peelforce import (
     branch_inverse,
     branch_structure,
     peel_force,
-    peel_force_coefficients,
 )
 from peelapprox._status import status_error
 from peelapprox._validate import choice, duration, in_range, optional, state
@@ -284,12 +283,10 @@ V_CEILING = 1e3
 def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``."""
+    from peelapprox.kernels import model_block  # local: this helper's edits stay inside _param_vector (issue 14)
+
     bs = branch_structure(params.V)
-    b, A = peel_force_coefficients(params.V)
-    p = np.zeros(H.N_P)
-    p[H.P_V], p[H.P_I], p[H.P_K], p[H.P_R], p[H.P_L] = params.V, params.I, params.k, params.R, params.l
-    p[H.P_B], p[H.P_A] = b, A
-    p[H.P_GEOM] = 0.0 if params.geometry == "paper" else 1.0
+    p = model_block(params, H.N_P)  # the model block (peelapprox.kernels), then the hybrid driver's fields
     p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
     p[H.P_VMAX] = bs.v_max if bs.has_folds else math.inf
     p[H.P_VMIN] = bs.v_min if bs.has_folds else 0.0

@@ -5,9 +5,16 @@ stick-slip in peeling of an adhesive tape".  The core package holds the model
 parameters, the peel-force function, the paper's reduced branch-wise
 equations (Sec. V) and regime estimates; the exact DAE solvers live in the
 ``exact`` package and the approximate-vs-exact harness in ``comparisons``.
+
+The (I, V) sweep (``sweep``, ``load_sweep``, ``SweepResult``, ``register_measure``, ``MEASURES``,
+``parse_grid``) is an experiment and lives in :mod:`comparisons.sweep`; these names are offered here too,
+imported from there on first use (``import peelapprox`` imports no sibling package).  So are the
+dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lyapunov(params, method=...)``),
+``lyapunov_tangent``, ``lyapunov_return_map``, ``LyapunovResult``, ``benettin``, ``attractors``,
+``Attractor``.  The return-map analysis of a trajectory (``return_map``, ``periodicity``, ``classify``,
+``force_drops``, ``settle_time``) is the core's own.
 """
 
-from . import _dynamics  # noqa: F401  (registers the sweep measures "period" and "lyapunov")
 from ._alpha import (
     ALPHA_FORMS,
     InertialPeriods,
@@ -49,13 +56,7 @@ from ._peelforce import (
 )
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
-from ._sweep import MEASURES, SweepResult, load_sweep, parse_grid, register_measure, sweep
 from ._version import __version__ as __version__
-
-#: Names offered here that live in the ``exact`` package (they run its solver): imported from it on first
-#: access (module ``__getattr__``), so that ``import peelapprox`` does not import ``exact``.
-_FROM_EXACT = ("attractors", "Attractor", "lyapunov", "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult",
-               "benettin")
 
 __all__ = [
     "PeelParams",
@@ -127,17 +128,24 @@ __all__ = [
     "parse_grid",
 ]
 
+#: Names offered here that live in another package: name -> module, imported on first access (a module
+#: ``__getattr__``), so that ``import peelapprox`` imports no sibling package.  The object is the module's
+#: own (``peelapprox.MEASURES is comparisons.sweep.MEASURES``: one registry).
+_LAZY = {name: "comparisons.sweep" for name in
+         ("sweep", "load_sweep", "SweepResult", "register_measure", "MEASURES", "parse_grid")}
+# the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
+_LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
+                                         "lyapunov_return_map", "LyapunovResult", "benettin")})
+
 
 def __getattr__(name: str):
-    """The names of :data:`_FROM_EXACT`, imported from ``exact`` when first asked for (PEP 562)."""
-    if name in _FROM_EXACT:
-        import exact
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
 
-        value = getattr(exact, name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_FROM_EXACT))
+    return sorted(set(globals()) | set(_LAZY))

@@ -24,9 +24,20 @@ to the peel velocity (approxvdot, fullvdot, genalpha with v̇) is in
 
 Units: t [s], α [rad], α̇ [rad/s], F [N], R [m], I [kg m²], k [N/m], v, V [m/s].
 
-The closed forms are written once, as functions of scalars that work both on
-numpy arrays and inside numba (``_sinusoid``, ``_harmonic``, ``_decay``); the
-compiled segment solver uses the same functions.
+Each formula of these equations is written once, below, as a function of
+scalars that works on numpy arrays and inside numba (:func:`peelapprox._jit.jitable`):
+the approxalpha frequency and restoring term (``_omega``, ``_restoring``), the
+closed forms (``_sinusoid``, ``_harmonic``, ``_decay``), the CD damping time
+(``_damping_time``) and the frozen force rate (``_frozen_rate``).  The public
+functions here and the compiled segment solver (:mod:`peelapprox._segment_kernel`)
+call the same functions.  Two caveats, both measured: numpy's vectorised ``exp``
+(SIMD) and the libm ``exp`` of the compiled code differ in the last bit for ~5 %
+of arguments, so ``_decay`` on an array and inside the kernel agree to 1 ulp,
+not bitwise (``sin``/``cos`` agreed bitwise on 10^5 arguments); and the damping
+terms of Airy1/Airy2 appear in two arithmetic forms — ``(Ḟ + F α̇)/(R f')`` in
+:func:`alpha_numerical`, and multiplied by ``dt/ds = v f'`` with the ``f'``
+cancelled in the segment solver (which integrates through the fold, where
+``f' = 0``) — the same equation, not the same floating-point operations.
 """
 
 from __future__ import annotations
@@ -38,6 +49,7 @@ import numpy as np
 from scipy import integrate, special
 
 from ._errors import SolverFailure
+from ._jit import jitable
 from ._params import TIME_MAX, PeelParams
 from ._peelforce import branch_structure, peel_force_derivative
 from ._validate import choice, in_range, optional, state, states, times
@@ -68,10 +80,33 @@ ALPHA_FORMS = ("airy", "airy1", "airy2")
 AIRY_X_MAX = 1e6
 
 
-# ------------------------------------------------------------ shared closed forms
-# (numpy- and numba-compatible: only arithmetic and np ufuncs)
+# ------------------------------------------------------------ the equations, each written once
+# (numpy- and numba-compatible: only arithmetic and np ufuncs; kernels call them through jitable)
 
 
+@jitable
+def _omega(F, R, I):
+    """Angular frequency ``sqrt(F R/I)`` of approxalpha at force F [rad/s]."""
+    return np.sqrt(R * F / I)
+
+
+@jitable
+def _restoring(F, alpha, R, I):
+    """The right side ``-F R α/I`` of approxalpha and Airy (FLOW2 with ``sin α ≈ α``) [rad/s²]."""
+    return -F * R * alpha / I
+
+
+def _damping_time(R, fp, F):
+    """Damping time ``R f'(v)/F`` of α in Airy2 and its CD limit [s]."""
+    return R * fp / F
+
+
+def _frozen_rate(params: PeelParams, v=0.0):
+    """The force rate ``k (V - v)`` of flow3 with v frozen [N/s] (the paper drops v on AB: ``v = 0``)."""
+    return params.k * (params.V - v)
+
+
+@jitable
 def _sinusoid(t, A, phi, F_in, s, R, I):
     """(α, α̇) of the WKB sinusoid with amplitude A and phase φ at t = 0."""
     F = F_in + s * t
@@ -82,17 +117,19 @@ def _sinusoid(t, A, phi, F_in, s, R, I):
     env = A * np.sqrt(np.sqrt(F_in / F))
     sn = np.sin(Phi + phi)
     cs = np.cos(Phi + phi)
-    return env * sn, env * (np.sqrt(R * F / I) * cs - s / (4.0 * F) * sn)
+    return env * sn, env * (_omega(F, R, I) * cs - s / (4.0 * F) * sn)
 
 
+@jitable
 def _harmonic(t, alpha_in, alphadot_in, F, R, I):
     """(α, α̇) of approxalpha with constant F."""
-    Om = np.sqrt(R * F / I)
+    Om = _omega(F, R, I)
     c = np.cos(Om * t)
     s = np.sin(Om * t)
     return alpha_in * c + alphadot_in / Om * s, -alpha_in * Om * s + alphadot_in * c
 
 
+@jitable
 def _decay(t, alpha_in, tau):
     """(α, α̇) of ``α̇ = -α/τ``."""
     a = alpha_in * np.exp(-t / tau)
@@ -110,7 +147,7 @@ def _times(t) -> np.ndarray:
 def _force_ramp(params: PeelParams, t: np.ndarray, F_in, F_rate) -> tuple[float, float]:
     """Validate ``F = F_in + F_rate t`` (default rate ``k V``) and keep it positive over t."""
     F_in = state("F_in", F_in, "F")
-    s = params.k * params.V if F_rate is None else state("F_rate", F_rate, "F_rate")
+    s = _frozen_rate(params) if F_rate is None else state("F_rate", F_rate, "F_rate")
     F_end = F_in + s * float(np.max(t))
     if not F_end > 0.0:
         raise ValueError(
@@ -141,7 +178,7 @@ def inertial_frequency(params: PeelParams, F):
     """
     params = _params("params", params)
     Fa = states("F", F, "F")
-    out = np.sqrt(Fa * params.R / params.I)
+    out = _omega(Fa, params.R, params.I)
     return float(out) if out.ndim == 0 else out
 
 
@@ -288,7 +325,7 @@ def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alp
     """
     F_in, s = _force_ramp(_params("params", params), np.zeros(1), F_in, F_rate)
     a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
-    Om = math.sqrt(params.R * F_in / params.I)
+    Om = _omega(F_in, params.R, params.I)
     c = (ad_in + s * a_in / (4.0 * F_in)) / Om
     return math.hypot(a_in, c), math.atan2(a_in, c)
 
@@ -360,7 +397,7 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
     if v is not None:
         v = state("v", v, "v")
         if F_rate is None:
-            F_rate = params.k * (params.V - v)
+            F_rate = _frozen_rate(params, v)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
     R, I = params.R, params.I
     damp = 0.0
@@ -375,7 +412,7 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
 
     def rhs(tt, y):
         F = F_in + s * tt
-        return [y[1], -F * R * y[0] / I - damp * (drive + F * y[1])]
+        return [y[1], _restoring(F, y[0], R, I) - damp * (drive + F * y[1])]
 
     order = np.argsort(t.ravel(), kind="stable")
     tv = t.ravel()[order]
@@ -405,7 +442,7 @@ def cd_damping_time(params: PeelParams, F, v):
     fp = np.asarray(peel_force_derivative(states("v", v, "v"), params.V), dtype=float)
     if np.any(fp <= 0):
         raise ValueError(f"v must be on a stable branch of f(., V={params.V}) (f'(v) > 0)")
-    out = params.R * fp / Fa
+    out = _damping_time(params.R, fp, Fa)
     return float(out) if out.ndim == 0 else out
 
 

@@ -180,15 +180,16 @@ def check_sweep_plot_key(key: str, measures: Sequence[str]) -> None:
     """Before a sweep: ValueError unless ``key`` can be a record key of ``measures``.
 
     Record keys are the engine's (``I``, ``V``, ``status``) and the measures'
-    keys, which the engine prefixes ``"<measure>_"`` (:func:`peelapprox._sweep._prefixed`,
+    keys, which the engine prefixes ``"<measure>_"`` (:func:`comparisons.sweep.measures.record_key`,
     reused here so the rule stays in one place).  Which suffixes a measure
     returns is known only after it ran; the CLI checks the exact key again then.
     """
-    from ._sweep import RESERVED, _prefixed
+    from comparisons.sweep.measures import record_key
+    from comparisons.sweep.store import RESERVED
 
     if os.sep in key or (os.altsep and os.altsep in key):
         raise ValueError(f"--plot {key!r}: a record key has no path separator (the plot goes to DIR/KEY.png)")
-    if key in RESERVED or any(key in _prefixed(m, {key: None}) for m in measures):
+    if key in RESERVED or any(record_key(m, key) == key for m in measures):
         return
     raise ValueError(f"--plot {key!r} is not a key of the measures {list(measures)}: keys are "
                      f"{', '.join(RESERVED)} or start with {', '.join(m + '_' for m in measures)}")

@@ -2,7 +2,7 @@
 
 Both compiled solvers of the package use this module: the hybrid (ε → 0) DAE
 solver (``exact._hybrid``) and the reduced branch-wise equations
-(``peelapprox._segment``).  Each of them owns its *driver* (what happens at
+(``peelapprox._segment_kernel``).  Each of them owns its *driver* (what happens at
 events, jumps and output), never the step itself.
 
 Method

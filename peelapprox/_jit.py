@@ -20,8 +20,9 @@ Where no cache location is writable (read-only install, HOME, XDG cache and
 caching, with one :class:`~peelapprox._errors.KernelCacheWarning`: the
 package works, and every new process compiles again.
 
-Every function compiled by the package goes through :func:`kernel`; it
-refuses a function whose source file is not in :data:`KERNEL_SOURCES`, so a
+Every function compiled by the package goes through :func:`kernel` (or, for a
+formula that plain Python and numpy call as well, :func:`jitable`); both
+refuse a function whose source file is not in :data:`KERNEL_SOURCES`, so a
 new kernel module cannot silently escape the hash.
 """
 
@@ -36,10 +37,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from numba import njit
+from numba.extending import register_jitable
 
 from ._errors import KernelCacheWarning
 
-__all__ = ["kernel", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
+__all__ = ["kernel", "jitable", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -50,7 +52,8 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_peelforce.py",
     "peelapprox/_dop853.py",
     "peelapprox/_alpha.py",
-    "peelapprox/_segment.py",
+    "peelapprox/_segment_kernel.py",
+    "peelapprox/_packing.py",  # the parameter-vector layouts, frozen into the kernels
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "peelapprox/kernels.py",
     "exact/_hybrid.py",
@@ -178,3 +181,21 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
                 stacklevel=2,
             )
     return njit(cache=False, inline=inline, fastmath=fastmath)(fn)
+
+
+def jitable(fn: Callable) -> Callable:
+    """Return the plain function ``fn``, registered so that kernels can call it too (one definition, both worlds).
+
+    Python and numpy callers call ``fn`` itself (on scalars or arrays); a kernel that calls it gets it compiled
+    into its own code and inlined at the IR level (numba's ``register_jitable(inline="always")``), so it is
+    cached, and re-compiled on a source change, with that kernel.  Use for a formula of the model that both the
+    vectorised public functions and the compiled solvers evaluate, e.g. the closed forms of the reduced α
+    equations (:mod:`peelapprox._alpha`).
+
+    Raises
+    ------
+    RuntimeError
+        If ``fn``'s source file is not in :data:`KERNEL_SOURCES` (a developer error).
+    """
+    _check_source(fn)
+    return register_jitable(inline="always")(fn)

@@ -48,8 +48,9 @@ with ``N`` the numerator of the v equation; every ``1/f'`` cancels, so the
 field is smooth through the fold and the exit is the transversal event
 ``ln v = ln v_f``.  Closed-form α models are evaluated at the current t.
 
-The integrator is the package's one compiled DOP853 (:mod:`peelapprox._dop853`)
-with scipy's tolerance semantics: a step is accepted when the RMS of
+The integrator is the package's one compiled DOP853 (:mod:`peelapprox._dop853`),
+driven by :mod:`peelapprox._segment_kernel` (the field, its parameter layout and
+the exit event), with scipy's tolerance semantics: a step is accepted when the RMS of
 ``err_i / (atol_i + rtol·|y_i|)`` is below 1 over ``y = (t, ln v, F, α, α̇)``.
 The default ``atol = rtol × (1 ms, 1, F_in, α_scale, Ω_in α_scale)`` with
 ``α_scale = max(|α_in|, |α̇_in|/Ω_in, 1e-8)``, ``Ω_in = sqrt(F_in R/I)``.
@@ -64,204 +65,23 @@ from typing import cast
 
 import numpy as np
 
-from ._alpha import _decay, _harmonic, _sinusoid, wkb_amplitude_phase
-from ._dop853 import N_STAGES as _NS
-from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
-from ._jit import kernel
+from . import _segment_kernel as K
+from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, wkb_amplitude_phase
+from ._packing import model_block
 from ._params import RTOL_RANGE, TIME_MAX, PeelParams
-from ._peelforce import BRANCHES, branch_structure, peel_force_coefficients, peel_force_derivative, peel_force_fp_jit
-from ._status import (
-    DONE,
-    F_NONPOSITIVE,
-    MAX_STEPS,
-    NONFINITE,
-    OUT_FULL,
-    STEP_FAIL,
-    T_MAX,
-    V_CEILING,
-    V_FLOOR,
-    status_error,
-)
+from ._peelforce import BRANCHES, branch_structure, peel_force_derivative
+from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
+from ._status import DONE, MAX_STEPS, OUT_FULL, T_MAX, status_error
 from ._validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
 from ._validate import params as _params
 from ._validate import state as _state
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
 
-#: α models accepted by :func:`reduced_segment` (module docstring)
-ALPHA_MODELS = (
-    "sinusoid", "harmonic", "approxalpha", "airy2", "airy2_frozen", "airy1", "genalpha", "exponential", "static",
-)
-#: velocity equations accepted by :func:`reduced_segment`
-V_EQUATIONS = ("approxvdot", "fullvdot")
 #: Valid ``atol`` components: below 1e-100 the squared scaled errors of the step-size control underflow
 #: (``atol = 1e-200`` divided by zero); above 1e3 the error test accepts any step (every component's
 #: natural scale on a branch is smaller, except F in N, whose default atol is ``rtol F_in``).
 ATOL_RANGE = (1e-100, 1e3)
-
-AM_SIN, AM_HARM, AM_APPROX, AM_AIRY2, AM_AIRY2F, AM_AIRY1, AM_GEN, AM_EXP, AM_STATIC = range(9)
-VE_APPROX, VE_FULL = range(2)
-_CLOSED = (AM_SIN, AM_HARM, AM_EXP, AM_STATIC)
-
-# parameter vector layout
-(Q_V, Q_I, Q_K, Q_R, Q_B, Q_A, Q_AM, Q_VE, Q_FIN, Q_VIN, Q_FPIN, Q_S, Q_AMP, Q_PH, Q_AIN, Q_ADIN, Q_TAU) = range(17)
-N_Q = 17
-# counters
-C_STEPS, C_REJ, C_RHS, C_NOUT, C_TEVAL = range(5)
-# save modes
-SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = range(3)
-
-_sinusoid_jit = kernel(inline="always")(_sinusoid)
-_harmonic_jit = kernel(inline="always")(_harmonic)
-_decay_jit = kernel(inline="always")(_decay)
-
-
-@kernel(inline="always")  # inlined into the field (numba does not inline separate dispatchers)
-def _alpha_of(y, q):
-    """(α, α̇) at state y: closed forms evaluated at t, else the state's own."""
-    am = int(q[Q_AM])
-    t = y[0]
-    if am == AM_SIN:
-        return _sinusoid_jit(t, q[Q_AMP], q[Q_PH], q[Q_FIN], q[Q_S], q[Q_R], q[Q_I])
-    if am == AM_HARM:
-        return _harmonic_jit(t, q[Q_AIN], q[Q_ADIN], q[Q_FIN], q[Q_R], q[Q_I])
-    if am == AM_EXP:
-        return _decay_jit(t, q[Q_AIN], q[Q_TAU])
-    if am == AM_STATIC:
-        return q[Q_AIN], 0.0
-    return y[3], y[4]
-
-
-@kernel
-def _field(y, q, out):
-    """d(t, ln v, F, α, α̇)/ds with dt/ds = v f'(v) (module docstring)."""
-    v = np.exp(y[1])
-    F = y[2]
-    if not (v > 0.0 and F > 0.0 and np.isfinite(v)):
-        for i in range(5):
-            out[i] = np.nan
-        return
-    V, I, k, R = q[Q_V], q[Q_I], q[Q_K], q[Q_R]
-    f, fp = peel_force_fp_jit(v, q[Q_B], q[Q_A])
-    g = v * fp
-    al, ad = _alpha_of(y, q)
-    am = int(q[Q_AM])
-    if int(q[Q_VE]) == VE_APPROX:
-        Fd = k * (V - v)
-        N = Fd + F * ad
-    else:
-        Fd = k * (V - v + R * al * ad)
-        N = Fd * (1.0 + al) + F * ad
-    out[0] = g
-    out[1] = N
-    out[2] = g * Fd
-    if am == AM_SIN or am == AM_HARM or am == AM_EXP or am == AM_STATIC:
-        out[3] = 0.0
-        out[4] = 0.0
-        return
-    out[3] = g * ad
-    if am == AM_AIRY2F:
-        Fi = q[Q_FIN]
-        out[4] = g * (-Fi * R * al / I) - g * Fi * ad / (R * q[Q_FPIN])
-        return
-    acc = g * (-F * R * al / I)
-    if am == AM_AIRY2:
-        acc -= v * F * ad / R
-    elif am == AM_AIRY1:
-        acc -= v * (Fd + F * ad) / R
-    elif am == AM_GEN:
-        acc -= v * N / R
-    out[4] = acc
-
-
-_dop = make_dop853(_field)
-
-
-@kernel
-def _store(out, row, y, q):
-    al, ad = _alpha_of(y, q)
-    out[row, 0] = y[0]
-    out[row, 1] = np.exp(y[1])
-    out[row, 2] = y[2]
-    out[row, 3] = al
-    out[row, 4] = ad
-
-
-@kernel
-def _run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
-    """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state."""
-    K, y_new, f0, tmp, sc, work, Fc, ye = workspace(5)
-    cap = out.shape[0]
-    n_te = t_eval.shape[0]
-
-    _field(y, q, f0)
-    h = _dop.initial_step(y, f0, q, rtol, atol, work)
-    cnt[C_RHS] += 2
-    if save_mode == SAVE_STEPS:
-        _store(out, cnt[C_NOUT], y, q)
-        cnt[C_NOUT] += 1
-    while True:
-        if cnt[C_STEPS] >= max_steps:
-            return MAX_STEPS
-        if save_mode == SAVE_STEPS and cnt[C_NOUT] + 2 > cap:
-            return OUT_FULL
-        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, q, rtol, atol, K, y_new, tmp, sc)
-        cnt[C_REJ] += n_rej
-        cnt[C_RHS] += n_rhs
-        if status == STEP_FAILED:
-            return STEP_FAIL
-        cnt[C_STEPS] += 1
-        dense = False
-        x_exit = 2.0
-        gA = y[1] - x_f
-        gB = y_new[1] - x_f
-        if (upward and gB >= 0.0) or ((not upward) and gB <= 0.0):
-            dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
-            x_exit = solve_theta(y, Fc, 1, x_f, gA, 1.0, gB)
-        x_tmax = 2.0
-        if y_new[0] >= t_max:
-            dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
-            x_tmax = crossing(y, Fc, 0, t_max, 1.0, y_new[0])
-        x_stop = min(x_exit, x_tmax, 1.0)
-        if save_mode == SAVE_TEVAL:
-            t_stop = interp1(y, Fc, x_stop, 0) if x_stop < 1.0 else y_new[0]
-            while cnt[C_TEVAL] < n_te and t_eval[cnt[C_TEVAL]] <= t_stop:
-                te = t_eval[cnt[C_TEVAL]]
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
-                state_at(y, Fc, 0, te, x_stop, t_stop, ye)
-                _store(out, cnt[C_NOUT], ye, q)
-                cnt[C_NOUT] += 1
-                cnt[C_TEVAL] += 1
-        if min(x_exit, x_tmax) <= 1.0:  # the exit or t_max lies in this step
-            interp(y, Fc, x_stop, ye)
-            for i in range(5):
-                y[i] = ye[i]
-            if x_exit <= x_tmax:
-                y[1] = x_f
-                code = DONE
-            else:
-                y[0] = t_max
-                code = T_MAX
-            if save_mode == SAVE_STEPS:
-                _store(out, cnt[C_NOUT], y, q)
-                cnt[C_NOUT] += 1
-            return code
-        for i in range(5):
-            if not np.isfinite(y_new[i]):
-                return NONFINITE
-        for i in range(5):
-            y[i] = y_new[i]
-            f0[i] = K[_NS, i]
-        h = h_next
-        if save_mode == SAVE_STEPS:
-            _store(out, cnt[C_NOUT], y, q)
-            cnt[C_NOUT] += 1
-        if y[1] <= x_lo:
-            return V_FLOOR
-        if y[1] >= x_hi:
-            return V_CEILING
-        if y[2] <= 0.0:
-            return F_NONPOSITIVE
 
 
 @dataclass(frozen=True)
@@ -461,10 +281,10 @@ def reduced_segment(
 
     # ---- α inputs
     am = ALPHA_MODELS.index(alpha_model)
-    s = params.k * (params.V - v_in) if F_rate is None else F_rate
+    s = _frozen_rate(params, v_in) if F_rate is None else F_rate
     fp_in = float(peel_force_derivative(v_in, params.V))
-    tau = params.R * fp_in / F_in
-    if am == AM_SIN:
+    tau = _damping_time(params.R, fp_in, F_in)
+    if am == K.AM_SIN:
         if amplitude is not None or phase is not None:
             if amplitude is None or phase is None:
                 raise ValueError("alpha_model='sinusoid' needs both amplitude and phase (or alpha_in and alphadot_in)")
@@ -474,23 +294,19 @@ def reduced_segment(
             amplitude, phase = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in,
                                                    F_rate=s)
         alpha_in, alphadot_in = (float(x) for x in _sinusoid(0.0, amplitude, phase, F_in, s, params.R, params.I))
-    elif am in (AM_EXP, AM_STATIC):
+    elif am in (K.AM_EXP, K.AM_STATIC):
         if alpha_in is None:
             raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in")
-        alphadot_in = -alpha_in / tau if am == AM_EXP else 0.0
+        alphadot_in = float(_decay(0.0, alpha_in, tau)[1]) if am == K.AM_EXP else 0.0
     elif alpha_in is None or alphadot_in is None:
         raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in and alphadot_in")
 
-    b, A = peel_force_coefficients(params.V)
-    q = np.zeros(N_Q)
-    q[[Q_V, Q_I, Q_K, Q_R, Q_B, Q_A]] = params.V, params.I, params.k, params.R, b, A
-    q[Q_AM] = am
-    q[Q_VE] = V_EQUATIONS.index(v_equation)
-    q[[Q_FIN, Q_VIN, Q_FPIN, Q_S, Q_AIN, Q_ADIN, Q_TAU]] = F_in, v_in, fp_in, s, alpha_in, alphadot_in, tau
-    q[Q_AMP] = amplitude if amplitude is not None else 0.0
-    q[Q_PH] = phase if phase is not None else 0.0
+    q = K.segment_parameters(
+        model_block(params, K.N_Q), alpha_model=am, v_equation=V_EQUATIONS.index(v_equation), F_in=F_in, v_in=v_in,
+        fp_in=fp_in, F_rate=s, amplitude=amplitude if amplitude is not None else 0.0,
+        phase=phase if phase is not None else 0.0, alpha_in=alpha_in, alphadot_in=alphadot_in, tau=tau)
 
-    Om = math.sqrt(F_in * params.R / params.I)
+    Om = float(_omega(F_in, params.R, params.I))
     a_scale = max(abs(alpha_in), abs(alphadot_in) / Om, 1e-8)
     if atol is None:
         atol_v = rtol * np.array([1e-3, 1.0, F_in, a_scale, Om * a_scale])
@@ -499,10 +315,10 @@ def reduced_segment(
         t_max = 20.0 * gap / (params.k * params.V) + 20.0 * 2.0 * math.pi / Om
 
     if te is not None:
-        mode, cap = SAVE_TEVAL, te.size
+        mode, cap = K.SAVE_TEVAL, te.size
     else:
         te = np.empty(0)
-        mode, cap = (SAVE_STEPS, 4096) if save == "steps" else (SAVE_NONE, 1)
+        mode, cap = (K.SAVE_STEPS, 4096) if save == "steps" else (K.SAVE_NONE, 1)
 
     y0 = np.array([0.0, math.log(v_in), F_in, alpha_in, alphadot_in])
     x_lo = math.log(max(v_in, 1e-300)) - 60.0 if branch == "AB" else -np.inf  # v fell by e^60: v -> 0
@@ -511,22 +327,23 @@ def reduced_segment(
         y = y0.copy()
         out = np.empty((cap, 5))
         cnt = np.zeros(5, dtype=np.int64)
-        code = _run(y, q, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max, int(max_steps), mode,
+        code = K.run(y, q, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max, int(max_steps), mode,
                     te, out, cnt)
         if code == OUT_FULL:
             cap *= 4
             continue
         break
-    n_out = int(cnt[C_NOUT])
+    n_out = int(cnt[K.C_NOUT])
     rows = out[:n_out]
-    al_e, ad_e = (float(x) for x in _alpha_of(y, q))
+    al_e, ad_e = (float(x) for x in K.alpha_of(y, q))
     state = {"t": float(y[0]), "v": float(np.exp(y[1])), "F": float(y[2]), "alpha": al_e, "alphadot": ad_e}
     res = ReducedSegment(
         branch=branch, alpha_model=alpha_model, v_equation=v_equation, dt=float(y[0]), F_in=F_in,
         F_exit=float(y[2]), dF=float(y[2] - F_in), v_in=v_in, v_f=v_f, alpha_in=float(alpha_in),
         alphadot_in=float(alphadot_in), alpha_exit=al_e, alphadot_exit=ad_e,
         t=rows[:, 0].copy(), v=rows[:, 1].copy(), F=rows[:, 2].copy(), alpha=rows[:, 3].copy(),
-        alphadot=rows[:, 4].copy(), n_steps=int(cnt[C_STEPS]), n_rejected=int(cnt[C_REJ]), n_rhs=int(cnt[C_RHS]),
+        alphadot=rows[:, 4].copy(), n_steps=int(cnt[K.C_STEPS]), n_rejected=int(cnt[K.C_REJ]),
+        n_rhs=int(cnt[K.C_RHS]),
         wall_time=time.perf_counter() - t_wall, rtol=rtol, atol=atol_v,
     )
     if code == DONE:

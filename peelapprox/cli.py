@@ -276,8 +276,8 @@ def _benchmark(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-
-    from ._sweep import RESULTS, load_sweep, parse_grid, sweep
+    from comparisons.sweep import load_sweep, parse_grid, sweep
+    from comparisons.sweep.store import MANIFEST, RESULTS
 
     I_values = parse_grid(args.I, name="--I")
     V_values = parse_grid(args.V, name="--V")
@@ -291,7 +291,7 @@ def _sweep(args: argparse.Namespace) -> int:
     check_output_path(args.out, "dir", "--out", read_only_ok=True)  # a complete sweep is only read
     if args.plot:
         check_sweep_plot_key(args.plot, [m.strip() for m in args.measure.split(",") if m.strip()])
-    if os.path.exists(os.path.join(args.out, "sweep.json")):
+    if os.path.exists(os.path.join(args.out, MANIFEST)):
         prev = load_sweep(args.out)
         print(f"{args.out} holds a sweep with {len(prev.records)}/{prev.I_values.size * prev.V_values.size} points "
               "done: resuming it if grid, measures and options match", file=sys.stderr)

@@ -4,11 +4,12 @@ Everything here is compiled by :func:`peelapprox._jit.kernel` from the one gener
 (:mod:`peelapprox._generated`, written by :mod:`peelapprox._symbolic`), compiled once, and shared by every
 driver: the peel force (fvV) in the velocity and in the ln v form, the ``cos θ`` closures with the
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
-system XDAE and its Jacobian; the DOP853 pieces (:mod:`peelapprox._dop853`), the kernel compiler and the
-status codes (:mod:`peelapprox._status`) are offered here too, so ``exact`` needs no private module of
-``peelapprox`` for its kernels.  The same system written in DiffSL and JIT-compiled by pydiffsol (optional,
-the ``bench`` extra; :mod:`peelapprox._diffsl`) is offered here for the ε-variational Lyapunov exponent of
-``exact`` and the peers of ``comparisons``.
+system XDAE and its Jacobian.  The model block every driver's parameter vector starts with
+(:mod:`peelapprox._packing`: the index constants ``M_*``, its length ``N_M``, :func:`model_block`), the DOP853
+pieces (:mod:`peelapprox._dop853`), the kernel compiler and the status codes (:mod:`peelapprox._status`) are
+offered here too, so ``exact`` needs no private module of ``peelapprox`` for its kernels.  The same system
+written in DiffSL and JIT-compiled by pydiffsol (optional, the ``bench`` extra; :mod:`peelapprox._diffsl`) is
+offered here for the ε-variational Lyapunov exponent of ``exact`` and the peers of ``comparisons``.
 
 The model functions are ``inline="always"``: numba inlines them into the fields at the IR level (as separate
 compiled functions their calls cost half of a field evaluation, 72 -> 35 ns measured).
@@ -41,6 +42,7 @@ from ._dop853 import (
     workspace,
 )
 from ._jit import kernel
+from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
 from ._peelforce import peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
 
 __all__ = [
@@ -48,6 +50,7 @@ __all__ = [
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
     "regularized_rhs", "regularized_jacobian",
+    "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",

@@ -9,7 +9,7 @@ import math
 import os
 import time
 
-from peelapprox._sweep import register_measure
+from comparisons.sweep import register_measure
 
 
 def slowprod(params, options):

@@ -8,6 +8,8 @@ resolve.  Moves record themselves in CHANGELOG.md.
 from __future__ import annotations
 
 import importlib
+import subprocess
+import sys
 
 import pytest
 
@@ -37,6 +39,9 @@ API = {
         "STAT_RUNS", "Scene", "Segment", "StatRow", "TransientCheck", "TransientNotPassed", "check_past_transient",
         "compare", "exact_run", "local_period", "markdown", "run_compare", "run_reduction", "scene_rows",
         "segments", "statistics",
+    },
+    "comparisons.sweep": {
+        "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
     },
 }
 
@@ -84,12 +89,37 @@ def test_import_peelapprox_does_not_import_exact():
     after ``import peelapprox`` ``exact`` is not in ``sys.modules``; ``dir(peelapprox)`` lists the lazy names;
     accessing ``peelapprox.lyapunov`` imports ``exact`` and gives the very object ``exact.lyapunov``
     (identity, categorical)."""
-    import subprocess
-    import sys
-
     code = ("import sys, peelapprox; assert 'exact' not in sys.modules, 'exact imported'; "
             "assert {'lyapunov', 'attractors', 'LyapunovResult'} <= set(dir(peelapprox)); "
             "f = peelapprox.lyapunov; import exact; assert f is exact.lyapunov; "
             "from peelapprox import Attractor; assert Attractor is exact.Attractor; print('ok')")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+
+
+def test_import_peelapprox_imports_no_sibling_package():
+    """Hypothesis: ``import peelapprox`` loads neither ``exact`` nor ``comparisons`` (the rooms' one-way
+    doors); the sweep names it offers are imported from ``comparisons.sweep`` on first access only.  A fresh
+    interpreter, since this one has imported everything already."""
+    code = ("import sys, peelapprox\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('exact', 'comparisons')))\n"
+            "assert 'sweep' in dir(peelapprox)\n"
+            "peelapprox.MEASURES\n"
+            "print('comparisons.sweep' in sys.modules)\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["[]", "True"], proc.stdout
+
+
+def test_sweep_names_are_the_same_objects_both_ways():
+    """The lazily re-exported sweep names are the objects of ``comparisons.sweep``; in particular MEASURES is
+    one registry, so a measure registered through either name is seen through the other (identity)."""
+    import comparisons.sweep
+    import peelapprox
+
+    for name in API["comparisons.sweep"]:
+        assert getattr(peelapprox, name) is getattr(comparisons.sweep, name), name
+    assert peelapprox.register_measure is comparisons.sweep.register_measure
+    assert {"regime", "jumps", "period", "lyapunov"} <= set(peelapprox.MEASURES)
+    with pytest.raises(AttributeError, match="no attribute 'nosuch'"):
+        peelapprox.nosuch  # noqa: B018 - the lazy __getattr__ still refuses unknown names

@@ -19,16 +19,16 @@ import _sweep_measures  # noqa: F401  (registers "slowprod" and "flaky")
 import numpy as np
 import pytest
 
-from peelapprox import PeelParams, estimate
-from peelapprox._sweep import (
+from comparisons.sweep import (
     MEASURES,
     SweepResult,
-    _lock,
     load_sweep,
     parse_grid,
     register_measure,
     sweep,
 )
+from comparisons.sweep.store import lock as _lock
+from peelapprox import PeelParams, estimate
 from peelapprox.cli import main
 
 TESTS = str(Path(__file__).resolve().parent)
@@ -146,7 +146,7 @@ def test_kill_and_resume(tmp_path):
     out = tmp_path / "killed"
     code = (f"import sys; sys.path.insert(0, {TESTS!r})\n"
             "import _sweep_measures\n"
-            "from peelapprox._sweep import sweep\n"
+            "from comparisons.sweep import sweep\n"
             f"sweep({I!r}, {V!r}, {measures!r}, out={str(out)!r}, max_workers=2, options={opts!r}, progress=False)\n")
     log = open(tmp_path / "child.log", "w")
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
@@ -556,7 +556,7 @@ def test_unshippable_measure_fails_before_any_point(tmp_path, monkeypatch):
     """Hypothesis: without cloudpickle, a measure from ``__main__`` (or a lambda) on a process pool is a
     ValueError before any point, saying to define it in an importable module or use max_workers=0; nothing
     is written.  (It used to run every point on the pool as an error record.)"""
-    from peelapprox import _sweep as sw
+    from comparisons.sweep import task as sw
 
     monkeypatch.setattr(sw, "_cloudpickle", lambda: None)
 
@@ -719,3 +719,15 @@ def test_read_only_complete_sweep_loads_and_reports(tmp_path, capsys, read_only)
     assert json.loads(cap.out) == full.records and "cannot write" in cap.err
     with pytest.raises(ValueError, match=r"not writable.*1 of 4 points"):
         sweep(I2, V2, "slowprod", out=part, executor="serial", progress=False)
+
+
+def test_python_m_comparisons_sweep_is_the_cli(tmp_path):
+    """Hypothesis: ``python -m comparisons.sweep ARGS`` is ``peelapprox sweep ARGS``: a one-point ``regime``
+    sweep in a subprocess writes the record the in-process API writes (exact equality: deterministic
+    closed form)."""
+    out = tmp_path / "m"
+    proc = subprocess.run([sys.executable, "-m", "comparisons.sweep", "--I", "1e-5", "--V", "1", "--out", str(out),
+                           "--workers", "0", "--format", "json"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    ref = sweep([1e-5], [1.0], "regime", out=tmp_path / "api", max_workers=0, progress=False)
+    assert json.loads(proc.stdout) == ref.rows()

@@ -48,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from .._worker import message
 from .points import StressPoint
 
 __all__ = ["ALLOWED_PREFIXES", "BUG_CLASSES", "DRIFT_FRACTION", "run_point", "is_allowed", "is_bug"]
@@ -177,7 +178,7 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
     try:
         exact.initial_state(params, alpha0=point.alpha0)
     except ValueError as e:
-        rec.update(outcome="invalid_initial_state", exception="ValueError", message=str(e)[:300], t_reached=0.0,
+        rec.update(outcome="invalid_initial_state", exception="ValueError", message=message(e), t_reached=0.0,
                    wall=time.perf_counter() - t0)
         return _finish(point, rec)
     kw: dict[str, Any] = dict(alpha0=point.alpha0, method=point.method, rtol=point.rtol, atol=point.atol,
@@ -194,16 +195,16 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
     except ModelBreakdown as e:
         rec.update(outcome=f"breakdown:{e.reason}", exception="ModelBreakdown", reason=str(e.reason), t_reached=e.t)
         tr, exc = e.partial, e
-        rec["message"] = str(e)[:300]
+        rec["message"] = message(e)
     except SolverBudgetExceeded as e:
         rec.update(outcome=f"budget:{e.budget}", exception="SolverBudgetExceeded", reason=str(e.budget), t_reached=e.t)
         tr, exc = e.partial, e
-        rec["message"] = str(e)[:300]
+        rec["message"] = message(e)
     except SolverFailure as e:
-        rec.update(outcome="solver_failure", exception="SolverFailure", t_reached=e.t, message=str(e)[:300])
+        rec.update(outcome="solver_failure", exception="SolverFailure", t_reached=e.t, message=message(e))
         tr, exc = e.partial, e
     except Exception as e:  # noqa: BLE001 - anything else is a finding, not a crash of the suite
-        rec.update(outcome=f"unexpected:{type(e).__name__}", exception=type(e).__name__, message=str(e)[:300])
+        rec.update(outcome=f"unexpected:{type(e).__name__}", exception=type(e).__name__, message=message(e))
         tr = None
     rec["wall"] = time.perf_counter() - t0
     if tr is not None:

@@ -1,7 +1,9 @@
-"""The worker-process machinery: runs of stress points that cannot hang the suite.
+"""Runs of stress points that cannot hang the suite.
 
 :class:`StressRunner` runs tasks in one spawned worker process with a
-wall-clock timeout (killing and restarting the worker on a hang or a crash);
+wall-clock timeout (killing and restarting the worker on a hang or a crash;
+the process handling is :class:`comparisons._worker.TimedWorker`, shared with
+the sweep's workers), turning a timeout or crash into a point's record;
 :func:`run_points` runs a list of points through it, and
 :func:`budget_edge_probes` checks that budgets equal to a run's needs do not
 raise.
@@ -9,14 +11,12 @@ raise.
 
 from __future__ import annotations
 
-import multiprocessing as mp
-import sys
-import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from peelapprox._validate import positive
 
+from .._worker import TimedWorker, write_line
 from .points import StressPoint
 from .run import _empty_record, _finish, is_bug, run_point
 
@@ -30,30 +30,15 @@ def _run_task(task: Any) -> dict:
     return run_point(task)
 
 
-def _worker_main(conn: Any, func: Callable[[Any], Any], warm: bool) -> None:
-    """Worker loop: receive a task, send back ``func(task)``; ``None`` stops."""
-    if warm:
-        import exact
+def _warm() -> None:
+    """Load the hybrid kernel in a starting worker, so the first task's wall time does not include it."""
+    import exact
 
-        exact.compile_kernels()
-    conn.send(("ready", None))
-    while True:
-        try:
-            task = conn.recv()
-        except (EOFError, OSError):
-            return
-        if task is None:
-            return
-        try:
-            res = func(task)
-        except BaseException as e:  # noqa: BLE001 - reported to the parent
-            res = {"outcome": f"unexpected:{type(e).__name__}", "exception": type(e).__name__,
-                   "message": str(e)[:300]}
-        conn.send(("result", res))
+    exact.compile_kernels()
 
 
 class StressRunner:
-    """One worker process that runs tasks with a wall-clock timeout.
+    """One worker process that runs tasks with a wall-clock timeout (:class:`comparisons._worker.TimedWorker`).
 
     A task that does not answer within ``timeout`` seconds is recorded as
     ``outcome="timeout"``, the worker (this runner's own process, by its
@@ -85,34 +70,13 @@ class StressRunner:
         if not callable(self.func):
             raise ValueError(f"func must be a picklable module-level callable, got {func!r}")
         self.warm = bool(warm)
-        self._ctx = mp.get_context("spawn")
-        self._proc: Any = None
-        self._conn: Any = None
-        self.restarts = 0
+        self._worker = TimedWorker(self.func, self.start_timeout, init=_warm if self.warm else None,
+                                   name="stress worker")
 
-    def _start(self) -> None:
-        parent, child = self._ctx.Pipe()
-        proc = self._ctx.Process(target=_worker_main, args=(child, self.func, self.warm), daemon=True)
-        proc.start()
-        child.close()
-        if not parent.poll(self.start_timeout):
-            proc.kill()
-            proc.join()
-            raise RuntimeError(f"stress worker did not start within start_timeout={self.start_timeout} s")
-        try:
-            parent.recv()
-        except EOFError:
-            proc.join()
-            raise RuntimeError(f"stress worker died while starting (exit code {proc.exitcode})") from None
-        self._proc, self._conn = proc, parent
-
-    def _kill(self) -> None:
-        if self._proc is not None:
-            if self._proc.is_alive():
-                self._proc.kill()
-            self._proc.join()
-            self._conn.close()
-        self._proc = self._conn = None
+    @property
+    def restarts(self) -> int:
+        """Workers killed (timeout) or found dead (crash) so far."""
+        return self._worker.restarts
 
     def run(self, task: Any, timeout: float | None = None) -> dict:
         """Run one task in the worker; returns its record (or a timeout/crash record).
@@ -124,38 +88,20 @@ class StressRunner:
             Overrides the runner's timeout for this task (> 0).
         """
         tmo = self.timeout if timeout is None else positive("timeout", timeout)
-        if self._proc is None or not self._proc.is_alive():
-            if self._proc is not None:
-                self._kill()
-            self._start()
         pt = task[0] if isinstance(task, tuple) and task and isinstance(task[0], StressPoint) else task
         task_is_point = isinstance(pt, StressPoint)
         base = _empty_record(pt) if task_is_point else {"task": repr(task)}
-        t0 = time.perf_counter()
-        try:
-            self._conn.send(task)
-            answered = self._conn.poll(tmo)
-        except (BrokenPipeError, EOFError, OSError):
-            answered = True  # recv below reports the crash
-        if not answered:
-            self._kill()
-            self.restarts += 1
-            base.update(outcome="timeout", wall=time.perf_counter() - t0,
-                        message=f"no answer within timeout={tmo} s; worker killed")
-            return _finish(pt, base) if task_is_point else base
-        try:
-            kind, res = self._conn.recv()
-        except (EOFError, OSError):
-            self._proc.join()
-            code = self._proc.exitcode
-            self._kill()
-            self.restarts += 1
-            base.update(outcome="crash", wall=time.perf_counter() - t0, message=f"worker died (exit code {code})")
+        kind, res, wall = self._worker.call(task, tmo)
+        if kind != "result":
+            if kind == "timeout":
+                base.update(outcome="timeout", wall=wall, message=f"no answer within timeout={tmo} s; worker killed")
+            else:
+                base.update(outcome="crash", wall=wall, message=f"worker died (exit code {res})")
             return _finish(pt, base) if task_is_point else base
         if not isinstance(res, dict):
             res = {"outcome": "ok", "result": res}
         if "wall" not in res or not isinstance(res.get("wall"), float):
-            res["wall"] = time.perf_counter() - t0
+            res["wall"] = wall
         if task_is_point and res.get("outcome", "").startswith("unexpected:") and "V" not in res:
             base.update(res)
             res = _finish(pt, base)
@@ -163,13 +109,7 @@ class StressRunner:
 
     def close(self) -> None:
         """Stop the worker (politely, then by kill)."""
-        if self._proc is not None and self._proc.is_alive():
-            try:
-                self._conn.send(None)
-            except (BrokenPipeError, OSError):
-                pass
-            self._proc.join(5.0)
-        self._kill()
+        self._worker.close()
 
     def __enter__(self) -> StressRunner:
         return self
@@ -230,9 +170,8 @@ def run_points(points: Sequence[StressPoint], timeout: float = 60.0, progress: b
                 flag = "" if not is_bug(rec) else "   <-- BUG"
                 if p.expect and not rec["expect_met"]:
                     flag += f"   <-- expected {p.expect}"
-                sys.stderr.write(f"{i:4d}/{n} {_fmt_point(p)} -> {rec['outcome']} "
-                                 f"({rec['wall']:.3g} s, {rec['n_jumps']} jumps){flag}\n")
-                sys.stderr.flush()
+                write_line(f"{i:4d}/{n} {_fmt_point(p)} -> {rec['outcome']} "
+                           f"({rec['wall']:.3g} s, {rec['n_jumps']} jumps){flag}")
     finally:
         if own:
             runner.close()

@@ -1,4 +1,4 @@
-"""The on-disk format of a sweep: manifest, records and lock (the files are described in :mod:`peelapprox._sweep`).
+"""The on-disk format of a sweep: manifest, records and lock (the files are described in :mod:`comparisons.sweep`).
 
 Every file is opened without following a symbolic link (``os.O_NOFOLLOW``) and must be a regular file, so
 a link planted in the output directory cannot redirect a write (or a read) out of it.  Whatever is read is
@@ -18,7 +18,7 @@ import warnings
 from collections.abc import Iterable, Sequence
 from typing import IO, Any
 
-from ._validate import reals
+from peelapprox._validate import reals
 
 __all__ = [
     "MANIFEST", "RESULTS", "LOCK", "FORMAT", "RESERVED", "TEMPORARY", "GRID_RTOL",

@@ -1,0 +1,265 @@
+"""The sweep itself: :func:`sweep` checks its arguments and every option, then computes the points left in
+``out`` (resume, retry of failed points) on an executor and appends each record as it finishes."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import numbers
+import os
+from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import Executor
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from peelapprox import PARAM_RANGES
+from peelapprox._validate import ArgumentTypeError
+from peelapprox._validate import path as _path
+
+from .._worker import SERIAL, Progress, run_tasks, write_line
+from .measures import _OPTION_CHECKS, MEASURES, _ref
+from .result import SweepResult
+from .store import (
+    FORMAT,
+    RESULTS,
+    Plan,
+    append_records,
+    check_axis,
+    is_read_only,
+    json_norm,
+    rewrite_records,
+    truncate_records,
+    versions,
+    write_manifest,
+    write_record,
+)
+from .store import lock as _lock
+from .task import PARAM_OPTIONS, make_params, run_point, worker_refs
+
+__all__ = ["sweep"]
+
+
+def _progress_line(total: int, done0: int) -> Callable[[int, int, dict], None]:
+    """``progress=True``: one line per finished point on stderr, with the elapsed time and an ETA."""
+    prog = Progress(total, done0)
+
+    def report(done: int, total: int, rec: dict) -> None:
+        write_line(f"sweep {prog.prefix(done)} I={rec['I']:.4g} V={rec['V']:.4g} {rec['status'][:60]}  "
+                   f"{prog.times(done)}")
+
+    return report
+
+
+def sweep(
+    I_values: Sequence[float] | np.ndarray,
+    V_values: Sequence[float] | np.ndarray,
+    measures: str | Sequence[str] = ("regime",),
+    *,
+    out,
+    executor: None | str | Executor = None,
+    max_workers: int | None = None,
+    options: Mapping[str, Any] | None = None,
+    progress: bool | Callable[[int, int, dict], None] | None = True,
+    resume: bool = True,
+    retry_failed: bool = False,
+) -> SweepResult:
+    """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
+
+    Parameters
+    ----------
+    I_values, V_values : sequence of float
+        Grid axes (finite, > 0, no repeats); every pair is one task.
+    measures : str or sequence of str
+        Names in :data:`MEASURES` (``"regime,jumps"`` is split at commas).
+    out : path
+        Output directory (created); see :mod:`comparisons.sweep` for its files.
+    executor : None, "serial" or concurrent.futures.Executor
+        ``None``: a local :class:`ProcessPoolExecutor` (``spawn`` start
+        method, ``max_workers`` processes, shut down at the end).
+        ``"serial"``: in this process, one point after another (debugging).
+        Any Executor: used as is and left running, e.g.
+        ``distributed.Client(...).get_executor()`` for a dask cluster.
+    max_workers : int, optional
+        Processes of the local pool (default: CPUs available, at most the
+        number of points to compute); 0 runs in this process, as
+        ``executor="serial"`` (the CLI's ``--workers 0``).  Only with
+        ``executor=None``.
+    options : mapping, optional
+        JSON-serialisable settings passed to every measure (see
+        :mod:`comparisons.sweep`), checked before the first point.
+    progress : bool or callable
+        ``True``: one line per finished point on stderr, with an ETA.  A
+        callable receives ``(done, total, record)`` (``done`` counts resumed
+        points too).
+    resume : bool
+        With an existing sweep in ``out`` (same grid, measures and options,
+        else ValueError naming what differs): skip its finished points.
+        ``resume=False`` refuses a non-empty ``out`` (ValueError) rather than
+        overwrite it.
+    retry_failed : bool
+        Also compute again the points of ``out`` whose status is an error
+        (their records are dropped first); by default they count as finished.
+
+    Returns
+    -------
+    SweepResult
+        All records in ``out`` (the resumed and the new ones).
+
+    Raises
+    ------
+    ValueError
+        Invalid arguments or options (naming the argument or option and its
+        valid range), unknown measures (listing the known ones), a measure
+        the workers can neither import nor be sent, an ``out`` holding
+        another sweep, a malformed or symbolically linked file in ``out``, an
+        ``out`` this process cannot write while points remain to compute.
+    RuntimeError
+        ``out`` is locked by another sweep; or tasks were lost to the
+        executor (a worker died): the records written stay, and calling
+        :func:`sweep` again computes the lost points.
+
+    Notes
+    -----
+    A point whose measure raises is recorded with ``status = "error: ..."``
+    and the sweep goes on; such points count as finished on resume unless
+    ``retry_failed=True``.  Nothing is written before every argument and
+    option has been checked.
+    """
+    I_vals = check_axis("I_values", I_values, *PARAM_RANGES["I"])
+    V_vals = check_axis("V_values", V_values, *PARAM_RANGES["V"])
+    if isinstance(measures, str):
+        measures = [m.strip() for m in measures.split(",") if m.strip()]
+    if not isinstance(measures, (list, tuple)) or not all(isinstance(m, str) for m in measures):
+        raise ArgumentTypeError(f"measures must be a str or a sequence of str (names in MEASURES), got {measures!r}")
+    measures = list(measures)
+    if not measures:
+        raise ValueError(f"measures must name at least one measure; known: {sorted(MEASURES)}")
+    if len(set(measures)) != len(measures):
+        raise ValueError(f"measures must not repeat a name, got {measures}")
+    unknown = [m for m in measures if m not in MEASURES]
+    if unknown:
+        raise ValueError(f"measures: unknown measure(s) {unknown}; known: {sorted(MEASURES)}")
+    options = {} if options is None else options
+    if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
+        raise ValueError(f"options must be a mapping with str keys, got {options!r}")
+    try:
+        options = json_norm(dict(options))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
+            from None
+    _check_options(measures, options)
+    if max_workers is not None:
+        if isinstance(max_workers, bool) or not isinstance(max_workers, numbers.Integral) or max_workers < 0:
+            raise ValueError(f"max_workers must be an integer in [0, inf) (0: in this process) or None, "
+                             f"got {max_workers!r}")
+        if executor is not None:
+            raise ValueError("max_workers applies only to the local process pool (executor=None); "
+                             "size your executor instead")
+    if executor is not None and not (isinstance(executor, str) and executor == SERIAL) \
+            and not callable(getattr(executor, "submit", None)):
+        raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
+    if not (isinstance(progress, bool) or progress is None or callable(progress)):
+        raise ValueError("progress must be a bool, None or a callable (done, total, record)")
+    for name, flag in (("resume", resume), ("retry_failed", retry_failed)):
+        if not isinstance(flag, bool):
+            raise ValueError(f"{name} must be True or False, got {flag!r}")
+    if max_workers == 0:
+        executor = SERIAL
+    refs = {name: _ref(MEASURES[name]) for name in measures}
+    task_refs = refs if executor == SERIAL else worker_refs(measures)
+
+    out = _path("out", out)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise ValueError(f"out={out!r} exists and is not a directory")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"out={out!r}: cannot create the directory ({exc})") from None
+    plan = dict(out=out, I_vals=I_vals, V_vals=V_vals, measures=measures, options=options, resume=resume,
+                retry_failed=retry_failed)
+    try:
+        lock = _lock(out)
+    except OSError as exc:
+        if not is_read_only(exc):
+            raise
+        return _sweep_read_only(exc, **plan)
+    try:
+        return _sweep_locked(Plan(**plan), refs, task_refs, executor, max_workers, progress)
+    finally:
+        lock.close()
+
+
+def _check_options(measures: Sequence[str], options: Mapping) -> None:
+    """Every option the engine and ``measures`` read, checked before any point (ValueError naming it)."""
+    try:
+        make_params(1.0, 1.0, options)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"options: invalid PeelParams fields {[k for k in PARAM_OPTIONS if k in options]}: {exc}") \
+            from None
+    frozen = MappingProxyType(options)
+    for name in measures:
+        check = _OPTION_CHECKS.get(name)
+        if check is not None:
+            try:
+                check(frozen)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"options (read by measure {name!r}): {exc}") from None
+
+
+def _sweep_read_only(exc: OSError, **plan) -> SweepResult:
+    """``out`` cannot be written: return its sweep if nothing is left to compute, else ValueError."""
+    p = Plan(**plan)
+    if p.manifest is not None and not p.todo:
+        return _result(p)
+    left = f"{len(p.todo)} of {p.total} points are still to compute" if p.manifest else "it holds no sweep yet"
+    raise ValueError(f"out={p.out!r} is not writable ({exc}) and {left}: make it writable or use another directory")
+
+
+def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress) -> SweepResult:
+    out = p.out
+    if p.manifest is None:
+        p.manifest = {
+            "format": FORMAT,
+            "I_values": p.I_vals,
+            "V_values": p.V_vals,
+            "measures": p.measures,
+            "options": p.options,
+            "measure_refs": refs,
+            "grid_order": "I major: results arrays are [i, j] for I_values[i], V_values[j]",
+            "versions": versions(),
+            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        }
+        write_manifest(out, p.manifest)
+    if p.retry:  # drop the failed points' records (and any partial tail) before computing them again
+        rewrite_records(out, [r for r in p.records if (float(r["I"]), float(r["V"])) not in p.retry])
+    elif p.partial:  # the last write was cut off: drop it so appends start on a clean line
+        truncate_records(out, p.end)
+    done, todo, total = p.done, p.todo, p.total
+    report = _progress_line(total, len(done)) if progress is True else (progress or None)
+
+    with append_records(out) as fh:
+        def write(key: tuple[float, float], rec: dict) -> None:
+            if (float(rec["I"]), float(rec["V"])) != key:  # pragma: no cover - defensive
+                raise RuntimeError(f"executor returned the record of {rec['I'], rec['V']} for {key}")
+            write_record(fh, rec)
+            done[(rec["I"], rec["V"])] = rec
+            if report:
+                report(len(done), total, rec)
+
+        lost = run_tasks(run_point, [((I, V), (I, V, p.measures, p.options, task_refs)) for I, V in todo], write,
+                         executor=executor, max_workers=max_workers)
+    if lost:
+        hint = ""
+        if executor is None and any("BrokenProcessPool" in err for _, err in lost):
+            hint = ("; a worker process died (crash, out of memory, killed) or could not start: with the 'spawn' "
+                    "start method a script that calls sweep() must do so under `if __name__ == '__main__':`")
+        raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: I={lost[0][0][0]}, "
+                           f"V={lost[0][0][1]}: {lost[0][1]}); {len(done)}/{total} points are in "
+                           f"{os.path.join(out, RESULTS)}; call sweep() again with the same arguments to compute "
+                           "the rest" + hint)
+    return _result(p)
+
+
+def _result(p: Plan) -> SweepResult:
+    return SweepResult(p.I_vals, p.V_vals, p.measures, p.options, p.done.values(), manifest=p.manifest, out=p.out)

@@ -1,0 +1,243 @@
+"""The measures of a sweep: the registry (:data:`MEASURES`, :func:`register_measure`) and the built-ins.
+
+A measure is ``fn(params: PeelParams, options: Mapping) -> dict`` of JSON scalars, evaluated at every grid
+point (see :mod:`comparisons.sweep`).  To add one, write the function and register it, with a
+``check_options(options)`` that validates every option it reads with the validators of
+:mod:`peelapprox._validate` (raising ValueError naming the option and its range); :func:`~comparisons.sweep.sweep`
+calls it before the first point:
+
+    from comparisons.sweep import register_measure
+    register_measure("mine", fn, check_options=check)
+
+The built-ins: ``regime`` (:func:`peelapprox.estimate`, closed form), ``jumps`` (jump statistics of one
+windowed exact run), ``period`` (the return map's period over the same run), ``lyapunov`` (the largest
+Lyapunov exponent of :func:`peelapprox.lyapunov`, bits/s).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from peelapprox import ModelBreakdown, PeelParams, estimate
+from peelapprox._params import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT, TIME_MAX
+from peelapprox._validate import duration, in_range, positive, state
+
+from .store import RESERVED
+
+__all__ = ["MEASURES", "register_measure", "record_key", "measure_period", "measure_lyapunov"]
+
+Measure = Callable[[PeelParams, Mapping], dict]
+OptionCheck = Callable[[Mapping], Any]
+
+#: name -> measure function.  Add entries with :func:`register_measure`.
+MEASURES: dict[str, Measure] = {}
+#: name -> its options check (``check_options`` of :func:`register_measure`).
+_OPTION_CHECKS: dict[str, OptionCheck] = {}
+
+_NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def _ref(fn: Callable) -> str:
+    return f"{getattr(fn, '__module__', '?')}:{getattr(fn, '__qualname__', '?')}"
+
+
+def register_measure(name: str, fn: Measure | None = None, *, replace: bool = False,
+                     check_options: OptionCheck | None = None):
+    """Register ``fn(params, options) -> dict`` under ``name``.
+
+    without ``fn`` it returns a decorator.
+
+    Parameters
+    ----------
+    name : str
+        ``[A-Za-z][A-Za-z0-9_]*``, not one of ``I, V, status``.
+    fn : callable
+        The measure.  Pool and cluster workers import it by ``module:qualname``;
+        one they cannot import (a notebook's, ``__main__``'s, a lambda) is
+        shipped by value with cloudpickle if installed, else :func:`sweep`
+        refuses it before the first point.
+    replace : bool
+        Registering another function under a taken name raises ValueError
+        unless True (registering the same function again, e.g. on re-import,
+        is allowed).
+    check_options : callable, optional
+        ``check_options(options)`` raises ValueError naming an option this
+        measure reads that is invalid; :func:`sweep` calls it before the first
+        point, so a bad option never turns every point into an error record.
+
+    Returns
+    -------
+    callable
+        ``fn``.
+    """
+    if fn is None:
+        return lambda f: register_measure(name, f, replace=replace, check_options=check_options)
+    if not isinstance(name, str) or not _NAME_RE.match(name) or name in RESERVED:
+        raise ValueError(
+            f"measure name must match [A-Za-z][A-Za-z0-9_]* and not be one of {RESERVED}, got {name!r}")
+    if not callable(fn):
+        raise ValueError(f"measure {name!r}: fn must be callable (params, options) -> dict, got {fn!r}")
+    if check_options is not None and not callable(check_options):
+        raise ValueError(f"measure {name!r}: check_options must be callable (options) or None, got {check_options!r}")
+    old = MEASURES.get(name)
+    if old is not None and old is not fn and _ref(old) != _ref(fn) and not replace:
+        raise ValueError(f"measure {name!r} is already registered as {_ref(old)}; pass replace=True to replace it")
+    MEASURES[name] = fn
+    if check_options is None:
+        _OPTION_CHECKS.pop(name, None)
+    else:
+        _OPTION_CHECKS[name] = check_options
+    return fn
+
+
+def record_key(name: str, key: str) -> str:
+    """The record key of ``key`` returned by measure ``name``: ``key`` itself if it is ``name`` or starts
+    with ``"<name>_"``, else ``"<name>_<key>"``."""
+    return key if (key == name or key.startswith(name + "_")) else f"{name}_{key}"
+
+
+# --------------------------------------------------------------------------------------------- built-in measures
+
+def _window_api() -> tuple[Callable[..., Any], Callable[..., Any], dict]:
+    """``(window_run, classify, WINDOW_DEFAULTS)``: the one windowed exact run behind ``jumps`` and ``period``
+    (its last call is cached, so the two measures of a point share it), imported at call time."""
+    from exact import window_run
+    from peelapprox import classify
+    from peelapprox._params import WINDOW_DEFAULTS
+
+    return window_run, classify, WINDOW_DEFAULTS
+
+
+def _measure_regime(params: PeelParams, options: Mapping) -> dict:
+    """Regime label of :func:`peelapprox.estimate` and its closed-form time scales (a few ms)."""
+    e = estimate(params)
+    return {
+        "label": e.label,
+        "inertia": e.inertia,
+        "velocity": e.velocity,
+        "fixed_point_stable": bool(e.fixed_point_stable),
+        "inertia_ratio": e.inertia_ratio,
+        "period_at_mean": e.period_at_mean,
+        "cd_damping_time": e.cd_damping_time,
+        "t_ab_crude": e.t_ab_crude,
+        "t_ab_quasi_static": e.t_ab_quasi_static,
+        "t_cd_quasi_static": e.t_cd_quasi_static,
+        "oscillations_per_ab": e.oscillations_per_ab,
+        "force_gap": e.force_gap,
+    }
+
+
+def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
+    """Stick-slip jump statistics of the exact solution in the window ``[t_transient, t_end]``
+    (``window_run``: t_transient 30 s, t_end t_transient + 20 s, rtol 1e-10).
+
+    ``count`` jumps in the window, ``n_slips`` of them AB→CD; ``mean_interval``
+    = mean time between consecutive jumps (either kind), ``mean_period`` =
+    mean time between consecutive AB→CD jumps (the stick-slip period);
+    ``mean_force_drop`` = mean over AB→CD jumps of F there minus F at the next
+    CD→AB jump [N].  Statistics that need more jumps than the window holds are
+    None.  A :class:`ModelBreakdown` gives ``status = "breakdown:<reason>"``
+    and the breakdown time ``t_breakdown``.
+    """
+    from peelapprox import force_drops, return_map
+
+    window_run = _window_api()[0]
+    try:  # the same windowed run (and defaults) as the `period` measure: computed once per point
+        traj = window_run(params, **_window_options(options))
+    except ModelBreakdown as exc:
+        return {"status": f"breakdown:{exc.reason}", "t_breakdown": float(exc.t)}
+    t = np.asarray(traj.jumps.t, dtype=float)
+    t_slip = t[np.asarray(traj.jumps.from_branch) == 0]  # AB -> CD
+    drops = force_drops(traj)
+    return {
+        "status": "ok",
+        "count": int(t.size),
+        "n_slips": int(return_map(traj).size),
+        "mean_interval": float(np.mean(np.diff(t))) if t.size >= 2 else None,
+        "mean_period": float(np.mean(np.diff(t_slip))) if t_slip.size >= 2 else None,
+        "mean_force_drop": float(np.mean(drops)) if drops.size else None,
+    }
+
+
+def _check_window_options(options: Mapping) -> None:
+    """The options of the windowed run (:func:`_window_options` checks them)."""
+    _window_options(options)
+
+
+def _window_options(options) -> dict:
+    """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted),
+    checked by the same validators as :func:`window_run` (ValueError/TypeError naming the option and its valid
+    range; the sweep calls this before the first point)."""
+    kw = dict(_window_api()[2])
+    kw.update({key: options[key] for key in kw if options.get(key) is not None})
+    kw["t_transient"] = duration("t_transient", kw["t_transient"], zero=True)
+    kw["alpha0"] = state("alpha0", kw["alpha0"], "alpha")
+    kw["rtol"] = in_range("rtol", kw["rtol"], *RTOL_RANGE)
+    if options.get("t_end") is not None:
+        t_end = duration("t_end", options["t_end"])
+        if not t_end > kw["t_transient"]:
+            raise ValueError(f"t_end must be greater than t_transient = {kw['t_transient']:g} (the measured window "
+                             f"is [t_transient, t_end]), got {options['t_end']!r}")
+        kw["window"] = t_end - kw["t_transient"]
+    kw["window"] = duration("window", kw["window"])
+    if kw["t_transient"] + kw["window"] > TIME_MAX:
+        raise ValueError(f"t_transient + window must be at most {TIME_MAX:g} s (simulate's t_end), got "
+                         f"{kw['t_transient']:g} + {kw['window']:g}")
+    return kw
+
+
+def _period_options(options) -> dict:
+    """The checked options of the ``period`` measure: :func:`_window_options` and ``period_rtol`` (1e-6)."""
+    return {**_window_options(options), "period_rtol": positive("period_rtol", options.get("period_rtol", 1e-6))}
+
+
+def _lyapunov_options(options) -> dict:
+    """The checked options of the ``lyapunov`` measure: ``t_transient`` (30 s), ``lyapunov_time`` (50 s, at most
+    1e6 s) and ``alpha0`` (0), with :func:`lyapunov`'s validators."""
+    return {"t_transient": duration("t_transient", options.get("t_transient", T_TRANSIENT), zero=True),
+            "lyapunov_time": in_range("lyapunov_time", options.get("lyapunov_time", 50.0), 2 * LYAPUNOV_TAU,
+                                      TIME_MAX),
+            "alpha0": state("alpha0", options.get("alpha0", 0.0), "alpha")}
+
+
+def measure_period(params: PeelParams, options) -> dict:
+    """Sweep measure ``period``: the return map's period over the window of :func:`window_run` (options
+    ``t_transient`` = 30 s, ``t_end`` = t_transient + 20 s, ``rtol`` = 1e-10, ``alpha0`` = 0,
+    ``period_rtol`` = 1e-6).  ``period`` is None when aperiodic (no n <= 32 repeats), too short or without
+    stick-slip; a ``ModelBreakdown`` is ``status = "breakdown:<reason>"``."""
+    window_run, classify, _ = _window_api()
+    kw = _period_options(options)
+    period_rtol = kw.pop("period_rtol")
+    try:
+        tr = window_run(params, **kw)
+    except ModelBreakdown as exc:
+        return {"status": f"breakdown:{exc.reason}"}
+    p = classify(tr, period_rtol=period_rtol)
+    return {"status": "ok", "label": p.label, "period": p.period,
+            "mismatch": p.mismatch if math.isfinite(p.mismatch) else None, "n_returns": p.n_returns}
+
+
+def measure_lyapunov(params: PeelParams, options) -> dict:
+    """Sweep measure ``lyapunov``: :func:`lyapunov` with its defaults, except options ``t_transient`` (30 s)
+    and ``lyapunov_time`` (50 s of renormalisation intervals of 0.005 s)."""
+    from exact import lyapunov
+
+    tau = LYAPUNOV_TAU
+    kw = _lyapunov_options(options)
+    try:
+        r = lyapunov(params, t_transient=kw["t_transient"], tau=tau, n=max(2, int(kw["lyapunov_time"] / tau)),
+                     alpha0=kw["alpha0"])
+    except ModelBreakdown as exc:
+        return {"status": f"breakdown:{exc.reason}"}
+    return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}
+
+
+register_measure("regime", _measure_regime)
+register_measure("jumps", _measure_jumps, check_options=_check_window_options)
+register_measure("period", measure_period, check_options=_period_options)
+register_measure("lyapunov", measure_lyapunov, check_options=_lyapunov_options)

@@ -1,0 +1,147 @@
+"""The records of a sweep on its grid: :class:`SweepResult` and :func:`load_sweep` (read-only)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+
+from peelapprox._validate import path as _path
+
+from .store import RESERVED, failed, read_manifest, read_records
+
+__all__ = ["SweepResult", "load_sweep"]
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, str)
+
+
+class SweepResult:
+    """Records of a sweep on its (I, V) grid.
+
+    Attributes
+    ----------
+    I_values, V_values : ndarray
+        The grid axes, in the order given (``values()`` arrays are indexed
+        ``[i, j]`` for ``I_values[i], V_values[j]``).
+    measures : tuple of str
+    options : dict
+    records : list of dict
+        Finished points, in grid order (I major); see :mod:`comparisons.sweep`.
+    manifest : dict
+    out : str or None
+    """
+
+    def __init__(self, I_values, V_values, measures, options, records: Iterable[dict], *,
+                 manifest: dict | None = None, out: str | None = None):
+        self.I_values = np.asarray(I_values, dtype=float)
+        self.V_values = np.asarray(V_values, dtype=float)
+        self.measures = tuple(measures)
+        self.options = dict(options)
+        self.manifest = manifest or {}
+        self.out = out
+        index = {(float(I), float(V)): (i, j) for i, I in enumerate(self.I_values) for j, V in enumerate(self.V_values)}
+        by_key: dict = {}
+        for rec in records:
+            key = (float(rec["I"]), float(rec["V"]))
+            if key in index and key not in by_key:
+                by_key[key] = rec
+        self._index = index
+        self._by_key = by_key
+        self.records = [by_key[k] for k in sorted(by_key, key=index.__getitem__)]
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self.I_values.size, self.V_values.size)
+
+    @property
+    def complete(self) -> bool:
+        """Every grid point has a record."""
+        return len(self.records) == self.I_values.size * self.V_values.size
+
+    def missing(self) -> list[tuple[float, float]]:
+        """(I, V) of the points without a record, in grid order."""
+        return [k for k in self._index if k not in self._by_key]
+
+    def failed(self) -> list[tuple[float, float]]:
+        """(I, V) of the points whose record is an error (a measure raised), in grid order; see ``retry_failed``
+        of :func:`sweep`."""
+        return [(float(r["I"]), float(r["V"])) for r in self.records if failed(r)]
+
+    def record(self, I: float, V: float) -> dict | None:
+        """The record at exactly (I, V), or None."""
+        return self._by_key.get((float(I), float(V)))
+
+    def keys(self) -> list[str]:
+        """All record keys, ``I, V, status`` first, then in order of first appearance."""
+        seen = dict.fromkeys(RESERVED)
+        for rec in self.records:
+            seen.update(dict.fromkeys(rec))
+        return list(seen)
+
+    def values(self, key: str) -> np.ndarray:
+        """``key`` over the grid as a 2-D array, shape ``(len(I_values), len(V_values))``.
+
+        A float array when every present value is a number (bools become 0/1);
+        NaN marks only the points that have no such value: not computed yet,
+        the key absent from the record (e.g. ``jumps_count`` after a model
+        breakdown, or a failed measure) or None (a statistic that needs more
+        jumps than the window has).  Otherwise (e.g. ``regime_label``) an
+        object array with None at those points.
+
+        Raises
+        ------
+        KeyError
+            If no record has ``key`` (the message lists the keys that exist).
+        """
+        if not any(key in rec for rec in self.records):
+            raise KeyError(f"no record has key {key!r}; keys: {self.keys()}")
+        present = [rec[key] for rec in self.records if rec.get(key) is not None]
+        numeric = all(_is_number(v) for v in present)
+        arr = np.full(self.shape, np.nan if numeric else None, dtype=float if numeric else object)
+        for rec in self.records:
+            v = rec.get(key)
+            if v is not None:
+                arr[self._by_key_index(rec)] = float(v) if numeric else v
+        return arr
+
+    def _by_key_index(self, rec: dict) -> tuple[int, int]:
+        return self._index[(float(rec["I"]), float(rec["V"]))]
+
+    def rows(self) -> list[dict]:
+        """The records as a list of dicts (copies), in grid order."""
+        return [dict(r) for r in self.records]
+
+    def to_csv(self, path) -> None:
+        """One row per finished point; columns :meth:`keys`; None/absent as an empty cell; floats in full precision."""
+        from peelapprox._io import write_rows
+
+        if not str(path).endswith(".csv"):
+            raise ValueError(f"path must end in .csv, got {str(path)!r}")
+        write_rows(path, self.records, fields=self.keys())
+
+    def __repr__(self) -> str:
+        n = self.I_values.size * self.V_values.size
+        return (f"SweepResult({self.I_values.size} I x {self.V_values.size} V, measures={list(self.measures)}, "
+                f"{len(self.records)}/{n} points, out={self.out!r})")
+
+
+def load_sweep(out) -> SweepResult:
+    """Read a sweep directory (finished or not) without changing it.
+
+    A truncated last line of ``results.jsonl`` is ignored; if a point occurs
+    twice (only possible if the file was edited) the first record is used.
+    Works in a directory this process cannot write.
+
+    Raises
+    ------
+    ValueError
+        No manifest, a file that is a symbolic link, or a malformed manifest
+        or record (the message names the file and line).
+    """
+    out = _path("out", out)
+    m = read_manifest(out)
+    recs, _, _ = read_records(out)
+    return SweepResult(m["I_values"], m["V_values"], m["measures"], m["options"], recs, manifest=m, out=out)

@@ -1,0 +1,172 @@
+"""One grid point of a sweep, as it runs in a worker, and how the measures reach the workers.
+
+:func:`run_point` evaluates the measures at one (I, V) and returns its record; it never raises for a
+measure's failure (the point's status says it).  Workers get each measure by its import reference
+``module:qualname``, or by value (cloudpickle bytes) if they could not import it (:func:`worker_refs`).
+"""
+
+from __future__ import annotations
+
+import importlib
+import numbers
+from collections.abc import Callable, Mapping, Sequence
+from types import MappingProxyType, ModuleType
+from typing import Any, cast
+
+import numpy as np
+
+from peelapprox import PeelParams
+
+from .._worker import error_text
+from .measures import MEASURES, Measure, _ref, record_key
+from .store import RESERVED
+
+__all__ = ["PARAM_OPTIONS", "run_point", "make_params", "worker_refs"]
+
+#: Options the engine turns into :class:`peelapprox.PeelParams` fields.
+PARAM_OPTIONS = ("k", "R", "l", "geometry")
+
+
+def _import_ref(ref: str) -> Callable:
+    mod, _, qual = ref.partition(":")
+    obj: Any = importlib.import_module(mod)
+    for part in qual.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+def _resolve(name: str, ref: None | str | bytes) -> Measure:
+    """The measure function in this (worker) process: unpickled if shipped by value (bytes), else by import
+    reference, else by registry name."""
+    if isinstance(ref, bytes):
+        import pickle
+
+        try:
+            return pickle.loads(ref)
+        except Exception as exc:
+            raise LookupError(f"measure {name!r} was shipped by value (cloudpickle) but cannot be unpickled in this "
+                              f"process ({type(exc).__name__}: {exc}); install cloudpickle where the workers run, "
+                              "or define the measure in an importable module") from None
+    if ref is not None:
+        fn = MEASURES.get(name)
+        if fn is not None and _ref(fn) == ref:
+            return fn
+        try:
+            return _import_ref(ref)
+        except Exception:
+            pass
+    if name in MEASURES:
+        return MEASURES[name]
+    raise LookupError(f"measure {name!r} cannot be resolved in this process (import reference {ref!r}); "
+                      "define it at module level in a module the workers can import")
+
+
+def _scalar(v: Any) -> Any:
+    if v is None or isinstance(v, (bool, str)):
+        return v
+    if isinstance(v, np.generic) or (isinstance(v, np.ndarray) and v.ndim == 0):
+        v = v.item()
+        return v if isinstance(v, (bool, str)) else _scalar(v)
+    if isinstance(v, numbers.Integral):
+        return int(v)
+    if isinstance(v, numbers.Real):
+        return float(v)
+    raise TypeError(f"value {v!r} of type {type(v).__name__} is not a JSON scalar (float, int, str, bool, None)")
+
+
+def _prefixed(name: str, out: Any) -> dict:
+    if not isinstance(out, Mapping):
+        raise TypeError(f"measure {name!r} must return a dict, got {type(out).__name__}")
+    rec = {}
+    for key, val in out.items():
+        if not isinstance(key, str) or not key:
+            raise TypeError(f"measure {name!r} returned a non-string key {key!r}")
+        full = record_key(name, key)
+        try:
+            rec[full] = _scalar(val)
+        except TypeError as exc:
+            raise TypeError(f"measure {name!r}, key {key!r}: {exc}") from None
+    return rec
+
+
+def make_params(I: float, V: float, options: Mapping) -> PeelParams:
+    """The point's :class:`peelapprox.PeelParams`: ``I``, ``V`` and the options :data:`PARAM_OPTIONS`."""
+    return PeelParams(V=V, I=I, **{k: options[k] for k in PARAM_OPTIONS if k in options})
+
+
+def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
+              refs: Mapping[str, str | bytes] | None = None) -> dict:
+    """Evaluate ``measures`` at one grid point; never raises for a measure's failure.
+
+    Module level and plain-data in/out, so any executor can ship it.  ``refs``
+    maps a measure's name to its import reference, or to its cloudpickle bytes.
+    Returns the record ``{"I", "V", "status", <measure keys>...}``; ``status``
+    as in the docstring of :mod:`comparisons.sweep`.
+    """
+    refs = refs or {}
+    body: dict = {}
+    error = reported = None
+    try:
+        params = make_params(I, V, options)
+    except Exception as exc:
+        return {"I": I, "V": V, "status": error_text(exc)}
+    opts = MappingProxyType(dict(options))
+    for name in measures:
+        try:
+            out = _prefixed(name, _resolve(name, refs.get(name))(params, opts))
+            clash = (set(out) & set(body)) | (set(out) & set(RESERVED))
+            if clash:
+                raise ValueError(f"measure {name!r} returned keys that are already taken: {sorted(clash)}")
+            body.update(out)
+            own = out.get(f"{name}_status")
+            if reported is None and isinstance(own, str) and own != "ok":
+                reported = own
+        except Exception as exc:
+            err = error_text(exc)
+            body[f"{name}_status"] = err
+            error = error or err
+    return {"I": I, "V": V, "status": error or reported or "ok", **body}
+
+
+def _cloudpickle() -> ModuleType | None:
+    """The cloudpickle module, or None if it is not installed."""
+    try:
+        import cloudpickle
+    except ImportError:
+        return None
+    return cloudpickle
+
+
+def _importable(fn: Callable) -> bool:
+    """Whether a worker process can import ``fn`` by its ``module:qualname`` (as this process resolves it)."""
+    mod, _, qual = _ref(fn).partition(":")
+    if mod in ("__main__", "__mp_main__", "?") or "<" in qual:
+        return False
+    try:
+        return _import_ref(_ref(fn)) is fn
+    except Exception:
+        return False
+
+
+def worker_refs(measures: Sequence[str]) -> dict[str, str | bytes]:
+    """What the workers get for each measure: its import reference, or its cloudpickle bytes if they could not
+    import it.  ValueError (before any point runs) if such a measure cannot be shipped."""
+    refs: dict[str, str | bytes] = {name: _ref(MEASURES[name]) for name in measures}
+    lone = [name for name in measures if not _importable(MEASURES[name])]
+    if not lone:
+        return refs
+    cp = _cloudpickle()
+    if cp is None:
+        raise ValueError(f"measure(s) {lone} ({[refs[n] for n in lone]}) cannot be imported by worker processes "
+                         "(defined in a notebook or __main__, a lambda or a local function) and cloudpickle, which "
+                         "would ship them, is not installed: define them in an importable module, "
+                         "pip install cloudpickle, or run in this process with max_workers=0 (--workers 0)")
+    for name in lone:
+        try:
+            refs[name] = cp.dumps(MEASURES[name])
+        except Exception as exc:
+            ref = cast(str, refs[name])  # still its import reference: dumps raised before the assignment
+            raise ValueError(f"measure {name!r} ({ref}) cannot be pickled to ship it to the workers "
+                             f"({type(exc).__name__}: {exc}): define it in an importable module, or run in this "
+                             "process with max_workers=0 (--workers 0)") from None
+    return refs
