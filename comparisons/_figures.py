@@ -109,7 +109,7 @@ def _fig3(out):
 
 def _fig4(out):
     plt = _plt()
-    from peelapprox._dynamics import periodicity, return_map
+    from peelapprox import periodicity, return_map
 
     tr = _sim(1.0, 1e-2, 40.0, t_transient=30.0)
     t_k, x = return_map(tr, with_times=True)
@@ -130,7 +130,7 @@ def _fig4(out):
 
 
 def _period_label(x):
-    from peelapprox._dynamics import periodicity
+    from peelapprox import periodicity
 
     return periodicity(x).label if len(x) > 1 else "–"
 
@@ -162,7 +162,7 @@ def fig6_data(Vs=_FIG6_V, Is=(1e-5, 1e-2), *, t_transient=20.0,
               window=20.0) -> dict[float, np.ndarray]:
     """Mean force drop [N] per V for each I (NaN where a run breaks down or has no slip)."""
     from exact import ModelBreakdown
-    from peelapprox._dynamics import force_drops
+    from peelapprox import force_drops
 
     out = {}
     for I in Is:
@@ -178,7 +178,7 @@ def fig6_data(Vs=_FIG6_V, Is=(1e-5, 1e-2), *, t_transient=20.0,
 
 
 def _fig6(out):
-    from peelapprox._dynamics import force_drops
+    from peelapprox import force_drops
 
     plt = _plt()
     data = fig6_data(_FIG6_V)

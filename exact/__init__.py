@@ -7,10 +7,20 @@ with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
 The option objects :class:`Hybrid`, :class:`Regularized` (the method and its
 error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the
 limits) are the validated forms of ``simulate``'s keywords.
+
+The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
+(sampled starts grouped by the attractor they reach) and the largest Lyapunov exponent,
+``lyapunov(params, method=...)`` with the methods "two-trajectory", "tangent", "return-map" and
+"variational" (also ``lyapunov_tangent``, ``lyapunov_return_map``; ``benettin`` is the generic
+two-trajectory method for any flow).  The return-map analysis of a trajectory (``return_map``,
+``periodicity``, ``force_drops``, ``settle_time``) is the core package's: :mod:`peelapprox`.
 """
 
 from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
+from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
+from ._benettin import BenettinResult, LyapunovResult, benettin
+from ._lyapunov import lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt
 from ._simulate import (
     ATOL_SCALE,
@@ -47,4 +57,15 @@ __all__ = [
     "ModelBreakdown",
     "SolverBudgetExceeded",
     "SolverFailure",
+    # dynamics of the exact solution
+    "window_run",
+    "attractors",
+    "Attractor",
+    "DEFAULT_MAX_WALL",
+    "lyapunov",
+    "lyapunov_tangent",
+    "lyapunov_return_map",
+    "LyapunovResult",
+    "benettin",
+    "BenettinResult",
 ]

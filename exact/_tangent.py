@@ -28,10 +28,11 @@ import math
 
 import numpy as np
 
+from peelapprox._errors import SolverBudgetExceeded, WallBudget
 from peelapprox._params import T_TRANSIENT
 from peelapprox._peelforce import BREAKDOWN_LEVEL, branch_structure
 from peelapprox._status import DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, status_error
-from peelapprox._validate import duration, integer, optional
+from peelapprox._validate import duration, integer, optional, positive
 from peelapprox.kernels import N_STAGES as _NS
 from peelapprox.kernels import STEP_FAILED, crossing, interp, interp1, kernel, make_dop853, solve_theta, workspace
 
@@ -158,7 +159,7 @@ MAX_DEFAULT_STEPS = 1_000_000_000
 
 
 def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 50.0, rtol: float = 1e-10,
-                       alpha0: float = 0.0, max_steps: int | None = None):
+                       alpha0: float = 0.0, max_steps: int | None = None, max_wall: float | None = None):
     """Largest Lyapunov exponent [1/s] from the tangent dynamics with saltation matrices (module docstring).
 
     Starts from the state at ``t_transient`` (exact.simulate from ``alpha0``), integrates the tangent for
@@ -168,18 +169,23 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     ``MAX_DEFAULT_STEPS`` = 1e9, ~35 min) bounds the accepted steps; exceeding it raises
     :class:`peelapprox.SolverBudgetExceeded`, a step-size failure :class:`peelapprox.SolverFailure` and a
     fold with no landing root :class:`peelapprox.ModelBreakdown`, each with the time and state.
+    ``max_wall`` [s] (None: unbounded) bounds the wall time, checked by the transient's run and after every
+    jump (the compiled loop between two jumps is bounded by ``max_steps``); exceeding it raises
+    :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
-    from exact import initial_state, simulate
-    from peelapprox._dynamics import natural_scales
-
-    from ._simulate import ATOL_SCALE, _param_vector
+    from ._benettin import natural_scales
+    from ._simulate import ATOL_SCALE, _param_vector, initial_state, simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     max_steps = optional(integer, "max_steps", max_steps)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     # no transient: the initial state itself (simulate needs t_end > 0)
-    s = (simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps").final_state if t_transient > 0
-         else initial_state(params, alpha0=alpha0))
+    try:
+        s = (simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps", max_wall=wall.limit).final_state
+             if t_transient > 0 else initial_state(params, alpha0=alpha0))
+    except SolverBudgetExceeded as exc:
+        raise wall.reraise(exc) from None
     p = _param_vector(params)
     scale = natural_scales(params)
     bs = branch_structure(params.V)
@@ -224,4 +230,5 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
         d = float(np.linalg.norm(_equal_time_vector(y, p, scale)))
         logs += math.log(d)
         y[4:] /= d
+        wall.left(t_transient + t, lambda t=t: where(t), t_transient + T)
     return logs / t, n_jumps, t, steps

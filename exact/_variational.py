@@ -34,7 +34,9 @@ from peelapprox.kernels import (
 from ._simulate import _atol_vector, initial_state
 
 if TYPE_CHECKING:  # pragma: no cover
-    from peelapprox import LyapunovResult, PeelParams
+    from peelapprox import PeelParams
+
+    from ._benettin import LyapunovResult
 
 __all__ = ["TANGENT_OPTIONS", "lyapunov_variational", "tangent_solve"]
 
@@ -141,8 +143,7 @@ def lyapunov_variational(
     peelapprox.SolverFailure
         diffsol gave up (its message, and the state at the start of the failing interval, are attached).
     """
-    from peelapprox import LyapunovResult
-    from peelapprox._dynamics import BenettinResult, natural_scales
+    from ._benettin import BenettinResult, LyapunovResult, natural_scales
 
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)

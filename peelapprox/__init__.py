@@ -8,7 +8,11 @@ equations (Sec. V) and regime estimates; the exact DAE solvers live in the
 
 The (I, V) sweep (``sweep``, ``load_sweep``, ``SweepResult``, ``register_measure``, ``MEASURES``,
 ``parse_grid``) is an experiment and lives in :mod:`comparisons.sweep`; these names are offered here too,
-imported from there on first use (``import peelapprox`` imports no sibling package).
+imported from there on first use (``import peelapprox`` imports no sibling package).  So are the
+dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lyapunov(params, method=...)``),
+``lyapunov_tangent``, ``lyapunov_return_map``, ``LyapunovResult``, ``benettin``, ``attractors``,
+``Attractor``.  The return-map analysis of a trajectory (``return_map``, ``periodicity``, ``classify``,
+``force_drops``, ``settle_time``) is the core's own.
 """
 
 from ._alpha import (
@@ -26,20 +30,6 @@ from ._alpha import (
     wkb_alpha,
     wkb_amplitude_phase,
     wkb_error_bound,
-)
-from ._dynamics import (
-    Attractor,
-    LyapunovResult,
-    Periodicity,
-    attractors,
-    benettin,
-    force_drops,
-    lyapunov,
-    lyapunov_return_map,
-    lyapunov_tangent,
-    periodicity,
-    return_map,
-    settle_time,
 )
 from ._errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._estimate import (
@@ -64,6 +54,7 @@ from ._peelforce import (
     peel_force,
     peel_force_derivative,
 )
+from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._version import __version__ as __version__
 
@@ -113,12 +104,14 @@ __all__ = [
     "force_bounds",
     "slope_criterion",
     "SlopeCriterion",
-    # dynamics of the exact solution (need the exact package at call time)
+    # the return map of an exact trajectory
     "return_map",
     "periodicity",
     "Periodicity",
+    "classify",
     "force_drops",
     "settle_time",
+    # dynamics of the exact solution: they live in exact, imported from it on first access
     "attractors",
     "Attractor",
     "lyapunov",
@@ -140,6 +133,9 @@ __all__ = [
 #: own (``peelapprox.MEASURES is comparisons.sweep.MEASURES``: one registry).
 _LAZY = {name: "comparisons.sweep" for name in
          ("sweep", "load_sweep", "SweepResult", "register_measure", "MEASURES", "parse_grid")}
+# the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
+_LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
+                                         "lyapunov_return_map", "LyapunovResult", "benettin")})
 
 
 def __getattr__(name: str):

@@ -7,8 +7,8 @@ from dataclasses import dataclass, field
 
 from ._validate import choice, in_range
 
-__all__ = ["EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "GEOMETRIES", "L_OVER_R_MIN", "PARAM_RANGES",
-           "STATE_RANGES", "TIME_MAX", "PeelParams"]
+__all__ = ["EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES", "L_OVER_R_MIN",
+           "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
 #: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
@@ -65,6 +65,9 @@ RTOL_RANGE = (1e-14, 1e-2)
 T_TRANSIENT = 30.0
 #: Default renormalisation interval [s] of the two-trajectory Lyapunov exponent (docs/dynamics.md).
 LYAPUNOV_TAU = 0.005
+#: Defaults of the windowed run (``exact.window_run``) shared by the attractors, the sweep measures ``period``
+#: and ``jumps`` and ``peelapprox dynamics``: 20 s of jumps after the transient, at rtol 1e-10, from α0 = 0.
+WINDOW_DEFAULTS = dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0)
 
 #: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons._benchmark) goes
 #: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding

@@ -382,18 +382,18 @@ def _figures(args: argparse.Namespace) -> int:
 
 
 def _dynamics(args: argparse.Namespace) -> int:
-    from exact import ModelBreakdown, simulate
+    from exact import ModelBreakdown, attractors, simulate
 
-    from ._dynamics import attractors, force_drops, periodicity, return_map, settle_time
+    from ._returnmap import force_drops, periodicity, return_map, settle_time
 
     out = check_output_path(args.out, "table", "--out") if args.out else None
     if args.lyapunov_method == "return-map" and args.alpha0 != 0.0:
         raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     if args.attractors:  # checked before the run, named as the user wrote it
-        from ._dynamics import states_alpha
+        from ._validate import states
 
-        states_alpha("--attractors", args.attractors)
+        states("--attractors", args.attractors, "alpha")
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
     try:
         # one run from t = 0: the window's jumps for the return map and force drops, all of them for the
@@ -448,20 +448,19 @@ LYAPUNOV_METHODS = ("two-trajectory", "saltation", "return-map", "regularized")
 
 def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, returns):
     """The largest Lyapunov exponent at ``p`` by one of :data:`LYAPUNOV_METHODS` over ``args.lyapunov_time`` s."""
-    from . import _dynamics as D
+    import exact
 
     T, common = args.lyapunov_time, dict(t_transient=args.t_transient, alpha0=args.alpha0)
     if method == "two-trajectory":
         tau = LYAPUNOV_TAU
-        return D.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), max_wall=args.max_wall, **common)
+        return exact.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), max_wall=args.max_wall, **common)
     if method == "saltation":
-        return D.lyapunov_tangent(p, T=T, **common)
+        return exact.lyapunov_tangent(p, T=T, **common)
     if method == "return-map":  # alpha0 = 0: checked by the subcommand before the run
         if not returns:
             raise ValueError("--lyapunov-method return-map needs AB→CD returns in the window; there are none")
-        return D.lyapunov_return_map(p, t_transient=args.t_transient, max_wall=args.max_wall,
-                                     n_returns=max(2, int(round(returns / args.window * T))))
-    from exact import lyapunov_variational
+        return exact.lyapunov_return_map(p, t_transient=args.t_transient, max_wall=args.max_wall,
+                                         n_returns=max(2, int(round(returns / args.window * T))))
 
     step = max(args.t_transient + T, 1e-9) / 10.0
     mark = [step]
@@ -471,7 +470,7 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
             print(f"  {t_done:g}/{t_total:g} s", file=sys.stderr, flush=True)
             mark[0] += step
 
-    return lyapunov_variational(p, eps=args.eps, T=T, progress=progress, **common)
+    return exact.lyapunov_variational(p, eps=args.eps, T=T, progress=progress, **common)
 
 
 def _add_params(sp: argparse.ArgumentParser) -> None:

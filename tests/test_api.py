@@ -20,7 +20,7 @@ API = {
         "PARAM_RANGES", "PeelParams", "Periodicity", "ReducedSegment", "RegimeEstimate", "SlopeCriterion",
         "SolverBudgetExceeded", "SolverFailure", "SweepResult", "VELOCITY_RULE", "V_EQUATIONS", "airy_alpha",
         "alpha_numerical", "attractors", "benettin", "branch_inverse", "branch_structure", "cd_damping_time",
-        "cd_decay_alpha", "crude_branch_time", "estimate", "fixed_point", "force_bounds", "force_drops",
+        "classify", "cd_decay_alpha", "crude_branch_time", "estimate", "fixed_point", "force_bounds", "force_drops",
         "harmonic_alpha", "inertial_frequency", "inertial_period", "inertial_periods", "load_sweep", "lyapunov",
         "lyapunov_return_map", "lyapunov_tangent", "parse_grid", "peel_force", "peel_force_derivative",
         "periodicity", "quasi_static_branch_time", "reduced_segment", "register_measure", "return_map",
@@ -31,6 +31,8 @@ API = {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "STEP_BUDGET", "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
+        "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
+        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
@@ -79,6 +81,20 @@ def test_version_single_sourced():
     import peelapprox
 
     assert version("peelapprox") == peelapprox.__version__
+
+
+def test_import_peelapprox_does_not_import_exact():
+    """Issue 14 (rooms): the core imports no sibling package; the names it offers that live in ``exact``
+    (the Lyapunov family, attractors) are imported on first access.  Hypothesis, in a fresh interpreter:
+    after ``import peelapprox`` ``exact`` is not in ``sys.modules``; ``dir(peelapprox)`` lists the lazy names;
+    accessing ``peelapprox.lyapunov`` imports ``exact`` and gives the very object ``exact.lyapunov``
+    (identity, categorical)."""
+    code = ("import sys, peelapprox; assert 'exact' not in sys.modules, 'exact imported'; "
+            "assert {'lyapunov', 'attractors', 'LyapunovResult'} <= set(dir(peelapprox)); "
+            "f = peelapprox.lyapunov; import exact; assert f is exact.lyapunov; "
+            "from peelapprox import Attractor; assert Attractor is exact.Attractor; print('ok')")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
 
 
 def test_import_peelapprox_imports_no_sibling_package():

@@ -8,8 +8,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
-from peelapprox import PeelParams
-from peelapprox._dynamics import attractors, benettin, force_drops, periodicity, return_map, settle_time
+from exact import attractors, benettin
+from peelapprox import PeelParams, force_drops, periodicity, return_map, settle_time
 
 
 def test_periodicity_of_synthetic_sequences():
@@ -105,7 +105,7 @@ def test_lyapunov_positive_in_the_chaotic_window_and_zero_on_a_periodic_orbit():
     V = 2, I = 1e-4 (aperiodic) gives λ in [3.5, 5] bits/s with the defaults (measured 4.06-4.15 over d0 in
     [1e-8, 1e-6] at d0/rtol >= 1e5; the band allows the finite-time spread); V = 1, I = 1e-2 (period 8) gives
     |λ| < 0.3 bits/s (the 1/T decay of the finite-time estimate over 50 s)."""
-    from peelapprox._dynamics import lyapunov
+    from exact import lyapunov
 
     chaotic = lyapunov(PeelParams(V=2.0, I=1e-4))
     assert 3.5 < chaotic.bits_per_s < 5.0
@@ -116,7 +116,7 @@ def test_lyapunov_positive_in_the_chaotic_window_and_zero_on_a_periodic_orbit():
 def test_return_map_lyapunov_needs_a_return_map():
     """Above the stick-slip window (V = 6: f has no folds) there is no AB→CD section to linearise: a
     ValueError says so; a non-positive h is refused by name."""
-    from peelapprox._dynamics import lyapunov_return_map
+    from exact import lyapunov_return_map
 
     with pytest.raises(ValueError, match="no AB→CD jump"):
         lyapunov_return_map(PeelParams(V=6.0, I=1e-3), t_transient=1.0)
@@ -129,7 +129,7 @@ def test_two_lyapunov_methods_agree_where_the_chaos_is_strongest():
     """Cross-check: at V = 2.5, I = 1e-4 the two-trajectory estimate (5.19 bits/s) and the tangent map of
     the return map (5.38 bits/s) agree to 10 %.  (At V = 1.5 and 2 they differ by 25-30 %, an open
     discrepancy recorded in docs/dynamics.md, so the test does not claim more.)"""
-    from peelapprox._dynamics import lyapunov, lyapunov_return_map
+    from exact import lyapunov, lyapunov_return_map
 
     a = lyapunov(PeelParams(V=2.5, I=1e-4)).bits_per_s
     b = lyapunov_return_map(PeelParams(V=2.5, I=1e-4)).bits_per_s
@@ -141,7 +141,7 @@ def test_saltation_tangent_dynamics_agrees_with_the_two_trajectory_estimate():
     """The issue's primary method (variational equations with saltation matrices at the jumps) against the
     two-trajectory estimate at V = 2.5, I = 1e-4: measured 5.05 bits/s over 20 s vs 5.19 over 50 s; the
     10 % band covers the finite-time spread of a 20 s estimate."""
-    from peelapprox._dynamics import lyapunov, lyapunov_tangent
+    from exact import lyapunov, lyapunov_tangent
 
     a = lyapunov(PeelParams(V=2.5, I=1e-4)).bits_per_s
     c = lyapunov_tangent(PeelParams(V=2.5, I=1e-4), T=20.0).bits_per_s
@@ -172,8 +172,8 @@ def test_saltation_maps_the_flow_direction_onto_the_flow_direction():
 def test_saltation_tangent_step_budget_raises_with_time_and_state():
     """An exhausted step budget is a SolverBudgetExceeded naming ``max_steps`` with the time and state where
     it stopped, never a truncated exponent; a non-positive budget is a ValueError naming it."""
+    from exact import lyapunov_tangent
     from peelapprox import SolverBudgetExceeded
-    from peelapprox._dynamics import lyapunov_tangent
 
     p = PeelParams(V=2.5, I=1e-4)
     with pytest.raises(SolverBudgetExceeded, match="max_steps") as info:

@@ -124,7 +124,7 @@ def test_dynamics_max_wall(fn, kw):
     20,000 by default), so a per-run budget does not bound the call.  Hypothesis: ``max_wall`` bounds the
     whole call: SolverBudgetExceeded(budget="max_wall", limit=max_wall) with a finite state (v > 0) from the
     orbit.  Categorical outcome; no wall time asserted (benchmarks measure time)."""
-    import peelapprox._dynamics as D
+    import exact as D
 
     with pytest.raises(SolverBudgetExceeded) as ei:
         getattr(D, fn)(PeelParams(V=2.0, I=1e-4), **kw)
@@ -140,7 +140,7 @@ def test_composite_calls_have_a_default_wall_budget():
     signatures."""
     import inspect
 
-    import peelapprox._dynamics as D
+    import exact as D
     from exact._tangent import MAX_DEFAULT_STEPS
 
     for fn in (D.lyapunov, D.lyapunov_return_map, D.attractors):
@@ -151,7 +151,7 @@ def test_composite_calls_have_a_default_wall_budget():
 def test_return_map_lyapunov_max_wall():
     """lyapunov_return_map shares one wall budget across its runs: with max_wall = 0.3 s and 10^6 returns it
     raises SolverBudgetExceeded(budget="max_wall") with a finite state (categorical; no time asserted)."""
-    import peelapprox._dynamics as D
+    import exact as D
 
     with pytest.raises(SolverBudgetExceeded) as ei:
         D.lyapunov_return_map(PeelParams(V=2.0, I=1e-4), t_transient=0.5, n_returns=10**6, max_wall=0.3)
@@ -191,8 +191,7 @@ def test_saltation_tangent_reports_no_root_breakdown():
     to underflow, ending in a step-size SolverFailure.  Hypothesis: at V=0.5, I=1e-4 (the hybrid solver's
     no_root breakdown at t = 0.0183 s) it raises ModelBreakdown('no_root') near that time (within 1e-3 s:
     both integrate the same field; the tangent's tolerances differ) with a finite state."""
-    from exact import ModelBreakdown
-    from peelapprox._dynamics import lyapunov_tangent
+    from exact import ModelBreakdown, lyapunov_tangent
 
     with pytest.raises(ModelBreakdown) as ei:
         lyapunov_tangent(PeelParams(V=0.5, I=1e-4), t_transient=0.0, T=0.05)

@@ -106,7 +106,9 @@ def record_key(name: str, key: str) -> str:
 def _window_api() -> tuple[Callable[..., Any], Callable[..., Any], dict]:
     """``(window_run, classify, WINDOW_DEFAULTS)``: the one windowed exact run behind ``jumps`` and ``period``
     (its last call is cached, so the two measures of a point share it), imported at call time."""
-    from peelapprox._dynamics import WINDOW_DEFAULTS, classify, window_run
+    from exact import window_run
+    from peelapprox import classify
+    from peelapprox._params import WINDOW_DEFAULTS
 
     return window_run, classify, WINDOW_DEFAULTS
 
@@ -223,7 +225,7 @@ def measure_period(params: PeelParams, options) -> dict:
 def measure_lyapunov(params: PeelParams, options) -> dict:
     """Sweep measure ``lyapunov``: :func:`lyapunov` with its defaults, except options ``t_transient`` (30 s)
     and ``lyapunov_time`` (50 s of renormalisation intervals of 0.005 s)."""
-    from peelapprox import lyapunov
+    from exact import lyapunov
 
     tau = LYAPUNOV_TAU
     kw = _lyapunov_options(options)

@@ -1,0 +1,152 @@
+"""Windowed runs of the exact solution and the attractors they reach.
+
+* :func:`window_run` — the jumps of one run over ``[t_transient, t_transient + window]``, the one windowed
+  run behind :func:`attractors`, the sweep measures ``period`` and ``jumps`` and ``peelapprox dynamics``.
+* :func:`attractors` — sample initial peel angles and group the attractors they reach, by the return-map
+  analysis of :mod:`peelapprox` (:func:`peelapprox.classify`, :func:`peelapprox.settle_time`).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, classify, return_map, settle_time
+from peelapprox._errors import WallBudget
+from peelapprox._params import RTOL_RANGE, T_TRANSIENT
+from peelapprox._validate import duration, function, in_range, optional, positive, state, states
+from peelapprox._validate import params as _params
+
+from ._simulate import initial_state, simulate
+
+__all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors"]
+
+#: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
+#: attractors): their work grows with counts (n, n_returns, starts) that no step budget bounds.
+DEFAULT_MAX_WALL = 3600.0
+
+
+def _rtol(name: str, x) -> float:
+    return in_range(name, x, *RTOL_RANGE)
+
+
+def states_alpha(name: str, x) -> np.ndarray:
+    """A non-empty 1-D array of initial peel angles, each in ``STATE_RANGES["alpha"]``."""
+    a = states(name, x, "alpha")
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D sequence of initial peel angles, got shape {a.shape}")
+    return a
+
+
+# ---------------------------------------------------------------------------------------------- windows
+def window_run(params: PeelParams, *, t_transient: float = T_TRANSIENT, window: float = 20.0, rtol: float = 1e-10,
+               alpha0: float = 0.0, max_wall: float | None = None):
+    """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
+
+    The one windowed run behind :func:`attractors`, the sweep measures ``period`` and
+    ``jumps`` and ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so
+    measures of one sweep point share it.  Raises ``ModelBreakdown`` and ``SolverBudgetExceeded`` (also
+    for ``max_wall`` seconds of wall time) as :func:`exact.simulate` does.
+    """
+    return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
+                       duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
+                       optional(positive, "max_wall", max_wall))
+
+
+@functools.lru_cache(maxsize=2)
+def _window_run(params, t_transient, window, rtol, alpha0, max_wall=None):
+    return simulate(params, t_transient + window, alpha0=alpha0, rtol=rtol, t_transient=t_transient, save="jumps",
+                    max_wall=max_wall)
+
+
+# ---------------------------------------------------------------------------------------------- attractors
+@dataclass(frozen=True)
+class Attractor:
+    """One attractor reached from sampled initial states (see :func:`attractors`).
+
+    ``signature`` is the sorted cycle of return-map values (periodic) or the (min, max, mean) of the
+    returns (aperiodic), rounded; ``starts`` the initial α0 values that reach it.
+    """
+
+    label: str
+    period: int | None
+    signature: tuple[float, ...]
+    F_range: tuple[float, float]
+    starts: tuple[float, ...]
+    settle_times: tuple[float | None, ...]
+
+
+def attractors(
+    params: PeelParams,
+    alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
+    *,
+    t_transient: float = T_TRANSIENT,
+    window: float = 20.0,
+    rtol: float = 1e-10,
+    period_rtol: float = 1e-6,
+    match_rtol: float = 1e-4,
+    progress: Callable[[str], None] | None = None,
+    max_wall: float | None = DEFAULT_MAX_WALL,
+) -> list[Attractor]:
+    """Sample initial peel angles and group the attractors they reach.
+
+    ``max_wall`` [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``;
+    None: unbounded).
+
+    Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
+    (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same
+    attractor when their
+    periods agree and their sorted return-map cycles agree to ``match_rtol`` relative (a cycle is the same
+    set of jump forces whatever its phase); aperiodic windows are grouped by their return range.  A start
+    that breaks down (``ModelBreakdown``) or is infeasible (``ValueError``) is reported as its own entry.
+    More than one entry means coexisting attractors — or a transient longer than ``t_transient``: the
+    entries' settle times tell which.
+    """
+    # validate everything up front: inside the loop a ValueError can then only be an infeasible start
+    params = _params("params", params)
+    kw = dict(t_transient=duration("t_transient", t_transient, zero=True), window=duration("window", window),
+              rtol=_rtol("rtol", rtol))
+    period_rtol = positive("period_rtol", period_rtol)
+    match_rtol = positive("match_rtol", match_rtol)
+    alpha0s = [float(a) for a in np.atleast_1d(states_alpha("alpha0s", alpha0s))]
+    say = optional(function, "progress", progress) or (lambda msg: None)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
+    groups: list[dict] = []
+    for a0 in alpha0s:
+        say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
+        try:
+            s0 = initial_state(params, alpha0=a0)
+            tr = window_run(params, alpha0=a0, max_wall=wall.left(0.0, s0.__dict__, kw["t_transient"] + kw["window"]),
+                            **kw)
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
+        except (ModelBreakdown, ValueError) as exc:
+            groups.append(dict(label=f"{type(exc).__name__}: {str(exc)[:80]}", period=None, signature=(),
+                               F_range=(math.nan, math.nan), starts=[a0], settle=[None]))
+            continue
+        per = classify(tr, period_rtol=period_rtol)
+        x = return_map(tr)
+        if per.kind == "no stick-slip":
+            groups.append(dict(label=per.kind, period=None, signature=(), F_range=(math.nan, math.nan),
+                               starts=[a0], settle=[None]))
+            continue
+        if per.kind == "periodic":
+            sig = tuple(float(v) for v in np.sort(x[: per.period]))
+        else:
+            sig = (float(x.min()), float(x.max()), float(x.mean()))
+        st = settle_time(tr, rtol=period_rtol)
+        for g in groups:
+            if g["period"] == per.period and g["label"] == per.label and len(g["signature"]) == len(sig) and \
+                    np.allclose(g["signature"], sig, rtol=match_rtol, atol=0.0):
+                g["starts"].append(a0)
+                g["settle"].append(st)
+                break
+        else:
+            groups.append(dict(label=per.label, period=per.period, signature=sig,
+                               F_range=(float(x.min()), float(x.max())), starts=[a0], settle=[st]))
+    return [Attractor(g["label"], g["period"], tuple(round(s, 6) for s in g["signature"]), g["F_range"],
+                      tuple(float(a) for a in g["starts"]), tuple(g["settle"])) for g in groups]

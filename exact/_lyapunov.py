@@ -1,0 +1,400 @@
+"""The largest Lyapunov exponent of the exact peeling dynamics: one entry point, four methods.
+
+``lyapunov(params, method, *, t_transient, alpha0, rtol, max_wall, **options)`` measures the largest
+exponent, in bits/s, of the full model FLOW1, FLOW2, flow3 with CONSTR after a transient, by one of
+:data:`METHODS`:
+
+* ``"two-trajectory"`` (default) — :func:`~exact._benettin.benettin`'s renormalisation of two neighbouring
+  hybrid orbits every ``tau`` seconds;
+* ``"tangent"`` — the variational equation of the hybrid solver's field with saltation matrices at the
+  jumps (:mod:`exact._tangent`; also :func:`lyapunov_tangent`);
+* ``"return-map"`` — the tangent map of the AB→CD jump-to-jump map by central differences (also
+  :func:`lyapunov_return_map`);
+* ``"variational"`` — the variational equations of the ε-regularised system XDAE through diffsol
+  (``exact._variational``, needs the ``bench`` extra).
+
+Every method returns one :class:`~exact._benettin.LyapunovResult`.  docs/dynamics.md compares them.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from peelapprox import BRANCHES, PeelParams, SolverBudgetExceeded, branch_structure
+from peelapprox._errors import WallBudget
+from peelapprox._params import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT
+from peelapprox._validate import (
+    ArgumentTypeError,
+    choice,
+    duration,
+    function,
+    in_range,
+    integer,
+    optional,
+    positive,
+    state,
+)
+from peelapprox._validate import params as _params
+
+from ._attractors import DEFAULT_MAX_WALL, window_run
+from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
+from ._simulate import initial_state, simulate
+
+__all__ = ["METHODS", "D0_RANGE", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]
+
+_AB = BRANCHES.index("AB")
+#: Valid initial perturbation ``d0`` of the two-trajectory method (scaled units): below 1e-12 the perturbation
+#: of F, ``d0 f_max``, nears the rounding of F itself (``2e-16 F``) and the two orbits can start at distance 0;
+#: above 1 it is not a perturbation.
+D0_RANGE = (1e-12, 1.0)
+
+#: The methods of :func:`lyapunov` and the options each takes besides the common ``t_transient``, ``alpha0``,
+#: ``rtol`` and ``max_wall`` (their defaults: the table of :func:`lyapunov`).
+METHODS: dict[str, tuple[str, ...]] = {
+    "two-trajectory": ("tau", "n", "n_discard", "d0"),
+    "tangent": ("T", "max_steps"),
+    "return-map": ("n_returns", "h"),
+    "variational": ("eps", "T", "tau", "progress"),
+}
+
+
+def _rtol(name: str, x) -> float:
+    return in_range(name, x, *RTOL_RANGE)
+
+
+def lyapunov(
+    params: PeelParams,
+    method: str = "two-trajectory",
+    *,
+    t_transient: float = T_TRANSIENT,
+    alpha0: float = 0.0,
+    rtol: float | None = None,
+    max_wall: float | None = DEFAULT_MAX_WALL,
+    **options: Any,
+) -> LyapunovResult:
+    """Largest Lyapunov exponent of the exact peeling dynamics, in bits/s, by one of four methods.
+
+    Parameters
+    ----------
+    params : PeelParams
+    method : {"two-trajectory", "tangent", "return-map", "variational"}
+        How (module docstring; costs and agreement in docs/usage.md and docs/dynamics.md).
+    t_transient : float
+        Seconds integrated from the initial state and discarded, in [0, 1e6].
+    alpha0 : float
+        Initial peel angle; the rest of the initial state is :func:`exact.initial_state`'s.
+    rtol : float, optional
+        Relative tolerance of the method's solver runs; None: the method's default (1e-12 two-trajectory and
+        return-map, 1e-10 tangent, 1e-8 variational).
+    max_wall : float or None
+        Wall-clock budget [s] of the whole call (``SolverBudgetExceeded`` with ``budget="max_wall"``; None:
+        unbounded), checked between solver runs (two-trajectory, return-map), at every jump (tangent) or
+        after every renormalisation interval (variational).
+    **options
+        Keyword-only options of the chosen method, validated by it; an option of another method, or of none,
+        raises :class:`peelapprox._validate.ArgumentTypeError` (a ``TypeError`` and ``ValueError``) naming
+        the option and the method:
+
+        ================  =========================================================================
+        method            options (defaults)
+        ================  =========================================================================
+        two-trajectory    ``tau`` (0.005 s), ``n`` (10000), ``n_discard`` (200), ``d0`` (1e-7)
+        tangent           ``T`` (50 s), ``max_steps`` (5e6 per simulated second, at most 1e9)
+        return-map        ``n_returns`` (5000), ``h`` (1e-6)
+        variational       ``eps`` (1e-7), ``T`` (50 s), ``tau`` (0.5 s), ``progress`` (None)
+        ================  =========================================================================
+
+    Returns
+    -------
+    LyapunovResult
+        ``bits_per_s``, ``per_s``, ``stderr_bits``, the ``benettin`` record (running estimate, local rates),
+        ``n_jumps``; ``method`` names the method.
+
+    Raises
+    ------
+    ValueError
+        An unknown method (the message lists :data:`METHODS`), or a bad argument (named, with its range).
+    peelapprox.ModelBreakdown, peelapprox.SolverFailure, peelapprox.SolverBudgetExceeded
+        As :func:`exact.simulate`, with the time and state.
+
+    Notes
+    -----
+    With the defaults (``method="two-trajectory"``) this is the two-trajectory renormalisation method
+    (Benettin et al. 1980) on the hybrid solver: 50 s measured after 30 s of transient, 3-4 s of wall time.
+    Its state is ``(α, ω, F, branch)`` — v follows from CONSTR — and the distance is measured in
+    ``(Δα/1 rad, Δω/(V/R), ΔF/f_max)``, continuous across the jumps; renormalisation every ``tau`` seconds is
+    postponed in steps of ``tau/8`` while the two orbits are on different branches.  Unless
+    ``d0/rtol >= 1e5`` the solver's local errors, fresh every ``tau`` and amplified by the jumps, inflate the
+    exponent (9.5-13.5 bits/s at V = 2, I = 1e-4 with d0/rtol = 10-100, 4.06-4.15 for every d0/rtol >= 1e5):
+    hence d0 = 1e-7, rtol = 1e-12.  ``d0`` must lie in :data:`D0_RANGE` = [1e-12, 1].
+    """
+    method = choice("method", method, tuple(METHODS))
+    own = METHODS[method]
+    for name in options:
+        if name not in own:
+            others = [m for m, opts in METHODS.items() if name in opts]
+            what = (f"an option of method {' and '.join(map(repr, others))}" if others else
+                    "an option of no method")
+            raise ArgumentTypeError(f"lyapunov: {name!r} is {what}, not of method={method!r} (whose options are "
+                                    f"{', '.join(own)})")
+    common: dict[str, Any] = dict(t_transient=t_transient, alpha0=alpha0)
+    if rtol is not None:
+        common["rtol"] = rtol
+    if method == "two-trajectory":
+        return _two_trajectory(params, max_wall=max_wall, **common, **options)
+    if method == "tangent":
+        return _tangent(params, max_wall=max_wall, **common, **options)
+    if method == "return-map":
+        return _return_map(params, max_wall=max_wall, **common, **options)
+    from ._variational import lyapunov_variational
+
+    progress = optional(function, "progress", options.pop("progress", None))
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
+    if wall.limit is not None:
+        progress = _watch_wall(wall, progress)
+    return lyapunov_variational(params, progress=progress, **common, **options)
+
+
+def _watch_wall(wall: WallBudget, progress: Callable | None) -> Callable:
+    """A ``progress(t_done, t_total)`` callback that raises once ``wall`` is spent, then calls ``progress``
+    (the variational method reports after every renormalisation interval)."""
+
+    def watch(t_done, t_total):
+        wall.left(t_done, {"t": t_done}, t_total)
+        if progress is not None:
+            progress(t_done, t_total)
+
+    return watch
+
+
+def _two_trajectory(
+    params: PeelParams,
+    *,
+    t_transient: float = T_TRANSIENT,
+    tau: float = LYAPUNOV_TAU,
+    n: int = 10000,
+    n_discard: int = 200,
+    d0: float = 1e-7,
+    alpha0: float = 0.0,
+    rtol: float = 1e-12,
+    max_wall: float | None = DEFAULT_MAX_WALL,
+) -> LyapunovResult:
+    """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver.
+
+    The two orbits' state is ``(α, ω, F, branch)``; ``run`` advances one by a hybrid run, ``rescale`` puts
+    the perturbation back to ``d0`` along its direction (halving the step while the moved state would leave
+    its branch's level range), ``advance`` postpones the renormalisation while the orbits are on different
+    branches.
+    """
+    params = _params("params", params)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
+    tau = duration("tau", tau)
+    d0 = in_range("d0", d0, *D0_RANGE)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    n, n_discard = integer("n", n, lo=2), integer("n_discard", n_discard, lo=0)
+    alpha0 = state("alpha0", alpha0, "alpha")
+    rtol = _rtol("rtol", rtol)
+    bs = branch_structure(params.V)
+    scale = natural_scales(params)
+    jumps = [0]
+    t_total = t_transient + (n + n_discard) * tau
+
+    def run(state, dt):
+        a, w, F, br = state
+        try:
+            tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps",
+                          max_wall=wall.left(0.0, lambda: initial_state(params, alpha0=a, omega0=w, F0=F,
+                                                                        branch0=br).__dict__, t_total))
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
+        s = tr.final_state
+        return (s.alpha, s.omega, s.F, s.branch), len(tr.jumps)
+
+    def vec(s):
+        return np.array(s[:3]) / scale
+
+    def distance(a, b):
+        return float(np.linalg.norm(vec(a) - vec(b)))
+
+    def rescale(ref, pert, factor):
+        # a state near a fold may leave its branch's level range when moved: halve the step until it does not
+        for _ in range(60):
+            x = (vec(ref) + factor * (vec(pert) - vec(ref))) * scale
+            G = x[2] * (1.0 + float(params.closure(x[0])[0]))
+            if bs.has_root(G, ref[3]):
+                return (float(x[0]), float(x[1]), float(x[2]), ref[3])
+            factor *= 0.5
+        return ref  # unreachable in practice: the reference itself lies on its branch
+
+    max_postpones = 64
+
+    def advance(ref, pert):
+        ref, nj = run(ref, tau)
+        pert, _ = run(pert, tau)
+        dt = tau
+        for _ in range(max_postpones):
+            if ref[3] == pert[3]:
+                break
+            ref, nj2 = run(ref, tau / 8)
+            pert, _ = run(pert, tau / 8)
+            dt += tau / 8
+            nj += nj2
+        else:
+            raise RuntimeError(f"lyapunov: the two orbits stayed on different branches for {max_postpones} "
+                               f"postponements of tau/8 = {tau / 8:g} s: d0 = {d0:g} is too large for this orbit")
+        jumps[0] += nj
+        return ref, pert, dt
+
+    s0 = initial_state(params, alpha0=alpha0)
+    ref = (s0.alpha, s0.omega, s0.F, s0.branch)
+    if t_transient > 0:
+        ref, _ = run(ref, t_transient)
+    # the perturbation: along F (the variable the constraint and the jumps act on), size d0
+    pert = rescale(ref, (ref[0], ref[1], ref[2] + d0 * scale[2], ref[3]), 1.0)
+    res = benettin(advance, ref, pert, distance, rescale, n, n_discard=n_discard)
+    ln2 = math.log(2.0)
+    return LyapunovResult(res.exponent, res.exponent / ln2, res.stderr / ln2, res, params, tau, jumps[0])
+
+
+def lyapunov_tangent(
+    params: PeelParams,
+    *,
+    t_transient: float = T_TRANSIENT,
+    T: float = 50.0,
+    rtol: float = 1e-10,
+    alpha0: float = 0.0,
+    max_steps: int | None = None,
+) -> LyapunovResult:
+    """Largest Lyapunov exponent from the tangent (variational) dynamics with saltation matrices, in bits/s.
+
+    ``max_steps`` bounds the accepted steps (default 5e6 per simulated second;
+    ~1.2e6 are used at V = 2, I = 1e-4); ``notes`` reports the steps taken.
+
+    The variational equation of the hybrid solver's desingularised field is integrated with the state by
+    the package's DOP853; the tangent crosses each jump through the saltation matrix of the fold event and
+    the reset to the landing root (:mod:`exact._tangent`).  Its equal-time (α, ω, F) size is measured and
+    renormalised after every jump.  Slower than the two-trajectory :func:`lyapunov` (hundreds of steps per
+    branch stay: the difference-quotient tangent is stiff near the folds), ~1 s of wall time per simulated
+    second at V = 2, I = 1e-4.  The same as ``lyapunov(params, "tangent", ..., max_wall=None)``.
+    """
+    return _tangent(params, t_transient=t_transient, T=T, rtol=rtol, alpha0=alpha0, max_steps=max_steps)
+
+
+def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float = 50.0, rtol: float = 1e-10,
+             alpha0: float = 0.0, max_steps: int | None = None, max_wall: float | None = None) -> LyapunovResult:
+    """Method ``"tangent"`` of :func:`lyapunov` (:func:`lyapunov_tangent`, and a wall budget ``max_wall``)."""
+    from ._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
+
+    params = _params("params", params)
+    T = duration("T", T)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    rtol = _rtol("rtol", rtol)
+    alpha0 = state("alpha0", alpha0, "alpha")
+    max_steps = optional(integer, "max_steps", max_steps)
+    max_wall = optional(positive, "max_wall", max_wall)
+    t0 = time.perf_counter()
+    lam, n_jumps, t, steps = lyapunov_saltation(params, t_transient=t_transient, T=T, rtol=rtol,
+                                                alpha0=alpha0, max_steps=max_steps, max_wall=max_wall)
+    b = BenettinResult(lam, np.array([lam]), np.array([lam]), math.nan, t, n_jumps, math.nan,
+                       time.perf_counter() - t0)
+    ln2 = math.log(2.0)
+    return LyapunovResult(lam, lam / ln2, math.nan, b, params, math.nan, n_jumps,
+                          method="tangent dynamics with saltation matrices", notes=[f"steps={steps}"])
+
+
+def lyapunov_return_map(
+    params: PeelParams,
+    *,
+    t_transient: float = T_TRANSIENT,
+    n_returns: int = 5000,
+    h: float = 1e-6,
+    rtol: float = 1e-12,
+    max_wall: float | None = DEFAULT_MAX_WALL,
+) -> LyapunovResult:
+    """Largest Lyapunov exponent from the tangent map of the jump-to-jump (Poincaré) map, in bits/s.
+
+    ``max_wall`` [s] bounds the whole computation
+    (``SolverBudgetExceeded``, ``budget="max_wall"``; None: unbounded).
+
+    The section is the AB→CD jump; the return map P takes the state (α, ω, F) just after one such jump to
+    the state at the next.  A tangent vector w is pushed through P's Jacobian by central differences,
+    ``DP w ≈ [P(x + h w) − P(x − h w)] / 2h`` in the scaled variables (α, ω/(V/R), F/f_max) — the jumps'
+    saltation is inside P, so nothing is linearised across them — and renormalised every return.  The
+    flow's exponent is ``Σ log|DP_k w_k| / Σ T_k`` over the return times T_k.  Unlike the two-trajectory
+    :func:`lyapunov` there is no finite perturbation left to grow and no renormalisation noise; the result is
+    independent of h over 1e-8 … 1e-5 (docs/dynamics.md).  On a periodic orbit it gives the (negative)
+    transverse exponent, not the flow's 0.  A cross-check of :func:`lyapunov`, not a replacement: it needs a
+    return map with at least two returns per second of the run.  Starts from ``alpha0 = 0``; the same as
+    ``lyapunov(params, "return-map", ...)``.
+    """
+    return _return_map(params, t_transient=t_transient, n_returns=n_returns, h=h, rtol=rtol, max_wall=max_wall)
+
+
+def _return_map(params: PeelParams, *, t_transient: float = T_TRANSIENT, n_returns: int = 5000, h: float = 1e-6,
+                rtol: float = 1e-12, alpha0: float = 0.0, max_wall: float | None = DEFAULT_MAX_WALL) -> LyapunovResult:
+    """Method ``"return-map"`` of :func:`lyapunov` (:func:`lyapunov_return_map`, from any ``alpha0``: the
+    transient's run starts there)."""
+    params = _params("params", params)
+    h = positive("h", h, hi=1.0)
+    rtol = _rtol("rtol", rtol)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    n_returns = integer("n_returns", n_returns, lo=2)
+    alpha0 = state("alpha0", alpha0, "alpha")
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
+    scale = natural_scales(params)
+
+    def ret(x, horizon):
+        try:
+            J = simulate(params, horizon, alpha0=x[0], omega0=x[1], F0=x[2], branch0="CD", rtol=rtol, save="jumps",
+                         max_wall=wall.left(0.0, lambda: initial_state(params, alpha0=x[0], omega0=x[1], F0=x[2],
+                                                                           branch0="CD").__dict__, horizon)).jumps
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
+        ab = np.flatnonzero(np.asarray(J.from_branch) == _AB)
+        if ab.size == 0:
+            return None, None
+        i = ab[0]
+        return np.array([J.alpha[i], J.omega[i], J.F[i]]), float(J.t[i])
+
+    try:
+        J0 = window_run(params, t_transient=0.0, window=max(float(t_transient), 1e-3), rtol=rtol, alpha0=alpha0,
+                        max_wall=wall.limit).jumps
+    except SolverBudgetExceeded as exc:
+        raise wall.reraise(exc) from None
+    ab = np.flatnonzero(np.asarray(J0.from_branch) == _AB)
+    if ab.size == 0:
+        raise ValueError(f"no AB→CD jump within t_transient = {t_transient} s: no return map to linearise")
+    k = int(ab[-1])  # start on the section, at the transient's last AB→CD jump
+    x = np.array([J0.alpha[k], J0.omega[k], J0.F[k]])
+    w = np.array([0.3, 0.3, 1.0]) / math.sqrt(1.18)
+    wall0 = time.perf_counter()
+    logs: list[float] = []
+    dts: list[float] = []
+    horizon, jumps = 1.0, 0
+    while len(logs) < int(n_returns):
+        y, dt = ret(x, horizon)
+        if y is None:
+            if horizon > 1e3:
+                raise ValueError("the orbit stopped returning to the AB→CD section (no stick-slip)")
+            horizon *= 2.0
+            continue
+        horizon = 3.0 * dt
+        yp, _ = ret(x + h * w * scale, horizon)
+        ym, _ = ret(x - h * w * scale, horizon)
+        if yp is None or ym is None:
+            raise ValueError("a perturbed orbit did not return within 3 return times: h is too large")
+        Dw = (yp - ym) / (2.0 * h) / scale
+        d = float(np.linalg.norm(Dw))
+        logs.append(math.log(d))
+        dts.append(dt)
+        w, x = Dw / d, y
+        jumps += 2
+    b = BenettinResult.from_logs(logs, dts, h, time.perf_counter() - wall0)
+    ln2 = math.log(2.0)
+    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, math.nan, jumps,
+                          method="tangent map of the AB→CD return map (central differences)")

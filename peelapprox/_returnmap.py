@@ -1,0 +1,160 @@
+"""Analysis of the return map of an exact trajectory: periodicity, force drops, settle time.
+
+Everything here reads the *jump sequence* of an exact (hybrid, ε → 0) trajectory, the natural Poincaré
+section of stick-slip: the pull force at the AB→CD jumps, ``x_k = F(t_k)``, is the return map whose
+periods the paper reports ("period 4 at V = 2, I = 1e-5", "period 8 at V = 1, I = 1e-2", ...).
+
+* :func:`return_map` — ``x_k``, the F values at AB→CD jumps.
+* :func:`periodicity` — period-n (n <= 32) of ``x_k`` to a stated tolerance, or aperiodic.
+* :func:`classify` — :func:`periodicity` of a trajectory's window, "no stick-slip" below 2 returns.
+* :func:`force_drops` — ``ΔF_k = F(AB→CD jump k) − F(next CD→AB jump)``, the slip's force drop (Fig. 6).
+* :func:`settle_time` — when a periodic orbit is reached (the transient's end).
+
+Pure analysis of a given trajectory (anything with ``jumps.t``, ``jumps.F``, ``jumps.from_branch``): no
+solver runs here.  The functions that run the exact solver (windowed runs, attractors, the Lyapunov family)
+live in :mod:`exact`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._peelforce import BRANCHES
+from ._validate import ArgumentTypeError, integer, positive, reals
+
+__all__ = ["return_map", "Periodicity", "periodicity", "classify", "force_drops", "settle_time"]
+
+_AB = BRANCHES.index("AB")
+
+
+def _trajectory(name: str, x):
+    """x if it looks like an :class:`exact.Trajectory` (has ``jumps`` with ``t``, ``F``, ``from_branch``)."""
+    J = getattr(x, "jumps", None)
+    if not all(hasattr(J, a) for a in ("t", "F", "from_branch")):
+        raise ArgumentTypeError(f"{name} must be an exact.Trajectory (with jumps), got {type(x).__name__}")
+    return x
+
+
+def return_map(trajectory, *, with_times: bool = False):
+    """``x_k``: the pull force [N] at the AB→CD jumps of an exact trajectory (its stored window).
+
+    With ``with_times=True``, the pair ``(t_k, x_k)`` of jump times and forces.
+    """
+    J = _trajectory("trajectory", trajectory).jumps
+    m = np.asarray(J.from_branch) == _AB
+    x = np.asarray(J.F)[m]
+    return (np.asarray(J.t)[m], x) if with_times else x
+
+
+@dataclass(frozen=True)
+class Periodicity:
+    """Period of the return map ``x_k`` (see :func:`periodicity`).
+
+    ``kind`` is ``"periodic"`` (``period`` = the smallest n that repeats), ``"aperiodic"`` (no n <=
+    ``max_period`` repeats; ``period`` None) or ``"too short"`` (fewer than
+    ``(min_repeats + 1) · max_period`` returns were given — 96 with the defaults — so not every n could be
+    tried, *and* no shorter period repeated).  ``mismatch`` = ``max_k |x_{k+n} − x_k| / max|x|`` for
+    the period found, or the smallest over all n tried (``inf`` when too few returns to try any n; NaN only
+    for "no stick-slip" from :func:`classify`); ``n_returns`` = ``len(x)``.
+    """
+
+    kind: str
+    period: int | None
+    mismatch: float
+    n_returns: int
+    rtol: float
+
+    @property
+    def label(self) -> str:
+        return f"period-{self.period}" if self.kind == "periodic" else self.kind
+
+
+def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int = 2) -> Periodicity:
+    """Classify the return map as period-n or aperiodic.
+
+    Parameters
+    ----------
+    x : array_like or exact.Trajectory
+        The F values at AB→CD jumps (or a trajectory, through :func:`return_map`), after the transient.
+    rtol : float
+        Tolerance: period n is accepted when ``max_k |x_{k+n} − x_k| <= rtol · max|x|`` over every k.  The
+        hybrid solver at rtol 1e-10 reproduces a periodic orbit's jump forces to ~1e-12, so 1e-6 separates
+        periodic orbits from chaotic ones, whose returns do not come within 1e-6 for n <= 32.
+    max_period : int
+        Largest n tried (the issue asks n <= 32).
+    min_repeats : int
+        A period n needs at least ``min_repeats · n`` pairs ``(x_k, x_{k+n})``.
+
+    Returns
+    -------
+    Periodicity
+    """
+    if hasattr(x, "jumps"):
+        x = return_map(x)
+    x = reals("x", x)
+    rtol = positive("rtol", rtol)
+    max_period, min_repeats = integer("max_period", max_period), integer("min_repeats", min_repeats)
+    if x.ndim != 1 or x.size < 2:
+        raise ValueError(f"x must be a 1-D finite sequence of at least 2 returns, got shape {x.shape}")
+    scale = float(np.max(np.abs(x)))
+    # differences of x / max|x| (in [-1, 1]): no overflow for |x| near the float maximum, and all-zero
+    # returns (scale 0) are the constant sequence, mismatch 0
+    xs = x / scale if scale > 0 else x
+    best = math.inf
+    for n in range(1, int(max_period) + 1):
+        if x.size - n < int(min_repeats) * n:
+            break
+        mis = float(np.max(np.abs(xs[n:] - xs[:-n])))
+        if mis <= rtol:
+            return Periodicity("periodic", n, mis, x.size, rtol)
+        best = min(best, mis)
+    enough = x.size - int(max_period) >= int(min_repeats) * int(max_period)
+    return Periodicity("aperiodic" if enough else "too short", None, best, x.size, rtol)
+
+
+def force_drops(trajectory) -> np.ndarray:
+    """Force drop of each slip [N]: ``F`` at an AB→CD jump minus ``F`` at the next CD→AB jump.
+
+    One value per completed slip in the stored window.
+    The paper's Fig. 6 plots their mean against V.
+    """
+    J = _trajectory("trajectory", trajectory).jumps
+    fb = np.asarray(J.from_branch)
+    F = np.asarray(J.F)
+    idx = np.flatnonzero(fb[:-1] == _AB)  # AB→CD followed by CD→AB (jumps alternate)
+    if np.any(fb[idx + 1] == _AB):
+        raise ValueError("force_drops: the jumps do not alternate AB→CD→AB (not an exact trajectory's jumps)")
+    return F[idx] - F[idx + 1]
+
+
+def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> float | None:
+    """The time from which the return map is periodic to the end of the stored window, or None.
+
+    The orbit's period n is found on the last half of the returns (:func:`periodicity`); the settle time is
+    that of the earliest AB→CD jump from which ``|x_{k+n} − x_k| <= rtol·max|x|`` holds for every later k.
+    None means no period was found in the last half (aperiodic, or still in the transient).
+    """
+    rtol = positive("rtol", rtol)
+    max_period = integer("max_period", max_period)
+    t, x = return_map(trajectory, with_times=True)
+    if x.size < 4:
+        return None
+    per = periodicity(x[x.size // 2:], rtol=rtol, max_period=max_period)
+    if per.kind != "periodic":
+        return None
+    n = per.period
+    assert n is not None  # kind "periodic" comes with its period
+    bad = np.abs(x[n:] - x[:-n]) > rtol * float(np.max(np.abs(x)))
+    k = int(np.flatnonzero(bad)[-1]) + 1 if bad.any() else 0
+    return float(t[k])
+
+
+def classify(trajectory, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
+    """:func:`periodicity` of a window's return map, with ``kind = "no stick-slip"`` below 2 returns."""
+    x = return_map(trajectory)
+    if x.size < 2:
+        return Periodicity("no stick-slip", None, math.nan, int(x.size), period_rtol)
+    return periodicity(x, rtol=period_rtol, max_period=max_period)
