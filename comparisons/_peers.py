@@ -35,17 +35,6 @@ __all__ = [
     "DIFFSL_INPUTS",
     "DIFFSL_TANGENT_INPUTS",
     "DIFFSOL_OPTIONS",
-    "TANGENT_OPTIONS",  # noqa: F822 - moved to exact._variational, re-exported by __getattr__ below
-    "tangent_solve",  # noqa: F822 - idem
     "lyapunov_regularized",
 ]
 
-
-def __getattr__(name: str):
-    """``TANGENT_OPTIONS`` and ``tangent_solve`` moved with the ε-variational Lyapunov exponent
-    (``lyapunov_regularized``, now :func:`exact.lyapunov_variational`) to :mod:`exact._variational`."""
-    if name in ("TANGENT_OPTIONS", "tangent_solve"):
-        from exact import _variational
-
-        return getattr(_variational, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -16,7 +16,7 @@ two-trajectory method for any flow).  The return-map analysis of a trajectory (`
 ``periodicity``, ``force_drops``, ``settle_time``) is the core package's: :mod:`peelapprox`.
 """
 
-from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin

@@ -15,11 +15,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, classify, return_map, settle_time
-from peelapprox._errors import WallBudget
-from peelapprox._params import RTOL_RANGE, T_TRANSIENT
-from peelapprox._validate import duration, function, in_range, optional, positive, state, states
-from peelapprox._validate import params as _params
+from peelapprox import (
+    RTOL_RANGE,
+    T_TRANSIENT,
+    ModelBreakdown,
+    PeelParams,
+    SolverBudgetExceeded,
+    classify,
+    return_map,
+    settle_time,
+)
+from peelapprox.errors import WallBudget
+from peelapprox.validate import duration, function, in_range, optional, positive, state, states
+from peelapprox.validate import params as _params
 
 from ._simulate import initial_state, simulate
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure
-from peelapprox._validate import function, integer
+from peelapprox.validate import function, integer
 
 __all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult"]
 

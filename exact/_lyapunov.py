@@ -25,10 +25,17 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import BRANCHES, PeelParams, SolverBudgetExceeded, branch_structure
-from peelapprox._errors import WallBudget
-from peelapprox._params import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT
-from peelapprox._validate import (
+from peelapprox import (
+    BRANCHES,
+    LYAPUNOV_TAU,
+    RTOL_RANGE,
+    T_TRANSIENT,
+    PeelParams,
+    SolverBudgetExceeded,
+    branch_structure,
+)
+from peelapprox.errors import WallBudget
+from peelapprox.validate import (
     ArgumentTypeError,
     choice,
     duration,
@@ -39,7 +46,7 @@ from peelapprox._validate import (
     positive,
     state,
 )
-from peelapprox._validate import params as _params
+from peelapprox.validate import params as _params
 
 from ._attractors import DEFAULT_MAX_WALL, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
@@ -97,7 +104,7 @@ def lyapunov(
         after every renormalisation interval (variational).
     **options
         Keyword-only options of the chosen method, validated by it; an option of another method, or of none,
-        raises :class:`peelapprox._validate.ArgumentTypeError` (a ``TypeError`` and ``ValueError``) naming
+        raises :class:`peelapprox.validate.ArgumentTypeError` (a ``TypeError`` and ``ValueError``) naming
         the option and the method:
 
         ================  =========================================================================

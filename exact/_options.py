@@ -12,7 +12,7 @@ In the style of diffrax (``diffeqsolve(solver=Dopri5(), saveat=SaveAt(ts=...), .
 
 ``simulate`` builds them from its keywords (or takes them as given) and hands them to the drivers, which
 read their fields and validate nothing again.  Each object checks its fields in ``__post_init__`` with the
-named validators of :mod:`peelapprox._validate`, so a bad field raises the same ``ValueError`` /
+named validators of :mod:`peelapprox.validate`, so a bad field raises the same ``ValueError`` /
 ``TypeError`` (naming the field and its valid range) as the ``simulate`` keyword of the same name.  What
 depends on the horizon ``t_end`` (``t_transient <= t_end``, the save times within it, the default step
 budget) is checked or resolved by ``simulate``, which knows it (:meth:`SaveAt.within`,
@@ -28,8 +28,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from peelapprox._params import EPS_RANGE, RTOL_RANGE, TIME_MAX
-from peelapprox._validate import ArgumentTypeError, choice, flag, in_range, integer, interval, optional, positive, reals
+from peelapprox import EPS_RANGE, RTOL_RANGE, TIME_MAX
+from peelapprox.validate import ArgumentTypeError, choice, flag, in_range, integer, interval, optional, positive, reals
 
 __all__ = ["Hybrid", "Regularized", "SaveAt", "Budget", "ATOL_SCALE", "ATOL_RANGE", "STEP_BUDGET",
            "default_max_steps", "method_option", "output_options"]

@@ -25,8 +25,8 @@ import numpy as np
 from scipy import integrate
 from scipy.optimize import brentq
 
-from peelapprox._errors import ModelBreakdown, SolverFailure, budget_exceeded
-from peelapprox._peelforce import BRANCHES, BREAKDOWN_LEVEL, branch_structure
+from peelapprox import BRANCHES, BREAKDOWN_LEVEL, branch_structure
+from peelapprox.errors import ModelBreakdown, SolverFailure, budget_exceeded
 from peelapprox.kernels import regularized_field as _fun  # the compiled field, Jacobian and parameter vector
 from peelapprox.kernels import regularized_field_jacobian as _jac
 from peelapprox.kernels import regularized_parameters as param_vector

@@ -10,20 +10,19 @@ from typing import cast
 
 import numpy as np
 
-from peelapprox import PeelParams
-from peelapprox import _status as S
-from peelapprox._errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox._params import TIME_MAX
-from peelapprox._peelforce import (
+from peelapprox import (
     BRANCHES,
     BREAKDOWN_LEVEL,
+    TIME_MAX,
+    PeelParams,
     branch_inverse,
     branch_structure,
     peel_force,
 )
-from peelapprox._status import status_error
-from peelapprox._validate import choice, duration, in_range, optional, state
-from peelapprox._validate import params as _params
+from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
+from peelapprox.kernels import status as S
+from peelapprox.validate import choice, duration, in_range, optional, state
+from peelapprox.validate import params as _params
 
 from . import _hybrid as H
 from ._options import (
@@ -420,7 +419,7 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
             status, why = S.V_FLOOR, f"the caller's v_floor; F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N"
         else:
             why = ""
-        raise status_error(
+        raise S.status_error(
             status, t=sd["t"], state=sd, partial=build(False),
             prefix=f"hybrid solver at t={sd['t']:.9g} on {sd['branch']}: ",
             f_zero=bs.f_zero, f_min=bs.f_min, level=BREAKDOWN_LEVEL, v=sd["v"], v_ceiling=V_CEILING,

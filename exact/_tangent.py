@@ -28,15 +28,18 @@ import math
 
 import numpy as np
 
-from peelapprox._errors import SolverBudgetExceeded, WallBudget
-from peelapprox._params import T_TRANSIENT
-from peelapprox._peelforce import BREAKDOWN_LEVEL, branch_structure
-from peelapprox._status import DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, status_error
-from peelapprox._validate import duration, integer, optional, positive
+from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, branch_structure
+from peelapprox.errors import SolverBudgetExceeded, WallBudget
 from peelapprox.kernels import N_STAGES as _NS
 from peelapprox.kernels import STEP_FAILED, crossing, interp, interp1, kernel, make_dop853, solve_theta, workspace
+from peelapprox.kernels import status as _st
+from peelapprox.validate import duration, integer, optional, positive
 
 from . import _hybrid as H
+
+DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL = (
+    _st.DONE, _st.FOLD, _st.MAX_STEPS, _st.NO_LANDING, _st.NO_ROOT, _st.STEP_FAIL)
+status_error = _st.status_error
 
 _EPS_FD = 1e-7
 

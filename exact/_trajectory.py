@@ -8,8 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peelapprox import PeelParams
-from peelapprox._peelforce import BRANCHES, peel_force
+from peelapprox import BRANCHES, PeelParams, peel_force
 
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 

@@ -19,10 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from peelapprox import SolverFailure
-from peelapprox._params import EPS_RANGE, T_TRANSIENT
-from peelapprox._validate import duration, function, in_range, optional, state
-from peelapprox._validate import params as _params
+from peelapprox import EPS_RANGE, T_TRANSIENT, SolverFailure
 from peelapprox.kernels import (
     DIFFSOL_OPTIONS,
     diffsl_inputs,
@@ -30,6 +27,8 @@ from peelapprox.kernels import (
     regularized_field_jacobian,
     regularized_parameters,
 )
+from peelapprox.validate import duration, function, in_range, optional, state
+from peelapprox.validate import params as _params
 
 from ._simulate import _atol_vector, initial_state
 

@@ -31,7 +31,6 @@ from ._alpha import (
     wkb_amplitude_phase,
     wkb_error_bound,
 )
-from ._errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from ._estimate import (
     INERTIA_RULE,
     VELOCITY_RULE,
@@ -43,9 +42,21 @@ from ._estimate import (
     quasi_static_branch_time,
     slope_criterion,
 )
-from ._params import GEOMETRIES, PARAM_RANGES, PeelParams
+from ._params import (
+    EPS_RANGE,
+    GEOMETRIES,
+    LYAPUNOV_TAU,
+    PARAM_RANGES,
+    RTOL_RANGE,
+    STATE_RANGES,
+    T_TRANSIENT,
+    TIME_MAX,
+    WINDOW_DEFAULTS,
+    PeelParams,
+)
 from ._peelforce import (
     BRANCHES,
+    BREAKDOWN_LEVEL,
     BranchStructure,
     FixedPoint,
     branch_inverse,
@@ -57,11 +68,20 @@ from ._peelforce import (
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._version import __version__ as __version__
+from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 __all__ = [
     "PeelParams",
     "GEOMETRIES",
     "PARAM_RANGES",
+    "STATE_RANGES",
+    "TIME_MAX",
+    "RTOL_RANGE",
+    "EPS_RANGE",
+    "T_TRANSIENT",
+    "LYAPUNOV_TAU",
+    "WINDOW_DEFAULTS",
+    "BREAKDOWN_LEVEL",
     "peel_force",
     "peel_force_derivative",
     "branch_structure",

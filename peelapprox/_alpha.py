@@ -48,13 +48,13 @@ from typing import NamedTuple
 import numpy as np
 from scipy import integrate, special
 
-from ._errors import SolverFailure
 from ._jit import jitable
 from ._params import TIME_MAX, PeelParams
 from ._peelforce import branch_structure, peel_force_derivative
-from ._validate import choice, in_range, optional, state, states, times
-from ._validate import finite as _finite
-from ._validate import params as _params
+from .errors import SolverFailure
+from .validate import choice, in_range, optional, state, states, times
+from .validate import finite as _finite
+from .validate import params as _params
 
 __all__ = [
     "inertial_frequency",

@@ -4,7 +4,7 @@ Argument types for :mod:`argparse` that reject out-of-range numbers with the
 argument's name (exit status 2, no traceback), and :func:`check_output_path`,
 which decides the exact file name an output option writes and fails *before*
 the run, not after it, when that name cannot be written.  The ranges come from
-:mod:`peelapprox._validate`, so the CLI and the Python API say the same thing.
+:mod:`peelapprox.validate`, so the CLI and the Python API say the same thing.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import argparse
 import os
 from collections.abc import Callable, Sequence
 
-from . import _validate
+from . import validate as _validate
 
 __all__ = [
     "DASK_CONNECT_TIMEOUT_S",
@@ -44,12 +44,12 @@ def _argtype(check: Callable[[str, float], object], text: str):
 
 
 def positive_float(text: str) -> float:
-    """Argparse type: a finite float in (0, inf) (:func:`peelapprox._validate.positive`)."""
+    """Argparse type: a finite float in (0, inf) (:func:`peelapprox.validate.positive`)."""
     return _argtype(_validate.positive, text)
 
 
 def nonnegative_float(text: str) -> float:
-    """Argparse type: a finite float in [0, inf) (:func:`peelapprox._validate.nonnegative`)."""
+    """Argparse type: a finite float in [0, inf) (:func:`peelapprox.validate.nonnegative`)."""
     return _argtype(_validate.nonnegative, text)
 
 
@@ -65,7 +65,7 @@ def positive_int(text: str) -> int:
 
 
 def finite_float_list(text: str) -> list[float]:
-    """Argparse type: a comma list of finite floats, at least one (:func:`peelapprox._validate.finite`)."""
+    """Argparse type: a comma list of finite floats, at least one (:func:`peelapprox.validate.finite`)."""
     items = [s.strip() for s in text.split(",")]
     if not text.strip() or any(not s for s in items):
         raise argparse.ArgumentTypeError(f"value must be a comma list of numbers, got {text!r}")
@@ -75,7 +75,7 @@ def finite_float_list(text: str) -> list[float]:
 # --------------------------------------------------------------------------------------------- output paths
 
 #: What an output option writes: ``"file"`` (any name), ``"table"`` (``.csv``/``.json``, by
-#: :func:`peelapprox._io.write_rows`), ``"npz"`` (numpy's ``.npz``, appended when missing, as numpy
+#: :func:`peelapprox.io.write_rows`), ``"npz"`` (numpy's ``.npz``, appended when missing, as numpy
 #: does), ``"image"`` (a matplotlib format by extension, ``.png`` appended when there is none, as
 #: matplotlib does) or ``"dir"`` (a directory, created with its parents).
 OUTPUT_KINDS = ("file", "table", "npz", "image", "dir")
@@ -92,7 +92,7 @@ def _file_name(path: str, kind: str, option: str) -> str:
     if kind == "npz":
         return path if path.endswith(".npz") else path + ".npz"
     if kind == "table":
-        from ._io import TABLE_EXTENSIONS
+        from .io import TABLE_EXTENSIONS
 
         if not path.endswith(TABLE_EXTENSIONS):
             raise ValueError(f"{option} must end in {' or '.join(TABLE_EXTENSIONS)}, got {path!r}")

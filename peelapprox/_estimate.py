@@ -20,8 +20,8 @@ from scipy import integrate
 from ._alpha import cd_damping_time, inertial_frequency, inertial_periods
 from ._params import PeelParams
 from ._peelforce import BranchStructure, FixedPoint, branch_structure, fixed_point, peel_force_derivative
-from ._validate import choice, flag, function, in_range, nonnegative, optional, state
-from ._validate import params as _params
+from .validate import choice, flag, function, in_range, nonnegative, optional, state
+from .validate import params as _params
 
 __all__ = [
     "crude_branch_time",

@@ -17,7 +17,7 @@ instead.
 
 Where no cache location is writable (read-only install, HOME, XDG cache and
 ``NUMBA_CACHE_DIR``: containers, HPC nodes) the kernels are compiled without
-caching, with one :class:`~peelapprox._errors.KernelCacheWarning`: the
+caching, with one :class:`~peelapprox.errors.KernelCacheWarning`: the
 package works, and every new process compiles again.
 
 Every function compiled by the package goes through :func:`kernel` (or, for a
@@ -39,7 +39,7 @@ from typing import Any, Literal
 from numba import njit
 from numba.extending import register_jitable
 
-from ._errors import KernelCacheWarning
+from .errors import KernelCacheWarning
 
 __all__ = ["kernel", "jitable", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ._validate import choice, in_range
+from ._checks import choice, in_range
 
 __all__ = ["EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES", "L_OVER_R_MIN",
            "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
@@ -102,7 +102,7 @@ class PeelParams:
     Raises
     ------
     TypeError
-        (:class:`peelapprox._validate.ArgumentTypeError`, also a
+        (:class:`peelapprox.validate.ArgumentTypeError`, also a
         ValueError) If a field is not a real number (None, a string, a
         bool) or ``geometry`` is not a string.
     ValueError

@@ -30,7 +30,7 @@ from scipy.optimize import brentq
 from . import _generated as _g
 from ._jit import kernel
 from ._params import PARAM_RANGES, STATE_RANGES
-from ._validate import choice, in_range, reals
+from .validate import choice, in_range, reals
 
 __all__ = [
     "peel_force",

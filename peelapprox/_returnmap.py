@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._peelforce import BRANCHES
-from ._validate import ArgumentTypeError, integer, positive, reals
+from .validate import ArgumentTypeError, integer, positive, reals
 
 __all__ = ["return_map", "Periodicity", "periodicity", "classify", "force_drops", "settle_time"]
 

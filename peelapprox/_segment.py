@@ -72,9 +72,9 @@ from ._params import RTOL_RANGE, TIME_MAX, PeelParams
 from ._peelforce import BRANCHES, branch_structure, peel_force_derivative
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
 from ._status import DONE, MAX_STEPS, OUT_FULL, T_MAX, status_error
-from ._validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
-from ._validate import params as _params
-from ._validate import state as _state
+from .validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
+from .validate import params as _params
+from .validate import state as _state
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from .errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 __all__ = ["Status", "STATUS", "status_error"]
 

@@ -114,11 +114,11 @@ def _folds(args: argparse.Namespace) -> int:
 
 
 def _write_rows(path: str, rows: list[dict]) -> None:
-    """Write rows as CSV or JSON, chosen by the file extension (:func:`peelapprox._io.write_rows`).
+    """Write rows as CSV or JSON, chosen by the file extension (:func:`peelapprox.io.write_rows`).
 
     ``path`` was checked by :func:`check_output_path` (kind ``"table"``) before the run.
     """
-    from ._io import write_rows
+    from .io import write_rows
 
     write_rows(path, rows)
     print(f"wrote {path}", file=sys.stderr)
@@ -338,7 +338,7 @@ def _sweep(args: argparse.Namespace) -> int:
     if args.format == "json":
         print(json.dumps(rows, indent=2))
     elif args.format == "csv":
-        from ._io import write_csv
+        from .io import write_csv
 
         write_csv(sys.stdout, rows, fields=cols)
     else:
@@ -391,7 +391,7 @@ def _dynamics(args: argparse.Namespace) -> int:
         raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     if args.attractors:  # checked before the run, named as the user wrote it
-        from ._validate import states
+        from .validate import states
 
         states("--attractors", args.attractors, "alpha")
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
@@ -659,7 +659,7 @@ def _exit_status(exc: BaseException) -> int | None:
     """2 for a bad argument, output path or missing optional package; 3 when the model or solver stopped; 1
     when writing failed after the checks (disk full, a path changed meanwhile); None for anything else."""
     from ._diffsl import PeerUnavailableError
-    from ._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+    from .errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
     if isinstance(exc, (ValueError, PeerUnavailableError)):
         return 2

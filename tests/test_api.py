@@ -15,7 +15,8 @@ import pytest
 
 API = {
     "peelapprox": {
-        "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BranchStructure", "FixedPoint", "GEOMETRIES",
+        "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BREAKDOWN_LEVEL", "EPS_RANGE", "LYAPUNOV_TAU",
+        "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "BranchStructure", "FixedPoint", "GEOMETRIES",
         "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
         "PARAM_RANGES", "PeelParams", "Periodicity", "ReducedSegment", "RegimeEstimate", "SlopeCriterion",
         "SolverBudgetExceeded", "SolverFailure", "SweepResult", "VELOCITY_RULE", "V_EQUATIONS", "airy_alpha",
@@ -66,7 +67,7 @@ def test_all_lists_no_unknown_name(package):
 
 
 def test_the_errors_are_one_class_each():
-    """The model exceptions offered by both packages are the same classes (one place: peelapprox._errors)."""
+    """The model exceptions offered by both packages are the same classes (one place: peelapprox.errors)."""
     import exact
     import peelapprox
 

@@ -50,9 +50,9 @@ from hypothesis import strategies as st
 import exact
 import peelapprox as pa
 from peelapprox import PARAM_RANGES, PeelParams
-from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from peelapprox._params import EPS_RANGE, STATE_RANGES, TIME_MAX
 from peelapprox.cli import main as cli_main
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 #: Cases per entry point and tier: (default, slow).  Sums: 565 default, 5650 slow (the issue asks >= 500
 #: and >= 5000); the split favours the cheap entry points with many arguments.

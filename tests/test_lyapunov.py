@@ -104,7 +104,7 @@ def test_an_option_of_another_method_is_refused_by_name(method, option, owner):
 ])
 def test_bad_values_are_refused_by_each_method_naming_the_argument(method, kw, name):
     """Hypothesis: each method validates its own options and the common arguments with the validators of
-    peelapprox._validate: a bad value is a ValueError (or ArgumentTypeError) whose message starts with the
+    peelapprox.validate: a bad value is a ValueError (or ArgumentTypeError) whose message starts with the
     argument's name (categorical)."""
     with pytest.raises(ValueError, match=rf"^{name} "):
         lyapunov(P, method, **kw)
@@ -129,7 +129,7 @@ def test_variational_wall_watch_raises_between_intervals():
     renormalisation interval).  Hypothesis: the watcher calls the user's progress while the budget lasts and
     raises SolverBudgetExceeded(budget="max_wall") with the interval's time once it is spent (categorical)."""
     from exact._lyapunov import _watch_wall
-    from peelapprox._errors import WallBudget
+    from peelapprox.errors import WallBudget
 
     seen = []
     watch = _watch_wall(WallBudget(0.05), lambda t, T: seen.append((t, T)))

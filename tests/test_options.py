@@ -16,7 +16,7 @@ import pytest
 import exact
 from exact import Budget, Hybrid, Regularized, SaveAt, simulate
 from peelapprox import PeelParams
-from peelapprox._validate import ArgumentTypeError
+from peelapprox.validate import ArgumentTypeError
 
 P = PeelParams(V=1, I=1e-5)
 NAN = math.nan

@@ -22,7 +22,7 @@ def test_params_reject_nonpositive_or_nonfinite(field, value):
     """Every field must be finite and inside its range (PARAM_RANGES); the message names the field and the
     range."""
     from peelapprox import PARAM_RANGES
-    from peelapprox._validate import interval
+    from peelapprox.validate import interval
 
     kw = dict(V=1.0, I=1e-5)
     kw[field] = value

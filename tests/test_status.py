@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from peelapprox import _status as S
-from peelapprox._errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 
 def test_drivers_use_the_table_codes():

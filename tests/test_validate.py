@@ -1,4 +1,4 @@
-"""The named argument validators (peelapprox._validate) and the item-6 reproducers of issue 13.
+"""The named argument validators (peelapprox.validate) and the item-6 reproducers of issue 13.
 
 Every bad argument must end in a ``ValueError`` or ``TypeError`` whose message names the argument, never in
 ZeroDivisionError, OverflowError, AttributeError, a numba error or a NaN result.
@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import peelapprox as pa
 from peelapprox import PARAM_RANGES, PeelParams
-from peelapprox import _validate as v
+from peelapprox import validate as v
 
 NOT_NUMBERS = [None, "abc", "1.0", True, False, np.bool_(True), [1.0], np.array([1.0, 2.0]), 1 + 2j, object()]
 

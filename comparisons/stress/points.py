@@ -17,9 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import GEOMETRIES
-from peelapprox._params import RTOL_RANGE
-from peelapprox._validate import finite, in_range, nonnegative, positive
+from peelapprox import GEOMETRIES, RTOL_RANGE
+from peelapprox.validate import finite, in_range, nonnegative, positive
 
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",

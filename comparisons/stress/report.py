@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox._io import write_rows
+from peelapprox.io import write_rows
 
 from .points import LONG_N_EVAL, LOOSE_TOLS, RANDOM_BOX, RANDOM_SEED
 from .run import DRIFT_FRACTION, is_bug

@@ -83,7 +83,7 @@ def _early_late(x: np.ndarray) -> tuple[float, float]:
 
 def _jump_residuals(tr: Any) -> np.ndarray:
     """Relative CONSTR residual at each jump, before and after, worst of the two [-]."""
-    from peelapprox._peelforce import peel_force
+    from peelapprox import peel_force
 
     J = tr.jumps
     if len(J) == 0:

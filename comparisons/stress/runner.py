@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from peelapprox._validate import positive
+from peelapprox.validate import positive
 
 from .._worker import TimedWorker, write_line
 from .points import StressPoint

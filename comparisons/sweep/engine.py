@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from peelapprox import PARAM_RANGES
-from peelapprox._validate import ArgumentTypeError
-from peelapprox._validate import path as _path
+from peelapprox.validate import ArgumentTypeError
+from peelapprox.validate import path as _path
 
 from .._worker import SERIAL, Progress, run_tasks, write_line
 from .measures import _OPTION_CHECKS, MEASURES, _ref

@@ -3,7 +3,7 @@
 A measure is ``fn(params: PeelParams, options: Mapping) -> dict`` of JSON scalars, evaluated at every grid
 point (see :mod:`comparisons.sweep`).  To add one, write the function and register it, with a
 ``check_options(options)`` that validates every option it reads with the validators of
-:mod:`peelapprox._validate` (raising ValueError naming the option and its range); :func:`~comparisons.sweep.sweep`
+:mod:`peelapprox.validate` (raising ValueError naming the option and its range); :func:`~comparisons.sweep.sweep`
 calls it before the first point:
 
     from comparisons.sweep import register_measure
@@ -23,9 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import ModelBreakdown, PeelParams, estimate
-from peelapprox._params import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT, TIME_MAX
-from peelapprox._validate import duration, in_range, positive, state
+from peelapprox import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT, TIME_MAX, ModelBreakdown, PeelParams, estimate
+from peelapprox.validate import duration, in_range, positive, state
 
 from .store import RESERVED
 
@@ -107,8 +106,7 @@ def _window_api() -> tuple[Callable[..., Any], Callable[..., Any], dict]:
     """``(window_run, classify, WINDOW_DEFAULTS)``: the one windowed exact run behind ``jumps`` and ``period``
     (its last call is cached, so the two measures of a point share it), imported at call time."""
     from exact import window_run
-    from peelapprox import classify
-    from peelapprox._params import WINDOW_DEFAULTS
+    from peelapprox import WINDOW_DEFAULTS, classify
 
     return window_run, classify, WINDOW_DEFAULTS
 

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox._validate import path as _path
+from peelapprox.validate import path as _path
 
 from .store import RESERVED, failed, read_manifest, read_records
 
@@ -116,7 +116,7 @@ class SweepResult:
 
     def to_csv(self, path) -> None:
         """One row per finished point; columns :meth:`keys`; None/absent as an empty cell; floats in full precision."""
-        from peelapprox._io import write_rows
+        from peelapprox.io import write_rows
 
         if not str(path).endswith(".csv"):
             raise ValueError(f"path must end in .csv, got {str(path)!r}")

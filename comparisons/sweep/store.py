@@ -18,7 +18,7 @@ import warnings
 from collections.abc import Iterable, Sequence
 from typing import IO, Any
 
-from peelapprox._validate import reals
+from peelapprox.validate import reals
 
 __all__ = [
     "MANIFEST", "RESULTS", "LOCK", "FORMAT", "RESERVED", "TEMPORARY", "GRID_RTOL",
@@ -146,7 +146,7 @@ def check_axis(name: str, values, lo: float = 0.0, hi: float = math.inf) -> list
     """A grid axis as a list of floats: non-empty, finite, in ``(lo, hi]`` (``(0, inf)`` by default), no repeats.
 
     Raises ArgumentTypeError (a TypeError and ValueError) for values that are not real numbers (None,
-    strings, bools), ValueError naming ``name`` otherwise (:func:`peelapprox._validate.reals`).
+    strings, bools), ValueError naming ``name`` otherwise (:func:`peelapprox.validate.reals`).
     """
     lo_open = lo == 0.0
     arr = reals(name, values, lo, hi, lo_open=lo_open).ravel()

@@ -11,11 +11,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from exact import default_atol, initial_state
-from peelapprox import branch_structure
-from peelapprox._params import EPS_RANGE
-from peelapprox._validate import choice, duration, in_range, reals
-from peelapprox._validate import params as _params
+from peelapprox import EPS_RANGE, branch_structure
 from peelapprox.kernels import PeerUnavailableError, import_optional
+from peelapprox.validate import choice, duration, in_range, reals
+from peelapprox.validate import params as _params
 
 from . import diffsol, sundials
 

@@ -1,0 +1,112 @@
+"""The named argument validators shared by every public function.
+
+One rule for every public argument, so that a bad argument is reported as what it is, by name, before
+any computation:
+
+* a value of the wrong *kind* — ``None``, a string, a bool, a sequence where a number is expected, a
+  float where an integer count is expected, anything but a :class:`PeelParams` where parameters are
+  expected — raises :class:`ArgumentTypeError` (a ``TypeError``);
+* a value of the right kind outside its valid range — NaN, ±inf, a negative time, an unknown choice —
+  raises ``ValueError``.
+
+Both messages name the argument and the valid range, in the one pattern
+``"<name> must be <kind> in <range>, got <value>"``, e.g.
+``"rtol must be finite and in (0, 1), got nan"`` or ``"alpha0 must be a real number in (-inf, inf), got 'abc'
+(str)"``.
+
+:class:`ArgumentTypeError` subclasses both ``TypeError`` and ``ValueError`` (as numpy's ``AxisError``
+subclasses ``ValueError`` and ``IndexError``), so callers written against the earlier rule "bad arguments
+raise ValueError" (the CLI's error report, ``except ValueError`` around a run) still catch it.
+
+Decisions recorded here once:
+
+* **bool and str are not numbers**: ``True`` is not 1.0 and ``"1e-3"`` is not 1e-3.
+* **integer counts are integers**: :func:`integer` accepts ``int`` and numpy integers and rejects every
+  float, integral or not (``max_points=100.0`` is refused rather than rounded: a float count is usually
+  a unit mix-up, and numpy refuses ``np.zeros(3.0)`` for the same reason).  Counts are bounded above by
+  :data:`MAX_COUNT` so that no budget overflows numba's int64 or means "forever".
+* ranges are closed unless stated open; bounds are printed with ``[``/``]`` or ``(``/``)`` accordingly.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ._checks import (
+    MAX_COUNT,
+    ArgumentTypeError,
+    _got,
+    choice,
+    finite,
+    flag,
+    function,
+    in_range,
+    integer,
+    interval,
+    nonnegative,
+    optional,
+    optional_finite,
+    path,
+    positive,
+    real,
+    reals,
+    times,
+)
+from ._params import STATE_RANGES, TIME_MAX, PeelParams
+
+__all__ = [
+    "ArgumentTypeError",
+    "MAX_COUNT",
+    "real",
+    "in_range",
+    "finite",
+    "positive",
+    "nonnegative",
+    "optional",
+    "optional_finite",
+    "integer",
+    "choice",
+    "flag",
+    "function",
+    "params",
+    "reals",
+    "times",
+    "interval",
+    "state",
+    "states",
+    "duration",
+    "path",
+]
+
+
+def params(name: str, x: Any):
+    """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError."""
+    if not isinstance(x, PeelParams):
+        raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
+    return x
+
+
+
+def state(name: str, x: Any, quantity: str) -> float:
+    """A scalar state variable in its range :data:`peelapprox._params.STATE_RANGES` [quantity].
+
+    ``quantity`` is ``"alpha"`` (rad), ``"omega"`` (rad/s, also for α̇), ``"F"`` (N), ``"v"`` (m/s, open at
+    0) or ``"F_rate"`` (N/s); e.g. ``state("F0", F0, "F")``.
+    """
+    lo, hi = STATE_RANGES[quantity]
+    return in_range(name, x, lo, hi, lo_open=quantity == "v")
+
+
+
+def states(name: str, x: Any, quantity: str) -> np.ndarray:
+    """:func:`state` for an array (any shape, scalars as 0-d), every element checked (:func:`reals`)."""
+    lo, hi = STATE_RANGES[quantity]
+    return reals(name, x, lo, hi, lo_open=quantity == "v")
+
+
+
+def duration(name: str, x: Any, *, zero: bool = False) -> float:
+    """A time span [s] in ``(0, TIME_MAX]`` (``[0, TIME_MAX]`` with ``zero``), TIME_MAX = 1e6 s."""
+    return in_range(name, x, 0.0, TIME_MAX, lo_open=not zero)
