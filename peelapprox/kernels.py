@@ -49,11 +49,14 @@ from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N
 from ._peelforce import _invert as branch_inverse_at
 from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
 
+#: Index of ε in the regularised system's parameter vector, after the model block.
+Q_EPS = N_M
+
 __all__ = [
     "kernel", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
-    "regularized_rhs", "regularized_jacobian", "regularized_parameters", "regularized_field",
+    "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",
     "regularized_field_jacobian", "peel_force_coefficients", "branch_inverse_at",
     "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
@@ -85,22 +88,21 @@ def closure(alpha, exact_geometry, R, l):
 
 
 def regularized_parameters(params, eps: float) -> np.ndarray:
-    """The parameter vector ``q`` of :func:`regularized_field` / :func:`regularized_field_jacobian`:
-    ``(V, I, k, R, l, b, A, eps, geometry)`` with ``(b, A)`` the coefficients of fvV and ``geometry`` 0 for the
-    paper's closure, 1 for the full one."""
-    b, A = peel_force_coefficients(params.V)
-    return np.array([params.V, params.I, params.k, params.R, params.l, b, A, eps,
-                     0.0 if params.geometry == "paper" else 1.0])
+    """The parameter vector ``q`` of :func:`regularized_field` / :func:`regularized_field_jacobian`: the model
+    block (:func:`model_block`: V, I, k, R, l, the fvV coefficients b and A, the geometry flag) followed by ε at
+    index :data:`Q_EPS` (= ``N_M``)."""
+    q = model_block(params, N_M + 1)
+    q[Q_EPS] = eps
+    return q
 
 
 @kernel
 def regularized_field(y, q):
     """XDAE's ``M⁻¹ φ(X)`` at ``y = (α, ω, F, v)`` as a new array (``q``: :func:`regularized_parameters`)."""
-    # q = V, I, k, R, l, b, A, eps, geom
     v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
-    f, _ = peel_force_fp_jit(v, q[5], q[6])
-    c, _ = closure(y[0], q[8], q[3], q[4])
-    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[7], q[0], q[1], q[2], q[3])
+    f, _ = peel_force_fp_jit(v, q[M_B], q[M_A])
+    c, _ = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
     return np.array([r[0], r[1], r[2], r[3]])
 
 
@@ -108,9 +110,9 @@ def regularized_field(y, q):
 def regularized_field_jacobian(y, q):
     """The Jacobian of :func:`regularized_field`, a (4, 4) array (with ``eps = 1`` in ``q``: ∂φ/∂X itself)."""
     v = max(y[3], 1e-300)
-    _, fp = peel_force_fp_jit(v, q[5], q[6])
-    c, dc = closure(y[0], q[8], q[3], q[4])
-    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[7], q[0], q[1], q[2], q[3])
+    _, fp = peel_force_fp_jit(v, q[M_B], q[M_A])
+    c, dc = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
+    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
     out = np.empty((4, 4))
     for i in range(16):
         out[i // 4, i % 4] = j[i]

@@ -130,8 +130,9 @@ def test_model_block_layout(geometry):
 
 
 def test_every_driver_vector_starts_with_the_model_block():
-    """Hypothesis: the hybrid driver's and the reduced segment's vectors are the model block followed by their
-    own fields, numbered from ``N_M`` without gaps or overlaps (exact comparisons of indices and values)."""
+    """Hypothesis: the hybrid driver's, the regularised system's and the reduced segment's vectors are the model
+    block followed by their own fields, numbered from ``N_M`` without gaps or overlaps (exact comparisons of
+    indices and values)."""
     from exact import _hybrid as H
     from exact._simulate import _param_vector
     from peelapprox import _segment_kernel as K
@@ -143,6 +144,11 @@ def test_every_driver_vector_starts_with_the_model_block():
     assert sorted(hybrid) == list(range(N_M, H.N_P))
     seg = (K.Q_AM, K.Q_VE, K.Q_FIN, K.Q_VIN, K.Q_FPIN, K.Q_S, K.Q_AMP, K.Q_PH, K.Q_AIN, K.Q_ADIN, K.Q_TAU)
     assert sorted(seg) == list(range(N_M, K.N_Q))
+    from peelapprox import kernels
+
+    q = kernels.regularized_parameters(p, 1e-7)
+    assert kernels.Q_EPS == N_M and q.shape == (N_M + 1,) and q[kernels.Q_EPS] == 1e-7
+    assert np.array_equal(q[:N_M], model_block(p))
 
 
 def test_jitable_refuses_a_function_outside_the_kernel_sources():

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from peelapprox.kernels import regularized_field, regularized_field_jacobian, regularized_parameters
+from peelapprox.kernels import Q_EPS, regularized_field, regularized_field_jacobian, regularized_parameters
 
 __all__ = ["run", "smoke"]
 
@@ -35,7 +35,7 @@ def run(sun, peer, params, t_end, eps, rtol, atol, y0, vm):
     c0 = time.perf_counter()
     q = regularized_parameters(params, eps)
     q1 = q.copy()
-    q1[7] = 1.0  # with eps = 1 the kernels give phi and d(phi)/dX themselves (M = I)
+    q1[Q_EPS] = 1.0  # with eps = 1 the kernels give phi and d(phi)/dX themselves (M = I)
     regularized_field(y0, q), regularized_field_jacobian(y0, q)
     mass = np.array([1.0, 1.0, 1.0, eps])
     mass_m = np.diag(mass)
