@@ -16,7 +16,8 @@ import pytest
 API = {
     "peelapprox": {
         "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BREAKDOWN_LEVEL", "EPS_RANGE", "LYAPUNOV_TAU",
-        "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "BranchStructure", "FixedPoint", "GEOMETRIES",
+        "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "BranchStructure", "FixedPoint",
+        "GEOMETRIES",
         "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
         "PARAM_RANGES", "PeelParams", "Periodicity", "ReducedSegment", "RegimeEstimate", "SlopeCriterion",
         "SolverBudgetExceeded", "SolverFailure", "SweepResult", "VELOCITY_RULE", "V_EQUATIONS", "airy_alpha",
@@ -39,7 +40,7 @@ API = {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
         "STAT_RUNS", "Scene", "Segment", "StatRow", "TransientCheck", "TransientNotPassed", "check_past_transient",
         "compare", "exact_run", "local_period", "markdown", "run_compare", "run_reduction", "scene_rows",
-        "segments", "statistics",
+        "segments", "statistics", "Figure", "FIGURES", "make_figures", "figures_markdown",
     },
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
