@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure, peel_force
+from peelapprox.plotting import pyplot
 
 __all__ = ["Figure", "FIGURES", "make_figures", "figures_markdown"]
 
@@ -29,15 +30,6 @@ class Figure:
     params: str
     note: str
     draw: Callable[[str], list[str]]
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _sim(V, I, t_end, *, t_transient=0.0, alpha0=0.0, **kw):
@@ -66,12 +58,12 @@ def _save(fig, out, name):
     path = os.path.join(out, f"{name}.png")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    _plt().close(fig)
+    pyplot().close(fig)
     return [path]
 
 
 def _fig2(out):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.2))
     for V, ls in ((1, "-"), (2, "--"), (4, "-."), (6, ":")):
         v = np.logspace(-4, np.log10(30), 800)
@@ -87,7 +79,7 @@ def _fig2(out):
 
 
 def _fig3(out):
-    plt = _plt()
+    plt = pyplot()
     fig, axs = plt.subplots(2, 2, figsize=(10, 7))
     tr = _sim(0.4, 1e-5, 2.0, t_transient=1.0, alpha0=0.2)
     _phase(axs[0, 0], tr.v, tr.F, tr.branch, 0.4, "(a) V=0.4, I=1e-5: v–F (start α0 = 0.2)")
@@ -108,7 +100,7 @@ def _fig3(out):
 
 
 def _fig4(out):
-    plt = _plt()
+    plt = pyplot()
     from peelapprox import periodicity, return_map
 
     tr = _sim(1.0, 1e-2, 40.0, t_transient=30.0)
@@ -136,7 +128,7 @@ def _period_label(x):
 
 
 def _fig5(out):
-    plt = _plt()
+    plt = pyplot()
     tr = _sim(4.0, 1e-2, 22.0, t_transient=20.0, alpha0=0.3)
     fig, axs = plt.subplots(2, 2, figsize=(10, 7))
     axs[0, 0].plot(tr.t, tr.F, lw=0.6)
@@ -180,7 +172,7 @@ def fig6_data(Vs=_FIG6_V, Is=(1e-5, 1e-2), *, t_transient=20.0,
 def _fig6(out):
     from peelapprox import force_drops
 
-    plt = _plt()
+    plt = pyplot()
     data = fig6_data(_FIG6_V)
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
     ax = axs[0]
@@ -204,7 +196,7 @@ def _fig6(out):
 
 
 def _fig7(out):
-    plt = _plt()
+    plt = pyplot()
     tr = _sim(0.4, 1e-3, 22.0, t_transient=20.0, alpha0=0.2)
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
     _phase(axs[0], tr.v, tr.F, tr.branch, 0.4, "Fig. 7: V=0.4, I=1e-3 in the v–F plane (start α0 = 0.2)")

@@ -11,6 +11,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from peelapprox.io import fmt_number
+
 from ._compare import compare
 from ._runs import RUNS, exact_run
 from ._scenes import SCENES, Row
@@ -157,13 +159,8 @@ def run_compare(scenes: Sequence[str] | None = None, *, statistics_runs: Sequenc
 # rendering
 
 def _fmt(x) -> str:
-    if x is None:
-        return "–"
-    if isinstance(x, float):
-        if x == 0 or 1e-3 <= abs(x) < 1e4:
-            return f"{x:.4g}"
-        return f"{x:.3e}"
-    return str(x)
+    """A number of the error tables: 4 significant digits, scientific notation outside [1e-3, 1e4)."""
+    return fmt_number(x, 4, nan="nan", plain=(1e-3, 1e4))
 
 
 def _pct(x, signed: bool = True) -> str:

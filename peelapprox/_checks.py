@@ -13,6 +13,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from .io import fmt_number
+
 __all__ = [
     "ArgumentTypeError",
     "MAX_COUNT",
@@ -48,24 +50,17 @@ class ArgumentTypeError(TypeError, ValueError):
     """
 
 
-def _fmt(x: float) -> str:
-    """A bound as people write it: ``0``, ``1e-14``, ``0.01``, ``1e+300`` -> ``1e300``, ``inf``."""
-    if isinstance(x, numbers.Integral):
-        return str(x) if abs(x) < 10**6 else f"{float(x):.0e}".replace("e+0", "e").replace("e+", "e")
-    if math.isinf(x):
-        return "inf" if x > 0 else "-inf"
-    s = f"{x:.6g}"
-    if "e" in s:
-        m, e = s.split("e")
-        s = f"{m}e{int(e)}"
-    return s
+def _bound(x: float) -> str:
+    """A bound as people write it (:func:`peelapprox.io.fmt_number`): ``0``, ``1e-14``, ``0.01``, ``1e+300`` ->
+    ``1e300``, ``inf``."""
+    return fmt_number(x, 6, nan="nan", int_digits=6, short_exponent=True)
 
 
 def interval(lo: float = -math.inf, hi: float = math.inf, *, lo_open: bool = False, hi_open: bool = False) -> str:
     """The text of a range, ``"[lo, hi]"`` with ``(``/``)`` for open or infinite ends (``"(0, inf)"``)."""
     left = "(" if lo_open or math.isinf(lo) else "["
     right = ")" if hi_open or math.isinf(hi) else "]"
-    return f"{left}{_fmt(lo)}, {_fmt(hi)}{right}"
+    return f"{left}{_bound(lo)}, {_bound(hi)}{right}"
 
 
 def _got(x: Any) -> str:

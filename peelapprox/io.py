@@ -1,28 +1,119 @@
-"""One writer for every table the package saves: rows (dicts) as CSV or JSON, chosen by the extension."""
+"""Input and output helpers shared by the three packages: one writer for every table (rows as CSV or JSON,
+chosen by the extension), one JSON normaliser (:func:`jsonable`) and one number formatter for tables and
+messages (:func:`fmt_number`)."""
 
 from __future__ import annotations
 
 import csv
 import json
 import math
+import numbers
 from collections.abc import Iterable, Mapping, Sequence
 from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["TABLE_EXTENSIONS", "jsonable", "write_csv", "write_rows"]
+__all__ = ["TABLE_EXTENSIONS", "fmt_number", "jsonable", "write_csv", "write_rows"]
 
 #: The file name endings :func:`write_rows` accepts.
 TABLE_EXTENSIONS = (".csv", ".json")
 
 
-def jsonable(v: Any) -> Any:
-    """A JSON-safe scalar: numpy scalars to Python, non-finite floats to None (strict JSON has no NaN)."""
-    if isinstance(v, np.generic):
-        v = v.item()
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
+def jsonable(x: Any, *, keep_nonfinite: bool = False, scalar: bool = False) -> Any:
+    """``x`` as plain JSON data: what it reads back as from JSON.
+
+    numpy scalars and 0-d arrays become Python scalars, integers ``int`` and other reals ``float`` (``bool``
+    stays ``bool``); tuples, lists and numpy arrays become lists and mappings dicts (non-str keys as their
+    JSON text, as :func:`json.dumps` writes them), recursively.
+
+    Parameters
+    ----------
+    x : Any
+        The value.
+    keep_nonfinite : bool
+        Keep NaN and ±inf (Python's JSON writes them as ``NaN``/``Infinity``); by default they become None
+        (strict JSON has no NaN: the tables of :func:`write_rows`).
+    scalar : bool
+        Accept only a JSON scalar (None, bool, str, int, float or a numpy scalar); a container is a TypeError.
+
+    Raises
+    ------
+    TypeError
+        For a value JSON cannot hold (or a container, with ``scalar=True``).
+    """
+    if x is None or isinstance(x, bool):
+        return x
+    if isinstance(x, str):
+        return str(x)
+    if isinstance(x, np.generic) or (isinstance(x, np.ndarray) and x.ndim == 0):
+        x = x.item()
+        if x is None or isinstance(x, (bool, str)):
+            return x
+    if isinstance(x, numbers.Integral):
+        return int(x)
+    if isinstance(x, numbers.Real):
+        v = float(x)
+        return v if keep_nonfinite or math.isfinite(v) else None
+    if not scalar:
+        if isinstance(x, Mapping):
+            return {_json_key(k): jsonable(v, keep_nonfinite=keep_nonfinite) for k, v in x.items()}
+        if isinstance(x, (list, tuple, np.ndarray)):
+            return [jsonable(v, keep_nonfinite=keep_nonfinite) for v in x]
+        raise TypeError(f"value {x!r} of type {type(x).__name__} is not JSON-serialisable")
+    raise TypeError(f"value {x!r} of type {type(x).__name__} is not a JSON scalar (float, int, str, bool, None)")
+
+
+def _json_key(k: Any) -> str:
+    """A mapping key as JSON writes it (str keys as they are; numbers, bools and None as their JSON text)."""
+    if isinstance(k, str):
+        return k
+    k = jsonable(k, keep_nonfinite=True, scalar=True)
+    return json.dumps(k)
+
+
+def fmt_number(x: Any, digits: int = 3, *, missing: str = "–", nan: str | None = None,
+               plain: tuple[float, float] | None = None, int_digits: int | None = None,
+               short_exponent: bool = False) -> str:
+    """A number for a table or a message, with ``digits`` significant digits.
+
+    Parameters
+    ----------
+    x : Any
+        The value: None prints as ``missing``, NaN as ``nan``, ±inf as ``inf``/``-inf``, an integer exactly,
+        a float in format ``g`` with ``digits`` significant digits; anything else (bool, str, ...) as ``str(x)``.
+    digits : int
+        Significant digits of a float.
+    missing : str
+        The text of None (a dash; ``""`` for an empty table cell).
+    nan : str or None
+        The text of NaN (default: ``missing``; ``"nan"`` where a report prints it).
+    plain : (float, float) or None
+        Print a nonzero float with ``lo <= |x| < hi`` in format ``g``, others in scientific notation (format
+        ``e``, also ``digits`` significant digits); None: format ``g`` throughout.
+    int_digits : int or None
+        Print an integer with more digits than this like a float; None: every integer exactly.
+    short_exponent : bool
+        Write exponents as people do: ``1e-05`` -> ``1e-5``, ``1e+300`` -> ``1e300``.
+    """
+    if x is None:
+        return missing
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
+        return str(x)
+    if isinstance(x, numbers.Integral) and (int_digits is None or abs(x) < 10**int_digits):
+        return str(x)
+    v = float(x)
+    if math.isnan(v):
+        return missing if nan is None else nan
+    if math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    if plain is not None and v != 0 and not plain[0] <= abs(v) < plain[1]:
+        s = f"{v:.{digits - 1}e}"
+    else:
+        s = f"{v:.{digits}g}"
+    if short_exponent and "e" in s:
+        m, e = s.split("e")
+        s = f"{m}e{int(e)}"
+    return s
 
 
 def write_rows(path, rows: Iterable[Mapping[str, Any]], *, fields: Sequence[str] | None = None) -> str:

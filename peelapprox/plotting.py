@@ -8,10 +8,14 @@ import numpy as np
 
 from ._peelforce import branch_structure, peel_force
 
-__all__ = ["plot_trajectory", "plot_segment"]
+__all__ = ["plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"]
 
 
-def _pyplot():
+def pyplot():
+    """``matplotlib.pyplot``, imported on first use, on the file backend Agg (an inline notebook backend is kept).
+
+    The one place that sets matplotlib up: every figure of the three packages is drawn with it.
+    """
     import matplotlib
 
     if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
@@ -39,7 +43,7 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     -------
     matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    plt = pyplot()
     p = traj.params
     fig, ax = plt.subplots(2, 2, figsize=(11, 7.5), constrained_layout=True)
     t = traj.t
@@ -90,7 +94,7 @@ def plot_segment(seg: Any, path: str | None = None, *, exact: Any = None, title:
     -------
     matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(3, 1, figsize=(7, 8), sharex=True, constrained_layout=True)
     label = f"{seg.alpha_model} + {seg.v_equation}"
     for a, y, name in ((ax[0], "v", "v [m/s]"), (ax[1], "alpha", r"$\alpha$ [rad]"), (ax[2], "F", "F [N]")):
@@ -134,7 +138,7 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
     -------
     matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    plt = pyplot()
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
@@ -186,4 +190,3 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
     return fig
 
 
-__all__.append("plot_phase_diagram")

@@ -40,8 +40,10 @@ API = {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
         "STAT_RUNS", "Scene", "Segment", "StatRow", "TransientCheck", "TransientNotPassed", "check_past_transient",
         "compare", "exact_run", "local_period", "markdown", "run_compare", "run_reduction", "scene_rows",
-        "segments", "statistics",
+        "segments", "statistics", "Figure", "FIGURES", "make_figures", "figures_markdown",
     },
+    "peelapprox.io": {"TABLE_EXTENSIONS", "fmt_number", "jsonable", "write_csv", "write_rows"},
+    "peelapprox.plotting": {"plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
     },
@@ -125,3 +127,15 @@ def test_sweep_names_are_the_same_objects_both_ways():
     assert {"regime", "jumps", "period", "lyapunov"} <= set(peelapprox.MEASURES)
     with pytest.raises(AttributeError, match="no attribute 'nosuch'"):
         peelapprox.nosuch  # noqa: B018 - the lazy __getattr__ still refuses unknown names
+
+
+def test_matplotlib_is_imported_by_plotting_only():
+    """Issue 14 (one matplotlib set-up, :func:`peelapprox.plotting.pyplot`): importing the packages, the CLI and
+    the plotting module itself loads no matplotlib; drawing does.  Fresh interpreter (categorical: module set)."""
+    code = ("import sys, peelapprox, peelapprox.cli, peelapprox.plotting, exact, comparisons, comparisons.benchmark\n"
+            "print('matplotlib' in sys.modules)\n"
+            "peelapprox.plotting.pyplot()\n"
+            "print('matplotlib.pyplot' in sys.modules)\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False", "True"], proc.stdout

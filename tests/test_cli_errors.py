@@ -17,7 +17,7 @@ import time
 
 import pytest
 
-from peelapprox import _cli_checks
+from peelapprox.cli import _checks as _cli_checks
 from peelapprox.cli import main
 
 SIM = ["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--quiet"]

@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 
+from peelapprox.plotting import pyplot
+
 from .report import BenchmarkReport
 from .scenes import BENCH_SCENES
 
@@ -15,10 +17,7 @@ __all__ = ["plot_work_precision", "plot_eps_study"]
 
 def plot_work_precision(rep: BenchmarkReport, path) -> None:
     """Time vs error, one panel per scene, one line per method family (log-log)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     scenes = [s.name for s in BENCH_SCENES]
     fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4.2), squeeze=False)
@@ -42,10 +41,7 @@ def plot_work_precision(rep: BenchmarkReport, path) -> None:
 
 def plot_eps_study(rep: BenchmarkReport, path) -> None:
     """Fold-passage delay vs ε (log-log) with the fitted power laws."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     for key, mk in (("delay_ab", "o"), ("delay_cd", "s")):

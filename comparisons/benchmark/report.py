@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
+from peelapprox.io import fmt_number as _g3  # 3 significant digits, None/NaN as a dash
+
 from .eps import EpsRow
 from .scenes import BENCH_SCENES
 from .work_precision import WPRow, ratio_summary
@@ -29,10 +31,6 @@ class BenchmarkReport:
     wall_time: float
     machine: str = field(default="")
     compile: tuple = (math.nan, math.nan)
-
-
-def _g3(x):
-    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else ("inf" if x == math.inf else f"{x:.3g}")
 
 
 def markdown(rep: BenchmarkReport) -> str:

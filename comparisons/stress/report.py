@@ -9,14 +9,13 @@
 
 from __future__ import annotations
 
-import math
 import os
 from collections import Counter
 from collections.abc import Iterable, Sequence
-from typing import Any
 
 import numpy as np
 
+from peelapprox.io import fmt_number as _g  # 3 significant digits, None/NaN as a dash
 from peelapprox.io import write_rows
 
 from .points import LONG_N_EVAL, LOOSE_TOLS, RANDOM_BOX, RANDOM_SEED
@@ -81,16 +80,6 @@ EXPLANATIONS: dict[str, str] = {
     "timeout": "BUG: no answer within the wall-clock timeout (a hang).",
     "crash": "BUG: the worker process died.",
 }
-
-
-def _g(x: Any) -> str:
-    if x is None:
-        return "–"
-    if isinstance(x, float):
-        if math.isnan(x):
-            return "–"
-        return f"{x:.3g}"
-    return str(x)
 
 
 def _example(r: dict) -> str:

@@ -48,6 +48,8 @@ from typing import Any
 
 import numpy as np
 
+from peelapprox.io import jsonable
+
 from .._worker import message
 from .points import StressPoint
 
@@ -228,7 +230,7 @@ def _finish(point: StressPoint, rec: dict) -> dict:
     rec["expect_met"] = (rec["outcome"] == point.expect) if point.expect else is_allowed(rec["outcome"])
     for key, val in list(rec.items()):
         if isinstance(val, (np.floating, np.integer, np.bool_)):
-            rec[key] = val.item()
+            rec[key] = jsonable(val, keep_nonfinite=True, scalar=True)
     return rec
 
 

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from peelapprox import PARAM_RANGES
+from peelapprox.io import jsonable
 from peelapprox.validate import ArgumentTypeError
 from peelapprox.validate import path as _path
 
@@ -27,7 +28,6 @@ from .store import (
     append_records,
     check_axis,
     is_read_only,
-    json_norm,
     rewrite_records,
     truncate_records,
     versions,
@@ -144,7 +144,7 @@ def sweep(
     if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
         raise ValueError(f"options must be a mapping with str keys, got {options!r}")
     try:
-        options = json_norm(dict(options))
+        options = jsonable(dict(options), keep_nonfinite=True)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
             from None

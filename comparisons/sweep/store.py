@@ -18,11 +18,12 @@ import warnings
 from collections.abc import Iterable, Sequence
 from typing import IO, Any
 
+from peelapprox.io import fmt_number, jsonable
 from peelapprox.validate import reals
 
 __all__ = [
     "MANIFEST", "RESULTS", "LOCK", "FORMAT", "RESERVED", "TEMPORARY", "GRID_RTOL",
-    "json_norm", "versions", "is_read_only", "check_axis", "compare_manifest",
+    "versions", "is_read_only", "check_axis", "compare_manifest",
     "read_manifest", "write_manifest", "read_records", "append_records", "write_record", "truncate_records",
     "rewrite_records",
     "lock", "failed", "Plan",
@@ -42,11 +43,6 @@ GRID_RTOL = 1e-12
 
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _EXTRA = _NOFOLLOW | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NONBLOCK", 0)  # NONBLOCK: never hang on a FIFO
-
-
-def json_norm(x: Any) -> Any:
-    """``x`` as it reads back from JSON (tuples become lists, numpy scalars fail: TypeError)."""
-    return json.loads(json.dumps(x))
 
 
 def versions() -> dict:
@@ -162,7 +158,8 @@ def _close(a: Sequence[float], b: Sequence[float]) -> bool:
 
 
 def _describe(vals: Sequence[float]) -> str:
-    return f"{len(vals)} values [{vals[0]:.6g} .. {vals[-1]:.6g}]" if len(vals) > 3 else str(list(vals))
+    return f"{len(vals)} values [{fmt_number(vals[0], 6)} .. {fmt_number(vals[-1], 6)}]" if len(vals) > 3 \
+        else str(list(vals))
 
 
 def compare_manifest(m: dict, I_vals, V_vals, measures, options, out: str) -> None:
@@ -173,7 +170,7 @@ def compare_manifest(m: dict, I_vals, V_vals, measures, options, out: str) -> No
             diffs.append(f"{name}: existing {_describe(old)}, requested {_describe(new)}")
     if list(m["measures"]) != list(measures):
         diffs.append(f"measures: existing {list(m['measures'])}, requested {list(measures)}")
-    old_o, new_o = m["options"], json_norm(options)
+    old_o, new_o = m["options"], jsonable(options, keep_nonfinite=True)
     if old_o != new_o:
         keys = sorted(set(old_o) | set(new_o))
         parts = [f"{k!r}: existing {old_o.get(k, '<unset>')!r}, requested {new_o.get(k, '<unset>')!r}"

@@ -8,14 +8,12 @@ measure's failure (the point's status says it).  Workers get each measure by its
 from __future__ import annotations
 
 import importlib
-import numbers
 from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType, ModuleType
 from typing import Any, cast
 
-import numpy as np
-
 from peelapprox import PeelParams
+from peelapprox.io import jsonable
 
 from .._worker import error_text
 from .measures import MEASURES, Measure, _ref, record_key
@@ -61,19 +59,6 @@ def _resolve(name: str, ref: None | str | bytes) -> Measure:
                       "define it at module level in a module the workers can import")
 
 
-def _scalar(v: Any) -> Any:
-    if v is None or isinstance(v, (bool, str)):
-        return v
-    if isinstance(v, np.generic) or (isinstance(v, np.ndarray) and v.ndim == 0):
-        v = v.item()
-        return v if isinstance(v, (bool, str)) else _scalar(v)
-    if isinstance(v, numbers.Integral):
-        return int(v)
-    if isinstance(v, numbers.Real):
-        return float(v)
-    raise TypeError(f"value {v!r} of type {type(v).__name__} is not a JSON scalar (float, int, str, bool, None)")
-
-
 def _prefixed(name: str, out: Any) -> dict:
     if not isinstance(out, Mapping):
         raise TypeError(f"measure {name!r} must return a dict, got {type(out).__name__}")
@@ -83,7 +68,7 @@ def _prefixed(name: str, out: Any) -> dict:
             raise TypeError(f"measure {name!r} returned a non-string key {key!r}")
         full = record_key(name, key)
         try:
-            rec[full] = _scalar(val)
+            rec[full] = jsonable(val, keep_nonfinite=True, scalar=True)
         except TypeError as exc:
             raise TypeError(f"measure {name!r}, key {key!r}: {exc}") from None
     return rec

@@ -1,9 +1,10 @@
-"""Checks the command line (:mod:`peelapprox.cli`) runs before any computation.
+"""Checks the command line (:mod:`peelapprox.cli`) runs before any computation, and its exit statuses.
 
 Argument types for :mod:`argparse` that reject out-of-range numbers with the
-argument's name (exit status 2, no traceback), and :func:`check_output_path`,
+argument's name (exit status 2, no traceback), :func:`check_output_path`,
 which decides the exact file name an output option writes and fails *before*
-the run, not after it, when that name cannot be written.  The ranges come from
+the run, not after it, when that name cannot be written, and
+:func:`exit_status`, which maps an exception to the CLI's exit status.  The ranges come from
 :mod:`peelapprox.validate`, so the CLI and the Python API say the same thing.
 """
 
@@ -11,9 +12,10 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from collections.abc import Callable, Sequence
 
-from . import validate as _validate
+from .. import validate as _validate
 
 __all__ = [
     "DASK_CONNECT_TIMEOUT_S",
@@ -21,6 +23,7 @@ __all__ = [
     "check_output_path",
     "check_sweep_plot_key",
     "connect_dask_scheduler",
+    "exit_status",
     "finite_float_list",
     "nonnegative_float",
     "one_line",
@@ -92,7 +95,7 @@ def _file_name(path: str, kind: str, option: str) -> str:
     if kind == "npz":
         return path if path.endswith(".npz") else path + ".npz"
     if kind == "table":
-        from .io import TABLE_EXTENSIONS
+        from ..io import TABLE_EXTENSIONS
 
         if not path.endswith(TABLE_EXTENSIONS):
             raise ValueError(f"{option} must end in {' or '.join(TABLE_EXTENSIONS)}, got {path!r}")
@@ -224,3 +227,29 @@ def connect_dask_scheduler(address: str):
 def one_line(exc: BaseException) -> str:
     """The exception's message on one line (whitespace runs, newlines included, become one space)."""
     return " ".join(str(exc).split()) or type(exc).__name__
+
+
+# --------------------------------------------------------------------------------------------- exit statuses
+
+def _loaded(module: str, name: str) -> tuple[type, ...]:
+    """``module.name`` if the subcommand imported that module, else nothing (the CLI loads no package it does
+    not use: ``peelapprox folds`` never imports the harness)."""
+    mod = sys.modules.get(module)
+    found = getattr(mod, name, None) if mod is not None else None
+    return (found,) if isinstance(found, type) else ()
+
+
+def exit_status(exc: BaseException) -> int | None:
+    """2 for a bad argument, output path or missing optional package; 3 when the model or solver stopped; 1
+    when writing failed after the checks (disk full, a path changed meanwhile); None for anything else."""
+    from .._diffsl import PeerUnavailableError
+    from ..errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+
+    if isinstance(exc, (ValueError, PeerUnavailableError)):
+        return 2
+    if isinstance(exc, (ModelBreakdown, SolverBudgetExceeded, SolverFailure,
+                        *_loaded("comparisons", "TransientNotPassed"))):
+        return 3
+    if isinstance(exc, OSError):
+        return 1
+    return None

@@ -1,0 +1,69 @@
+"""Command line: ``peelapprox simulate | folds | estimate | segment ...``.
+
+The CLI is the only place that ties the three packages (peelapprox, exact,
+comparisons) together; each subcommand lives in its own module here, and its
+handler imports what it needs (the solvers, the harness) lazily, through their
+public names, when it runs.
+
+Output paths are checked before any computation and reported exactly as
+written (:mod:`peelapprox.cli._checks`).  A user error is one line on stderr,
+``peelapprox <command>: error: <message>``, never a traceback; exit status 2
+for a usage error (a bad argument or output path), 3 when the model or solver
+stops (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed),
+1 when writing fails (OSError) or, for ``sweep``, when a point failed.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+
+from . import benchmark, compare, dynamics, estimate, figures, simulate, sweep
+from ._checks import exit_status, one_line
+
+__all__ = ["build_parser", "main"]
+
+# The handlers, looked up here when the parser is built (so that they can be replaced, e.g. in a test).
+_simulate = simulate.run
+_folds = estimate.run_folds
+_estimate = estimate.run_estimate
+_segment = estimate.run_segment
+_compare = compare.run
+_benchmark = benchmark.run
+_sweep = sweep.run
+_figures = figures.run
+_dynamics = dynamics.run
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of ``peelapprox``: one subparser per subcommand, its handler in ``func``."""
+    ap = argparse.ArgumentParser(prog="peelapprox", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    simulate.add_parser(sub).set_defaults(func=_simulate)
+    estimate.add_folds_parser(sub).set_defaults(func=_folds)
+    estimate.add_estimate_parser(sub).set_defaults(func=_estimate)
+    estimate.add_segment_parser(sub).set_defaults(func=_segment)
+    compare.add_parser(sub).set_defaults(func=_compare)
+    benchmark.add_parser(sub).set_defaults(func=_benchmark)
+    sweep.add_parser(sub).set_defaults(func=_sweep)
+    figures.add_parser(sub).set_defaults(func=_figures)
+    dynamics.add_parser(sub).set_defaults(func=_dynamics)
+    return ap
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
+
+    User errors end in ``SystemExit`` with one line on stderr (module docstring
+    for the statuses); any other exception is a bug and propagates with its
+    traceback.
+    """
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    try:
+        return args.func(args)
+    except Exception as exc:
+        status = exit_status(exc)
+        if status is None:  # not a user error or a documented stop: a bug, with its traceback
+            raise
+        ap.exit(status, f"peelapprox {args.command}: error: {one_line(exc)}\n")

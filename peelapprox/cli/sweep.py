@@ -1,0 +1,135 @@
+"""``peelapprox sweep``: measures over an (I, V) grid (:func:`comparisons.sweep.sweep`), locally or on dask."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    sw = sub.add_parser("sweep", help="measures over an (I, V) grid on a process pool or a dask cluster; "
+                                      "incremental output, resumes automatically")
+    sw.add_argument("--I", required=True, metavar="SPEC",
+                    help="roller inertias [kg m^2]: start:stop:num[:log] or a comma list, e.g. 1e-5:1e-2:8:log")
+    sw.add_argument("--V", required=True, metavar="SPEC", help="pull speeds [m/s], same syntax, e.g. 0.4:4:10")
+    sw.add_argument("--measure", default="regime", metavar="NAMES",
+                    help="comma-separated measures (regime; jumps; others registered via register_measure)")
+    sw.add_argument("--out", required=True, metavar="DIR",
+                    help="output directory: sweep.json, results.jsonl (one line per point), results.csv; "
+                         "an existing DIR with the same grid, measures and options is resumed")
+    where = sw.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="local worker processes (default: all CPUs; 0: in this process)")
+    where.add_argument("--dask-local", type=int, default=None, metavar="N",
+                       help="start a dask LocalCluster with N single-threaded worker processes")
+    where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
+                       help="connect to a running dask scheduler, e.g. tcp://host:8786")
+    sw.add_argument("--t-end", type=float, default=None, help="final time [s] (jumps, period: t_transient + 20)")
+    sw.add_argument("--t-transient", type=float, default=None, help="transient skipped [s] (30)")
+    sw.add_argument("--rtol", type=float, default=None, help="solver tolerance (jumps, period: 1e-10)")
+    sw.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (0)")
+    sw.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (1000)")
+    sw.add_argument("--R", type=float, default=None, help="roller radius [m] (0.1)")
+    sw.add_argument("--retry-failed", action="store_true",
+                    help="compute again the points of DIR whose status is an error (else they count as done)")
+    sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label")
+    sw.add_argument("--format", choices=("md", "csv", "json"), default="md", help="table printed at the end (md)")
+    sw.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
+    return sw
+
+
+def _options(args: argparse.Namespace) -> dict:
+    return {key: val for key, val in (("t_end", args.t_end), ("t_transient", args.t_transient),
+                                      ("rtol", args.rtol), ("alpha0", args.alpha0), ("k", args.k),
+                                      ("R", args.R)) if val is not None}
+
+
+def run(args: argparse.Namespace) -> int:
+    from comparisons.sweep import load_sweep, parse_grid, sweep
+    from comparisons.sweep.store import MANIFEST, RESULTS
+
+    I_values = parse_grid(args.I, name="--I")
+    V_values = parse_grid(args.V, name="--V")
+    options = _options(args)
+    if args.workers is not None and args.workers < 0:
+        raise ValueError(f"--workers must be >= 0 (0: in this process), got {args.workers}")
+    if args.dask_local is not None and args.dask_local < 1:
+        raise ValueError(f"--dask-local must be >= 1 workers, got {args.dask_local}")
+    check_output_path(args.out, "dir", "--out", read_only_ok=True)  # a complete sweep is only read
+    if args.plot:
+        check_sweep_plot_key(args.plot, [m.strip() for m in args.measure.split(",") if m.strip()])
+    if os.path.exists(os.path.join(args.out, MANIFEST)):
+        prev = load_sweep(args.out)
+        print(f"{args.out} holds a sweep with {len(prev.records)}/{prev.I_values.size * prev.V_values.size} points "
+              "done: resuming it if grid, measures and options match", file=sys.stderr)
+    client = cluster = None
+    executor, max_workers = None, None
+    if args.dask_local or args.dask_scheduler:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            print("error: --dask-local/--dask-scheduler need dask.distributed: pip install 'peelapprox[distributed]'",
+                  file=sys.stderr)
+            return 2
+        if args.dask_local:
+            cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
+            client = Client(cluster)
+        else:
+            client = connect_dask_scheduler(args.dask_scheduler)
+        print(f"dask: {client}", file=sys.stderr)
+        executor = client.get_executor()
+    else:
+        max_workers = args.workers  # 0: in this process
+    t0 = time.perf_counter()
+    try:
+        result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor, max_workers=max_workers,
+                       options=options, progress=not args.quiet, retry_failed=args.retry_failed)
+    except RuntimeError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    print(f"sweep: {len(result.records)} points in {args.out}/{RESULTS} ({time.perf_counter() - t0:.1f} s)",
+          file=sys.stderr)
+    csv_path = os.path.join(args.out, "results.csv")
+    try:
+        result.to_csv(csv_path)
+        print(f"wrote {csv_path}", file=sys.stderr)
+    except OSError as exc:  # e.g. a complete sweep in a read-only directory: still report it
+        print(f"note: cannot write {csv_path} ({exc}); the table is printed only", file=sys.stderr)
+    _print_table(result.rows(), result.keys(), args.format)
+    if args.plot:
+        from ..plotting import plot_phase_diagram
+
+        if args.plot not in result.keys():
+            raise ValueError(f"--plot {args.plot!r}: no record has this key (the sweep is saved in {args.out}); "
+                             f"keys: {', '.join(result.keys())}")
+        png = os.path.join(args.out, f"{args.plot}.png")
+        plot_phase_diagram(result, args.plot, png)
+        print(f"wrote {png}", file=sys.stderr)
+    return 1 if result.failed() else 0
+
+
+def _print_table(rows: list[dict], cols: list[str], fmt: str) -> None:
+    """The sweep's records as JSON, CSV or a markdown table (floats to 6 significant digits)."""
+    from ..io import fmt_number, write_csv
+
+    if fmt == "json":
+        print(json.dumps(rows, indent=2))
+    elif fmt == "csv":
+        write_csv(sys.stdout, rows, fields=cols)
+    else:
+        print("| " + " | ".join(cols) + " |")
+        print("|" + "|".join("---" for _ in cols) + "|")
+        for r in rows:
+            print("| " + " | ".join(fmt_number(r.get(c), 6, missing="", nan="nan") for c in cols) + " |")
