@@ -1,0 +1,55 @@
+"""The import contract's bookkeeping (the contract itself is checked by ``lint-imports`` in ``.ci/run``).
+
+import-linter's ``protected`` contracts in ``pyproject.toml`` list each package's private modules by name
+(its wildcards cannot match a name prefix such as ``_*``), so a new private module would escape them
+silently; these tests keep the lists equal to the modules on disk.
+"""
+
+from __future__ import annotations
+
+import pkgutil
+import sys
+from pathlib import Path
+
+import pytest
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    tomllib = pytest.importorskip("tomli")
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("peelapprox", "exact", "comparisons")
+
+
+def _contracts() -> dict[str, dict]:
+    with open(ROOT / "pyproject.toml", "rb") as fh:
+        cfg = tomllib.load(fh)["tool"]["importlinter"]
+    return {c["id"]: c for c in cfg["contracts"]}
+
+
+def _private_modules(package: str) -> set[str]:
+    """Every module of ``package`` (at any depth) whose own name starts with one underscore."""
+    found = set()
+    for info in pkgutil.walk_packages([str(ROOT / package)], package + "."):
+        last = info.name.rsplit(".", 1)[1]
+        if last.startswith("_") and not last.startswith("__"):
+            found.add(info.name)
+    return found
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_private_module_is_protected(package):
+    """Hypothesis: the ``private-<package>`` contract protects exactly the package's private modules (set
+    equality: a missing one would be importable from a sibling room unnoticed, an extra one is stale)."""
+    c = _contracts()[f"private-{package}"]
+    assert c["type"] == "protected" and c["allowed_importers"] == [package]
+    assert set(c["protected_modules"]) == _private_modules(package)
+
+
+def test_the_rooms_are_layered_in_the_documented_order():
+    """Hypothesis: the layers contract orders the rooms comparisons > exact > peelapprox, as CONTRIBUTING.md
+    and the design card state (exact list equality), and exempts only the CLI."""
+    c = _contracts()["rooms"]
+    assert c["type"] == "layers" and c["layers"] == ["comparisons", "exact", "peelapprox"]
+    assert all(rule.startswith("peelapprox.cli") for rule in c.get("ignore_imports", []))
