@@ -1,7 +1,7 @@
 """The model-independent argument checks behind :mod:`peelapprox.validate` (its docstring states the
 rules); :mod:`peelapprox._params` builds on these, and :mod:`peelapprox.validate` adds the checks that
-know the model (parameters, state ranges, durations), so neither imports the other in a circle."""
-
+know the model (parameters, state ranges, durations), so neither imports the other in a circle.
+The public list of names is ``peelapprox.validate.__all__``; this private module keeps none of its own."""
 
 from __future__ import annotations
 
@@ -14,26 +14,6 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .io import fmt_number
-
-__all__ = [
-    "ArgumentTypeError",
-    "MAX_COUNT",
-    "real",
-    "in_range",
-    "finite",
-    "positive",
-    "nonnegative",
-    "optional",
-    "optional_finite",
-    "integer",
-    "choice",
-    "flag",
-    "function",
-    "reals",
-    "times",
-    "interval",
-    "path",
-]
 
 T = TypeVar("T")
 
