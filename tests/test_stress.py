@@ -259,7 +259,7 @@ def test_tolerance_sweep_converges():
     rtol-1e-4 error but not the converged orbit: Δn = 0, 0 at 1e-5, 1e-14
     before and after).  Of 41 log-spaced rtols in [1e-5, 1e-4] only 1e-4 gives
     Δn ≠ 0, of 41 in [1e-6, 1e-5] none; the other three points have Δn = 0 at
-    all 82 (``len(exact.simulate(p, 1.0, alpha0=a0, rtol=10**e,
+    all 41 in [1e-5, 1e-4] (``len(exact.simulate(p, 1.0, alpha0=a0, rtol=10**e,
     save="jumps").jumps)`` for ``e in np.linspace(-4, -6, 81)``).  The margins
     themselves: :func:`test_cusp_count_hinges_on_a_graze_of_the_cd_fold`.
     """
@@ -294,13 +294,13 @@ def _graze_margin(rtol: float) -> float:
 def test_cusp_count_hinges_on_a_graze_of_the_cd_fold():
     """Hypothesis (why ``COUNT_RTOL`` is 1e-5 near the cusp): at V = 5, I = 1e-3, k = 1e4, α0 = 0.5 the
     CD stay after the jump at t = 0.22733 s turns back 5.32e-3 m/s above v_min (a miss, then a 0.024 s
-    stay), at every rtol ≤ 1e-6 to within 1 % (measured 5.26e-3-5.32e-3 over 41 rtols in [1e-6, 1e-5] and
-    1e-8, 1e-12, 1e-14), by 4.79e-3 at rtol 1e-5 (10 % of the margin used), and at rtol 1e-4 hits the fold
+    stay), measured 5.32e-3 at rtol 1e-8, 1e-12, 1e-14 and 5.26e-3-5.31e-3 at rtol 1e-6 … 3.2e-6;
+    4.79e-3 at rtol 1e-5 (10 % of the margin used); at rtol 1e-4 the orbit hits the fold instead
     (one more AB-CD cycle: Δn = 2 in the tolerance sweep).
 
-    Tolerance: 2 % about 5.32e-3 at rtol 1e-12 (the turning point is read from stored steps: 515 steps in
-    the stay at rtol 1e-12, the sampled minimum moves by 9e-4 relative between rtol 1e-12 and 1e-14);
-    [0.8, 1] × the reference at rtol 1e-5 (measured 0.90).
+    Tolerance: 2 % about 5.32e-3 at rtol 1e-12 (the turning point is read from stored steps, 515 in the
+    stay at rtol 1e-12; the sampled minima of all 24 approaches move by ≤ 9e-4 relative between rtol 1e-12
+    and 1e-14); [0.8, 1] × the reference at rtol 1e-5 (measured 0.90).
     """
     ref = _graze_margin(1e-12)
     assert abs(ref - 5.32e-3) <= 0.02 * 5.32e-3, ref
