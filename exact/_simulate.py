@@ -20,6 +20,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
+from peelapprox.kernels import model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -36,7 +37,7 @@ from ._options import (
     method_option,
     output_options,
 )
-from ._options import _atol_vector as _atol_vector  # read by comparisons._peers (exact.simulate's atol rule)
+from ._options import _atol_vector as _atol_vector  # also read by exact._variational (exact.simulate's atol rule)
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 __all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE", "STEP_BUDGET", "default_max_steps"]
@@ -282,8 +283,6 @@ V_CEILING = 1e3
 def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``."""
-    from peelapprox.kernels import model_block  # local: this helper's edits stay inside _param_vector (issue 14)
-
     bs = branch_structure(params.V)
     p = model_block(params, H.N_P)  # the model block (peelapprox.kernels), then the hybrid driver's fields
     p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
