@@ -61,6 +61,27 @@ def initial_state(
     ``f(v, V) = F (1 - cos θ)``: on AB if the level lies in AB's range
     ``(f(0+), f_max]``, otherwise on CD.
 
+    Parameters
+    ----------
+    params : PeelParams
+        The model's parameters (V, I, k, R, l, geometry).
+    alpha0 : float
+        Peel angle α [rad], in ``STATE_RANGES["alpha"]``.
+    omega0 : float, optional
+        Roller angular velocity ω [rad/s]; None: ``V/R`` (the roller turning with the pull).
+    F0 : float, optional
+        Pull force F [N]; None: ``1.01 f(V, V)``, just above steady sliding.
+    branch0 : {"AB", "CD"}, optional
+        The branch v is taken on; None: AB when the level has a root there, else CD.
+    t0 : float
+        Initial time [s], in ``[0, TIME_MAX]``.
+
+    Returns
+    -------
+    State
+        ``t, alpha, omega, F, v, branch`` with v solving CONSTR on the branch (consistent: the DAE starts on
+        its constraint manifold).
+
     Raises
     ------
     ValueError
@@ -429,8 +450,26 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
 def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] = None) -> np.ndarray:
     """The absolute tolerances ``simulate(method=method, rtol=rtol, atol=atol)`` uses, one per integrated component.
 
-    ``atol=None``: ``rtol * ATOL_SCALE[method]``; else ``atol`` checked (every component in
-    ``[1e-100, 1]``) and broadcast to 4 values.  Raises ValueError naming ``atol`` otherwise.
+    Parameters
+    ----------
+    method : {"hybrid", "regularized"}
+        The solver; its integrated components are (τ, α, ω, ln v) for ``"hybrid"`` and (α, ω, F, v) for
+        ``"regularized"``.
+    rtol : float
+        The relative tolerance (not checked here; :func:`simulate` checks it against ``RTOL_RANGE``).
+    atol : None, float or sequence of 4 floats
+        None: ``rtol * ATOL_SCALE[method]``, the default rule.  Else checked (every component in
+        ``[1e-100, 1]``) and a scalar broadcast to 4 values.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        A new array.
+
+    Raises
+    ------
+    ValueError
+        Naming ``atol``, if it is out of range or neither a scalar nor 4 values.
     """
     return _atol_vector(method, rtol, atol)
 
