@@ -25,7 +25,6 @@ from peelapprox.validate import function, integer
 __all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult"]
 
 
-
 def natural_scales(params: PeelParams) -> np.ndarray:
     """The natural sizes ``(1 rad, V/R, f_max)`` of ``(α, ω, F)``: every Lyapunov estimate measures
     perturbations in ``(δα, δω, δF)`` divided by these (``f_max`` is 1 N when f has no folds)."""

@@ -20,6 +20,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
+from peelapprox.kernels import model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -36,7 +37,7 @@ from ._options import (
     method_option,
     output_options,
 )
-from ._options import _atol_vector as _atol_vector  # read by comparisons._peers (exact.simulate's atol rule)
+from ._options import _atol_vector as _atol_vector  # also read by exact._variational (exact.simulate's atol rule)
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 __all__ = ["simulate", "initial_state", "compile_kernels", "ATOL_SCALE", "STEP_BUDGET", "default_max_steps"]
@@ -59,6 +60,27 @@ def initial_state(
     ``F = 1.01 f(V, V)`` and v the lowest-velocity stable root of CONSTR,
     ``f(v, V) = F (1 - cos θ)``: on AB if the level lies in AB's range
     ``(f(0+), f_max]``, otherwise on CD.
+
+    Parameters
+    ----------
+    params : PeelParams
+        The model's parameters (V, I, k, R, l, geometry).
+    alpha0 : float
+        Peel angle α [rad], in ``STATE_RANGES["alpha"]``.
+    omega0 : float, optional
+        Roller angular velocity ω [rad/s]; None: ``V/R`` (the roller turning with the pull).
+    F0 : float, optional
+        Pull force F [N]; None: ``1.01 f(V, V)``, just above steady sliding.
+    branch0 : {"AB", "CD"}, optional
+        The branch v is taken on; None: AB when the level has a root there, else CD.
+    t0 : float
+        Initial time [s], in ``[0, TIME_MAX]``.
+
+    Returns
+    -------
+    State
+        ``t, alpha, omega, F, v, branch`` with v solving CONSTR on the branch (consistent: the DAE starts on
+        its constraint manifold).
 
     Raises
     ------
@@ -282,8 +304,6 @@ V_CEILING = 1e3
 def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``."""
-    from peelapprox.kernels import model_block  # local: this helper's edits stay inside _param_vector (issue 14)
-
     bs = branch_structure(params.V)
     p = model_block(params, H.N_P)  # the model block (peelapprox.kernels), then the hybrid driver's fields
     p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
@@ -430,8 +450,26 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
 def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] = None) -> np.ndarray:
     """The absolute tolerances ``simulate(method=method, rtol=rtol, atol=atol)`` uses, one per integrated component.
 
-    ``atol=None``: ``rtol * ATOL_SCALE[method]``; else ``atol`` checked (every component in
-    ``[1e-100, 1]``) and broadcast to 4 values.  Raises ValueError naming ``atol`` otherwise.
+    Parameters
+    ----------
+    method : {"hybrid", "regularized"}
+        The solver; its integrated components are (τ, α, ω, ln v) for ``"hybrid"`` and (α, ω, F, v) for
+        ``"regularized"``.
+    rtol : float
+        The relative tolerance (not checked here; :func:`simulate` checks it against ``RTOL_RANGE``).
+    atol : None, float or sequence of 4 floats
+        None: ``rtol * ATOL_SCALE[method]``, the default rule.  Else checked (every component in
+        ``[1e-100, 1]``) and a scalar broadcast to 4 values.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        A new array.
+
+    Raises
+    ------
+    ValueError
+        Naming ``atol``, if it is out of range or neither a scalar nor 4 values.
     """
     return _atol_vector(method, rtol, atol)
 

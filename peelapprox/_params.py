@@ -69,7 +69,7 @@ LYAPUNOV_TAU = 0.005
 #: and ``jumps`` and ``peelapprox dynamics``: 20 s of jumps after the transient, at rtol 1e-10, from α0 = 0.
 WINDOW_DEFAULTS = dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0)
 
-#: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons._benchmark) goes
+#: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons.benchmark.eps) goes
 #: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding
 #: of t); at 1e-300 the rates (F(1 + c) - f)/ε overflow.  Above 1e-2 the "fast" transits last as long as
 #: the slow dynamics (the paper uses 1e-7): no longer a regularisation of the jumps.

@@ -257,6 +257,35 @@ def _folds_and_landings(V: float) -> BranchStructure:
 
 
 def _invert(G: float, bs: BranchStructure, branch: str, b: float, A: float) -> float:
+    """Velocity v on ``branch`` with ``f(v, V) = G`` for one level, the branch structure already at hand.
+
+    The scalar core of :func:`branch_inverse` (offered to the other packages as
+    :func:`peelapprox.kernels.branch_inverse_at`), for callers that invert many levels at one pull speed:
+    no argument is checked or converted here beyond the level's range.
+
+    Parameters
+    ----------
+    G : float
+        Level of the pull side of CONSTR, ``G = F(1 - cos θ)`` [N].
+    bs : BranchStructure
+        ``branch_structure(V)`` of the pull speed V.
+    branch : {"AB", "CD"}
+        The slow branch ``(0, v_max]`` or the fast branch ``[v_min, inf)``; must be one of the two.
+    b, A : float
+        ``peel_force_coefficients(V)`` of the same V.
+
+    Returns
+    -------
+    float
+        v [m/s] to ~4 ulp (Brent's method; on AB in ``w = ln v``, so small v keep full relative precision);
+        exactly ``v_max`` at ``G = f_max`` on AB and ``v_min`` at ``G = f_min`` on CD.
+
+    Raises
+    ------
+    ValueError
+        If ``G`` is outside the branch's level range (AB: ``(f(0+), f_max]``, CD: ``[f_min, inf)``),
+        naming the range, or if ``G`` is within rounding of ``f(0+, V)`` on AB (v would underflow).
+    """
     if not bs.has_root(G, branch):
         lo, hi = bs.level_range(branch)
         raise ValueError(

@@ -10,38 +10,84 @@ periods the paper reports ("period 4 at V = 2, I = 1e-5", "period 8 at V = 1, I 
 * :func:`force_drops` — ``ΔF_k = F(AB→CD jump k) − F(next CD→AB jump)``, the slip's force drop (Fig. 6).
 * :func:`settle_time` — when a periodic orbit is reached (the transient's end).
 
-Pure analysis of a given trajectory (anything with ``jumps.t``, ``jumps.F``, ``jumps.from_branch``): no
-solver runs here.  The functions that run the exact solver (windowed runs, attractors, the Lyapunov family)
-live in :mod:`exact`.
+Pure analysis of a given trajectory (anything with ``jumps.t``, ``jumps.F``, ``jumps.from_branch``: the
+protocol :class:`HasJumps`, which :class:`exact.Trajectory` satisfies, so this module need not import
+``exact``): no solver runs here.  The functions that run the exact solver (windowed runs, attractors, the
+Lyapunov family) live in :mod:`exact`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal, Protocol, cast, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._peelforce import BRANCHES
 from .validate import ArgumentTypeError, integer, positive, reals
 
-__all__ = ["return_map", "Periodicity", "periodicity", "classify", "force_drops", "settle_time"]
+__all__ = ["return_map", "Periodicity", "periodicity", "classify", "force_drops", "settle_time", "HasJumps",
+           "JumpRecord"]
 
 _AB = BRANCHES.index("AB")
 
 
-def _trajectory(name: str, x):
+class JumpRecord(Protocol):
+    """The jump sequence this module reads (as :class:`exact.Jumps`): one entry per jump, in time order."""
+
+    @property
+    def t(self) -> ArrayLike:
+        """Jump times [s]."""
+
+    @property
+    def F(self) -> ArrayLike:
+        """Pull force at each jump [N]."""
+
+    @property
+    def from_branch(self) -> ArrayLike:
+        """Branch left by each jump, as an index into :data:`peelapprox.BRANCHES`."""
+
+
+class HasJumps(Protocol):
+    """A trajectory with its jump sequence (as :class:`exact.Trajectory`): what the functions here analyse."""
+
+    @property
+    def jumps(self) -> JumpRecord:
+        """The jumps in the stored window."""
+
+
+def _trajectory(name: str, x: object) -> HasJumps:
     """x if it looks like an :class:`exact.Trajectory` (has ``jumps`` with ``t``, ``F``, ``from_branch``)."""
     J = getattr(x, "jumps", None)
     if not all(hasattr(J, a) for a in ("t", "F", "from_branch")):
         raise ArgumentTypeError(f"{name} must be an exact.Trajectory (with jumps), got {type(x).__name__}")
-    return x
+    return cast(HasJumps, x)
 
 
-def return_map(trajectory, *, with_times: bool = False):
+@overload
+def return_map(trajectory: HasJumps, *, with_times: Literal[False] = ...) -> np.ndarray: ...
+
+
+@overload
+def return_map(trajectory: HasJumps, *, with_times: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+def return_map(trajectory: HasJumps, *, with_times: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """``x_k``: the pull force [N] at the AB→CD jumps of an exact trajectory (its stored window).
 
-    With ``with_times=True``, the pair ``(t_k, x_k)`` of jump times and forces.
+    Parameters
+    ----------
+    trajectory : HasJumps
+        An :class:`exact.Trajectory`, or anything with ``jumps.t``, ``jumps.F`` and ``jumps.from_branch``.
+    with_times : bool
+        Also return the jump times.
+
+    Returns
+    -------
+    ndarray, or (ndarray, ndarray) with ``with_times=True``
+        ``x_k`` [N], or the pair ``(t_k, x_k)`` of jump times [s] and forces.
     """
     J = _trajectory("trajectory", trajectory).jumps
     m = np.asarray(J.from_branch) == _AB
@@ -72,7 +118,9 @@ class Periodicity:
         return f"period-{self.period}" if self.kind == "periodic" else self.kind
 
 
-def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int = 2) -> Periodicity:
+def periodicity(
+    x: ArrayLike | HasJumps, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int = 2
+) -> Periodicity:
     """Classify the return map as period-n or aperiodic.
 
     Parameters
@@ -93,7 +141,7 @@ def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int
     Periodicity
     """
     if hasattr(x, "jumps"):
-        x = return_map(x)
+        x = return_map(cast(HasJumps, x))
     x = reals("x", x)
     rtol = positive("rtol", rtol)
     max_period, min_repeats = integer("max_period", max_period), integer("min_repeats", min_repeats)
@@ -115,11 +163,21 @@ def periodicity(x, *, rtol: float = 1e-6, max_period: int = 32, min_repeats: int
     return Periodicity("aperiodic" if enough else "too short", None, best, x.size, rtol)
 
 
-def force_drops(trajectory) -> np.ndarray:
+def force_drops(trajectory: HasJumps) -> np.ndarray:
     """Force drop of each slip [N]: ``F`` at an AB→CD jump minus ``F`` at the next CD→AB jump.
 
     One value per completed slip in the stored window.
     The paper's Fig. 6 plots their mean against V.
+
+    Parameters
+    ----------
+    trajectory : HasJumps
+        As for :func:`return_map`; its jumps must alternate AB→CD→AB (else ValueError).
+
+    Returns
+    -------
+    ndarray
+        ``ΔF_k`` [N], one per AB→CD jump followed by a CD→AB jump in the window.
     """
     J = _trajectory("trajectory", trajectory).jumps
     fb = np.asarray(J.from_branch)
@@ -130,12 +188,24 @@ def force_drops(trajectory) -> np.ndarray:
     return F[idx] - F[idx + 1]
 
 
-def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> float | None:
+def settle_time(trajectory: HasJumps, *, rtol: float = 1e-6, max_period: int = 32) -> float | None:
     """The time from which the return map is periodic to the end of the stored window, or None.
 
     The orbit's period n is found on the last half of the returns (:func:`periodicity`); the settle time is
     that of the earliest AB→CD jump from which ``|x_{k+n} − x_k| <= rtol·max|x|`` holds for every later k.
     None means no period was found in the last half (aperiodic, or still in the transient).
+
+    Parameters
+    ----------
+    trajectory : HasJumps
+        As for :func:`return_map`.
+    rtol, max_period
+        As for :func:`periodicity`.
+
+    Returns
+    -------
+    float or None
+        The settle time [s], or None (fewer than 4 returns, or no period in the last half).
     """
     rtol = positive("rtol", rtol)
     max_period = integer("max_period", max_period)
@@ -152,8 +222,20 @@ def settle_time(trajectory, *, rtol: float = 1e-6, max_period: int = 32) -> floa
     return float(t[k])
 
 
-def classify(trajectory, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
-    """:func:`periodicity` of a window's return map, with ``kind = "no stick-slip"`` below 2 returns."""
+def classify(trajectory: HasJumps, *, period_rtol: float = 1e-6, max_period: int = 32) -> Periodicity:
+    """:func:`periodicity` of a window's return map, with ``kind = "no stick-slip"`` below 2 returns.
+
+    Parameters
+    ----------
+    trajectory : HasJumps
+        As for :func:`return_map`, after its transient.
+    period_rtol, max_period
+        ``rtol`` and ``max_period`` of :func:`periodicity`.
+
+    Returns
+    -------
+    Periodicity
+    """
     x = return_map(trajectory)
     if x.size < 2:
         return Periodicity("no stick-slip", None, math.nan, int(x.size), period_rtol)

@@ -1,4 +1,5 @@
-"""Plots.  matplotlib is imported here, lazily, and nowhere else."""
+"""Plots.  matplotlib is set up here (:func:`pyplot`, imported lazily) and nowhere else; the CLI's output-path
+check (:mod:`peelapprox.cli._checks`) only asks matplotlib, lazily too, which image formats it can write."""
 
 from __future__ import annotations
 

@@ -7,9 +7,11 @@ resolve.  Moves record themselves in CHANGELOG.md.
 
 from __future__ import annotations
 
+import ast
 import importlib
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -46,8 +48,85 @@ API = {
     "peelapprox.plotting": {"plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
+        "MANIFEST", "RESERVED", "RESULTS", "record_key",
+    },
+    "peelapprox.validate": {
+        "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",
+        "interval", "nonnegative", "optional", "optional_finite", "params", "path", "positive", "real", "reals",
+        "state", "states", "times",
+    },
+    "peelapprox.errors": {
+        "KernelCacheWarning", "ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "WallBudget",
+        "budget_exceeded",
+    },
+    # the door through which exact (and comparisons) reach the compiled model and integrator
+    "peelapprox.kernels": {
+        "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B",
+        "M_GEOM", "M_I", "M_K", "M_L", "M_R", "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS",
+        "STEP_FAILED", "branch_inverse_at", "closure", "closure_exact", "closure_paper", "constraint_rate",
+        "crossing", "diffsl_code", "diffsl_inputs", "diffsl_model", "import_optional", "interp", "interp1", "kernel",
+        "make_dop853", "model_block", "peel_force_coefficients", "peel_force_fp_jit", "peel_force_fpp_jit",
+        "peel_force_lnv_jit", "regularized_field", "regularized_field_jacobian", "regularized_jacobian",
+        "regularized_parameters", "regularized_rhs", "slow_rates", "solve_theta", "state_at", "status", "workspace",
+    },
+    "peelapprox.cli": {"build_parser", "main"},
+    "comparisons.benchmark": {
+        "BENCH_SCENES", "BenchScene", "BenchmarkReport", "EpsRow", "WPRow", "branchwise_reference", "compile_costs",
+        "eps_study", "fit_power_law", "jump_errors", "markdown", "matched_ratios", "plot_eps_study",
+        "plot_work_precision", "ratio_summary", "rows_as_dicts", "run_benchmark", "small_eps_check",
+        "speed_targets", "work_precision",
+    },
+    "comparisons.benchmark.peers": {
+        "DIFFSOL_OPTIONS", "PEERS", "PeerResult", "PeerUnavailableError", "available_peers", "run_peer",
+    },
+    "comparisons.stress": {
+        "ALLOWED_PREFIXES", "BUG_CLASSES", "GRID_ALPHA0", "GRID_I", "GRID_K", "GRID_V", "LONG_RUNS", "LOOSE_ALPHA0",
+        "LOOSE_I", "LOOSE_TOLS", "LOOSE_V", "RANDOM_BOX", "StressPoint", "StressRunner", "TOL_POINTS", "TOL_RTOLS",
+        "all_points", "budget_edge_probes", "budget_points", "grid_points", "is_allowed", "is_bug", "long_points",
+        "loose_points", "main", "pair_long_runs", "random_points", "robustness_markdown", "run_point", "run_points",
+        "tolerance_points", "tolerance_table", "variant_points", "write_records",
     },
 }
+
+#: The names of comparisons.sweep that peelapprox also offers (lazily); the store's names are not among them.
+SWEEP_NAMES = ("MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _public_modules() -> list[tuple[str, Path]]:
+    """Every public module of the three packages: no component of its dotted name starts with ``_``
+    (``__init__`` files stand for their package; ``__main__`` is an entry point, not a module to import)."""
+    found = []
+    for package in ("peelapprox", "exact", "comparisons"):
+        for path in sorted((ROOT / package).rglob("*.py")):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            if not any(part.startswith("_") for part in parts):
+                found.append((".".join(parts), path))
+    return found
+
+
+def _defines_all(path: Path) -> bool:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in tree.body:
+        targets = (node.targets if isinstance(node, ast.Assign)
+                   else [node.target] if isinstance(node, ast.AnnAssign) else [])
+        if any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets):
+            return True
+    return False
+
+
+def test_every_public_module_declares_all():
+    """Hypothesis: every public module (and package) of the three packages states its public names in a
+    module-level ``__all__`` (categorical: the list of modules without one is empty), so that what is public
+    is a decision, not whatever happens not to start with an underscore."""
+    modules = _public_modules()
+    assert {"peelapprox", "exact", "comparisons", "peelapprox.kernels", "comparisons.sweep.store"} <= {
+        name for name, _ in modules}
+    missing = sorted(name for name, path in modules if not _defines_all(path))
+    assert not missing, f"public modules without __all__: {missing}"
 
 
 @pytest.mark.parametrize("package", sorted(API))
@@ -121,7 +200,7 @@ def test_sweep_names_are_the_same_objects_both_ways():
     import comparisons.sweep
     import peelapprox
 
-    for name in API["comparisons.sweep"]:
+    for name in SWEEP_NAMES:
         assert getattr(peelapprox, name) is getattr(comparisons.sweep, name), name
     assert peelapprox.register_measure is comparisons.sweep.register_measure
     assert {"regime", "jumps", "period", "lyapunov"} <= set(peelapprox.MEASURES)

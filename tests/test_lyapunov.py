@@ -144,14 +144,12 @@ def test_variational_wall_watch_raises_between_intervals():
 def test_variational_method_refuses_a_bad_eps_and_equals_lyapunov_variational():
     """Hypothesis: ``lyapunov(p, "variational", eps=1e-300)`` is refused by the method's own validator with a
     ValueError naming ``eps``; a short run (V = 0.05, I = 1e-2: a stable sliding point, 2 s after 1 s) equals
-    ``lyapunov_variational`` with the same arguments bitwise (the wall watcher only wraps ``progress``).
-    Skipped until exact._variational (moved from comparisons._peers on a parallel branch) and pydiffsol are
-    both present."""
+    ``exact.lyapunov_variational`` with the same arguments bitwise (the wall watcher only wraps ``progress``).
+    Skipped without the optional pydiffsol (the ``[bench]`` extra)."""
     pytest.importorskip("pydiffsol")
-    variational = pytest.importorskip("exact._variational")
     p = PeelParams(V=0.05, I=1e-2)
     with pytest.raises(ValueError, match=r"^eps "):
         lyapunov(p, "variational", eps=1e-300)
     a = lyapunov(p, "variational", t_transient=1.0, T=2.0)
-    b = variational.lyapunov_variational(p, t_transient=1.0, T=2.0)
+    b = exact.lyapunov_variational(p, t_transient=1.0, T=2.0)
     assert (a.per_s, a.stderr_bits, a.n_jumps, a.notes) == (b.per_s, b.stderr_bits, b.n_jumps, b.notes)

@@ -183,7 +183,7 @@ def test_tangent_follows_finite_differences_across_the_jumps():
     pytest.importorskip("pydiffsol")
     p = PeelParams(V=2.0, I=1e-4)
     rtol, h = 1e-11, 1e-6
-    a = exact._simulate._atol_vector("regularized", rtol, None)
+    a = exact.default_atol("regularized", rtol)
     ode = K.diffsl_model("paper", tangent=True)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0
     for name, val in LV.TANGENT_OPTIONS.items():
@@ -202,7 +202,7 @@ def test_tangent_follows_finite_differences_across_the_jumps():
 
 
 @pytest.mark.parametrize("V, I", [(0.05, 1e-4), (0.1, 1e-2)])
-def test_lyapunov_regularized_at_a_stable_fixed_point_is_the_leading_eigenvalue(V, I):
+def test_lyapunov_variational_at_a_stable_fixed_point_is_the_leading_eigenvalue(V, I):
     """At a stable steady sliding point (α = 0, ω = V/R, v = V, F = f(V); f'(V) > 0) the largest Lyapunov
     exponent is the largest real part of the eigenvalues of M⁻¹ ∂φ/∂X there, in bits/s: the analytic oracle.
 
@@ -231,13 +231,13 @@ def test_lyapunov_regularized_at_a_stable_fixed_point_is_the_leading_eigenvalue(
     [(dict(eps=0.0), "eps"), (dict(T=0.0), "T"), (dict(tau=-1.0), "tau"), (dict(rtol=1.0), "rtol"),
      (dict(t_transient=-1.0), "t_transient"), (dict(progress=3), "progress")],
 )
-def test_lyapunov_regularized_rejects_bad_arguments(kwargs, name):
+def test_lyapunov_variational_rejects_bad_arguments(kwargs, name):
     """Bad arguments raise ValueError naming the argument, before any compilation or solve."""
     with pytest.raises(ValueError, match=name):
         LV.lyapunov_variational(PeelParams(V=2.0, I=1e-4), **kwargs)
 
 
-def test_lyapunov_regularized_reports_a_diffsol_failure_with_time_and_state(monkeypatch):
+def test_lyapunov_variational_reports_a_diffsol_failure_with_time_and_state(monkeypatch):
     """A diffsol failure inside an interval raises SolverFailure carrying the interval's start time and the
     state and tangent there (no tolerance involved)."""
     pytest.importorskip("pydiffsol")

@@ -270,8 +270,8 @@ def test_reproducer_raises_an_error_naming_the_argument(label, call, name, kind)
     assert str(exc.value).startswith(name + " "), str(exc.value)
 
 
-def test_lyapunov_regularized_eps_1e_300_names_eps():
-    """Hypothesis: eps=1e-300 (the regularised rates overflow) is refused by lyapunov_regularized with a
+def test_lyapunov_variational_eps_1e_300_names_eps():
+    """Hypothesis: eps=1e-300 (the regularised rates overflow) is refused by lyapunov_variational with a
     message naming eps and EPS_RANGE, before pydiffsol is needed."""
     from exact import lyapunov_variational
 

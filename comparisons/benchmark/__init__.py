@@ -39,7 +39,9 @@ Outputs: ``work_precision.csv`` / ``.json``, ``eps_study.csv``, ``work_precision
 Modules: :mod:`.scenes` (the scenes and the error metric), :mod:`.reference` (the branch-wise reference
 solver), :mod:`.work_precision`, :mod:`.eps` (the ε study), :mod:`.targets` (speed targets, compilation
 costs), :mod:`.run` (:func:`run_benchmark`), :mod:`.report` (the report and its markdown), :mod:`.plots`,
-:mod:`.timing` and :mod:`.peers` (one module per external peer).
+:mod:`.timing` and :mod:`.peers` (one module per external peer).  Two scripts time the other jobs:
+``python -m comparisons.benchmark.reduced_cost`` (the reduced equations, :mod:`.reduced_cost`) and
+``python -m comparisons.benchmark.compare_cost`` (``peelapprox compare``, cold and warm, :mod:`.compare_cost`).
 """
 
 from .eps import EpsRow, eps_study, fit_power_law, small_eps_check

@@ -66,7 +66,9 @@ writes (wrong types, missing keys, non-finite ``I``/``V``) is a ValueError
 naming the file (and line) as malformed.  A directory this process cannot
 write is read only: a complete sweep there is returned (and reported by the
 CLI); computing anything there is a ValueError.  The format itself lives in
-:mod:`comparisons.sweep.store`.
+:mod:`comparisons.sweep.store`; the names a reader of the directory needs are offered here:
+:data:`MANIFEST` and :data:`RESULTS` (the two file names), :data:`RESERVED` (the engine's own record keys)
+and :func:`record_key` (the key a measure's returned key is recorded under).
 
 Modules
 -------
@@ -90,7 +92,9 @@ Modules
 
 from .engine import sweep
 from .grid import parse_grid
-from .measures import MEASURES, register_measure
+from .measures import MEASURES, record_key, register_measure
 from .result import SweepResult, load_sweep
+from .store import MANIFEST, RESERVED, RESULTS
 
-__all__ = ["MEASURES", "register_measure", "sweep", "load_sweep", "SweepResult", "parse_grid"]
+__all__ = ["MEASURES", "register_measure", "sweep", "load_sweep", "SweepResult", "parse_grid",
+           "record_key", "RESERVED", "MANIFEST", "RESULTS"]

@@ -183,12 +183,11 @@ def check_sweep_plot_key(key: str, measures: Sequence[str]) -> None:
     """Before a sweep: ValueError unless ``key`` can be a record key of ``measures``.
 
     Record keys are the engine's (``I``, ``V``, ``status``) and the measures'
-    keys, which the engine prefixes ``"<measure>_"`` (:func:`comparisons.sweep.measures.record_key`,
+    keys, which the engine prefixes ``"<measure>_"`` (:func:`comparisons.sweep.record_key`,
     reused here so the rule stays in one place).  Which suffixes a measure
     returns is known only after it ran; the CLI checks the exact key again then.
     """
-    from comparisons.sweep.measures import record_key
-    from comparisons.sweep.store import RESERVED
+    from comparisons.sweep import RESERVED, record_key
 
     if os.sep in key or (os.altsep and os.altsep in key):
         raise ValueError(f"--plot {key!r}: a record key has no path separator (the plot goes to DIR/KEY.png)")

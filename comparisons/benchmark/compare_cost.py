@@ -1,6 +1,6 @@
 """Cost of the main job, ``peelapprox compare``, cold and warm, with the breakdown per exact run and scene.
 
-    python -m comparisons.benchmark_compare [--repeats N] [--csv out.csv]
+    python -m comparisons.benchmark.compare_cost [--repeats N] [--csv out.csv]
 
 Targets (issue "comparison harness"): the whole ``peelapprox compare`` (all scenes, statistics and
 Figs. 8-9) <= 60 s cold, compilation included, and <= 15 s warm on this 2-core machine.
@@ -23,6 +23,8 @@ import subprocess
 import sys
 import tempfile
 import time
+
+__all__ = ["main"]
 
 
 def _run(cache_dir: str, out_dir: str):

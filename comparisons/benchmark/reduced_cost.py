@@ -1,6 +1,6 @@
 """Cost of the reduced equations: one branch segment and one regime estimate.
 
-    python -m comparisons.benchmark_reduced [--repeats N] [--csv out.csv]
+    python -m comparisons.benchmark.reduced_cost [--repeats N] [--csv out.csv]
 
 Targets (issue "reduced branch-wise equations"): one reduced segment <= 1 ms,
 ``peelapprox.estimate`` <= 5 ms per call after the first.  Methodology: one
@@ -21,6 +21,8 @@ import sys
 import time
 
 from peelapprox import PeelParams, estimate, reduced_segment
+
+__all__ = ["CASES", "first_call_cost", "main"]
 
 P2 = PeelParams(V=1.0, I=1e-2)
 P5 = PeelParams(V=1.0, I=1e-5)
