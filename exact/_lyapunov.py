@@ -28,7 +28,6 @@ import numpy as np
 from peelapprox import (
     BRANCHES,
     LYAPUNOV_TAU,
-    RTOL_RANGE,
     T_TRANSIENT,
     PeelParams,
     SolverBudgetExceeded,
@@ -47,6 +46,7 @@ from peelapprox.validate import (
     state,
 )
 from peelapprox.validate import params as _params
+from peelapprox.validate import rtol as _rtol
 
 from ._attractors import DEFAULT_MAX_WALL, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
@@ -68,10 +68,6 @@ METHODS: dict[str, tuple[str, ...]] = {
     "return-map": ("n_returns", "h"),
     "variational": ("eps", "T", "tau", "progress"),
 }
-
-
-def _rtol(name: str, x) -> float:
-    return in_range(name, x, *RTOL_RANGE)
 
 
 def lyapunov(

@@ -17,7 +17,7 @@ API = {
     "peelapprox": {
         "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BREAKDOWN_LEVEL", "EPS_RANGE", "LYAPUNOV_TAU",
         "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "BranchStructure", "FixedPoint",
-        "GEOMETRIES",
+        "EPS_DEFAULT", "GEOMETRIES",
         "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
         "PARAM_RANGES", "PeelParams", "Periodicity", "ReducedSegment", "RegimeEstimate", "SlopeCriterion",
         "SolverBudgetExceeded", "SolverFailure", "SweepResult", "VELOCITY_RULE", "V_EQUATIONS", "airy_alpha",

@@ -17,8 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import GEOMETRIES, RTOL_RANGE
-from peelapprox.validate import finite, in_range, nonnegative, positive
+from peelapprox import GEOMETRIES
+from peelapprox.validate import finite, nonnegative, positive
+from peelapprox.validate import rtol as _rtol
 
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
@@ -151,7 +152,7 @@ class StressPoint:
         for name in ("V", "I", "k", "t_end"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "alpha0", finite("alpha0", self.alpha0))
-        object.__setattr__(self, "rtol", in_range("rtol", self.rtol, *RTOL_RANGE))
+        object.__setattr__(self, "rtol", _rtol("rtol", self.rtol))
         if self.atol is not None:
             object.__setattr__(self, "atol", nonnegative("atol", self.atol))
         if self.method not in _METHODS:

@@ -23,8 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT, TIME_MAX, ModelBreakdown, PeelParams, estimate
+from peelapprox import LYAPUNOV_TAU, T_TRANSIENT, TIME_MAX, ModelBreakdown, PeelParams, estimate
 from peelapprox.validate import duration, in_range, positive, state
+from peelapprox.validate import rtol as _rtol
 
 from .store import RESERVED
 
@@ -175,7 +176,7 @@ def _window_options(options) -> dict:
     kw.update({key: options[key] for key in kw if options.get(key) is not None})
     kw["t_transient"] = duration("t_transient", kw["t_transient"], zero=True)
     kw["alpha0"] = state("alpha0", kw["alpha0"], "alpha")
-    kw["rtol"] = in_range("rtol", kw["rtol"], *RTOL_RANGE)
+    kw["rtol"] = _rtol("rtol", kw["rtol"])
     if options.get("t_end") is not None:
         t_end = duration("t_end", options["t_end"])
         if not t_end > kw["t_transient"]:
