@@ -34,7 +34,7 @@ API = {
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
-        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult",
+        "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "check_lyapunov_options",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
