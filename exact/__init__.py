@@ -20,7 +20,7 @@ from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailur
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin
-from ._lyapunov import lyapunov, lyapunov_return_map, lyapunov_tangent
+from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt
 from ._simulate import (
     ATOL_SCALE,
@@ -63,6 +63,7 @@ __all__ = [
     "Attractor",
     "DEFAULT_MAX_WALL",
     "lyapunov",
+    "check_lyapunov_options",
     "lyapunov_tangent",
     "lyapunov_return_map",
     "LyapunovResult",

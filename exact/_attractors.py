@@ -16,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from peelapprox import (
-    RTOL_RANGE,
-    T_TRANSIENT,
+    WINDOW_DEFAULTS,
     ModelBreakdown,
     PeelParams,
     SolverBudgetExceeded,
@@ -26,20 +25,18 @@ from peelapprox import (
     settle_time,
 )
 from peelapprox.errors import WallBudget
-from peelapprox.validate import duration, function, in_range, optional, positive, state, states
+from peelapprox.validate import duration, function, optional, positive, state, states
 from peelapprox.validate import params as _params
+from peelapprox.validate import rtol as _rtol
 
 from ._simulate import initial_state, simulate
+from ._trajectory import Trajectory
 
 __all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors"]
 
 #: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
 #: attractors): their work grows with counts (n, n_returns, starts) that no step budget bounds.
 DEFAULT_MAX_WALL = 3600.0
-
-
-def _rtol(name: str, x) -> float:
-    return in_range(name, x, *RTOL_RANGE)
 
 
 def states_alpha(name: str, x) -> np.ndarray:
@@ -51,14 +48,47 @@ def states_alpha(name: str, x) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------------------------- windows
-def window_run(params: PeelParams, *, t_transient: float = T_TRANSIENT, window: float = 20.0, rtol: float = 1e-10,
-               alpha0: float = 0.0, max_wall: float | None = None):
+def window_run(
+    params: PeelParams,
+    *,
+    t_transient: float = WINDOW_DEFAULTS["t_transient"],
+    window: float = WINDOW_DEFAULTS["window"],
+    rtol: float = WINDOW_DEFAULTS["rtol"],
+    alpha0: float = WINDOW_DEFAULTS["alpha0"],
+    max_wall: float | None = None,
+) -> Trajectory:
     """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
 
-    The one windowed run behind :func:`attractors`, the sweep measures ``period`` and
-    ``jumps`` and ``peelapprox dynamics`` (the same defaults everywhere).  The last call is cached, so
-    measures of one sweep point share it.  Raises ``ModelBreakdown`` and ``SolverBudgetExceeded`` (also
-    for ``max_wall`` seconds of wall time) as :func:`exact.simulate` does.
+    The one windowed run behind :func:`attractors`, the sweep measures ``period`` and ``jumps`` and
+    ``peelapprox dynamics``; its defaults are :data:`peelapprox.WINDOW_DEFAULTS`, the same everywhere.  The
+    last call is cached, so measures of one sweep point share it.
+
+    Parameters
+    ----------
+    params : PeelParams
+    t_transient : float
+        Seconds integrated from the initial state before the window, discarded, in [0, 1e6] (30).
+    window : float
+        Seconds whose jumps are stored, in (0, 1e6] (20).
+    rtol : float
+        Relative tolerance of the run, in :data:`peelapprox.RTOL_RANGE` (1e-10).
+    alpha0 : float
+        Initial peel angle; the rest of the initial state is :func:`exact.initial_state`'s (0).
+    max_wall : float, optional
+        Wall-clock budget [s] of the run; None: unbounded.
+
+    Returns
+    -------
+    Trajectory
+        :func:`exact.simulate`'s with ``save="jumps"`` and ``t_transient``: the jumps in the window, no
+        stored points.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named, with its range).
+    peelapprox.ModelBreakdown, peelapprox.SolverBudgetExceeded
+        As :func:`exact.simulate` (also for ``max_wall`` seconds of wall time).
     """
     return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
                        duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
@@ -92,9 +122,9 @@ def attractors(
     params: PeelParams,
     alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
     *,
-    t_transient: float = T_TRANSIENT,
-    window: float = 20.0,
-    rtol: float = 1e-10,
+    t_transient: float = WINDOW_DEFAULTS["t_transient"],
+    window: float = WINDOW_DEFAULTS["window"],
+    rtol: float = WINDOW_DEFAULTS["rtol"],
     period_rtol: float = 1e-6,
     match_rtol: float = 1e-4,
     progress: Callable[[str], None] | None = None,
@@ -102,17 +132,43 @@ def attractors(
 ) -> list[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
-    ``max_wall`` [s] bounds the wall time of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``;
-    None: unbounded).
-
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
     (discarded) and ``window`` s (stored jumps) by :func:`window_run`.  Two periodic orbits are the same
-    attractor when their
-    periods agree and their sorted return-map cycles agree to ``match_rtol`` relative (a cycle is the same
-    set of jump forces whatever its phase); aperiodic windows are grouped by their return range.  A start
-    that breaks down (``ModelBreakdown``) or is infeasible (``ValueError``) is reported as its own entry.
-    More than one entry means coexisting attractors — or a transient longer than ``t_transient``: the
-    entries' settle times tell which.
+    attractor when their periods agree and their sorted return-map cycles agree to ``match_rtol`` relative (a
+    cycle is the same set of jump forces whatever its phase); aperiodic windows are grouped by their return
+    range.  A start that breaks down (``ModelBreakdown``) or is infeasible (``ValueError``) is reported as its
+    own entry.  More than one entry means coexisting attractors — or a transient longer than ``t_transient``:
+    the entries' settle times tell which.
+
+    Parameters
+    ----------
+    params : PeelParams
+    alpha0s : sequence of float
+        Initial peel angles [rad], each in ``STATE_RANGES["alpha"]``, at least one.
+    t_transient, window, rtol : float
+        Of each start's :func:`window_run` (defaults :data:`peelapprox.WINDOW_DEFAULTS`: 30 s, 20 s, 1e-10).
+    period_rtol : float
+        Relative tolerance of the period detection (:func:`peelapprox.classify`) and the settle time, > 0.
+    match_rtol : float
+        Relative tolerance within which two periodic cycles are the same attractor, > 0.
+    progress : callable, optional
+        Called as ``progress(message)`` before each start.
+    max_wall : float or None
+        Wall-clock budget [s] of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``; None:
+        unbounded).
+
+    Returns
+    -------
+    list of Attractor
+        One entry per attractor (or per failed start), in the order first reached; ``starts`` lists the α0
+        values that reach it, ``settle_times`` their settle times.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named, with its range).
+    peelapprox.SolverBudgetExceeded
+        When ``max_wall`` is spent.
     """
     # validate everything up front: inside the loop a ValueError can then only be an infeasible start
     params = _params("params", params)

@@ -1,8 +1,7 @@
 """The largest Lyapunov exponent of the exact peeling dynamics: one entry point, four methods.
 
-``lyapunov(params, method, *, t_transient, alpha0, rtol, max_wall, **options)`` measures the largest
-exponent, in bits/s, of the full model FLOW1, FLOW2, flow3 with CONSTR after a transient, by one of
-:data:`METHODS`:
+:func:`lyapunov` measures the largest exponent, in bits/s, of the full model FLOW1, FLOW2, flow3 with CONSTR
+after a transient, by one of :data:`METHODS`:
 
 * ``"two-trajectory"`` (default) — :func:`~exact._benettin.benettin`'s renormalisation of two neighbouring
   hybrid orbits every ``tau`` seconds;
@@ -13,7 +12,8 @@ exponent, in bits/s, of the full model FLOW1, FLOW2, flow3 with CONSTR after a t
 * ``"variational"`` — the variational equations of the ε-regularised system XDAE through diffsol
   (``exact._variational``, needs the ``bench`` extra).
 
-Every method returns one :class:`~exact._benettin.LyapunovResult`.  docs/dynamics.md compares them.
+Every method returns one :class:`~exact._benettin.LyapunovResult`; :func:`check_lyapunov_options` checks a
+method's options without running it.  docs/dynamics.md compares the methods.
 """
 
 from __future__ import annotations
@@ -28,7 +28,6 @@ import numpy as np
 from peelapprox import (
     BRANCHES,
     LYAPUNOV_TAU,
-    RTOL_RANGE,
     T_TRANSIENT,
     PeelParams,
     SolverBudgetExceeded,
@@ -46,13 +45,15 @@ from peelapprox.validate import (
     positive,
     state,
 )
+from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
+from peelapprox.validate import rtol as _rtol
 
 from ._attractors import DEFAULT_MAX_WALL, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
 from ._simulate import initial_state, simulate
 
-__all__ = ["METHODS", "D0_RANGE", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]
+__all__ = ["METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]
 
 _AB = BRANCHES.index("AB")
 #: Valid initial perturbation ``d0`` of the two-trajectory method (scaled units): below 1e-12 the perturbation
@@ -63,15 +64,74 @@ D0_RANGE = (1e-12, 1.0)
 #: The methods of :func:`lyapunov` and the options each takes besides the common ``t_transient``, ``alpha0``,
 #: ``rtol`` and ``max_wall`` (their defaults: the table of :func:`lyapunov`).
 METHODS: dict[str, tuple[str, ...]] = {
-    "two-trajectory": ("tau", "n", "n_discard", "d0"),
+    "two-trajectory": ("tau", "n", "T", "n_discard", "d0"),
     "tangent": ("T", "max_steps"),
     "return-map": ("n_returns", "h"),
     "variational": ("eps", "T", "tau", "progress"),
 }
 
+#: The check of each option of :data:`METHODS`, ``check(name, value) -> value``: the one the methods apply
+#: (the variational method's, in ``exact._variational``, are the same validators).
+_OPTION_CHECKS: dict[str, Callable[[str, Any], Any]] = {
+    "tau": duration,
+    "n": lambda name, x: integer(name, x, lo=2),
+    "T": duration,
+    "n_discard": lambda name, x: integer(name, x, lo=0),
+    "d0": lambda name, x: in_range(name, x, *D0_RANGE),
+    "max_steps": lambda name, x: optional(integer, name, x),
+    "n_returns": lambda name, x: integer(name, x, lo=2),
+    "h": lambda name, x: positive(name, x, hi=1.0),
+    "eps": _eps,
+    "progress": lambda name, x: optional(function, name, x),
+}
 
-def _rtol(name: str, x) -> float:
-    return in_range(name, x, *RTOL_RANGE)
+
+def _check(name: str, x: Any) -> Any:
+    """Option ``name`` of :data:`METHODS` checked by its :data:`_OPTION_CHECKS` entry."""
+    return _OPTION_CHECKS[name](name, x)
+
+
+def check_lyapunov_options(method: str = "two-trajectory", **options: Any) -> str:
+    """Check a method of :func:`lyapunov` and its options without running it (the checks :func:`lyapunov` makes).
+
+    For callers that want a bad option reported before their own long runs (``peelapprox dynamics`` checks
+    its ``--eps`` before the window run).
+
+    Parameters
+    ----------
+    method : {"two-trajectory", "tangent", "return-map", "variational"}
+    **options
+        Options of ``method`` (:data:`METHODS`), each checked by the validator the method applies.
+
+    Returns
+    -------
+    str
+        ``method``.
+
+    Raises
+    ------
+    ValueError
+        An unknown method (the message lists :data:`METHODS`), an option out of its range (named, with the
+        range), or both ``T`` and ``n`` for the two-trajectory method.
+    peelapprox.validate.ArgumentTypeError
+        (a ``TypeError`` and ``ValueError``) An option of another method, or of none (named, with the method),
+        or of the wrong kind.
+    """
+    method = choice("method", method, tuple(METHODS))
+    own = METHODS[method]
+    for name in options:
+        if name not in own:
+            others = [m for m, opts in METHODS.items() if name in opts]
+            what = (f"an option of method {' and '.join(map(repr, others))}" if others else
+                    "an option of no method")
+            raise ArgumentTypeError(f"lyapunov: {name!r} is {what}, not of method={method!r} (whose options are "
+                                    f"{', '.join(own)})")
+    for name, value in options.items():
+        _check(name, value)
+    if method == "two-trajectory" and options.get("T") is not None and options.get("n") is not None:
+        raise ValueError(f"lyapunov: give T (measured seconds, n = round(T/tau)) or n (renormalisation intervals), "
+                         f"not both; got T={options['T']!r} and n={options['n']!r}")
+    return method
 
 
 def lyapunov(
@@ -103,16 +163,21 @@ def lyapunov(
         unbounded), checked between solver runs (two-trajectory, return-map), at every jump (tangent) or
         after every renormalisation interval (variational).
     **options
-        Keyword-only options of the chosen method, validated by it; an option of another method, or of none,
-        raises :class:`peelapprox.validate.ArgumentTypeError` (a ``TypeError`` and ``ValueError``) naming
-        the option and the method:
+        Keyword-only options of the chosen method, checked before any run (:func:`check_lyapunov_options`); an
+        option of another method, or of none, raises :class:`peelapprox.validate.ArgumentTypeError` (a
+        ``TypeError`` and ``ValueError``) naming the option and the method.  ``T`` is the measured time [s]
+        wherever the method measures a time:
 
         ================  =========================================================================
         method            options (defaults)
         ================  =========================================================================
-        two-trajectory    ``tau`` (0.005 s), ``n`` (10000), ``n_discard`` (200), ``d0`` (1e-7)
+        two-trajectory    ``tau`` (0.005 s), ``n`` (10000) or ``T`` (n = max(2, round(T/tau));
+                          giving both is an error), ``n_discard`` (200), ``d0`` (1e-7)
         tangent           ``T`` (50 s), ``max_steps`` (5e6 per simulated second, at most 1e9)
-        return-map        ``n_returns`` (5000), ``h`` (1e-6)
+        return-map        ``n_returns`` (5000), ``h`` (1e-6); no ``T``: the method renormalises once per
+                          return and its length is a count of returns, whose times are known only as
+                          the orbit runs (``peelapprox dynamics`` converts its measured time with the
+                          return rate of its window)
         variational       ``eps`` (1e-7), ``T`` (50 s), ``tau`` (0.5 s), ``progress`` (None)
         ================  =========================================================================
 
@@ -140,15 +205,7 @@ def lyapunov(
     exponent (9.5-13.5 bits/s at V = 2, I = 1e-4 with d0/rtol = 10-100, 4.06-4.15 for every d0/rtol >= 1e5):
     hence d0 = 1e-7, rtol = 1e-12.  ``d0`` must lie in :data:`D0_RANGE` = [1e-12, 1].
     """
-    method = choice("method", method, tuple(METHODS))
-    own = METHODS[method]
-    for name in options:
-        if name not in own:
-            others = [m for m, opts in METHODS.items() if name in opts]
-            what = (f"an option of method {' and '.join(map(repr, others))}" if others else
-                    "an option of no method")
-            raise ArgumentTypeError(f"lyapunov: {name!r} is {what}, not of method={method!r} (whose options are "
-                                    f"{', '.join(own)})")
+    method = check_lyapunov_options(method, **options)
     common: dict[str, Any] = dict(t_transient=t_transient, alpha0=alpha0)
     if rtol is not None:
         common["rtol"] = rtol
@@ -184,7 +241,8 @@ def _two_trajectory(
     *,
     t_transient: float = T_TRANSIENT,
     tau: float = LYAPUNOV_TAU,
-    n: int = 10000,
+    n: int | None = None,
+    T: float | None = None,
     n_discard: int = 200,
     d0: float = 1e-7,
     alpha0: float = 0.0,
@@ -193,17 +251,20 @@ def _two_trajectory(
 ) -> LyapunovResult:
     """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver.
 
-    The two orbits' state is ``(α, ω, F, branch)``; ``run`` advances one by a hybrid run, ``rescale`` puts
-    the perturbation back to ``d0`` along its direction (halving the step while the moved state would leave
-    its branch's level range), ``advance`` postpones the renormalisation while the orbits are on different
-    branches.
+    ``n`` renormalisation intervals are measured (10000 by default), or ``max(2, round(T/tau))`` of them when
+    ``T`` is given (:func:`lyapunov` refuses both).  The two orbits' state is ``(α, ω, F, branch)``; ``run``
+    advances one by a hybrid run, ``rescale`` puts the perturbation back to ``d0`` along its direction
+    (halving the step while the moved state would leave its branch's level range), ``advance`` postpones the
+    renormalisation while the orbits are on different branches.
     """
     params = _params("params", params)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
-    tau = duration("tau", tau)
-    d0 = in_range("d0", d0, *D0_RANGE)
+    tau = _check("tau", tau)
+    d0 = _check("d0", d0)
     t_transient = duration("t_transient", t_transient, zero=True)
-    n, n_discard = integer("n", n, lo=2), integer("n_discard", n_discard, lo=0)
+    if T is not None:
+        n = max(2, round(_check("T", T) / tau))
+    n, n_discard = _check("n", 10000 if n is None else n), _check("n_discard", n_discard)
     alpha0 = state("alpha0", alpha0, "alpha")
     rtol = _rtol("rtol", rtol)
     bs = branch_structure(params.V)
@@ -279,15 +340,39 @@ def lyapunov_tangent(
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent (variational) dynamics with saltation matrices, in bits/s.
 
-    ``max_steps`` bounds the accepted steps (default 5e6 per simulated second;
-    ~1.2e6 are used at V = 2, I = 1e-4); ``notes`` reports the steps taken.
-
     The variational equation of the hybrid solver's desingularised field is integrated with the state by
     the package's DOP853; the tangent crosses each jump through the saltation matrix of the fold event and
     the reset to the landing root (:mod:`exact._tangent`).  Its equal-time (α, ω, F) size is measured and
     renormalised after every jump.  Slower than the two-trajectory :func:`lyapunov` (hundreds of steps per
     branch stay: the difference-quotient tangent is stiff near the folds), ~1 s of wall time per simulated
     second at V = 2, I = 1e-4.  The same as ``lyapunov(params, "tangent", ..., max_wall=None)``.
+
+    Parameters
+    ----------
+    params : PeelParams
+    t_transient : float
+        Seconds integrated from the initial state and discarded, in [0, 1e6].
+    T : float
+        Seconds measured, in (0, 1e6].
+    rtol : float
+        Relative tolerance of the DOP853 run, in :data:`peelapprox.RTOL_RANGE`.
+    alpha0 : float
+        Initial peel angle; the rest of the initial state is :func:`exact.initial_state`'s.
+    max_steps : int, optional
+        Bound on the accepted steps; None: 5e6 per simulated second (~1.2e6 are used at V = 2, I = 1e-4).
+
+    Returns
+    -------
+    LyapunovResult
+        ``bits_per_s`` and ``per_s`` (``stderr_bits`` is NaN: one estimate, no intervals), ``n_jumps``;
+        ``notes`` reports the steps taken.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named, with its range).
+    peelapprox.ModelBreakdown, peelapprox.SolverFailure
+        As :func:`exact.simulate`, with the time and state (also when ``max_steps`` is spent).
     """
     return _tangent(params, t_transient=t_transient, T=T, rtol=rtol, alpha0=alpha0, max_steps=max_steps)
 
@@ -298,11 +383,11 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     from ._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
 
     params = _params("params", params)
-    T = duration("T", T)
+    T = _check("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     rtol = _rtol("rtol", rtol)
     alpha0 = state("alpha0", alpha0, "alpha")
-    max_steps = optional(integer, "max_steps", max_steps)
+    max_steps = _check("max_steps", max_steps)
     max_wall = optional(positive, "max_wall", max_wall)
     t0 = time.perf_counter()
     lam, n_jumps, t, steps = lyapunov_saltation(params, t_transient=t_transient, T=T, rtol=rtol,
@@ -321,12 +406,10 @@ def lyapunov_return_map(
     n_returns: int = 5000,
     h: float = 1e-6,
     rtol: float = 1e-12,
+    alpha0: float = 0.0,
     max_wall: float | None = DEFAULT_MAX_WALL,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent from the tangent map of the jump-to-jump (Poincaré) map, in bits/s.
-
-    ``max_wall`` [s] bounds the whole computation
-    (``SolverBudgetExceeded``, ``budget="max_wall"``; None: unbounded).
 
     The section is the AB→CD jump; the return map P takes the state (α, ω, F) just after one such jump to
     the state at the next.  A tangent vector w is pushed through P's Jacobian by central differences,
@@ -336,21 +419,54 @@ def lyapunov_return_map(
     :func:`lyapunov` there is no finite perturbation left to grow and no renormalisation noise; the result is
     independent of h over 1e-8 … 1e-5 (docs/dynamics.md).  On a periodic orbit it gives the (negative)
     transverse exponent, not the flow's 0.  A cross-check of :func:`lyapunov`, not a replacement: it needs a
-    return map with at least two returns per second of the run.  Starts from ``alpha0 = 0``; the same as
+    return map with at least two returns per second of the run.  The same as
     ``lyapunov(params, "return-map", ...)``.
+
+    Parameters
+    ----------
+    params : PeelParams
+    t_transient : float
+        Seconds integrated from the initial state before the first section crossing, in [0, 1e6]; the map
+        starts at the transient's last AB→CD jump, so it must hold one.
+    n_returns : int
+        Returns measured, >= 2 (a count of returns, not a time: the table of :func:`lyapunov`).
+    h : float
+        Central-difference step in the scaled variables, in (0, 1].
+    rtol : float
+        Relative tolerance of every hybrid run, in :data:`peelapprox.RTOL_RANGE`.
+    alpha0 : float
+        Initial peel angle of the transient's run; the rest of the initial state is
+        :func:`exact.initial_state`'s.
+    max_wall : float or None
+        Wall-clock budget [s] of the whole computation (``SolverBudgetExceeded``, ``budget="max_wall"``; None:
+        unbounded).
+
+    Returns
+    -------
+    LyapunovResult
+        ``bits_per_s``, ``per_s``, ``stderr_bits`` (from the per-return logs), the ``benettin`` record,
+        ``n_jumps``; ``method`` names the method.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named, with its range); no AB→CD jump within ``t_transient``; the orbit stops
+        returning to the section; a perturbed orbit does not return (``h`` too large).
+    peelapprox.ModelBreakdown, peelapprox.SolverFailure, peelapprox.SolverBudgetExceeded
+        As :func:`exact.simulate`, with the time and state.
     """
-    return _return_map(params, t_transient=t_transient, n_returns=n_returns, h=h, rtol=rtol, max_wall=max_wall)
+    return _return_map(params, t_transient=t_transient, n_returns=n_returns, h=h, rtol=rtol, alpha0=alpha0,
+                       max_wall=max_wall)
 
 
 def _return_map(params: PeelParams, *, t_transient: float = T_TRANSIENT, n_returns: int = 5000, h: float = 1e-6,
                 rtol: float = 1e-12, alpha0: float = 0.0, max_wall: float | None = DEFAULT_MAX_WALL) -> LyapunovResult:
-    """Method ``"return-map"`` of :func:`lyapunov` (:func:`lyapunov_return_map`, from any ``alpha0``: the
-    transient's run starts there)."""
+    """Method ``"return-map"`` of :func:`lyapunov` (:func:`lyapunov_return_map`)."""
     params = _params("params", params)
-    h = positive("h", h, hi=1.0)
+    h = _check("h", h)
     rtol = _rtol("rtol", rtol)
     t_transient = duration("t_transient", t_transient, zero=True)
-    n_returns = integer("n_returns", n_returns, lo=2)
+    n_returns = _check("n_returns", n_returns)
     alpha0 = state("alpha0", alpha0, "alpha")
     wall = WallBudget(optional(positive, "max_wall", max_wall))
     scale = natural_scales(params)

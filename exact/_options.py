@@ -28,8 +28,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from peelapprox import EPS_RANGE, RTOL_RANGE, TIME_MAX
+from peelapprox import EPS_DEFAULT, TIME_MAX
 from peelapprox.validate import ArgumentTypeError, choice, flag, in_range, integer, interval, optional, positive, reals
+from peelapprox.validate import eps as _eps
+from peelapprox.validate import rtol as _rtol
 
 __all__ = ["Hybrid", "Regularized", "SaveAt", "Budget", "ATOL_SCALE", "ATOL_RANGE", "STEP_BUDGET",
            "default_max_steps", "method_option", "output_options"]
@@ -88,7 +90,7 @@ class _Method:
 
     def _check_shared(self) -> None:
         """Validate and normalise ``rtol`` (a float), ``atol`` (None or 4 floats) and ``v_floor``."""
-        rtol = in_range("rtol", self.rtol, *RTOL_RANGE)
+        rtol = _rtol("rtol", self.rtol)
         atol = None if self.atol is None else tuple(float(a) for a in _atol_vector(self.name, rtol, self.atol))
         object.__setattr__(self, "rtol", rtol)
         object.__setattr__(self, "atol", atol)
@@ -146,7 +148,7 @@ class Regularized(_Method):
     """
 
     name: ClassVar[str] = "regularized"
-    eps: float = 1e-7
+    eps: float = EPS_DEFAULT
     solver: str = "Radau"
     rtol: float = 1e-8
     atol: float | Sequence[float] | None = None
@@ -154,7 +156,7 @@ class Regularized(_Method):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "solver", choice("solver", self.solver, SOLVERS))
-        object.__setattr__(self, "eps", in_range("eps", self.eps, *EPS_RANGE))
+        object.__setattr__(self, "eps", _eps("eps", self.eps))
         self._check_shared()
 
 
@@ -312,7 +314,7 @@ def method_option(method: Any, *, solver: Any, eps: Any, rtol: Any, atol: Any, v
                 raise ValueError(f"{key} applies only to method='regularized' (the hybrid method is the eps -> 0 "
                                  f"limit, integrated by its own DOP853), got {key}={val!r} with method='hybrid'")
         return Hybrid(rtol=rtol, atol=atol, v_floor=v_floor)
-    return Regularized(solver="Radau" if solver is None else solver, eps=1e-7 if eps is None else eps, rtol=rtol,
+    return Regularized(solver="Radau" if solver is None else solver, eps=EPS_DEFAULT if eps is None else eps, rtol=rtol,
                        atol=atol, v_floor=v_floor)
 
 

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from peelapprox import EPS_RANGE, T_TRANSIENT, SolverFailure
+from peelapprox import EPS_DEFAULT, T_TRANSIENT, SolverFailure
 from peelapprox.kernels import (
     DIFFSOL_OPTIONS,
     diffsl_inputs,
@@ -28,6 +28,7 @@ from peelapprox.kernels import (
     regularized_parameters,
 )
 from peelapprox.validate import duration, function, in_range, optional, state
+from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
 
 from ._simulate import _atol_vector, initial_state
@@ -83,7 +84,7 @@ def tangent_solve(ode, params, eps: float, atol: np.ndarray, x, d, duration: flo
 def lyapunov_variational(
     params: PeelParams,
     *,
-    eps: float = 1e-7,
+    eps: float = EPS_DEFAULT,
     t_transient: float = T_TRANSIENT,
     T: float = 50.0,
     tau: float = 0.5,
@@ -148,7 +149,7 @@ def lyapunov_variational(
     t_transient = duration("t_transient", t_transient, zero=True)
     _params("params", params)
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
-    eps = in_range("eps", eps, *EPS_RANGE)
+    eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
     a = _atol_vector("regularized", rtol, None)
     alpha0 = state("alpha0", alpha0, "alpha")

@@ -43,6 +43,7 @@ from ._estimate import (
     slope_criterion,
 )
 from ._params import (
+    EPS_DEFAULT,
     EPS_RANGE,
     GEOMETRIES,
     LYAPUNOV_TAU,
@@ -78,6 +79,7 @@ __all__ = [
     "TIME_MAX",
     "RTOL_RANGE",
     "EPS_RANGE",
+    "EPS_DEFAULT",
     "T_TRANSIENT",
     "LYAPUNOV_TAU",
     "WINDOW_DEFAULTS",

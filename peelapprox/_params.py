@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
+import types
 from dataclasses import dataclass, field
 
 from ._checks import choice, in_range
 
-__all__ = ["EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES", "L_OVER_R_MIN",
-           "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
+__all__ = ["EPS_DEFAULT", "EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
+           "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
 #: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
@@ -67,13 +68,16 @@ T_TRANSIENT = 30.0
 LYAPUNOV_TAU = 0.005
 #: Defaults of the windowed run (``exact.window_run``) shared by the attractors, the sweep measures ``period``
 #: and ``jumps`` and ``peelapprox dynamics``: 20 s of jumps after the transient, at rtol 1e-10, from α0 = 0.
-WINDOW_DEFAULTS = dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0)
+#: Read-only (a ``types.MappingProxyType``): the one place these defaults are written.
+WINDOW_DEFAULTS = types.MappingProxyType(dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0))
 
 #: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons.benchmark.eps) goes
 #: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding
 #: of t); at 1e-300 the rates (F(1 + c) - f)/ε overflow.  Above 1e-2 the "fast" transits last as long as
 #: the slow dynamics (the paper uses 1e-7): no longer a regularisation of the jumps.
 EPS_RANGE = (1e-15, 1e-2)
+#: Default regularisation ε of the ε-regularised scheme and of the variational Lyapunov exponent: the paper's.
+EPS_DEFAULT = 1e-7
 
 
 

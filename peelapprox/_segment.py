@@ -68,12 +68,13 @@ import numpy as np
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, wkb_amplitude_phase
 from ._packing import model_block
-from ._params import RTOL_RANGE, TIME_MAX, PeelParams
+from ._params import TIME_MAX, PeelParams
 from ._peelforce import BRANCHES, branch_structure, peel_force_derivative
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
 from ._status import DONE, MAX_STEPS, OUT_FULL, T_MAX, status_error
-from .validate import choice, duration, in_range, integer, optional, optional_finite, reals, times
+from .validate import choice, duration, integer, optional, optional_finite, reals, times
 from .validate import params as _params
+from .validate import rtol as _rtol
 from .validate import state as _state
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"]
@@ -240,7 +241,7 @@ def reduced_segment(
     alpha_model = choice("alpha_model", alpha_model, ALPHA_MODELS)
     v_equation = choice("v_equation", v_equation, V_EQUATIONS)
     save = choice("save", save, ("steps", "none"))
-    rtol = in_range("rtol", rtol, *RTOL_RANGE)
+    rtol = _rtol("rtol", rtol)
     max_steps = integer("max_steps", max_steps)
     F_in = _state("F_in", F_in, "F")
     v_in, v_f = optional(_state, "v_in", v_in, "v"), optional(_state, "v_f", v_f, "v")

@@ -54,7 +54,7 @@ from ._checks import (
     reals,
     times,
 )
-from ._params import STATE_RANGES, TIME_MAX, PeelParams
+from ._params import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX, PeelParams
 
 __all__ = [
     "ArgumentTypeError",
@@ -77,6 +77,8 @@ __all__ = [
     "state",
     "states",
     "duration",
+    "rtol",
+    "eps",
     "path",
 ]
 
@@ -110,3 +112,13 @@ def states(name: str, x: Any, quantity: str) -> np.ndarray:
 def duration(name: str, x: Any, *, zero: bool = False) -> float:
     """A time span [s] in ``(0, TIME_MAX]`` (``[0, TIME_MAX]`` with ``zero``), TIME_MAX = 1e6 s."""
     return in_range(name, x, 0.0, TIME_MAX, lo_open=not zero)
+
+
+def rtol(name: str, x: Any) -> float:
+    """A relative tolerance of the package's solvers, in :data:`peelapprox.RTOL_RANGE` = [1e-14, 1e-2]."""
+    return in_range(name, x, *RTOL_RANGE)
+
+
+def eps(name: str, x: Any) -> float:
+    """A regularisation ε of the ε-regularised scheme, in :data:`peelapprox.EPS_RANGE` = [1e-15, 1e-2]."""
+    return in_range(name, x, *EPS_RANGE)

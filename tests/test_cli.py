@@ -72,6 +72,70 @@ def test_cli_dynamics_lyapunov_methods(capsys):
     assert exc.value.code == 2 and "no" in capsys.readouterr().err
 
 
+def test_cli_lyapunov_methods_are_exact_lyapunov_methods():
+    """Issue 14: ``dynamics --lyapunov-method`` takes exact.lyapunov's method names (the CLI writes them out so
+    that building the parser loads no ``exact``) and maps the earlier names saltation and regularized onto
+    tangent and variational.  Hypothesis: exact set equality with ``exact._lyapunov.METHODS``."""
+    from exact._lyapunov import METHODS
+    from peelapprox.cli.dynamics import LYAPUNOV_ALIASES, LYAPUNOV_METHODS
+
+    assert LYAPUNOV_METHODS == tuple(METHODS)
+    assert LYAPUNOV_ALIASES == {"saltation": "tangent", "regularized": "variational"}
+
+
+DYN_LY = ["dynamics", "--V", "1", "--I", "1e-3", "--t-transient", "0.5", "--window", "1", "--format", "json"]
+
+
+@pytest.mark.parametrize("name", ["two-trajectory", "tangent", "saltation"])
+def test_cli_lyapunov_is_exact_lyapunov_bitwise(name, capsys):
+    """Issue 14: the CLI calls ``exact.lyapunov(p, method, t_transient=..., alpha0=..., max_wall=..., T=...)``.
+    Hypothesis: its exponent equals, exactly, the call the CLI made before (two-trajectory: ``n =
+    max(2, int(round(T/tau)))`` intervals of LYAPUNOV_TAU; saltation: ``lyapunov_tangent(p, T=T, ...)``), and
+    the alias saltation gives tangent's number."""
+    import exact
+    from peelapprox import LYAPUNOV_TAU, PeelParams
+
+    T = 0.3
+    assert main([*DYN_LY, "--lyapunov-method", name, "--lyapunov-time", str(T)]) == 0
+    row = json.loads(capsys.readouterr().out)
+    p = PeelParams(V=1.0, I=1e-3)
+    if name == "two-trajectory":
+        old = exact.lyapunov(p, t_transient=0.5, tau=LYAPUNOV_TAU, n=max(2, int(round(T / LYAPUNOV_TAU))))
+    else:
+        old = exact.lyapunov_tangent(p, t_transient=0.5, T=T)
+    assert row["lyapunov_method"] == name and row["lyapunov_bits_per_s"] == old.bits_per_s
+
+
+def test_cli_return_map_lyapunov_starts_from_alpha0(capsys):
+    """Issue 14: ``--lyapunov-method return-map`` with ``--alpha0`` was refused (the named function started
+    from alpha0 = 0 only); it now runs ``exact.lyapunov(p, "return-map", alpha0=...)``.  Hypothesis: the CLI's
+    exponent equals that call with the CLI's ``n_returns = max(2, round(returns / window * T))`` exactly."""
+    import exact
+    from peelapprox import PeelParams
+
+    T = 0.4
+    assert main([*DYN_LY, "--alpha0", "0.1", "--lyapunov-method", "return-map", "--lyapunov-time", str(T)]) == 0
+    row = json.loads(capsys.readouterr().out)
+    n = max(2, int(round(row["returns"] / 1.0 * T)))
+    ref = exact.lyapunov(PeelParams(V=1.0, I=1e-3), "return-map", t_transient=0.5, alpha0=0.1, n_returns=n)
+    assert row["lyapunov_bits_per_s"] == ref.bits_per_s
+
+
+def test_cli_bad_lyapunov_option_is_refused_before_the_window_run(monkeypatch, capsys):
+    """Issue 14: a bad ``--eps`` was reported only after the window run.  Hypothesis: with ``exact.simulate``
+    replaced by a function that fails the test, ``--lyapunov-method regularized --eps 1e-30`` still exits
+    with status 2 naming eps and its range: the option is checked before any run (categorical)."""
+    import exact
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the window run started")
+
+    monkeypatch.setattr(exact, "simulate", no_run)
+    with pytest.raises(SystemExit) as exc:
+        main([*DYN_LY, "--lyapunov-method", "regularized", "--eps", "1e-30"])
+    assert exc.value.code == 2 and "eps must be finite and in [1e-15, 0.01]" in capsys.readouterr().err
+
+
 def test_cli_figures_list_and_bad_name(capsys):
     """``figures --list`` names fig2 … fig9; an unknown ``--only`` is a clean usage error (exit 2)."""
     from peelapprox.cli import main

@@ -72,8 +72,10 @@ CASES = [
     ("dynamics-max-period-zero", DYN + ["--max-period", "0"], 2, ["argument --max-period", "integer >= 1"]),
     ("dynamics-attractors-nan", DYN + ["--attractors=nan"], 2, ["argument --attractors", "finite", "got nan"]),
     ("dynamics-attractors-empty-item", DYN + ["--attractors=0.1,,0.2"], 2, ["argument --attractors", "comma list"]),
-    ("dynamics-return-map-alpha0", DYN + ["--alpha0", "0.1", "--lyapunov-method", "return-map"], 2,
-     ["return-map", "alpha0"]),
+    # (issue 14: "dynamics-return-map-alpha0", the refusal of --alpha0 with --lyapunov-method return-map, is
+    # gone: exact.lyapunov's return-map method starts from any alpha0; tests/test_cli.py runs it)
+    ("dynamics-lyapunov-eps", DYN + ["--lyapunov-method", "regularized", "--eps", "1e-30"], 2,
+     ["eps", "1e-15", "got 1e-30"]),
 ]
 
 

@@ -71,7 +71,7 @@ def test_unknown_method_lists_the_methods():
 
 @pytest.mark.parametrize("method, option, owner", [
     ("tangent", "n", "two-trajectory"),
-    ("two-trajectory", "T", "tangent"),
+    ("return-map", "T", "tangent"),
     ("return-map", "d0", "two-trajectory"),
     ("two-trajectory", "eps", "variational"),
     ("variational", "n_returns", "return-map"),
@@ -81,7 +81,8 @@ def test_an_option_of_another_method_is_refused_by_name(method, option, owner):
     """Hypothesis: an option the chosen method does not take raises before any run a TypeError (also a
     ValueError, peelapprox's ArgumentTypeError) naming the option, the chosen method and, when it is another
     method's option, that method (substrings; categorical).  The variational case needs no pydiffsol: the
-    check comes first."""
+    check comes first.  (Issue 14: T is now also an option of two-trajectory, so the row that refused T for
+    two-trajectory asks return-map, the one method without T.)"""
     t0 = time.perf_counter()
     with pytest.raises(TypeError) as ei:
         lyapunov(P, method, **{option: 1})
@@ -153,3 +154,52 @@ def test_variational_method_refuses_a_bad_eps_and_equals_lyapunov_variational():
     a = lyapunov(p, "variational", t_transient=1.0, T=2.0)
     b = exact.lyapunov_variational(p, t_transient=1.0, T=2.0)
     assert (a.per_s, a.stderr_bits, a.n_jumps, a.notes) == (b.per_s, b.stderr_bits, b.n_jumps, b.notes)
+
+
+def test_two_trajectory_T_is_round_T_over_tau_intervals_and_excludes_n():
+    """Issue 14: ``T`` (measured seconds) is common to the methods that measure a time.  Hypothesis: for
+    two-trajectory ``T`` runs ``n = max(2, round(T/tau))`` intervals, bitwise the run with that ``n`` (0.1 s is
+    20 intervals of 0.005 s; 0.0124 s rounds to 2); giving both ``T`` and ``n`` is a ValueError naming both,
+    raised before any run (substrings)."""
+    kw = dict(t_transient=0.5, n_discard=2)
+    a, b = lyapunov(P, T=0.1, **kw), lyapunov(P, n=20, **kw)
+    assert (a.per_s, a.stderr_bits, a.n_jumps) == (b.per_s, b.stderr_bits, b.n_jumps)
+    assert list(a.benettin.running) == list(b.benettin.running)
+    c, d = lyapunov(P, T=0.0124, **kw), lyapunov(P, n=2, **kw)
+    assert (c.per_s, c.n_jumps) == (d.per_s, d.n_jumps)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"T .*n .*not both") as ei:
+        lyapunov(P, T=1.0, n=200)
+    assert "T=1.0" in str(ei.value) and "n=200" in str(ei.value)
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_check_lyapunov_options_checks_without_running():
+    """Hypothesis: ``exact.check_lyapunov_options(method, **options)`` returns the method and raises the
+    errors ``lyapunov`` would raise for the options (bad eps, T with n, another method's option, unknown
+    method), in well under a second and without pydiffsol (categorical; messages by substring)."""
+    from exact import check_lyapunov_options
+
+    t0 = time.perf_counter()
+    assert check_lyapunov_options("variational", eps=1e-7, T=5.0, progress=None) == "variational"
+    assert check_lyapunov_options() == "two-trajectory"
+    with pytest.raises(ValueError, match=r"^eps must be finite and in \[1e-15, 0.01\], got 1e-30"):
+        check_lyapunov_options("variational", eps=1e-30)
+    with pytest.raises(ValueError, match="not both"):
+        check_lyapunov_options("two-trajectory", T=1.0, n=10)
+    with pytest.raises(TypeError, match="'n_returns' is an option of method 'return-map'"):
+        check_lyapunov_options("tangent", n_returns=10)
+    with pytest.raises(ValueError, match="method must be one of"):
+        check_lyapunov_options("saltation")
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_return_map_takes_alpha0_like_the_dispatcher():
+    """Issue 14: ``lyapunov_return_map`` takes ``alpha0`` as ``lyapunov(p, "return-map", ...)`` does.
+    Hypothesis: from alpha0 = 0.1 the two are equal bitwise (exponent, standard error, local rates), and the
+    start matters (a different exponent than from 0: the transient's last section crossing moves)."""
+    kw = dict(t_transient=1.0, n_returns=6, h=1e-6)
+    a, b = lyapunov(P, "return-map", alpha0=0.1, **kw), lyapunov_return_map(P, alpha0=0.1, **kw)
+    assert (a.per_s, a.stderr_bits, a.n_jumps) == (b.per_s, b.stderr_bits, b.n_jumps)
+    assert list(a.benettin.local) == list(b.benettin.local)
+    assert a.per_s != lyapunov_return_map(P, **kw).per_s

@@ -160,7 +160,9 @@ def test_long_run_constraint_does_not_drift_short():
 
 def test_bad_inputs_raise_value_error():
     """Hypothesis: bad arguments to the stress API raise ValueError naming the
-    argument and its valid range.
+    argument and its valid range.  (Issue 14: the budgets are checked by peelapprox.validate.integer, whose
+    one message pattern, "an integer in [1, 1e15]", replaced the hand-written "a positive integer"; an
+    integral float such as 3.0 is now refused as well, as counts are integers.)
 
     Tolerance: none.
     """
@@ -170,8 +172,10 @@ def test_bad_inputs_raise_value_error():
         StressPoint(V=1.0, I=1e-3, rtol=0.1)
     with pytest.raises(ValueError, match="save must be"):
         StressPoint(V=1.0, I=1e-3, save="all")
-    with pytest.raises(ValueError, match="max_jumps must be a positive integer"):
+    with pytest.raises(ValueError, match=r"max_jumps must be an integer in \[1, 1e15\], got 0"):
         StressPoint(V=1.0, I=1e-3, max_jumps=0)
+    with pytest.raises(TypeError, match="max_steps must be an integer"):
+        StressPoint(V=1.0, I=1e-3, max_steps=3.0)
     with pytest.raises(ValueError, match="point must be a StressPoint"):
         run_point({"V": 1.0})
     with pytest.raises(ValueError, match="timeout must be"):

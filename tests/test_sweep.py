@@ -253,7 +253,9 @@ def test_resume_tolerates_rebuilt_grid_roundoff(tmp_path):
 
 
 def test_validation_messages(tmp_path):
-    """Hypothesis: bad arguments raise ValueError naming the argument and its valid range (or the known measures)."""
+    """Hypothesis: bad arguments raise ValueError naming the argument and its valid range (or the known measures).
+    (Issue 14: max_workers is checked by peelapprox.validate.integer, whose one message pattern replaced the
+    hand-written "an integer in [0, inf) (0: in this process)".)"""
     out = tmp_path / "sw"
     with pytest.raises(ValueError, match=r"I_values .*empty array"):
         sweep([], V2, out=out)
@@ -263,7 +265,7 @@ def test_validation_messages(tmp_path):
         sweep(I2, [1.0, 1.0], out=out)
     with pytest.raises(ValueError, match=r"unknown measure\(s\) \['nope'\]; known: \[.*'jumps'.*'regime'"):
         sweep(I2, V2, "regime,nope", out=out)
-    with pytest.raises(ValueError, match=r"max_workers must be an integer in \[0, inf\) \(0: in this process\)"):
+    with pytest.raises(ValueError, match=r"max_workers must be an integer in \[0, 1e15\], got -1"):
         sweep(I2, V2, out=out, max_workers=-1)
     with pytest.raises(ValueError, match="options must be JSON-serialisable"):
         sweep(I2, V2, out=out, options={"x": object()})

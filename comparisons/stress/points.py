@@ -13,12 +13,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-from peelapprox import GEOMETRIES, RTOL_RANGE
-from peelapprox.validate import finite, in_range, nonnegative, positive
+from peelapprox import GEOMETRIES
+from peelapprox.validate import finite, integer, nonnegative, positive
+from peelapprox.validate import rtol as _rtol
 
 __all__ = [
     "GRID_I", "GRID_V", "GRID_K", "GRID_ALPHA0", "RANDOM_BOX", "TOL_RTOLS", "TOL_POINTS", "LONG_RUNS",
@@ -87,12 +87,6 @@ _METHODS = ("hybrid", "regularized")
 _SAVES = ("steps", "jumps")
 
 
-def _posint(name: str, x: Any) -> int:
-    if isinstance(x, bool) or not isinstance(x, (int, np.integer, float)) or int(x) != x or x < 1:
-        raise ValueError(f"{name} must be a positive integer (>= 1), got {x!r}")
-    return int(x)
-
-
 @dataclass(frozen=True)
 class StressPoint:
     """One run of the stress suite: the arguments of :func:`exact.simulate`.
@@ -151,7 +145,7 @@ class StressPoint:
         for name in ("V", "I", "k", "t_end"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "alpha0", finite("alpha0", self.alpha0))
-        object.__setattr__(self, "rtol", in_range("rtol", self.rtol, *RTOL_RANGE))
+        object.__setattr__(self, "rtol", _rtol("rtol", self.rtol))
         if self.atol is not None:
             object.__setattr__(self, "atol", nonnegative("atol", self.atol))
         if self.method not in _METHODS:
@@ -160,11 +154,9 @@ class StressPoint:
             raise ValueError(f"geometry must be one of {GEOMETRIES}, got {self.geometry!r}")
         if self.save not in _SAVES:
             raise ValueError(f"save must be one of {_SAVES}, got {self.save!r}")
-        if isinstance(self.n_eval, bool) or int(self.n_eval) != self.n_eval or self.n_eval < 0:
-            raise ValueError(f"n_eval must be an integer >= 0 (0: no t_eval), got {self.n_eval!r}")
-        object.__setattr__(self, "n_eval", int(self.n_eval))
+        object.__setattr__(self, "n_eval", integer("n_eval", self.n_eval, lo=0))  # 0: no t_eval
         for name in ("max_steps", "max_jumps", "max_points"):
-            object.__setattr__(self, name, _posint(name, getattr(self, name)))
+            object.__setattr__(self, name, integer(name, getattr(self, name)))
         if self.n_eval > self.max_points:
             raise ValueError(f"n_eval must be in [0, max_points] = [0, {self.max_points}], got {self.n_eval}")
 
@@ -264,8 +256,7 @@ def random_points(n: int = N_RANDOM, seed: int = RANDOM_SEED, t_end: float = GRI
     t_end : float
         Horizon [s], > 0.
     """
-    if isinstance(n, bool) or int(n) != n or n < 0:
-        raise ValueError(f"n must be an integer >= 0, got {n!r}")
+    n = integer("n", n, lo=0)
     t_end = positive("t_end", t_end)
     rng = np.random.default_rng(int(seed))
     B = RANDOM_BOX

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import datetime as _dt
-import numbers
 import os
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
@@ -15,7 +14,7 @@ import numpy as np
 
 from peelapprox import PARAM_RANGES
 from peelapprox.io import jsonable
-from peelapprox.validate import ArgumentTypeError
+from peelapprox.validate import ArgumentTypeError, integer, optional
 from peelapprox.validate import path as _path
 
 from .._worker import SERIAL, Progress, run_tasks, write_line
@@ -149,10 +148,8 @@ def sweep(
         raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
             from None
     _check_options(measures, options)
+    max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
     if max_workers is not None:
-        if isinstance(max_workers, bool) or not isinstance(max_workers, numbers.Integral) or max_workers < 0:
-            raise ValueError(f"max_workers must be an integer in [0, inf) (0: in this process) or None, "
-                             f"got {max_workers!r}")
         if executor is not None:
             raise ValueError("max_workers applies only to the local process pool (executor=None); "
                              "size your executor instead")

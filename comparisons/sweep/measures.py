@@ -23,8 +23,21 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import LYAPUNOV_TAU, RTOL_RANGE, T_TRANSIENT, TIME_MAX, ModelBreakdown, PeelParams, estimate
+from exact import lyapunov, window_run
+from peelapprox import (
+    LYAPUNOV_TAU,
+    T_TRANSIENT,
+    TIME_MAX,
+    WINDOW_DEFAULTS,
+    ModelBreakdown,
+    PeelParams,
+    classify,
+    estimate,
+    force_drops,
+    return_map,
+)
 from peelapprox.validate import duration, in_range, positive, state
+from peelapprox.validate import rtol as _rtol
 
 from .store import RESERVED
 
@@ -101,15 +114,8 @@ def record_key(name: str, key: str) -> str:
 
 
 # --------------------------------------------------------------------------------------------- built-in measures
-
-def _window_api() -> tuple[Callable[..., Any], Callable[..., Any], dict]:
-    """``(window_run, classify, WINDOW_DEFAULTS)``: the one windowed exact run behind ``jumps`` and ``period``
-    (its last call is cached, so the two measures of a point share it), imported at call time."""
-    from exact import window_run
-    from peelapprox import WINDOW_DEFAULTS, classify
-
-    return window_run, classify, WINDOW_DEFAULTS
-
+# ``jumps`` and ``period`` share the one windowed exact run, :func:`exact.window_run` (its last call is cached,
+# so the two measures of a point compute it once).
 
 def _measure_regime(params: PeelParams, options: Mapping) -> dict:
     """Regime label of :func:`peelapprox.estimate` and its closed-form time scales (a few ms)."""
@@ -142,9 +148,6 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     None.  A :class:`ModelBreakdown` gives ``status = "breakdown:<reason>"``
     and the breakdown time ``t_breakdown``.
     """
-    from peelapprox import force_drops, return_map
-
-    window_run = _window_api()[0]
     try:  # the same windowed run (and defaults) as the `period` measure: computed once per point
         traj = window_run(params, **_window_options(options))
     except ModelBreakdown as exc:
@@ -171,11 +174,11 @@ def _window_options(options) -> dict:
     """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted),
     checked by the same validators as :func:`window_run` (ValueError/TypeError naming the option and its valid
     range; the sweep calls this before the first point)."""
-    kw = dict(_window_api()[2])
+    kw = dict(WINDOW_DEFAULTS)
     kw.update({key: options[key] for key in kw if options.get(key) is not None})
     kw["t_transient"] = duration("t_transient", kw["t_transient"], zero=True)
     kw["alpha0"] = state("alpha0", kw["alpha0"], "alpha")
-    kw["rtol"] = in_range("rtol", kw["rtol"], *RTOL_RANGE)
+    kw["rtol"] = _rtol("rtol", kw["rtol"])
     if options.get("t_end") is not None:
         t_end = duration("t_end", options["t_end"])
         if not t_end > kw["t_transient"]:
@@ -208,7 +211,6 @@ def measure_period(params: PeelParams, options) -> dict:
     ``t_transient`` = 30 s, ``t_end`` = t_transient + 20 s, ``rtol`` = 1e-10, ``alpha0`` = 0,
     ``period_rtol`` = 1e-6).  ``period`` is None when aperiodic (no n <= 32 repeats), too short or without
     stick-slip; a ``ModelBreakdown`` is ``status = "breakdown:<reason>"``."""
-    window_run, classify, _ = _window_api()
     kw = _period_options(options)
     period_rtol = kw.pop("period_rtol")
     try:
@@ -221,15 +223,12 @@ def measure_period(params: PeelParams, options) -> dict:
 
 
 def measure_lyapunov(params: PeelParams, options) -> dict:
-    """Sweep measure ``lyapunov``: :func:`lyapunov` with its defaults, except options ``t_transient`` (30 s)
-    and ``lyapunov_time`` (50 s of renormalisation intervals of 0.005 s)."""
-    from exact import lyapunov
-
-    tau = LYAPUNOV_TAU
+    """Sweep measure ``lyapunov``: :func:`lyapunov` with its defaults, except options ``t_transient`` (30 s),
+    ``alpha0`` (0) and ``lyapunov_time``, its measured time ``T`` (50 s: ``round(T/tau)`` renormalisation
+    intervals of 0.005 s)."""
     kw = _lyapunov_options(options)
     try:
-        r = lyapunov(params, t_transient=kw["t_transient"], tau=tau, n=max(2, int(kw["lyapunov_time"] / tau)),
-                     alpha0=kw["alpha0"])
+        r = lyapunov(params, t_transient=kw["t_transient"], T=kw["lyapunov_time"], alpha0=kw["alpha0"])
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
     return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}

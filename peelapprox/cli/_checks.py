@@ -26,6 +26,7 @@ __all__ = [
     "exit_status",
     "finite_float_list",
     "nonnegative_float",
+    "nonnegative_int",
     "one_line",
     "positive_float",
     "positive_int",
@@ -56,15 +57,25 @@ def nonnegative_float(text: str) -> float:
     return _argtype(_validate.nonnegative, text)
 
 
-def positive_int(text: str) -> int:
-    """Argparse type: an integer >= 1, written as one (``"3"``, not ``"3.0"`` or ``"inf"``)."""
+def _int_at_least(text: str, lo: int) -> int:
+    """``int(text)`` if ``text`` is written as an integer (``"3"``, not ``"3.0"`` or ``"inf"``) >= ``lo``."""
     try:
         n = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"value must be an integer >= 1, got {text!r}") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"value must be an integer >= 1, got {text!r}")
+        n = lo - 1
+    if n < lo:
+        raise argparse.ArgumentTypeError(f"value must be an integer >= {lo}, got {text!r}")
     return n
+
+
+def positive_int(text: str) -> int:
+    """Argparse type: an integer >= 1, written as one (``"3"``, not ``"3.0"`` or ``"inf"``)."""
+    return _int_at_least(text, 1)
+
+
+def nonnegative_int(text: str) -> int:
+    """Argparse type: an integer >= 0, written as one."""
+    return _int_at_least(text, 0)
 
 
 def finite_float_list(text: str) -> list[float]:

@@ -7,50 +7,60 @@ import argparse
 import json
 import sys
 
-from .. import LYAPUNOV_TAU, T_TRANSIENT, PeelParams
+from .. import EPS_DEFAULT, WINDOW_DEFAULTS, PeelParams
+from ..io import fmt_number
 from ._checks import check_output_path, finite_float_list, nonnegative_float, positive_float, positive_int
 from ._common import add_params, print_mapping, say, write_table
 
-__all__ = ["LYAPUNOV_METHODS", "add_parser", "run"]
+__all__ = ["LYAPUNOV_ALIASES", "LYAPUNOV_METHODS", "add_parser", "run"]
 
-#: ``peelapprox dynamics --lyapunov-method`` choices.
-LYAPUNOV_METHODS = ("two-trajectory", "saltation", "return-map", "regularized")
+#: ``peelapprox dynamics --lyapunov-method`` choices: the methods of ``exact.lyapunov`` (``exact._lyapunov.METHODS``,
+#: not imported here: the parser is built without loading ``exact``; tests/test_cli.py keeps the two equal).
+LYAPUNOV_METHODS = ("two-trajectory", "tangent", "return-map", "variational")
+#: Earlier names of two of them, still accepted: alias -> method.
+LYAPUNOV_ALIASES = {"saltation": "tangent", "regularized": "variational"}
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
     dy = sub.add_parser("dynamics", help="period of the return map, force drops, settle time, attractors, "
                                          "Lyapunov exponent at one (V, I)")
     add_params(dy)
-    dy.add_argument("--alpha0", type=float, default=0.0)
-    dy.add_argument("--t-transient", type=nonnegative_float, default=T_TRANSIENT,
-                    help=f"discarded [s] ({T_TRANSIENT:g})")
-    dy.add_argument("--window", type=positive_float, default=20.0, help="analysed [s] (20)")
-    dy.add_argument("--rtol", type=float, default=1e-10)
+    w = WINDOW_DEFAULTS
+    dy.add_argument("--alpha0", type=float, default=w["alpha0"])
+    dy.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"],
+                    help=f"discarded [s] ({w['t_transient']:g})")
+    dy.add_argument("--window", type=positive_float, default=w["window"], help=f"analysed [s] ({w['window']:g})")
+    dy.add_argument("--rtol", type=float, default=w["rtol"], help=f"of the window's run ({w['rtol']:g})")
     dy.add_argument("--max-period", type=positive_int, default=32)
     dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (a few s)")
-    dy.add_argument("--lyapunov-method", choices=LYAPUNOV_METHODS,
-                    help="how (implies --lyapunov): two-trajectory renormalisation (the default), saltation "
-                         "(tangent dynamics with saltation matrices), return-map (tangent of the jump-to-jump "
-                         "map), regularized (variational equations of the ε-system; needs pydiffsol)")
+    dy.add_argument("--lyapunov-method", choices=(*LYAPUNOV_METHODS, *LYAPUNOV_ALIASES), metavar="METHOD",
+                    help="how (implies --lyapunov), a method of exact.lyapunov: two-trajectory renormalisation "
+                         "(the default), tangent (tangent dynamics with saltation matrices; alias saltation), "
+                         "return-map (tangent of the jump-to-jump map, its returns as many as the window's "
+                         "return rate gives in --lyapunov-time), variational (variational equations of the "
+                         "ε-system; alias regularized; needs pydiffsol)")
     dy.add_argument("--lyapunov-time", type=positive_float, default=50.0, help="measured time [s] (50)")
-    dy.add_argument("--eps", type=float, default=1e-7, help="ε of --lyapunov-method regularized (1e-7)")
+    dy.add_argument("--eps", type=float, default=EPS_DEFAULT,
+                    help=f"ε of --lyapunov-method variational ({fmt_number(EPS_DEFAULT, 3, short_exponent=True)})")
     dy.add_argument("--attractors", type=finite_float_list, metavar="A0,A0,...",
                     help="sample these initial peel angles for coexisting attractors")
     dy.add_argument("--format", choices=("table", "json"), default="table")
     dy.add_argument("--out", help="also write the summary row to this .csv or .json")
     dy.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
-                    help="wall-clock budget of each computation (run, two-trajectory λ, attractors) [s] (600)")
+                    help="wall-clock budget of each computation (run, Lyapunov exponent, attractors) [s] (600)")
     return dy
 
 
 def run(args: argparse.Namespace) -> int:
-    from exact import ModelBreakdown, attractors, simulate
+    from exact import ModelBreakdown, attractors, check_lyapunov_options, lyapunov, simulate
 
     from .. import force_drops, periodicity, return_map, settle_time
 
     out = check_output_path(args.out, "table", "--out") if args.out else None
-    if args.lyapunov_method == "return-map" and args.alpha0 != 0.0:
-        raise ValueError("--lyapunov-method return-map starts from alpha0 = 0 only; drop --alpha0")
+    wants_lyapunov = bool(args.lyapunov or args.lyapunov_method)
+    if wants_lyapunov:  # the method's options, checked before the window run (named as the CLI spells them)
+        method, options = _lyapunov_options(args, returns=None)
+        check_lyapunov_options(method, **options)
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
     if args.attractors:  # checked before the run, named as the user wrote it
         from ..validate import states
@@ -76,14 +86,16 @@ def run(args: argparse.Namespace) -> int:
                    F_min_at_jumps=float(x.min()) if x.size else None, F_max_at_jumps=float(x.max()) if x.size else None)
     except ModelBreakdown as exc:
         row.update(status=f"breakdown:{exc.reason} at t={exc.t:.6g}")
-    if args.lyapunov or args.lyapunov_method:
-        method = args.lyapunov_method or "two-trajectory"
-        print(f"lyapunov ({method}, {args.lyapunov_time:g} s after {args.t_transient:g} s) ...", file=sys.stderr,
+    if wants_lyapunov:
+        name = args.lyapunov_method or "two-trajectory"
+        print(f"lyapunov ({name}, {args.lyapunov_time:g} s after {args.t_transient:g} s) ...", file=sys.stderr,
               flush=True)
-        ly = _lyapunov_by_method(p, method, args, row.get("returns"))
-        row.update(lyapunov_method=method, lyapunov_time=args.lyapunov_time, lyapunov_bits_per_s=ly.bits_per_s,
+        method, options = _lyapunov_options(args, returns=row.get("returns", 0))
+        ly = lyapunov(p, method, t_transient=args.t_transient, alpha0=args.alpha0, max_wall=args.max_wall,
+                            **options)
+        row.update(lyapunov_method=name, lyapunov_time=args.lyapunov_time, lyapunov_bits_per_s=ly.bits_per_s,
                    lyapunov_stderr=ly.stderr_bits, lyapunov_wall_time=ly.benettin.wall_time)
-        if method == "regularized":
+        if method == "variational":
             row.update(eps=args.eps)
     print_mapping(row, args.format)
     if args.attractors:
@@ -104,22 +116,21 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, returns):
-    """The largest Lyapunov exponent at ``p`` by one of :data:`LYAPUNOV_METHODS` over ``args.lyapunov_time`` s."""
-    import exact
-
-    T, common = args.lyapunov_time, dict(t_transient=args.t_transient, alpha0=args.alpha0)
-    if method == "two-trajectory":
-        tau = LYAPUNOV_TAU
-        return exact.lyapunov(p, tau=tau, n=max(2, int(round(T / tau))), max_wall=args.max_wall, **common)
-    if method == "saltation":
-        return exact.lyapunov_tangent(p, T=T, **common)
-    if method == "return-map":  # alpha0 = 0: checked by the subcommand before the run
+def _lyapunov_options(args: argparse.Namespace, returns: int | None) -> tuple[str, dict]:
+    """``(method, options)`` of ``exact.lyapunov`` for ``--lyapunov-method`` (aliases mapped) and
+    ``--lyapunov-time`` T: T itself where the method measures a time; for return-map as many returns as the
+    window's return rate gives in T (``returns`` in the window; None: not known yet, before the window run)."""
+    name = args.lyapunov_method or "two-trajectory"
+    method = LYAPUNOV_ALIASES.get(name, name)
+    T = args.lyapunov_time
+    if method == "return-map":
+        if returns is None:
+            return method, {}
         if not returns:
-            raise ValueError("--lyapunov-method return-map needs AB→CD returns in the window; there are none")
-        return exact.lyapunov_return_map(p, t_transient=args.t_transient, max_wall=args.max_wall,
-                                         n_returns=max(2, int(round(returns / args.window * T))))
-
+            raise ValueError(f"--lyapunov-method {name} needs AB→CD returns in the window; there are none")
+        return method, {"n_returns": max(2, int(round(returns / args.window * T)))}
+    if method != "variational":
+        return method, {"T": T}
     step = max(args.t_transient + T, 1e-9) / 10.0
     mark = [step]
 
@@ -128,4 +139,4 @@ def _lyapunov_by_method(p: PeelParams, method: str, args: argparse.Namespace, re
             print(f"  {t_done:g}/{t_total:g} s", file=sys.stderr, flush=True)
             mark[0] += step
 
-    return exact.lyapunov_variational(p, eps=args.eps, T=T, progress=progress, **common)
+    return method, {"eps": args.eps, "T": T, "progress": progress}

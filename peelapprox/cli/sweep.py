@@ -8,7 +8,7 @@ import os
 import sys
 import time
 
-from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler
+from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler, nonnegative_int, positive_int
 
 __all__ = ["add_parser", "run"]
 
@@ -25,9 +25,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     help="output directory: sweep.json, results.jsonl (one line per point), results.csv; "
                          "an existing DIR with the same grid, measures and options is resumed")
     where = sw.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, default=None, metavar="N",
+    where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
                        help="local worker processes (default: all CPUs; 0: in this process)")
-    where.add_argument("--dask-local", type=int, default=None, metavar="N",
+    where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
                        help="start a dask LocalCluster with N single-threaded worker processes")
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
                        help="connect to a running dask scheduler, e.g. tcp://host:8786")
@@ -58,10 +58,6 @@ def run(args: argparse.Namespace) -> int:
     I_values = parse_grid(args.I, name="--I")
     V_values = parse_grid(args.V, name="--V")
     options = _options(args)
-    if args.workers is not None and args.workers < 0:
-        raise ValueError(f"--workers must be >= 0 (0: in this process), got {args.workers}")
-    if args.dask_local is not None and args.dask_local < 1:
-        raise ValueError(f"--dask-local must be >= 1 workers, got {args.dask_local}")
     check_output_path(args.out, "dir", "--out", read_only_ok=True)  # a complete sweep is only read
     if args.plot:
         check_sweep_plot_key(args.plot, [m.strip() for m in args.measure.split(",") if m.strip()])

@@ -11,9 +11,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from exact import default_atol, initial_state
-from peelapprox import EPS_RANGE, branch_structure
+from peelapprox import branch_structure
 from peelapprox.kernels import PeerUnavailableError, import_optional
 from peelapprox.validate import choice, duration, in_range, reals
+from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
 
 from . import diffsol, sundials
@@ -109,7 +110,7 @@ def available_peers() -> tuple[str, ...]:
 def _check(peer, params, t_end, eps, rtol, atol):
     choice("peer", peer, PEERS)
     _params("params", params)
-    t_end, eps = duration("t_end", t_end), in_range("eps", eps, *EPS_RANGE)
+    t_end, eps = duration("t_end", t_end), _eps("eps", eps)
     rt = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
     if atol is not None:
         reals("atol", atol, 0.0)  # kind and sign; exact.simulate's parser checks the shape
