@@ -53,7 +53,7 @@ API = {
     "peelapprox.validate": {
         "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",
         "interval", "nonnegative", "optional", "optional_finite", "params", "path", "positive", "real", "reals",
-        "state", "states", "times",
+        "state", "states", "times", "rtol", "eps",
     },
     "peelapprox.errors": {
         "KernelCacheWarning", "ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "WallBudget",
