@@ -80,7 +80,6 @@ EPS_RANGE = (1e-15, 1e-2)
 EPS_DEFAULT = 1e-7
 
 
-
 @dataclass(frozen=True)
 class PeelParams:
     """Physical parameters of the peeling model (SI units).

@@ -90,7 +90,6 @@ def params(name: str, x: Any):
     return x
 
 
-
 def state(name: str, x: Any, quantity: str) -> float:
     """A scalar state variable in its range :data:`peelapprox._params.STATE_RANGES` [quantity].
 
@@ -101,12 +100,10 @@ def state(name: str, x: Any, quantity: str) -> float:
     return in_range(name, x, lo, hi, lo_open=quantity == "v")
 
 
-
 def states(name: str, x: Any, quantity: str) -> np.ndarray:
     """:func:`state` for an array (any shape, scalars as 0-d), every element checked (:func:`reals`)."""
     lo, hi = STATE_RANGES[quantity]
     return reals(name, x, lo, hi, lo_open=quantity == "v")
-
 
 
 def duration(name: str, x: Any, *, zero: bool = False) -> float:

@@ -60,9 +60,8 @@ def _ref(fn: Callable) -> str:
 
 def register_measure(name: str, fn: Measure | None = None, *, replace: bool = False,
                      check_options: OptionCheck | None = None):
-    """Register ``fn(params, options) -> dict`` under ``name``.
-
-    without ``fn`` it returns a decorator.
+    """Register ``fn(params, options) -> dict`` under ``name``; called without ``fn``, return a decorator that
+    registers the function it decorates.
 
     Parameters
     ----------

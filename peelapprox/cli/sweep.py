@@ -52,8 +52,7 @@ def _options(args: argparse.Namespace) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from comparisons.sweep import load_sweep, parse_grid, sweep
-    from comparisons.sweep.store import MANIFEST, RESULTS
+    from comparisons.sweep import MANIFEST, RESULTS, load_sweep, parse_grid, sweep
 
     I_values = parse_grid(args.I, name="--I")
     V_values = parse_grid(args.V, name="--V")
