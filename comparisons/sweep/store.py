@@ -15,7 +15,7 @@ import os
 import stat
 import sys
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import IO, Any
 
 from peelapprox.io import fmt_number, jsonable
@@ -349,7 +349,8 @@ class Plan:
     ``todo`` (keys to compute, grid order), ``total``.
     """
 
-    def __init__(self, out, I_vals, V_vals, measures, options, resume, retry_failed):
+    def __init__(self, out: str, I_vals: list[float], V_vals: list[float], measures: Sequence[str],
+                 options: Mapping[str, Any], resume: bool, retry_failed: bool) -> None:
         self.out, self.measures, self.options = out, measures, options
         others = [f for f in os.listdir(out) if f not in (LOCK, *TEMPORARY)]
         if os.path.lexists(os.path.join(out, MANIFEST)):
