@@ -1,3 +1,3 @@
 """The package version, single-sourced: pyproject.toml reads it from here (``[tool.setuptools.dynamic]``)."""
 
-__version__ = "0.2.0"
+__version__ = "0.3.0.dev0"

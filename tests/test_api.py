@@ -1,6 +1,6 @@
 """The public API of each package (issue 14: names that move between rooms must keep working).
 
-Each set below is the package's public API as of 0.2.0.  A name may be added to a package (then add it
+Each set below is the package's public API as of 0.3.0.dev0.  A name may be added to a package (then add it
 here), but one listed here may not disappear: the test fails if it is missing from ``__all__`` or does not
 resolve.  Moves record themselves in CHANGELOG.md.
 """
