@@ -70,25 +70,26 @@ def _check_arrays(va: np.ndarray, fa: np.ndarray, label: str) -> tuple[tuple[flo
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
             i = int(bad[0])
-            raise ValueError(f"{name}{label} must be finite: {name}[{i}] = {a[i]!r}")
+            raise ValueError(f"{name}{label} must be finite: {name}[{i}] = {float(a[i])!r}")
     bad = np.flatnonzero(va <= 0)
     if bad.size:
         i = int(bad[0])
-        raise ValueError(f"v{label} must be > 0 (peel velocities in m/s): v[{i}] = {va[i]!r}")
+        raise ValueError(f"v{label} must be > 0 (peel velocities in m/s): v[{i}] = {float(va[i])!r}")
     bad = np.flatnonzero(np.diff(va) <= 0)
     if bad.size:
         i = int(bad[0])
-        raise ValueError(f"v{label} must be strictly increasing: v[{i}] = {va[i]!r} >= v[{i + 1}] = {va[i + 1]!r}")
+        raise ValueError(f"v{label} must be strictly increasing: v[{i}] = {float(va[i])!r} >= "
+                         f"v[{i + 1}] = {float(va[i + 1])!r}")
     bad = np.flatnonzero(fa <= 0)
     if bad.size:
         i = int(bad[0])
-        raise ValueError(f"f{label} must be > 0 (a peel force in N): f[{i}] = {fa[i]!r} at v = {va[i]!r}")
+        raise ValueError(f"f{label} must be > 0 (a peel force in N): f[{i}] = {float(fa[i])!r} at v = {float(va[i])!r}")
     d = np.diff(fa)
     bad = np.flatnonzero(d == 0)
     if bad.size:
         i = int(bad[0])
         raise ValueError(f"f{label} must have no flat step (the fold would be ambiguous): f[{i}] = f[{i + 1}] "
-                         f"= {fa[i]!r} at v = {va[i]!r}, {va[i + 1]!r}")
+                         f"= {float(fa[i])!r} at v = {float(va[i])!r}, {float(va[i + 1])!r}")
     turns = np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:])) + 1  # interior local extrema of the data
     kinds = ["max" if d[i - 1] > 0 else "min" for i in turns]
     if kinds != ["max", "min"]:
