@@ -20,7 +20,6 @@ at ``import peelapprox``, by :mod:`peelapprox._law_paper` (:func:`register_paper
 from __future__ import annotations
 
 import hashlib
-import math
 import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -121,7 +120,7 @@ class PeelForce:
             source = _law_expr.canonical(_sympify(source), {})
         elif kind == "tabulated":
             tables = (_canonical_tables(tables[0][1], tables[0][2], tables[0][0]) if len(tables) == 1
-                      else _law_table.check_tables(tables))
+                      else _law_table.check_tables(tables, _hooks()["V_range"]))
         extra = [name for name, e in empty.items() if not e and name not in needs]
         if extra:
             raise ValueError(f"a {kind!r} law takes no {', '.join(extra)}")
@@ -223,7 +222,7 @@ class PeelForce:
         if tables is not None:
             if v is not None or f is not None or V is not None:
                 raise ValueError("give either v and f (and V) or tables, not both")
-            return cls("tabulated", tables=_law_table.check_tables(tables))
+            return cls("tabulated", tables=_law_table.check_tables(tables, _hooks()["V_range"]))
         if v is None or f is None:
             raise ValueError("tabulated needs v and f (arrays of peel velocities [m/s] and forces [N])")
         return cls("tabulated", tables=_canonical_tables(v, f, V))
@@ -414,7 +413,7 @@ def _sympify(text: str) -> Any:
 
 
 def _canonical_tables(v: Any, f: Any, V: Any) -> tuple:
-    Vc = None if V is None else in_range("V", V, 0.0, math.inf, lo_open=True)
+    Vc = None if V is None else in_range("V", V, *_hooks()["V_range"])
     vv, ff = _law_table.check_table(v, f)
     return ((Vc, vv, ff),)
 

@@ -18,11 +18,9 @@ outside the table's range: a tabulated law is never extrapolated.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-__all__ = ["MIN_POINTS", "TableLaw", "check_table"]
+__all__ = ["MIN_POINTS", "TableLaw", "check_table", "check_tables"]
 
 #: Fewest points of a table: one maximum then one minimum, each with a neighbour on either side.
 MIN_POINTS = 5
@@ -150,8 +148,12 @@ class TableLaw:
         return out
 
 
-def check_tables(tables) -> tuple[tuple[float | None, tuple[float, ...], tuple[float, ...]], ...]:
-    """A sequence of ``(V, v, f)`` at increasing V (at least two) as canonical tuples, each checked."""
+Table = tuple[float | None, tuple[float, ...], tuple[float, ...]]
+
+
+def check_tables(tables, V_range: tuple[float, float]) -> tuple[Table, ...]:
+    """A sequence of ``(V, v, f)`` at increasing V (at least two, each in ``V_range``) as canonical tuples,
+    each table checked by :func:`check_table`."""
     from ._checks import in_range
 
     try:
@@ -164,7 +166,7 @@ def check_tables(tables) -> tuple[tuple[float | None, tuple[float, ...], tuple[f
     for n, item in enumerate(items):
         if not isinstance(item, (tuple, list)) or len(item) != 3:
             raise ValueError(f"tables[{n}] must be a (V, v, f) triple, got {type(item).__name__}")
-        V = in_range(f"V of tables[{n}]", item[0], 0.0, math.inf, lo_open=True)
+        V = in_range(f"V of tables[{n}]", item[0], *V_range)
         vv, ff = check_table(item[1], item[2], f" of tables[{n}] (V={V!r})")
         out.append((V, vv, ff))
     for n in range(1, len(out)):

@@ -272,6 +272,20 @@ def test_equality_hash_pickle_json_each_kind():
     assert eval(repr(PeelForce.power_branches()), {"PeelForce": PeelForce}) == PeelForce.power_branches()
 
 
+def test_expression_from_sympy_and_text_agree():
+    """Hypothesis: a sympy expression (its own symbols v, V, without assumptions) and the same text give one
+    law (equal, same key), and an expression law's derivatives are sympy's: f' of the cubic text equals
+    b - 2 c v + 3 d v² to 1e-13 relative (a few roundings of a short polynomial)."""
+    import sympy as sp
+
+    v, a = sp.symbols("v a")
+    law = PeelForce.expression(a + 300 * v - 300 * v**2 + 80 * v**3, a=150)
+    assert law == PeelForce.expression("a + 300*v - 300*v^2 + 80*v^3", a=150) and law.key == law.key
+    x = np.linspace(0.01, 5, 50)
+    assert np.allclose(law.df(x, 1.0), 300 - 600 * x + 240 * x**2, rtol=1e-13, atol=1e-13 * 300)
+    assert not law.depends_on_V and law.v_range == (1e-6, 1e3)
+
+
 def test_keys_are_stable_across_processes():
     """Hypothesis: a law's key (SHA-256 of its canonical content) is the same in another process with another
     hash seed (exact string equality): it can name a cache on disk."""
