@@ -119,12 +119,11 @@ class PeelForce:
                 raise TypeError(f"source of an expression law must be a string, got {type(source).__name__}")
             source = _law_expr.canonical(_sympify(source), {})
         elif kind == "tabulated":
-            tables = (_canonical_tables(tables[0][1], tables[0][2], tables[0][0]) if len(tables) == 1
-                      else _law_table.check_tables(tables, _hooks()["V_range"]))
+            tables = _law_table.check_tables(tables, _hooks()["V_range"])
         extra = [name for name, e in empty.items() if not e and name not in needs]
         if extra:
             raise ValueError(f"a {kind!r} law takes no {', '.join(extra)}")
-        for name, value in (("coefficients", coef), ("source", source), ("tables", tables)):
+        for name, value in (("coefficients", coef or ()), ("source", source), ("tables", tables or ())):
             object.__setattr__(self, name, value)
         if not self.display:
             object.__setattr__(self, "display", self._default_display())
@@ -141,10 +140,7 @@ class PeelForce:
         ValueError for an unknown family or coefficient name (the message lists the valid ones), a
         non-finite coefficient, or a non-positive scale (``v3``, ``A1``, ``v1``, ``m``).
         """
-        if name not in _law_families.FAMILIES:
-            raise ValueError(f"unknown peel-force family {name!r}: the families are "
-                             f"{', '.join(_law_families.FAMILIES)}")
-        return cls("family", name, _law_families.coefficients(_law_families.FAMILIES[name], coefficients))
+        return cls("family", name, tuple(coefficients.items()))
 
     @classmethod
     def paper_family(cls, **params: float) -> PeelForce:
@@ -201,7 +197,7 @@ class PeelForce:
         text = _law_expr.canonical(expr, constants)
         shown = ", ".join([repr(expr if isinstance(expr, str) else str(expr))]
                           + [f"{k}={_num(float(val))}" for k, val in constants.items()])
-        return cls("expression", source=text, display=shown)
+        return _restore("expression", None, (), text, (), shown)  # checked: no second parse and probe
 
     @classmethod
     def tabulated(cls, v: Any = None, f: Any = None, *, V: float | None = None, tables: Any = None) -> PeelForce:
@@ -222,18 +218,15 @@ class PeelForce:
         if tables is not None:
             if v is not None or f is not None or V is not None:
                 raise ValueError("give either v and f (and V) or tables, not both")
-            return cls("tabulated", tables=_law_table.check_tables(tables, _hooks()["V_range"]))
+            return cls("tabulated", tables=tables)
         if v is None or f is None:
             raise ValueError("tabulated needs v and f (arrays of peel velocities [m/s] and forces [N])")
-        return cls("tabulated", tables=_canonical_tables(v, f, V))
+        return cls("tabulated", tables=((V, v, f),))
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
         """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated."""
-        d = dict(d)
-        tables = tuple((t[0], tuple(t[1]), tuple(t[2])) for t in d.pop("tables", ()))
-        coef = tuple((str(n), x) for n, x in d.pop("coefficients", ()))
-        return cls(**d, coefficients=coef, tables=tables)
+        return cls(**dict(d))  # lists for tuples: __post_init__ makes them canonical
 
     # ------------------------------------------------------------------ value semantics
     def _key(self) -> tuple:
@@ -410,12 +403,6 @@ def _sympify(text: str) -> Any:
     import sympy as sp
 
     return sp.sympify(text)
-
-
-def _canonical_tables(v: Any, f: Any, V: Any) -> tuple:
-    Vc = None if V is None else in_range("V", V, *_hooks()["V_range"])
-    vv, ff = _law_table.check_table(v, f)
-    return ((Vc, vv, ff),)
 
 
 def _restore(kind: str, name: str | None, coefficients: tuple, source: str | None, tables: tuple,

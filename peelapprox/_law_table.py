@@ -152,25 +152,29 @@ Table = tuple[float | None, tuple[float, ...], tuple[float, ...]]
 
 
 def check_tables(tables, V_range: tuple[float, float]) -> tuple[Table, ...]:
-    """A sequence of ``(V, v, f)`` at increasing V (at least two, each in ``V_range``) as canonical tuples,
-    each table checked by :func:`check_table`."""
+    """``(V, v, f)`` triples as canonical tuples, each table checked by :func:`check_table`: one table (V a
+    pull speed in ``V_range`` or None: used at every V), or several at strictly increasing V in ``V_range``
+    whose v ranges overlap."""
     from ._checks import in_range
 
     try:
         items = list(tables)
     except TypeError:
         raise TypeError(f"tables must be a sequence of (V, v, f) triples, got {type(tables).__name__}") from None
-    if len(items) < 2:
-        raise ValueError(f"tables must hold at least two (V, v, f) triples (one table: pass v, f), got {len(items)}")
+    if not items:
+        raise ValueError("tables must hold at least one (V, v, f) triple, got none")
     out = []
     for n, item in enumerate(items):
         if not isinstance(item, (tuple, list)) or len(item) != 3:
             raise ValueError(f"tables[{n}] must be a (V, v, f) triple, got {type(item).__name__}")
+        if len(items) == 1:
+            V = None if item[0] is None else in_range("V", item[0], *V_range)
+            out.append((V, *check_table(item[1], item[2])))
+            break
         V = in_range(f"V of tables[{n}]", item[0], *V_range)
-        vv, ff = check_table(item[1], item[2], f" of tables[{n}] (V={V!r})")
-        out.append((V, vv, ff))
+        out.append((V, *check_table(item[1], item[2], f" of tables[{n}] (V={V!r})")))
     for n in range(1, len(out)):
-        if not out[n][0] > out[n - 1][0]:
+        if not out[n][0] > out[n - 1][0]:  # type: ignore[operator]  # several tables: every V is a number
             raise ValueError(f"the tables' pull speeds must be strictly increasing: tables[{n - 1}] has V="
                              f"{out[n - 1][0]!r}, tables[{n}] has V={out[n][0]!r}")
     lo, hi = max(t[1][0] for t in out), min(t[1][-1] for t in out)

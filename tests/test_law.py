@@ -375,6 +375,9 @@ def _bad_analytic():
         "min before max": (lambda: PeelForce.cubic(a=500, b=-300, c=-300, d=-80).folds(1.0),
                            "found a local min at v=0.69.*local max at v=1.8"),
         "decreasing": (lambda: PeelForce.expression("300 - v").folds(1.0), "decreases in v throughout"),
+        "a paper law with coefficients": (lambda: PeelForce("paper", coefficients=(("a", 1.0),)),
+                                         "'paper' law takes no coefficients"),
+        "unknown kind": (lambda: PeelForce.from_dict({"kind": "spline"}), "kind must be one of paper, family"),
         "v outside an expression's domain": (lambda: PeelForce.expression("v + 1").f(1e-7, 1.0),
                                              "outside the domain"),
     }
