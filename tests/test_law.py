@@ -316,6 +316,21 @@ def test_peelparams_default_unchanged():
         PeelParams(V=1, I=1e-5, force="cubic")  # type: ignore[arg-type]
 
 
+def test_saved_trajectory_records_the_law(tmp_path):
+    """Hypothesis: a trajectory saved with to_npz records its law in the meta JSON (dataclasses.asdict of
+    PeelParams) and loads back to equal params (exact equality); a file from before the field (no "force")
+    loads with the paper's law."""
+    p = PeelParams(V=1.0, I=1e-5)
+    tr = exact.simulate(p, 0.01, save="jumps")
+    tr.to_npz(tmp_path / "t.npz")
+    with np.load(tmp_path / "t.npz") as z:
+        meta = json.loads(str(z["meta"]))
+    assert meta["params"]["force"]["kind"] == "paper"
+    assert exact.Trajectory.from_npz(tmp_path / "t.npz").params == p
+    old = {k: x for k, x in meta["params"].items() if k != "force"}
+    assert PeelParams(**old) == p and PeelParams(**old).force is PeelForce.paper()
+
+
 CONSUMERS = {
     "simulate": lambda p: exact.simulate(p, 0.1),
     "estimate": lambda p: pa.estimate(p),
