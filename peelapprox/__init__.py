@@ -15,6 +15,7 @@ dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lya
 ``force_drops``, ``settle_time``) is the core's own.
 """
 
+from . import _law_paper  # noqa: F401  (hands the built-in law to PeelForce; see its docstring)
 from ._alpha import (
     ALPHA_FORMS,
     InertialPeriods,
@@ -42,6 +43,8 @@ from ._estimate import (
     quasi_static_branch_time,
     slope_criterion,
 )
+from ._law import PeelForce
+from ._law_folds import Folds
 from ._params import (
     EPS_DEFAULT,
     EPS_RANGE,
@@ -73,6 +76,8 @@ from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, So
 
 __all__ = [
     "PeelParams",
+    "PeelForce",
+    "Folds",
     "GEOMETRIES",
     "PARAM_RANGES",
     "STATE_RANGES",

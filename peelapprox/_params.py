@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import math
 import types
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from ._checks import choice, in_range
+from ._checks import ArgumentTypeError, _got, choice, in_range
+from ._law import PeelForce
 
 __all__ = ["EPS_DEFAULT", "EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
            "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
@@ -80,7 +82,7 @@ EPS_RANGE = (1e-15, 1e-2)
 EPS_DEFAULT = 1e-7
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class PeelParams:
     """Physical parameters of the peeling model (SI units).
 
@@ -101,6 +103,12 @@ class PeelParams:
     geometry : {"paper", "exact"}, default "paper"
         Closure of ``cos θ``: the paper's ``-sin α`` or the exact
         ``-l sin α / L(α)``.
+    force : PeelForce, default ``PeelForce.paper()``
+        The peel-force law f(v, V) (fvV by default).  A mapping (as
+        ``dataclasses.asdict`` writes it) is turned back into a law.  Other
+        laws than the paper's are refused, for now, by the functions that
+        use the parameters (issue 15); the default leaves ``repr``,
+        equality and ``hash`` as they were before the field existed.
 
     Raises
     ------
@@ -162,6 +170,7 @@ class PeelParams:
     R: float = 0.1
     l: float = 1.0
     geometry: str = field(default="paper")
+    force: PeelForce = field(default=PeelForce.paper())
 
     def __post_init__(self) -> None:
         for name, (lo, hi) in PARAM_RANGES.items():
@@ -172,6 +181,22 @@ class PeelParams:
                 f"[{L_OVER_R_MIN * self.R:g}, {PARAM_RANGES['l'][1]:g}], got l={self.l!r} with R={self.R!r}"
             )
         object.__setattr__(self, "geometry", choice("geometry", self.geometry, GEOMETRIES))
+        if isinstance(self.force, Mapping):  # as dataclasses.asdict (a saved trajectory's JSON) wrote it
+            object.__setattr__(self, "force", PeelForce.from_dict(self.force))
+        if not isinstance(self.force, PeelForce):
+            raise ArgumentTypeError(f"force must be a PeelForce (e.g. PeelForce.paper()), got {_got(self.force)}")
+
+    def _fields(self) -> tuple:
+        """The fields as before ``force`` existed, then ``force`` if it is not the paper's law."""
+        base = (self.V, self.I, self.k, self.R, self.l, self.geometry)
+        return base if self.force.kind == "paper" else base + (self.force,)
+
+    def __hash__(self) -> int:
+        return hash(self._fields())
+
+    def __repr__(self) -> str:
+        names = ("V", "I", "k", "R", "l", "geometry", "force")
+        return f"PeelParams({', '.join(f'{n}={x!r}' for n, x in zip(names, self._fields()))})"
 
     def closure(self, alpha):
         """``(c, dc/dα)`` with ``c = -cos θ`` for this geometry; scalar or array ``alpha``."""

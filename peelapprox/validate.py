@@ -54,6 +54,7 @@ from ._checks import (
     reals,
     times,
 )
+from ._law import require_paper_force
 from ._params import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX, PeelParams
 
 __all__ = [
@@ -84,9 +85,14 @@ __all__ = [
 
 
 def params(name: str, x: Any):
-    """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError."""
+    """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError.
+
+    A ValueError, for now, if ``x.force`` is not the paper's law: every function that validates its
+    parameters here still evaluates fvV itself (issue 15); the message names that function.
+    """
     if not isinstance(x, PeelParams):
         raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
+    require_paper_force(x)
     return x
 
 

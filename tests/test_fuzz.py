@@ -71,6 +71,7 @@ CASES: dict[str, tuple[int, int]] = {
     "sweep": (20, 200),
     "load_sweep": (20, 200),
     "cli": (60, 600),
+    "PeelForce.tabulated": (60, 600),
 }
 TIERS = [pytest.param(0, id="default"), pytest.param(1, id="slow", marks=pytest.mark.slow)]
 
@@ -937,6 +938,50 @@ def test_fuzz_regression_periodicity_zero_and_huge_returns():
     # not periodic below n = 3: the smallest mismatch tried, max|x_{k+n} - x_k| / max|x| = 2 (n = 1, 2), finite
     p = pa.periodicity([1e308, -1e308, 0.0] * 50, max_period=2)
     assert p.kind == "aperiodic" and p.mismatch == 2.0
+
+
+# ---------------------------------------------------------------------------------------------- PeelForce
+#: A valid table: the default cubic law (folds at 0.691 and 1.809 m/s) on 12 points of [0.1, 3] m/s.
+TABLE_V = np.exp(np.linspace(math.log(0.1), math.log(3.0), 12))
+TABLE_F = 150 + TABLE_V * (300 + TABLE_V * (-300 + 80 * TABLE_V))
+#: Names a bad table's message may give: the array and index, or the rule it breaks.
+TABLE_NAMES = ("v[", "f[", "v must", "f must", "v and f", "peel-force table", "V must", "V=")
+
+
+def check_law(law: Any, where: str) -> None:
+    """A law built from a table: its folds (at its V, or 1 m/s) are finite and ordered."""
+    fo = law.folds(law.tables[0][0] or 1.0)
+    assert fo.has_folds and _all_finite([fo.v_max, fo.f_max, fo.v_min, fo.f_min]), f"{where}: {fo}"
+    assert fo.v_max < fo.v_min and fo.f_max > fo.f_min, f"{where}: {fo}"
+
+
+@pytest.mark.parametrize("tier", TIERS)
+def test_fuzz_tabulated_law(tier):
+    """Hypothesis: a table with one entry of v or f (or V, or a whole array) replaced by anything builds a law
+    whose folds are finite and ordered, or raises ValueError/TypeError naming the array and index (or V)."""
+    args = {
+        "v[i]": st.tuples(st.integers(0, 11), nasty_or(edges(0.05, 5.0))),
+        "f[i]": st.tuples(st.integers(0, 11), nasty_or(edges(1.0, 1e3))),
+        "v": NASTY, "f": NASTY, "V": nasty_or(edges(1e-6, 100.0)),
+    }
+
+    def body(case):
+        name, value = case
+        v, f, kw = TABLE_V.copy(), TABLE_F.copy(), {}
+        if name in ("v[i]", "f[i]"):
+            i, x = value
+            try:
+                (v if name == "v[i]" else f)[i] = x
+            except (TypeError, ValueError, OverflowError):
+                return  # not a float: the whole-array cases cover it
+        elif name == "V":
+            kw["V"] = value
+        else:
+            v, f = (value, f) if name == "v" else (v, value)
+        classify("PeelForce.tabulated", lambda: pa.PeelForce.tabulated(v, f, **kw), TABLE_NAMES,
+                 f"PeelForce.tabulated({name}={value!r})", check=check_law)
+
+    run_tier(tier, "PeelForce.tabulated", one_of_args(args), body)
 
 
 def test_fuzz_regression_lyapunov_tangent_without_transient():

@@ -1,0 +1,431 @@
+"""The peel-force law as data: :class:`PeelForce`, its folds (:class:`Folds`), the not-yet-supported check.
+
+A :class:`PeelForce` is one law ``f(v, V)`` [N] of the peel velocity v and the pull speed V [m/s]
+(Eq. fvV is the paper's).  Four kinds, each plain data (strings and tuples of floats), so a law is
+immutable, hashable, equal by value, picklable and JSON-able (``dataclasses.asdict``):
+
+* ``"paper"`` — the built-in fvV (:meth:`PeelForce.paper`), evaluated by :func:`peelapprox.peel_force`
+  itself, bitwise;
+* ``"family"`` — a fixed form with its coefficients as data (:mod:`peelapprox._law_families`: the paper's
+  family, the N-shaped cubic, the power-law branches);
+* ``"expression"`` — a sympy expression in ``v`` and ``V`` kept as canonical text
+  (:mod:`peelapprox._law_expr`);
+* ``"tabulated"`` — measured curves, PCHIP in ln v (:mod:`peelapprox._law_table`).
+
+The evaluation of the paper kind and the parameter ranges live in modules that import
+:mod:`peelapprox._params`, which imports this one (for ``PeelParams.force``); so they are handed in once,
+at ``import peelapprox``, by :mod:`peelapprox._law_paper` (:func:`register_paper`) instead of imported here.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import sys
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _law_expr, _law_families, _law_table
+from ._checks import in_range, reals
+from ._law_folds import Folds, find_folds
+
+__all__ = ["FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "register_paper", "require_paper_force"]
+
+#: The kinds of law, in the order of the module docstring.
+KINDS = ("paper", "family", "expression", "tabulated")
+#: Points per unit of ln v of the grid on which :meth:`PeelForce.folds` brackets the sign changes of f'
+#: (neighbours 0.5 % apart in v; at least 2001 points).
+FOLD_GRID_DENSITY = 200
+#: Lower end [m/s] of the fold search of the families (the built-in law searches from the same 1e-12).
+_FAMILY_FOLD_LO = 1e-12
+
+#: Filled by :func:`register_paper` at ``import peelapprox``.
+_PAPER: dict[str, Any] = {}
+
+
+def register_paper(*, evaluate: Callable, branch_structure: Callable, V_range: tuple[float, float],
+                   v_range: tuple[float, float]) -> None:
+    """Hand in the built-in law's evaluation, its branch structure and the ranges of V and v (see module)."""
+    _PAPER.update(evaluate=evaluate, branch_structure=branch_structure, V_range=V_range, v_range=v_range)
+
+
+def _hooks() -> dict[str, Any]:
+    if not _PAPER:  # pragma: no cover - peelapprox/__init__ imports _law_paper
+        raise RuntimeError("peelapprox._law_paper has not registered the paper's law: import peelapprox first")
+    return _PAPER
+
+
+def _num(x: float) -> str:
+    """A coefficient as a physicist writes it, exact (shortest repr, ``150`` for ``150.0``)."""
+    r = repr(float(x))
+    return r[:-2] if r.endswith(".0") else r
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PeelForce:
+    """A peel-force law ``f(v, V)`` [N]: the paper's fvV, a family, an expression or a table.
+
+    Build one with :meth:`paper`, :meth:`family` (or :meth:`paper_family`, :meth:`cubic`,
+    :meth:`power_branches`), :meth:`expression` or :meth:`tabulated`; the fields below are its plain-data
+    state (validated again if the class is called directly, e.g. from a dict by :meth:`from_dict`).
+
+    Attributes
+    ----------
+    kind : {"paper", "family", "expression", "tabulated"}
+    name : str or None
+        The family's name (``"paper"``, ``"cubic"``, ``"power_branches"``) of a family law.
+    coefficients : tuple of (name, float)
+        A family law's coefficients, in the family's order.
+    source : str or None
+        An expression law's canonical text (sympy ``srepr``, constants substituted).
+    tables : tuple of (V or None, v tuple, f tuple)
+        A tabulated law's tables.
+    display : str
+        What ``repr`` shows for an expression law (the text and constants as given); not compared.
+
+    Notes
+    -----
+    Equal (and equally hashed) by kind and canonical content: family coefficients as floats, an
+    expression by its canonical text (``"2*v"`` equals ``"v + v"``), tables by their values.  Pickles as
+    its plain-data fields (compiled evaluators are rebuilt lazily in each process).  Evaluation:
+    ``law(v, V)`` or :meth:`f`, :meth:`df`, :meth:`d2f`, vectorised over v; V must be in
+    ``PARAM_RANGES["V"]`` and is ignored by a V-independent law.
+    """
+
+    kind: str
+    name: str | None = None
+    coefficients: tuple = ()
+    source: str | None = None
+    tables: tuple = ()
+    display: str = ""
+
+    # ------------------------------------------------------------------ construction
+    def __post_init__(self) -> None:
+        kind, family, coef, source, tables = self.kind, self.name, self.coefficients, self.source, self.tables
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
+        empty = {"name": family is None, "coefficients": not coef, "source": source is None, "tables": not tables}
+        needs = {"paper": (), "family": ("name",), "expression": ("source",), "tabulated": ("tables",)}[kind]
+        if kind == "family":
+            if family not in _law_families.FAMILIES:
+                raise ValueError(f"unknown peel-force family {family!r}: the families are "
+                                 f"{', '.join(_law_families.FAMILIES)}")
+            coef = _law_families.coefficients(_law_families.FAMILIES[family], dict(coef))
+            needs = ("name", "coefficients")
+        elif kind == "expression":
+            if not isinstance(source, str):
+                raise TypeError(f"source of an expression law must be a string, got {type(source).__name__}")
+            source = _law_expr.canonical(_sympify(source), {})
+        elif kind == "tabulated":
+            tables = _law_table.check_tables(tables, _hooks()["V_range"])
+        extra = [name for name, e in empty.items() if not e and name not in needs]
+        if extra:
+            raise ValueError(f"a {kind!r} law takes no {', '.join(extra)}")
+        for name, value in (("coefficients", coef or ()), ("source", source), ("tables", tables or ())):
+            object.__setattr__(self, name, value)
+        if not self.display:
+            object.__setattr__(self, "display", self._default_display())
+
+    @classmethod
+    def paper(cls) -> PeelForce:
+        """The paper's law fvV, evaluated by :func:`peelapprox.peel_force` (bitwise): the default."""
+        return _PAPER_LAW
+
+    @classmethod
+    def family(cls, name: str, **coefficients: float) -> PeelForce:
+        """A law of the named family (:mod:`peelapprox._law_families`), missing coefficients at their defaults.
+
+        ValueError for an unknown family or coefficient name (the message lists the valid ones), a
+        non-finite coefficient, or a non-positive scale (``v3``, ``A1``, ``v1``, ``m``).
+        """
+        return cls("family", name, tuple(coefficients.items()))
+
+    @classmethod
+    def paper_family(cls, **params: float) -> PeelForce:
+        """fvV with its 14 numbers as coefficients (defaults: the paper's)::
+
+            f = a1 v^p1 + a2 v^p2 + a3 e^(v/v3) - a4 V^q4 - (a5 - a6 V^q6 - a7 V^q7) v^p5
+
+        a1=400, p1=0.35, a2=110, p2=0.15, a3=130, v3=11, a4=2, q4=1.5, a5=415, a6=45, q6=0.4, a7=0.35,
+        q7=2.15, p5=0.5 (De, Maybhate & Ananthakrishna 2004, Eq. fvV).  With the defaults it equals
+        :meth:`paper` to ~1e-15 relative (not bitwise).  V-dependent, as fvV.
+        """
+        return cls.family("paper", **params)
+
+    @classmethod
+    def cubic(cls, a: float = 150.0, b: float = 300.0, c: float = 300.0, d: float = 80.0) -> PeelForce:
+        """The N-shaped cubic ``f = a + b v - c v^2 + d v^3`` [N, v in m/s], V-independent.
+
+        The smooth normal form of the N-shaped (rising-falling-rising) law of Hong & Yue, Phys. Rev. Lett.
+        74, 254 (1995) — the generic smooth N, not Hong & Yue's own numbers (which could not be verified).
+        Folds at the roots of ``b - 2 c v + 3 d v^2``; defaults (the issue's example) put them at 0.691 and
+        1.809 m/s.
+        """
+        return cls.family("cubic", a=a, b=b, c=c, d=d)
+
+    @classmethod
+    def power_branches(cls, A1: float = 338.5, n1: float = 0.1038, v1: float = 3.244, m: float = 1.074,
+                       A2: float = 14.36, n2: float = 0.8502) -> PeelForce:
+        """Two rising power-law branches joined by a falling one, V-independent::
+
+            f(v) = A1 v^n1 / (1 + (v/v1)^m) + A2 v^n2
+
+        The slow (viscoelastic) and fast (glassy) branches of G(v) = f/b measured on adhesive tapes by
+        Maugis & Barquins (1988) and Barquins & Ciccotti (Int. J. Adhes. Adhes. 17, 65, 1997).  The defaults
+        are a calibration to the paper's fvV at V = 1 m/s (v_max ≈ 0.506 m/s, f_max ≈ 285.6 N,
+        v_min ≈ 8.59 m/s, f_min ≈ 199.4 N), not the measured constants of a 3M tape (unverified here).
+        """
+        return cls.family("power_branches", A1=A1, n1=n1, v1=v1, m=m, A2=A2, n2=n2)
+
+    @classmethod
+    def expression(cls, expr: Any, **constants: float) -> PeelForce:
+        """A law written as a sympy expression (or its text) in ``v`` [m/s] and optionally ``V`` [m/s].
+
+        ``constants`` are substituted (``PeelForce.expression("a + b*v - c*v**2 + d*v**3", a=150, b=300,
+        c=300, d=80)``); ``^`` means a power.  f' and f'' come from sympy; evaluation is numpy through
+        ``sympy.lambdify``, on ``v`` in [1e-6, 1e3] m/s (the probed domain).
+
+        Raises
+        ------
+        ValueError
+            Unknown symbols (named), an undefined function, an unused or ill-named constant, no dependence
+            on v, or f, f', f'' complex or non-finite at a point of the probe (v log-spaced over
+            [1e-6, 1e3] m/s; V in 0.01, 0.1, 1, 10 m/s if the law depends on V), the point named.
+        """
+        text = _law_expr.canonical(expr, constants)
+        shown = ", ".join([repr(expr if isinstance(expr, str) else str(expr))]
+                          + [f"{k}={_num(float(val))}" for k, val in constants.items()])
+        return _restore("expression", None, (), text, (), shown)  # checked: no second parse and probe
+
+    @classmethod
+    def tabulated(cls, v: Any = None, f: Any = None, *, V: float | None = None, tables: Any = None) -> PeelForce:
+        """A measured curve: ``tabulated(v, f)`` (optionally ``V=`` its pull speed), or several,
+        ``tabulated(tables=[(V1, v1, f1), (V2, v2, f2), ...])`` at increasing V.
+
+        f is interpolated by PCHIP in ln v (shape-preserving: no extremum the data lack; f' continuous);
+        between tables, linearly in V.  One table with ``V=None`` is used at every V; with ``V=x``, at x
+        only.  v outside the table (or V outside the tables' speeds) is refused, never extrapolated.
+
+        Raises
+        ------
+        ValueError
+            Naming the offending index and value: not 1-D, lengths differ, fewer than 5 points, a NaN or
+            inf, v not > 0 or not strictly increasing, f not > 0, a flat step, or not exactly one local
+            maximum followed by one local minimum in the data.
+        """
+        if tables is not None:
+            if v is not None or f is not None or V is not None:
+                raise ValueError("give either v and f (and V) or tables, not both")
+            return cls("tabulated", tables=tables)
+        if v is None or f is None:
+            raise ValueError("tabulated needs v and f (arrays of peel velocities [m/s] and forces [N])")
+        return cls("tabulated", tables=((V, v, f),))
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
+        """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated."""
+        return cls(**dict(d))  # lists for tuples: __post_init__ makes them canonical
+
+    # ------------------------------------------------------------------ value semantics
+    def _key(self) -> tuple:
+        return (self.kind, self.name, self.coefficients, self.source, self.tables)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, PeelForce) and self._key() == other._key()
+
+    def __hash__(self) -> int:
+        h = self.__dict__.get("_hash")
+        if h is None:
+            h = hash(self._key())
+            object.__setattr__(self, "_hash", h)
+        return h
+
+    def __reduce__(self):
+        return (_restore, (self.kind, self.name, self.coefficients, self.source, self.tables, self.display))
+
+    def _default_display(self) -> str:
+        if self.kind == "expression":
+            return repr(self.source)
+        if self.kind == "tabulated":
+            parts = []
+            for V, v, f in self.tables:
+                parts.append(f"V={V!r}: {len(v)} points, v in [{v[0]:.6g}, {v[-1]:.6g}] m/s, "
+                             f"f in [{min(f):.6g}, {max(f):.6g}] N")
+            return "; ".join(parts)
+        return ""
+
+    def __repr__(self) -> str:
+        if self.kind == "paper":
+            return "PeelForce.paper()"
+        if self.kind == "family":
+            ctor = _law_families.FAMILIES[str(self.name)].constructor
+            return f"PeelForce.{ctor}({', '.join(f'{n}={_num(x)}' for n, x in self.coefficients)})"
+        if self.kind == "expression":
+            return f"PeelForce.expression({self.display})"
+        return f"PeelForce.tabulated(<{self.display}>)"
+
+    @property
+    def key(self) -> str:
+        """SHA-256 (hex) of the law's canonical content: of an expression's canonical text, else of its
+        kind, family, coefficients (exact hex floats) and tables; the same in every process."""
+        if self.kind == "expression":
+            text = str(self.source)
+        else:
+            parts = [self.kind, str(self.name)] + [f"{n}={float(x).hex()}" for n, x in self.coefficients]
+            for V, v, f in self.tables:
+                parts.append(f"V={'None' if V is None else float(V).hex()}")
+                parts.append(":".join(np.asarray(x, dtype="<f8").tobytes().hex() for x in (v, f)))
+            text = "|".join(parts)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    @property
+    def depends_on_V(self) -> bool:
+        """True if f changes with the pull speed V."""
+        if self.kind == "paper":
+            return True
+        if self.kind == "family":
+            return _law_families.FAMILIES[str(self.name)].depends_on_V
+        if self.kind == "expression":
+            return bool(self._impl().depends_on_V)
+        return len(self.tables) > 1
+
+    @property
+    def v_range(self) -> tuple[float, float]:
+        """``(lo, hi)`` [m/s]: the peel velocities at which the law may be evaluated (the built-in law and the
+        families: ``STATE_RANGES["v"]``, open at lo; an expression: [1e-6, 1e3]; a table: its range)."""
+        if self.kind in ("paper", "family"):
+            return _hooks()["v_range"]
+        if self.kind == "expression":
+            return _law_expr.V_DOMAIN
+        return self._impl().v_range()
+
+    # ------------------------------------------------------------------ evaluation
+    def _impl(self) -> Any:
+        impl = self.__dict__.get("_evaluator")
+        if impl is None:
+            if self.kind == "expression":
+                impl = _law_expr.ExpressionLaw(str(self.source))
+            elif self.kind == "tabulated":
+                impl = _law_table.TableLaw(self.tables)
+            else:
+                fam = _law_families.FAMILIES[str(self.name)]
+                c = tuple(x for _, x in self.coefficients)
+                impl = lambda v, V, order: fam.evaluate(v, V, c, order)  # noqa: E731
+            object.__setattr__(self, "_evaluator", impl)
+        return impl
+
+    def _evaluate(self, v: Any, V: Any, order: int) -> Any:
+        hooks = _hooks()
+        if self.kind == "paper":
+            return hooks["evaluate"](v, V, order)
+        V = in_range("V", V, *hooks["V_range"])
+        if self.kind == "family":
+            lo, hi = hooks["v_range"]
+            va = reals("v", v, lo, hi, lo_open=True)
+        else:
+            va = reals("v", v)
+        with np.errstate(all="ignore"):
+            out = np.asarray(self._impl()(va, V, order), dtype=float)
+        if not np.all(np.isfinite(out)):
+            i = int(np.flatnonzero(~np.isfinite(out).ravel())[0])
+            what = ("f", "f'", "f''")[order]
+            raise ValueError(f"the peel-force law {self!r} gives {what} = "
+                             f"{out.ravel()[i]} at v={float(va.ravel()[i])!r} m/s, V={V!r} m/s")
+        return out[()] if out.ndim == 0 else out
+
+    def f(self, v: Any, V: float) -> Any:
+        """f(v, V) [N], vectorised over v (a float for a scalar v)."""
+        return self._evaluate(v, V, 0)
+
+    __call__ = f
+
+    def df(self, v: Any, V: float) -> Any:
+        """∂f/∂v (v, V) [N s/m]."""
+        return self._evaluate(v, V, 1)
+
+    def d2f(self, v: Any, V: float) -> Any:
+        """∂²f/∂v² (v, V) [N s²/m²]."""
+        return self._evaluate(v, V, 2)
+
+    def folds(self, V: float) -> Folds:
+        """The folds of ``f(·, V)`` (local maximum, then local minimum in v) and where jumps from them land.
+
+        The built-in law's are :func:`peelapprox.branch_structure`'s.  Any other law's are found on its
+        own: the sign changes of f' on a grid in ln v (:data:`FOLD_GRID_DENSITY` points per unit) over the
+        fold window (a family: [1e-12, 1e3] m/s; an expression: [1e-6, 1e3]; a table: its range), each
+        refined by Brent's method in ln v; the landings by Brent's method on the other branch, over the
+        law's whole domain (:attr:`v_range`).  Cached per V.
+
+        Returns
+        -------
+        Folds
+            ``has_folds=False`` (every fold field None) when f' > 0 throughout: no stick-slip at this V.
+
+        Raises
+        ------
+        ValueError
+            If f' < 0 throughout (no stable slow branch), or the extrema are not exactly one maximum
+            followed by one minimum (the message lists those found), or V is out of range.
+        """
+        cache = self.__dict__.get("_folds")
+        if cache is None:
+            cache = {}
+            object.__setattr__(self, "_folds", cache)
+        V = in_range("V", V, *_hooks()["V_range"])
+        if V not in cache:
+            if len(cache) >= 256:
+                cache.clear()
+            cache[V] = self._find_folds(V)
+        return cache[V]
+
+    def _find_folds(self, V: float) -> Folds:
+        if self.kind == "paper":
+            bs = _hooks()["branch_structure"](V)
+            return Folds(V, bs.has_folds, bs.v_max, bs.f_max, bs.v_min, bs.f_min, bs.v_land_cd, bs.v_land_ab)
+        lo, hi = self.v_range
+        if self.kind == "family":
+            lo = lo * 10.0  # the families' domain is open at lo
+            window = (_FAMILY_FOLD_LO, hi)
+        else:
+            window = (lo, hi)
+        impl = self._impl()
+
+        def fn(v: np.ndarray, order: int) -> np.ndarray:
+            with np.errstate(all="ignore"):
+                return np.asarray(impl(v, V, order), dtype=float)
+
+        return find_folds(fn, V, window, (lo, hi), repr(self), FOLD_GRID_DENSITY)
+
+
+def _sympify(text: str) -> Any:
+    import sympy as sp
+
+    return sp.sympify(text)
+
+
+def _restore(kind: str, name: str | None, coefficients: tuple, source: str | None, tables: tuple,
+             display: str) -> PeelForce:
+    """Unpickle a law without validating it again (it was validated when first built)."""
+    law = object.__new__(PeelForce)
+    for field_name, value in (("kind", kind), ("name", name), ("coefficients", coefficients), ("source", source),
+                              ("tables", tables), ("display", display)):
+        object.__setattr__(law, field_name, value)
+    return law
+
+
+_PAPER_LAW = PeelForce("paper")
+
+
+def require_paper_force(params: Any, where: str | None = None) -> None:
+    """ValueError unless ``params.force`` (if any) is the paper's law: the one check, at every consumer that
+    does not honour other laws yet (issue 15).  ``where`` names the consumer (default: the caller's caller,
+    i.e. the public function that validated its ``params``)."""
+    force = getattr(params, "force", None)
+    if force is None or force.kind == "paper":
+        return
+    if where is None:
+        where = sys._getframe(2).f_code.co_name
+    raise ValueError(f"params.force: force laws other than the paper's are not yet supported by {where} (got "
+                     f"{force!r}); see issue 15")

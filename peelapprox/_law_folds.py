@@ -1,0 +1,127 @@
+"""The folds of any peel-force law: the local maximum and minimum of ``f(·, V)`` and the jumps' landings.
+
+:func:`find_folds` works on a vectorised evaluator ``fn(v, order)`` of f (order 0) and f' (order 1) at one
+pull speed, so it serves every kind of :class:`peelapprox.PeelForce` but the built-in one (whose folds are
+:func:`peelapprox.branch_structure`'s):
+
+1. f' on a grid uniform in ``ln v`` over the fold window; its sign changes (zeros skipped) bracket the
+   extrema of f: ``+ -> -`` a maximum, ``- -> +`` a minimum;
+2. each refined by Brent's method in ``ln v`` (xtol 1e-15, rtol 4 ulp);
+3. exactly one maximum followed by one minimum is stick-slip (the N shape): the folds; none with f' > 0 is
+   no stick-slip at this V (``has_folds=False``); anything else is a ValueError listing the extrema;
+4. the landings: Brent's method in ``ln v`` for ``f = f_max`` on ``[v_min, hi]`` (CD) and ``f = f_min`` on
+   ``[lo, v_max]`` (AB) over the law's whole domain ``(lo, hi)``; None where f does not reach the level.
+
+Two extrema closer than the grid spacing (0.5 % in v at the default density, e.g. right at the cusp
+where the folds are born) fall in one cell and are not seen: the law is then reported without folds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+__all__ = ["Folds", "find_folds"]
+
+_RTOL = 4 * np.finfo(float).eps
+
+
+@dataclass(frozen=True)
+class Folds:
+    """The folds of ``f(·, V)`` and where jumps from them land (:meth:`peelapprox.PeelForce.folds`).
+
+    Attributes
+    ----------
+    V : float
+        Pull speed [m/s].
+    has_folds : bool
+        True if f has a local maximum followed by a local minimum in v (stick-slip at this V); False if f
+        increases in v throughout (no stick-slip: one stable branch, every other field None).
+    v_max, f_max : float or None
+        The fold ending the slow branch AB (local maximum of f) [m/s, N].
+    v_min, f_min : float or None
+        The fold starting the fast branch CD (local minimum of f) [m/s, N].
+    v_land_cd : float or None
+        Where an AB→CD jump lands: the CD velocity with ``f = f_max``; None if f stays below ``f_max`` up
+        to the end of the law's domain (e.g. a table that stops too early).
+    v_land_ab : float or None
+        Where a CD→AB jump lands: the AB velocity with ``f = f_min``; None if f stays above ``f_min`` down
+        to the start of the law's domain.
+    """
+
+    V: float
+    has_folds: bool
+    v_max: float | None = None
+    f_max: float | None = None
+    v_min: float | None = None
+    f_min: float | None = None
+    v_land_cd: float | None = None
+    v_land_ab: float | None = None
+
+
+def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tuple[float, float],
+               domain: tuple[float, float], label: str, density: int) -> Folds:
+    """The :class:`Folds` of the law ``fn`` at pull speed V (module docstring).
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(v, order)``: f (order 0) or f' (order 1) at the peel velocities v [m/s] (an array).
+    V : float
+        The pull speed [m/s], recorded in the result.
+    window : (lo, hi)
+        Where to look for the extrema [m/s].
+    domain : (lo, hi)
+        Where the law may be evaluated [m/s], the range of the landings (contains the window).
+    label : str
+        The law, for messages.
+    density : int
+        Grid points per unit of ln v (at least 2001 in all).
+    """
+    wlo, whi = math.log(window[0]), math.log(window[1])
+    n = max(2001, int(density * (whi - wlo)) + 1)
+    w = np.linspace(wlo, whi, n)
+    vg = np.clip(np.exp(w), window[0], window[1])
+
+    def at(x: float, order: int) -> float:
+        v = min(max(math.exp(x), domain[0]), domain[1])
+        return float(fn(np.array([v]), order)[0])
+
+    d = fn(vg, 1)
+    if not np.all(np.isfinite(d)):
+        i = int(np.flatnonzero(~np.isfinite(d))[0])
+        raise ValueError(f"the peel-force law {label} has f' = {d[i]} at v={vg[i]!r} m/s, V={V!r} m/s")
+    nz = np.flatnonzero(d != 0)
+    if nz.size == 0:
+        raise ValueError(f"the peel-force law {label} has f' = 0 throughout v in [{window[0]:g}, {window[1]:g}] m/s "
+                         f"at V={V!r}: no branch structure")
+    s = np.sign(d[nz])
+    extrema = []
+    for c in np.flatnonzero(s[:-1] != s[1:]):
+        i, j = nz[c], nz[c + 1]
+        x = brentq(lambda x: at(x, 1), w[i], w[j], xtol=1e-15, rtol=_RTOL)
+        v = min(max(math.exp(x), domain[0]), domain[1])
+        extrema.append(("max" if s[c] > 0 else "min", v, at(math.log(v), 0)))
+    kinds = [k for k, _, _ in extrema]
+    if not kinds:
+        if s[0] > 0:
+            return Folds(V, False)
+        raise ValueError(f"the peel-force law {label} decreases in v throughout [{window[0]:g}, {window[1]:g}] m/s "
+                         f"at V={V!r}: no stable branch")
+    if kinds != ["max", "min"]:
+        found = ", ".join(f"a local {k} at v={v:.6g} m/s (f={fv:.6g} N)" for k, v, fv in extrema)
+        raise ValueError(f"the peel-force law {label} must have exactly one local maximum followed by one local "
+                         f"minimum in v at V={V!r} (stick-slip) or none (no stick-slip); found {found}")
+    (_, v_max, f_max), (_, v_min, f_min) = extrema
+    lo, hi = math.log(domain[0]), math.log(domain[1])
+    v_land_cd = None
+    if at(hi, 0) > f_max:
+        v_land_cd = math.exp(brentq(lambda x: at(x, 0) - f_max, math.log(v_min), hi, xtol=1e-15, rtol=_RTOL))
+    v_land_ab = None
+    if at(lo, 0) < f_min:
+        v_land_ab = math.exp(brentq(lambda x: at(x, 0) - f_min, lo, math.log(v_max), xtol=1e-15, rtol=_RTOL))
+    return Folds(V, True, v_max, f_max, v_min, f_min, v_land_cd, v_land_ab)
