@@ -81,8 +81,12 @@ when an output buffer fills or the run ends.
 from __future__ import annotations
 
 import numpy as np
+from numba import types as _t
 
 from peelapprox.kernels import (
+    LAW_FP,
+    LAW_LNV,
+    LAW_TYPE,
     M_A,
     M_B,
     M_GEOM,
@@ -144,16 +148,26 @@ def _closure(alpha, p):
 
 @kernel
 def pull_force(alpha, v, p):
-    """F = f(v, V) / (1 + c(α))  (CONSTR solved for F)."""
+    """F = f(v, V) / (1 + c(α))  (CONSTR solved for F), the paper's law inlined (fvV, ``p[M_B], p[M_A]``)."""
     f, _ = peel_force_fp_jit(v, p[M_B], p[M_A])
     c, _ = _closure(alpha, p)
     return f / (1.0 + c)
 
 
-@kernel
-def _rhs(y, p, out):
-    """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring)."""
-    v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
+_A1 = _t.float64[::1]
+
+
+@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1))
+def pull_force_law(alpha, v, p, law, coef):
+    """F = f(v) / (1 + c(α))  (CONSTR solved for F), f the law ``law(v, coef, LAW_FP)`` (peelapprox.kernels)."""
+    f, _, _ = law(v, coef, LAW_FP)
+    c, _ = _closure(alpha, p)
+    return f / (1.0 + c)
+
+
+@kernel(inline="always")
+def _field(y, p, v, f, g, out):
+    """The field at ``y`` given ``v = e^u``, ``f(v)`` and ``g = v f'(v)`` (whichever law gave them)."""
     if not (v > 0.0):  # trial stage left the model's domain (v underflowed): poison the step
         for i in range(4):
             out[i] = np.nan
@@ -172,7 +186,24 @@ def _rhs(y, p, out):
     out[3] = Gd  # d(ln v)/ds = (dv/ds)/v = Ġ
 
 
-_dop = make_dop853(_rhs)
+@kernel
+def _rhs(y, p, out):
+    """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring), the paper's law
+    inlined: the field of the saltation tangent (``exact._tangent``) and of ``exact.hybrid_field``."""
+    v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
+    _field(y, p, v, f, g, out)
+
+
+@kernel
+def _rhs_law(y, P, out):
+    """The field of :func:`_rhs` for the law of ``P = (p, law, coef)``: ``law(u, coef, LAW_LNV)`` gives
+    ``(v, f, v f')``; the driver :func:`run` integrates this one."""
+    p, law, coef = P
+    v, f, g = law(y[3], coef, LAW_LNV)
+    _field(y, p, v, f, g, out)
+
+
+_dop = make_dop853(_rhs_law)
 
 
 @kernel
@@ -217,10 +248,11 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-@kernel
-def run(
+def _run(
     st,
     p,
+    law,
+    coef,
     rtol,
     atol,
     t_end,
@@ -237,8 +269,11 @@ def run(
 
     Returns a status code (module constants).  All state needed to continue is
     in ``st`` and ``cnt``; the caller empties full buffers and calls again.
-    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.
+    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force is the law ``law``
+    (:data:`peelapprox.kernels.LAW_TYPE`) with the coefficients ``coef``: compiled once for that type
+    (:data:`RUN_SIG`), so another law or other coefficients recompile nothing.
     """
+    P = (p, law, coef)  # what the field receives through the DOP853 pieces (_rhs_law)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
 
@@ -257,10 +292,10 @@ def run(
     calls = 0
     n_bad = 0  # successive steps rejected for their dense output
 
-    _rhs(y, p, f0)
+    _rhs_law(y, P, f0)
     cnt[C_RHS] += 1
     if h <= 0.0:
-        h = _dop.initial_step(y, f0, p, rtol, atol, work)
+        h = _dop.initial_step(y, f0, P, rtol, atol, work)
         cnt[C_RHS] += 1
 
     while True:
@@ -276,7 +311,7 @@ def run(
             return JUMPS_FULL
 
         # ---- one accepted step
-        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
+        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, P, rtol, atol, K, y_new, tmp, sc)
         cnt[C_REJ] += n_rej
         cnt[C_RHS] += n_rhs
         if status == STEP_FAILED:
@@ -301,7 +336,7 @@ def run(
             gB = y_new[3] - uf
             crossed = gB >= 0.0 if br == 0 else gB <= 0.0
             if crossed:
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 ok = _finite_rows(Fc)
                 if ok:
                     x_fold = solve_theta(y, Fc, 3, uf, gA, 1.0, gB)
@@ -326,7 +361,7 @@ def run(
                 x_b = 1.0
                 tau_b = y_new[0]
             if tau_b >= tau_end:
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 ok = _finite_rows(Fc)
                 if ok:
                     x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
@@ -340,13 +375,13 @@ def run(
                 tau_stop = y_new[0]
             while cnt[C_TEVAL] < n_teval and t_eval[cnt[C_TEVAL]] - t0 <= tau_stop:
                 te = t_eval[cnt[C_TEVAL]]
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
                 if not _in_domain(ye, p):
                     ok = False
                     break
                 ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], te, ye, ve, pull_force(ye[1], ve, p), out_br, br)
+                _store(out, cnt[C_NOUT], te, ye, ve, pull_force_law(ye[1], ve, p, law, coef), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
@@ -392,7 +427,7 @@ def run(
             ye[0] = t_end - t0
             if save_mode == SAVE_STEPS and t_end >= t_store:
                 ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], t_end, ye, ve, pull_force(ye[1], ve, p), out_br, br)
+                _store(out, cnt[C_NOUT], t_end, ye, ve, pull_force_law(ye[1], ve, p, law, coef), out_br, br)
                 cnt[C_NOUT] += 1
             for i in range(4):
                 y[i] = ye[i]
@@ -405,7 +440,7 @@ def run(
             ye[3] = np.log(v_fold)
             ye[0] = max(ye[0], y[0])  # as for a plain step (below)
             tj = t0 + ye[0]
-            Fj = pull_force(ye[1], v_fold, p)
+            Fj = pull_force_law(ye[1], v_fold, p, law, coef)
             if br == 0:
                 v_after = p[P_VLCD]
             else:
@@ -441,8 +476,8 @@ def run(
             if tj >= t_store and save_mode == SAVE_STEPS:
                 _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
                 cnt[C_NOUT] += 1
-            _rhs(y, p, f0)
-            h = _dop.initial_step(y, f0, p, rtol, atol, work)
+            _rhs_law(y, P, f0)
+            h = _dop.initial_step(y, f0, P, rtol, atol, work)
             cnt[C_RHS] += 2
             continue
 
@@ -458,5 +493,15 @@ def run(
         h = h_next
         if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
             v = np.exp(y[3])
-            _store(out, cnt[C_NOUT], t0 + y[0], y, v, pull_force(y[1], v, p), out_br, br)
+            _store(out, cnt[C_NOUT], t0 + y[0], y, v, pull_force_law(y[1], v, p, law, coef), out_br, br)
             cnt[C_NOUT] += 1
+
+
+#: The one signature :func:`run` is compiled for (its law argument of :data:`peelapprox.kernels.LAW_TYPE`).
+RUN_SIG = _t.int64(
+    _A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.float64, _t.int64, _A1, _t.float64[:, ::1], _t.int8[::1],
+    _t.float64[:, ::1], _t.int64[::1], _t.int64,
+)
+#: The hybrid driver (:func:`_run`), compiled for :data:`RUN_SIG` when this module is imported (loaded from the
+#: cache when it is there).
+run = kernel(signature=RUN_SIG)(_run)

@@ -14,13 +14,14 @@ from peelapprox import (
     BRANCHES,
     BREAKDOWN_LEVEL,
     TIME_MAX,
+    BranchStructure,
     PeelParams,
     branch_inverse,
     branch_structure,
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox.kernels import model_block
+from peelapprox.kernels import LAWS, model_block, paper_coefficients
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -301,10 +302,31 @@ def simulate(
 V_CEILING = 1e3
 
 
-def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarray:
+def _law_for(params: PeelParams) -> tuple[Callable, np.ndarray, BranchStructure]:
+    """The peel-force law of ``params`` as the hybrid driver takes it: ``(law, coef, branch structure)``.
+
+    The internal hook of issue 15 for ``PeelParams(force=...)``: a ``params.force`` that is not None must have
+    ``kind`` (a key of :data:`peelapprox.kernels.LAWS`: the compiled law), ``coefficients(V)`` (its ``coef``
+    array) and ``branch_structure(V)`` (its folds and landings, a :class:`peelapprox.BranchStructure`).
+    Without one: the paper's law fvV, ``coef = [b, A] = peel_force_coefficients(V)`` and
+    :func:`peelapprox.branch_structure`.
+    """
+    force = getattr(params, "force", None)
+    if force is None:
+        return LAWS["paper"], paper_coefficients(params.V), branch_structure(params.V)
+    if force.kind not in LAWS:
+        raise ValueError(f"params.force.kind must be one of {sorted(LAWS)}, got {force.kind!r}")
+    coef = np.ascontiguousarray(force.coefficients(params.V), dtype=float)
+    return LAWS[force.kind], coef, force.branch_structure(params.V)
+
+
+def _param_vector(params: PeelParams, v_floor: float | None = None,
+                  bs: BranchStructure | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
-    criterion, ``BranchStructure.v_breakdown``."""
-    bs = branch_structure(params.V)
+    criterion, ``BranchStructure.v_breakdown``; ``bs``: the law's branch structure (default: the paper's law's,
+    :func:`peelapprox.branch_structure`)."""
+    if bs is None:
+        bs = branch_structure(params.V)
     p = model_block(params, H.N_P)  # the model block (peelapprox.kernels), then the hybrid driver's fields
     p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
     p[H.P_VMAX] = bs.v_max if bs.has_folds else math.inf
@@ -328,7 +350,8 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
     t_store, max_wall = saveat.t_transient, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
-    p = _param_vector(params, v_floor)
+    law, coef, bs = _law_for(params)
+    p = _param_vector(params, v_floor, bs)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
     if saveat.ts is not None:
@@ -355,7 +378,7 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
 
     def state_dict():
         a, v = st[H.S_AL], math.exp(st[H.S_U])
-        F = float(H.pull_force(a, v, p))  # the kernel keeps the state in the domain (v = e^u > 0)
+        F = float(H.pull_force_law(a, v, p, law, coef))  # the kernel keeps the state in the domain (v = e^u > 0)
         return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
                     branch=BRANCHES[int(st[H.S_BR])])
 
@@ -400,7 +423,8 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
         # means the run needs more than the budget
         nv = cap if mode != H.SAVE_STEPS else min(cap, max_points + 2 - n_stored)
         jv = min(jcap, max_jumps + 1 - n_jstored)
-        status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv], cnt, quota)
+        status = H.run(st, p, law, coef, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv],
+                       cnt, quota)
         if status == S.DONE:
             if n_stored + int(cnt[H.C_NOUT]) > max_points:
                 raise over_budget("max_points", max_points)
@@ -434,7 +458,6 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
             checkpoint()
             continue
         sd = state_dict()
-        bs = branch_structure(params.V)
         if status == S.NO_ROOT and v_floor is not None and v_floor > bs.v_breakdown:
             status, why = S.V_FLOOR, f"the caller's v_floor; F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N"
         else:

@@ -50,6 +50,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_jit.py",
     "peelapprox/_generated.py",
     "peelapprox/_peelforce.py",
+    "peelapprox/_law_abi.py",  # the peel-force law ABI and the compiled laws
     "peelapprox/_dop853.py",
     "peelapprox/_alpha.py",
     "peelapprox/_segment_kernel.py",
@@ -129,7 +130,7 @@ def _check_source(fn: Callable) -> None:
 
 
 def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "never", fastmath: bool = False,
-           name: str | None = None) -> Any:
+           name: str | None = None, signature: Any = None) -> Any:
     """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 
     Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.
@@ -146,6 +147,13 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         Base name of the cache files (default: the function's qualname); the
         DOP853 pieces of :func:`peelapprox._dop853.make_dop853` are named after
         their vector field.
+    signature : numba signature, optional
+        Compile for this one signature now (loaded from the cache when it is there) and never for another,
+        as ``njit(signature)`` does: the form of a driver that takes a first-class function argument
+        (``numba.types.FunctionType``, e.g. the peel-force law of :mod:`peelapprox._law_abi`), which numba
+        caches across processes only when the argument's type is fixed in advance (a dispatcher passed to a
+        lazily typed function is specialised on and recompiled in every process).  The source stamp is set
+        before this compilation, so a changed kernel source recompiles it as any other kernel.
 
     Returns
     -------
@@ -157,7 +165,16 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         If ``fn``'s source file is not in :data:`KERNEL_SOURCES` (a developer error).
     """
     if fn is None:
-        return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name)
+        return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name, signature=signature)
+    d = _compile(fn, inline, fastmath, name)
+    if signature is not None:
+        d.compile(signature)
+        d.disable_compile()
+    return d
+
+
+def _compile(fn: Callable, inline: Literal["never", "always"], fastmath: bool, name: str | None) -> Any:
+    """The dispatcher of :func:`kernel`, stamped (or uncached after one warning), not compiled yet."""
     _check_source(fn)
     if name is not None:  # distinct cache files for the pieces of each vector field (make_dop853)
         fn = _renamed(fn, name.replace("<locals>.", "").replace(".", "_"))
@@ -178,7 +195,7 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
                 "the user cache directory); kernels are compiled without caching, so every new process "
                 "compiles them again (~20 s). Set NUMBA_CACHE_DIR to a writable directory to cache them.",
                 KernelCacheWarning,
-                stacklevel=2,
+                stacklevel=3,
             )
     return njit(cache=False, inline=inline, fastmath=fastmath)(fn)
 
