@@ -80,6 +80,8 @@ when an output buffer fills or the run ends.
 
 from __future__ import annotations
 
+import types as pytypes
+
 import numpy as np
 from numba import types as _t
 
@@ -157,12 +159,19 @@ def pull_force(alpha, v, p):
 _A1 = _t.float64[::1]
 
 
-@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1))
-def pull_force_law(alpha, v, p, law, coef):
-    """F = f(v) / (1 + c(α))  (CONSTR solved for F), f the law ``law(v, coef, LAW_FP)`` (peelapprox.kernels)."""
+@kernel(nrt=False)  # no reference counting around the law call (peelapprox._jit.kernel, ``nrt``)
+def _pull_force_P(alpha, v, P):
+    """F = f(v) / (1 + c(α))  (CONSTR solved for F), f the law of ``P = (p, law, coef)``: ``law(v, coef, LAW_FP)``."""
+    p, law, coef = P
     f, _, _ = law(v, coef, LAW_FP)
     c, _ = _closure(alpha, p)
     return f / (1.0 + c)
+
+
+@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1), nrt=False)
+def pull_force_law(alpha, v, p, law, coef):
+    """:func:`pull_force` for the law ``law`` with the coefficients ``coef`` (peelapprox.kernels.LAW_TYPE)."""
+    return _pull_force_P(alpha, v, (p, law, coef))
 
 
 @kernel(inline="always")
@@ -194,16 +203,13 @@ def _rhs(y, p, out):
     _field(y, p, v, f, g, out)
 
 
-@kernel
+@kernel(nrt=False)  # no reference counting around the law call (peelapprox._jit.kernel, ``nrt``)
 def _rhs_law(y, P, out):
     """The field of :func:`_rhs` for the law of ``P = (p, law, coef)``: ``law(u, coef, LAW_LNV)`` gives
-    ``(v, f, v f')``; the driver :func:`run` integrates this one."""
+    ``(v, f, v f')``; the field of the driver that takes the law as an argument (:func:`driver`)."""
     p, law, coef = P
     v, f, g = law(y[3], coef, LAW_LNV)
     _field(y, p, v, f, g, out)
-
-
-_dop = make_dop853(_rhs_law)
 
 
 @kernel
@@ -248,6 +254,23 @@ def _save(st, y, h):
     st[S_H] = h
 
 
+@kernel(inline="always")
+def _pack_paper(p, law, coef):
+    """What the inlined-law driver's field receives: ``p`` (the paper's law reads ``p[M_B], p[M_A]``)."""
+    return p
+
+
+@kernel(inline="always")
+def _pack_law(p, law, coef):
+    """What the law driver's field receives: ``(p, law, coef)``."""
+    return (p, law, coef)
+
+
+#: The law driver's pieces (the globals :func:`_run` calls; :func:`_driver_copy` swaps them for the inlined one)
+_FIELD, _PULL, _PACK = _rhs_law, _pull_force_P, _pack_law
+_dop = make_dop853(_rhs_law)
+
+
 def _run(
     st,
     p,
@@ -269,11 +292,9 @@ def _run(
 
     Returns a status code (module constants).  All state needed to continue is
     in ``st`` and ``cnt``; the caller empties full buffers and calls again.
-    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force is the law ``law``
-    (:data:`peelapprox.kernels.LAW_TYPE`) with the coefficients ``coef``: compiled once for that type
-    (:data:`RUN_SIG`), so another law or other coefficients recompile nothing.
+    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force: :func:`driver`.
     """
-    P = (p, law, coef)  # what the field receives through the DOP853 pieces (_rhs_law)
+    P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
 
@@ -292,7 +313,7 @@ def _run(
     calls = 0
     n_bad = 0  # successive steps rejected for their dense output
 
-    _rhs_law(y, P, f0)
+    _FIELD(y, P, f0)
     cnt[C_RHS] += 1
     if h <= 0.0:
         h = _dop.initial_step(y, f0, P, rtol, atol, work)
@@ -381,7 +402,7 @@ def _run(
                     ok = False
                     break
                 ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], te, ye, ve, pull_force_law(ye[1], ve, p, law, coef), out_br, br)
+                _store(out, cnt[C_NOUT], te, ye, ve, _PULL(ye[1], ve, P), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
@@ -427,7 +448,7 @@ def _run(
             ye[0] = t_end - t0
             if save_mode == SAVE_STEPS and t_end >= t_store:
                 ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], t_end, ye, ve, pull_force_law(ye[1], ve, p, law, coef), out_br, br)
+                _store(out, cnt[C_NOUT], t_end, ye, ve, _PULL(ye[1], ve, P), out_br, br)
                 cnt[C_NOUT] += 1
             for i in range(4):
                 y[i] = ye[i]
@@ -440,7 +461,7 @@ def _run(
             ye[3] = np.log(v_fold)
             ye[0] = max(ye[0], y[0])  # as for a plain step (below)
             tj = t0 + ye[0]
-            Fj = pull_force_law(ye[1], v_fold, p, law, coef)
+            Fj = _PULL(ye[1], v_fold, P)
             if br == 0:
                 v_after = p[P_VLCD]
             else:
@@ -476,7 +497,7 @@ def _run(
             if tj >= t_store and save_mode == SAVE_STEPS:
                 _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
                 cnt[C_NOUT] += 1
-            _rhs_law(y, P, f0)
+            _FIELD(y, P, f0)
             h = _dop.initial_step(y, f0, P, rtol, atol, work)
             cnt[C_RHS] += 2
             continue
@@ -493,15 +514,47 @@ def _run(
         h = h_next
         if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
             v = np.exp(y[3])
-            _store(out, cnt[C_NOUT], t0 + y[0], y, v, pull_force_law(y[1], v, p, law, coef), out_br, br)
+            _store(out, cnt[C_NOUT], t0 + y[0], y, v, _PULL(y[1], v, P), out_br, br)
             cnt[C_NOUT] += 1
 
-
-#: The one signature :func:`run` is compiled for (its law argument of :data:`peelapprox.kernels.LAW_TYPE`).
+#: The one signature the drivers are compiled for (the law argument of :data:`peelapprox.kernels.LAW_TYPE`).
 RUN_SIG = _t.int64(
     _A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.float64, _t.int64, _A1, _t.float64[:, ::1], _t.int8[::1],
     _t.float64[:, ::1], _t.int64[::1], _t.int64,
 )
-#: The hybrid driver (:func:`_run`), compiled for :data:`RUN_SIG` when this module is imported (loaded from the
-#: cache when it is there).
-run = kernel(signature=RUN_SIG)(_run)
+#: The two drivers: the paper's law inlined (the default path: no indirect call, the code of 0.2.0) and the law as
+#: a function argument (any compiled law, ``coef`` as data: a new law or coefficients compile nothing).
+def _driver_copy(field, pull, pack) -> pytypes.FunctionType:
+    """:func:`_run` reading ``field``, ``pull``, ``pack`` and their DOP853 pieces as its globals ``_FIELD``,
+    ``_PULL``, ``_PACK``, ``_dop``: a module-level function (no closure), so numba caches it across processes."""
+    g = dict(globals(), _FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
+    fn = pytypes.FunctionType(_run.__code__, g, _run.__name__, _run.__defaults__, None)
+    fn.__qualname__, fn.__module__, fn.__doc__ = _run.__qualname__, _run.__module__, _run.__doc__
+    return fn
+
+
+_DRIVERS = {
+    False: kernel(_driver_copy(_rhs, pull_force, _pack_paper), name="run_inlined"),
+    True: kernel(_run, name="run_law"),
+}
+
+
+def driver(law_argument: bool):
+    """The hybrid driver ``run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, out_br, jbuf,
+    cnt, max_call_steps) -> status``, compiled for :data:`RUN_SIG` on first use (loaded from numba's cache when it
+    is there) and for no other signature.
+
+    ``law_argument=False``: the paper's law fvV inlined, ``law`` and ``coef`` unused (the default path; an
+    indirect call per field evaluation and the lost inlining would cost ~4 ns of a ~25 ns field, ~5-10 % per
+    step: comparisons.benchmark.law_cost).  ``True``: the law ``law`` (:data:`peelapprox.kernels.LAW_TYPE`) with
+    the coefficients ``coef``.
+
+    ``run`` advances the hybrid solver from ``st`` until t_end or a buffer/quota limit and returns a status code
+    (module constants).  All state needed to continue is in ``st`` and ``cnt``; the caller empties full buffers
+    and calls again.  In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.
+    """
+    d = _DRIVERS[bool(law_argument)]
+    if not d.signatures:
+        d.compile(RUN_SIG)
+        d.disable_compile()
+    return d

@@ -6,7 +6,7 @@ import math
 import sys
 import time
 from collections.abc import Callable, Sequence
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -124,7 +124,7 @@ def initial_state(
 
 
 def compile_kernels() -> float:
-    """Compile (or load from numba's on-disk cache) the hybrid kernel.
+    """Compile (or load from numba's on-disk cache) the hybrid kernel (the driver with the paper's law inlined).
 
     Returns the seconds spent in this process the first time; 0 afterwards.
     """
@@ -352,6 +352,8 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
     law, coef, bs = _law_for(params)
     p = _param_vector(params, v_floor, bs)
+    law_argument = getattr(params, "force", None) is not None  # else the driver with the paper's law inlined
+    run = H.driver(law_argument)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
     if saveat.ts is not None:
@@ -378,7 +380,8 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
 
     def state_dict():
         a, v = st[H.S_AL], math.exp(st[H.S_U])
-        F = float(H.pull_force_law(a, v, p, law, coef))  # the kernel keeps the state in the domain (v = e^u > 0)
+        # the kernel keeps the state in the domain (v = e^u > 0)
+        F = float(H.pull_force_law(a, v, p, law, coef) if law_argument else H.pull_force(a, v, p))
         return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
                     branch=BRANCHES[int(st[H.S_BR])])
 
@@ -423,7 +426,7 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
         # means the run needs more than the budget
         nv = cap if mode != H.SAVE_STEPS else min(cap, max_points + 2 - n_stored)
         jv = min(jcap, max_jumps + 1 - n_jstored)
-        status = H.run(st, p, law, coef, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv],
+        status = run(st, p, law, coef, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv],
                        cnt, quota)
         if status == S.DONE:
             if n_stored + int(cnt[H.C_NOUT]) > max_points:
@@ -497,8 +500,20 @@ def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] 
     return _atol_vector(method, rtol, atol)
 
 
-def hybrid_field(params: PeelParams, v_floor: float | None = None) -> tuple[Callable, np.ndarray]:
+def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
+                 law_argument: bool = False) -> tuple[Callable, Any]:
     """The hybrid solver's compiled field ``rhs(y, p, out)`` and its parameter vector ``p`` for ``params``
-    (``v_floor`` as in :func:`simulate`), e.g. to time one field evaluation in a compiled loop."""
-    return H._rhs, _param_vector(params, v_floor)
+    (``v_floor`` as in :func:`simulate`), e.g. to time one field evaluation in a compiled loop.
+
+    ``law_argument=False``: the field with the paper's law fvV inlined and ``p`` the parameter vector.
+    ``law_argument=True``: the field of the driver that takes the law as a function argument (used with a
+    ``params.force``; also for the paper's law, which the default driver inlines) and ``(p, law, coef)``; the
+    field is called as ``rhs(y, (p, law, coef), out)`` from a loop compiled with ``law`` of type
+    :data:`peelapprox.kernels.LAW_TYPE`.
+    """
+    if not law_argument:
+        return H._rhs, _param_vector(params, v_floor)
+    law, coef, bs = _law_for(params)
+    p = _param_vector(params, v_floor, bs)
+    return H._rhs_law, (p, law, coef)
 
