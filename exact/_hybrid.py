@@ -75,20 +75,18 @@ relative to the segment duration, not to the absolute time).  This module is
 its event driver: folds, jumps, t_end, output and breakdown checks.
 
 Everything per step runs inside one numba function; Python is entered only
-when an output buffer fills or the run ends.
+when an output buffer fills or the run ends.  That function, :func:`_run`, is
+compiled twice by :mod:`exact._hybrid_law`: with the paper's law fvV inlined
+(the default) and with the peel-force law as a typed function argument.
 """
 
 from __future__ import annotations
 
-import types as pytypes
+from typing import Any
 
 import numpy as np
-from numba import types as _t
 
 from peelapprox.kernels import (
-    LAW_FP,
-    LAW_LNV,
-    LAW_TYPE,
     M_A,
     M_B,
     M_GEOM,
@@ -106,7 +104,6 @@ from peelapprox.kernels import (
     interp,
     interp1,
     kernel,
-    make_dop853,
     peel_force_fp_jit,
     peel_force_lnv_jit,
     slow_rates,
@@ -156,24 +153,6 @@ def pull_force(alpha, v, p):
     return f / (1.0 + c)
 
 
-_A1 = _t.float64[::1]
-
-
-@kernel(nrt=False)  # no reference counting around the law call (peelapprox._jit.kernel, ``nrt``)
-def _pull_force_P(alpha, v, P):
-    """F = f(v) / (1 + c(α))  (CONSTR solved for F), f the law of ``P = (p, law, coef)``: ``law(v, coef, LAW_FP)``."""
-    p, law, coef = P
-    f, _, _ = law(v, coef, LAW_FP)
-    c, _ = _closure(alpha, p)
-    return f / (1.0 + c)
-
-
-@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1), nrt=False)
-def pull_force_law(alpha, v, p, law, coef):
-    """:func:`pull_force` for the law ``law`` with the coefficients ``coef`` (peelapprox.kernels.LAW_TYPE)."""
-    return _pull_force_P(alpha, v, (p, law, coef))
-
-
 @kernel(inline="always")
 def _field(y, p, v, f, g, out):
     """The field at ``y`` given ``v = e^u``, ``f(v)`` and ``g = v f'(v)`` (whichever law gave them)."""
@@ -200,15 +179,6 @@ def _rhs(y, p, out):
     """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring), the paper's law
     inlined: the field of the saltation tangent (``exact._tangent``) and of ``exact.hybrid_field``."""
     v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
-    _field(y, p, v, f, g, out)
-
-
-@kernel(nrt=False)  # no reference counting around the law call (peelapprox._jit.kernel, ``nrt``)
-def _rhs_law(y, P, out):
-    """The field of :func:`_rhs` for the law of ``P = (p, law, coef)``: ``law(u, coef, LAW_LNV)`` gives
-    ``(v, f, v f')``; the field of the driver that takes the law as an argument (:func:`driver`)."""
-    p, law, coef = P
-    v, f, g = law(y[3], coef, LAW_LNV)
     _field(y, p, v, f, g, out)
 
 
@@ -254,21 +224,13 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-@kernel(inline="always")
-def _pack_paper(p, law, coef):
-    """What the inlined-law driver's field receives: ``p`` (the paper's law reads ``p[M_B], p[M_A]``)."""
-    return p
-
-
-@kernel(inline="always")
-def _pack_law(p, law, coef):
-    """What the law driver's field receives: ``(p, law, coef)``."""
-    return (p, law, coef)
-
-
-#: The law driver's pieces (the globals :func:`_run` calls; :func:`_driver_copy` swaps them for the inlined one)
-_FIELD, _PULL, _PACK = _rhs_law, _pull_force_P, _pack_law
-_dop = make_dop853(_rhs_law)
+#: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_law` (the paper's law inlined, or the
+#: law as an argument): the field ``_FIELD(y, P, out)``, the pull force ``_PULL(alpha, v, P)``,
+#: ``P = _PACK(p, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
+_FIELD: Any = None
+_PULL: Any = None
+_PACK: Any = None
+_dop: Any = None
 
 
 def _run(
@@ -292,9 +254,10 @@ def _run(
 
     Returns a status code (module constants).  All state needed to continue is
     in ``st`` and ``cnt``; the caller empties full buffers and calls again.
-    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force: :func:`driver`.
+    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force is ``law`` with ``coef``,
+    or the paper's law inlined: :func:`exact._hybrid_law.driver`.
     """
-    P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces
+    P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
 
@@ -516,45 +479,3 @@ def _run(
             v = np.exp(y[3])
             _store(out, cnt[C_NOUT], t0 + y[0], y, v, _PULL(y[1], v, P), out_br, br)
             cnt[C_NOUT] += 1
-
-#: The one signature the drivers are compiled for (the law argument of :data:`peelapprox.kernels.LAW_TYPE`).
-RUN_SIG = _t.int64(
-    _A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.float64, _t.int64, _A1, _t.float64[:, ::1], _t.int8[::1],
-    _t.float64[:, ::1], _t.int64[::1], _t.int64,
-)
-#: The two drivers: the paper's law inlined (the default path: no indirect call, the code of 0.2.0) and the law as
-#: a function argument (any compiled law, ``coef`` as data: a new law or coefficients compile nothing).
-def _driver_copy(field, pull, pack) -> pytypes.FunctionType:
-    """:func:`_run` reading ``field``, ``pull``, ``pack`` and their DOP853 pieces as its globals ``_FIELD``,
-    ``_PULL``, ``_PACK``, ``_dop``: a module-level function (no closure), so numba caches it across processes."""
-    g = dict(globals(), _FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
-    fn = pytypes.FunctionType(_run.__code__, g, _run.__name__, _run.__defaults__, None)
-    fn.__qualname__, fn.__module__, fn.__doc__ = _run.__qualname__, _run.__module__, _run.__doc__
-    return fn
-
-
-_DRIVERS = {
-    False: kernel(_driver_copy(_rhs, pull_force, _pack_paper), name="run_inlined"),
-    True: kernel(_run, name="run_law"),
-}
-
-
-def driver(law_argument: bool):
-    """The hybrid driver ``run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, out_br, jbuf,
-    cnt, max_call_steps) -> status``, compiled for :data:`RUN_SIG` on first use (loaded from numba's cache when it
-    is there) and for no other signature.
-
-    ``law_argument=False``: the paper's law fvV inlined, ``law`` and ``coef`` unused (the default path; an
-    indirect call per field evaluation and the lost inlining would cost ~4 ns of a ~25 ns field, ~5-10 % per
-    step: comparisons.benchmark.law_cost).  ``True``: the law ``law`` (:data:`peelapprox.kernels.LAW_TYPE`) with
-    the coefficients ``coef``.
-
-    ``run`` advances the hybrid solver from ``st`` until t_end or a buffer/quota limit and returns a status code
-    (module constants).  All state needed to continue is in ``st`` and ``cnt``; the caller empties full buffers
-    and calls again.  In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.
-    """
-    d = _DRIVERS[bool(law_argument)]
-    if not d.signatures:
-        d.compile(RUN_SIG)
-        d.disable_compile()
-    return d

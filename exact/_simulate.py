@@ -21,12 +21,13 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox.kernels import LAWS, model_block, paper_coefficients
+from peelapprox.kernels import model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
 
 from . import _hybrid as H
+from . import _hybrid_law as HL
 from ._options import (
     ATOL_SCALE,
     STEP_BUDGET,
@@ -302,24 +303,6 @@ def simulate(
 V_CEILING = 1e3
 
 
-def _law_for(params: PeelParams) -> tuple[Callable, np.ndarray, BranchStructure]:
-    """The peel-force law of ``params`` as the hybrid driver takes it: ``(law, coef, branch structure)``.
-
-    The internal hook of issue 15 for ``PeelParams(force=...)``: a ``params.force`` that is not None must have
-    ``kind`` (a key of :data:`peelapprox.kernels.LAWS`: the compiled law), ``coefficients(V)`` (its ``coef``
-    array) and ``branch_structure(V)`` (its folds and landings, a :class:`peelapprox.BranchStructure`).
-    Without one: the paper's law fvV, ``coef = [b, A] = peel_force_coefficients(V)`` and
-    :func:`peelapprox.branch_structure`.
-    """
-    force = getattr(params, "force", None)
-    if force is None:
-        return LAWS["paper"], paper_coefficients(params.V), branch_structure(params.V)
-    if force.kind not in LAWS:
-        raise ValueError(f"params.force.kind must be one of {sorted(LAWS)}, got {force.kind!r}")
-    coef = np.ascontiguousarray(force.coefficients(params.V), dtype=float)
-    return LAWS[force.kind], coef, force.branch_structure(params.V)
-
-
 def _param_vector(params: PeelParams, v_floor: float | None = None,
                   bs: BranchStructure | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
@@ -350,10 +333,9 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
     t_store, max_wall = saveat.t_transient, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
-    law, coef, bs = _law_for(params)
+    law, coef, bs, law_argument = HL.law_for(params)  # no law given: the driver with the paper's law inlined
     p = _param_vector(params, v_floor, bs)
-    law_argument = getattr(params, "force", None) is not None  # else the driver with the paper's law inlined
-    run = H.driver(law_argument)
+    run = HL.driver(law_argument)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
     if saveat.ts is not None:
@@ -381,7 +363,7 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     def state_dict():
         a, v = st[H.S_AL], math.exp(st[H.S_U])
         # the kernel keeps the state in the domain (v = e^u > 0)
-        F = float(H.pull_force_law(a, v, p, law, coef) if law_argument else H.pull_force(a, v, p))
+        F = float(HL.pull_force_law(a, v, p, law, coef) if law_argument else H.pull_force(a, v, p))
         return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
                     branch=BRANCHES[int(st[H.S_BR])])
 
@@ -513,7 +495,6 @@ def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
     """
     if not law_argument:
         return H._rhs, _param_vector(params, v_floor)
-    law, coef, bs = _law_for(params)
-    p = _param_vector(params, v_floor, bs)
-    return H._rhs_law, (p, law, coef)
+    law, coef, bs, _ = HL.law_for(params)
+    return HL._rhs_law, (_param_vector(params, v_floor, bs), law, coef)
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import exact._hybrid as H
+import exact._hybrid_law as HL
 import exact._simulate as ES
 from exact import Budget, Hybrid, SaveAt, State
 from peelapprox import PeelParams
@@ -76,11 +77,11 @@ def test_paper_law_is_the_inlined_law_bitwise():
             assert paper_law(v, c, LAW_FPP) == peel_force_fpp_jit(v, b, A)
         p = ES._param_vector(PeelParams(V=V, I=1e-5))
         for a, v in ((0.0, 0.1), (0.3, 1e-20), (-0.5, 3.0)):
-            assert H.pull_force_law(a, v, p, paper_law, c) == H.pull_force(a, v, p)
+            assert HL.pull_force_law(a, v, p, paper_law, c) == H.pull_force(a, v, p)
             y = np.array([0.0, a, 10.0, np.log(v)])
             g0, g1 = np.empty(4), np.empty(4)
             H._rhs(y, p, g0)
-            H._rhs_law(y, (p, paper_law, c), g1)
+            HL._rhs_law(y, (p, paper_law, c), g1)
             assert np.array_equal(g0, g1)
 
 
@@ -170,7 +171,7 @@ def test_second_law_runs_in_the_compiled_driver_with_its_own_folds():
     params = _ParamsWithForce(V=1.2, I=1e-5, force=_CubicForce())
     v0 = 0.5
     s0 = State(0.0, 0.0, 1.2 / 0.1, float(np.polyval(_poly(COEF), v0)), v0, "AB")
-    run = H.driver(True)
+    run = HL.driver(True)
     assert len(run.signatures) == 1
     tr = ES._run_hybrid(params, 2.0, s0, Hybrid(rtol=1e-10), SaveAt(jumps_only=True),
                         Budget(max_points=10, max_steps=10**7, max_jumps=10**5), None)
@@ -196,4 +197,4 @@ def test_unknown_law_kind_is_refused():
         kind = "spline"
 
     with pytest.raises(ValueError, match="params.force.kind"):
-        ES._law_for(_ParamsWithForce(V=1.2, I=1e-5, force=Bad()))
+        HL.law_for(_ParamsWithForce(V=1.2, I=1e-5, force=Bad()))

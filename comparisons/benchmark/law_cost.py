@@ -10,10 +10,12 @@ One run prints a table of:
   law's function type, as the driver is, so the call is not specialised away);
 * **per step**: µs per accepted step of ``exact.simulate`` (rtol 1e-8, save="jumps", the best of the rounds)
   on the benchmark scenes, for the tree at ``--before`` (default ``/work/main`` when it exists: the inlined
-  law) and for this tree (the law argument), each measured in its own process, alternating, so both see the
-  same machine load; and for the cubic law on a stick-slip scene of its own;
+  law) and for this tree, default (the driver with the law inlined) and with the paper's law given as a law
+  (the driver taking the law as an argument), each measured in its own process, alternating, so all see the
+  same machine load; and for the cubic law on stick-slip scenes of its own;
 * **second law**: the wall time of the first ``simulate`` with the cubic law in a process that has already run
-  the paper's law, with the number of numba compilations during it (numba's event recorder);
+  a first law (the paper's, given as a law), with the number of numba compilations during it (numba's event
+  recorder);
 * **driver load**: ``import exact; exact.compile_kernels()`` in a new process, from a warm cache and from an
   empty one (``NUMBA_CACHE_DIR``), for both trees.
 """
@@ -34,13 +36,13 @@ from pathlib import Path
 import numpy as np
 
 from exact import hybrid_field, simulate
-from peelapprox import PeelParams
+from peelapprox import PeelParams, branch_structure
 from peelapprox.io import fmt_number
 from peelapprox.kernels import LAW_TYPE, LAWS, cubic_v_structure, paper_coefficients
 
 from .scenes import BENCH_SCENES
 
-__all__ = ["CUBIC_COEF", "CubicForce", "field_costs", "main"]
+__all__ = ["CUBIC_COEF", "CubicForce", "PaperForce", "field_costs", "main"]
 
 _ROOT = Path(__file__).resolve().parents[2]
 #: f = 150 + 300 v - 300 v^2 + 80 v^3 [N] (folds at 0.691 and 1.809 m/s; tests/test_law_abi.py).
@@ -59,6 +61,18 @@ class CubicForce:
 
     def branch_structure(self, V: float):
         return cubic_v_structure(CUBIC_COEF, V)
+
+
+class PaperForce:
+    """The hook for the paper's law given as a law: the run takes the law driver (the indirect call)."""
+
+    kind = "paper"
+
+    def coefficients(self, V: float) -> np.ndarray:
+        return paper_coefficients(V)
+
+    def branch_structure(self, V: float):
+        return branch_structure(V)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -123,9 +137,14 @@ import json, time, sys
 import exact
 from peelapprox import PeelParams
 scenes = json.loads(sys.argv[1])
+if sys.argv[2] == "law":  # the paper's law given as a law: the law driver (this tree only)
+    from comparisons.benchmark.law_cost import PaperForce, _ParamsWithForce
+    make = lambda V, I: _ParamsWithForce(V=V, I=I, force=PaperForce())
+else:
+    make = lambda V, I: PeelParams(V=V, I=I)
 out = {}
 for name, V, I, alpha0, t_end in scenes:
-    p = PeelParams(V=V, I=I)
+    p = make(V, I)
     exact.simulate(p, min(t_end, 0.2), alpha0=alpha0, rtol=1e-8, save="jumps")
     best = 1e9
     for _ in range(3 if t_end < 10 else 1):
@@ -137,11 +156,12 @@ print(json.dumps(out))
 """
 
 
-def _per_step(tree: Path) -> dict[str, float]:
-    """µs per step on the benchmark scenes, measured in a new process running the package of ``tree``."""
+def _per_step(tree: Path, mode: str = "default") -> dict[str, float]:
+    """µs per step on the benchmark scenes, measured in a new process running the package of ``tree``
+    (``mode="law"``: the paper's law given as a law, through the law driver)."""
     scenes = [(s.name, s.V, s.I, s.alpha0, _T_END[s.name]) for s in BENCH_SCENES]
     env = dict(os.environ, PYTHONPATH=str(tree))
-    r = subprocess.run([sys.executable, "-c", _STEP_CODE, json.dumps(scenes)], env=env, capture_output=True,
+    r = subprocess.run([sys.executable, "-c", _STEP_CODE, json.dumps(scenes), mode], env=env, capture_output=True,
                        text=True, check=True, cwd=tempfile.gettempdir())
     return json.loads(r.stdout.strip().splitlines()[-1])
 
@@ -164,18 +184,21 @@ _SECOND_CODE = r"""
 import json, time
 from numba.core import event
 import exact
-from comparisons.benchmark.law_cost import _cubic_params
-from peelapprox import PeelParams
-exact.simulate(PeelParams(V=1.0, I=1e-5), 0.05, save="jumps")   # warm: the driver is loaded, the paper run
+from comparisons.benchmark.law_cost import PaperForce, _ParamsWithForce, _cubic_params
+p = _ParamsWithForce(V=1.0, I=1e-5, force=PaperForce())
 t0 = time.perf_counter()
-exact.simulate(PeelParams(V=1.0, I=1e-5), 0.05, save="jumps")
+exact.simulate(p, 0.05, save="jumps")   # warm: a first law run loads the law driver from the cache
+t_first_law = time.perf_counter() - t0
+t0 = time.perf_counter()
+exact.simulate(p, 0.05, save="jumps")
 t_paper = time.perf_counter() - t0
 with event.install_recorder("numba:compile") as rec:
     t0 = time.perf_counter()
     tr = exact.simulate(_cubic_params(1e-5), 0.05, save="jumps")
     t_cubic = time.perf_counter() - t0
 n_compiles = sum(1 for _, e in rec.buffer if e.is_start)
-print(json.dumps(dict(t_paper=t_paper, t_cubic=t_cubic, compiles=n_compiles, jumps=len(tr.jumps.t))))
+print(json.dumps(dict(t_first_law=t_first_law, t_paper=t_paper, t_cubic=t_cubic, compiles=n_compiles,
+                      jumps=len(tr.jumps.t))))
 """
 
 _LOAD_CODE = ("import time; t=time.perf_counter(); import exact; exact.compile_kernels(); "
@@ -202,10 +225,12 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     res: dict = {"field_ns": field_costs()}
     trees = {"after": _ROOT} | ({"before": args.before.resolve()} if args.before else {})
-    steps: dict[str, dict[str, float]] = {k: {} for k in trees}
+    runs = [("after", _ROOT, "default"), ("after_law", _ROOT, "law")] + (
+        [("before", args.before.resolve(), "default")] if args.before else [])
+    steps: dict[str, dict[str, float]] = {k: {} for k, _, _ in runs}
     for _ in range(args.rounds):
-        for k, tree in trees.items():
-            for name, us in _per_step(tree).items():
+        for k, tree, mode in runs:
+            for name, us in _per_step(tree, mode).items():
                 steps[k][name] = min(steps[k].get(name, math.inf), us)
     res["us_per_step"] = steps
     res["cubic_us_per_step"] = _cubic_per_step(args.rounds)
@@ -218,18 +243,22 @@ def main(argv: list[str] | None = None) -> int:
     print("field evaluation [ns]        inlined paper  paper via law  cubic via law  paper law/inlined")
     print(f"                             {fmt_number(f['inline'], 4):>13}  {fmt_number(f['paper'], 4):>13}  "
           f"{fmt_number(f['cubic'], 4):>13}  {fmt_number(f['paper'] / f['inline'], 4):>17}")
-    print("\nper step [us], best of rounds  before (inlined)  after (law arg)  after/before")
+    print("\nper step [us], best of rounds   before   after (default)  after (paper as law)   ratios to before")
     for name, us in steps["after"].items():
         b = steps.get("before", {}).get(name)
-        print(f"  {name:<28} {fmt_number(b, 4) if b else '-':>15}  {fmt_number(us, 4):>15}  "
-              f"{fmt_number(us / b, 4) if b else '-':>12}")
-    paper_mean = float(np.mean(list(steps["after"].values())))
+        la = steps["after_law"][name]
+        ratios = f"{fmt_number(us / b, 3)}  {fmt_number(la / b, 3)}" if b else "-"
+        print(f"  {name:<28} {fmt_number(b, 4) if b else '-':>7}  {fmt_number(us, 4):>15}  {fmt_number(la, 4):>20}"
+              f"   {ratios}")
+    paper_mean = float(np.mean(list(steps["after_law"].values())))
     for name, us in res["cubic_us_per_step"].items():
-        print(f"  {name:<28} {'':>15}  {fmt_number(us, 4):>15}  (cubic / mean paper after: "
+        print(f"  {name:<28} {'':>7}  {'':>15}  {fmt_number(us, 4):>20}   (/ mean paper as law: "
               f"{fmt_number(us / paper_mean, 3)})")
     s = res["second_law"]
-    print(f"\nsecond law, first simulate (0.05 s) in a warm process: {fmt_number(1e3 * s['t_cubic'], 3)} ms "
-          f"({s['compiles']} numba compilations; the paper's warm simulate: {fmt_number(1e3 * s['t_paper'], 3)} ms)")
+    print("\nsecond law, first simulate (0.05 s) in a process that ran a first law: "
+          f"{fmt_number(1e3 * s['t_cubic'], 3)} ms, {s['compiles']} numba compilations\n  (the first law's first "
+          f"simulate, loading the law driver from the cache: {fmt_number(1e3 * s['t_first_law'], 3)} ms; "
+          f"its second: {fmt_number(1e3 * s['t_paper'], 3)} ms)")
     print("\nimport exact + compile_kernels() in a new process [s]:   cold (empty cache)   warm (cache)")
     for k, v in res["load_s"].items():
         print(f"  {k:<54} {fmt_number(v['cold'], 3):>8}   {fmt_number(v['warm'], 3):>12}")
