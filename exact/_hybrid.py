@@ -75,10 +75,14 @@ relative to the segment duration, not to the absolute time).  This module is
 its event driver: folds, jumps, t_end, output and breakdown checks.
 
 Everything per step runs inside one numba function; Python is entered only
-when an output buffer fills or the run ends.
+when an output buffer fills or the run ends.  That function, :func:`_run`, is
+compiled twice by :mod:`exact._hybrid_law`: with the paper's law fvV inlined
+(the default) and with the peel-force law as a typed function argument.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
@@ -100,7 +104,6 @@ from peelapprox.kernels import (
     interp,
     interp1,
     kernel,
-    make_dop853,
     peel_force_fp_jit,
     peel_force_lnv_jit,
     slow_rates,
@@ -144,16 +147,15 @@ def _closure(alpha, p):
 
 @kernel
 def pull_force(alpha, v, p):
-    """F = f(v, V) / (1 + c(α))  (CONSTR solved for F)."""
+    """F = f(v, V) / (1 + c(α))  (CONSTR solved for F), the paper's law inlined (fvV, ``p[M_B], p[M_A]``)."""
     f, _ = peel_force_fp_jit(v, p[M_B], p[M_A])
     c, _ = _closure(alpha, p)
     return f / (1.0 + c)
 
 
-@kernel
-def _rhs(y, p, out):
-    """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring)."""
-    v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
+@kernel(inline="always")
+def _field(y, p, v, f, g, out):
+    """The field at ``y`` given ``v = e^u``, ``f(v)`` and ``g = v f'(v)`` (whichever law gave them)."""
     if not (v > 0.0):  # trial stage left the model's domain (v underflowed): poison the step
         for i in range(4):
             out[i] = np.nan
@@ -172,7 +174,12 @@ def _rhs(y, p, out):
     out[3] = Gd  # d(ln v)/ds = (dv/ds)/v = Ġ
 
 
-_dop = make_dop853(_rhs)
+@kernel
+def _rhs(y, p, out):
+    """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring), the paper's law
+    inlined: the field of the saltation tangent (``exact._tangent``) and of ``exact.hybrid_field``."""
+    v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
+    _field(y, p, v, f, g, out)
 
 
 @kernel
@@ -217,10 +224,20 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-@kernel
-def run(
+#: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_law` (the paper's law inlined, or the
+#: law as an argument): the field ``_FIELD(y, P, out)``, the pull force ``_PULL(alpha, v, P)``,
+#: ``P = _PACK(p, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
+_FIELD: Any = None
+_PULL: Any = None
+_PACK: Any = None
+_dop: Any = None
+
+
+def _run(
     st,
     p,
+    law,
+    coef,
     rtol,
     atol,
     t_end,
@@ -237,8 +254,10 @@ def run(
 
     Returns a status code (module constants).  All state needed to continue is
     in ``st`` and ``cnt``; the caller empties full buffers and calls again.
-    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.
+    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force is ``law`` with ``coef``,
+    or the paper's law inlined: :func:`exact._hybrid_law.driver`.
     """
+    P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
 
@@ -257,10 +276,10 @@ def run(
     calls = 0
     n_bad = 0  # successive steps rejected for their dense output
 
-    _rhs(y, p, f0)
+    _FIELD(y, P, f0)
     cnt[C_RHS] += 1
     if h <= 0.0:
-        h = _dop.initial_step(y, f0, p, rtol, atol, work)
+        h = _dop.initial_step(y, f0, P, rtol, atol, work)
         cnt[C_RHS] += 1
 
     while True:
@@ -276,7 +295,7 @@ def run(
             return JUMPS_FULL
 
         # ---- one accepted step
-        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
+        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, P, rtol, atol, K, y_new, tmp, sc)
         cnt[C_REJ] += n_rej
         cnt[C_RHS] += n_rhs
         if status == STEP_FAILED:
@@ -301,7 +320,7 @@ def run(
             gB = y_new[3] - uf
             crossed = gB >= 0.0 if br == 0 else gB <= 0.0
             if crossed:
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 ok = _finite_rows(Fc)
                 if ok:
                     x_fold = solve_theta(y, Fc, 3, uf, gA, 1.0, gB)
@@ -326,7 +345,7 @@ def run(
                 x_b = 1.0
                 tau_b = y_new[0]
             if tau_b >= tau_end:
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 ok = _finite_rows(Fc)
                 if ok:
                     x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
@@ -340,13 +359,13 @@ def run(
                 tau_stop = y_new[0]
             while cnt[C_TEVAL] < n_teval and t_eval[cnt[C_TEVAL]] - t0 <= tau_stop:
                 te = t_eval[cnt[C_TEVAL]]
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, p, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
                 if not _in_domain(ye, p):
                     ok = False
                     break
                 ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], te, ye, ve, pull_force(ye[1], ve, p), out_br, br)
+                _store(out, cnt[C_NOUT], te, ye, ve, _PULL(ye[1], ve, P), out_br, br)
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
@@ -392,7 +411,7 @@ def run(
             ye[0] = t_end - t0
             if save_mode == SAVE_STEPS and t_end >= t_store:
                 ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], t_end, ye, ve, pull_force(ye[1], ve, p), out_br, br)
+                _store(out, cnt[C_NOUT], t_end, ye, ve, _PULL(ye[1], ve, P), out_br, br)
                 cnt[C_NOUT] += 1
             for i in range(4):
                 y[i] = ye[i]
@@ -405,7 +424,7 @@ def run(
             ye[3] = np.log(v_fold)
             ye[0] = max(ye[0], y[0])  # as for a plain step (below)
             tj = t0 + ye[0]
-            Fj = pull_force(ye[1], v_fold, p)
+            Fj = _PULL(ye[1], v_fold, P)
             if br == 0:
                 v_after = p[P_VLCD]
             else:
@@ -441,8 +460,8 @@ def run(
             if tj >= t_store and save_mode == SAVE_STEPS:
                 _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
                 cnt[C_NOUT] += 1
-            _rhs(y, p, f0)
-            h = _dop.initial_step(y, f0, p, rtol, atol, work)
+            _FIELD(y, P, f0)
+            h = _dop.initial_step(y, f0, P, rtol, atol, work)
             cnt[C_RHS] += 2
             continue
 
@@ -458,5 +477,5 @@ def run(
         h = h_next
         if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
             v = np.exp(y[3])
-            _store(out, cnt[C_NOUT], t0 + y[0], y, v, pull_force(y[1], v, p), out_br, br)
+            _store(out, cnt[C_NOUT], t0 + y[0], y, v, _PULL(y[1], v, P), out_br, br)
             cnt[C_NOUT] += 1

@@ -6,7 +6,7 @@ import math
 import sys
 import time
 from collections.abc import Callable, Sequence
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -14,6 +14,7 @@ from peelapprox import (
     BRANCHES,
     BREAKDOWN_LEVEL,
     TIME_MAX,
+    BranchStructure,
     PeelParams,
     branch_inverse,
     branch_structure,
@@ -26,6 +27,7 @@ from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
 
 from . import _hybrid as H
+from . import _hybrid_law as HL
 from ._options import (
     ATOL_SCALE,
     STEP_BUDGET,
@@ -123,7 +125,7 @@ def initial_state(
 
 
 def compile_kernels() -> float:
-    """Compile (or load from numba's on-disk cache) the hybrid kernel.
+    """Compile (or load from numba's on-disk cache) the hybrid kernel (the driver with the paper's law inlined).
 
     Returns the seconds spent in this process the first time; 0 afterwards.
     """
@@ -301,10 +303,13 @@ def simulate(
 V_CEILING = 1e3
 
 
-def _param_vector(params: PeelParams, v_floor: float | None = None) -> np.ndarray:
+def _param_vector(params: PeelParams, v_floor: float | None = None,
+                  bs: BranchStructure | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
-    criterion, ``BranchStructure.v_breakdown``."""
-    bs = branch_structure(params.V)
+    criterion, ``BranchStructure.v_breakdown``; ``bs``: the law's branch structure (default: the paper's law's,
+    :func:`peelapprox.branch_structure`)."""
+    if bs is None:
+        bs = branch_structure(params.V)
     p = model_block(params, H.N_P)  # the model block (peelapprox.kernels), then the hybrid driver's fields
     p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
     p[H.P_VMAX] = bs.v_max if bs.has_folds else math.inf
@@ -328,7 +333,9 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
     t_store, max_wall = saveat.t_transient, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
-    p = _param_vector(params, v_floor)
+    law, coef, bs, law_argument = HL.law_for(params)  # no law given: the driver with the paper's law inlined
+    p = _param_vector(params, v_floor, bs)
+    run = HL.driver(law_argument)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
     if saveat.ts is not None:
@@ -355,7 +362,8 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
 
     def state_dict():
         a, v = st[H.S_AL], math.exp(st[H.S_U])
-        F = float(H.pull_force(a, v, p))  # the kernel keeps the state in the domain (v = e^u > 0)
+        # the kernel keeps the state in the domain (v = e^u > 0)
+        F = float(HL.pull_force_law(a, v, p, law, coef) if law_argument else H.pull_force(a, v, p))
         return dict(t=float(st[H.S_T0] + st[H.S_TAU]), alpha=float(a), omega=float(st[H.S_OM]), F=F, v=float(v),
                     branch=BRANCHES[int(st[H.S_BR])])
 
@@ -400,7 +408,8 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
         # means the run needs more than the budget
         nv = cap if mode != H.SAVE_STEPS else min(cap, max_points + 2 - n_stored)
         jv = min(jcap, max_jumps + 1 - n_jstored)
-        status = H.run(st, p, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv], cnt, quota)
+        status = run(st, p, law, coef, rtol, atol, t_end, t_store, mode, t_eval, out[:nv], out_br[:nv], jbuf[:jv],
+                       cnt, quota)
         if status == S.DONE:
             if n_stored + int(cnt[H.C_NOUT]) > max_points:
                 raise over_budget("max_points", max_points)
@@ -434,7 +443,6 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
             checkpoint()
             continue
         sd = state_dict()
-        bs = branch_structure(params.V)
         if status == S.NO_ROOT and v_floor is not None and v_floor > bs.v_breakdown:
             status, why = S.V_FLOOR, f"the caller's v_floor; F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N"
         else:
@@ -474,8 +482,19 @@ def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] 
     return _atol_vector(method, rtol, atol)
 
 
-def hybrid_field(params: PeelParams, v_floor: float | None = None) -> tuple[Callable, np.ndarray]:
+def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
+                 law_argument: bool = False) -> tuple[Callable, Any]:
     """The hybrid solver's compiled field ``rhs(y, p, out)`` and its parameter vector ``p`` for ``params``
-    (``v_floor`` as in :func:`simulate`), e.g. to time one field evaluation in a compiled loop."""
-    return H._rhs, _param_vector(params, v_floor)
+    (``v_floor`` as in :func:`simulate`), e.g. to time one field evaluation in a compiled loop.
+
+    ``law_argument=False``: the field with the paper's law fvV inlined and ``p`` the parameter vector.
+    ``law_argument=True``: the field of the driver that takes the law as a function argument (used with a
+    ``params.force``; also for the paper's law, which the default driver inlines) and ``(p, law, coef)``; the
+    field is called as ``rhs(y, (p, law, coef), out)`` from a loop compiled with ``law`` of type
+    :data:`peelapprox.kernels.LAW_TYPE`.
+    """
+    if not law_argument:
+        return H._rhs, _param_vector(params, v_floor)
+    law, coef, bs, _ = HL.law_for(params)
+    return HL._rhs_law, (_param_vector(params, v_floor, bs), law, coef)
 

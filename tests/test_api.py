@@ -62,13 +62,15 @@ API = {
     },
     # the door through which exact (and comparisons) reach the compiled model and integrator
     "peelapprox.kernels": {
-        "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B",
-        "M_GEOM", "M_I", "M_K", "M_L", "M_R", "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS",
-        "STEP_FAILED", "branch_inverse_at", "closure", "closure_exact", "closure_paper", "constraint_rate",
-        "crossing", "diffsl_code", "diffsl_inputs", "diffsl_model", "import_optional", "interp", "interp1", "kernel",
-        "make_dop853", "model_block", "peel_force_coefficients", "peel_force_fp_jit", "peel_force_fpp_jit",
-        "peel_force_lnv_jit", "regularized_field", "regularized_field_jacobian", "regularized_jacobian",
-        "regularized_parameters", "regularized_rhs", "slow_rates", "solve_theta", "state_at", "status", "workspace",
+        "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",
+        "LAW_SIG", "LAW_TYPE", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B", "M_GEOM", "M_I", "M_K", "M_L", "M_R",
+        "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS", "STEP_FAILED", "branch_inverse_at", "closure",
+        "closure_exact", "closure_paper", "constraint_rate", "crossing", "cubic_v_law", "cubic_v_structure",
+        "diffsl_code", "diffsl_inputs", "diffsl_model", "import_optional", "interp", "interp1", "kernel",
+        "make_dop853", "model_block", "paper_coefficients", "paper_law", "peel_force_coefficients",
+        "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit", "regularized_field",
+        "regularized_field_jacobian", "regularized_jacobian", "regularized_parameters", "regularized_rhs",
+        "slow_rates", "solve_theta", "state_at", "status", "workspace",
     },
     "peelapprox.cli": {"build_parser", "main"},
     "comparisons.benchmark": {

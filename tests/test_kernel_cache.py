@@ -28,16 +28,22 @@ with warnings.catch_warnings(record=True) as w:
     import peelapprox, exact
     from peelapprox import PeelParams
     from peelapprox._peelforce import peel_force
+    from peelapprox.kernels import paper_coefficients, paper_law
     from exact._hybrid import pull_force
+    from exact._hybrid_law import driver, pull_force_law
+    run = driver(True)  # the driver taking the law as an argument: compiled or loaded from the cache here
     from exact._simulate import _param_vector
     p = PeelParams(V=1.0, I=1e-5)
     kern = float(pull_force(0.2, 0.1, _param_vector(p, 1e-9)))
+    kern_law = float(pull_force_law(0.2, 0.1, _param_vector(p, 1e-9), paper_law, paper_coefficients(1.0)))
+    run_hits, run_misses = sum(run.stats.cache_hits.values()), sum(run.stats.cache_misses.values())
     ref = float(peel_force(0.1, 1.0)) / (1.0 + float(p.closure(0.2)[0]))
     extra = {}
     if {simulate}:
         tr = exact.simulate(p, 0.01)
         extra = dict(res=float(np.max(np.abs(tr.constraint_residual(relative=True)))), n=len(tr.t))
-print(json.dumps(dict(file=peelapprox.__file__, kern=kern, ref=ref,
+print(json.dumps(dict(file=peelapprox.__file__, kern=kern, ref=ref, kern_law=kern_law, run_hits=run_hits,
+                      run_misses=run_misses, n_run=len(run.signatures),
                       warnings=[type(x.message).__name__ for x in w], **extra)))
 """
 
@@ -94,11 +100,19 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     loaded unchanged (the pull force of the kernel then disagreed with the numpy law by ~37 N).  Hypothesis:
     the kernel follows the changed source.  The kernel and numpy evaluate the same expression, so they agree
     to rounding (1e-12 relative); the change of 400 v^0.35 -> 401 v^0.35 at v = 0.1 moves f by 0.447 N (F by 0.373 N),
-    10^9 times that tolerance."""
+    10^9 times that tolerance.  The same for the law passed as a function argument (issue 15: ``paper_law``
+    and the driver taking it, ``exact._hybrid_law.driver(True)``, compiled for an explicit signature): the driver is
+    loaded from the cache by a second process (a cache hit, no miss, one signature) and compiled anew after the
+    change (a miss)."""
     _copy_packages(tmp_path)
     before = _probe(tmp_path)  # compiles and caches in the copy's __pycache__
     assert abs(before["kern"] - before["ref"]) <= 1e-12 * abs(before["ref"])
+    assert before["kern_law"] == before["kern"]  # the paper law through the ABI is the inlined law, bitwise
+    assert (before["run_hits"], before["run_misses"], before["n_run"]) == (0, 1, 1)
     assert list((tmp_path / "exact" / "__pycache__").glob("*pull_force*.nbi")), "the first run did not cache"
+    again = _probe(tmp_path)
+    assert (again["run_hits"], again["run_misses"], again["n_run"]) == (1, 0, 1)
+    assert again["kern_law"] == before["kern_law"]
     gen = tmp_path / "peelapprox" / "_generated.py"
     src = gen.read_text()
     assert src.count("400*x2") == 3  # f in peel_force_fp, peel_force_fpp, peel_force_lnv
@@ -106,6 +120,8 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     after = _probe(tmp_path)
     assert abs(after["ref"] - before["ref"]) > 0.3  # the numpy law did change ...
     assert abs(after["kern"] - after["ref"]) <= 1e-12 * abs(after["ref"])  # ... and so did the kernel
+    assert after["kern_law"] == after["kern"]  # ... and the law of the ABI
+    assert (after["run_hits"], after["run_misses"]) == (0, 1)  # the driver was compiled anew
 
 
 def test_import_and_simulate_without_writable_cache(tmp_path):

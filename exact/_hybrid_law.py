@@ -1,0 +1,141 @@
+"""The hybrid solver's two drivers: the peel-force law inlined, or passed as a typed function argument (issue 15).
+
+The driver body is one function, :func:`exact._hybrid._run`; it calls its field, pull force and DOP853 pieces
+through module globals, which this module binds twice:
+
+* ``driver(False)`` -- the paper's law fvV **inlined** (the field :func:`exact._hybrid._rhs`, the parameter
+  vector ``p`` carrying ``b, A``): the default path, the arithmetic and the speed of 0.2.0;
+* ``driver(True)`` -- the law as an **argument**: ``law`` of type :data:`peelapprox.kernels.LAW_TYPE` and its
+  coefficients ``coef`` (float64[::1]) travel with ``p`` as ``P = (p, law, coef)`` to the field
+  :func:`_rhs_law`, which calls ``law(u, coef, LAW_LNV)``.  Compiled once for :data:`RUN_SIG`, it runs every
+  compiled law (:data:`peelapprox.kernels.LAWS`) with any coefficients without compiling again.
+
+Why two: through the argument the law is an indirect call that LLVM cannot inline into the field (~4 ns of a
+~25 ns field evaluation, ~12 per step: +5-10 % per step on the benchmark scenes; ``python -m
+comparisons.benchmark.law_cost``), so the default path keeps the inlined law.  Both drivers are compiled for the
+same explicit signature on first use and cached across processes (module-level function copies: numba does not
+cache a closure over dispatchers across processes).  The kernels that call a law are compiled without numba's
+reference-counting runtime (``kernel(nrt=False)``): it wraps every indirect call with an array argument in atomic
+reference-count updates it cannot prune (measured: 62 instead of 29 ns per field evaluation).
+"""
+
+from __future__ import annotations
+
+import types as pytypes
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numba import types as _t
+
+from peelapprox import BranchStructure, PeelParams, branch_structure
+from peelapprox.kernels import LAW_FP, LAW_LNV, LAW_TYPE, LAWS, kernel, make_dop853, paper_coefficients
+
+from . import _hybrid as H
+
+__all__ = ["RUN_SIG", "driver", "law_for", "pull_force_law"]
+
+_A1 = _t.float64[::1]
+
+
+@kernel(nrt=False)  # no reference counting around the law call (module docstring)
+def _pull_force_P(alpha, v, P):
+    """F = f(v) / (1 + c(α))  (CONSTR solved for F), f the law of ``P = (p, law, coef)``: ``law(v, coef, LAW_FP)``."""
+    p, law, coef = P
+    f, _, _ = law(v, coef, LAW_FP)
+    c, _ = H._closure(alpha, p)
+    return f / (1.0 + c)
+
+
+@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1), nrt=False)
+def pull_force_law(alpha, v, p, law, coef):
+    """:func:`exact._hybrid.pull_force` for the law ``law`` with the coefficients ``coef``."""
+    return _pull_force_P(alpha, v, (p, law, coef))
+
+
+@kernel(nrt=False)  # no reference counting around the law call (module docstring)
+def _rhs_law(y, P, out):
+    """The field of :func:`exact._hybrid._rhs` for the law of ``P = (p, law, coef)``: ``law(u, coef, LAW_LNV)``
+    gives ``(v, f, v f')``."""
+    p, law, coef = P
+    v, f, g = law(y[3], coef, LAW_LNV)
+    H._field(y, p, v, f, g, out)
+
+
+@kernel(inline="always")
+def _pack_paper(p, law, coef):
+    """What the inlined-law driver's field receives: ``p`` (the paper's law reads ``p[M_B], p[M_A]``)."""
+    return p
+
+
+@kernel(inline="always")
+def _pack_law(p, law, coef):
+    """What the law driver's field receives: ``(p, law, coef)``."""
+    return (p, law, coef)
+
+
+#: The one signature of both drivers: ``(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out,
+#: out_br, jbuf, cnt, max_call_steps) -> status``.
+RUN_SIG = _t.int64(
+    _A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.float64, _t.int64, _A1, _t.float64[:, ::1], _t.int8[::1],
+    _t.float64[:, ::1], _t.int64[::1], _t.int64,
+)
+
+
+def _driver_copy(field: Callable, pull: Callable, pack: Callable) -> pytypes.FunctionType:
+    """:func:`exact._hybrid._run` reading ``field``, ``pull``, ``pack`` and the DOP853 pieces of ``field`` as its
+    globals ``_FIELD``, ``_PULL``, ``_PACK``, ``_dop``: a module-level function (no closure), so numba caches it."""
+    run = H._run
+    g = dict(run.__globals__, _FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
+    fn = pytypes.FunctionType(run.__code__, g, run.__name__, run.__defaults__, None)
+    fn.__qualname__, fn.__module__, fn.__doc__ = run.__qualname__, run.__module__, run.__doc__
+    return fn
+
+
+_DRIVERS = {
+    False: kernel(_driver_copy(H._rhs, H.pull_force, _pack_paper), name="run_inlined"),
+    True: kernel(_driver_copy(_rhs_law, _pull_force_P, _pack_law), name="run_law"),
+}
+
+
+def driver(law_argument: bool) -> Any:
+    """The hybrid driver, compiled for :data:`RUN_SIG` on first use (loaded from numba's cache when it is there)
+    and for no other signature.
+
+    Parameters
+    ----------
+    law_argument : bool
+        False: the paper's law fvV inlined, ``law`` and ``coef`` unused (the default path).  True: the law
+        ``law`` (:data:`peelapprox.kernels.LAW_TYPE`) with the coefficients ``coef``.
+
+    Returns
+    -------
+    numba dispatcher
+        ``run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, out_br, jbuf, cnt,
+        max_call_steps) -> status`` (:func:`exact._hybrid._run`).
+    """
+    d = _DRIVERS[bool(law_argument)]
+    if not d.signatures:
+        d.compile(RUN_SIG)
+        d.disable_compile()
+    return d
+
+
+def law_for(params: PeelParams) -> tuple[Callable, np.ndarray, BranchStructure, bool]:
+    """The peel-force law of ``params`` as the hybrid drivers take it: ``(law, coef, branch structure, given)``.
+
+    The paper's law (``PeelParams.force`` = ``PeelForce.paper()``, the default) is the inlined driver's:
+    ``(paper_law, [b, A] = peel_force_coefficients(V), branch_structure(V), False)``.  The law driver
+    (``driver(True)``, ``given`` True) takes a compiled law of :data:`peelapprox.kernels.LAWS` with its
+    coefficients as data; connecting ``PeelForce``'s families to it is the next step of issue 15 (until then
+    the tests reach it by substituting this function).
+
+    Raises
+    ------
+    ValueError
+        For a law other than the paper's (``validate.params`` refuses those first).
+    """
+    force = params.force
+    if force.kind != "paper":
+        raise ValueError(f"params.force: {force!r} is not yet supported by exact.simulate; see issue 15")
+    return LAWS["paper"], paper_coefficients(params.V), branch_structure(params.V), False

@@ -1,0 +1,203 @@
+"""The peel-force law as a function argument of the hybrid driver (issue 15, the compiled side).
+
+The paper's law through the ABI must be *the same arithmetic* as the inlined law (bitwise), and a second law
+must run through the one compiled law driver without compiling it again, with the physics of that law: its jumps
+leave the slow branch at its own fold levels, found here independently with numpy's polynomial roots.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import exact._hybrid as H
+import exact._hybrid_law as HL
+import exact._simulate as ES
+from exact import Budget, Hybrid, SaveAt, State
+from peelapprox import PeelParams
+from peelapprox.kernels import (
+    LAW_FP,
+    LAW_FPP,
+    LAW_LNV,
+    LAWS,
+    cubic_v_law,
+    cubic_v_structure,
+    paper_coefficients,
+    paper_law,
+    peel_force_fp_jit,
+    peel_force_fpp_jit,
+    peel_force_lnv_jit,
+)
+
+#: f = 150 + 300 v - 300 v^2 + 80 v^3 [N]: folds at v = (5 -+ sqrt 5)/4 (0.691, 1.809 m/s), f_max 240.45 N,
+#: f_min 184.55 N, f(0+) = 150 N: the paper's range of forces, with an N shape of the paper's kind.
+COEF = np.array([150.0, 300.0, 300.0, 80.0])
+
+
+def _poly(coef):
+    """numpy's coefficients (highest power first) of a + b v - c v^2 + d v^3."""
+    a, b, c, d = coef
+    return np.array([d, -c, b, a])
+
+
+class _CubicForce:
+    """The hook ``params.force`` of exact._simulate (kind, coefficients(V), branch_structure(V))."""
+
+    kind = "cubic_v"
+
+    def coefficients(self, V):
+        return COEF
+
+    def branch_structure(self, V):
+        return cubic_v_structure(COEF, V)
+
+
+def _give_law(monkeypatch, force) -> None:
+    """Route runs through the law driver with ``force`` (kind, coefficients(V), branch_structure(V)) by
+    substituting ``exact._hybrid_law.law_for``: until PeelForce's families are connected to the compiled laws,
+    this is how the law driver is reached (issue 15)."""
+    monkeypatch.setattr(HL, "law_for", lambda params: (
+        LAWS[force.kind], np.ascontiguousarray(force.coefficients(params.V), dtype=float),
+        force.branch_structure(params.V), True))
+
+
+def test_paper_law_is_the_inlined_law_bitwise():
+    """Hypothesis: ``paper_law`` evaluates the generated fvV code unchanged, so every form equals the inlined
+    kernels exactly (tolerance 0: the same operations in the same order), at V in {0.3, 1, 4} and v from 1e-60
+    to 30 m/s; the pull force and the field through the law equal the inlined ones exactly too."""
+    vs = np.concatenate([np.logspace(-60, 1.5, 40), [0.1, 0.5, 2.0]])
+    for V in (0.3, 1.0, 4.0):
+        c = paper_coefficients(V)
+        b, A = c
+        for v in vs:
+            u = float(np.log(v))
+            assert paper_law(u, c, LAW_LNV) == peel_force_lnv_jit(u, b, A)
+            f, fp, nan = paper_law(v, c, LAW_FP)
+            assert (f, fp) == peel_force_fp_jit(v, b, A) and np.isnan(nan)
+            assert paper_law(v, c, LAW_FPP) == peel_force_fpp_jit(v, b, A)
+        p = ES._param_vector(PeelParams(V=V, I=1e-5))
+        for a, v in ((0.0, 0.1), (0.3, 1e-20), (-0.5, 3.0)):
+            assert HL.pull_force_law(a, v, p, paper_law, c) == H.pull_force(a, v, p)
+            y = np.array([0.0, a, 10.0, np.log(v)])
+            g0, g1 = np.empty(4), np.empty(4)
+            H._rhs(y, p, g0)
+            HL._rhs_law(y, (p, paper_law, c), g1)
+            assert np.array_equal(g0, g1)
+
+
+class _PaperForce(_CubicForce):
+    kind = "paper"
+
+    def coefficients(self, V):
+        return paper_coefficients(V)
+
+    def branch_structure(self, V):
+        from peelapprox import branch_structure
+
+        return branch_structure(V)
+
+
+def test_paper_law_through_the_law_driver_is_the_default_run_bitwise(monkeypatch):
+    """Hypothesis: the paper's law given as a law (``params.force`` of kind "paper": the law driver, an indirect
+    call per field evaluation) gives the default run (the driver with the law inlined) bit for bit: every stored
+    point, jump and counter of a 0.3 s run at V = 1, I = 1e-5 with 8 jumps, and of a ``t_eval`` run at V = 4,
+    I = 1e-2 (tolerance 0: the same operations in the same order)."""
+    from exact import simulate
+
+    for V, I, kw in ((1.0, 1e-5, dict(save="steps")), (4.0, 1e-2, dict(t_eval=np.linspace(0.0, 0.05, 101)))):
+        a = simulate(PeelParams(V=V, I=I), kw.get("t_eval", [0.3])[-1], **kw)
+        with monkeypatch.context() as m:
+            _give_law(m, _PaperForce())
+            b = simulate(PeelParams(V=V, I=I), kw.get("t_eval", [0.3])[-1], **kw)
+        for name in ("t", "alpha", "omega", "F", "v", "branch"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+        for name in ("t", "F", "alpha", "omega", "v_before", "v_after"):
+            assert np.array_equal(getattr(a.jumps, name), getattr(b.jumps, name)), name
+        assert (a.stats.n_steps, a.stats.n_rhs, a.stats.n_rejected) == (b.stats.n_steps, b.stats.n_rhs,
+                                                                        b.stats.n_rejected)
+        assert a.final_state == b.final_state
+    assert len(a.jumps.t) >= 1
+
+
+def test_cubic_law_against_numpy_polynomials():
+    """Hypothesis: the three forms of ``cubic_v_law`` are the cubic, its derivatives and ``v f'`` as numpy's
+    ``polyval``/``polyder`` give them (an independent evaluation: Horner in another arrangement), to 1e-13
+    relative of the largest term (a few roundings of terms of size ~d v^3)."""
+    P = _poly(COEF)
+    for v in (1e-6, 0.1, 0.6909, 1.25, 2.0, 7.0):
+        scale = np.polyval(np.abs(P), v)
+        f, fp, fpp = cubic_v_law(v, COEF, LAW_FPP)
+        assert abs(f - np.polyval(P, v)) <= 1e-13 * scale
+        assert abs(fp - np.polyval(np.polyder(P), v)) <= 1e-13 * scale / min(v, 1.0)
+        assert abs(fpp - np.polyval(np.polyder(P, 2), v)) <= 1e-13 * scale / min(v, 1.0) ** 2
+        vv, f2, g = cubic_v_law(np.log(v), COEF, LAW_LNV)
+        assert abs(vv - v) <= 1e-15 * v
+        assert abs(f2 - f) <= 1e-13 * scale and abs(g - v * fp) <= 1e-13 * scale
+        assert cubic_v_law(v, COEF, LAW_FP)[:2] == (f, fp)
+    assert set(LAWS) == {"paper", "cubic_v"}
+
+
+def _numpy_folds(coef):
+    P = _poly(coef)
+    v_max, v_min = np.sort(np.roots(np.polyder(P)).real)
+    f_max, f_min = np.polyval(P, v_max), np.polyval(P, v_min)
+    land_cd = max(np.roots(P - [0, 0, 0, f_max]).real)
+    land_ab = min(r.real for r in np.roots(P - [0, 0, 0, f_min]) if r.real > 0)
+    return v_max, f_max, v_min, f_min, land_cd, land_ab
+
+
+def test_cubic_structure_is_the_numpy_roots():
+    """Hypothesis: the closed-form folds and landings of ``cubic_v_structure`` are the roots numpy finds (the
+    companion-matrix eigenvalues): folds and landings to 1e-7 relative (``np.roots`` of the double root
+    ``v_max`` of ``f - f_max`` is only sqrt(eps)-accurate; the landing is a simple root, to ~1e-13), levels to
+    1e-13 (stationary at the folds)."""
+    bs = cubic_v_structure(COEF, 1.2)
+    v_max, f_max, v_min, f_min, land_cd, land_ab = _numpy_folds(COEF)
+    assert bs.has_folds and bs.f_zero == 150.0
+    assert bs.v_max == pytest.approx(v_max, rel=1e-13) and bs.v_min == pytest.approx(v_min, rel=1e-13)
+    assert bs.f_max == pytest.approx(f_max, rel=1e-13) and bs.f_min == pytest.approx(f_min, rel=1e-13)
+    assert bs.v_land_cd == pytest.approx(land_cd, rel=1e-7) and bs.v_land_ab == pytest.approx(land_ab, rel=1e-7)
+    assert 0 < bs.v_breakdown < 1e-9
+    with pytest.raises(ValueError, match="coef"):
+        cubic_v_structure([150.0, 300.0, 10.0, 80.0], 1.0)  # c^2 < 3 b d: no fold
+
+
+def test_second_law_runs_in_the_compiled_driver_with_its_own_folds(monkeypatch):
+    """Hypothesis: a second law goes through the one compiled law driver (its signature list stays one entry and
+    it cannot compile: ``driver(True)`` is compiled for ``RUN_SIG`` only), and gives that law's physics: every
+    AB→CD jump leaves at the level ``G = F(1 + sin α) = f_max`` and every CD→AB jump at ``f_min`` of the cubic,
+    with v at its fold before and at its landing root after, the folds found independently by numpy.  Tolerances: levels
+    1e-12 relative (the jump is taken at v = v_fold exactly and F = f(v_fold)/(1 + c), so G is f at the fold to a
+    few roundings; f is stationary there, so the closed-form vs numpy v_max differences of ~1e-15 do not show),
+    velocities 1e-7 (numpy's root of the double root, as above)."""
+    params = PeelParams(V=1.2, I=1e-5)
+    _give_law(monkeypatch, _CubicForce())
+    v0 = 0.5
+    s0 = State(0.0, 0.0, 1.2 / 0.1, float(np.polyval(_poly(COEF), v0)), v0, "AB")
+    run = HL.driver(True)
+    assert len(run.signatures) == 1
+    tr = ES._run_hybrid(params, 2.0, s0, Hybrid(rtol=1e-10), SaveAt(jumps_only=True),
+                        Budget(max_points=10, max_steps=10**7, max_jumps=10**5), None)
+    assert len(run.signatures) == 1
+    v_max, f_max, v_min, f_min, land_cd, land_ab = _numpy_folds(COEF)
+    j = tr.jumps
+    assert len(j.t) >= 20  # stick-slip: ~17 cycles per second at these parameters
+    G = j.F * (1.0 + np.sin(j.alpha))
+    up = j.from_branch == 0
+    assert up.any() and (~up).any()
+    np.testing.assert_allclose(G[up], f_max, rtol=1e-12)
+    np.testing.assert_allclose(G[~up], f_min, rtol=1e-12)
+    np.testing.assert_allclose(j.v_before[up], v_max, rtol=1e-7)
+    np.testing.assert_allclose(j.v_after[up], land_cd, rtol=1e-7)
+    np.testing.assert_allclose(j.v_before[~up], v_min, rtol=1e-7)
+    np.testing.assert_allclose(j.v_after[~up], land_ab, rtol=1e-7)
+
+
+def test_a_law_other_than_the_papers_is_refused_by_the_hook():
+    """Hypothesis: until PeelForce's families are compiled laws, ``law_for`` refuses any law but the paper's with
+    a ValueError naming ``params.force`` (validate.params refuses them before a run gets there; this is the
+    hook's own guard)."""
+    from peelapprox import PeelForce
+
+    with pytest.raises(ValueError, match="params.force"):
+        HL.law_for(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic()))
