@@ -21,19 +21,33 @@ reference-count updates it cannot prune (measured: 62 instead of 29 ns per field
 
 from __future__ import annotations
 
+import math
 import types as pytypes
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numba import types as _t
+from scipy.optimize import brentq
 
 from peelapprox import BranchStructure, PeelParams, branch_structure
-from peelapprox.kernels import LAW_FP, LAW_LNV, LAW_TYPE, LAWS, kernel, make_dop853, paper_coefficients
+from peelapprox.kernels import (
+    LAW_FP,
+    LAW_LNV,
+    LAW_TYPE,
+    LAWS,
+    cubic_v_structure,
+    kernel,
+    make_dop853,
+    paper_coefficients,
+)
 
 from . import _hybrid as H
 
-__all__ = ["RUN_SIG", "driver", "law_for", "pull_force_law"]
+__all__ = ["HYBRID_LAWS", "RUN_SIG", "branch_root", "driver", "law_for", "pull_force_law"]
+
+#: The laws (``PeelParams.force``, by ``peelapprox._law.law_label``) that ``simulate(method="hybrid")`` runs.
+HYBRID_LAWS = ("paper", "cubic")
 
 _A1 = _t.float64[::1]
 
@@ -124,18 +138,47 @@ def driver(law_argument: bool) -> Any:
 def law_for(params: PeelParams) -> tuple[Callable, np.ndarray, BranchStructure, bool]:
     """The peel-force law of ``params`` as the hybrid drivers take it: ``(law, coef, branch structure, given)``.
 
-    The paper's law (``PeelParams.force`` = ``PeelForce.paper()``, the default) is the inlined driver's:
-    ``(paper_law, [b, A] = peel_force_coefficients(V), branch_structure(V), False)``.  The law driver
-    (``driver(True)``, ``given`` True) takes a compiled law of :data:`peelapprox.kernels.LAWS` with its
-    coefficients as data; connecting ``PeelForce``'s families to it is the next step of issue 15 (until then
-    the tests reach it by substituting this function).
+    * the paper's law (``PeelParams.force`` = ``PeelForce.paper()``, the default): the inlined driver's
+      ``(paper_law, [b, A] = peel_force_coefficients(V), branch_structure(V), False)``;
+    * ``PeelForce.cubic(a, b, c, d)``: ``(cubic_v_law, [a, b, c, d], cubic_v_structure(coef, V), True)``, run
+      by the law driver ``driver(True)`` (folds and landings in closed form).
 
     Raises
     ------
     ValueError
-        For a law other than the paper's (``validate.params`` refuses those first).
+        Naming ``params.force``: for any other law (``validate.params`` refuses those first), or a cubic
+        without two folds whose CD→AB jumps land (``cubic_v_structure``'s conditions).
     """
     force = params.force
-    if force.kind != "paper":
-        raise ValueError(f"params.force: {force!r} is not yet supported by exact.simulate; see issue 15")
-    return LAWS["paper"], paper_coefficients(params.V), branch_structure(params.V), False
+    if force.kind == "paper":
+        return LAWS["paper"], paper_coefficients(params.V), branch_structure(params.V), False
+    if force.kind == "family" and force.name == "cubic":
+        named = dict(force.coefficients)
+        coef = np.array([named[k] for k in ("a", "b", "c", "d")], dtype=float)
+        try:
+            bs = cubic_v_structure(coef, params.V)
+        except ValueError as e:
+            raise ValueError(f"params.force: {force!r} cannot be run by the hybrid solver: {e}") from None
+        return LAWS["cubic_v"], coef, bs, True
+    raise ValueError(f"params.force: {force!r} is not yet supported by exact.simulate; see issue 15")
+
+
+def branch_root(law: Callable, coef: np.ndarray, bs: BranchStructure, G: float, branch: str) -> float:
+    """v on ``branch`` with ``f(v) = G`` (CONSTR) for the compiled law ``law`` with ``coef``: Brent's method in
+    ln v (relative accuracy ~4 ulp in v), bracketed by the law's folds ``bs`` -- AB on ``(0, v_max]`` from
+    ``v = e^-690`` (where ``f = f(0+)`` to rounding), CD on ``[v_min, ∞)`` up to where f first exceeds G
+    (doubling).  ``G`` must be in ``bs.level_range(branch)`` (the caller checks :meth:`BranchStructure.has_root`).
+    """
+
+    def g(u: float) -> float:
+        return float(law(math.exp(u), coef, LAW_FP)[0]) - G
+
+    if branch == "AB":  # the laws run through here have folds (law_for)
+        lo, hi = -690.0, math.log(cast(float, bs.v_max))
+    else:
+        lo = hi = math.log(cast(float, bs.v_min))
+        while g(hi) < 0.0:
+            hi += math.log(2.0)
+    if g(hi) == 0.0:
+        return math.exp(hi)
+    return math.exp(brentq(g, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))

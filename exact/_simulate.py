@@ -21,7 +21,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox.kernels import model_block
+from peelapprox.kernels import LAW_FP, model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -61,7 +61,8 @@ def initial_state(
     Defaults (documented behaviour): ``α = 0``, ``ω = V/R``,
     ``F = 1.01 f(V, V)`` and v the lowest-velocity stable root of CONSTR,
     ``f(v, V) = F (1 - cos θ)``: on AB if the level lies in AB's range
-    ``(f(0+), f_max]``, otherwise on CD.
+    ``(f(0+), f_max]``, otherwise on CD.  f is the law ``params.force`` (the paper's fvV, or a cubic, whose
+    folds are :func:`peelapprox.kernels.cubic_v_structure`'s and whose root is found in ln v by Brent's method).
 
     Parameters
     ----------
@@ -91,17 +92,19 @@ def initial_state(
         ``F0 (1 - cos θ(α0))`` has no root on the requested branch (or on
         any branch), or if ``1 - cos θ(α0) <= 0``.
     """
-    _params("params", params)
+    _params("params", params, laws=HL.HYBRID_LAWS)
     a0 = state("alpha0", alpha0, "alpha")
     w0 = params.V / params.R if omega0 is None else state("omega0", omega0, "omega")
-    F = 1.01 * float(peel_force(params.V, params.V)) if F0 is None else state("F0", F0, "F")
+    law = None if params.force.kind == "paper" else HL.law_for(params)  # (law, coef, bs, True) of another law
+    fVV = float(peel_force(params.V, params.V) if law is None else law[0](params.V, law[1], LAW_FP)[0])
+    F = 1.01 * fVV if F0 is None else state("F0", F0, "F")
     t0 = in_range("t0", t0, 0.0, TIME_MAX)
     branch0 = optional(choice, "branch0", branch0, BRANCHES)
     c = float(params.closure(a0)[0])
     if not (1.0 + c > 0.0):
         raise ValueError(f"alpha0={a0} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
     G = F * (1.0 + c)
-    bs = branch_structure(params.V)
+    bs = branch_structure(params.V) if law is None else law[2]
     if branch0 is None:
         for cand in ("AB", "CD") if bs.has_folds else ("AB",):
             if bs.has_root(G, cand):
@@ -120,7 +123,7 @@ def initial_state(
             f"F0={F} at alpha0={a0} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
             f"valid F0 range on {branch0}: ({lo / (1 + c)}, {hi / (1 + c)})"
         )
-    v = branch_inverse(G, params.V, branch0)
+    v = branch_inverse(G, params.V, branch0) if law is None else HL.branch_root(law[0], law[1], bs, G, branch0)
     return State(float(t0), a0, w0, F, float(v), branch0)
 
 
@@ -186,7 +189,8 @@ def simulate(
     Parameters
     ----------
     params : PeelParams
-        Physical parameters and the ``cos θ`` closure (``geometry``).
+        Physical parameters, the ``cos θ`` closure (``geometry``) and the law ``force``: the paper's fvV, or
+        ``PeelForce.cubic(...)`` with ``method="hybrid"`` (the law driver); other laws: ValueError.
     t_end : float
         Final time [s], in (0, TIME_MAX] = (0, 1e6].
     alpha0, omega0, F0, branch0 : optional
@@ -275,8 +279,10 @@ def simulate(
     SolverBudgetExceeded, SolverFailure
         Budget used up / the integrator cannot proceed.
     """
-    _params("params", params)
+    _params("params", params, laws=HL.HYBRID_LAWS)
     opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor)
+    if not isinstance(opts, Hybrid):  # the regularized scheme evaluates fvV itself
+        _params("params", params, where='exact.simulate(method="regularized")')
     t_end = duration("t_end", t_end)
     out, lim = output_options(opts.name, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
                               max_points=max_points, max_steps=max_steps, max_jumps=max_jumps, max_wall=max_wall)
@@ -307,10 +313,11 @@ def _param_vector(params: PeelParams, v_floor: float | None = None,
                   bs: BranchStructure | None = None) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``; ``bs``: the law's branch structure (default: the paper's law's,
-    :func:`peelapprox.branch_structure`)."""
+    :func:`peelapprox.branch_structure`, and only the paper's law is accepted: the inlined driver's vector)."""
+    laws = ("paper",) if bs is None else HL.HYBRID_LAWS  # another law: b, A unused (0.0), the law driver's
     if bs is None:
         bs = branch_structure(params.V)
-    p = model_block(params, H.N_P)  # the model block (peelapprox.kernels), then the hybrid driver's fields
+    p = model_block(params, H.N_P, laws)  # the model block (peelapprox.kernels), then the hybrid driver's fields
     p[H.P_FOLDS] = 1.0 if bs.has_folds else 0.0
     p[H.P_VMAX] = bs.v_max if bs.has_folds else math.inf
     p[H.P_VMIN] = bs.v_min if bs.has_folds else 0.0

@@ -220,11 +220,12 @@ class Trajectory:
     def constraint_residual(self, relative: bool = False) -> np.ndarray:
         """``F (1 - cos θ) - f(v, V)`` at every stored point (CONSTR) [N].
 
-        With ``relative=True``, divided by ``f(v, V)``.
+        With ``relative=True``, divided by ``f(v, V)``.  f is the run's law ``params.force``.
         """
         if len(self.t) == 0:
             return np.zeros(0)
-        f = peel_force(self.v, self.params.V)
+        force = self.params.force
+        f = peel_force(self.v, self.params.V) if force.kind == "paper" else np.asarray(force.f(self.v, self.params.V))
         r = self.F * (1.0 + self.closure_c) - f
         return r / f if relative else r
 

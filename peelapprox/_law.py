@@ -31,7 +31,8 @@ from . import _law_expr, _law_families, _law_table
 from ._checks import in_range, reals
 from ._law_folds import Folds, find_folds
 
-__all__ = ["FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "register_paper", "require_paper_force"]
+__all__ = ["FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "law_label", "register_paper",
+           "require_paper_force"]
 
 #: The kinds of law, in the order of the module docstring.
 KINDS = ("paper", "family", "expression", "tabulated")
@@ -418,14 +419,24 @@ def _restore(kind: str, name: str | None, coefficients: tuple, source: str | Non
 _PAPER_LAW = PeelForce("paper")
 
 
-def require_paper_force(params: Any, where: str | None = None) -> None:
-    """ValueError unless ``params.force`` (if any) is the paper's law: the one check, at every consumer that
-    does not honour other laws yet (issue 15).  ``where`` names the consumer (default: the caller's caller,
-    i.e. the public function that validated its ``params``)."""
+def law_label(force: Any) -> str:
+    """The name by which a consumer lists the laws it honours: ``"paper"`` (the built-in fvV), a family's
+    constructor (``"paper_family"``, ``"cubic"``, ``"power_branches"``), ``"expression"`` or ``"tabulated"``."""
+    if force.kind == "family":
+        return str(_law_families.FAMILIES[str(force.name)].constructor)
+    return str(force.kind)
+
+
+def require_paper_force(params: Any, where: str | None = None, laws: tuple[str, ...] = ("paper",)) -> None:
+    """ValueError unless ``params.force`` (if any) is one of ``laws`` (:func:`law_label` names; default: the
+    paper's law only): the one check, at every consumer that does not honour every law yet (issue 15).
+    ``where`` names the consumer (default: the caller's caller, i.e. the public function that validated its
+    ``params``)."""
     force = getattr(params, "force", None)
-    if force is None or force.kind == "paper":
+    if force is None or force.kind == "paper" or law_label(force) in laws:
         return
     if where is None:
         where = sys._getframe(2).f_code.co_name
-    raise ValueError(f"params.force: force laws other than the paper's are not yet supported by {where} (got "
+    other = "the paper's" if tuple(laws) == ("paper",) else ", ".join(repr(x) for x in laws)
+    raise ValueError(f"params.force: force laws other than {other} are not yet supported by {where} (got "
                      f"{force!r}); see issue 15")

@@ -36,7 +36,7 @@ M_V, M_I, M_K, M_R, M_L, M_B, M_A, M_GEOM = range(len(MODEL_FIELDS))
 N_M = len(MODEL_FIELDS)
 
 
-def model_block(params: PeelParams, size: int = N_M) -> np.ndarray:
+def model_block(params: PeelParams, size: int = N_M, laws: tuple[str, ...] = ("paper",)) -> np.ndarray:
     """A driver's parameter vector of length ``size`` with the model block filled and the rest zero.
 
     Parameters
@@ -45,16 +45,21 @@ def model_block(params: PeelParams, size: int = N_M) -> np.ndarray:
         Already validated.
     size : int, default N_M
         Length of the driver's vector, ``N_M`` plus its own fields (which the driver fills).
+    laws : tuple of str, default ("paper",)
+        The laws ``params.force`` may be (``peelapprox._law.law_label`` names): those the calling driver
+        honours.  A driver that takes the law as an argument (the hybrid law driver: ``"cubic"``) passes it
+        its own coefficients; for such a law the slots ``b, A`` of fvV are unused and hold 0.0 (not NaN, which
+        the vector's checks would trip on).
 
     Returns
     -------
     ndarray
         ``(V, I, k, R, l, b, A, geometry, 0, ..., 0)``, float64.
     """
-    require_paper_force(params, "the compiled drivers (model_block)")
+    require_paper_force(params, "the compiled drivers (model_block)", laws)
     if size < N_M:
         raise ValueError(f"size must be at least the model block's length {N_M}, got {size}")
-    b, A = peel_force_coefficients(params.V)
+    b, A = peel_force_coefficients(params.V) if params.force.kind == "paper" else (0.0, 0.0)
     p = np.zeros(size)
     p[:N_M] = params.V, params.I, params.k, params.R, params.l, b, A, 0.0 if params.geometry == "paper" else 1.0
     return p

@@ -84,15 +84,17 @@ __all__ = [
 ]
 
 
-def params(name: str, x: Any):
+def params(name: str, x: Any, *, laws: tuple[str, ...] = ("paper",), where: str | None = None):
     """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError.
 
-    A ValueError, for now, if ``x.force`` is not the paper's law: every function that validates its
-    parameters here still evaluates fvV itself (issue 15); the message names that function.
+    A ValueError if ``x.force`` is not one of ``laws``, the laws the calling function honours (by their
+    names: ``"paper"``, ``"cubic"``, ... as in ``peelapprox._law.law_label``; default the paper's law only,
+    as most functions still evaluate fvV themselves, issue 15); the message names ``where`` (default: that
+    function).
     """
     if not isinstance(x, PeelParams):
         raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
-    require_paper_force(x)
+    require_paper_force(x, where, laws)
     return x
 
 

@@ -345,8 +345,9 @@ CONSUMERS = {
 @pytest.mark.parametrize("name", sorted(CONSUMERS))
 def test_consumers_refuse_other_laws_for_now(name):
     """Hypothesis: until the consumers honour PeelParams.force, each refuses a non-paper law with a ValueError
-    that says so and points to issue 15 (message text), instead of silently using fvV."""
-    p = PeelParams(V=1.0, I=1e-5, force=PeelForce.cubic())
+    that says so and points to issue 15 (message text), instead of silently using fvV.  (The power-law branches:
+    the cubic runs in exact.simulate's hybrid solver, tests/test_law_runs.py.)"""
+    p = PeelParams(V=1.0, I=1e-5, force=PeelForce.power_branches())
     with pytest.raises(ValueError, match=r"not yet supported by .*issue 15"):
         CONSUMERS[name](p)
 

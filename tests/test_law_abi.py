@@ -179,9 +179,15 @@ def test_second_law_runs_in_the_compiled_driver_with_its_own_folds(monkeypatch):
     tr = ES._run_hybrid(params, 2.0, s0, Hybrid(rtol=1e-10), SaveAt(jumps_only=True),
                         Budget(max_points=10, max_steps=10**7, max_jumps=10**5), None)
     assert len(run.signatures) == 1
-    v_max, f_max, v_min, f_min, land_cd, land_ab = _numpy_folds(COEF)
-    j = tr.jumps
-    assert len(j.t) >= 20  # stick-slip: ~17 cycles per second at these parameters
+    assert len(tr.jumps.t) >= 20  # stick-slip: ~17 cycles per second at these parameters
+    assert_jumps_at_cubic_folds(tr.jumps, COEF)
+
+
+def assert_jumps_at_cubic_folds(j, coef) -> None:
+    """Every AB→CD jump of ``j`` at the level ``F(1 + sin α) = f_max`` of the cubic ``coef`` (1e-12 relative),
+    every CD→AB jump at ``f_min``, v at numpy's fold before and landing root after (1e-7 relative); both kinds
+    present.  (Shared with tests/test_law_runs.py.)"""
+    v_max, f_max, v_min, f_min, land_cd, land_ab = _numpy_folds(coef)
     G = j.F * (1.0 + np.sin(j.alpha))
     up = j.from_branch == 0
     assert up.any() and (~up).any()
@@ -193,11 +199,13 @@ def test_second_law_runs_in_the_compiled_driver_with_its_own_folds(monkeypatch):
     np.testing.assert_allclose(j.v_after[~up], land_ab, rtol=1e-7)
 
 
-def test_a_law_other_than_the_papers_is_refused_by_the_hook():
-    """Hypothesis: until PeelForce's families are compiled laws, ``law_for`` refuses any law but the paper's with
-    a ValueError naming ``params.force`` (validate.params refuses them before a run gets there; this is the
-    hook's own guard)."""
+def test_a_law_without_a_compiled_law_is_refused_by_the_hook():
+    """Hypothesis: ``law_for`` refuses a law that is neither the paper's nor the cubic (those with compiled laws)
+    with a ValueError naming ``params.force`` (validate.params refuses them before a run gets there; this is the
+    hook's own guard), and a cubic whose structure the solver cannot run (one fold) likewise."""
     from peelapprox import PeelForce
 
     with pytest.raises(ValueError, match="params.force"):
-        HL.law_for(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic()))
+        HL.law_for(PeelParams(V=1.2, I=1e-5, force=PeelForce.power_branches()))
+    with pytest.raises(ValueError, match=r"params.force.*coef"):
+        HL.law_for(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(c=10.0)))
