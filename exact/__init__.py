@@ -21,12 +21,11 @@ from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailur
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
-from ._options import Budget, Hybrid, Regularized, SaveAt
+from ._options import Budget, Hybrid, Regularized, SaveAt, default_atol
 from ._simulate import (
     ATOL_SCALE,
     STEP_BUDGET,
     compile_kernels,
-    default_atol,
     default_max_steps,
     hybrid_field,
     initial_state,

@@ -34,7 +34,7 @@ from peelapprox.validate import eps as _eps
 from peelapprox.validate import rtol as _rtol
 
 __all__ = ["Hybrid", "Regularized", "SaveAt", "Budget", "ATOL_SCALE", "ATOL_RANGE", "STEP_BUDGET",
-           "default_max_steps", "method_option", "output_options"]
+           "default_max_steps", "default_atol", "method_option", "output_options"]
 
 METHODS = ("hybrid", "regularized")
 SOLVERS = ("Radau", "BDF", "LSODA")
@@ -356,3 +356,30 @@ def output_options(method: str, t_end: float, saveat: Any, budget: Any, *, save:
     if saveat.ts is not None and saveat.ts.size > budget.max_points:
         raise ValueError(f"{name} has {saveat.ts.size} points, more than max_points={budget.max_points}")
     return saveat, budget.resolved(method, t_end)
+
+
+def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] = None) -> np.ndarray:
+    """The absolute tolerances ``simulate(method=method, rtol=rtol, atol=atol)`` uses, one per integrated component.
+
+    Parameters
+    ----------
+    method : {"hybrid", "regularized"}
+        The solver; its integrated components are (τ, α, ω, ln v) for ``"hybrid"`` and (α, ω, F, v) for
+        ``"regularized"``.
+    rtol : float
+        The relative tolerance (not checked here; :func:`simulate` checks it against ``RTOL_RANGE``).
+    atol : None, float or sequence of 4 floats
+        None: ``rtol * ATOL_SCALE[method]``, the default rule.  Else checked (every component in
+        ``[1e-100, 1]``) and a scalar broadcast to 4 values.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        A new array.
+
+    Raises
+    ------
+    ValueError
+        Naming ``atol``, if it is out of range or neither a scalar nor 4 values.
+    """
+    return _atol_vector(method, rtol, atol)

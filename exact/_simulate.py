@@ -462,33 +462,6 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
         )
 
 
-def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] = None) -> np.ndarray:
-    """The absolute tolerances ``simulate(method=method, rtol=rtol, atol=atol)`` uses, one per integrated component.
-
-    Parameters
-    ----------
-    method : {"hybrid", "regularized"}
-        The solver; its integrated components are (τ, α, ω, ln v) for ``"hybrid"`` and (α, ω, F, v) for
-        ``"regularized"``.
-    rtol : float
-        The relative tolerance (not checked here; :func:`simulate` checks it against ``RTOL_RANGE``).
-    atol : None, float or sequence of 4 floats
-        None: ``rtol * ATOL_SCALE[method]``, the default rule.  Else checked (every component in
-        ``[1e-100, 1]``) and a scalar broadcast to 4 values.
-
-    Returns
-    -------
-    ndarray, shape (4,)
-        A new array.
-
-    Raises
-    ------
-    ValueError
-        Naming ``atol``, if it is out of range or neither a scalar nor 4 values.
-    """
-    return _atol_vector(method, rtol, atol)
-
-
 def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
                  law_argument: bool = False) -> tuple[Callable, Any]:
     """The hybrid solver's compiled field ``rhs(y, p, out)`` and its parameter vector ``p`` for ``params``

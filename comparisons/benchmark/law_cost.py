@@ -23,7 +23,6 @@ One run prints a table of:
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
 import os
@@ -36,52 +35,25 @@ from pathlib import Path
 import numpy as np
 
 from exact import hybrid_field, simulate
-from peelapprox import PeelParams, branch_structure
+from peelapprox import PeelForce, PeelParams
 from peelapprox.io import fmt_number
-from peelapprox.kernels import LAW_TYPE, LAWS, cubic_v_structure, paper_coefficients
+from peelapprox.kernels import LAW_TYPE, LAWS, paper_coefficients
 
 from .scenes import BENCH_SCENES
 
-__all__ = ["CUBIC_COEF", "CubicForce", "PaperForce", "field_costs", "main"]
+__all__ = ["CUBIC_COEF", "CUBIC_COEF_2", "field_costs", "main"]
 
 _ROOT = Path(__file__).resolve().parents[2]
 #: f = 150 + 300 v - 300 v^2 + 80 v^3 [N] (folds at 0.691 and 1.809 m/s; tests/test_law_abi.py).
 CUBIC_COEF = (150.0, 300.0, 300.0, 80.0)
+#: A second cubic of the same family (other coefficients: data, not code).
+CUBIC_COEF_2 = (100.0, 250.0, 280.0, 90.0)
 #: (name, t_end) of the per-step scenes: the benchmark's three, as in targets.py (1 s, 5 s, 20 s).
 _T_END = {"V1-I1e-5": 1.0, "V1-I1e-2": 5.0, "V4-I1e-2": 20.0}
 
 
-class CubicForce:
-    """The ``params.force`` hook of ``exact.simulate`` for the test cubic law (kind, coefficients, folds)."""
-
-    kind = "cubic_v"
-
-    def coefficients(self, V: float) -> np.ndarray:
-        return np.array(CUBIC_COEF)
-
-    def branch_structure(self, V: float):
-        return cubic_v_structure(CUBIC_COEF, V)
-
-
-class PaperForce:
-    """The hook for the paper's law given as a law: the run takes the law driver (the indirect call)."""
-
-    kind = "paper"
-
-    def coefficients(self, V: float) -> np.ndarray:
-        return paper_coefficients(V)
-
-    def branch_structure(self, V: float):
-        return branch_structure(V)
-
-
-@dataclasses.dataclass(frozen=True)
-class _ParamsWithForce(PeelParams):
-    force: object = None
-
-
 def _cubic_params(I: float) -> PeelParams:
-    return _ParamsWithForce(V=1.2, I=I, force=CubicForce())
+    return PeelParams(V=1.2, I=I, force=PeelForce.cubic(*CUBIC_COEF))
 
 
 def field_costs(n: int = 200_000) -> dict[str, float]:
@@ -137,11 +109,7 @@ import json, time, sys
 import exact
 from peelapprox import PeelParams
 scenes = json.loads(sys.argv[1])
-if sys.argv[2] == "law":  # the paper's law given as a law: the law driver (this tree only)
-    from comparisons.benchmark.law_cost import PaperForce, _ParamsWithForce
-    make = lambda V, I: _ParamsWithForce(V=V, I=I, force=PaperForce())
-else:
-    make = lambda V, I: PeelParams(V=V, I=I)
+make = lambda V, I: PeelParams(V=V, I=I)
 out = {}
 for name, V, I, alpha0, t_end in scenes:
     p = make(V, I)
@@ -156,12 +124,12 @@ print(json.dumps(out))
 """
 
 
-def _per_step(tree: Path, mode: str = "default") -> dict[str, float]:
-    """µs per step on the benchmark scenes, measured in a new process running the package of ``tree``
-    (``mode="law"``: the paper's law given as a law, through the law driver)."""
+def _per_step(tree: Path) -> dict[str, float]:
+    """µs per step on the benchmark scenes (the paper's law, the default path), measured in a new process
+    running the package of ``tree``."""
     scenes = [(s.name, s.V, s.I, s.alpha0, _T_END[s.name]) for s in BENCH_SCENES]
     env = dict(os.environ, PYTHONPATH=str(tree))
-    r = subprocess.run([sys.executable, "-c", _STEP_CODE, json.dumps(scenes), mode], env=env, capture_output=True,
+    r = subprocess.run([sys.executable, "-c", _STEP_CODE, json.dumps(scenes)], env=env, capture_output=True,
                        text=True, check=True, cwd=tempfile.gettempdir())
     return json.loads(r.stdout.strip().splitlines()[-1])
 
@@ -184,8 +152,9 @@ _SECOND_CODE = r"""
 import json, time
 from numba.core import event
 import exact
-from comparisons.benchmark.law_cost import PaperForce, _ParamsWithForce, _cubic_params
-p = _ParamsWithForce(V=1.0, I=1e-5, force=PaperForce())
+from peelapprox import PeelForce, PeelParams
+from comparisons.benchmark.law_cost import CUBIC_COEF_2, _cubic_params
+p = _cubic_params(1e-5)
 t0 = time.perf_counter()
 exact.simulate(p, 0.05, save="jumps")   # warm: a first law run loads the law driver from the cache
 t_first_law = time.perf_counter() - t0
@@ -194,7 +163,7 @@ exact.simulate(p, 0.05, save="jumps")
 t_paper = time.perf_counter() - t0
 with event.install_recorder("numba:compile") as rec:
     t0 = time.perf_counter()
-    tr = exact.simulate(_cubic_params(1e-5), 0.05, save="jumps")
+    tr = exact.simulate(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(*CUBIC_COEF_2)), 0.05, save="jumps")
     t_cubic = time.perf_counter() - t0
 n_compiles = sum(1 for _, e in rec.buffer if e.is_start)
 print(json.dumps(dict(t_first_law=t_first_law, t_paper=t_paper, t_cubic=t_cubic, compiles=n_compiles,
@@ -218,19 +187,18 @@ def _load_times(tree: Path) -> tuple[float, float]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m comparisons.benchmark.law_cost", description=__doc__.split("\n")[0])
-    ap.add_argument("--before", type=Path, default=Path("/work/main") if Path("/work/main").is_dir() else None,
-                    help="checkout of the tree with the inlined law (default /work/main if present)")
+    ap.add_argument("--before", type=Path, default=None,
+                    help="a checkout of an earlier tree to compare the default path's per-step cost with")
     ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of the per-step runs (default 3)")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures as JSON")
     args = ap.parse_args(argv)
     res: dict = {"field_ns": field_costs()}
     trees = {"after": _ROOT} | ({"before": args.before.resolve()} if args.before else {})
-    runs = [("after", _ROOT, "default"), ("after_law", _ROOT, "law")] + (
-        [("before", args.before.resolve(), "default")] if args.before else [])
-    steps: dict[str, dict[str, float]] = {k: {} for k, _, _ in runs}
+    runs = [("after", _ROOT)] + ([("before", args.before.resolve())] if args.before else [])
+    steps: dict[str, dict[str, float]] = {k: {} for k, _ in runs}
     for _ in range(args.rounds):
-        for k, tree, mode in runs:
-            for name, us in _per_step(tree, mode).items():
+        for k, tree in runs:
+            for name, us in _per_step(tree).items():
                 steps[k][name] = min(steps[k].get(name, math.inf), us)
     res["us_per_step"] = steps
     res["cubic_us_per_step"] = _cubic_per_step(args.rounds)
@@ -243,20 +211,18 @@ def main(argv: list[str] | None = None) -> int:
     print("field evaluation [ns]        inlined paper  paper via law  cubic via law  paper law/inlined")
     print(f"                             {fmt_number(f['inline'], 4):>13}  {fmt_number(f['paper'], 4):>13}  "
           f"{fmt_number(f['cubic'], 4):>13}  {fmt_number(f['paper'] / f['inline'], 4):>17}")
-    print("\nper step [us], best of rounds   before   after (default)  after (paper as law)   ratios to before")
+    print("\nper step [us], best of rounds   before   after (paper's law, inlined)   after / before")
     for name, us in steps["after"].items():
         b = steps.get("before", {}).get(name)
-        la = steps["after_law"][name]
-        ratios = f"{fmt_number(us / b, 3)}  {fmt_number(la / b, 3)}" if b else "-"
-        print(f"  {name:<28} {fmt_number(b, 4) if b else '-':>7}  {fmt_number(us, 4):>15}  {fmt_number(la, 4):>20}"
-              f"   {ratios}")
-    paper_mean = float(np.mean(list(steps["after_law"].values())))
+        print(f"  {name:<28} {fmt_number(b, 4) if b else '-':>7}  {fmt_number(us, 4):>29}   "
+              f"{fmt_number(us / b, 3) if b else '-'}")
+    paper_mean = float(np.mean(list(steps["after"].values())))
     for name, us in res["cubic_us_per_step"].items():
-        print(f"  {name:<28} {'':>7}  {'':>15}  {fmt_number(us, 4):>20}   (/ mean paper as law: "
-              f"{fmt_number(us / paper_mean, 3)})")
+        print(f"  {name:<28} {'':>7}  {fmt_number(us, 4):>29}   (the cubic through the law argument / mean "
+              f"paper inlined: {fmt_number(us / paper_mean, 3)})")
     s = res["second_law"]
-    print("\nsecond law, first simulate (0.05 s) in a process that ran a first law: "
-          f"{fmt_number(1e3 * s['t_cubic'], 3)} ms, {s['compiles']} numba compilations\n  (the first law's first "
+    print("\nsecond cubic (other coefficients), first simulate (0.05 s) in a process that ran a first cubic: "
+          f"{fmt_number(1e3 * s['t_cubic'], 3)} ms, {s['compiles']} numba compilations\n  (the first cubic's first "
           f"simulate, loading the law driver from the cache: {fmt_number(1e3 * s['t_first_law'], 3)} ms; "
           f"its second: {fmt_number(1e3 * s['t_paper'], 3)} ms)")
     print("\nimport exact + compile_kernels() in a new process [s]:   cold (empty cache)   warm (cache)")
