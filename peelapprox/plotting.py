@@ -54,11 +54,16 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     ax[0, 1].set(xlabel="t [s]", ylabel=r"$\alpha$ [rad]", title=r"peel angle $\alpha(t)$")
     ax[1, 0].semilogy(t, traj.v, lw=0.8, color="C3")
     ax[1, 0].set(xlabel="t [s]", ylabel="v [m/s]", title="peel velocity v(t)")
-    bs = branch_structure(p.V)
     vlo = float(np.min(traj.v)) / 2 if len(traj.v) else 1e-4
     vhi = float(np.max(traj.v)) * 1.3 if len(traj.v) else 30.0
     vv = np.logspace(np.log10(vlo), np.log10(vhi), 600)
-    ax[1, 1].semilogx(vv, peel_force(vv, p.V), color="k", lw=1.5, label="f(v, V)")
+    law = getattr(p, "force", None)
+    if law is None or law.kind == "paper":
+        bs: Any = branch_structure(p.V)
+        f_vv = peel_force(vv, p.V)
+    else:  # the run's own law (PeelParams.force), never the paper's in its place
+        bs, f_vv = law.folds(p.V), law.f(vv, p.V)
+    ax[1, 1].semilogx(vv, f_vv, color="k", lw=1.5, label="f(v, V)")
     ax[1, 1].semilogx(traj.v, traj.F, lw=0.6, color="C0", label="orbit (v, F)")
     if bs.has_folds:
         ax[1, 1].plot([bs.v_max, bs.v_min], [bs.f_max, bs.f_min], "o", color="C1", label="folds B, D")

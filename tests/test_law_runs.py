@@ -110,3 +110,20 @@ def test_laws_pass_through_validate_and_model_block():
     assert blk[M_B] == 0.0 and blk[M_A] == 0.0 and blk[0] == 1.2
     with pytest.raises(ValueError, match="model_block"):
         model_block(cub)
+
+
+def test_plot_of_a_cubic_run_draws_the_cubic_and_its_folds():
+    """Hypothesis: ``plot_trajectory`` of a run with the cubic law draws that law's f(v) and folds, not the
+    paper's (a silent wrong picture otherwise): the drawn curve equals ``law.f`` exactly (the same evaluation)
+    and the fold markers sit at ``law.folds(V)`` exactly."""
+    pytest.importorskip("matplotlib")
+    from peelapprox.plotting import plot_trajectory
+
+    law = PeelForce.cubic()
+    tr = exact.simulate(PeelParams(V=1.2, I=1e-5, force=law), 0.3)
+    fig = plot_trajectory(tr)
+    phase = fig.axes[3]
+    curve, folds = phase.lines[0], phase.lines[2]
+    assert np.array_equal(curve.get_ydata(), law.f(curve.get_xdata(), 1.2))
+    fo = law.folds(1.2)
+    assert list(folds.get_xdata()) == [fo.v_max, fo.v_min] and list(folds.get_ydata()) == [fo.f_max, fo.f_min]

@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 from exact import SolverFailure, initial_state
 from peelapprox import PeelParams, branch_structure
 from peelapprox.kernels import branch_inverse_at, closure_paper, peel_force_coefficients, slow_rates
+from peelapprox.validate import params as _params
 
 # the generated model functions themselves, in plain Python: the reference uses no compiled kernel
 _closure_paper, _slow_rates = closure_paper.py_func, slow_rates.py_func
@@ -48,6 +49,7 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
     (t, F) : tuple of ndarray
         Jump times and F at the jumps.
     """
+    _params("params", params)  # the paper's law only: the reference integrates fvV itself
     s0 = initial_state(params, alpha0=alpha0)
     bs = branch_structure(params.V)
     b, A = peel_force_coefficients(params.V)
