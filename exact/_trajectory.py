@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peelapprox import BRANCHES, PeelParams, peel_force
+from peelapprox import BRANCHES, PeelParams
 
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 
@@ -224,8 +224,7 @@ class Trajectory:
         """
         if len(self.t) == 0:
             return np.zeros(0)
-        force = self.params.force
-        f = peel_force(self.v, self.params.V) if force.kind == "paper" else np.asarray(force.f(self.v, self.params.V))
+        f = np.asarray(self.params.force.f(self.v, self.params.V))  # the paper's: peel_force itself (bitwise)
         r = self.F * (1.0 + self.closure_c) - f
         return r / f if relative else r
 

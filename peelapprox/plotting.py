@@ -7,8 +7,6 @@ from typing import Any, cast
 
 import numpy as np
 
-from ._peelforce import branch_structure, peel_force
-
 __all__ = ["plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"]
 
 
@@ -57,13 +55,8 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     vlo = float(np.min(traj.v)) / 2 if len(traj.v) else 1e-4
     vhi = float(np.max(traj.v)) * 1.3 if len(traj.v) else 30.0
     vv = np.logspace(np.log10(vlo), np.log10(vhi), 600)
-    law = getattr(p, "force", None)
-    if law is None or law.kind == "paper":
-        bs: Any = branch_structure(p.V)
-        f_vv = peel_force(vv, p.V)
-    else:  # the run's own law (PeelParams.force), never the paper's in its place
-        bs, f_vv = law.folds(p.V), law.f(vv, p.V)
-    ax[1, 1].semilogx(vv, f_vv, color="k", lw=1.5, label="f(v, V)")
+    bs = p.force.folds(p.V)  # the run's own law (the paper's: branch_structure's folds, peel_force itself)
+    ax[1, 1].semilogx(vv, p.force.f(vv, p.V), color="k", lw=1.5, label="f(v, V)")
     ax[1, 1].semilogx(traj.v, traj.F, lw=0.6, color="C0", label="orbit (v, F)")
     if bs.has_folds:
         ax[1, 1].plot([bs.v_max, bs.v_min], [bs.f_max, bs.f_min], "o", color="C1", label="folds B, D")
