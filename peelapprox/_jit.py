@@ -41,7 +41,7 @@ from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
 
-__all__ = ["kernel", "jitable", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
+__all__ = ["kernel", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -116,6 +116,16 @@ def _renamed(fn: Callable, name: str) -> Callable:
     g.__module__ = fn.__module__
     g.__doc__ = fn.__doc__
     g.__kwdefaults__ = fn.__kwdefaults__
+    return g
+
+
+def rebind(fn: Callable, **bound: Any) -> Callable:
+    """A copy of the plain module-level function ``fn`` that reads ``bound`` as its globals (the rest as ``fn``
+    does): how one driver body is compiled twice, with the peel-force law inlined and as an argument.  The copy
+    has no closure, so numba caches it across processes (a closure over dispatchers is not cached); compile each
+    copy under its own ``name`` (:func:`kernel`)."""
+    g = types.FunctionType(fn.__code__, dict(fn.__globals__, **bound), fn.__name__, fn.__defaults__, None)
+    g.__qualname__, g.__module__, g.__doc__ = fn.__qualname__, fn.__module__, fn.__doc__
     return g
 
 
