@@ -250,3 +250,27 @@ def test_const_keeps_integer_and_float_apart():
     _same(_law("--force", "a*v + 100", "--const", "a=150"), PeelForce.expression("a*v + 100", a=150))
     _same(_law("--force", "a*v + 100", "--const", "a=150.0"), PeelForce.expression("a*v + 100", a=150.0))
     _same(_law("--force", "a*v + 100", "--const", "a=1.5e2"), PeelForce.expression("a*v + 100", a=150.0))
+
+
+def test_folds_of_a_given_law(tmp_path, capsys):
+    """Hypothesis: ``folds --force-family cubic`` prints the cubic's folds, at the roots of f' = b - 2cv + 3dv²
+    (closed form; ≤ 1e-9 as issue 15 asks of folds) with f there, and the fixed point's f'(V, V) (the
+    polynomial, to rounding: 1e-12 relative); the record rebuilds the law.  ``--force-table`` of the same
+    cubic sampled every 0.5 % in v finds v_max within one table spacing (the folds of a table are data
+    points, docs/usage.md)."""
+    b, c, d, V = 300.0, 300.0, 80.0, 1.2  # PeelForce.cubic()'s, a = 150 in _cubic_points
+    assert main(["folds", "--V", str(V), "--force-family", "cubic", "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)
+    root = math.sqrt(c * c - 3 * b * d)
+    v_max, v_min = (c - root) / (3 * d), (c + root) / (3 * d)
+    assert row["has_folds"] and abs(row["v_max"] - v_max) <= 1e-9 and abs(row["v_min"] - v_min) <= 1e-9
+    assert np.allclose([row["f_max"], row["f_min"]], _cubic_points(np.array([v_max, v_min])), rtol=1e-9, atol=0)
+    fp = b - 2 * c * V + 3 * d * V * V
+    assert row["fixed_point_stable"] is False and abs(row["fprime_at_V"] - fp) <= 1e-12 * abs(fp)
+    _same(PeelForce.from_dict(row["law_spec"]), PeelForce.cubic())
+    v = np.geomspace(0.05, 5.0, 925)  # ratio 1.005
+    path = tmp_path / "cubic.csv"
+    path.write_text("v,f\n" + "".join(f"{float(x)!r},{float(y)!r}\n" for x, y in zip(v, _cubic_points(v))))
+    assert main(["folds", "--V", str(V), "--force-table", str(path), "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)
+    assert abs(row["v_max"] - v_max) <= 0.005 * v_max and row["law"].startswith("PeelForce.tabulated(<V=None: 925")

@@ -10,14 +10,16 @@ import sys
 from .. import ALPHA_MODELS, V_EQUATIONS, PeelParams
 from ._checks import check_output_path
 from ._common import add_params, print_mapping, write_table
-from ._force import force_from_args, law_fields
+from ._force import add_force_options, force_from_args, law_fields
 
 __all__ = ["add_estimate_parser", "add_folds_parser", "add_segment_parser", "run_estimate", "run_folds", "run_segment"]
 
 
 def add_folds_parser(sub) -> argparse.ArgumentParser:
-    fo = sub.add_parser("folds", help="folds, landing velocities and fixed point of f(v, V)")
+    fo = sub.add_parser("folds", help="folds, landing velocities and fixed point of f(v, V) (the paper's fvV or "
+                                      "the law given)")
     fo.add_argument("--V", type=float, required=True)
+    add_force_options(fo)
     fo.add_argument("--format", choices=("table", "json"), default="table")
     return fo
 
@@ -25,9 +27,17 @@ def add_folds_parser(sub) -> argparse.ArgumentParser:
 def run_folds(args: argparse.Namespace) -> int:
     from .. import branch_structure, fixed_point
 
-    bs = branch_structure(args.V)
-    fp = fixed_point(args.V)
-    row = {**bs.__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
+    law = force_from_args(args)
+    if law.kind == "paper":
+        bs = branch_structure(args.V)
+        fp = fixed_point(args.V)
+        row = {**bs.__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
+    else:  # the law's own folds (PeelForce.folds) and the steady sliding v = V, stable iff f'(V, V) > 0
+        import dataclasses
+
+        fprime = float(law.df(args.V, args.V))
+        row = {**dataclasses.asdict(law.folds(args.V)), "fixed_point_stable": fprime > 0, "fprime_at_V": fprime}
+    row.update(law_fields(law, spec=args.format == "json"))
     if args.format == "json":
         print(json.dumps(row, indent=2))
     else:
