@@ -274,3 +274,21 @@ def test_folds_of_a_given_law(tmp_path, capsys):
     assert main(["folds", "--V", str(V), "--force-table", str(path), "--format", "json"]) == 0
     row = json.loads(capsys.readouterr().out)
     assert abs(row["v_max"] - v_max) <= 0.005 * v_max and row["law"].startswith("PeelForce.tabulated(<V=None: 925")
+
+
+def test_compare_out_records_the_papers_law(tmp_path, capsys):
+    """Hypothesis: ``compare --out DIR`` writes its rows with the law they ran, the paper's (``law``, ``law_key``
+    in CSV and JSON, ``law_spec`` in JSON rebuilding ``PeelForce.paper()``), after the rows' own columns, whose
+    numbers equal the ones printed by ``--format json`` (exact: the same run, only metadata added)."""
+    argv = ["compare", "--scene", "case-II-point-a", "--no-stats", "--no-figures"]
+    assert main([*argv, "--format", "json"]) == 0
+    printed = json.loads(capsys.readouterr().out)["rows"]
+    assert main([*argv, "--out", str(tmp_path)]) == 0
+    rows = json.loads((tmp_path / "compare_rows.json").read_text())
+    paper = PeelForce.paper()
+    assert [{k: v for k, v in r.items() if not k.startswith("law")} for r in rows] == printed
+    assert all(r["law"] == "PeelForce.paper()" and r["law_key"] == paper.key for r in rows)
+    _same(PeelForce.from_dict(rows[0]["law_spec"]), paper)
+    with open(tmp_path / "compare_rows.csv", newline="") as fh:
+        header = next(csv.reader(fh))
+    assert header[-2:] == ["law", "law_key"] and "law_spec" not in header
