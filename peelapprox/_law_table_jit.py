@@ -10,7 +10,8 @@ What it evaluates
 Exactly the piecewise cubic that :class:`~peelapprox._law_table.TableLaw` evaluates with scipy: for each table
 the :class:`~scipy.interpolate.PchipInterpolator` of f in ``u = ln v`` (its breakpoints ``.x`` and its
 coefficients ``.c`` are packed as they are), evaluated on the interval ``x[i] <= u < x[i+1]`` (the last one
-closed at the right, as scipy's ``find_interval``), found by binary search, at ``s = u - x[i]`` in the order
+closed at the right, as scipy's ``find_interval``), found by binary search between the bounds of a guide
+(below), at ``s = u - x[i]`` in the order
 of operations of scipy's ``PPoly`` (``_ppoly.evaluate_poly1``: the power sum in ascending powers, not
 Horner)::
 
@@ -48,11 +49,18 @@ The coefficient vector (:func:`table_coefficients`)
 (those of nonzero weight) and ``[lo, hi]`` the common v range of **all** the law's tables (TableLaw's
 ``v_range()``, whatever V), then for each table used a block::
 
-    [w, n, x_0 .. x_{n-1}, c[0,0], c[1,0], c[2,0], c[3,0], ..., c[0,n-2], c[1,n-2], c[2,n-2], c[3,n-2]]
+    [w, n, r, x_0 .. x_{n-1}, g_0 .. g_{n-1}, c[0,0], c[1,0], c[2,0], c[3,0], ..., c[0,n-2], .., c[3,n-2]]
 
-its weight, its number of knots (a float holding an integer), its knots in u (``PchipInterpolator.x``) and
-the four coefficients of each of its ``n - 1`` intervals, interval by interval (``.c[:, i]``, highest power
-first); a block is ``5 n - 2`` numbers long.  The kernel reads only what :func:`table_coefficients` wrote:
+its weight ``w``, its number of knots ``n`` (a float holding an integer), ``r = (n - 1) / (x_{n-1} - x_0)``, its
+knots in u (``PchipInterpolator.x``), the guide ``g`` of the interval search and the four coefficients of each
+of its ``n - 1`` intervals, interval by interval (``.c[:, i]``, highest power first); a block is ``6 n - 1``
+numbers long.  The guide cuts ``[x_0, x_{n-1}]`` into ``n - 1`` equal cells (``r`` per unit of u): ``g_j`` is the
+interval holding the left edge of cell j (``g_{n-1} = n - 2``), so the interval of a u in cell
+``j = int((u - x_0) r)`` lies in ``[g_j, g_{j+1}]``: the bisection looks at the knots in that cell only, none
+or one for knots spread evenly in ln v, ``log2`` of their number where knots bunch.  So the cost of a call
+hardly grows with the length of an even table, nor depends on where the previous call was (a bisection over
+the whole table costs ``log2 n`` steps, mispredicted when successive calls are far apart: measured in
+comparisons/benchmark/table_cost.py).  The kernel reads only what :func:`table_coefficients` wrote:
 a vector from elsewhere is not checked (numba does not check bounds).
 """
 
@@ -71,15 +79,30 @@ T_COUNT, T_ULO, T_UHI, T_HEAD = 0, 1, 2, 3
 
 
 @kernel(inline="always")
-def _interval(coef, xo, n, u):
+def _interval(coef, xo, go, n, ginv, u):
     """``i`` with ``x[i] <= u < x[i+1]`` (``n - 2`` at ``u = x[n-1]``) of the knots ``x = coef[xo:xo+n]``, for
-    ``x[0] <= u <= x[n-1]``: scipy's ``find_interval`` by bisection."""
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
+    ``x[0] <= u <= x[n-1]``: scipy's ``find_interval``, by bisection between the guide's bounds.
+
+    The guide ``coef[go:go+n]`` holds, for each of the ``n - 1`` equal cells of ``[x[0], x[n-1]]`` (``ginv`` is
+    cells per unit of u), the interval holding the cell's left edge (and ``n - 2`` for the right end): the
+    interval of u lies between the guide entries of its cell and of the next, one or two intervals apart
+    for evenly spread knots.  Should rounding put u in a neighbouring cell, the bounds are widened to the
+    whole table (the answer stays exact, only slower)."""
+    j = int((u - coef[xo]) * ginv)
+    if j > n - 2:
+        j = n - 2
+    elif j < 0:
+        j = 0
+    lo = int(coef[go + j])
+    hi = int(coef[go + j + 1])
+    if u < coef[xo + lo]:
+        lo = 0
+    if hi < n - 2 and u >= coef[xo + hi + 1]:
+        hi = n - 2
+    while lo < hi:  # x[lo] <= u, and u < x[hi + 1] unless hi = n - 2
+        mid = (lo + hi + 1) >> 1
         if u < coef[xo + mid]:
-            hi = mid
+            hi = mid - 1
         else:
             lo = mid
     return lo
@@ -95,10 +118,11 @@ def _pchip_sums(coef, u):
     for _ in range(int(coef[T_COUNT])):
         w = coef[o]
         n = int(coef[o + 1])
-        xo = o + 2
-        i = _interval(coef, xo, n, u)
+        xo = o + 3
+        go = xo + n
+        i = _interval(coef, xo, go, n, coef[o + 2], u)
         s = u - coef[xo + i]
-        co = xo + n + 4 * i
+        co = go + n + 4 * i
         c0 = coef[co]
         c1 = coef[co + 1]
         c2 = coef[co + 2]
@@ -110,7 +134,7 @@ def _pchip_sums(coef, u):
         F += w * p
         D += w * p1
         D2 += w * p2
-        o = xo + n + 4 * (n - 1)
+        o = go + n + 4 * (n - 1)
     return F, D, D2
 
 
@@ -127,7 +151,7 @@ def table_law(x, coef, form):
         u = np.log(x)
     ulo = coef[T_ULO]
     uhi = coef[T_UHI]
-    if u < ulo or u > uhi:  # the C¹ continuation (module docstring)
+    if not (ulo <= u <= uhi):  # the C¹ continuation (module docstring); NaN: NaN, never an index from it
         u0 = ulo if u < ulo else uhi
         F, D, _ = _pchip_sums(coef, u0)
         F = F + D * (u - u0)
@@ -139,6 +163,14 @@ def table_law(x, coef, form):
     if form == LAW_FP:
         return F, D / v, np.nan
     return F, D / v, (D2 - D) / (v * v)
+
+
+def _guide(x: np.ndarray) -> np.ndarray:
+    """The guide of :func:`_interval` for the knots x: the interval holding each cell's left edge, as floats."""
+    n = x.size
+    edges = x[0] + np.arange(n - 1) * ((x[-1] - x[0]) / (n - 1))
+    g = np.clip(np.searchsorted(x, edges, side="right") - 1, 0, n - 2)
+    return np.append(g, n - 2).astype(float)
 
 
 def table_coefficients(tables, V: float) -> np.ndarray:
@@ -181,5 +213,5 @@ def table_coefficients(tables, V: float) -> np.ndarray:
         c = np.asarray(p.c, dtype=float)
         if c.shape != (4, x.size - 1):  # pragma: no cover - PchipInterpolator is a cubic PPoly
             raise RuntimeError(f"unexpected PCHIP coefficient shape {c.shape} for {x.size} knots")
-        parts += [np.array([w, float(x.size)]), x, c.T.reshape(-1)]
+        parts += [np.array([w, float(x.size), (x.size - 1) / (x[-1] - x[0])]), x, _guide(x), c.T.reshape(-1)]
     return np.ascontiguousarray(np.concatenate([np.array([float(len(used)), u_lo, u_hi]), *parts]), dtype=float)

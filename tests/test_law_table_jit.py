@@ -17,7 +17,16 @@ from numba.core import event
 from peelapprox import PeelForce, peel_force
 from peelapprox._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_TYPE, paper_coefficients, paper_law
 from peelapprox._law_table import TableLaw
-from peelapprox._law_table_jit import T_COUNT, T_HEAD, T_UHI, T_ULO, table_coefficients, table_law
+from peelapprox._law_table_jit import (
+    T_COUNT,
+    T_HEAD,
+    T_UHI,
+    T_ULO,
+    _guide,
+    _interval,
+    table_coefficients,
+    table_law,
+)
 
 EPS = np.finfo(float).eps
 
@@ -107,8 +116,9 @@ def test_one_table_in_u_is_scipy_bitwise():
 
 def test_layout_of_the_coefficients():
     """Hypothesis: the coefficient vector is as documented: header (m, ln lo, ln hi), then per table used
-    (w, n, the knots, the four coefficients of each interval) -- checked against TableLaw's PCHIPs exactly
-    (copies of numbers: tolerance 0), with the weights of TableLaw._weights."""
+    (w, n, r, the knots, the guide, the four coefficients of each interval) -- checked against TableLaw's PCHIPs
+    exactly (copies of numbers: tolerance 0), with the weights of TableLaw._weights; the guide's entry j is the
+    interval of the left edge of cell j (numpy's searchsorted, the oracle)."""
     law = TableLaw(TABLES)
     coef = table_coefficients(TABLES, 1.37)
     lo, hi = law.v_range()
@@ -118,12 +128,45 @@ def test_layout_of_the_coefficients():
     o = T_HEAD
     for j, w in law._weights(1.37):
         p = law.pchips[j]
-        n = p.x.size
-        assert coef[o] == w and coef[o + 1] == n
-        assert np.array_equal(coef[o + 2:o + 2 + n], p.x)
-        assert np.array_equal(coef[o + 2 + n:o + 5 * n - 2].reshape(n - 1, 4), p.c.T)
-        o += 5 * n - 2
+        x, n = p.x, p.x.size
+        assert coef[o] == w and coef[o + 1] == n and coef[o + 2] == (n - 1) / (x[-1] - x[0])
+        assert np.array_equal(coef[o + 3:o + 3 + n], x)
+        edges = x[0] + np.arange(n - 1) * ((x[-1] - x[0]) / (n - 1))
+        assert np.array_equal(coef[o + 3 + n:o + 3 + 2 * n - 1], np.searchsorted(x, edges, side="right") - 1)
+        assert coef[o + 3 + 2 * n - 1] == n - 2
+        assert np.array_equal(coef[o + 3 + 2 * n:o + 6 * n - 1].reshape(n - 1, 4), p.c.T)
+        o += 6 * n - 1
     assert o == coef.size and coef.flags.c_contiguous and coef.dtype == np.float64
+
+
+@pytest.mark.parametrize("spacing", ["even", "random", "bunched", "above edges", "below edges"])
+def test_the_interval_is_scipys(spacing):
+    """Hypothesis: the guided bisection finds scipy's interval, ``x[i] <= u < x[i+1]`` (the last closed), for
+    knots even in ln v, at random, bunched (half of 300 knots within 1 % of the range, so that cells hold
+    up to ~150 knots and others none), or one double above (below) the cell edges of an even grid, where the
+    rounding of the cell number puts u in the neighbouring cell and the guards must widen the bounds: at every
+    knot, the doubles either side, every cell edge and the doubles either side, and 2000 random u.  Oracle:
+    numpy's searchsorted; tolerance: none (an index)."""
+    n = 300
+    rng = np.random.default_rng(5)
+    if spacing == "even":
+        x = np.linspace(-7.0, 3.0, n)
+    elif spacing == "random":
+        x = np.sort(rng.uniform(-7.0, 3.0, n))
+    elif spacing == "bunched":
+        x = np.sort(np.concatenate([rng.uniform(-7.0, 3.0, n // 2), rng.uniform(-1.05, -0.95, n - n // 2)]))
+    else:
+        x = -7.0 + np.arange(n) * (10.0 / (n - 1))
+        x[1:-1] = np.nextafter(x[1:-1], np.inf if spacing == "above edges" else -np.inf)
+    block = np.concatenate([x, _guide(x)])
+    r = (n - 1) / (x[-1] - x[0])
+    edges = x[0] + np.arange(n - 1) * ((x[-1] - x[0]) / (n - 1))
+    us = np.concatenate([x, np.nextafter(x, -np.inf), np.nextafter(x, np.inf), edges, np.nextafter(edges, -np.inf),
+                         np.nextafter(edges, np.inf), rng.uniform(x[0], x[-1], 2000)])
+    us = us[(us >= x[0]) & (us <= x[-1])]
+    want = np.clip(np.searchsorted(x, us, side="right") - 1, 0, n - 2)
+    got = np.array([_interval(block, 0, n, n, r, u) for u in us])
+    assert np.array_equal(got, want)
 
 
 def test_continuity_at_the_knots():
@@ -172,6 +215,14 @@ def test_c1_continuation_outside_the_table():
             # the law just inside has the same slope to rounding (C¹ at the end)
             _, _, di = table_law(np.nextafter(u0, -side * np.inf), coef, LAW_LNV)
             assert abs(di - d0) <= 64 * EPS * (abs(d0) + abs(f0))
+
+
+def test_nan_in_nan_out():
+    """Hypothesis: a NaN argument gives NaN (never an index computed from it: no read outside coef), in every
+    form; the solvers never pass one (the drivers check their states)."""
+    coef = table_coefficients(TABLES, 1.37)
+    for form in (LAW_LNV, LAW_FP, LAW_FPP):
+        assert math.isnan(table_law(math.nan, coef, form)[1 if form == LAW_LNV else 0])
 
 
 @njit(types.float64(LAW_TYPE, types.float64[::1], types.float64, types.float64, types.int64))
