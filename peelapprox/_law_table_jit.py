@@ -41,7 +41,8 @@ this law continues C¹-linearly in u from the nearer end ``u0``::
     f(u) = f(u0) + p'(u0) (u - u0),     p'(u) = p'(u0),     p''(u) = 0
 
 (f and f' are continuous at the ends; f'' jumps there, as it does at every knot).  These numbers only keep a
-stage finite; no result of a run may rest on them.
+stage finite; no result of a run may rest on them.  (A NaN argument, or v <= 0 in the forms that take v, gives
+non-finite numbers, never a read outside ``coef``; the drivers pass neither.)
 
 The coefficient vector (:func:`table_coefficients`)
 --------------------------------------------------
@@ -87,7 +88,7 @@ def _interval(coef, xo, go, n, ginv, u):
     cells per unit of u), the interval holding the cell's left edge (and ``n - 2`` for the right end): the
     interval of u lies between the guide entries of its cell and of the next, one or two intervals apart
     for evenly spread knots.  Should rounding put u in a neighbouring cell, the bounds are widened to the
-    whole table (the answer stays exact, only slower)."""
+    table's end on that side (the answer stays exact, only slower)."""
     j = int((u - coef[xo]) * ginv)
     if j > n - 2:
         j = n - 2
