@@ -51,6 +51,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_generated.py",
     "peelapprox/_peelforce.py",
     "peelapprox/_law_abi.py",  # the peel-force law ABI and the compiled laws
+    "peelapprox/_law_table_jit.py",  # the compiled tabulated law
     "peelapprox/_dop853.py",
     "peelapprox/_alpha.py",
     "peelapprox/_segment_kernel.py",

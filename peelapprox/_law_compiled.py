@@ -36,6 +36,7 @@ from scipy.optimize import brentq
 
 from ._law import PeelForce
 from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients
+from ._law_table_jit import table_coefficients, table_law
 from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint
 from ._peelforce import branch_structure as _paper_structure
 from ._peelforce import fixed_point as _paper_fixed_point
@@ -133,6 +134,8 @@ def _kernel(force: PeelForce, V: float) -> tuple[Callable, np.ndarray, bool]:
         if force.name == "cubic":
             coef = np.array([x for _, x in force.coefficients], dtype=float)
             return LAWS["cubic_v"], coef, False
+    if force.kind == "tabulated":
+        return table_law, table_coefficients(force.tables, V), False
     raise ValueError(f"params.force: {force!r} has no compiled kernel yet (issue 15)")
 
 

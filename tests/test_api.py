@@ -71,7 +71,7 @@ API = {
         "make_dop853", "model_block", "paper_coefficients", "paper_law", "peel_force_coefficients",
         "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit", "regularized_field",
         "regularized_field_jacobian", "regularized_jacobian", "regularized_parameters", "regularized_rhs",
-        "slow_rates", "solve_theta", "state_at", "status", "workspace",
+        "slow_rates", "solve_theta", "state_at", "status", "table_coefficients", "table_law", "workspace",
     },
     "peelapprox.cli": {"build_parser", "main"},
     "comparisons.benchmark": {
