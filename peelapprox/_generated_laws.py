@@ -11,76 +11,34 @@ import numpy
 
 
 def law_paper(x, coef, form):
-    """The 'paper' family (De, Maybhate & Ananthakrishna, Phys. Rev. E (2004), Eq. fvV) in the ABI of peelapprox._law_abi; coef = law_paper_pack(V, c):
+    """The 'paper' family (De, Maybhate & Ananthakrishna, Phys. Rev. E (2004), Eq. fvV) in the ABI of peelapprox._law_abi.
 
-        coef[0] = a1
-        coef[1] = a2
-        coef[2] = a3
-        coef[3] = p1
-        coef[4] = p2
-        coef[5] = p5
-        coef[6] = (1.0/v3)
-        coef[7] = a1*p1
-        coef[8] = a2*p2
-        coef[9] = a3/v3**2
-        coef[10] = a3/v3
-        coef[11] = -V**q4*a4
-        coef[12] = a1*p1*(p1 - 1)
-        coef[13] = a2*p2*(p2 - 1)
-        coef[14] = V**q6*a6 + V**q7*a7 - a5
-        coef[15] = -p5*(-V**q6*a6 - V**q7*a7 + a5)
-        coef[16] = -p5*(p5 - 1)*(-V**q6*a6 - V**q7*a7 + a5)
+    coef = law_paper_pack(V, c) = [a1, a2, a3, p1, p2, p5, (1.0/v3), a1*p1, a2*p2, a3/v3**2, a3/v3, -V**q4*a4, a1*p1*(p1 - 1), a2*p2*(p2 - 1), V**q6*a6 + V**q7*a7 - a5, -p5*(-V**q6*a6 - V**q7*a7 + a5), -p5*(p5 - 1)*(-V**q6*a6 - V**q7*a7 + a5)]
     """
-    k0 = coef[0]
-    k1 = coef[1]
-    k2 = coef[2]
-    k3 = coef[3]
-    k4 = coef[4]
-    k5 = coef[5]
-    k6 = coef[6]
-    k7 = coef[7]
-    k8 = coef[8]
-    k9 = coef[9]
-    k10 = coef[10]
-    k11 = coef[11]
-    k12 = coef[12]
-    k13 = coef[13]
-    k14 = coef[14]
-    k15 = coef[15]
-    k16 = coef[16]
-    if form == 0:  # LAW_LNV: x = ln v -> (v, f, v f')
-        u = x
-        v = numpy.exp(u)
-        w0 = numpy.exp(k3*u)
-        w1 = numpy.exp(k4*u)
-        w2 = numpy.exp(k5*u)
-        w3 = numpy.exp(k6*v)
-        f = k0*w0 + k1*w1 + k11 + k14*w2 + k2*w3
-        vfp = k10*v*w3 + k15*w2 + k7*w0 + k8*w1
+    v = numpy.exp(x) if form == 0 else x  # LAW_LNV: x = ln v -> (v, f, v f'); else x = v
+    u = x if form == 0 else numpy.log(v)
+    w0 = numpy.exp(coef[3]*u)
+    w1 = numpy.exp(coef[5]*u)
+    w2 = numpy.exp(coef[4]*u)
+    w3 = numpy.exp(coef[6]*v)
+    f = coef[0]*w0 + coef[11] + coef[14]*w1 + coef[1]*w2 + coef[2]*w3
+    if form == 0:
+        w4 = coef[15]*w1
+        w5 = coef[7]*w0
+        w6 = coef[8]*w2
+        w7 = coef[10]*w3
+        vfp = v*w7 + w4 + w5 + w6
         return v, f, vfp
-    if form == 1:  # LAW_FP: x = v -> (f, f', nan)
-        v = x
-        u = numpy.log(v)
-        w0 = numpy.exp(k3*u)
-        w1 = numpy.exp(k4*u)
-        w2 = numpy.exp(k5*u)
-        w3 = numpy.exp(k6*v)
-        w4 = (1.0/v)
-        f = k0*w0 + k1*w1 + k11 + k14*w2 + k2*w3
-        fp = k10*w3 + k15*w2*w4 + k7*w0*w4 + k8*w1*w4
+    w4 = coef[15]*w1
+    w5 = coef[7]*w0
+    w6 = coef[8]*w2
+    w7 = coef[10]*w3
+    w8 = (1.0/v)
+    fp = w4*w8 + w5*w8 + w6*w8 + w7
+    if form == 1:
         return f, fp, numpy.nan
-    # LAW_FPP: x = v -> (f, f', f'')
-    v = x
-    u = numpy.log(v)
-    w0 = numpy.exp(k3*u)
-    w1 = numpy.exp(k4*u)
-    w2 = numpy.exp(k5*u)
-    w3 = numpy.exp(k6*v)
-    w4 = (1.0/v)
-    w5 = (1.0/(v**2))
-    f = k0*w0 + k1*w1 + k11 + k14*w2 + k2*w3
-    fp = k10*w3 + k15*w2*w4 + k7*w0*w4 + k8*w1*w4
-    fpp = k12*w0*w5 + k13*w1*w5 + k16*w2*w5 + k9*w3
+    w9 = (1.0/(v**2))
+    fpp = coef[12]*w0*w9 + coef[13]*w2*w9 + coef[16]*w1*w9 + coef[9]*w3
     return f, fp, fpp
 
 
@@ -92,145 +50,59 @@ def law_paper_pack(V, cs=()):
     t2 = a2*p2
     t3 = V**q6*a6 + V**q7*a7 - a5
     t4 = p5*t3
-    k0 = a1
-    k1 = a2
-    k2 = a3
-    k3 = p1
-    k4 = p2
-    k5 = p5
-    k6 = t0
-    k7 = t1
-    k8 = t2
-    k9 = a3/v3**2
-    k10 = a3*t0
-    k11 = -V**q4*a4
-    k12 = t1*(p1 - 1)
-    k13 = t2*(p2 - 1)
-    k14 = t3
-    k15 = t4
-    k16 = t4*(p5 - 1)
-    return numpy.array([k0, k1, k2, k3, k4, k5, k6, k7, k8, k9, k10, k11, k12, k13, k14, k15, k16], dtype=numpy.float64)
+    return numpy.array([a1, a2, a3, p1, p2, p5, t0, t1, t2, a3/v3**2, a3*t0, -V**q4*a4, t1*(p1 - 1), t2*(p2 - 1), t3, t4, t4*(p5 - 1)], dtype=numpy.float64)
 
 
 def law_cubic(x, coef, form):
-    """The 'cubic' family (the smooth normal form of the N-shaped law of Hong & Yue, Phys. Rev. Lett. 74, 254 (1995)) in the ABI of peelapprox._law_abi; coef = law_cubic_pack(V, c):
+    """The 'cubic' family (the smooth normal form of the N-shaped law of Hong & Yue, Phys. Rev. Lett. 74, 254 (1995)) in the ABI of peelapprox._law_abi.
 
-        coef[0] = a
-        coef[1] = b
-        coef[2] = d
-        coef[3] = -2*c
-        coef[4] = -c
-        coef[5] = 3*d
-        coef[6] = 6*d
+    coef = law_cubic_pack(V, c) = [a, b, d, -2*c, -c, 3*d, 6*d]
     """
-    k0 = coef[0]
-    k1 = coef[1]
-    k2 = coef[2]
-    k3 = coef[3]
-    k4 = coef[4]
-    k5 = coef[5]
-    k6 = coef[6]
-    if form == 0:  # LAW_LNV: x = ln v -> (v, f, v f')
-        u = x
-        v = numpy.exp(u)
-        w0 = v**2
-        f = k0 + k1*v + k2*v**3 + k4*w0
-        vfp = v*(k1 + k3*v + k5*w0)
-        return v, f, vfp
-    if form == 1:  # LAW_FP: x = v -> (f, f', nan)
-        v = x
-        w0 = v**2
-        f = k0 + k1*v + k2*v**3 + k4*w0
-        fp = k1 + k3*v + k5*w0
-        return f, fp, numpy.nan
-    # LAW_FPP: x = v -> (f, f', f'')
-    v = x
+    v = numpy.exp(x) if form == 0 else x  # LAW_LNV: x = ln v -> (v, f, v f'); else x = v
     w0 = v**2
-    f = k0 + k1*v + k2*v**3 + k4*w0
-    fp = k1 + k3*v + k5*w0
-    fpp = k3 + k6*v
+    f = coef[0] + coef[1]*v + coef[2]*v**3 + coef[4]*w0
+    if form == 0:
+        w1 = coef[1] + coef[3]*v + coef[5]*w0
+        vfp = v*w1
+        return v, f, vfp
+    w1 = coef[1] + coef[3]*v + coef[5]*w0
+    fp = w1
+    if form == 1:
+        return f, fp, numpy.nan
+    fpp = coef[3] + coef[6]*v
     return f, fp, fpp
 
 
 def law_cubic_pack(V, cs=()):
     """coef of law_cubic at the pull speed V from the coefficients cs = (a, b, c, d)."""
     a, b, c, d = cs
-    k0 = a
-    k1 = b
-    k2 = d
-    k3 = -2*c
-    k4 = -c
-    k5 = 3*d
-    k6 = 6*d
-    return numpy.array([k0, k1, k2, k3, k4, k5, k6], dtype=numpy.float64)
+    return numpy.array([a, b, d, -2*c, -c, 3*d, 6*d], dtype=numpy.float64)
 
 
 def law_power_branches(x, coef, form):
-    """The 'power_branches' family (Maugis & Barquins (1988); Barquins & Ciccotti, Int. J. Adhes. Adhes. 17, 65 (1997); defaults calibrated to fvV at V = 1 m/s) in the ABI of peelapprox._law_abi; coef = law_power_branches_pack(V, c):
+    """The 'power_branches' family (Maugis & Barquins (1988); Barquins & Ciccotti, Int. J. Adhes. Adhes. 17, 65 (1997); defaults calibrated to fvV at V = 1 m/s) in the ABI of peelapprox._law_abi.
 
-        coef[0] = A1
-        coef[1] = A2
-        coef[2] = m
-        coef[3] = n1
-        coef[4] = n2
-        coef[5] = 2*m
-        coef[6] = A1*n1
-        coef[7] = A2*n2
-        coef[8] = v1**(-m)
-        coef[9] = A1*n1*(n1 - 1)
-        coef[10] = A2*n2*(n2 - 1)
-        coef[11] = -A1*m*v1**(-m)
-        coef[12] = 2*A1*m**2*v1**(-2*m)
-        coef[13] = -A1*m*v1**(-m)*(m + 2*n1 - 1)
+    coef = law_power_branches_pack(V, c) = [A1, A2, m, n1, n2, 2*m, A1*n1, A2*n2, v1**(-m), A1*n1*(n1 - 1), A2*n2*(n2 - 1), -A1*m*v1**(-m), 2*A1*m**2*v1**(-2*m), -A1*m*v1**(-m)*(m + 2*n1 - 1)]
     """
-    k0 = coef[0]
-    k1 = coef[1]
-    k2 = coef[2]
-    k3 = coef[3]
-    k4 = coef[4]
-    k5 = coef[5]
-    k6 = coef[6]
-    k7 = coef[7]
-    k8 = coef[8]
-    k9 = coef[9]
-    k10 = coef[10]
-    k11 = coef[11]
-    k12 = coef[12]
-    k13 = coef[13]
-    if form == 0:  # LAW_LNV: x = ln v -> (v, f, v f')
-        u = x
-        v = numpy.exp(u)
-        w0 = numpy.exp(k4*u)
-        w1 = numpy.exp(k2*u)
-        w2 = k8*w1 + 1
-        w3 = numpy.exp(k3*u)
-        w4 = w3/w2
-        f = k0*w4 + k1*w0
-        vfp = k11*w1*w3/w2**2 + k6*w4 + k7*w0
-        return v, f, vfp
-    if form == 1:  # LAW_FP: x = v -> (f, f', nan)
-        v = x
-        u = numpy.log(v)
-        w0 = numpy.exp(k4*u)
-        w1 = numpy.exp(k2*u)
-        w2 = k8*w1 + 1
-        w3 = numpy.exp(k3*u)
-        w4 = w3/w2
-        f = k0*w4 + k1*w0
-        fp = (k11*w1*w3/w2**2 + k6*w4 + k7*w0)/v
-        return f, fp, numpy.nan
-    # LAW_FPP: x = v -> (f, f', f'')
-    v = x
-    u = numpy.log(v)
-    w0 = numpy.exp(k4*u)
-    w1 = numpy.exp(k2*u)
-    w2 = k8*w1 + 1
-    w3 = numpy.exp(k3*u)
+    v = numpy.exp(x) if form == 0 else x  # LAW_LNV: x = ln v -> (v, f, v f'); else x = v
+    u = x if form == 0 else numpy.log(v)
+    w0 = numpy.exp(coef[4]*u)
+    w1 = numpy.exp(coef[2]*u)
+    w2 = coef[8]*w1 + 1
+    w3 = numpy.exp(coef[3]*u)
     w4 = w3/w2
+    f = coef[0]*w4 + coef[1]*w0
+    if form == 0:
+        w5 = w1*w3/w2**2
+        w6 = coef[11]*w5 + coef[6]*w4 + coef[7]*w0
+        vfp = w6
+        return v, f, vfp
     w5 = w1*w3/w2**2
-    f = k0*w4 + k1*w0
-    fp = (k11*w5 + k6*w4 + k7*w0)/v
-    fpp = (k10*w0 + k12*w3*numpy.exp(k5*u)/w2**3 + k13*w5 + k9*w4)/v**2
+    w6 = coef[11]*w5 + coef[6]*w4 + coef[7]*w0
+    fp = w6/v
+    if form == 1:
+        return f, fp, numpy.nan
+    fpp = (coef[10]*w0 + coef[12]*w3*numpy.exp(coef[5]*u)/w2**3 + coef[13]*w5 + coef[9]*w4)/v**2
     return f, fp, fpp
 
 
@@ -242,21 +114,7 @@ def law_power_branches_pack(V, cs=()):
     t2 = A2*n2
     t3 = v1**(-m)
     t4 = A1*m*t3
-    k0 = A1
-    k1 = A2
-    k2 = m
-    k3 = n1
-    k4 = n2
-    k5 = t0
-    k6 = t1
-    k7 = t2
-    k8 = t3
-    k9 = t1*(n1 - 1)
-    k10 = t2*(n2 - 1)
-    k11 = -t4
-    k12 = 2*A1*m**2*v1**(-t0)
-    k13 = -t4*(m + 2*n1 - 1)
-    return numpy.array([k0, k1, k2, k3, k4, k5, k6, k7, k8, k9, k10, k11, k12, k13], dtype=numpy.float64)
+    return numpy.array([A1, A2, m, n1, n2, t0, t1, t2, t3, t1*(n1 - 1), t2*(n2 - 1), -t4, 2*A1*m**2*v1**(-t0), -t4*(m + 2*n1 - 1)], dtype=numpy.float64)
 
 
 #: family name -> (law, pack)

@@ -14,7 +14,7 @@ a law of the ABI of :mod:`peelapprox._law_abi` — ``law(x, coef, form) -> (f8, 
   coefficients only: ``-a4 V^q4``, ``-(a5 - a6 V^q6 - a7 V^q7)``, ``a1 p1``, ``1/v3`` ...) becomes one entry
   of ``coef``, computed once by ``pack`` when a run is packed.  The kernel does no arithmetic on V or the
   coefficients alone; numbers stay literals.  The entries are numbered in sympy's canonical order, and each
-  law's docstring lists them (``coef[i] = ...``): that is the coef layout.
+  law's docstring lists them (``coef = pack(V, c) = [...]``): that is the coef layout.
 * **CSE** per form, as :mod:`peelapprox._symbolic` does; floats are printed exactly (``repr``).
 
 The families are rendered into the committed module :mod:`peelapprox._generated_laws` (regenerate with
@@ -58,7 +58,7 @@ _FORMS = (LAW_LNV, LAW_FP, LAW_FPP)
 assert _FORMS == (0, 1, 2), _FORMS
 #: Names a coefficient may not take (the kernel's and pack's own).
 _RESERVED = {"x", "coef", "form", "v", "u", "s", "V", "numpy", "cs"}
-_GENERATED_NAME = re.compile(r"^[kwt]\d+$")
+_GENERATED_NAME = re.compile(r"^[wt]\d+$")
 
 
 # ---------------------------------------------------------------------------------------------- rendering
@@ -147,19 +147,7 @@ def _check_names(coef_symbols: Sequence[Any]) -> None:
         n = s.name
         if not n.isidentifier() or n in _RESERVED or _GENERATED_NAME.match(n) or n.startswith("_"):
             raise ValueError(f"coefficient name {n!r} is not usable in generated code: it must be a Python name "
-                             f"other than {', '.join(sorted(_RESERVED))}, k<i>, w<i>, t<i> or one starting with _")
-
-
-def _body(printer: Any, exprs: list, outs: list[str], prelude: list[str], cse_prefix: str) -> list[str]:
-    import sympy as sp
-
-    repl, red = sp.cse(exprs, symbols=sp.numbered_symbols(cse_prefix), optimizations="basic")
-    lines = list(prelude)
-    lines += [f"{s} = {printer.doprint(e)}" for s, e in repl]
-    for o, e in zip(outs, red):
-        e = sp.Float(e) if e.is_Number else e  # homogeneous float tuples for numba
-        lines.append(f"{o} = {printer.doprint(e)}")
-    return lines
+                             f"other than {', '.join(sorted(_RESERVED))}, w<i>, t<i> or one starting with _")
 
 
 def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name: str | None = None,
@@ -210,37 +198,49 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     hoisted = {k: hoist(_expand(e)) for k, e in outputs.items()}
     # number the coef entries in canonical order (deterministic text), then rename the placeholders
     derived = list(sp.ordered(hoist.table))
-    ks = [sp.Symbol(f"k{i}", real=True) for i in range(len(derived))]
+    ks = [sp.Symbol(f"coef[{i}]", real=True) for i in range(len(derived))]  # read in place
     rename = {hoist.table[d]: ks[i] for i, d in enumerate(derived)}
-    hoisted = {k: e.xreplace(rename) for k, e in hoisted.items()}
+    outs = ("f", "vfp", "fp", "fpp")
+    repl, red = sp.cse([hoisted[k].xreplace(rename) for k in outs], symbols=sp.numbered_symbols("w"),
+                       optimizations="basic")
+    red = [sp.Float(e) if e.is_Number else e for e in red]  # homogeneous float tuples for numba
+    defs = dict(repl)
+    used = set().union(*(e.free_symbols for e in red), *(e.free_symbols for _, e in repl))
 
     p = _printer()
+
+    def stage(out: str, done: set, indent: str) -> list[str]:
+        """The CSE lines ``out`` needs that ``done`` does not hold (in order), then ``out`` itself."""
+        e = red[outs.index(out)]
+        need, stack = set(), list(e.free_symbols)
+        while stack:
+            sym = stack.pop()
+            if sym in defs and sym not in need and sym not in done:
+                need.add(sym)
+                stack.extend(defs[sym].free_symbols)
+        done |= need
+        return [f"{indent}{sym} = {p.doprint(rhs)}" for sym, rhs in repl if sym in need] + [
+            f"{indent}{out} = {p.doprint(e)}"]
+
     pack_name = pack_name or f"{name}_pack"
-    layout = [f"        coef[{i}] = {p.doprint(d)}" for i, d in enumerate(derived)] or ["        (empty)"]
+    layout = ", ".join(p.doprint(d) for d in derived)
     lines = [f"def {name}(x, coef, form):",
-             f'    """{doc or "A peel-force law"} in the ABI of peelapprox._law_abi; coef = {pack_name}(V, c):',
+             f'    """{doc or "A peel-force law"} in the ABI of peelapprox._law_abi.',
              "",
-             *layout,
-             '    """']
-    lines += [f"    {k} = coef[{i}]" for i, k in enumerate(ks)]
-
-    def branch(exprs: list, outs: list[str], x_is_u: bool, indent: str = "        ") -> list[str]:
-        used = set().union(*(e.free_symbols for e in exprs))
-        if x_is_u:
-            prelude = ["u = x", "v = numpy.exp(u)"]
-        else:
-            prelude = ["v = x"] + (["u = numpy.log(v)"] if u in used else [])
-        prelude += ["s = numpy.sqrt(v)"] if sq in used else []
-        return [indent + s for s in _body(p, exprs, outs, prelude, "w")]
-
-    lines.append("    if form == 0:  # LAW_LNV: x = ln v -> (v, f, v f')")
-    lines += branch([hoisted["f"], hoisted["vfp"]], ["f", "vfp"], True)
+             f"    coef = {pack_name}(V, c) = [{layout}]",
+             '    """',
+             "    v = numpy.exp(x) if form == 0 else x  # LAW_LNV: x = ln v -> (v, f, v f'); else x = v"]
+    lines += ["    u = x if form == 0 else numpy.log(v)"] if u in used else []
+    lines += ["    s = numpy.sqrt(v)"] if sq in used else []
+    done: set = set()
+    lines += stage("f", done, "    ")
+    lines.append("    if form == 0:")
+    lines += stage("vfp", set(done), "        ")
     lines.append("        return v, f, vfp")
-    lines.append("    if form == 1:  # LAW_FP: x = v -> (f, f', nan)")
-    lines += branch([hoisted["f"], hoisted["fp"]], ["f", "fp"], False)
+    lines += stage("fp", done, "    ")
+    lines.append("    if form == 1:")
     lines.append("        return f, fp, numpy.nan")
-    lines.append("    # LAW_FPP: x = v -> (f, f', f'')")
-    lines += branch([hoisted["f"], hoisted["fp"], hoisted["fpp"]], ["f", "fp", "fpp"], False, "    ")
+    lines += stage("fpp", done, "    ")
     lines.append("    return f, fp, fpp")
     law = "\n".join(lines) + "\n"
 
@@ -250,8 +250,9 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     if names:
         plines.append(f"    {', '.join(names)}{',' if len(names) == 1 else ''} = cs")
     if derived:
-        plines += ["    " + s for s in _body(p, derived, [str(k) for k in ks], [], "t")]
-        plines.append(f"    return numpy.array([{', '.join(str(k) for k in ks)}], dtype=numpy.float64)")
+        repl, red = sp.cse(derived, symbols=sp.numbered_symbols("t"), optimizations="basic")
+        plines += [f"    {sym} = {p.doprint(rhs)}" for sym, rhs in repl]
+        plines.append(f"    return numpy.array([{', '.join(p.doprint(e) for e in red)}], dtype=numpy.float64)")
     else:
         plines.append("    return numpy.zeros(0, dtype=numpy.float64)")
     return law + "\n\n" + "\n".join(plines) + "\n"
