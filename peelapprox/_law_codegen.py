@@ -89,6 +89,9 @@ def _in_u(expr: Any, v: Any, u: Any, s: Any) -> Any:
         return bool(a.is_Pow and a.base == v and a.exp.is_Rational and a.exp.q == 2)
 
     e = sp.expand_power_base(expr)  # (v/v1)^m -> v^m v1^-m (v and the scales are positive)
+    # a float exponent that is a multiple of 1/2 (v**0.5, v**2.0) is that exact rational: the same number
+    e = e.replace(lambda a: a.is_Pow and a.base == v and a.exp.is_Float and float(a.exp * 2).is_integer(),
+                  lambda a: v ** sp.Rational(int(float(a.exp * 2)), 2))
     e = e.replace(lambda a: isinstance(a, sp.log) and a.args[0] == v, lambda a: u)
     e = e.replace(half, lambda a: v ** (a.exp - sp.Rational(1, 2)) * s)
     return e.replace(lambda a: a.is_Pow and a.base == v and not a.exp.is_Integer, lambda a: sp.exp(a.exp * u))
@@ -120,7 +123,8 @@ class _Hoister:
         import sympy as sp
 
         if not (e.free_symbols & self.vars):
-            return self._free(sp.factor(e) if e.is_Add else sp.factor_terms(e))
+            # factor sums of symbols (a5 p5 - a5 -> a5 (p5 - 1)); not floats, which factor would rescale
+            return self._free(sp.factor(e) if e.is_Add and not e.has(sp.Float) else sp.factor_terms(e))
         if e.is_Atom:
             return e
         if e.is_Add:
