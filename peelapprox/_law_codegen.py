@@ -15,7 +15,8 @@ a law of the ABI of :mod:`peelapprox._law_abi` — ``law(x, coef, form) -> (f8, 
   of ``coef``, computed once by ``pack`` when a run is packed.  The kernel does no arithmetic on V or the
   coefficients alone; numbers stay literals.  The entries are numbered in sympy's canonical order, and each
   law's docstring lists them (``coef = pack(V, c) = [...]``): that is the coef layout.
-* **CSE** per form, as :mod:`peelapprox._symbolic` does; floats are printed exactly (``repr``).
+* **One code path, CSE** over f, v f', f', f'' (as :mod:`peelapprox._symbolic` does): f, then the return of
+  ``LAW_LNV`` with v f', then f' and the return of ``LAW_FP``, then f''; floats are printed exactly (``repr``).
 
 The families are rendered into the committed module :mod:`peelapprox._generated_laws` (regenerate with
 ``python -m peelapprox._law_codegen``; a test checks that it is current) and compiled lazily by
@@ -48,8 +49,8 @@ from ._jit import kernel
 from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
 from .errors import KernelCacheWarning
 
-__all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "family_kernel",
-           "render_law", "render_module", "write_module"]
+__all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "expression_source",
+           "family_kernel", "render_law", "render_module", "write_module"]
 
 #: Bump when the rendering changes what a law computes (the file's own hash is in :func:`codegen_version` too).
 CODEGEN_VERSION = "law-codegen-1"
