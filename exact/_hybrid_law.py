@@ -21,33 +21,30 @@ reference-count updates it cannot prune (measured: 62 instead of 29 ns per field
 
 from __future__ import annotations
 
-import math
-import types as pytypes
 from collections.abc import Callable
-from typing import Any, cast
+from typing import Any
 
-import numpy as np
 from numba import types as _t
-from scipy.optimize import brentq
 
-from peelapprox import BranchStructure, PeelParams, branch_structure
+from peelapprox import PeelParams
 from peelapprox.kernels import (
+    ALL_LAWS,
     LAW_FP,
     LAW_LNV,
     LAW_TYPE,
-    LAWS,
-    cubic_v_structure,
+    CompiledLaw,
+    compiled_law,
     kernel,
     make_dop853,
-    paper_coefficients,
+    rebind,
 )
 
 from . import _hybrid as H
 
-__all__ = ["HYBRID_LAWS", "RUN_SIG", "branch_root", "driver", "law_for", "pull_force_law"]
+__all__ = ["HYBRID_LAWS", "RUN_SIG", "driver", "field_law", "law_for", "pull_force_law"]
 
 #: The laws (``PeelParams.force``, by ``peelapprox._law.law_label``) that ``simulate(method="hybrid")`` runs.
-HYBRID_LAWS = ("paper", "cubic")
+HYBRID_LAWS = ALL_LAWS
 
 _A1 = _t.float64[::1]
 
@@ -76,6 +73,22 @@ def _rhs_law(y, P, out):
     H._field(y, p, v, f, g, out)
 
 
+@kernel(nrt=False)
+def _field_law(y, p, law, coef, out):
+    """:func:`_rhs_law` with the law and its coefficients as separate arguments (the form Python calls)."""
+    _rhs_law(y, (p, law, coef), out)
+
+
+def field_law() -> Any:
+    """``field(y, p, law, coef, out)``: the hybrid field d(τ, α, ω, u)/ds for the law ``law`` with ``coef`` (as
+    :func:`exact._hybrid._rhs` for the inlined law), compiled for that one signature on first use (loaded from
+    numba's cache when it is there): the saltation tangent's field outside its compiled driver."""
+    if not _field_law.signatures:
+        _field_law.compile(_t.void(_A1, _A1, LAW_TYPE, _A1, _A1))
+        _field_law.disable_compile()
+    return _field_law
+
+
 @kernel(inline="always")
 def _pack_paper(p, law, coef):
     """What the inlined-law driver's field receives: ``p`` (the paper's law reads ``p[M_B], p[M_A]``)."""
@@ -96,14 +109,10 @@ RUN_SIG = _t.int64(
 )
 
 
-def _driver_copy(field: Callable, pull: Callable, pack: Callable) -> pytypes.FunctionType:
+def _driver_copy(field: Callable, pull: Callable, pack: Callable) -> Callable:
     """:func:`exact._hybrid._run` reading ``field``, ``pull``, ``pack`` and the DOP853 pieces of ``field`` as its
-    globals ``_FIELD``, ``_PULL``, ``_PACK``, ``_dop``: a module-level function (no closure), so numba caches it."""
-    run = H._run
-    g = dict(run.__globals__, _FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
-    fn = pytypes.FunctionType(run.__code__, g, run.__name__, run.__defaults__, None)
-    fn.__qualname__, fn.__module__, fn.__doc__ = run.__qualname__, run.__module__, run.__doc__
-    return fn
+    globals ``_FIELD``, ``_PULL``, ``_PACK``, ``_dop`` (:func:`peelapprox.kernels.rebind`)."""
+    return rebind(H._run, _FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
 
 
 _DRIVERS = {
@@ -135,50 +144,21 @@ def driver(law_argument: bool) -> Any:
     return d
 
 
-def law_for(params: PeelParams) -> tuple[Callable, np.ndarray, BranchStructure, bool]:
-    """The peel-force law of ``params`` as the hybrid drivers take it: ``(law, coef, branch structure, given)``.
-
-    * the paper's law (``PeelParams.force`` = ``PeelForce.paper()``, the default): the inlined driver's
-      ``(paper_law, [b, A] = peel_force_coefficients(V), branch_structure(V), False)``;
-    * ``PeelForce.cubic(a, b, c, d)``: ``(cubic_v_law, [a, b, c, d], cubic_v_structure(coef, V), True)``, run
-      by the law driver ``driver(True)`` (folds and landings in closed form).
+def law_for(params: PeelParams) -> CompiledLaw:
+    """The peel-force law of ``params`` as the hybrid drivers take it: :func:`peelapprox.kernels.compiled_law` at
+    ``params.V`` (kernel, coefficients, branch structure, domain; ``inlined`` for the paper's law, run by the
+    driver with fvV inlined).
 
     Raises
     ------
     ValueError
-        Naming ``params.force``: for any other law (``validate.params`` refuses those first), or a cubic
-        without two folds whose CD→AB jumps land (``cubic_v_structure``'s conditions).
+        Naming ``params.force``: a law without a compiled kernel, whose folds cannot be found, or whose AB→CD
+        jumps would land outside its domain (a table that stops below ``f_max`` on CD).
     """
-    force = params.force
-    if force.kind == "paper":
-        return LAWS["paper"], paper_coefficients(params.V), branch_structure(params.V), False
-    if force.kind == "family" and force.name == "cubic":
-        named = dict(force.coefficients)
-        coef = np.array([named[k] for k in ("a", "b", "c", "d")], dtype=float)
-        try:
-            bs = cubic_v_structure(coef, params.V)
-        except ValueError as e:
-            raise ValueError(f"params.force: {force!r} cannot be run by the hybrid solver: {e}") from None
-        return LAWS["cubic_v"], coef, bs, True
-    raise ValueError(f"params.force: {force!r} is not yet supported by exact.simulate; see issue 15")
-
-
-def branch_root(law: Callable, coef: np.ndarray, bs: BranchStructure, G: float, branch: str) -> float:
-    """v on ``branch`` with ``f(v) = G`` (CONSTR) for the compiled law ``law`` with ``coef``: Brent's method in
-    ln v (relative accuracy ~4 ulp in v), bracketed by the law's folds ``bs`` -- AB on ``(0, v_max]`` from
-    ``v = e^-690`` (where ``f = f(0+)`` to rounding), CD on ``[v_min, ∞)`` up to where f first exceeds G
-    (doubling).  ``G`` must be in ``bs.level_range(branch)`` (the caller checks :meth:`BranchStructure.has_root`).
-    """
-
-    def g(u: float) -> float:
-        return float(law(math.exp(u), coef, LAW_FP)[0]) - G
-
-    if branch == "AB":  # the laws run through here have folds (law_for)
-        lo, hi = -690.0, math.log(cast(float, bs.v_max))
-    else:
-        lo = hi = math.log(cast(float, bs.v_min))
-        while g(hi) < 0.0:
-            hi += math.log(2.0)
-    if g(hi) == 0.0:
-        return math.exp(hi)
-    return math.exp(brentq(g, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
+    law = compiled_law(params.force, params.V)
+    bs = law.structure
+    if bs.has_folds and bs.v_land_cd is None:
+        raise ValueError(f"params.force: {params.force!r} at V={params.V!r} m/s never reaches f_max={bs.f_max!r} N "
+                         f"on its fast branch within its domain up to {law.domain[1]!r} m/s: an AB->CD jump could not "
+                         "land (extend the table to higher v)")
+    return law

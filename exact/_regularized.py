@@ -25,8 +25,9 @@ import numpy as np
 from scipy import integrate
 from scipy.optimize import brentq
 
-from peelapprox import BRANCHES, BREAKDOWN_LEVEL, branch_structure
+from peelapprox import BRANCHES, BREAKDOWN_LEVEL
 from peelapprox.errors import ModelBreakdown, SolverFailure, budget_exceeded
+from peelapprox.kernels import ALL_LAWS, compiled_law, regularized_law_field
 from peelapprox.kernels import regularized_field as _fun  # the compiled field, Jacobian and parameter vector
 from peelapprox.kernels import regularized_field_jacobian as _jac
 from peelapprox.kernels import regularized_parameters as param_vector
@@ -47,12 +48,19 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
     solver, eps, rtol, atol, v_floor = method.solver, method.eps, method.rtol, method.atol_vector(), method.v_floor
     t_store, te, max_wall = saveat.t_transient, saveat.ts, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
-    bs = branch_structure(params.V)
+    cl = compiled_law(params.force, params.V)  # the paper's law: fvV inlined in the field (the default)
+    bs, (v_lo, v_hi) = cl.structure, cl.domain
     no_root_margin = BREAKDOWN_LEVEL * max(abs(bs.f_zero), 1.0)  # the hybrid solver's criterion (v_breakdown)
-    q = param_vector(params, eps)
+    q = param_vector(params, eps, ("paper",) if cl.inlined else ALL_LAWS)
     v_mid = bs.v_inflection
-    fun = lambda t, y: _fun(y, q)  # noqa: E731
-    jac = lambda t, y: _jac(y, q)  # noqa: E731
+    if cl.inlined:
+        fun = lambda t, y: _fun(y, q)  # noqa: E731
+        jac = lambda t, y: _jac(y, q)  # noqa: E731
+    else:
+        lfun, ljac = regularized_law_field()
+        law, coef = cl.fn, cl.coef
+        fun = lambda t, y: lfun(y, q, law, coef)  # noqa: E731
+        jac = lambda t, y: ljac(y, q, law, coef)  # noqa: E731
     y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v])
     wall0 = time.perf_counter()
     ode = _SOLVERS[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, jac=jac)
@@ -117,6 +125,11 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
                                 f"{level_gap(y_old):.3g} N there; near 0 the orbit is approaching the no_root "
                                 "breakdown, else tighten rtol)",
                                 t=float(t_old), state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
+        if not v_lo <= y[3] <= v_hi:
+            raise ModelBreakdown(
+                f"model breakdown at t={ode.t:.9g}: v = {y[3]:.6g} m/s left the domain [{v_lo:.6g}, {v_hi:.6g}] m/s "
+                f"of the peel-force law {params.force!r}: the law is not extrapolated (extend the table or the "
+                "law's range)", t=float(ode.t), state=sdict(ode.t, y), reason="law_domain", partial=build(False))
         if v_floor is not None and y[3] <= v_floor:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "

@@ -21,7 +21,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox.kernels import LAW_FP, model_block
+from peelapprox.kernels import CompiledLaw, model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -95,8 +95,14 @@ def initial_state(
     _params("params", params, laws=HL.HYBRID_LAWS)
     a0 = state("alpha0", alpha0, "alpha")
     w0 = params.V / params.R if omega0 is None else state("omega0", omega0, "omega")
-    law = None if params.force.kind == "paper" else HL.law_for(params)  # (law, coef, bs, True) of another law
-    fVV = float(peel_force(params.V, params.V) if law is None else law[0](params.V, law[1], LAW_FP)[0])
+    law = None if params.force.kind == "paper" else HL.law_for(params)  # another law: its compiled form
+    if law is None:
+        fVV = float(peel_force(params.V, params.V))
+    elif F0 is None and not law.domain[0] <= params.V <= law.domain[1]:
+        raise ValueError(f"F0=None starts at 1.01 f(V, V), but v=V={params.V!r} m/s is outside the domain "
+                         f"{law.domain} m/s of params.force={params.force!r}: give F0")
+    else:
+        fVV = law.f(params.V)
     F = 1.01 * fVV if F0 is None else state("F0", F0, "F")
     t0 = in_range("t0", t0, 0.0, TIME_MAX)
     branch0 = optional(choice, "branch0", branch0, BRANCHES)
@@ -104,7 +110,7 @@ def initial_state(
     if not (1.0 + c > 0.0):
         raise ValueError(f"alpha0={a0} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
     G = F * (1.0 + c)
-    bs = branch_structure(params.V) if law is None else law[2]
+    bs = branch_structure(params.V) if law is None else law.structure
     if branch0 is None:
         for cand in ("AB", "CD") if bs.has_folds else ("AB",):
             if bs.has_root(G, cand):
@@ -123,7 +129,7 @@ def initial_state(
             f"F0={F} at alpha0={a0} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
             f"valid F0 range on {branch0}: ({lo / (1 + c)}, {hi / (1 + c)})"
         )
-    v = branch_inverse(G, params.V, branch0) if law is None else HL.branch_root(law[0], law[1], bs, G, branch0)
+    v = branch_inverse(G, params.V, branch0) if law is None else law.branch_root(G, branch0)
     return State(float(t0), a0, w0, F, float(v), branch0)
 
 
@@ -281,8 +287,6 @@ def simulate(
     """
     _params("params", params, laws=HL.HYBRID_LAWS)
     opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor)
-    if not isinstance(opts, Hybrid):  # the regularized scheme evaluates fvV itself
-        _params("params", params, where='exact.simulate(method="regularized")')
     t_end = duration("t_end", t_end)
     out, lim = output_options(opts.name, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
                               max_points=max_points, max_steps=max_steps, max_jumps=max_jumps, max_wall=max_wall)
@@ -309,8 +313,8 @@ def simulate(
 V_CEILING = 1e3
 
 
-def _param_vector(params: PeelParams, v_floor: float | None = None,
-                  bs: BranchStructure | None = None) -> np.ndarray:
+def _param_vector(params: PeelParams, v_floor: float | None = None, bs: BranchStructure | None = None,
+                  domain: tuple[float, float] = (0.0, math.inf)) -> np.ndarray:
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``; ``bs``: the law's branch structure (default: the paper's law's,
     :func:`peelapprox.branch_structure`, and only the paper's law is accepted: the inlined driver's vector)."""
@@ -324,7 +328,7 @@ def _param_vector(params: PeelParams, v_floor: float | None = None,
     p[H.P_VLCD] = bs.v_land_cd if bs.has_folds else 0.0
     p[H.P_VLAB] = bs.v_land_ab if (bs.has_folds and bs.v_land_ab is not None) else -1.0
     p[H.P_UFLOOR] = math.log(bs.v_breakdown if v_floor is None else max(v_floor, bs.v_breakdown))
-    p[H.P_UCEIL] = math.log(V_CEILING)
+    p[H.P_UCEIL] = math.log(min(V_CEILING, domain[1]))
     # the fold fields are floats when has_folds (peelapprox.BranchStructure)
     p[H.P_UEV_AB] = math.log(cast(float, bs.v_max) * (1.0 - H.FOLD_REL)) if bs.has_folds else math.inf
     p[H.P_UEV_CD] = math.log(cast(float, bs.v_min) * (1.0 + H.FOLD_REL)) if bs.has_folds else -math.inf
@@ -340,8 +344,9 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
     t_store, max_wall = saveat.t_transient, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
-    law, coef, bs, law_argument = HL.law_for(params)  # no law given: the driver with the paper's law inlined
-    p = _param_vector(params, v_floor, bs)
+    cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
+    law, coef, bs, law_argument = cl.fn, cl.coef, cl.structure, not cl.inlined
+    p = _param_vector(params, v_floor, bs, cl.domain)
     run = HL.driver(law_argument)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)
     cnt = np.zeros(H.N_C, dtype=np.int64)
@@ -454,12 +459,30 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
             status, why = S.V_FLOOR, f"the caller's v_floor; F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N"
         else:
             why = ""
+        lo, hi = cl.domain
+        status, what = domain_status(status, cl, sd["v"], V_CEILING)
         raise S.status_error(
             status, t=sd["t"], state=sd, partial=build(False),
             prefix=f"hybrid solver at t={sd['t']:.9g} on {sd['branch']}: ",
             f_zero=bs.f_zero, f_min=bs.f_min, level=BREAKDOWN_LEVEL, v=sd["v"], v_ceiling=V_CEILING,
-            v_floor=v_floor, why=why,
+            v_floor=v_floor, why=why, lo=lo, hi=hi, law=repr(params.force), what=what,
         )
+
+
+def domain_status(status: int, cl: CompiledLaw, v: float, ceiling: float) -> tuple[int, str]:
+    """``(status, what)``: a driver's breakdown status re-read as ``LAW_DOMAIN`` where the law's domain, not the
+    model, stopped the run -- the floor on AB (NO_ROOT) or a CD→AB landing (NO_LANDING) at a domain starting above
+    0, the CD ceiling below ``ceiling`` -- with ``what`` happened (the message's first words)."""
+    lo, hi = cl.domain
+    bs = cl.structure
+    if status == S.NO_ROOT and lo > 0:
+        return S.LAW_DOMAIN, f"on AB the level F(1 - cos theta) fell to f = {bs.f_zero:.6g} N at the start of the law"
+    if status == S.NO_LANDING and lo > 0:
+        return S.LAW_DOMAIN, (f"the CD->AB jump from f_min = {bs.f_min:.6g} N would land below the start of the law "
+                              f"(f = {bs.f_zero:.6g} N there)")
+    if status == S.V_CEILING and hi < ceiling:
+        return S.LAW_DOMAIN, f"v = {v:.6g} m/s rose above the end of the law on CD"
+    return status, ""
 
 
 def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
@@ -475,6 +498,6 @@ def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
     """
     if not law_argument:
         return H._rhs, _param_vector(params, v_floor)
-    law, coef, bs, _ = HL.law_for(params)
-    return HL._rhs_law, (_param_vector(params, v_floor, bs), law, coef)
+    cl = HL.law_for(params)
+    return HL._rhs_law, (_param_vector(params, v_floor, cl.structure, cl.domain), cl.fn, cl.coef)
 

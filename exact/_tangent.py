@@ -25,30 +25,52 @@ DOP853 (:mod:`peelapprox._dop853`).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+from numba import types as _t
 
-from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, branch_structure
+from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT
 from peelapprox.errors import SolverBudgetExceeded, WallBudget
+from peelapprox.kernels import (
+    LAW_TYPE,
+    STEP_FAILED,
+    crossing,
+    interp,
+    interp1,
+    kernel,
+    make_dop853,
+    rebind,
+    solve_theta,
+    workspace,
+)
 from peelapprox.kernels import N_STAGES as _NS
-from peelapprox.kernels import STEP_FAILED, crossing, interp, interp1, kernel, make_dop853, solve_theta, workspace
 from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, integer, optional, positive
 
 from . import _hybrid as H
+from . import _hybrid_law as HL
 
-DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL = (
-    _st.DONE, _st.FOLD, _st.MAX_STEPS, _st.NO_LANDING, _st.NO_ROOT, _st.STEP_FAIL)
+DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, V_CEILING = (
+    _st.DONE, _st.FOLD, _st.MAX_STEPS, _st.NO_LANDING, _st.NO_ROOT, _st.STEP_FAIL, _st.V_CEILING)
 status_error = _st.status_error
 
 _EPS_FD = 1e-7
 
 
-@kernel
-def _rhs_tangent(y, p, out):
+#: Bound per copy of the driver (:func:`to_fold`): the field ``_FIELD(y, P, out)`` (the hybrid solver's, the
+#: law inlined or as an argument), ``P = _PACK(p, law, coef)``, the tangent field ``_RHS_T`` and ``_dop_t``, its
+#: DOP853 pieces.  Never compiled with these placeholders.
+_FIELD: Any = None
+_PACK: Any = None
+_RHS_T: Any = None
+_dop_t: Any = None
+
+
+def _rhs_tangent(y, P, out):
     """d(y, δy)/ds: the hybrid field and its directional derivative along δy (central difference)."""
     g = np.empty(4)
-    H._rhs(y[:4], p, g)
+    _FIELD(y[:4], P, g)
     nrm = 0.0
     ysz = 0.0
     for i in range(4):
@@ -69,29 +91,26 @@ def _rhs_tangent(y, p, out):
         ym[i] = y[i] - eta * y[4 + i]
     gp = np.empty(4)
     gm = np.empty(4)
-    H._rhs(yp, p, gp)
-    H._rhs(ym, p, gm)
+    _FIELD(yp, P, gp)
+    _FIELD(ym, P, gm)
     for i in range(4):
         out[4 + i] = (gp[i] - gm[i]) / (2.0 * eta)
 
 
-_dop_t = make_dop853(_rhs_tangent)
-
-
-@kernel
-def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
+def _to_fold(y, p, law, coef, br, rtol, atol, t_max, max_steps):
     """Integrate (y, δy) from ``y`` on branch ``br`` to its fold or to t = t_max (whichever first).
 
     Returns (status, steps) with a code of :mod:`peelapprox._status`; y holds the state there: FOLD (v
     exactly at the fold), DONE (t = t_max), STEP_FAIL, MAX_STEPS, NO_ROOT (u <= ln v_breakdown on AB, the
-    model's criterion).
+    model's criterion, or the start of the law's domain).
     """
+    P = _PACK(p, law, coef)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(8)
-    _rhs_tangent(y, p, f0)
-    h = _dop_t.initial_step(y, f0, p, rtol, atol, work)
+    _RHS_T(y, P, f0)
+    h = _dop_t.initial_step(y, f0, P, rtol, atol, work)
     uf = p[H.P_UEV_AB] if br == 0 else p[H.P_UEV_CD]
     for n in range(max_steps):
-        status, h, h_next, n_rej, n_rhs = _dop_t.step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc)
+        status, h, h_next, n_rej, n_rhs = _dop_t.step(y, f0, h, P, rtol, atol, K, y_new, tmp, sc)
         if status == STEP_FAILED:
             return STEP_FAIL, n
         if br == 0 and y_new[3] <= p[H.P_UFLOOR]:
@@ -101,14 +120,14 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
         crossed = (y_new[3] >= uf) if br == 0 else (y_new[3] <= uf)
         x_fold = 2.0
         if crossed:
-            _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
+            _dop_t.dense(y, y_new, K, h, P, Fc, tmp)
             x_fold = solve_theta(y, Fc, 3, uf, y[3] - uf, 1.0, y_new[3] - uf)
         # t_max inside the step (tau increases up to the fold): stop exactly there, as simulate does at t_end
         x_b = min(x_fold, 1.0)
         tau_b = interp1(y, Fc, x_b, 0) if crossed else y_new[0]
         if tau_b >= t_max:
             if not crossed:
-                _dop_t.dense(y, y_new, K, h, p, Fc, tmp)
+                _dop_t.dense(y, y_new, K, h, P, Fc, tmp)
             interp(y, Fc, crossing(y, Fc, 0, t_max, x_b, tau_b), ye)
             for i in range(8):
                 y[i] = ye[i]
@@ -120,11 +139,40 @@ def _to_fold(y, p, br, rtol, atol, t_max, max_steps):
                 y[i] = ye[i]
             y[3] = np.log(p[H.P_VMAX] if br == 0 else p[H.P_VMIN])
             return FOLD, n + 1
+        if br == 1 and y_new[3] > p[H.P_UCEIL]:  # above the law's domain (a table's end) or a runaway
+            for i in range(8):
+                y[i] = y_new[i]
+            return V_CEILING, n + 1
         for i in range(8):
             y[i] = y_new[i]
             f0[i] = K[_NS, i]
         h = h_next
     return MAX_STEPS, max_steps
+
+
+_A1 = _t.float64[::1]
+#: The one signature of both copies of :func:`_to_fold`: ``(y, p, law, coef, br, rtol, atol, t_max, max_steps)
+#: -> (status, steps)``.
+TO_FOLD_SIG = _t.UniTuple(_t.int64, 2)(_A1, _A1, LAW_TYPE, _A1, _t.int64, _t.float64, _A1, _t.float64, _t.int64)
+
+
+def _make_to_fold(field, pack, tag: str):
+    rhs_t = kernel(rebind(_rhs_tangent, _FIELD=field), name=f"rhs_tangent_{tag}")
+    return kernel(rebind(_to_fold, _PACK=pack, _RHS_T=rhs_t, _dop_t=make_dop853(rhs_t)), name=f"to_fold_{tag}")
+
+
+_TO_FOLD = {False: _make_to_fold(H._rhs, HL._pack_paper, "inlined"),
+            True: _make_to_fold(HL._rhs_law, HL._pack_law, "law")}
+
+
+def to_fold(law_argument: bool) -> Any:
+    """The tangent driver :func:`_to_fold` with the paper's law inlined (False, the default path) or with the
+    law as an argument (True), compiled for :data:`TO_FOLD_SIG` on first use (loaded from numba's cache)."""
+    d = _TO_FOLD[bool(law_argument)]
+    if not d.signatures:
+        d.compile(TO_FOLD_SIG)
+        d.disable_compile()
+    return d
 
 
 def saltation(dy, g_minus, g_plus) -> np.ndarray:
@@ -135,10 +183,11 @@ def saltation(dy, g_minus, g_plus) -> np.ndarray:
     return R_dy + (np.asarray(g_plus) - R_g) * (dy[3] / g_minus[3])
 
 
-def _equal_time_vector(y, p, scale):
-    """(δα, δω, δF) at equal t (module docstring), scaled by (1, V/R, f_max)."""
+def _equal_time_vector(y, field, pull, scale):
+    """(δα, δω, δF) at equal t (module docstring), scaled by (1, V/R, f_max); ``field(y, out)`` and
+    ``pull(alpha, v)`` are the hybrid field and CONSTR's pull force of the run's law."""
     g = np.empty(4)
-    H._rhs(y[:4], p, g)
+    field(y[:4], g)
     dt = y[4]
     if g[0] != 0.0:
         da = y[5] - g[1] / g[0] * dt
@@ -148,8 +197,8 @@ def _equal_time_vector(y, p, scale):
         da, dw, du = y[5], y[6], y[7]
     eps = 1e-7
     v = math.exp(y[3])
-    Fa = (H.pull_force(y[1] + eps, v, p) - H.pull_force(y[1] - eps, v, p)) / (2 * eps)
-    Fu = (H.pull_force(y[1], math.exp(y[3] + eps), p) - H.pull_force(y[1], math.exp(y[3] - eps), p)) / (2 * eps)
+    Fa = (pull(y[1] + eps, v) - pull(y[1] - eps, v)) / (2 * eps)
+    Fu = (pull(y[1], math.exp(y[3] + eps)) - pull(y[1], math.exp(y[3] - eps))) / (2 * eps)
     return np.array([da, dw, Fa * da + Fu * du]) / scale
 
 
@@ -177,7 +226,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
     from ._benettin import natural_scales
-    from ._simulate import ATOL_SCALE, _param_vector, initial_state, simulate
+    from ._simulate import ATOL_SCALE, _param_vector, domain_status, initial_state, simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
@@ -189,9 +238,25 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
              if t_transient > 0 else initial_state(params, alpha0=alpha0))
     except SolverBudgetExceeded as exc:
         raise wall.reraise(exc) from None
-    p = _param_vector(params)
+    cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
+    law, coef, bs = cl.fn, cl.coef, cl.structure
+    p = _param_vector(params) if cl.inlined else _param_vector(params, None, bs, cl.domain)
+    run = to_fold(not cl.inlined)
+    if cl.inlined:
+        def field(y, out):
+            H._rhs(y, p, out)
+
+        def pull(a, v):
+            return H.pull_force(a, v, p)
+    else:
+        rhs_law = HL.field_law()
+
+        def field(y, out):
+            rhs_law(y, p, law, coef, out)
+
+        def pull(a, v):
+            return HL.pull_force_law(a, v, p, law, coef)
     scale = natural_scales(params)
-    bs = branch_structure(params.V)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
     # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
     atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])
@@ -201,36 +266,41 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
 
     def where(t_now):
         v = math.exp(y[3])
-        return dict(t=t_transient + t_now, alpha=float(y[1]), omega=float(y[2]), F=float(H.pull_force(y[1], v, p)),
+        return dict(t=t_transient + t_now, alpha=float(y[1]), omega=float(y[2]), F=float(pull(y[1], v)),
                     v=v, branch="AB" if br == 0 else "CD")
 
     y = np.array([0.0, s.alpha, s.omega, math.log(s.v), 0.0, 0.0, 0.0, 1.0])
-    y[4:] /= np.linalg.norm(_equal_time_vector(y, p, scale))
+    y[4:] /= np.linalg.norm(_equal_time_vector(y, field, pull, scale))
     t, logs, n_jumps, steps = 0.0, 0.0, 0, 0
     g_minus, g_plus = np.empty(4), np.empty(4)
     while t < T:
-        status, n = _to_fold(y, p, br, rtol, atol, T - t, max_steps - steps)
+        status, n = run(y, p, law, coef, br, rtol, atol, T - t, max_steps - steps)
         steps += n
         if status == DONE:
             t += y[0]
-            logs += math.log(np.linalg.norm(_equal_time_vector(y, p, scale)))
+            logs += math.log(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
             break
         if status != FOLD:
+            lo, hi = cl.domain
+            status, what = domain_status(status, cl, math.exp(y[3]), math.inf)
             raise status_error(status, t=t_transient + t + y[0], state=where(t + y[0]), prefix="tangent integration: ",
                                where=f"at t = {t_transient + t + y[0]:.6g} s", limit=int(max_steps),
-                               f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]))
+                               f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]), lo=lo, hi=hi,
+                               law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)
         t += y[0]
-        H._rhs(y[:4], p, g_minus)
+        field(y[:4], g_minus)
         v_land = p[H.P_VLCD] if br == 0 else p[H.P_VLAB]
         if not v_land > 0.0:
-            raise status_error(NO_LANDING, t=t_transient + t, state=where(t), prefix="tangent integration: ",
-                               where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero)
+            code, what = domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
+            raise status_error(code, t=t_transient + t, state=where(t), prefix="tangent integration: ",
+                               where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero, what=what,
+                               lo=cl.domain[0], hi=cl.domain[1], law=repr(params.force))
         y[0], y[3] = 0.0, math.log(v_land)
-        H._rhs(y[:4], p, g_plus)
+        field(y[:4], g_plus)
         y[4:] = saltation(y[4:], g_minus, g_plus)
         br = 1 - br
         n_jumps += 1
-        d = float(np.linalg.norm(_equal_time_vector(y, p, scale)))
+        d = float(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
         logs += math.log(d)
         y[4:] /= d
         wall.left(t_transient + t, lambda t=t: where(t), t_transient + T)

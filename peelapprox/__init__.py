@@ -44,6 +44,7 @@ from ._estimate import (
     slope_criterion,
 )
 from ._law import PeelForce
+from ._law_compiled import branch_structure, fixed_point
 from ._law_folds import Folds
 from ._params import (
     EPS_DEFAULT,
@@ -64,8 +65,6 @@ from ._peelforce import (
     BranchStructure,
     FixedPoint,
     branch_inverse,
-    branch_structure,
-    fixed_point,
     peel_force,
     peel_force_derivative,
 )

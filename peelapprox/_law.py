@@ -31,11 +31,13 @@ from . import _law_expr, _law_families, _law_table
 from ._checks import in_range, reals
 from ._law_folds import Folds, find_folds
 
-__all__ = ["FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "law_label", "register_paper",
+__all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "law_label", "register_paper",
            "require_paper_force"]
 
 #: The kinds of law, in the order of the module docstring.
 KINDS = ("paper", "family", "expression", "tabulated")
+#: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
+ALL_LAWS = ("paper", *(f.constructor for f in _law_families.FAMILIES.values()), "expression", "tabulated")
 #: Points per unit of ln v of the grid on which :meth:`PeelForce.folds` brackets the sign changes of f'
 #: (neighbours 0.5 % apart in v; at least 2001 points).
 FOLD_GRID_DENSITY = 200

@@ -30,6 +30,7 @@ V_CEILING = 13  # v ran away on CD
 V_FLOOR = 14  # v fell to a floor (the caller's, or the reduced equations' e^-60 fall)
 F_NONPOSITIVE = 15  # the pull force reached 0 (reduced equations)
 NONFINITE = 16  # the state became non-finite (reduced equations)
+LAW_DOMAIN = 17  # v left the peel-force law's domain (a table's range, an expression's probed range)
 STEP_FAIL = 20  # step-size underflow or repeated rejection
 MAX_STEPS = 21  # the step budget is used up
 T_MAX = 22  # the reduced segment did not reach its exit velocity before t_max
@@ -64,6 +65,9 @@ STATUS: dict[int, Status] = {s.code: s for s in (
     Status(V_FLOOR, "v_floor", ModelBreakdown, "v fell to {v_floor:.3g} m/s on AB ({why})"),
     Status(F_NONPOSITIVE, "F_nonpositive", ModelBreakdown, "the pull force reached 0"),
     Status(NONFINITE, "nonfinite", ModelBreakdown, "the state became non-finite"),
+    Status(LAW_DOMAIN, "law_domain", ModelBreakdown,
+           "{what}: the peel-force law {law} is defined on [{lo:.6g}, {hi:.6g}] m/s only and is not extrapolated "
+           "(extend the table or the law's range)"),
     Status(STEP_FAIL, "step_fail", SolverFailure, "step size collapsed"),
     Status(MAX_STEPS, "max_steps", SolverBudgetExceeded, "max_steps={limit} steps used"),
     Status(T_MAX, "t_max", SolverBudgetExceeded, "v did not reach v_f={v_f} before t_max={limit} s"),

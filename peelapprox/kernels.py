@@ -4,7 +4,8 @@ Everything here is compiled by :func:`peelapprox._jit.kernel` from the one gener
 (:mod:`peelapprox._generated`, written by :mod:`peelapprox._symbolic`), compiled once, and shared by every
 driver: the peel force (fvV) in the velocity and in the ln v form, the law ABI by which a driver takes the
 peel-force law as a function argument with its coefficients as data (:mod:`peelapprox._law_abi`: ``LAW_SIG``,
-``LAW_TYPE``, the forms ``LAW_*``, the compiled laws ``LAWS``; the laws generated from their symbolic form,
+``LAW_TYPE``, the forms ``LAW_*``, the compiled laws ``LAWS``; the tabulated law ``table_law`` and its packing
+``table_coefficients``, :mod:`peelapprox._law_table_jit`; the laws generated from their symbolic form,
 :func:`family_kernel` and :func:`expression_kernel` of :mod:`peelapprox._law_codegen`), the ``cos θ`` closures with the
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
 system XDAE and its Jacobian (also as whole fields of the state and a packed parameter vector, the form the
@@ -21,7 +22,10 @@ compiled functions their calls cost half of a field evaluation, 72 -> 35 ns meas
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numba import types as _nb
 
 from . import _generated as _g
 from . import _status as status
@@ -47,7 +51,8 @@ from ._dop853 import (
     state_at,
     workspace,
 )
-from ._jit import kernel
+from ._jit import kernel, rebind
+from ._law import ALL_LAWS
 from ._law_abi import (
     LAW_FP,
     LAW_FPP,
@@ -61,6 +66,8 @@ from ._law_abi import (
     paper_law,
 )
 from ._law_codegen import expression_kernel, family_kernel
+from ._law_compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
+from ._law_table_jit import table_coefficients, table_law
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
 from ._peelforce import _invert as branch_inverse_at
 from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
@@ -69,13 +76,14 @@ from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_f
 Q_EPS = N_M
 
 __all__ = [
-    "kernel", "status",
+    "kernel", "rebind", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
     "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "cubic_v_law", "paper_coefficients",
-    "cubic_v_structure", "family_kernel", "expression_kernel",
+    "cubic_v_structure", "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
+    "table_law", "table_coefficients", "family_kernel", "expression_kernel",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
     "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",
-    "regularized_field_jacobian", "peel_force_coefficients", "branch_inverse_at",
+    "regularized_field_jacobian", "regularized_law_field", "peel_force_coefficients", "branch_inverse_at",
     "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
@@ -105,11 +113,12 @@ def closure(alpha, exact_geometry, R, l):
     return closure_exact(alpha, R, l)
 
 
-def regularized_parameters(params, eps: float) -> np.ndarray:
+def regularized_parameters(params, eps: float, laws: tuple[str, ...] = ("paper",)) -> np.ndarray:
     """The parameter vector ``q`` of :func:`regularized_field` / :func:`regularized_field_jacobian`: the model
     block (:func:`model_block`: V, I, k, R, l, the fvV coefficients b and A, the geometry flag) followed by ε at
-    index :data:`Q_EPS` (= ``N_M``)."""
-    q = model_block(params, N_M + 1)
+    index :data:`Q_EPS` (= ``N_M``); ``laws`` as for :func:`model_block` (:data:`ALL_LAWS` for the fields of
+    :func:`regularized_law_field`)."""
+    q = model_block(params, N_M + 1, laws)
     q[Q_EPS] = eps
     return q
 
@@ -135,3 +144,40 @@ def regularized_field_jacobian(y, q):
     for i in range(16):
         out[i // 4, i % 4] = j[i]
     return out
+
+
+@kernel
+def _regularized_field_law(y, q, law, coef):
+    """:func:`regularized_field` for the law ``law`` with the coefficients ``coef`` (``LAW_FP``)."""
+    v = max(y[3], 1e-300)
+    f, _, _ = law(v, coef, LAW_FP)
+    c, _ = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
+    return np.array([r[0], r[1], r[2], r[3]])
+
+
+@kernel
+def _regularized_field_jacobian_law(y, q, law, coef):
+    """:func:`regularized_field_jacobian` for the law ``law`` with the coefficients ``coef``."""
+    v = max(y[3], 1e-300)
+    _, fp, _ = law(v, coef, LAW_FP)
+    c, dc = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
+    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
+    out = np.empty((4, 4))
+    for i in range(16):
+        out[i // 4, i % 4] = j[i]
+    return out
+
+
+def regularized_law_field() -> tuple[Any, Any]:
+    """``(field, jacobian)`` of the regularised system (XDAE) with the peel-force law as an argument:
+    ``field(y, q, law, coef)`` and ``jacobian(y, q, law, coef)`` as :func:`regularized_field` and
+    :func:`regularized_field_jacobian` with ``law`` (:data:`LAW_TYPE`) and its coefficients ``coef``.  Compiled
+    for that one signature on first use (loaded from numba's cache when it is there), so every law and every
+    coefficient vector runs without compiling again."""
+    a1 = _nb.float64[::1]
+    for d, ret in ((_regularized_field_law, a1), (_regularized_field_jacobian_law, _nb.float64[:, ::1])):
+        if not d.signatures:
+            d.compile(ret(a1, a1, LAW_TYPE, a1))
+            d.disable_compile()
+    return _regularized_field_law, _regularized_field_jacobian_law

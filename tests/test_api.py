@@ -62,6 +62,7 @@ API = {
     },
     # the door through which exact (and comparisons) reach the compiled model and integrator
     "peelapprox.kernels": {
+        "ALL_LAWS", "CompiledLaw", "U_ZERO", "compiled_law", "law_domain", "rebind", "regularized_law_field",
         "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",
         "LAW_SIG", "LAW_TYPE", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B", "M_GEOM", "M_I", "M_K", "M_L", "M_R",
         "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS", "STEP_FAILED", "branch_inverse_at", "closure",
@@ -71,7 +72,7 @@ API = {
         "make_dop853", "model_block", "paper_coefficients", "paper_law", "peel_force_coefficients",
         "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit", "regularized_field",
         "regularized_field_jacobian", "regularized_jacobian", "regularized_parameters", "regularized_rhs",
-        "slow_rates", "solve_theta", "state_at", "status", "workspace",
+        "slow_rates", "solve_theta", "state_at", "status", "table_coefficients", "table_law", "workspace",
     },
     "peelapprox.cli": {"build_parser", "main"},
     "comparisons.benchmark": {

@@ -332,10 +332,8 @@ def test_saved_trajectory_records_the_law(tmp_path):
 
 
 CONSUMERS = {
-    "simulate": lambda p: exact.simulate(p, 0.1),
     "estimate": lambda p: pa.estimate(p),
     "reduced_segment": lambda p: pa.reduced_segment(p, "AB", F_in=250.0),
-    "initial_state": lambda p: exact.initial_state(p),
     "window_run": lambda p: exact.window_run(p),
     "lyapunov": lambda p: exact.lyapunov(p),
     "hybrid_field": lambda p: exact.hybrid_field(p),

@@ -56,9 +56,11 @@ def _give_law(monkeypatch, force) -> None:
     """Route runs through the law driver with ``force`` (kind, coefficients(V), branch_structure(V)) by
     substituting ``exact._hybrid_law.law_for``: until PeelForce's families are connected to the compiled laws,
     this is how the law driver is reached (issue 15)."""
-    monkeypatch.setattr(HL, "law_for", lambda params: (
-        LAWS[force.kind], np.ascontiguousarray(force.coefficients(params.V), dtype=float),
-        force.branch_structure(params.V), True))
+    from peelapprox.kernels import CompiledLaw
+
+    monkeypatch.setattr(HL, "law_for", lambda params: CompiledLaw(
+        params.force, params.V, LAWS[force.kind], np.ascontiguousarray(force.coefficients(params.V), dtype=float),
+        force.branch_structure(params.V), (0.0, np.inf), False))
 
 
 def test_paper_law_is_the_inlined_law_bitwise():
@@ -199,13 +201,16 @@ def assert_jumps_at_cubic_folds(j, coef) -> None:
     np.testing.assert_allclose(j.v_after[~up], land_ab, rtol=1e-7)
 
 
-def test_a_law_without_a_compiled_law_is_refused_by_the_hook():
-    """Hypothesis: ``law_for`` refuses a law that is neither the paper's nor the cubic (those with compiled laws)
-    with a ValueError naming ``params.force`` (validate.params refuses them before a run gets there; this is the
-    hook's own guard), and a cubic whose structure the solver cannot run (one fold) likewise."""
+def test_a_monotone_cubic_runs_without_jumps():
+    """Hypothesis: a cubic with ``c² < 3 b d`` increases in v throughout (no folds: no stick-slip), so the
+    hybrid solver runs it on the one branch AB with no jump, and every stored point satisfies CONSTR,
+    ``F (1 - cos θ) = f(v)``, to 1e-9 relative (the solver solves CONSTR to ~1e-12; the stored F is computed
+    from it)."""
+    from exact import simulate
     from peelapprox import PeelForce
 
-    with pytest.raises(ValueError, match="params.force"):
-        HL.law_for(PeelParams(V=1.2, I=1e-5, force=PeelForce.power_branches()))
-    with pytest.raises(ValueError, match=r"params.force.*coef"):
-        HL.law_for(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(c=10.0)))
+    law = PeelForce.cubic(c=10.0)
+    tr = simulate(PeelParams(V=1.2, I=1e-3, force=law), 0.2)
+    assert tr.jumps.t.size == 0 and set(np.unique(tr.branch)) == {0}
+    G = tr.F * (1.0 + PeelParams(V=1.2, I=1e-3).closure(tr.alpha)[0])
+    np.testing.assert_allclose(G, law.f(tr.v, 1.2), rtol=1e-9)

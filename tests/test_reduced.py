@@ -395,4 +395,4 @@ def test_cli_estimate_and_segment(tmp_path):
                "--alphadot-in", "9.7", "--v-in", "0.00188", "--v-f", "0.4", "--curves", str(csv), "--format", "json"])
     assert rc == 0
     lines = csv.read_text().splitlines()
-    assert lines[0] == "t,v,F,alpha,alphadot" and len(lines) == 801
+    assert lines[0] == "t,v,F,alpha,alphadot,law,law_key" and len(lines) == 801  # the law recorded (issue 15)

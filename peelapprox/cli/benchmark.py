@@ -9,6 +9,7 @@ import os
 import sys
 import time
 
+from .. import PeelForce
 from ._checks import check_output_path
 from ._common import write_table
 
@@ -60,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
                            ("targets", report.targets)):
             for ext in ("csv", "json"):
                 if data:
-                    write_table(os.path.join(args.out, f"{stem}.{ext}"), data)
+                    write_table(os.path.join(args.out, f"{stem}.{ext}"), data, PeelForce.paper())
         plot_work_precision(report, os.path.join(args.out, "work_precision.png"))
         plot_eps_study(report, os.path.join(args.out, "eps_study.png"))
         print(f"wrote {os.path.join(args.out, 'benchmark.md')} and the plots", file=sys.stderr)

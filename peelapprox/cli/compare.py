@@ -7,6 +7,7 @@ import json
 import os
 import sys
 
+from .. import PeelForce
 from ._checks import check_output_path
 from ._common import say, write_table
 
@@ -69,6 +70,6 @@ def run(args: argparse.Namespace) -> int:
         for stem, data in (("compare_rows", rows), ("compare_statistics", stats)):
             for ext in ("csv", "json"):
                 if data:
-                    write_table(os.path.join(args.out, f"{stem}.{ext}"), data)
+                    write_table(os.path.join(args.out, f"{stem}.{ext}"), data, PeelForce.paper())
         print(f"wrote {os.path.join(args.out, 'tables.md')}", file=sys.stderr)
     return 0

@@ -11,6 +11,7 @@ from .. import EPS_DEFAULT, WINDOW_DEFAULTS, PeelParams
 from ..io import fmt_number
 from ._checks import check_output_path, finite_float_list, nonnegative_float, positive_float, positive_int
 from ._common import add_params, print_mapping, say, write_table
+from ._force import force_from_args, law_fields
 
 __all__ = ["LYAPUNOV_ALIASES", "LYAPUNOV_METHODS", "add_parser", "run"]
 
@@ -62,7 +63,8 @@ def run(args: argparse.Namespace) -> int:
     if wants_lyapunov:  # the method's options, checked before the window run (named as the CLI spells them)
         method, options = _lyapunov_options(args, returns=None)
         check_lyapunov_options(method, **options)
-    p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    law = force_from_args(args)
+    p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=law)
     if args.attractors:  # checked before the run, named as the user wrote it
         from ..validate import states
 
@@ -98,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
                    lyapunov_stderr=ly.stderr_bits, lyapunov_wall_time=ly.benettin.wall_time)
         if method == "variational":
             row.update(eps=args.eps)
-    print_mapping(row, args.format)
+    print_mapping({**row, **law_fields(law, spec=args.format == "json")}, args.format)
     if args.attractors:
         a0s = args.attractors
         res = attractors(p, a0s, t_transient=args.t_transient, window=args.window, max_wall=args.max_wall,
@@ -113,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  {r['attractor']:>14}  F at AB→CD jumps {r['F_min']:.4g}…{r['F_max']:.4g} N  "
                       f"from alpha0 = {r['starts']}")
     if out:
-        write_table(out, [row])
+        write_table(out, [row], law)
     return 0
 
 

@@ -10,13 +10,16 @@ import sys
 from .. import ALPHA_MODELS, V_EQUATIONS, PeelParams
 from ._checks import check_output_path
 from ._common import add_params, print_mapping, write_table
+from ._force import add_force_options, force_from_args, law_fields
 
 __all__ = ["add_estimate_parser", "add_folds_parser", "add_segment_parser", "run_estimate", "run_folds", "run_segment"]
 
 
 def add_folds_parser(sub) -> argparse.ArgumentParser:
-    fo = sub.add_parser("folds", help="folds, landing velocities and fixed point of f(v, V)")
+    fo = sub.add_parser("folds", help="folds, landing velocities and fixed point of f(v, V) (the paper's fvV or "
+                                      "the law given)")
     fo.add_argument("--V", type=float, required=True)
+    add_force_options(fo)
     fo.add_argument("--format", choices=("table", "json"), default="table")
     return fo
 
@@ -24,9 +27,17 @@ def add_folds_parser(sub) -> argparse.ArgumentParser:
 def run_folds(args: argparse.Namespace) -> int:
     from .. import branch_structure, fixed_point
 
-    bs = branch_structure(args.V)
-    fp = fixed_point(args.V)
-    row = {**bs.__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
+    law = force_from_args(args)
+    if law.kind == "paper":
+        bs = branch_structure(args.V)
+        fp = fixed_point(args.V)
+        row = {**bs.__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
+    else:  # the law's own folds (PeelForce.folds) and the steady sliding v = V, stable iff f'(V, V) > 0
+        import dataclasses
+
+        fprime = float(law.df(args.V, args.V))
+        row = {**dataclasses.asdict(law.folds(args.V)), "fixed_point_stable": fprime > 0, "fprime_at_V": fprime}
+    row.update(law_fields(law, spec=args.format == "json"))
     if args.format == "json":
         print(json.dumps(row, indent=2))
     else:
@@ -49,11 +60,12 @@ def run_estimate(args: argparse.Namespace) -> int:
     from .. import estimate
 
     out = check_output_path(args.out, "table", "--out") if args.out else None
-    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    law = force_from_args(args)
+    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=law)
     row = estimate(params, alpha_min=args.alpha_min, alpha_max=args.alpha_max).as_dict()
-    print_mapping(row, args.format)
+    print_mapping({**row, **law_fields(law, spec=args.format == "json")}, args.format)
     if out:
-        write_table(out, [row])
+        write_table(out, [row], law)
     return 0
 
 
@@ -84,14 +96,15 @@ def run_segment(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "table", "--out") if args.out else None
     curves = check_output_path(args.curves, "table", "--curves") if args.curves else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R)
+    law = force_from_args(args)
+    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=law)
     entry = dict(F_in=args.F_in, alpha_in=args.alpha_in, alphadot_in=args.alphadot_in, amplitude=args.amplitude,
                  phase=args.phase, v_in=args.v_in, v_f=args.v_f, alpha_model=args.alpha_model,
                  v_equation=args.v_equation, rtol=args.rtol)
     seg = reduced_segment(params, args.branch, **entry)
-    print_mapping(seg.as_dict(), args.format)
+    print_mapping({**seg.as_dict(), **law_fields(law, spec=args.format == "json")}, args.format)
     if out:
-        write_table(out, [seg.as_dict()])
+        write_table(out, [seg.as_dict()], law)
     if curves or plot:
         # smooth curves: the same integration again, sampled by dense output
         import numpy as np
@@ -100,7 +113,7 @@ def run_segment(args: argparse.Namespace) -> int:
     if curves:
         rows = [dict(t=float(a), v=float(b), F=float(c), alpha=float(d), alphadot=float(e))
                 for a, b, c, d, e in zip(seg.t, seg.v, seg.F, seg.alpha, seg.alphadot)]
-        write_table(curves, rows)
+        write_table(curves, rows, law)
     if plot:
         from ..plotting import plot_segment
 

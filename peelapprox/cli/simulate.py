@@ -9,6 +9,7 @@ import sys
 from .. import GEOMETRIES, PeelParams
 from ._checks import check_output_path, positive_float
 from ._common import add_params
+from ._force import force_from_args, law_fields
 
 __all__ = ["add_parser", "run"]
 
@@ -48,7 +49,8 @@ def run(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "npz", "--out") if args.out else None
     jumps_csv = check_output_path(args.jumps_csv, "file", "--jumps-csv") if args.jumps_csv else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, l=args.l, geometry=args.geometry)
+    law = force_from_args(args)
+    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, l=args.l, geometry=args.geometry, force=law)
     traj = simulate(
         params,
         args.t_end,
@@ -84,16 +86,17 @@ def run(args: argparse.Namespace) -> int:
     }
     if len(traj.jumps):
         summary["F_at_jumps_range"] = [float(traj.jumps.F.min()), float(traj.jumps.F.max())]
+    summary.update(law_fields(law, spec=args.format == "json"))
     if args.format == "json":
         print(json.dumps(summary, indent=2))
     else:
         for key, val in summary.items():
             print(f"{key:>18}: {val}")
     if out:
-        traj.to_npz(out)
+        traj.to_npz(out)  # records the law: its params (with force) as dataclasses.asdict
         print(f"wrote {out}", file=sys.stderr)
     if jumps_csv:
-        traj.jumps.to_csv(jumps_csv)
+        _write_jumps(jumps_csv, traj.jumps, law)
         print(f"wrote {jumps_csv}", file=sys.stderr)
     if plot:
         from ..plotting import plot_trajectory
@@ -101,3 +104,15 @@ def run(args: argparse.Namespace) -> int:
         plot_trajectory(traj, plot)
         print(f"wrote {plot}", file=sys.stderr)
     return 0
+
+
+def _write_jumps(path: str, jumps, law) -> None:
+    """The jumps as ``Jumps.to_csv`` writes them (same columns, floats in full precision), then the columns
+    ``law`` and ``law_key`` (:func:`~peelapprox.cli._force.law_fields`) on every row."""
+    import dataclasses
+
+    from ..io import write_csv
+
+    rec = law_fields(law)
+    with open(path, "w", newline="") as fh:
+        write_csv(fh, [{**dataclasses.asdict(j), **rec} for j in jumps], fields=[*jumps.FIELDS, *rec])

@@ -1,0 +1,265 @@
+"""Any :class:`peelapprox.PeelForce` as the compiled solvers take it: kernel, coefficients, branch structure, domain.
+
+:func:`compiled_law` is the one place where a law becomes what a compiled driver calls (the ABI of
+:mod:`peelapprox._law_abi`: ``law(x, coef, form)``) at one pull speed V:
+
+=================  ==========================================================================================
+kind               kernel and ``coef``
+=================  ==========================================================================================
+``paper``          :func:`peelapprox._law_abi.paper_law`, ``(b, A)`` of fvV; the drivers inline it instead
+                   (``inlined=True``: the default path, bitwise the numbers of 0.2.0)
+``family``         the family's kernel compiled once with the package; ``coef`` packed from V and the
+                   coefficients (changing a coefficient recompiles nothing)
+``expression``     the expression's kernel, generated into the user cache and compiled once per machine
+``tabulated``      the table kernel; ``coef`` the packed PCHIP pieces of the table(s) at V
+=================  ==========================================================================================
+
+and :func:`law_structure` gives the law's :class:`peelapprox.BranchStructure` — the folds and landings of
+:meth:`PeelForce.folds`, plus what the drivers need beyond them: ``f(0+)`` (``f_zero``), the breakdown
+velocity and the minimiser of f' (``v_inflection``) — so that every solver reads the same folds for a law.
+
+The law's **domain** ``(lo, hi)`` [m/s] is where it may be evaluated: ``(0, inf)`` for the paper's law and
+the families, ``[1e-6, 1e3]`` for an expression (its probed range), the table's range for a tabulated law.
+A run that leaves it is stopped (:data:`peelapprox._status.LAW_DOMAIN`), never extrapolated: below ``lo``
+the breakdown velocity is ``lo`` itself and ``f_zero = f(lo)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, cast
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ._law import PeelForce
+from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients
+from ._law_table_jit import table_coefficients, table_law
+from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint
+from ._peelforce import branch_structure as _paper_structure
+from ._peelforce import fixed_point as _paper_fixed_point
+
+__all__ = ["CompiledLaw", "U_ZERO", "branch_structure", "compiled_law", "fixed_point", "law_domain", "law_structure"]
+
+#: ``ln v`` standing for ``v = 0+`` where a law's domain reaches 0 (e^-690 ≈ 1e-300 m/s: f(0+) to rounding).
+U_ZERO = -690.0
+_RTOL = 4 * np.finfo(float).eps
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledLaw:
+    """A peel-force law at one pull speed, as the compiled drivers take it (module docstring).
+
+    Attributes
+    ----------
+    force : PeelForce
+        The law.
+    V : float
+        The pull speed [m/s] the coefficients are packed for.
+    fn : numba dispatcher
+        The law's kernel, signature ``LAW_SIG``: ``fn(x, coef, form) -> (float, float, float)``.
+    coef : numpy.ndarray
+        Its coefficient vector (float64, contiguous).
+    structure : BranchStructure
+        Folds, landings, ``f(0+)``, breakdown velocity of ``f(·, V)`` (:func:`law_structure`).
+    domain : (float, float)
+        ``(lo, hi)`` [m/s] where the law may be evaluated (module docstring).
+    inlined : bool
+        True for the paper's law, which the drivers inline (they ignore ``fn`` and ``coef``).
+    """
+
+    force: PeelForce
+    V: float
+    fn: Any
+    coef: np.ndarray
+    structure: BranchStructure
+    domain: tuple[float, float]
+    inlined: bool
+
+    def f(self, v: float) -> float:
+        """f(v) [N] through the compiled kernel."""
+        return float(self.fn(float(v), self.coef, LAW_FP)[0])
+
+    def df(self, v: float) -> float:
+        """f'(v) [N s/m] through the compiled kernel."""
+        return float(self.fn(float(v), self.coef, LAW_FP)[1])
+
+    def branch_root(self, G: float, branch: str) -> float:
+        """v on ``branch`` with ``f(v) = G`` (CONSTR): Brent's method in ln v (~4 ulp in v), bracketed by the
+        folds -- AB on ``(lo, v_max]`` (``lo`` the domain's start, or ``v = e^-690`` where f = f(0+) to
+        rounding), CD on ``[v_min, hi)`` up to where f first exceeds G (doubling, at most to the domain's end).
+        ``G`` must be in ``structure.level_range(branch)`` (the caller checks :meth:`BranchStructure.has_root`);
+        ValueError if the CD root lies beyond the domain."""
+        bs = self.structure
+
+        def g(u: float) -> float:
+            return self.f(math.exp(u)) - G
+
+        lo_d, hi_d = self.domain
+        if branch == "AB":
+            lo = math.log(lo_d) if lo_d > 0 else U_ZERO
+            hi = math.log(cast(float, bs.v_max)) if bs.has_folds else math.log(min(hi_d, 1e3))
+            if not bs.has_folds:
+                while g(hi) < 0.0 and hi < math.log(hi_d) and hi < 700.0:
+                    hi = min(hi + math.log(2.0), math.log(hi_d))
+        else:
+            lo = hi = math.log(float(bs.v_min))  # type: ignore[arg-type]  # CD exists: has_folds
+            u_end = math.log(hi_d) if math.isfinite(hi_d) else 700.0
+            while g(hi) < 0.0:
+                if hi >= u_end:
+                    raise ValueError(f"the level f = {G!r} N has no CD root within the peel-force law's domain "
+                                     f"[{lo_d!r}, {hi_d!r}] m/s ({self.force!r})")
+                hi = min(hi + math.log(2.0), u_end)
+        if g(hi) == 0.0:
+            return math.exp(hi)
+        if g(lo) == 0.0:
+            return math.exp(lo)
+        return math.exp(brentq(g, lo, hi, xtol=1e-15, rtol=_RTOL))
+
+
+def law_domain(force: PeelForce) -> tuple[float, float]:
+    """``(lo, hi)`` [m/s] where the compiled law may be evaluated (module docstring)."""
+    if force.kind in ("paper", "family"):
+        return (0.0, math.inf)
+    return force.v_range
+
+
+def _kernel(force: PeelForce, V: float) -> tuple[Callable, np.ndarray, bool]:
+    """``(kernel, coef, inlined)`` of ``force`` at V."""
+    if force.kind == "paper":
+        return LAWS["paper"], paper_coefficients(V), True
+    if force.kind == "family":
+        if force.name == "cubic":
+            coef = np.array([x for _, x in force.coefficients], dtype=float)
+            return LAWS["cubic_v"], coef, False
+    if force.kind == "tabulated":
+        return table_law, table_coefficients(force.tables, V), False
+    raise ValueError(f"params.force: {force!r} has no compiled kernel yet (issue 15)")
+
+
+def law_structure(force: PeelForce, V: float, fn: Callable, coef: np.ndarray,
+                  domain: tuple[float, float]) -> BranchStructure:
+    """The :class:`BranchStructure` of ``force`` at V with the compiled kernel ``fn``/``coef``.
+
+    The paper's law: :func:`peelapprox.branch_structure` (bitwise).  Any other: the folds and landings of
+    :meth:`PeelForce.folds`; ``f_zero = f(lo)`` (``lo`` the domain's start, or ``v = e^-690`` for a domain
+    reaching 0); the breakdown velocity is ``lo`` for a domain starting above 0, else where
+    ``f - f_zero = BREAKDOWN_LEVEL max(|f_zero|, 1)`` (Brent in ln v, as for fvV); ``v_inflection`` the root
+    of f'' between the folds (Brent), or without folds the minimiser of f' on a grid.
+    """
+    if force.kind == "paper":
+        return _paper_structure(V)
+    fo = force.folds(V)
+    lo_d, hi_d = domain
+
+    def f(u: float) -> float:
+        return float(fn(math.exp(u), coef, LAW_FP)[0])
+
+    def fpp(u: float) -> float:
+        return float(fn(math.exp(u), coef, LAW_FPP)[2])
+
+    u_lo = math.log(lo_d) if lo_d > 0 else U_ZERO
+    f_zero = f(u_lo)
+    u_top = math.log(fo.v_max) if fo.has_folds else math.log(min(hi_d, 1e3))  # type: ignore[arg-type]
+    if lo_d > 0:
+        v_br = lo_d
+    else:
+        margin = BREAKDOWN_LEVEL * max(abs(f_zero), 1.0)
+        if f(u_top) - f_zero - margin > 0:
+            v_br = math.exp(brentq(lambda u: f(u) - f_zero - margin, u_lo, u_top, xtol=1e-12, rtol=_RTOL))
+        else:  # f barely rises on AB: the whole branch is within rounding of f(0+)
+            v_br = math.exp(u_top)
+    if fo.has_folds:
+        a, b = math.log(fo.v_max), math.log(fo.v_min)  # type: ignore[arg-type]
+        v_infl = math.exp(brentq(fpp, a, b, xtol=1e-15, rtol=_RTOL)) if fpp(a) * fpp(b) < 0 else math.sqrt(
+            fo.v_max * fo.v_min)  # type: ignore[operator]
+    else:
+        w = np.linspace(max(u_lo, math.log(1e-6)), math.log(min(hi_d, 1e3)), 2001)
+        d = np.array([float(fn(math.exp(x), coef, LAW_FP)[1]) for x in w])
+        v_infl = math.exp(float(w[int(np.argmin(d))]))
+    return BranchStructure(V=float(V), has_folds=fo.has_folds, v_max=fo.v_max, f_max=fo.f_max, v_min=fo.v_min,
+                           f_min=fo.f_min, v_inflection=v_infl, f_zero=f_zero, v_land_cd=fo.v_land_cd,
+                           v_land_ab=fo.v_land_ab, v_breakdown=v_br)
+
+
+_CACHE: dict[tuple[PeelForce, float], CompiledLaw] = {}
+
+
+def compiled_law(force: PeelForce, V: float) -> CompiledLaw:
+    """The law ``force`` at pull speed V as the compiled drivers take it (module docstring); cached per (law, V).
+
+    Raises
+    ------
+    ValueError
+        Naming ``params.force``: a law whose folds cannot be found (:meth:`PeelForce.folds`), or V outside a
+        tabulated law's speeds.
+    """
+    key = (force, float(V))
+    out = _CACHE.get(key)
+    if out is None:
+        fn, coef, inlined = _kernel(force, V)
+        domain = law_domain(force)
+        try:
+            bs = law_structure(force, V, fn, coef, domain)
+        except ValueError as e:
+            raise ValueError(f"params.force: {e}") from None
+        out = CompiledLaw(force, float(V), fn, np.ascontiguousarray(coef, dtype=float), bs, domain, inlined)
+        if len(_CACHE) >= 512:
+            _CACHE.clear()
+        _CACHE[key] = out
+    return out
+
+
+def branch_structure(V: float, *, force: PeelForce | None = None) -> BranchStructure:
+    """Folds, inflection and landing velocities of ``f(·, V)``; cached per V (per law and V).
+
+    The structure every solver uses for the law ``force`` (a :class:`peelapprox.PeelForce`; None or
+    ``PeelForce.paper()``: fvV).  For fvV, the folds are the two roots of ``f'(v, V) = 0`` on either side of the
+    unique minimiser of ``f'`` (root of ``f''``), each located by Brent's method to ``xtol = 4 ulp``, robust
+    near the cusp where the folds merge (``V ≈ 5.2``).  For another law, :func:`law_structure` (the folds of
+    :meth:`PeelForce.folds`, ``f(0+)`` or f at the start of the law's domain, the breakdown velocity, the
+    minimiser of f').
+
+    Parameters
+    ----------
+    V : float
+        Pull speed [m/s], in ``PARAM_RANGES["V"]``.
+    force : PeelForce, optional
+        The law (default: the paper's fvV).
+
+    Returns
+    -------
+    BranchStructure
+
+    Raises
+    ------
+    ValueError
+        If V is outside ``PARAM_RANGES["V"]`` (TypeError if not a number), or the law's folds cannot be found
+        (the message names ``params.force``).
+    """
+    if force is None or force.kind == "paper":
+        return _paper_structure(V)
+    return compiled_law(force, _checked_V(V)).structure
+
+
+def _checked_V(V: float) -> float:
+    from ._params import PARAM_RANGES
+    from .validate import in_range
+
+    return in_range("V", V, *PARAM_RANGES["V"])
+
+
+def fixed_point(V: float, R: float = 0.1, *, force: PeelForce | None = None) -> FixedPoint:
+    """Fixed point ``α = 0, ω = V/R, v = V, F = f(V, V)`` of FLOW1–flow3 with CONSTR and its stability
+    (``f'(V, V) > 0``: the paper's Hopf criterion).
+
+    ``V`` and ``R`` must lie in :data:`peelapprox.PARAM_RANGES`; ``force`` (a :class:`peelapprox.PeelForce`;
+    None: fvV) is the law, evaluated at ``v = V`` (ValueError if V is outside its domain).
+    """
+    base = _paper_fixed_point(V, R)  # validates V and R
+    if force is None or force.kind == "paper":
+        return base
+    f, fp = float(force.f(base.v, base.v)), float(force.df(base.v, base.v))
+    return FixedPoint(0.0, base.omega, f, base.v, fp, bool(fp > 0))

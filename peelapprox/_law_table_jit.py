@@ -1,0 +1,218 @@
+"""The compiled tabulated peel-force law: a measured curve f(v) as data for the compiled solvers (issue 15).
+
+:func:`table_law` is a law of the ABI of :mod:`peelapprox._law_abi` (signature ``LAW_SIG``, compiled once,
+cached on disk): its coefficients ``coef`` are the packed tables of a ``PeelForce.tabulated`` law at the run's
+pull speed V, built by :func:`table_coefficients`.  A new table, of any length, is new data and recompiles
+nothing.  It plays the part of Eq. (fvV) for a measured curve.
+
+What it evaluates
+-----------------
+Exactly the piecewise cubic that :class:`~peelapprox._law_table.TableLaw` evaluates with scipy: for each table
+the :class:`~scipy.interpolate.PchipInterpolator` of f in ``u = ln v`` (its breakpoints ``.x`` and its
+coefficients ``.c`` are packed as they are), evaluated on the interval ``x[i] <= u < x[i+1]`` (the last one
+closed at the right, as scipy's ``find_interval``), found by binary search between the bounds of a guide
+(below), at ``s = u - x[i]`` in the order
+of operations of scipy's ``PPoly`` (``_ppoly.evaluate_poly1``: the power sum in ascending powers, not
+Horner)::
+
+    p   = ((c3 + c2 s) + c1 (s s)) + c0 ((s s) s)
+    p'  = (c2 + (c1 s) 2) + (c0 (s s)) 3
+    p'' = c1 2 + (c0 s) 6
+
+with ``c0..c3 = c[0..3, i]`` (highest power first).  Several tables at several V are combined linearly in V
+with the weights of ``TableLaw._weights`` (one table, or the two around V), summed as TableLaw sums them:
+``f = w0 p_0 + w1 p_1`` (likewise p', p'').  The derivatives in v follow from ``u = ln v``::
+
+    f'(v) = p'(u) / v,      f''(v) = (p''(u) - p'(u)) / v²
+
+and the three forms are ``LAW_LNV: (v, f, p'(u))`` (p'(u) is ``v f'(v)``), ``LAW_FP: (f, f', NaN)``,
+``LAW_FPP: (f, f', f'')``.  With one table, at the same u, the numbers are scipy's bitwise (the same
+operations in the same order; tests/test_law_table_jit.py); with two, the sum is formed in u before the
+division by v, so f' and f'' differ from TableLaw's by rounding; in the forms that take v, ``u = ln v`` is
+numba's log, which may differ from numpy's by an ulp.
+
+Outside the table: a C¹ continuation for the solvers, not extrapolation
+-------------------------------------------------------------------------
+A tabulated law is **not extrapolated**: ``PeelForce``/``TableLaw`` refuse a v outside the tables' common
+range ``[lo, hi]`` and the drivers stop a run that leaves it (the law's domain).  But a Runge-Kutta step
+evaluates its stages before it can see that, and they must get finite numbers, so outside ``[ln lo, ln hi]``
+this law continues C¹-linearly in u from the nearer end ``u0``::
+
+    f(u) = f(u0) + p'(u0) (u - u0),     p'(u) = p'(u0),     p''(u) = 0
+
+(f and f' are continuous at the ends; f'' jumps there, as it does at every knot).  These numbers only keep a
+stage finite; no result of a run may rest on them.  (A NaN argument, or v <= 0 in the forms that take v, gives
+non-finite numbers, never a read outside ``coef``; the drivers pass neither.)
+
+The coefficient vector (:func:`table_coefficients`)
+--------------------------------------------------
+``coef = [m, ln lo, ln hi, block_1, ..., block_m]`` with ``m`` in {1, 2} the number of tables used at V
+(those of nonzero weight) and ``[lo, hi]`` the common v range of **all** the law's tables (TableLaw's
+``v_range()``, whatever V), then for each table used a block::
+
+    [w, n, r, x_0 .. x_{n-1}, g_0 .. g_{n-1}, c[0,0], c[1,0], c[2,0], c[3,0], ..., c[0,n-2], .., c[3,n-2]]
+
+its weight ``w``, its number of knots ``n`` (a float holding an integer), ``r = (n - 1) / (x_{n-1} - x_0)``, its
+knots in u (``PchipInterpolator.x``), the guide ``g`` of the interval search and the four coefficients of each
+of its ``n - 1`` intervals, interval by interval (``.c[:, i]``, highest power first); a block is ``6 n - 1``
+numbers long.  The guide cuts ``[x_0, x_{n-1}]`` into ``n - 1`` equal cells (``r`` per unit of u): ``g_j`` is the
+interval holding the left edge of cell j (``g_{n-1} = n - 2``), so the interval of a u in cell
+``j = int((u - x_0) r)`` lies in ``[g_j, g_{j+1}]``: the bisection looks at the knots in that cell only, none
+or one for knots spread evenly in ln v, ``log2`` of their number where knots bunch.  So the cost of a call
+hardly grows with the length of an even table, nor depends on where the previous call was (a bisection over
+the whole table costs ``log2 n`` steps, mispredicted when successive calls are far apart: measured in
+comparisons/benchmark/table_cost.py).  The kernel reads only what :func:`table_coefficients` wrote:
+a vector from elsewhere is not checked (numba does not check bounds).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._jit import kernel
+from ._law_abi import LAW_FP, LAW_LNV, LAW_SIG
+from ._law_table import TableLaw, check_tables
+
+__all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "table_law", "table_coefficients"]
+
+#: Indices of the header of ``coef``: the number of tables used, ln lo, ln hi; the first block starts at T_HEAD.
+T_COUNT, T_ULO, T_UHI, T_HEAD = 0, 1, 2, 3
+
+
+@kernel(inline="always")
+def _interval(coef, xo, go, n, ginv, u):
+    """``i`` with ``x[i] <= u < x[i+1]`` (``n - 2`` at ``u = x[n-1]``) of the knots ``x = coef[xo:xo+n]``, for
+    ``x[0] <= u <= x[n-1]``: scipy's ``find_interval``, by bisection between the guide's bounds.
+
+    The guide ``coef[go:go+n]`` holds, for each of the ``n - 1`` equal cells of ``[x[0], x[n-1]]`` (``ginv`` is
+    cells per unit of u), the interval holding the cell's left edge (and ``n - 2`` for the right end): the
+    interval of u lies between the guide entries of its cell and of the next, one or two intervals apart
+    for evenly spread knots.  Should rounding put u in a neighbouring cell, the bounds are widened to the
+    table's end on that side (the answer stays exact, only slower)."""
+    j = int((u - coef[xo]) * ginv)
+    if j > n - 2:
+        j = n - 2
+    elif j < 0:
+        j = 0
+    lo = int(coef[go + j])
+    hi = int(coef[go + j + 1])
+    if u < coef[xo + lo]:
+        lo = 0
+    if hi < n - 2 and u >= coef[xo + hi + 1]:
+        hi = n - 2
+    while lo < hi:  # x[lo] <= u, and u < x[hi + 1] unless hi = n - 2
+        mid = (lo + hi + 1) >> 1
+        if u < coef[xo + mid]:
+            hi = mid - 1
+        else:
+            lo = mid
+    return lo
+
+
+@kernel(inline="always")
+def _pchip_sums(coef, u):
+    """``(Σ w p, Σ w p', Σ w p'')`` of the packed tables at ``u`` in ``[ln lo, ln hi]`` (module docstring)."""
+    F = 0.0
+    D = 0.0
+    D2 = 0.0
+    o = T_HEAD
+    for _ in range(int(coef[T_COUNT])):
+        w = coef[o]
+        n = int(coef[o + 1])
+        xo = o + 3
+        go = xo + n
+        i = _interval(coef, xo, go, n, coef[o + 2], u)
+        s = u - coef[xo + i]
+        co = go + n + 4 * i
+        c0 = coef[co]
+        c1 = coef[co + 1]
+        c2 = coef[co + 2]
+        c3 = coef[co + 3]
+        ss = s * s
+        p = ((c3 + c2 * s) + c1 * ss) + c0 * (ss * s)
+        p1 = (c2 + (c1 * s) * 2.0) + (c0 * ss) * 3.0
+        p2 = c1 * 2.0 + (c0 * s) * 6.0
+        F += w * p
+        D += w * p1
+        D2 += w * p2
+        o = go + n + 4 * (n - 1)
+    return F, D, D2
+
+
+@kernel(signature=LAW_SIG)
+def table_law(x, coef, form):
+    """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox._law_abi`), ``coef`` from
+    :func:`table_coefficients`: PCHIP in ``u = ln v`` as scipy evaluates it, continued C¹-linearly in u outside
+    the tables' common range (for Runge-Kutta stages only: module docstring)."""
+    if form == LAW_LNV:
+        u = x
+        v = np.exp(x)
+    else:
+        v = x
+        u = np.log(x)
+    ulo = coef[T_ULO]
+    uhi = coef[T_UHI]
+    if not (ulo <= u <= uhi):  # the C¹ continuation (module docstring); NaN: NaN, never an index from it
+        u0 = ulo if u < ulo else uhi
+        F, D, _ = _pchip_sums(coef, u0)
+        F = F + D * (u - u0)
+        D2 = 0.0
+    else:
+        F, D, D2 = _pchip_sums(coef, u)
+    if form == LAW_LNV:
+        return v, F, D
+    if form == LAW_FP:
+        return F, D / v, np.nan
+    return F, D / v, (D2 - D) / (v * v)
+
+
+def _guide(x: np.ndarray) -> np.ndarray:
+    """The guide of :func:`_interval` for the knots x: the interval holding each cell's left edge, as floats."""
+    n = x.size
+    edges = x[0] + np.arange(n - 1) * ((x[-1] - x[0]) / (n - 1))
+    g = np.clip(np.searchsorted(x, edges, side="right") - 1, 0, n - 2)
+    return np.append(g, n - 2).astype(float)
+
+
+def table_coefficients(tables, V: float) -> np.ndarray:
+    """``coef`` of :func:`table_law` for a tabulated law at the pull speed V (layout: module docstring).
+
+    Parameters
+    ----------
+    tables : sequence of (V or None, v, f)
+        The law's tables, as ``PeelForce.tables`` (checked again by
+        :func:`peelapprox._law_table.check_tables`: sorted, positive, finite, one maximum then one minimum).
+    V : float
+        The run's pull speed [m/s] (constant during a run): selects the table, or the two around V and their
+        weights (linear in V), as :class:`~peelapprox._law_table.TableLaw` does.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64, contiguous: the header and the blocks of the tables of nonzero weight.
+
+    Raises
+    ------
+    ValueError
+        V outside the tables' pull speeds, or a table measured at one V used at another (the messages of
+        TableLaw); a bad table (the messages of ``check_tables``); V not finite.
+    TypeError
+        V not a real number, tables not a sequence of triples.
+    """
+    from ._checks import finite
+
+    V = finite("V", V)
+    tables = check_tables(tables, (0.0, np.inf))
+    law = TableLaw(tables)
+    u_lo = max(float(p.x[0]) for p in law.pchips)
+    u_hi = min(float(p.x[-1]) for p in law.pchips)
+    parts = []
+    used = [(j, w) for j, w in law._weights(V) if w != 0.0]
+    for j, w in used:
+        p = law.pchips[j]
+        x = np.asarray(p.x, dtype=float)
+        c = np.asarray(p.c, dtype=float)
+        if c.shape != (4, x.size - 1):  # pragma: no cover - PchipInterpolator is a cubic PPoly
+            raise RuntimeError(f"unexpected PCHIP coefficient shape {c.shape} for {x.size} knots")
+        parts += [np.array([w, float(x.size), (x.size - 1) / (x[-1] - x[0])]), x, _guide(x), c.T.reshape(-1)]
+    return np.ascontiguousarray(np.concatenate([np.array([float(len(used)), u_lo, u_hi]), *parts]), dtype=float)
