@@ -60,8 +60,6 @@ from ._law_abi import (
     LAW_SIG,
     LAW_TYPE,
     LAWS,
-    cubic_v_law,
-    cubic_v_structure,
     paper_coefficients,
     paper_law,
 )
@@ -78,8 +76,8 @@ Q_EPS = N_M
 __all__ = [
     "kernel", "rebind", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
-    "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "cubic_v_law", "paper_coefficients",
-    "cubic_v_structure", "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
+    "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "paper_coefficients",
+    "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
     "table_law", "table_coefficients", "family_kernel", "expression_kernel",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
     "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",

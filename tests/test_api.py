@@ -66,7 +66,7 @@ API = {
         "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",
         "LAW_SIG", "LAW_TYPE", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B", "M_GEOM", "M_I", "M_K", "M_L", "M_R",
         "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS", "STEP_FAILED", "branch_inverse_at", "closure",
-        "closure_exact", "closure_paper", "constraint_rate", "crossing", "cubic_v_law", "cubic_v_structure",
+        "closure_exact", "closure_paper", "constraint_rate", "crossing",
         "diffsl_code", "diffsl_inputs", "diffsl_model", "expression_kernel", "family_kernel", "import_optional",
         "interp", "interp1", "kernel",
         "make_dop853", "model_block", "paper_coefficients", "paper_law", "peel_force_coefficients",

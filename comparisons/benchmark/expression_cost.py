@@ -14,7 +14,7 @@ One run prints:
 * **per call**: ns per law call in a loop compiled for the law's function type ``FunctionType(LAW_SIG)`` (the
   drivers' pattern: an indirect call, not specialised away), for each form (LAW_LNV, LAW_FP, LAW_FPP), the best
   of 5, for the built-in ``paper_law``, the generated paper family at the paper's coefficients, the generated
-  ``power_branches`` and ``cubic``, the hand-written ``cubic_v_law``, and fvV typed as an expression law; with
+  ``power_branches`` and ``cubic``, and fvV typed as an expression law; with
   the ratio to ``paper_law``.
 """
 
@@ -29,8 +29,6 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-
-import numpy as np
 
 __all__ = ["FVV_TEXT", "call_costs", "expression_costs", "main"]
 
@@ -79,7 +77,6 @@ def call_costs(n: int = 2_000_000, repeats: int = 5) -> dict[str, dict[str, floa
         LAW_FPP,
         LAW_LNV,
         LAW_TYPE,
-        cubic_v_law,
         expression_kernel,
         family_kernel,
         paper_coefficients,
@@ -112,7 +109,7 @@ def call_costs(n: int = 2_000_000, repeats: int = 5) -> dict[str, dict[str, floa
     def defaults(name: str) -> tuple:
         return tuple(x for _, x in PeelForce.family(name).coefficients)
 
-    laws = {"paper_law": (paper_law, paper_coefficients(V)), "cubic_v_law": (cubic_v_law, np.array(defaults("cubic")))}
+    laws = {"paper_law": (paper_law, paper_coefficients(V))}
     for name in ("paper", "power_branches", "cubic"):
         law, pack = family_kernel(name)
         laws[f"family {name}"] = (law, pack(V, defaults(name)))
