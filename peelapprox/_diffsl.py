@@ -21,8 +21,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._law_compiled import branch_structure
 from ._params import GEOMETRIES
-from ._peelforce import branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._params import PeelParams
@@ -66,17 +66,44 @@ DIFFSL_INPUTS = ("V", "I", "k", "R", "l", "eps", "vm", "a0", "w0", "F0", "v0", "
 DIFFSL_TANGENT_INPUTS = ("d0a", "d0w", "d0F", "d0v", "ta", "tw", "tF", "tv")
 
 
-def _diffsl_expressions(geometry: str) -> dict:
+def _law_expression(force):
+    """f(v, V) of the law ``force`` (None or the paper's: fvV) in the symbols of :mod:`peelapprox._symbolic`.
+
+    Raises
+    ------
+    ValueError
+        For a tabulated law (no closed form to write in DiffSL), naming ``params.force``.
+    """
+    from . import _symbolic as S
+
+    if force is None or force.kind == "paper":
+        return S.peel_force_expr(S.v, S.V)
+    from . import _law_sympy as L
+
+    try:
+        e = L.law_expression(force)
+    except ValueError:
+        raise ValueError(f"params.force: {force!r} is tabulated and cannot be written in DiffSL: the diffsol peer and "
+                         "the eps-variational Lyapunov method need a closed-form law (an expression or a family); "
+                         "the hybrid, regularised and SUNDIALS solvers run tables") from None
+    return e.xreplace({L.v: S.v, L.V: S.V})
+
+
+def _diffsl_expressions(geometry: str, force=None) -> dict:
     """DiffSL (C-syntax) expressions of c(α), φ_α, φ_ω, φ_F and φ_v, printed from the one symbolic source
-    :mod:`peelapprox._symbolic` (``cos_theta_expr``, ``equations_of_motion``; fvV inside CONSTR), so the
-    peer integrates the same model as every other solver without a second copy of the formulas.  The pull
-    force is named ``Fp`` in DiffSL (``F_i`` is DiffSL's right-hand side)."""
+    :mod:`peelapprox._symbolic` (``cos_theta_expr``, ``equations_of_motion``; fvV inside CONSTR, or the law
+    ``force`` in its place, :mod:`peelapprox._law_sympy`), so the peer integrates the same model as every other
+    solver without a second copy of the formulas.  The pull force is named ``Fp`` in DiffSL (``F_i`` is
+    DiffSL's right-hand side)."""
     import sympy as sp
 
     from . import _symbolic as S
 
     Fp = sp.Symbol("Fp", real=True)
     alpha_dot, omega_dot, F_dot, constraint = S.equations_of_motion(S.c_)
+    f_law = _law_expression(force)
+    if force is not None and force.kind != "paper":  # CONSTR with the law instead of fvV
+        constraint = constraint + S.peel_force_expr(S.v, S.V) - f_law
     sub = {S.F: Fp}
     code = {name: sp.ccode(e.xreplace(sub)) for name, e in
             (("phi_a", alpha_dot), ("phi_w", omega_dot), ("phi_F", F_dot), ("phi_v", constraint))}
@@ -87,12 +114,12 @@ def _diffsl_expressions(geometry: str) -> dict:
     J = J.copy()
     J[3, :] = J[3, :] * S.eps
     code["dc"] = sp.ccode(sp.diff(-S.cos_theta_expr(geometry), S.alpha))
-    code["fp"] = sp.ccode(sp.diff(S.peel_force_expr(S.v, S.V), S.v))
+    code["fp"] = sp.ccode(sp.diff(f_law, S.v))
     code["jac"] = [[sp.ccode(sp.expand(J[i, j]).xreplace(sub)) for j in range(4)] for i in range(4)]
     return code
 
 
-def diffsl_code(geometry: str = "paper", *, tangent: bool = False) -> str:
+def diffsl_code(geometry: str = "paper", *, tangent: bool = False, force=None) -> str:
     """The DiffSL source of the regularised system for pydiffsol.
 
     Printed from the symbolic model (:func:`_diffsl_expressions`).  The state is ``y = X / s`` with
@@ -114,16 +141,23 @@ def diffsl_code(geometry: str = "paper", *, tangent: bool = False) -> str:
         Closure of ``cos θ`` (``PeelParams.geometry``).
     tangent : bool, keyword-only
         Append the variational equations (8 states instead of 4).
+    force : PeelForce, optional, keyword-only
+        The peel-force law (``PeelParams.force``; None: fvV), printed from its sympy form.
 
     Returns
     -------
     str
+
+    Raises
+    ------
+    ValueError
+        For a tabulated law (no closed form), naming ``params.force``.
     """
     if geometry not in GEOMETRIES:
         raise ValueError(f"geometry must be one of {GEOMETRIES}, got {geometry!r}")
     names = DIFFSL_INPUTS + (DIFFSL_TANGENT_INPUTS if tangent else ())
     inputs = ", ".join(f"{n} = 1.0" for n in names)
-    e = _diffsl_expressions(geometry)
+    e = _diffsl_expressions(geometry, force)
     u = ["ya = a0 / sa", "yw = w0 / sw", "yF = F0 / sF", "yv = v0 / sv"]
     du = ["dya", "dyw", "dyF", "dyv"]
     mass = ["dya", "dyw", "dyF", "eps * dyv"]
@@ -158,16 +192,25 @@ reset_i {{ {", ".join(states)} }}
 """
 
 
-def diffsl_model(geometry: str = "paper", *, tangent: bool = False):
+def diffsl_model(geometry: str = "paper", *, tangent: bool = False, force=None):
     """JIT-compile :func:`diffsl_code` into a ``pydiffsol.Ode`` (dense LU, BDF).
 
     Raises
     ------
     PeerUnavailableError
         If pydiffsol is not installed.
+    ValueError
+        For a law that cannot be written in DiffSL (a table; an expression using a function DiffSL lacks),
+        naming ``params.force``.
     """
     ds = import_optional("pydiffsol", "pydiffsol", "peer 'diffsol'")
-    return ds.Ode(diffsl_code(geometry, tangent=tangent), matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
+    code = diffsl_code(geometry, tangent=tangent, force=force)
+    if force is None or force.kind == "paper":
+        return ds.Ode(code, matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
+    try:
+        return ds.Ode(code, matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
+    except Exception as exc:  # pydiffsol reports a DiffSL compile error as its own exception type
+        raise ValueError(f"params.force: {force!r} cannot be compiled to DiffSL: {exc}") from None
 
 
 def diffsl_inputs(params: PeelParams, eps: float, state, scale, tangent=None, tangent_scale=None) -> np.ndarray:
@@ -187,7 +230,7 @@ def diffsl_inputs(params: PeelParams, eps: float, state, scale, tangent=None, ta
         Initial tangent ``δX`` and its scales ``t`` (``z = δX / t``), for the
         ``tangent=True`` model; ``tangent_scale`` defaults to ``scale``.
     """
-    vm = branch_structure(params.V).v_inflection
+    vm = branch_structure(params.V, force=params.force).v_inflection
     out = [params.V, params.I, params.k, params.R, params.l, eps, vm, *state, *scale]
     if tangent is not None:
         out += [*tangent, *(scale if tangent_scale is None else tangent_scale)]

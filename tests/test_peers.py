@@ -130,7 +130,7 @@ def test_solver_failure_is_reported_not_raised(monkeypatch, p_low):
         def solve(self, params, t_end):
             raise RuntimeError("ODE solver error: Step size is too small")
 
-    monkeypatch.setattr(PD, "diffsl_model", lambda geometry: Broken())
+    monkeypatch.setattr(PD, "diffsl_model", lambda geometry, force=None: Broken())
     r = P.run_peer("diffsol", p_low, 0.01, eps=EPS, rtol=1e-6)
     assert r.status.startswith("failed: ") and "Step size is too small" in r.status
     assert r.jump_t.size == 0 and r.n_steps == -1

@@ -12,7 +12,7 @@ import numpy as np
 
 from exact import default_atol, initial_state
 from peelapprox import branch_structure
-from peelapprox.kernels import PeerUnavailableError, import_optional
+from peelapprox.kernels import ALL_LAWS, PeerUnavailableError, import_optional
 from peelapprox.validate import choice, duration, in_range, reals
 from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
@@ -109,7 +109,7 @@ def available_peers() -> tuple[str, ...]:
 
 def _check(peer, params, t_end, eps, rtol, atol):
     choice("peer", peer, PEERS)
-    _params("params", params)
+    _params("params", params, laws=ALL_LAWS)  # every law; the diffsol peer refuses a table (no closed form)
     t_end, eps = duration("t_end", t_end), _eps("eps", eps)
     rt = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
     if atol is not None:
@@ -183,7 +183,7 @@ def run_peer(
     s0 = initial_state(params, alpha0=alpha0)
     mod = _import(peer)
     y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v])
-    vm = branch_structure(params.V).v_inflection
+    vm = branch_structure(params.V, force=params.force).v_inflection
     if peer == "diffsol":
         out = diffsol.run(params, t_end, eps, rtol, a, y0)
     else:

@@ -9,7 +9,15 @@ import time
 
 import numpy as np
 
-from peelapprox.kernels import Q_EPS, regularized_field, regularized_field_jacobian, regularized_parameters
+from peelapprox.kernels import (
+    ALL_LAWS,
+    Q_EPS,
+    compiled_law,
+    regularized_field,
+    regularized_field_jacobian,
+    regularized_law_field,
+    regularized_parameters,
+)
 
 __all__ = ["run", "smoke"]
 
@@ -33,19 +41,26 @@ def smoke(sun, peer: str) -> bool:
 def run(sun, peer, params, t_end, eps, rtol, atol, y0, vm):
     """Integrate with IDA or CVODE (``sun``: the imported sksundae) from ``y0``; the fields of a PeerResult."""
     c0 = time.perf_counter()
-    q = regularized_parameters(params, eps)
+    cl = compiled_law(params.force, params.V)  # the paper's law: fvV inlined in the field (the default)
+    q = regularized_parameters(params, eps, ("paper",) if cl.inlined else ALL_LAWS)
     q1 = q.copy()
     q1[Q_EPS] = 1.0  # with eps = 1 the kernels give phi and d(phi)/dX themselves (M = I)
-    regularized_field(y0, q), regularized_field_jacobian(y0, q)
+    if cl.inlined:
+        field, field_jac = regularized_field, regularized_field_jacobian
+    else:  # the law as an argument: every law, tables included
+        lfun, ljac = regularized_law_field()
+        field = lambda y, q: lfun(y, q, cl.fn, cl.coef)  # noqa: E731
+        field_jac = lambda y, q: ljac(y, q, cl.fn, cl.coef)  # noqa: E731
+    field(y0, q), field_jac(y0, q)
     mass = np.array([1.0, 1.0, 1.0, eps])
     mass_m = np.diag(mass)
     common = dict(rtol=rtol, atol=atol, num_events=1, max_num_steps=_MAX_NUM_STEPS, linsolver="dense")
     if peer == "cvode":
         def rhs(t, y, yp):
-            yp[:] = regularized_field(y, q)
+            yp[:] = field(y, q)
 
         def jac(t, y, yp, JJ):
-            JJ[:, :] = regularized_field_jacobian(y, q)
+            JJ[:, :] = field_jac(y, q)
 
         def events(t, y, ev):
             ev[0] = y[3] - vm
@@ -55,17 +70,17 @@ def run(sun, peer, params, t_end, eps, rtol, atol, y0, vm):
         args = ([0.0, t_end], y0)
     else:
         def res(t, y, yp, out):
-            out[:] = mass * yp - regularized_field(y, q1)
+            out[:] = mass * yp - field(y, q1)
 
         def jac_dae(t, y, yp, r, cj, JJ):  # IDA's signatures differ from CVODE's: own names (mypy [misc])
-            JJ[:, :] = cj * mass_m - regularized_field_jacobian(y, q1)
+            JJ[:, :] = cj * mass_m - field_jac(y, q1)
 
         def events_dae(t, y, yp, ev):
             ev[0] = y[3] - vm
 
         events_dae.terminal, events_dae.direction = [False], [0]
         solver = sun.ida.IDA(res, jacfn=jac_dae, eventsfn=events_dae, **common)
-        args = ([0.0, t_end], y0, regularized_field(y0, q))  # consistent yp0 = M^-1 phi(y0)
+        args = ([0.0, t_end], y0, field(y0, q))  # consistent yp0 = M^-1 phi(y0)
     compile_time = time.perf_counter() - c0
     w0 = time.perf_counter()
     try:
