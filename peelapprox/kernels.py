@@ -171,8 +171,8 @@ def regularized_law_field() -> tuple[Any, Any]:
     """``(field, jacobian)`` of the regularised system (XDAE) with the peel-force law as an argument:
     ``field(y, q, law, coef)`` and ``jacobian(y, q, law, coef)`` as :func:`regularized_field` and
     :func:`regularized_field_jacobian` with ``law`` (:data:`LAW_TYPE`) and its coefficients ``coef``.  Compiled
-    for that signature (``y`` writeable or read-only) on first use (loaded from numba's cache when it is there), so every law and every
-    coefficient vector runs without compiling again."""
+    for that signature (``y`` writeable or read-only) on first use (loaded from numba's cache when it is there),
+    so every law and every coefficient vector runs without compiling again."""
     a1 = _nb.float64[::1]
     ro = _nb.Array(_nb.float64, 1, "C", readonly=True)  # the state as SUNDIALS passes it
     for d, ret in ((_regularized_field_law, a1), (_regularized_field_jacobian_law, _nb.float64[:, ::1])):
