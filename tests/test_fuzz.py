@@ -72,6 +72,7 @@ CASES: dict[str, tuple[int, int]] = {
     "load_sweep": (20, 200),
     "cli": (60, 600),
     "PeelForce.tabulated": (60, 600),
+    "simulate with a law": (30, 300),
 }
 TIERS = [pytest.param(0, id="default"), pytest.param(1, id="slow", marks=pytest.mark.slow)]
 
@@ -982,6 +983,46 @@ def test_fuzz_tabulated_law(tier):
                  f"PeelForce.tabulated({name}={value!r})", check=check_law)
 
     run_tier(tier, "PeelForce.tabulated", one_of_args(args), body)
+
+
+#: Names a refused law's message may give (the law is a field of params).
+LAW_NAMES = ("params.force", "force", "v[", "f[", "v must", "f must", "coefficient", "a must", "b must", "c must",
+             "d must")
+#: A law that runs: a cubic with any coefficients (folds or none, landings or none), or the test table with
+#: one force scaled (its folds moved, or the table refused), each run by the hybrid or the regularised solver.
+LAW_CASES = st.one_of(
+    st.tuples(st.just("cubic"), st.tuples(*(nasty_or(edges(1e-3, 1e3)) for _ in range(4)))),
+    st.tuples(st.just("table"), st.tuples(st.integers(0, 11), edges(0.5, 2.0))),
+)
+
+
+@pytest.mark.parametrize("tier", TIERS)
+def test_fuzz_simulate_with_a_law(tier):
+    """Hypothesis: ``simulate`` of a law with odd coefficients or a perturbed table (hybrid for the even draws,
+    regularised at ε = 1e-4 for the odd ones) returns a finite trajectory, raises ValueError/TypeError naming
+    the law (params.force, a coefficient, a table entry), or stops with a documented model exception (a
+    breakdown such as ``law_domain`` or ``no_landing``) with a finite time and state: never another exception,
+    never a non-finite number."""
+    def body(case):
+        kind, value = case
+        try:
+            if kind == "cubic":
+                law = pa.PeelForce.cubic(*value)
+            else:
+                i, scale = value
+                f = TABLE_F.copy()
+                f[i] = f[i] * scale
+                law = pa.PeelForce.tabulated(TABLE_V, f)
+        except (ValueError, TypeError) as exc:
+            assert any(n in str(exc) for n in LAW_NAMES), f"{case}: {exc}"
+            COUNTS["simulate with a law", "arg_error"] += 1
+            return
+        p = PeelParams(V=1.2, I=1e-3, force=law)
+        method = dict(method="regularized", eps=1e-4) if hash(repr(case)) % 2 else {}
+        classify("simulate with a law", lambda: exact.simulate(p, 0.05, max_wall=30.0, **method), LAW_NAMES,
+                 f"simulate({law!r}, {method})")
+
+    run_tier(tier, "simulate with a law", LAW_CASES, body)
 
 
 def test_fuzz_regression_lyapunov_tangent_without_transient():
