@@ -79,8 +79,9 @@ def _fprime(params: PeelParams) -> Callable[[float], float]:
 
 
 def _law_free(params: PeelParams) -> PeelParams:
-    """``params`` with the paper's law, for the functions of :mod:`peelapprox._alpha` that read only I and R (no
-    peel force) but accept the paper's law only (``inertial_period``)."""
+    """``params`` with the paper's law, for the functions of :mod:`peelapprox._alpha` that read only V, I, k, R (no
+    peel force) but accept the paper's law only (``inertial_period``, ``inertial_frequency``,
+    ``wkb_amplitude_phase``)."""
     return params if params.force.kind == "paper" else params.replace(force=PeelForce.paper())
 
 

@@ -67,7 +67,8 @@ import numpy as np
 
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, wkb_amplitude_phase
-from ._law import ALL_LAWS, PeelForce
+from ._estimate import _law_free
+from ._law import ALL_LAWS
 from ._law_compiled import compiled_law
 from ._packing import model_block
 from ._params import TIME_MAX, PeelParams
@@ -376,8 +377,3 @@ def reduced_segment(
                        why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * v_in, v=state["v"], lo=d_lo,
                        hi=d_hi, law=repr(params.force))
 
-
-def _law_free(params: PeelParams) -> PeelParams:
-    """``params`` with the paper's law, for the functions of :mod:`peelapprox._alpha` that read only V, I, k, R
-    (no peel force) but accept the paper's law only (``wkb_amplitude_phase``)."""
-    return params if params.force.kind == "paper" else params.replace(force=PeelForce.paper())
