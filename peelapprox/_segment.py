@@ -369,11 +369,12 @@ def reduced_segment(
         return res
     left = (code == V_FLOOR and floor_law) or (code == V_CEILING and ceiling_law)
     status = LAW_DOMAIN if left else int(code)  # that floor (ceiling) was the law's end, not the e^60 fall
+    what = f"v = {state['v']:.6g} m/s {'fell below the start' if branch == 'AB' else 'rose above the end'} of the law"
     limit = {T_MAX: t_max, MAX_STEPS: int(max_steps)}.get(status)
     raise status_error(status, t=state["t"], state=state, partial=res,
                        prefix=f"{alpha_model}+{v_equation} on {branch}: ",
                        where=f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})",
                        limit=limit, v_f=v_f, v_floor=math.exp(x_lo) if branch == "AB" else 0.0,
                        why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * v_in, v=state["v"], lo=d_lo,
-                       hi=d_hi, law=repr(params.force))
+                       hi=d_hi, law=repr(params.force), what=what)
 
