@@ -6,6 +6,10 @@ integrated to the segment's exit velocity (the fold), and reports Δt, ΔF and
 the local α period (:meth:`Segment.local_period`) from both, with absolute and relative errors.  A
 reduction that breaks down (for example v → 0 on AB) or does not reach the
 fold is reported as a failed row with its reason, never silently dropped.
+
+The trajectory may be of any peel-force law (``trajectory.params.force``): every reduction is then integrated
+with that law (its folds, f' and domain: :func:`peelapprox.reduced_segment`), seeded from that law's exact
+segments; a reduction that leaves the law's domain (a table's range) is the row ``"breakdown: law_domain"``.
 """
 
 from __future__ import annotations
@@ -84,7 +88,8 @@ def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None =
     Parameters
     ----------
     trajectory : exact.Trajectory
-        Stored points are needed for the period columns (else they are None).
+        Of any peel-force law (its ``params.force`` is the reductions' law).  Stored points are needed for the
+        period columns (else they are None).
     models : dict, optional
         ``{"AB": [(alpha_model, v_equation), ...], "CD": [...]}``; default
         :data:`DEFAULT_MODELS`.

@@ -14,7 +14,7 @@ import numpy as np
 from peelapprox.io import fmt_number
 
 from ._compare import compare
-from ._runs import RUNS, exact_run
+from ._runs import RUNS, RunSpec, exact_run
 from ._scenes import SCENES, Row
 
 __all__ = ["StatRow", "CompareReport", "statistics", "run_compare", "markdown", "STAT_RUNS"]
@@ -47,15 +47,17 @@ class StatRow:
         return asdict(self)
 
 
-def statistics(runs: Sequence[str] = STAT_RUNS, models=None) -> list[StatRow]:
+def statistics(runs: Sequence[str | RunSpec] = STAT_RUNS, models=None) -> list[StatRow]:
     """Median, 90th percentile and max of |relative error| of Δt, ΔF and the α period, per run, branch and
     reduction, over every complete segment of each run's window (seeded from the exact entries).
 
-    ``models`` as in :func:`compare` (default :data:`DEFAULT_MODELS`).
+    ``runs`` are names of :data:`RUNS` or :class:`RunSpec` s (a run of any peel-force law: its reductions use
+    that law); ``models`` as in :func:`compare` (default :data:`DEFAULT_MODELS`).
     """
     out: list[StatRow] = []
-    for name in runs:
-        run = exact_run(name)
+    for spec in runs:
+        run = exact_run(spec)
+        name = run.spec.name
         rows = compare(run.trajectory, models, segs=run.segments)
         keys = []
         for r in rows:

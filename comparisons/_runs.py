@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from exact import Trajectory, simulate
-from peelapprox import PeelParams, periodicity
+from peelapprox import PeelForce, PeelParams, periodicity
 
 from ._segments import Segment, segments
 
@@ -114,7 +114,12 @@ class RunSpec:
 
     ``alpha0`` is the initial peel angle (the rest of the initial state is
     :func:`exact.initial_state`'s default), ``t_transient`` [s] is integrated
-    and discarded, ``window`` [s] is stored, ``rtol`` is the hybrid solver's.
+    and discarded, ``window`` [s] is stored, ``rtol`` is the hybrid solver's,
+    ``force`` the peel-force law (default the paper's fvV: the runs of
+    :data:`RUNS`); a run of another law is passed to :func:`exact_run` (and
+    :func:`comparisons.statistics`) as its RunSpec, and every reduction of
+    its segments is seeded from that law's exact run and integrated with
+    that law.
     """
 
     name: str
@@ -125,10 +130,11 @@ class RunSpec:
     alpha0: float = 0.0
     rtol: float = 1e-10
     regime: str = ""
+    force: PeelForce = PeelForce.paper()
 
     @property
     def params(self) -> PeelParams:
-        return PeelParams(V=self.V, I=self.I)
+        return PeelParams(V=self.V, I=self.I, force=self.force)
 
 
 #: The runs of the paper's three cases (Sec. V) and an intermediate-inertia point for the statistics.
@@ -152,20 +158,28 @@ class ExactRun:
     wall_time: float
 
 
-@functools.cache
-def exact_run(name: str) -> ExactRun:
-    """The exact run ``RUNS[name]``, integrated once per process and checked past its transient.
+def exact_run(name: str | RunSpec) -> ExactRun:
+    """The exact run ``RUNS[name]`` (or the run a :class:`RunSpec` describes, of any peel-force law), integrated
+    once per process and checked past its transient.
 
     Raises
     ------
     ValueError
-        Unknown ``name`` (the valid names are listed).
+        Unknown ``name`` (the valid names are listed); a law the hybrid solver cannot run (naming
+        ``params.force``).
     TransientNotPassed
         See :func:`check_past_transient`.
     """
+    if isinstance(name, RunSpec):
+        return _exact_run(name)
     if name not in RUNS:
-        raise ValueError(f"run must be one of {sorted(RUNS)}, got {name!r}")
-    spec = RUNS[name]
+        raise ValueError(f"run must be one of {sorted(RUNS)} or a RunSpec, got {name!r}")
+    return _exact_run(RUNS[name])
+
+
+@functools.cache
+def _exact_run(spec: RunSpec) -> ExactRun:
+    """:func:`exact_run` of one spec (cached per spec: equal specs share the run)."""
     t0 = time.perf_counter()
     tr = simulate(spec.params, spec.t_transient + spec.window, alpha0=spec.alpha0, rtol=spec.rtol,
                   t_transient=spec.t_transient, save="steps")

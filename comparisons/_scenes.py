@@ -199,7 +199,7 @@ def _case_i_periods(run: ExactRun) -> list[Row]:
 def _case_i_times(run: ExactRun) -> list[Row]:
     ab = _nearest_F_in(run, "AB", 211.5)
     cd = _after(run, ab)
-    fmax = branch_structure(run.spec.V).f_max
+    fmax = branch_structure(run.spec.V, force=run.spec.force).f_max
     assert fmax is not None  # case I is a stick-slip run (V = 1): the folds exist
     rows = _reduce_rows(
         "case-I-times", run, ab, (("approxalpha", "approxvdot"), ("sinusoid", "approxvdot")),

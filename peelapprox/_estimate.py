@@ -1,6 +1,8 @@
 """Regime estimates without running the DAE (paper Sec. V).
 
-Everything here is closed form or one quadrature of ``f'(v, V)``: the folds,
+Everything here is closed form or one quadrature of ``f'(v, V)`` of the law ``params.force`` (any
+:class:`peelapprox.PeelForce` whose folds can be found: its :func:`peelapprox.branch_structure`,
+:func:`peelapprox.fixed_point` and ``force.df``; the paper's fvV by default): the folds,
 the fixed point and its Hopf stability, the inertial periods (approxalpha),
 the CD damping time (Airy2), branch times and force changes in the
 quasi-static limit, the paper's crude estimates, the force bounds
@@ -17,9 +19,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import integrate
 
-from ._alpha import cd_damping_time, inertial_frequency, inertial_periods
+from ._alpha import InertialPeriods, _damping_time, cd_damping_time, inertial_frequency, inertial_period
+from ._law import ALL_LAWS, PeelForce
+from ._law_compiled import branch_structure, fixed_point
 from ._params import PeelParams
-from ._peelforce import BranchStructure, FixedPoint, branch_structure, fixed_point, peel_force_derivative
+from ._peelforce import BranchStructure, FixedPoint, peel_force_derivative
 from .validate import choice, flag, function, in_range, nonnegative, optional, state
 from .validate import params as _params
 
@@ -49,11 +53,55 @@ VELOCITY_RULE = (
 )
 
 
+def _checked(params: PeelParams) -> PeelParams:
+    """``params`` validated, any law (ValueError naming ``params.force`` for a law whose folds cannot be found)."""
+    return _params("params", params, laws=ALL_LAWS)
+
+
+def _law_structure(params: PeelParams) -> BranchStructure:
+    """The law's branch structure at V (:func:`peelapprox.branch_structure` with ``force=params.force``)."""
+    return branch_structure(params.V, force=params.force)
+
+
 def _folds(params: PeelParams) -> BranchStructure:
-    bs = branch_structure(_params("params", params).V)
+    bs = _law_structure(_checked(params))
     if not bs.has_folds:
-        raise ValueError(f"V={params.V} is outside the stick-slip window: f(v, V) has no folds")
+        raise ValueError(f"V={params.V} is outside the stick-slip window: f(v, V) has no folds "
+                         f"(law {params.force!r})")
     return bs
+
+
+def _fprime(params: PeelParams) -> Callable[[float], float]:
+    """``v -> f'(v, V)`` of the law (fvV: the generated derivative, as before laws were data)."""
+    if params.force.kind == "paper":
+        return lambda v: peel_force_derivative(v, params.V)
+    return lambda v: params.force.df(v, params.V)
+
+
+def _law_free(params: PeelParams) -> PeelParams:
+    """``params`` with the paper's law, for the functions of :mod:`peelapprox._alpha` that read only V, I, k, R (no
+    peel force) but accept the paper's law only (``inertial_period``, ``inertial_frequency``,
+    ``wkb_amplitude_phase``)."""
+    return params if params.force.kind == "paper" else params.replace(force=PeelForce.paper())
+
+
+def _periods(params: PeelParams, bs: BranchStructure) -> InertialPeriods:
+    """:func:`peelapprox.inertial_periods` at the folds of the law (``bs``): the same three periods."""
+    assert bs.f_min is not None and bs.f_max is not None  # caller: has_folds
+    pp = _law_free(params)
+    Fm = 0.5 * (bs.f_min + bs.f_max)
+    return InertialPeriods(inertial_period(pp, bs.f_min), inertial_period(pp, bs.f_max), inertial_period(pp, Fm),
+                           bs.f_min, bs.f_max, Fm)
+
+
+def _cd_damping_time(params: PeelParams, F: float, v: float) -> float:
+    """:func:`peelapprox.cd_damping_time` with f' of the law ``params.force``."""
+    if params.force.kind == "paper":
+        return cd_damping_time(params, F, v)
+    fp = float(params.force.df(v, params.V))
+    if not fp > 0:
+        raise ValueError(f"v={v} must be on a stable branch of the law {params.force!r} at V={params.V} (f'(v) > 0)")
+    return float(_damping_time(params.R, fp, F))
 
 
 def crude_branch_time(params: PeelParams) -> float:
@@ -114,7 +162,7 @@ def quasi_static_branch_time(
     else:
         v_in = bs.v_land_cd if v_in is None else v_in
         v_f = bs.v_min if v_f is None else v_f
-    fpr = (lambda v: peel_force_derivative(v, params.V)) if fprime is None else fprime
+    fpr = _fprime(params) if fprime is None else fprime
     k, V = params.k, params.V
     if rate == "kV":
         integrand = lambda v: float(fpr(v)) / (k * V)  # noqa: E731
@@ -177,14 +225,14 @@ def slope_criterion(params: PeelParams, *, F_in: float, alphadot_in: float, alph
     the asymmetry from ``v/R`` in FLOW1 that the argument neglects; 0.25 puts
     the paper's two points on either side.
     """
-    params = _params("params", params)
+    params = _checked(params)  # reads I and R only: any law
     F_in = state("F_in", F_in, "F")
     alphadot_in = state("alphadot_in", alphadot_in, "omega")
     alpha0 = state("alpha0", alpha0, "alpha")
     if alpha0 == 0.0:
         raise ValueError(f"alpha0 must be finite and non-zero (signed amplitude), got {alpha0}")
     tol = nonnegative("tol", tol)
-    nat = float(inertial_frequency(params, F_in)) * alpha0
+    nat = float(inertial_frequency(_law_free(params), F_in)) * alpha0
     ratio = alphadot_in / nat
     return SlopeCriterion(nat, ratio, bool(0.0 < ratio <= 1.0 + tol), tol)
 
@@ -257,13 +305,29 @@ def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: f
     bounds ``f/(1 + sin α)`` are added when both α extremes are given.
     A few milliseconds per call after the first for a given V (the fold
     search is cached).
+
+    Every number is the law ``params.force``'s (its folds and landings from
+    :func:`peelapprox.branch_structure`, its fixed point from
+    :func:`peelapprox.fixed_point`, f' from ``force.df``).  A law with no
+    folds at this V (f' > 0 throughout, so the fixed point is stable) gives
+    the no-stick-slip estimate: ``has_folds=False``, the fold, period,
+    branch-time and bound fields None, ``inertia="n/a"``,
+    ``velocity="stable"``.
+
+    Raises
+    ------
+    ValueError
+        Naming ``params.force``: a law whose folds cannot be found
+        (:meth:`PeelForce.folds`), V outside a table's speeds or its fixed
+        point outside the law's domain, or a law whose AB→CD jumps cannot
+        land within its domain (a table that stops below ``f_max`` on CD).
     """
-    params = _params("params", params)
+    params = _checked(params)
     angle = dict(lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True)
     alpha_min = optional(in_range, "alpha_min", alpha_min, **angle)
     alpha_max = optional(in_range, "alpha_max", alpha_max, **angle)
-    bs = branch_structure(params.V)
-    fp: FixedPoint = fixed_point(params.V, params.R)
+    bs = _law_structure(params)
+    fp: FixedPoint = fixed_point(params.V, params.R, force=params.force)
     velocity = "stable" if fp.stable else None
     if not bs.has_folds:
         return RegimeEstimate(
@@ -271,8 +335,11 @@ def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: f
             fp.fprime, fp.stable, None, None, None, None, None, None, None, None, None, None, None, None, None,
             "n/a", "stable")
     assert bs.v_max is not None and bs.f_max is not None and bs.v_min is not None and bs.f_min is not None
-    per = inertial_periods(params)
-    tau_cd = cd_damping_time(params, per.F_mean, bs.v_land_cd)
+    per = _periods(params, bs)
+    if bs.v_land_cd is None:  # a table that stops below f_max on CD: no AB->CD landing, no CD damping time
+        raise ValueError(f"params.force: {params.force!r} at V={params.V} never reaches f_max={bs.f_max} N on its "
+                         "fast branch within its domain: an AB->CD jump could not land (extend the table)")
+    tau_cd = _cd_damping_time(params, per.F_mean, bs.v_land_cd)
     ratio = per.at_mean / tau_cd
     inertia = "low" if ratio < 1.0 else ("intermediate" if ratio < 5.0 else "high")
     gap = (bs.f_max - bs.f_min) / bs.f_max

@@ -67,11 +67,14 @@ import numpy as np
 
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, wkb_amplitude_phase
+from ._estimate import _law_free
+from ._law import ALL_LAWS
+from ._law_compiled import compiled_law
 from ._packing import model_block
 from ._params import TIME_MAX, PeelParams
-from ._peelforce import BRANCHES, branch_structure, peel_force_derivative
+from ._peelforce import BRANCHES, peel_force_derivative
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
-from ._status import DONE, MAX_STEPS, OUT_FULL, T_MAX, status_error
+from ._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V_FLOOR, status_error
 from .validate import choice, duration, integer, optional, optional_finite, reals, times
 from .validate import params as _params
 from .validate import rtol as _rtol
@@ -173,8 +176,10 @@ def reduced_segment(
     Parameters
     ----------
     params : PeelParams
-        V, I, k, R.  The reduced equations are linear in α (the paper's
-        ``sin α ≈ α``), whatever ``params.geometry``.
+        V, I, k, R and the peel-force law ``params.force`` (any law with a compiled kernel,
+        :func:`peelapprox.kernels.compiled_law`: its folds, landings, ``f'(v_in)`` and its domain, which v may
+        not leave).  The reduced equations are linear in α (the paper's ``sin α ≈ α``), whatever
+        ``params.geometry``.
     branch : {"AB", "CD"}
         AB: v rises from ``v_in`` to ``v_f`` (default ``v_max``); CD: v falls
         from ``v_in`` to ``v_f`` (default ``v_min``).
@@ -188,7 +193,7 @@ def reduced_segment(
         The paper's ``(α_in, φ)`` of the sinusoid (``"sinusoid"`` only).
     v_in : float, optional
         Entry velocity [m/s]; default the landing velocity of a jump onto the
-        branch (``branch_structure(V).v_land_ab`` / ``v_land_cd``).
+        branch (``branch_structure(V, force=params.force).v_land_ab`` / ``v_land_cd``).
     v_f : float, optional
         Exit velocity [m/s]; default the branch's fold.
     alpha_model : str, default "approxalpha"
@@ -227,16 +232,16 @@ def reduced_segment(
         (``ArgumentTypeError``, also a ValueError) For an argument of the wrong kind: a string, bool or
         None for a number, a float for ``max_steps``, anything but a PeelParams for ``params``.
     ValueError
-        For an unknown model, a value out of its range, a velocity off the branch, or missing inputs;
-        the message names the argument.
+        For an unknown model, a value out of its range, a velocity off the branch or outside the law's domain,
+        missing inputs, or a law without a compiled kernel; the message names the argument.
     ModelBreakdown
-        If v → 0 on AB, v runs away on CD, or F reaches 0 (reason in the
-        exception, with the time and state).
+        If v → 0 on AB, v runs away on CD, F reaches 0, or v leaves the law's domain (a table's range: reason
+        ``"law_domain"``); the reason is in the exception, with the time and state.
     SolverBudgetExceeded
         If v does not reach ``v_f`` before ``t_max`` or within ``max_steps``.
     """
     t_wall = time.perf_counter()
-    params = _params("params", params)
+    params = _params("params", params, laws=ALL_LAWS)
     branch = choice("branch", branch, BRANCHES)
     alpha_model = choice("alpha_model", alpha_model, ALPHA_MODELS)
     v_equation = choice("v_equation", v_equation, V_EQUATIONS)
@@ -258,7 +263,9 @@ def reduced_segment(
         atol_v = np.broadcast_to(atol_v, (5,)).copy()
     t_max = optional(duration, "t_max", t_max)
     te = None if t_eval is None else times("t_eval", t_eval, hi=TIME_MAX)
-    bs = branch_structure(params.V)
+    law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
+    bs = law.structure
+    d_lo, d_hi = law.domain
 
     # ---- velocities
     if branch == "CD" and not bs.has_folds:
@@ -279,11 +286,15 @@ def reduced_segment(
         raise ValueError(f"v_f must be in (v_in, v_max] = ({v_in}, {hi}] on AB, got {v_f}")
     if branch == "CD" and not (lo <= v_f < v_in):
         raise ValueError(f"v_f must be in [v_min, v_in) = [{lo}, {v_in}) on CD, got {v_f}")
+    for name, x in (("v_in", v_in), ("v_f", v_f)):
+        if not d_lo <= x <= d_hi:
+            raise ValueError(f"{name} must lie in the domain [{d_lo}, {d_hi}] m/s of the peel-force law "
+                             f"{params.force!r}, got {x}")
 
     # ---- α inputs
     am = ALPHA_MODELS.index(alpha_model)
     s = _frozen_rate(params, v_in) if F_rate is None else F_rate
-    fp_in = float(peel_force_derivative(v_in, params.V))
+    fp_in = float(peel_force_derivative(v_in, params.V)) if law.inlined else law.df(v_in)
     tau = _damping_time(params.R, fp_in, F_in)
     if am == K.AM_SIN:
         if amplitude is not None or phase is not None:
@@ -292,8 +303,8 @@ def reduced_segment(
         elif alpha_in is None or alphadot_in is None:
             raise ValueError("alpha_model='sinusoid' needs (amplitude, phase) or (alpha_in, alphadot_in)")
         else:
-            amplitude, phase = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in,
-                                                   F_rate=s)
+            amplitude, phase = wkb_amplitude_phase(_law_free(params), F_in=F_in, alpha_in=alpha_in,
+                                                   alphadot_in=alphadot_in, F_rate=s)
         alpha_in, alphadot_in = (float(x) for x in _sinusoid(0.0, amplitude, phase, F_in, s, params.R, params.I))
     elif am in (K.AM_EXP, K.AM_STATIC):
         if alpha_in is None:
@@ -303,8 +314,8 @@ def reduced_segment(
         raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in and alphadot_in")
 
     q = K.segment_parameters(
-        model_block(params, K.N_Q), alpha_model=am, v_equation=V_EQUATIONS.index(v_equation), F_in=F_in, v_in=v_in,
-        fp_in=fp_in, F_rate=s, amplitude=amplitude if amplitude is not None else 0.0,
+        model_block(params, K.N_Q, ALL_LAWS), alpha_model=am, v_equation=V_EQUATIONS.index(v_equation), F_in=F_in,
+        v_in=v_in, fp_in=fp_in, F_rate=s, amplitude=amplitude if amplitude is not None else 0.0,
         phase=phase if phase is not None else 0.0, alpha_in=alpha_in, alphadot_in=alphadot_in, tau=tau)
 
     Om = float(_omega(F_in, params.R, params.I))
@@ -324,12 +335,19 @@ def reduced_segment(
     y0 = np.array([0.0, math.log(v_in), F_in, alpha_in, alphadot_in])
     x_lo = math.log(max(v_in, 1e-300)) - 60.0 if branch == "AB" else -np.inf  # v fell by e^60: v -> 0
     x_hi = math.log(1e3 * v_in) if branch == "CD" else np.inf
+    # the law's domain: v leaves it only below v_in on AB or above v_in on CD (the exit v_f lies inside it)
+    floor_law = branch == "AB" and d_lo > 0 and math.log(d_lo) > x_lo
+    ceiling_law = branch == "CD" and math.isfinite(d_hi) and math.log(d_hi) < x_hi
+    x_lo = math.log(d_lo) if floor_law else x_lo
+    x_hi = math.log(d_hi) if ceiling_law else x_hi
+    drive = K.run(not law.inlined)
+    te = np.ascontiguousarray(te, dtype=float)
     while True:
         y = y0.copy()
         out = np.empty((cap, 5))
         cnt = np.zeros(5, dtype=np.int64)
-        code = K.run(y, q, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max, int(max_steps), mode,
-                    te, out, cnt)
+        code = drive(y, q, law.fn, law.coef, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max,
+                     int(max_steps), mode, te, out, cnt)
         if code == OUT_FULL:
             cap *= 4
             continue
@@ -349,8 +367,14 @@ def reduced_segment(
     )
     if code == DONE:
         return res
-    limit = {T_MAX: t_max, MAX_STEPS: int(max_steps)}.get(code)
-    raise status_error(code, t=state["t"], state=state, partial=res, prefix=f"{alpha_model}+{v_equation} on {branch}: ",
+    left = (code == V_FLOOR and floor_law) or (code == V_CEILING and ceiling_law)
+    status = LAW_DOMAIN if left else int(code)  # that floor (ceiling) was the law's end, not the e^60 fall
+    what = f"v = {state['v']:.6g} m/s {'fell below the start' if branch == 'AB' else 'rose above the end'} of the law"
+    limit = {T_MAX: t_max, MAX_STEPS: int(max_steps)}.get(status)
+    raise status_error(status, t=state["t"], state=state, partial=res,
+                       prefix=f"{alpha_model}+{v_equation} on {branch}: ",
                        where=f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})",
                        limit=limit, v_f=v_f, v_floor=math.exp(x_lo) if branch == "AB" else 0.0,
-                       why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * v_in)
+                       why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * v_in, v=state["v"], lo=d_lo,
+                       hi=d_hi, law=repr(params.force), what=what)
+

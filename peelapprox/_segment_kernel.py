@@ -12,21 +12,39 @@ through the fold.
 Parameter vector ``q``: the model block of :mod:`peelapprox._packing` (``M_V``, ``M_I``, ``M_K``, ``M_R``,
 ``M_B``, ``M_A``; the reduced equations are linear in α and read neither ``M_L`` nor ``M_GEOM``), then this
 driver's fields ``Q_*`` from index ``N_M``.
+
+The peel-force law (issue 15): the driver body :func:`_run` is compiled twice (:func:`peelapprox._jit.rebind`),
+as the hybrid solver's (``exact._hybrid_law``):
+
+* ``run(False)`` -- the paper's law fvV **inlined** (:func:`field`, ``q`` carrying ``b, A``): the default path,
+  bitwise the numbers of 0.2.0;
+* ``run(True)`` -- the law as an **argument** ``law`` of type :data:`peelapprox._law_abi.LAW_TYPE` with its
+  coefficients ``coef`` (:func:`field_law`: ``law(ln v, coef, LAW_LNV)``), for any compiled law
+  (:func:`peelapprox._law_compiled.compiled_law`) without compiling again.
+
+Both are compiled for the one signature :data:`RUN_SIG` on first use and cached across processes; the law's
+field is compiled without numba's reference-counting runtime (``kernel(nrt=False)``), which would wrap every
+indirect law call in atomic reference-count updates.  Where the law may be evaluated (its domain) is the
+caller's floor and ceiling ``x_lo``/``x_hi`` of ln v (:func:`peelapprox.reduced_segment`).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numba import types as _t
 
 from ._alpha import _decay, _harmonic, _restoring, _sinusoid
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
-from ._jit import kernel
+from ._jit import kernel, rebind
+from ._law_abi import LAW_LNV, LAW_TYPE
 from ._packing import M_A, M_B, M_I, M_K, M_R, M_V, N_M
 from ._peelforce import peel_force_fp_jit
 from ._status import DONE, F_NONPOSITIVE, MAX_STEPS, NONFINITE, OUT_FULL, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
 
-__all__ = ["ALPHA_MODELS", "V_EQUATIONS", "alpha_of", "field", "run", "segment_parameters"]
+__all__ = ["ALPHA_MODELS", "RUN_SIG", "V_EQUATIONS", "alpha_of", "field", "field_law", "run", "segment_parameters"]
 
 #: α models accepted by :func:`peelapprox.reduced_segment` (:mod:`peelapprox._segment`); the code of each is
 #: its index (``AM_*``)
@@ -79,18 +97,11 @@ def alpha_of(y, q):
     return y[3], y[4]
 
 
-@kernel
-def field(y, q, out):
-    """d(t, ln v, F, α, α̇)/ds with dt/ds = v f'(v) (module docstring)."""
-    v = np.exp(y[1])
+@kernel(inline="always")  # inlined into both fields: the arithmetic of the field of 0.2.0
+def _field_at(y, q, v, g, out):
+    """d(t, ln v, F, α, α̇)/ds at y with ``v = exp(y[1])`` and ``g = v f'(v)`` already evaluated (both fields)."""
     F = y[2]
-    if not (v > 0.0 and F > 0.0 and np.isfinite(v)):
-        for i in range(5):
-            out[i] = np.nan
-        return
     V, I, k, R = q[M_V], q[M_I], q[M_K], q[M_R]
-    f, fp = peel_force_fp_jit(v, q[M_B], q[M_A])
-    g = v * fp
     al, ad = alpha_of(y, q)
     am = int(q[Q_AM])
     if int(q[Q_VE]) == VE_APPROX:
@@ -121,7 +132,43 @@ def field(y, q, out):
     out[4] = acc
 
 
-_dop = make_dop853(field)
+@kernel
+def field(y, q, out):
+    """d(t, ln v, F, α, α̇)/ds with dt/ds = v f'(v) (module docstring), the paper's law fvV inlined (``q``
+    carries its coefficients ``b, A``)."""
+    v = np.exp(y[1])
+    F = y[2]
+    if not (v > 0.0 and F > 0.0 and np.isfinite(v)):
+        for i in range(5):
+            out[i] = np.nan
+        return
+    f, fp = peel_force_fp_jit(v, q[M_B], q[M_A])
+    _field_at(y, q, v, v * fp, out)
+
+
+@kernel(nrt=False)  # no reference counting around the law call (exact._hybrid_law: 62 vs 29 ns per field)
+def field_law(y, P, out):
+    """:func:`field` for the law of ``P = (q, law, coef)``: ``law(ln v, coef, LAW_LNV)`` gives ``(v, f, v f')``."""
+    q, law, coef = P
+    F = y[2]
+    v, f, g = law(y[1], coef, LAW_LNV)
+    if not (v > 0.0 and F > 0.0 and np.isfinite(v) and np.isfinite(g)):
+        for i in range(5):
+            out[i] = np.nan
+        return
+    _field_at(y, q, v, g, out)
+
+
+@kernel(inline="always")
+def _pack_paper(q, law, coef):
+    """What the inlined-law driver's field receives: ``q`` (fvV reads ``q[M_B], q[M_A]``)."""
+    return q
+
+
+@kernel(inline="always")
+def _pack_law(q, law, coef):
+    """What the law driver's field receives: ``(q, law, coef)``."""
+    return (q, law, coef)
 
 
 @kernel
@@ -135,15 +182,23 @@ def _store(out, row, y, q):
     out[row, 4] = ad
 
 
-@kernel
-def run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
-    """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state."""
+#: The pieces :func:`_run` calls, bound per copy (:data:`_RUNS`): the field ``_FIELD(y, P, out)``, ``P =
+#: _PACK(q, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
+_FIELD: Any = None
+_PACK: Any = None
+_dop: Any = None
+
+
+def _run(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
+    """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state.  The peel force is
+    ``law`` with ``coef``, or the paper's law inlined (:func:`run`)."""
+    P = _PACK(q, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(5)
     cap = out.shape[0]
     n_te = t_eval.shape[0]
 
-    field(y, q, f0)
-    h = _dop.initial_step(y, f0, q, rtol, atol, work)
+    _FIELD(y, P, f0)
+    h = _dop.initial_step(y, f0, P, rtol, atol, work)
     cnt[C_RHS] += 2
     if save_mode == SAVE_STEPS:
         _store(out, cnt[C_NOUT], y, q)
@@ -153,7 +208,7 @@ def run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, 
             return MAX_STEPS
         if save_mode == SAVE_STEPS and cnt[C_NOUT] + 2 > cap:
             return OUT_FULL
-        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, q, rtol, atol, K, y_new, tmp, sc)
+        status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, P, rtol, atol, K, y_new, tmp, sc)
         cnt[C_REJ] += n_rej
         cnt[C_RHS] += n_rhs
         if status == STEP_FAILED:
@@ -164,18 +219,18 @@ def run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, 
         gA = y[1] - x_f
         gB = y_new[1] - x_f
         if (upward and gB >= 0.0) or ((not upward) and gB <= 0.0):
-            dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
+            dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
             x_exit = solve_theta(y, Fc, 1, x_f, gA, 1.0, gB)
         x_tmax = 2.0
         if y_new[0] >= t_max:
-            dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
+            dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
             x_tmax = crossing(y, Fc, 0, t_max, 1.0, y_new[0])
         x_stop = min(x_exit, x_tmax, 1.0)
         if save_mode == SAVE_TEVAL:
             t_stop = interp1(y, Fc, x_stop, 0) if x_stop < 1.0 else y_new[0]
             while cnt[C_TEVAL] < n_te and t_eval[cnt[C_TEVAL]] <= t_stop:
                 te = t_eval[cnt[C_TEVAL]]
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, q, Fc, tmp, cnt, C_RHS)
+                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 state_at(y, Fc, 0, te, x_stop, t_stop, ye)
                 _store(out, cnt[C_NOUT], ye, q)
                 cnt[C_NOUT] += 1
@@ -210,3 +265,41 @@ def run(y, q, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, 
             return V_CEILING
         if y[2] <= 0.0:
             return F_NONPOSITIVE
+
+
+_A1 = _t.float64[::1]
+#: The one signature of both copies of :func:`_run`: ``(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward,
+#: t_max, max_steps, save_mode, t_eval, out, cnt) -> status``.
+RUN_SIG = _t.int64(_A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.float64, _t.float64, _t.boolean,
+                   _t.float64, _t.int64, _t.int64, _A1, _t.float64[:, ::1], _t.int64[::1])
+
+#: The two copies of :func:`_run`: the paper's law inlined (False) and the law as an argument (True).
+_RUNS = {
+    False: kernel(rebind(_run, _FIELD=field, _PACK=_pack_paper, _dop=make_dop853(field)), name="segment_run_inlined"),
+    True: kernel(rebind(_run, _FIELD=field_law, _PACK=_pack_law, _dop=make_dop853(field_law)),
+                 name="segment_run_law"),
+}
+
+
+def run(law_argument: bool) -> Any:
+    """The segment driver, compiled for :data:`RUN_SIG` on first use (loaded from numba's cache when it is there)
+    and for no other signature.
+
+    Parameters
+    ----------
+    law_argument : bool
+        False: the paper's law fvV inlined, ``law`` and ``coef`` unused (the default path, the numbers of 0.2.0).
+        True: the law ``law`` (:data:`peelapprox._law_abi.LAW_TYPE`) with the coefficients ``coef``; a new law or
+        new coefficients compile nothing.
+
+    Returns
+    -------
+    numba dispatcher
+        ``run(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt)
+        -> status`` (:func:`_run`).
+    """
+    d = _RUNS[bool(law_argument)]
+    if not d.signatures:
+        d.compile(RUN_SIG)
+        d.disable_compile()
+    return d

@@ -1,19 +1,24 @@
 """A third solver of the full DAE, independent of the two of ``exact``: the benchmark reference's cross-check.
 
 On a stable branch the DAE (FLOW1, FLOW2, flow3, CONSTR) is an ODE in ``(α, ω, F)`` with v from the branch
-inverse of fvV; scipy's DOP853 integrates it and the folds are terminal events (:func:`branchwise_reference`).
+inverse of the peel-force law (fvV, or any ``params.force`` evaluated by :meth:`peelapprox.PeelForce.f` -- numpy
+and scipy, not the compiled law kernels the solvers of ``exact`` call); scipy's DOP853 integrates it and the
+folds are terminal events (:func:`branchwise_reference`).
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from typing import cast
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from exact import SolverFailure, initial_state
-from peelapprox import PeelParams, branch_structure
-from peelapprox.kernels import branch_inverse_at, closure_paper, peel_force_coefficients, slow_rates
+from peelapprox import BranchStructure, PeelParams, branch_structure
+from peelapprox.kernels import ALL_LAWS, branch_inverse_at, closure_paper, peel_force_coefficients, slow_rates
 from peelapprox.validate import params as _params
 
 # the generated model functions themselves, in plain Python: the reference uses no compiled kernel
@@ -34,6 +39,12 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
     desingularisation, no compiled kernel, no v state.  Near a fold ``v(G)`` has a square-root singularity,
     so this is slow and loses a few digits; it is a check, not a solver.
 
+    The law is ``params.force``: fvV through the generated model functions, any other law through
+    :meth:`peelapprox.PeelForce.f` (its numpy/scipy evaluator, independent of the compiled law kernels), its folds
+    from :func:`peelapprox.branch_structure` with ``force=``, and its branch inverse by Brent's method in ln v
+    over the law's range (:attr:`peelapprox.PeelForce.v_range`); a level whose root would lie outside that range
+    (a table's end) raises a ValueError naming ``params.force``.
+
     Parameters
     ----------
     params : PeelParams
@@ -49,20 +60,22 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
     (t, F) : tuple of ndarray
         Jump times and F at the jumps.
     """
-    _params("params", params)  # the paper's law only: the reference integrates fvV itself
-    s0 = initial_state(params, alpha0=alpha0)
-    bs = branch_structure(params.V)
-    b, A = peel_force_coefficients(params.V)
-    V, I, k, R, L = params.V, params.I, params.k, params.R, params.l
+    _params("params", params, laws=ALL_LAWS)
     if params.geometry != "paper":
         raise ValueError("branchwise_reference supports geometry='paper' only")
+    s0 = initial_state(params, alpha0=alpha0)
+    bs = branch_structure(params.V, force=params.force)
+    if not bs.has_folds:
+        raise ValueError(f"params: the law {params.force!r} has no folds at V={params.V}: no jumps to reproduce")
+    V, I, k, R, L = params.V, params.I, params.k, params.R, params.l
+    inverse = _paper_inverse(params, bs) if params.force.kind == "paper" else _law_inverse(params, bs)
 
     def v_of(y, branch):
         c, _ = _closure_paper(y[0], R, L)
         G = y[2] * (1.0 + c)
         if branch == "AB":
-            return branch_inverse_at(min(G, bs.f_max), bs, "AB", b, A), c
-        return branch_inverse_at(max(G, bs.f_min), bs, "CD", b, A), c
+            return inverse(min(G, bs.f_max), "AB"), c
+        return inverse(max(G, bs.f_min), "CD"), c
 
     def make(branch):
         def rhs(t, y):
@@ -97,3 +110,35 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
         else:
             break
     return np.array(jt), np.array(jF)
+
+
+def _paper_inverse(params: PeelParams, bs: BranchStructure) -> Callable[[float, str], float]:
+    """``(G, branch) -> v`` of fvV: the package's branch inverse (Brent in ln v on AB)."""
+    b, A = peel_force_coefficients(params.V)
+    return lambda G, branch: branch_inverse_at(G, bs, branch, b, A)
+
+
+def _law_inverse(params: PeelParams, bs: BranchStructure) -> Callable[[float, str], float]:
+    """``(G, branch) -> v`` of ``params.force`` by Brent's method in ln v on :meth:`PeelForce.f`: AB in
+    ``(lo, v_max]``, CD in ``[v_min, hi)`` of the law's range ``(lo, hi)``; exactly the fold at its level."""
+    force, V = params.force, params.V
+    lo, hi = force.v_range
+    v_max, v_min = float(cast(float, bs.v_max)), float(cast(float, bs.v_min))
+    w_lo, w_hi = math.log(max(lo, 1e-300)) + (1e-12 if lo > 0 else 0.0), math.log(hi) - 1e-12
+
+    def f(w: float) -> float:
+        return float(force.f(math.exp(w), V))
+
+    def inverse(G: float, branch: str) -> float:
+        if branch == "AB" and G == bs.f_max:
+            return v_max
+        if branch == "CD" and G == bs.f_min:
+            return v_min
+        a, b = (w_lo, math.log(v_max)) if branch == "AB" else (math.log(v_min), w_hi)
+        fa, fb = f(a) - G, f(b) - G
+        if not fa <= 0.0 <= fb:
+            raise ValueError(f"params.force: the level G={G!r} N has no {branch} root of the law {force!r} at V={V} "
+                             f"within its range [{lo!r}, {hi!r}] m/s (f from {fa + G!r} to {fb + G!r} N there)")
+        return math.exp(brentq(lambda w: f(w) - G, a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps))
+
+    return inverse
