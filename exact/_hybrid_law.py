@@ -36,6 +36,8 @@ from peelapprox.kernels import (
     compiled_law,
     kernel,
     make_dop853,
+    pack_inlined,
+    pack_law,
     rebind,
 )
 
@@ -89,18 +91,6 @@ def field_law() -> Any:
     return _field_law
 
 
-@kernel(inline="always")
-def _pack_paper(p, law, coef):
-    """What the inlined-law driver's field receives: ``p`` (the paper's law reads ``p[M_B], p[M_A]``)."""
-    return p
-
-
-@kernel(inline="always")
-def _pack_law(p, law, coef):
-    """What the law driver's field receives: ``(p, law, coef)``."""
-    return (p, law, coef)
-
-
 #: The one signature of both drivers: ``(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out,
 #: out_br, jbuf, cnt, max_call_steps) -> status``.
 RUN_SIG = _t.int64(
@@ -116,8 +106,8 @@ def _driver_copy(field: Callable, pull: Callable, pack: Callable) -> Callable:
 
 
 _DRIVERS = {
-    False: kernel(_driver_copy(H._rhs, H.pull_force, _pack_paper), name="run_inlined"),
-    True: kernel(_driver_copy(_rhs_law, _pull_force_P, _pack_law), name="run_law"),
+    False: kernel(_driver_copy(H._rhs, H.pull_force, pack_inlined), name="run_inlined"),
+    True: kernel(_driver_copy(_rhs_law, _pull_force_P, pack_law), name="run_law"),
 }
 
 

@@ -40,6 +40,8 @@ from peelapprox.kernels import (
     interp1,
     kernel,
     make_dop853,
+    pack_inlined,
+    pack_law,
     rebind,
     solve_theta,
     workspace,
@@ -161,8 +163,8 @@ def _make_to_fold(field, pack, tag: str):
     return kernel(rebind(_to_fold, _PACK=pack, _RHS_T=rhs_t, _dop_t=make_dop853(rhs_t)), name=f"to_fold_{tag}")
 
 
-_TO_FOLD = {False: _make_to_fold(H._rhs, HL._pack_paper, "inlined"),
-            True: _make_to_fold(HL._rhs_law, HL._pack_law, "law")}
+_TO_FOLD = {False: _make_to_fold(H._rhs, pack_inlined, "inlined"),
+            True: _make_to_fold(HL._rhs_law, pack_law, "law")}
 
 
 def to_fold(law_argument: bool) -> Any:

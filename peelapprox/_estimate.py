@@ -19,11 +19,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import integrate
 
-from ._alpha import InertialPeriods, _damping_time, cd_damping_time, inertial_frequency, inertial_period
-from ._law import ALL_LAWS, PeelForce
+from ._alpha import cd_damping_time, inertial_frequency, inertial_periods, law_fprime
+from ._law import ALL_LAWS
 from ._law_compiled import branch_structure, fixed_point
 from ._params import PeelParams
-from ._peelforce import BranchStructure, FixedPoint, peel_force_derivative
+from ._peelforce import BranchStructure, FixedPoint
 from .validate import choice, flag, function, in_range, nonnegative, optional, state
 from .validate import params as _params
 
@@ -69,39 +69,6 @@ def _folds(params: PeelParams) -> BranchStructure:
         raise ValueError(f"V={params.V} is outside the stick-slip window: f(v, V) has no folds "
                          f"(law {params.force!r})")
     return bs
-
-
-def _fprime(params: PeelParams) -> Callable[[float], float]:
-    """``v -> f'(v, V)`` of the law (fvV: the generated derivative, as before laws were data)."""
-    if params.force.kind == "paper":
-        return lambda v: peel_force_derivative(v, params.V)
-    return lambda v: params.force.df(v, params.V)
-
-
-def _law_free(params: PeelParams) -> PeelParams:
-    """``params`` with the paper's law, for the functions of :mod:`peelapprox._alpha` that read only V, I, k, R (no
-    peel force) but accept the paper's law only (``inertial_period``, ``inertial_frequency``,
-    ``wkb_amplitude_phase``)."""
-    return params if params.force.kind == "paper" else params.replace(force=PeelForce.paper())
-
-
-def _periods(params: PeelParams, bs: BranchStructure) -> InertialPeriods:
-    """:func:`peelapprox.inertial_periods` at the folds of the law (``bs``): the same three periods."""
-    assert bs.f_min is not None and bs.f_max is not None  # caller: has_folds
-    pp = _law_free(params)
-    Fm = 0.5 * (bs.f_min + bs.f_max)
-    return InertialPeriods(inertial_period(pp, bs.f_min), inertial_period(pp, bs.f_max), inertial_period(pp, Fm),
-                           bs.f_min, bs.f_max, Fm)
-
-
-def _cd_damping_time(params: PeelParams, F: float, v: float) -> float:
-    """:func:`peelapprox.cd_damping_time` with f' of the law ``params.force``."""
-    if params.force.kind == "paper":
-        return cd_damping_time(params, F, v)
-    fp = float(params.force.df(v, params.V))
-    if not fp > 0:
-        raise ValueError(f"v={v} must be on a stable branch of the law {params.force!r} at V={params.V} (f'(v) > 0)")
-    return float(_damping_time(params.R, fp, F))
 
 
 def crude_branch_time(params: PeelParams) -> float:
@@ -162,7 +129,7 @@ def quasi_static_branch_time(
     else:
         v_in = bs.v_land_cd if v_in is None else v_in
         v_f = bs.v_min if v_f is None else v_f
-    fpr = _fprime(params) if fprime is None else fprime
+    fpr = (lambda v: law_fprime(params, v)) if fprime is None else fprime
     k, V = params.k, params.V
     if rate == "kV":
         integrand = lambda v: float(fpr(v)) / (k * V)  # noqa: E731
@@ -232,7 +199,7 @@ def slope_criterion(params: PeelParams, *, F_in: float, alphadot_in: float, alph
     if alpha0 == 0.0:
         raise ValueError(f"alpha0 must be finite and non-zero (signed amplitude), got {alpha0}")
     tol = nonnegative("tol", tol)
-    nat = float(inertial_frequency(_law_free(params), F_in)) * alpha0
+    nat = float(inertial_frequency(params, F_in)) * alpha0
     ratio = alphadot_in / nat
     return SlopeCriterion(nat, ratio, bool(0.0 < ratio <= 1.0 + tol), tol)
 
@@ -335,11 +302,11 @@ def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: f
             fp.fprime, fp.stable, None, None, None, None, None, None, None, None, None, None, None, None, None,
             "n/a", "stable")
     assert bs.v_max is not None and bs.f_max is not None and bs.v_min is not None and bs.f_min is not None
-    per = _periods(params, bs)
+    per = inertial_periods(params)
     if bs.v_land_cd is None:  # a table that stops below f_max on CD: no AB->CD landing, no CD damping time
         raise ValueError(f"params.force: {params.force!r} at V={params.V} never reaches f_max={bs.f_max} N on its "
                          "fast branch within its domain: an AB->CD jump could not land (extend the table)")
-    tau_cd = _cd_damping_time(params, per.F_mean, bs.v_land_cd)
+    tau_cd = cd_damping_time(params, per.F_mean, bs.v_land_cd)
     ratio = per.at_mean / tau_cd
     inertia = "low" if ratio < 1.0 else ("intermediate" if ratio < 5.0 else "high")
     gap = (bs.f_max - bs.f_min) / bs.f_max

@@ -39,7 +39,8 @@ from ._peelforce import (
     peel_force_lnv_jit,
 )
 
-__all__ = ["LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "paper_coefficients"]
+__all__ = ["LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "pack_inlined", "pack_law", "paper_law",
+           "paper_coefficients"]
 
 #: ``law(x, coef, form) -> (float, float, float)`` (module docstring).
 LAW_SIG = types.UniTuple(types.float64, 3)(types.float64, types.float64[::1], types.int64)
@@ -59,6 +60,19 @@ def paper_law(x, coef, form):
         f, fp = peel_force_fp_jit(x, coef[0], coef[1])
         return f, fp, np.nan
     return peel_force_fpp_jit(x, coef[0], coef[1])
+
+
+@kernel(inline="always")
+def pack_inlined(p, law, coef):
+    """What a field with the paper's law inlined receives from a driver copy: its parameter vector ``p`` (fvV
+    reads ``p[M_B], p[M_A]``); ``law`` and ``coef`` unused (:func:`peelapprox._jit.rebind`)."""
+    return p
+
+
+@kernel(inline="always")
+def pack_law(p, law, coef):
+    """What a field taking the law as an argument receives from a driver copy: ``(p, law, coef)``."""
+    return (p, law, coef)
 
 
 #: The compiled laws by kind (module docstring).

@@ -67,7 +67,6 @@ import numpy as np
 
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, wkb_amplitude_phase
-from ._estimate import _law_free
 from ._law import ALL_LAWS
 from ._law_compiled import compiled_law
 from ._packing import model_block
@@ -303,7 +302,7 @@ def reduced_segment(
         elif alpha_in is None or alphadot_in is None:
             raise ValueError("alpha_model='sinusoid' needs (amplitude, phase) or (alpha_in, alphadot_in)")
         else:
-            amplitude, phase = wkb_amplitude_phase(_law_free(params), F_in=F_in, alpha_in=alpha_in,
+            amplitude, phase = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in,
                                                    alphadot_in=alphadot_in, F_rate=s)
         alpha_in, alphadot_in = (float(x) for x in _sinusoid(0.0, amplitude, phase, F_in, s, params.R, params.I))
     elif am in (K.AM_EXP, K.AM_STATIC):

@@ -39,7 +39,7 @@ from ._alpha import _decay, _harmonic, _restoring, _sinusoid
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from ._jit import kernel, rebind
-from ._law_abi import LAW_LNV, LAW_TYPE
+from ._law_abi import LAW_LNV, LAW_TYPE, pack_inlined, pack_law
 from ._packing import M_A, M_B, M_I, M_K, M_R, M_V, N_M
 from ._peelforce import peel_force_fp_jit
 from ._status import DONE, F_NONPOSITIVE, MAX_STEPS, NONFINITE, OUT_FULL, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
@@ -159,18 +159,6 @@ def field_law(y, P, out):
     _field_at(y, q, v, g, out)
 
 
-@kernel(inline="always")
-def _pack_paper(q, law, coef):
-    """What the inlined-law driver's field receives: ``q`` (fvV reads ``q[M_B], q[M_A]``)."""
-    return q
-
-
-@kernel(inline="always")
-def _pack_law(q, law, coef):
-    """What the law driver's field receives: ``(q, law, coef)``."""
-    return (q, law, coef)
-
-
 @kernel
 def _store(out, row, y, q):
     """Row ``row`` of the output: (t, v, F, α, α̇) at state y."""
@@ -275,8 +263,8 @@ RUN_SIG = _t.int64(_A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.floa
 
 #: The two copies of :func:`_run`: the paper's law inlined (False) and the law as an argument (True).
 _RUNS = {
-    False: kernel(rebind(_run, _FIELD=field, _PACK=_pack_paper, _dop=make_dop853(field)), name="segment_run_inlined"),
-    True: kernel(rebind(_run, _FIELD=field_law, _PACK=_pack_law, _dop=make_dop853(field_law)),
+    False: kernel(rebind(_run, _FIELD=field, _PACK=pack_inlined, _dop=make_dop853(field)), name="segment_run_inlined"),
+    True: kernel(rebind(_run, _FIELD=field_law, _PACK=pack_law, _dop=make_dop853(field_law)),
                  name="segment_run_law"),
 }
 

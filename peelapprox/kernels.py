@@ -60,6 +60,8 @@ from ._law_abi import (
     LAW_SIG,
     LAW_TYPE,
     LAWS,
+    pack_inlined,
+    pack_law,
     paper_coefficients,
     paper_law,
 )
@@ -77,6 +79,7 @@ __all__ = [
     "kernel", "rebind", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
     "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "paper_coefficients",
+    "pack_inlined", "pack_law",
     "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
     "table_law", "table_coefficients", "family_kernel", "expression_kernel",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
@@ -121,14 +124,31 @@ def regularized_parameters(params, eps: float, laws: tuple[str, ...] = ("paper",
     return q
 
 
+@kernel(inline="always")
+def _field_at(y, q, v, f):
+    """XDAE's ``M⁻¹ φ`` at ``y`` given ``v`` and ``f(v)`` (whichever law gave it), as a new array."""
+    c, _ = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
+    return np.array([r[0], r[1], r[2], r[3]])
+
+
+@kernel(inline="always")
+def _jacobian_at(y, q, v, fp):
+    """The Jacobian of :func:`_field_at` given ``v`` and ``f'(v)``, a (4, 4) array."""
+    c, dc = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
+    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
+    out = np.empty((4, 4))
+    for i in range(16):
+        out[i // 4, i % 4] = j[i]
+    return out
+
+
 @kernel
 def regularized_field(y, q):
     """XDAE's ``M⁻¹ φ(X)`` at ``y = (α, ω, F, v)`` as a new array (``q``: :func:`regularized_parameters`)."""
     v = max(y[3], 1e-300)  # Newton iterates may probe v <= 0; accepted steps are checked
     f, _ = peel_force_fp_jit(v, q[M_B], q[M_A])
-    c, _ = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
-    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
-    return np.array([r[0], r[1], r[2], r[3]])
+    return _field_at(y, q, v, f)
 
 
 @kernel
@@ -136,12 +156,7 @@ def regularized_field_jacobian(y, q):
     """The Jacobian of :func:`regularized_field`, a (4, 4) array (with ``eps = 1`` in ``q``: ∂φ/∂X itself)."""
     v = max(y[3], 1e-300)
     _, fp = peel_force_fp_jit(v, q[M_B], q[M_A])
-    c, dc = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
-    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
-    out = np.empty((4, 4))
-    for i in range(16):
-        out[i // 4, i % 4] = j[i]
-    return out
+    return _jacobian_at(y, q, v, fp)
 
 
 @kernel
@@ -149,9 +164,7 @@ def _regularized_field_law(y, q, law, coef):
     """:func:`regularized_field` for the law ``law`` with the coefficients ``coef`` (``LAW_FP``)."""
     v = max(y[3], 1e-300)
     f, _, _ = law(v, coef, LAW_FP)
-    c, _ = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
-    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
-    return np.array([r[0], r[1], r[2], r[3]])
+    return _field_at(y, q, v, f)
 
 
 @kernel
@@ -159,12 +172,7 @@ def _regularized_field_jacobian_law(y, q, law, coef):
     """:func:`regularized_field_jacobian` for the law ``law`` with the coefficients ``coef``."""
     v = max(y[3], 1e-300)
     _, fp, _ = law(v, coef, LAW_FP)
-    c, dc = closure(y[0], q[M_GEOM], q[M_R], q[M_L])
-    j = regularized_jacobian(y[0], y[1], y[2], v, c, dc, fp, q[Q_EPS], q[M_V], q[M_I], q[M_K], q[M_R])
-    out = np.empty((4, 4))
-    for i in range(16):
-        out[i // 4, i % 4] = j[i]
-    return out
+    return _jacobian_at(y, q, v, fp)
 
 
 def regularized_law_field() -> tuple[Any, Any]:
