@@ -38,7 +38,12 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from ._benettin import LyapunovResult
 
-__all__ = ["TANGENT_OPTIONS", "lyapunov_variational", "tangent_solve"]
+__all__ = ["TANGENT_OPTIONS", "VARIATIONAL_LAWS_NOTE", "lyapunov_variational", "tangent_solve"]
+
+#: Who refuses a law other than the paper's, and why (the ``where`` of the refusal): the DiffSL model is printed
+#: from the paper's symbolic law only, for now (issue 15).
+VARIATIONAL_LAWS_NOTE = ("lyapunov method 'variational' (lyapunov_variational: its DiffSL model is printed from the "
+                         "paper's law only; the methods 'two-trajectory', 'tangent' and 'return-map' run any law)")
 
 #: pydiffsol options of the tangent model: :data:`peelapprox.kernels.DIFFSOL_OPTIONS` and a
 #: practically unlimited number of error-test failures per solve (the default,
@@ -137,7 +142,8 @@ def lyapunov_variational(
     Raises
     ------
     ValueError
-        Bad arguments (the message names the argument and its range).
+        Bad arguments (the message names the argument and its range); a law ``params.force`` other than the
+        paper's (the message names the method and the law: the DiffSL model is printed from fvV only, for now).
     peelapprox.kernels.PeerUnavailableError
         (an ``ImportError``) pydiffsol is not installed (``pip install peelapprox[bench]``).
     peelapprox.SolverFailure
@@ -147,7 +153,7 @@ def lyapunov_variational(
 
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)
-    _params("params", params)
+    _params("params", params, where=VARIATIONAL_LAWS_NOTE)
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
     eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)

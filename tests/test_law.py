@@ -334,9 +334,6 @@ def test_saved_trajectory_records_the_law(tmp_path):
 CONSUMERS = {
     "estimate": lambda p: pa.estimate(p),
     "reduced_segment": lambda p: pa.reduced_segment(p, "AB", F_in=250.0),
-    "window_run": lambda p: exact.window_run(p),
-    "lyapunov": lambda p: exact.lyapunov(p),
-    "hybrid_field": lambda p: exact.hybrid_field(p),
 }
 
 
