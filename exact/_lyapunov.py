@@ -68,6 +68,9 @@ def lyapunov(
     Parameters
     ----------
     params : PeelParams
+        With any law ``params.force`` that :func:`exact.simulate` runs (its scales and branches are the law's:
+        :func:`peelapprox.branch_structure` with ``force``); ``"variational"``: the paper's law only (ValueError
+        naming the method and the law otherwise).
     method : {"two-trajectory", "tangent", "return-map", "variational"}
         How (module docstring; costs and agreement in docs/usage.md and docs/dynamics.md).
     t_transient : float
