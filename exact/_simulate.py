@@ -21,7 +21,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox.kernels import model_block
+from peelapprox.kernels import CompiledLaw, model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -460,14 +460,29 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
         else:
             why = ""
         lo, hi = cl.domain
-        if (status == S.NO_ROOT and lo > 0) or (status == S.V_CEILING and hi < V_CEILING):
-            status = S.LAW_DOMAIN  # the floor (ceiling) was the law's domain, not the model's breakdown
+        status, what = domain_status(status, cl, sd["v"], V_CEILING)
         raise S.status_error(
             status, t=sd["t"], state=sd, partial=build(False),
             prefix=f"hybrid solver at t={sd['t']:.9g} on {sd['branch']}: ",
             f_zero=bs.f_zero, f_min=bs.f_min, level=BREAKDOWN_LEVEL, v=sd["v"], v_ceiling=V_CEILING,
-            v_floor=v_floor, why=why, lo=lo, hi=hi, law=repr(params.force),
+            v_floor=v_floor, why=why, lo=lo, hi=hi, law=repr(params.force), what=what,
         )
+
+
+def domain_status(status: int, cl: CompiledLaw, v: float, ceiling: float) -> tuple[int, str]:
+    """``(status, what)``: a driver's breakdown status re-read as ``LAW_DOMAIN`` where the law's domain, not the
+    model, stopped the run -- the floor on AB (NO_ROOT) or a CD→AB landing (NO_LANDING) at a domain starting above
+    0, the CD ceiling below ``ceiling`` -- with ``what`` happened (the message's first words)."""
+    lo, hi = cl.domain
+    bs = cl.structure
+    if status == S.NO_ROOT and lo > 0:
+        return S.LAW_DOMAIN, f"on AB the level F(1 - cos theta) fell to f = {bs.f_zero:.6g} N at the start of the law"
+    if status == S.NO_LANDING and lo > 0:
+        return S.LAW_DOMAIN, (f"the CD->AB jump from f_min = {bs.f_min:.6g} N would land below the start of the law "
+                              f"(f = {bs.f_zero:.6g} N there)")
+    if status == S.V_CEILING and hi < ceiling:
+        return S.LAW_DOMAIN, f"v = {v:.6g} m/s rose above the end of the law on CD"
+    return status, ""
 
 
 def hybrid_field(params: PeelParams, v_floor: float | None = None, *,

@@ -226,7 +226,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
     from ._benettin import natural_scales
-    from ._simulate import ATOL_SCALE, _param_vector, initial_state, simulate
+    from ._simulate import ATOL_SCALE, _param_vector, domain_status, initial_state, simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
@@ -282,18 +282,19 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
             break
         if status != FOLD:
             lo, hi = cl.domain
-            if (status == NO_ROOT and lo > 0) or (status == V_CEILING and math.isfinite(hi)):
-                status = _st.LAW_DOMAIN  # the floor (ceiling) was the law's domain, not the model's breakdown
+            status, what = domain_status(status, cl, math.exp(y[3]), math.inf)
             raise status_error(status, t=t_transient + t + y[0], state=where(t + y[0]), prefix="tangent integration: ",
                                where=f"at t = {t_transient + t + y[0]:.6g} s", limit=int(max_steps),
                                f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]), lo=lo, hi=hi,
-                               law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]))
+                               law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)
         t += y[0]
         field(y[:4], g_minus)
         v_land = p[H.P_VLCD] if br == 0 else p[H.P_VLAB]
         if not v_land > 0.0:
-            raise status_error(NO_LANDING, t=t_transient + t, state=where(t), prefix="tangent integration: ",
-                               where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero)
+            code, what = domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
+            raise status_error(code, t=t_transient + t, state=where(t), prefix="tangent integration: ",
+                               where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero, what=what,
+                               lo=cl.domain[0], hi=cl.domain[1], law=repr(params.force))
         y[0], y[3] = 0.0, math.log(v_land)
         field(y[:4], g_plus)
         y[4:] = saltation(y[4:], g_minus, g_plus)

@@ -36,6 +36,7 @@ from scipy.optimize import brentq
 
 from ._law import PeelForce
 from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients
+from ._law_codegen import expression_kernel, family_kernel
 from ._law_table_jit import table_coefficients, table_law
 from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint
 from ._peelforce import branch_structure as _paper_structure
@@ -127,16 +128,16 @@ def law_domain(force: PeelForce) -> tuple[float, float]:
 
 
 def _kernel(force: PeelForce, V: float) -> tuple[Callable, np.ndarray, bool]:
-    """``(kernel, coef, inlined)`` of ``force`` at V."""
+    """``(kernel, coef, inlined)`` of ``force`` at V (module docstring's table)."""
     if force.kind == "paper":
         return LAWS["paper"], paper_coefficients(V), True
     if force.kind == "family":
-        if force.name == "cubic":
-            coef = np.array([x for _, x in force.coefficients], dtype=float)
-            return LAWS["cubic_v"], coef, False
-    if force.kind == "tabulated":
-        return table_law, table_coefficients(force.tables, V), False
-    raise ValueError(f"params.force: {force!r} has no compiled kernel yet (issue 15)")
+        fn, pack = family_kernel(str(force.name))
+        return fn, pack(V, tuple(x for _, x in force.coefficients)), False
+    if force.kind == "expression":
+        fn, pack = expression_kernel(str(force.source))
+        return fn, pack(V), False
+    return table_law, table_coefficients(force.tables, V), False
 
 
 def law_structure(force: PeelForce, V: float, fn: Callable, coef: np.ndarray,

@@ -85,8 +85,9 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
     unused = sorted(n for n, s in names.items() if s not in e.free_symbols)
     if unused:
         raise ValueError(f"constant(s) {', '.join(unused)} do not occur in the expression {expr!r}")
-    e = e.xreplace({s: (sp.Integer(int(val)) if isinstance(val, (int, np.integer)) else sp.Float(float(val)))
-                    for s, val in ((names[n], constants[n]) for n in names)})
+    e = e.xreplace({s: sp.Float(float(val)) for s, val in ((names[n], constants[n]) for n in names)})
+    # one canonical number: an integral float is the integer (a=150 and a=150.0, "150.0*v" and "150*v" are one law)
+    e = e.xreplace({x: sp.Integer(int(x)) for x in e.atoms(sp.Float) if float(x).is_integer()})
     unknown = sorted(s.name for s in e.free_symbols - {v, V})
     if unknown:
         raise ValueError(f"unknown symbol(s) {', '.join(unknown)} in the expression {expr!r}: a law may use v "

@@ -1,9 +1,12 @@
 """The families of peel-force laws: one fixed form each, its coefficients as data (issue 15).
 
-A family is a formula ``f(v, V; c)`` written once here, with its coefficients ``c`` passed as numbers, so
-that changing a coefficient changes data, not code.  Each family is a :class:`Family` in :data:`FAMILIES`:
-its coefficient names and defaults, whether it depends on the pull speed V, and a numpy evaluator of
-``f``, ``f'`` and ``f''`` in v.  :class:`peelapprox.PeelForce` (``PeelForce.family(name, **c)`` and the
+A family is a formula ``f(v, V; c)`` with its coefficients ``c`` passed as numbers, so that changing a
+coefficient changes data, not code.  Each family is a :class:`Family` in :data:`FAMILIES`: its coefficient
+names and defaults, whether it depends on the pull speed V, and a numpy evaluator of ``f``, ``f'`` and
+``f''`` in v.  The formula itself is written once, in sympy, in :mod:`peelapprox._law_sympy`; the evaluator
+is the law rendered from it into :mod:`peelapprox._generated_laws` (the same source numba compiles into
+the family's law of the ABI, :func:`peelapprox._law_codegen.family_kernel`).
+:class:`peelapprox.PeelForce` (``PeelForce.family(name, **c)`` and the
 convenience constructors) is the public face; this module knows nothing of it.
 
 * ``paper`` — Eq. (fvV) of De, Maybhate & Ananthakrishna (PRE 2004) with its 14 numbers as coefficients::
@@ -34,6 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _generated_laws
+
 __all__ = ["FAMILIES", "Family"]
 
 #: An evaluator: (v array, V float, coefficient tuple in the family's order, order 0|1|2) -> array.
@@ -57,40 +62,20 @@ class Family:
         return tuple(n for n, _ in self.defaults)
 
 
-def _paper(v: np.ndarray, V: float, c: tuple, order: int) -> np.ndarray:
-    a1, p1, a2, p2, a3, v3, a4, q4, a5, a6, q6, a7, q7, p5 = c
-    A = a5 - a6 * V**q6 - a7 * V**q7  # the prefactor of -v^p5
-    e = a3 * np.exp(v / v3)
-    if order == 0:
-        return a1 * v**p1 + a2 * v**p2 + e - a4 * V**q4 - A * v**p5
-    if order == 1:
-        return a1 * p1 * v ** (p1 - 1) + a2 * p2 * v ** (p2 - 1) + e / v3 - A * p5 * v ** (p5 - 1)
-    return (a1 * p1 * (p1 - 1) * v ** (p1 - 2) + a2 * p2 * (p2 - 1) * v ** (p2 - 2) + e / (v3 * v3)
-            - A * p5 * (p5 - 1) * v ** (p5 - 2))
+def _generated(name: str) -> Evaluator:
+    """The evaluator of the family ``name``: its law rendered from the symbolic form (:mod:`peelapprox._law_sympy`
+    by :mod:`peelapprox._law_codegen` into :mod:`peelapprox._generated_laws`), evaluated by numpy on arrays.
 
+    The same source is the compiled law of the ABI, so the formula lives in one place; f and f' come from the
+    form ``LAW_FP`` and f'' from ``LAW_FPP`` (x = v).
+    """
+    law, pack = _generated_laws.LAWS[name]
 
-def _cubic(v: np.ndarray, V: float, c: tuple, order: int) -> np.ndarray:
-    a, b, cc, d = c
-    if order == 0:
-        return a + v * (b + v * (-cc + v * d))
-    if order == 1:
-        return b + v * (-2 * cc + 3 * d * v)
-    return -2 * cc + 6 * d * v
+    def evaluate(v: np.ndarray, V: float, c: tuple, order: int) -> np.ndarray:
+        out = np.asarray(law(v, pack(V, c), 2 if order == 2 else 1)[order], dtype=float)
+        return out if out.shape == np.shape(v) else np.broadcast_to(out, np.shape(v)).copy()
 
-
-def _power_branches(v: np.ndarray, V: float, c: tuple, order: int) -> np.ndarray:
-    A1, n1, v1, m, A2, n2 = c
-    x = (v / v1) ** m
-    g = 1.0 + x  # f = A1 v^n1 / g + A2 v^n2
-    t = A1 * v**n1 / g
-    if order == 0:
-        return t + A2 * v**n2
-    # with s = m x / g = v g'/g:  v (v^n1/g)' = (n1 - s) v^n1/g,  v² (v^n1/g)'' = [(n1 - s)(n1 - s - 1) - v s'] v^n1/g
-    s = m * x / g
-    if order == 1:
-        return (t * (n1 - s) + A2 * n2 * v**n2) / v
-    vs = m * s / g  # v ds/dv = m² x / g² = m s / g
-    return (t * ((n1 - s) * (n1 - s - 1) - vs) + A2 * n2 * (n2 - 1) * v**n2) / (v * v)
+    return evaluate
 
 
 FAMILIES: dict[str, Family] = {
@@ -100,14 +85,14 @@ FAMILIES: dict[str, Family] = {
                (("a1", 400.0), ("p1", 0.35), ("a2", 110.0), ("p2", 0.15), ("a3", 130.0), ("v3", 11.0),
                 ("a4", 2.0), ("q4", 1.5), ("a5", 415.0), ("a6", 45.0), ("q6", 0.4), ("a7", 0.35),
                 ("q7", 2.15), ("p5", 0.5)),
-               True, ("v3",), _paper,
+               True, ("v3",), _generated("paper"),
                "De, Maybhate & Ananthakrishna, Phys. Rev. E (2004), Eq. fvV"),
         Family("cubic", "cubic", (("a", 150.0), ("b", 300.0), ("c", 300.0), ("d", 80.0)),
-               False, (), _cubic,
+               False, (), _generated("cubic"),
                "the smooth normal form of the N-shaped law of Hong & Yue, Phys. Rev. Lett. 74, 254 (1995)"),
         Family("power_branches", "power_branches",
                (("A1", 338.5), ("n1", 0.1038), ("v1", 3.244), ("m", 1.074), ("A2", 14.36), ("n2", 0.8502)),
-               False, ("A1", "v1", "m"), _power_branches,
+               False, ("A1", "v1", "m"), _generated("power_branches"),
                "Maugis & Barquins (1988); Barquins & Ciccotti, Int. J. Adhes. Adhes. 17, 65 (1997); "
                "defaults calibrated to fvV at V = 1 m/s"),
     )

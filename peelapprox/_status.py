@@ -66,8 +66,8 @@ STATUS: dict[int, Status] = {s.code: s for s in (
     Status(F_NONPOSITIVE, "F_nonpositive", ModelBreakdown, "the pull force reached 0"),
     Status(NONFINITE, "nonfinite", ModelBreakdown, "the state became non-finite"),
     Status(LAW_DOMAIN, "law_domain", ModelBreakdown,
-           "v = {v:.6g} m/s left the domain [{lo:.6g}, {hi:.6g}] m/s of the peel-force law {law}: the law is not "
-           "extrapolated (extend the table or the law's range)"),
+           "{what}: the peel-force law {law} is defined on [{lo:.6g}, {hi:.6g}] m/s only and is not extrapolated "
+           "(extend the table or the law's range)"),
     Status(STEP_FAIL, "step_fail", SolverFailure, "step size collapsed"),
     Status(MAX_STEPS, "max_steps", SolverBudgetExceeded, "max_steps={limit} steps used"),
     Status(T_MAX, "t_max", SolverBudgetExceeded, "v did not reach v_f={v_f} before t_max={limit} s"),

@@ -5,7 +5,8 @@ Everything here is compiled by :func:`peelapprox._jit.kernel` from the one gener
 driver: the peel force (fvV) in the velocity and in the ln v form, the law ABI by which a driver takes the
 peel-force law as a function argument with its coefficients as data (:mod:`peelapprox._law_abi`: ``LAW_SIG``,
 ``LAW_TYPE``, the forms ``LAW_*``, the compiled laws ``LAWS``; the tabulated law ``table_law`` and its packing
-``table_coefficients``, :mod:`peelapprox._law_table_jit`), the ``cos θ`` closures with the
+``table_coefficients``, :mod:`peelapprox._law_table_jit`; the laws generated from their symbolic form,
+:func:`family_kernel` and :func:`expression_kernel` of :mod:`peelapprox._law_codegen`), the ``cos θ`` closures with the
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
 system XDAE and its Jacobian (also as whole fields of the state and a packed parameter vector, the form the
 stiff solvers call).  The model block every driver's parameter vector starts with (:mod:`peelapprox._packing`:
@@ -59,11 +60,10 @@ from ._law_abi import (
     LAW_SIG,
     LAW_TYPE,
     LAWS,
-    cubic_v_law,
-    cubic_v_structure,
     paper_coefficients,
     paper_law,
 )
+from ._law_codegen import expression_kernel, family_kernel
 from ._law_compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
 from ._law_table_jit import table_coefficients, table_law
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
@@ -76,9 +76,9 @@ Q_EPS = N_M
 __all__ = [
     "kernel", "rebind", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
-    "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "cubic_v_law", "paper_coefficients",
-    "cubic_v_structure", "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
-    "table_law", "table_coefficients",
+    "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "paper_coefficients",
+    "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
+    "table_law", "table_coefficients", "family_kernel", "expression_kernel",
     "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
     "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",
     "regularized_field_jacobian", "regularized_law_field", "peel_force_coefficients", "branch_inverse_at",

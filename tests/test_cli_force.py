@@ -124,15 +124,21 @@ def test_bad_law_options_are_one_line_errors(flags, says, capsys):
     assert line.startswith("peelapprox estimate: error:") and says in line
 
 
-def test_an_unsupported_consumer_is_a_one_line_error(capsys):
-    """Hypothesis: a consumer that does not honour a law yet (``estimate``; the regularised method of
-    ``simulate``) refuses it with its own ValueError, which reaches the user as one line, exit 2, no
-    traceback, naming the law."""
-    line = _error([*BASE, "--force-family", "cubic"], capsys)
-    assert "not yet supported by estimate" in line and "PeelForce.cubic(a=150, b=300, c=300, d=80)" in line
-    line = _error(["simulate", "--V", "1.2", "--I", "1e-3", "--t-end", "0.1", "--method", "regularized",
-                   "--force-family", "power_branches", "--quiet"], capsys)
-    assert "issue 15" in line and "power_branches" in line
+def test_a_law_the_run_cannot_use_is_a_one_line_error(capsys, tmp_path):
+    """Hypothesis: a law a consumer refuses (a table of the cubic ending at 2.2 m/s, below where its AB→CD jumps
+    land, 2.37 m/s: ``simulate`` refuses it before running) reaches the user as one line with exit status 2, no
+    traceback, naming params.force and what to do."""
+    import numpy as np
+
+    from peelapprox import PeelForce
+
+    v = np.exp(np.linspace(np.log(0.05), np.log(2.2), 60))
+    f = PeelForce.cubic().f(v, 1.0)
+    path = tmp_path / "short.csv"
+    path.write_text("v,f\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(v, f)))
+    line = _error(["simulate", "--V", "1.2", "--I", "1e-3", "--t-end", "0.1", "--force-table", str(path),
+                   "--quiet"], capsys)
+    assert line.startswith("peelapprox simulate: error: params.force") and "extend the table" in line
 
 
 # ------------------------------------------------------------------------------------------------ the table file

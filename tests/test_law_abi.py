@@ -14,14 +14,12 @@ import exact._hybrid as H
 import exact._hybrid_law as HL
 import exact._simulate as ES
 from exact import Budget, Hybrid, SaveAt, State
-from peelapprox import PeelParams
+from peelapprox import PeelForce, PeelParams, branch_structure
 from peelapprox.kernels import (
     LAW_FP,
     LAW_FPP,
     LAW_LNV,
-    LAWS,
-    cubic_v_law,
-    cubic_v_structure,
+    family_kernel,
     paper_coefficients,
     paper_law,
     peel_force_fp_jit,
@@ -40,27 +38,16 @@ def _poly(coef):
     return np.array([d, -c, b, a])
 
 
-class _CubicForce:
-    """The hook ``params.force`` of exact._simulate (kind, coefficients(V), branch_structure(V))."""
+def _give_paper_as_law(monkeypatch) -> None:
+    """Route runs of the paper's law through the law driver (``inlined=False``: the law as an argument) by
+    substituting ``exact._hybrid_law.law_for``."""
+    from peelapprox.kernels import CompiledLaw, compiled_law
 
-    kind = "cubic_v"
+    def law_for(params):
+        cl = compiled_law(params.force, params.V)
+        return CompiledLaw(cl.force, cl.V, cl.fn, cl.coef, cl.structure, cl.domain, False)
 
-    def coefficients(self, V):
-        return COEF
-
-    def branch_structure(self, V):
-        return cubic_v_structure(COEF, V)
-
-
-def _give_law(monkeypatch, force) -> None:
-    """Route runs through the law driver with ``force`` (kind, coefficients(V), branch_structure(V)) by
-    substituting ``exact._hybrid_law.law_for``: until PeelForce's families are connected to the compiled laws,
-    this is how the law driver is reached (issue 15)."""
-    from peelapprox.kernels import CompiledLaw
-
-    monkeypatch.setattr(HL, "law_for", lambda params: CompiledLaw(
-        params.force, params.V, LAWS[force.kind], np.ascontiguousarray(force.coefficients(params.V), dtype=float),
-        force.branch_structure(params.V), (0.0, np.inf), False))
+    monkeypatch.setattr(HL, "law_for", law_for)
 
 
 def test_paper_law_is_the_inlined_law_bitwise():
@@ -87,18 +74,6 @@ def test_paper_law_is_the_inlined_law_bitwise():
             assert np.array_equal(g0, g1)
 
 
-class _PaperForce(_CubicForce):
-    kind = "paper"
-
-    def coefficients(self, V):
-        return paper_coefficients(V)
-
-    def branch_structure(self, V):
-        from peelapprox import branch_structure
-
-        return branch_structure(V)
-
-
 def test_paper_law_through_the_law_driver_is_the_default_run_bitwise(monkeypatch):
     """Hypothesis: the paper's law given as a law (``params.force`` of kind "paper": the law driver, an indirect
     call per field evaluation) gives the default run (the driver with the law inlined) bit for bit: every stored
@@ -109,7 +84,7 @@ def test_paper_law_through_the_law_driver_is_the_default_run_bitwise(monkeypatch
     for V, I, kw in ((1.0, 1e-5, dict(save="steps")), (4.0, 1e-2, dict(t_eval=np.linspace(0.0, 0.05, 101)))):
         a = simulate(PeelParams(V=V, I=I), kw.get("t_eval", [0.3])[-1], **kw)
         with monkeypatch.context() as m:
-            _give_law(m, _PaperForce())
+            _give_paper_as_law(m)
             b = simulate(PeelParams(V=V, I=I), kw.get("t_eval", [0.3])[-1], **kw)
         for name in ("t", "alpha", "omega", "F", "v", "branch"):
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
@@ -122,21 +97,23 @@ def test_paper_law_through_the_law_driver_is_the_default_run_bitwise(monkeypatch
 
 
 def test_cubic_law_against_numpy_polynomials():
-    """Hypothesis: the three forms of ``cubic_v_law`` are the cubic, its derivatives and ``v f'`` as numpy's
-    ``polyval``/``polyder`` give them (an independent evaluation: Horner in another arrangement), to 1e-13
-    relative of the largest term (a few roundings of terms of size ~d v^3)."""
+    """Hypothesis: the three forms of the cubic family's compiled law (generated from its sympy form) are the
+    cubic, its derivatives and ``v f'`` as numpy's ``polyval``/``polyder`` give them (an independent evaluation:
+    Horner in another arrangement), to 1e-13 relative of the largest term (a few roundings of terms of size
+    ~d v^3)."""
+    cubic_v_law, pack = family_kernel("cubic")
+    coef = pack(1.2, tuple(COEF))
     P = _poly(COEF)
     for v in (1e-6, 0.1, 0.6909, 1.25, 2.0, 7.0):
         scale = np.polyval(np.abs(P), v)
-        f, fp, fpp = cubic_v_law(v, COEF, LAW_FPP)
+        f, fp, fpp = cubic_v_law(v, coef, LAW_FPP)
         assert abs(f - np.polyval(P, v)) <= 1e-13 * scale
         assert abs(fp - np.polyval(np.polyder(P), v)) <= 1e-13 * scale / min(v, 1.0)
         assert abs(fpp - np.polyval(np.polyder(P, 2), v)) <= 1e-13 * scale / min(v, 1.0) ** 2
-        vv, f2, g = cubic_v_law(np.log(v), COEF, LAW_LNV)
+        vv, f2, g = cubic_v_law(np.log(v), coef, LAW_LNV)
         assert abs(vv - v) <= 1e-15 * v
         assert abs(f2 - f) <= 1e-13 * scale and abs(g - v * fp) <= 1e-13 * scale
-        assert cubic_v_law(v, COEF, LAW_FP)[:2] == (f, fp)
-    assert set(LAWS) == {"paper", "cubic_v"}
+        assert cubic_v_law(v, coef, LAW_FP)[:2] == (f, fp)
 
 
 def _numpy_folds(coef):
@@ -149,22 +126,22 @@ def _numpy_folds(coef):
 
 
 def test_cubic_structure_is_the_numpy_roots():
-    """Hypothesis: the closed-form folds and landings of ``cubic_v_structure`` are the roots numpy finds (the
-    companion-matrix eigenvalues): folds and landings to 1e-7 relative (``np.roots`` of the double root
-    ``v_max`` of ``f - f_max`` is only sqrt(eps)-accurate; the landing is a simple root, to ~1e-13), levels to
-    1e-13 (stationary at the folds)."""
-    bs = cubic_v_structure(COEF, 1.2)
+    """Hypothesis: the branch structure the solvers use for a cubic (folds by Brent's method on f', landings on
+    f, breakdown velocity) has the roots numpy finds (the companion-matrix eigenvalues): folds to 1e-13 relative
+    (Brent to ~4 ulp in ln v, numpy's simple roots of f' to ~1e-15), landings to 1e-7 (``np.roots`` of the double
+    root ``v_max`` of ``f - f_max`` is only sqrt(eps)-accurate), levels to 1e-13 (stationary at the folds); a
+    cubic with c² < 3 b d has no fold (f' > 0 throughout)."""
+    bs = branch_structure(1.2, force=PeelForce.cubic(*COEF))
     v_max, f_max, v_min, f_min, land_cd, land_ab = _numpy_folds(COEF)
     assert bs.has_folds and bs.f_zero == 150.0
     assert bs.v_max == pytest.approx(v_max, rel=1e-13) and bs.v_min == pytest.approx(v_min, rel=1e-13)
     assert bs.f_max == pytest.approx(f_max, rel=1e-13) and bs.f_min == pytest.approx(f_min, rel=1e-13)
     assert bs.v_land_cd == pytest.approx(land_cd, rel=1e-7) and bs.v_land_ab == pytest.approx(land_ab, rel=1e-7)
     assert 0 < bs.v_breakdown < 1e-9
-    with pytest.raises(ValueError, match="coef"):
-        cubic_v_structure([150.0, 300.0, 10.0, 80.0], 1.0)  # c^2 < 3 b d: no fold
+    assert not branch_structure(1.0, force=PeelForce.cubic(150.0, 300.0, 10.0, 80.0)).has_folds
 
 
-def test_second_law_runs_in_the_compiled_driver_with_its_own_folds(monkeypatch):
+def test_second_law_runs_in_the_compiled_driver_with_its_own_folds():
     """Hypothesis: a second law goes through the one compiled law driver (its signature list stays one entry and
     it cannot compile: ``driver(True)`` is compiled for ``RUN_SIG`` only), and gives that law's physics: every
     AB→CD jump leaves at the level ``G = F(1 + sin α) = f_max`` and every CD→AB jump at ``f_min`` of the cubic,
@@ -172,8 +149,7 @@ def test_second_law_runs_in_the_compiled_driver_with_its_own_folds(monkeypatch):
     1e-12 relative (the jump is taken at v = v_fold exactly and F = f(v_fold)/(1 + c), so G is f at the fold to a
     few roundings; f is stationary there, so the closed-form vs numpy v_max differences of ~1e-15 do not show),
     velocities 1e-7 (numpy's root of the double root, as above)."""
-    params = PeelParams(V=1.2, I=1e-5)
-    _give_law(monkeypatch, _CubicForce())
+    params = PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(*COEF))
     v0 = 0.5
     s0 = State(0.0, 0.0, 1.2 / 0.1, float(np.polyval(_poly(COEF), v0)), v0, "AB")
     run = HL.driver(True)

@@ -5,19 +5,23 @@
 One run prints a table of:
 
 * **field**: ns per evaluation of the hybrid field with the paper's law inlined (``hybrid_field``, the pattern
-  every driver used before) and through the law argument (``law(u, coef, LAW_LNV)``, an indirect call) for the
-  paper's law and the test cubic ``cubic_v`` (compiled loops, the best of 5; the law loop is compiled for the
-  law's function type, as the driver is, so the call is not specialised away);
+  every driver uses by default) and through the law argument (``law(u, coef, LAW_LNV)``, an indirect call) for
+  each kind of law, all of them fvV or a sample of it at V = 1 m/s (:data:`LAWS_OF_FVV`), and the cubic
+  (compiled loops, the best of 5; the law loop is compiled for the law's function type, as the driver is, so
+  the call is not specialised away);
 * **per step**: µs per accepted step of ``exact.simulate`` (rtol 1e-8, save="jumps", the best of the rounds)
-  on the benchmark scenes, for the tree at ``--before`` (default ``/work/main`` when it exists: the inlined
-  law) and for this tree, default (the driver with the law inlined) and with the paper's law given as a law
-  (the driver taking the law as an argument), each measured in its own process, alternating, so all see the
-  same machine load; and for the cubic law on stick-slip scenes of its own;
-* **second law**: the wall time of the first ``simulate`` with the cubic law in a process that has already run
-  a first law (the paper's, given as a law), with the number of numba compilations during it (numba's event
+  on the benchmark scenes, with the paper's law inlined (the default), and with fvV given as each other kind
+  of law -- the paper family (its 14 numbers as data), the expression typed as text, a table of 600 points
+  sampled from it (PCHIP in ln v) -- which follow the same orbits (to rounding, or to the table's
+  interpolation error), so the ratios are the cost of the law alone; each in its own process, alternating, so
+  all see the same machine load; optionally for the tree at ``--before`` too;
+* **second law**: the wall time of the first ``simulate`` with a second cubic (other coefficients) in a
+  process that has already run a first one, with the number of numba compilations during it (numba's event
   recorder);
 * **driver load**: ``import exact; exact.compile_kernels()`` in a new process, from a warm cache and from an
   empty one (``NUMBA_CACHE_DIR``), for both trees.
+
+An expression law's own compile and cached-load times are ``python -m comparisons.benchmark.expression_cost``'s.
 """
 
 from __future__ import annotations
@@ -34,14 +38,15 @@ from pathlib import Path
 
 import numpy as np
 
-from exact import hybrid_field, simulate
-from peelapprox import PeelForce, PeelParams
+from exact import hybrid_field
+from peelapprox import PeelForce, PeelParams, peel_force
 from peelapprox.io import fmt_number
-from peelapprox.kernels import LAW_TYPE, LAWS, paper_coefficients
+from peelapprox.kernels import LAW_TYPE, LAWS, compiled_law, paper_coefficients
 
+from .expression_cost import FVV_TEXT
 from .scenes import BENCH_SCENES
 
-__all__ = ["CUBIC_COEF", "CUBIC_COEF_2", "field_costs", "main"]
+__all__ = ["CUBIC_COEF", "CUBIC_COEF_2", "LAWS_OF_FVV", "field_costs", "fvv_as", "main"]
 
 _ROOT = Path(__file__).resolve().parents[2]
 #: f = 150 + 300 v - 300 v^2 + 80 v^3 [N] (folds at 0.691 and 1.809 m/s; tests/test_law_abi.py).
@@ -56,8 +61,23 @@ def _cubic_params(I: float) -> PeelParams:
     return PeelParams(V=1.2, I=I, force=PeelForce.cubic(*CUBIC_COEF))
 
 
+#: fvV as every kind of law, by name: the law each per-step and field figure is measured with (module docstring).
+LAWS_OF_FVV = ("paper_family", "expression", "tabulated")
+
+
+def fvv_as(kind: str, V: float) -> PeelForce:
+    """fvV as a law of ``kind`` (:data:`LAWS_OF_FVV`; a table: 600 points log-spaced over 1e-8-100 m/s at V)."""
+    if kind == "paper_family":
+        return PeelForce.paper_family()
+    if kind == "expression":
+        return PeelForce.expression(FVV_TEXT)
+    v = np.logspace(-8.0, 2.0, 600)
+    return PeelForce.tabulated(v, peel_force(v, V))
+
+
 def field_costs(n: int = 200_000) -> dict[str, float]:
-    """ns per hybrid field evaluation: the paper's law inlined, and through the law argument (paper, cubic)."""
+    """ns per hybrid field evaluation: the paper's law inlined, and through the law argument (fvV as each kind
+    of law, the cubic)."""
     from numba import njit, types
 
     rhs, p = hybrid_field(PeelParams(V=1.0, I=1e-5), 1e-9)
@@ -94,13 +114,16 @@ def field_costs(n: int = 200_000) -> dict[str, float]:
         return 1e9 * t / n
 
     y, out = np.array([0.0, 0.01, 10.0, -1.2]), np.empty(4)
-    cp, cc = paper_coefficients(1.0), np.array(CUBIC_COEF)
-    res = {}
+    laws = {"paper": (LAWS["paper"], paper_coefficients(1.0))}
+    for kind in (*LAWS_OF_FVV, "cubic"):
+        cl = compiled_law(PeelForce.cubic(*CUBIC_COEF) if kind == "cubic" else fvv_as(kind, 1.0), 1.0)
+        laws[kind] = (cl.fn, cl.coef)
+    res: dict[str, float] = {}
     for _ in range(2):  # alternate, keep the best
-        for key, fn in (("inline", lambda k: loop_inline(y, p, out, k)),
-                        ("paper", lambda k: loop_law(y, p, LAWS["paper"], cp, out, k)),
-                        ("cubic", lambda k: loop_law(y, p, LAWS["cubic_v"], cc, out, k))):
-            res[key] = min(res.get(key, math.inf), best(fn))
+        res["inline"] = min(res.get("inline", math.inf), best(lambda k: loop_inline(y, p, out, k)))
+        for key, (law, coef) in laws.items():
+            res[key] = min(res.get(key, math.inf),
+                           best(lambda k, law=law, coef=coef: loop_law(y, p, law, coef, out, k)))
     return res
 
 
@@ -108,8 +131,12 @@ _STEP_CODE = r"""
 import json, time, sys
 import exact
 from peelapprox import PeelParams
-scenes = json.loads(sys.argv[1])
-make = lambda V, I: PeelParams(V=V, I=I)
+scenes, kind = json.loads(sys.argv[1]), sys.argv[2]
+if kind == "default":
+    make = lambda V, I: PeelParams(V=V, I=I)
+else:
+    from comparisons.benchmark.law_cost import fvv_as
+    make = lambda V, I: PeelParams(V=V, I=I, force=fvv_as(kind, V))
 out = {}
 for name, V, I, alpha0, t_end in scenes:
     p = make(V, I)
@@ -124,35 +151,21 @@ print(json.dumps(out))
 """
 
 
-def _per_step(tree: Path) -> dict[str, float]:
-    """µs per step on the benchmark scenes (the paper's law, the default path), measured in a new process
-    running the package of ``tree``."""
+def _per_step(tree: Path, kind: str = "default") -> dict[str, float]:
+    """µs per step on the benchmark scenes with fvV as the law ``kind`` ("default": the paper's law inlined, or
+    one of :data:`LAWS_OF_FVV`), measured in a new process running the package of ``tree``."""
     scenes = [(s.name, s.V, s.I, s.alpha0, _T_END[s.name]) for s in BENCH_SCENES]
     env = dict(os.environ, PYTHONPATH=str(tree))
-    r = subprocess.run([sys.executable, "-c", _STEP_CODE, json.dumps(scenes)], env=env, capture_output=True,
+    r = subprocess.run([sys.executable, "-c", _STEP_CODE, json.dumps(scenes), kind], env=env, capture_output=True,
                        text=True, check=True, cwd=tempfile.gettempdir())
     return json.loads(r.stdout.strip().splitlines()[-1])
-
-
-def _cubic_per_step(rounds: int) -> dict[str, float]:
-    out = {}
-    for I, t_end in ((1e-5, 1.0), (1e-2, 5.0)):
-        p = _cubic_params(I)
-        simulate(p, 0.2, rtol=1e-8, save="jumps")
-        best, n = math.inf, 1
-        for _ in range(max(rounds, 2)):
-            t0 = time.perf_counter()
-            tr = simulate(p, t_end, rtol=1e-8, save="jumps")
-            best, n = min(best, time.perf_counter() - t0), tr.stats.n_steps
-        out[f"cubic V1.2-I{I:g}"] = 1e6 * best / n
-    return out
 
 
 _SECOND_CODE = r"""
 import json, time
 from numba.core import event
 import exact
-from peelapprox import PeelForce, PeelParams
+from peelapprox import PeelForce, PeelParams, peel_force
 from comparisons.benchmark.law_cost import CUBIC_COEF_2, _cubic_params
 p = _cubic_params(1e-5)
 t0 = time.perf_counter()
@@ -194,32 +207,29 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     res: dict = {"field_ns": field_costs()}
     trees = {"after": _ROOT} | ({"before": args.before.resolve()} if args.before else {})
-    runs = [("after", _ROOT)] + ([("before", args.before.resolve())] if args.before else [])
-    steps: dict[str, dict[str, float]] = {k: {} for k, _ in runs}
+    runs = [("after", _ROOT, "default")] + [(k, _ROOT, k) for k in LAWS_OF_FVV]
+    runs += [("before", args.before.resolve(), "default")] if args.before else []
+    steps: dict[str, dict[str, float]] = {k: {} for k, _, _ in runs}
     for _ in range(args.rounds):
-        for k, tree in runs:
-            for name, us in _per_step(tree).items():
+        for k, tree, kind in runs:
+            for name, us in _per_step(tree, kind).items():
                 steps[k][name] = min(steps[k].get(name, math.inf), us)
     res["us_per_step"] = steps
-    res["cubic_us_per_step"] = _cubic_per_step(args.rounds)
     env = dict(os.environ, PYTHONPATH=str(_ROOT))
     res["second_law"] = json.loads(subprocess.check_output([sys.executable, "-c", _SECOND_CODE], env=env,
                                                            cwd=tempfile.gettempdir()).decode().splitlines()[-1])
     res["load_s"] = {k: dict(zip(("cold", "warm"), _load_times(tree))) for k, tree in trees.items()}
 
     f = res["field_ns"]
-    print("field evaluation [ns]        inlined paper  paper via law  cubic via law  paper law/inlined")
-    print(f"                             {fmt_number(f['inline'], 4):>13}  {fmt_number(f['paper'], 4):>13}  "
-          f"{fmt_number(f['cubic'], 4):>13}  {fmt_number(f['paper'] / f['inline'], 4):>17}")
-    print("\nper step [us], best of rounds   before   after (paper's law, inlined)   after / before")
-    for name, us in steps["after"].items():
-        b = steps.get("before", {}).get(name)
-        print(f"  {name:<28} {fmt_number(b, 4) if b else '-':>7}  {fmt_number(us, 4):>29}   "
-              f"{fmt_number(us / b, 3) if b else '-'}")
-    paper_mean = float(np.mean(list(steps["after"].values())))
-    for name, us in res["cubic_us_per_step"].items():
-        print(f"  {name:<28} {'':>7}  {fmt_number(us, 4):>29}   (the cubic through the law argument / mean "
-              f"paper inlined: {fmt_number(us / paper_mean, 3)})")
+    print("field evaluation [ns] (fvV at V = 1 as each kind of law; the cubic)     ns   / paper inlined")
+    for key, ns in f.items():
+        print(f"  {key:<24} {fmt_number(ns, 4):>10}   {fmt_number(ns / f['inline'], 3):>8}")
+    print("\nper step [us], best of rounds: fvV inlined ('after', the default) and as each kind of law (ratio)")
+    print("  scene        " + "".join(f"{k:>24}" for k in steps))
+    for name in steps["after"]:
+        row = "".join(f"{fmt_number(steps[k][name], 4):>14} ({fmt_number(steps[k][name] / steps['after'][name], 3):>7})"
+                      for k in steps)
+        print(f"  {name:<12} {row}")
     s = res["second_law"]
     print("\nsecond cubic (other coefficients), first simulate (0.05 s) in a process that ran a first cubic: "
           f"{fmt_number(1e3 * s['t_cubic'], 3)} ms, {s['compiles']} numba compilations\n  (the first cubic's first "

@@ -1,0 +1,435 @@
+"""Compiled peel-force laws generated from their symbolic form: the families and user expressions (issue 15).
+
+:func:`render_law` turns a law ``f(v, V; c)`` (sympy, :mod:`peelapprox._law_sympy`) into the Python source of
+a law of the ABI of :mod:`peelapprox._law_abi` — ``law(x, coef, form) -> (f8, f8, f8)`` — and of its packing
+``pack(V, c) -> coef``.  The rendering:
+
+* **u = ln v.**  Every power of v with a non-integer exponent becomes ``exp(p u)`` (a half-integer one
+  ``v^k s`` with ``s = sqrt v``, cheaper) and ``ln v`` becomes ``u`` (integer powers stay products).  The law
+  is then ``F(v, u, s)``, so ``f' = D F`` with ``D = d/dv + (d/du + s/2 d/ds) / v`` and
+  ``v f' = v F_v + F_u + s F_s / 2``: the derivatives keep the exponentials of f (no new ``pow``), the form
+  ``LAW_LNV`` (x = u) needs no ``log`` and ``LAW_FP``/``LAW_FPP`` (x = v) one ``log`` (only if u occurs).
+* **The V-dependence is hoisted.**  Each output is expanded into a sum of terms, terms with the same
+  v-dependent factor are collected, and every maximal subexpression free of v and u (of V and the
+  coefficients only: ``-a4 V^q4``, ``-(a5 - a6 V^q6 - a7 V^q7)``, ``a1 p1``, ``1/v3`` ...) becomes one entry
+  of ``coef``, computed once by ``pack`` when a run is packed.  The kernel does no arithmetic on V or the
+  coefficients alone; numbers stay literals.  The entries are numbered in sympy's canonical order, and each
+  law's docstring lists them (``coef = pack(V, c) = [...]``): that is the coef layout.
+* **One code path, CSE** over f, v f', f', f'' (as :mod:`peelapprox._symbolic` does): f, then the return of
+  ``LAW_LNV`` with v f', then f' and the return of ``LAW_FP``, then f''; floats are printed exactly (``repr``).
+
+The families are rendered into the committed module :mod:`peelapprox._generated_laws` (regenerate with
+``python -m peelapprox._law_codegen``; a test checks that it is current) and compiled lazily by
+:func:`family_kernel`.  An expression law is rendered by :func:`expression_kernel` into a module of the user's
+cache directory (``PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``), named by the SHA-256 of its
+canonical text and :func:`codegen_version` (so a changed expression or code generator is a new file, never a
+stale kernel), written atomically (temp file + ``os.replace``) and compiled with numba's on-disk cache: a
+second process loads the law and compiles nothing.
+
+sympy is imported by this module (rendering) only when a law is rendered; :func:`family_kernel` does not
+import it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import re
+import sys
+import tempfile
+import warnings
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._jit import kernel
+from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
+from .errors import KernelCacheWarning
+
+__all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "expression_source",
+           "family_kernel", "render_law", "render_module", "write_module"]
+
+#: Bump when the rendering changes what a law computes (the file's own hash is in :func:`codegen_version` too).
+CODEGEN_VERSION = "law-codegen-1"
+#: The forms hard-coded in the rendered source (0, 1, 2), checked against the ABI's.
+_FORMS = (LAW_LNV, LAW_FP, LAW_FPP)
+assert _FORMS == (0, 1, 2), _FORMS
+#: Names a coefficient may not take (the kernel's and pack's own).
+_RESERVED = {"x", "coef", "form", "v", "u", "s", "V", "numpy", "cs"}
+_GENERATED_NAME = re.compile(r"^[wt]\d+$")
+
+
+# ---------------------------------------------------------------------------------------------- rendering
+def _printer() -> Any:
+    from sympy.printing.numpy import NumPyPrinter
+
+    class _Printer(NumPyPrinter):
+        """numpy printer with exact floats and integer powers as products (numba: no ``pow`` call)."""
+
+        def _print_Float(self, expr: Any) -> str:
+            return repr(float(expr))
+
+        def _print_Pow(self, expr: Any, rational: bool = False) -> str:
+            if expr.exp.is_Integer and expr.exp < 0:
+                base = expr.base ** (-expr.exp)
+                return f"(1.0/{self.parenthesize(base, 1000)})" if base.is_Pow else f"(1.0/{self._print(base)})"
+            return super()._print_Pow(expr, rational=rational)
+
+    return _Printer({"fully_qualified_modules": True, "inline": True})
+
+
+def _in_u(expr: Any, v: Any, u: Any, s: Any) -> Any:
+    """``expr`` with ``ln v -> u``, ``v^(n/2) -> v^((n-1)/2) s`` (s = sqrt v, cheaper than exp) and
+    ``v^p -> exp(p u)`` for other non-integer p (powers of products split first)."""
+    import sympy as sp
+
+    def half(a: Any) -> bool:
+        return bool(a.is_Pow and a.base == v and a.exp.is_Rational and a.exp.q == 2)
+
+    e = sp.expand_power_base(expr)  # (v/v1)^m -> v^m v1^-m (v and the scales are positive)
+    # a float exponent that is a multiple of 1/2 (v**0.5, v**2.0) is that exact rational: the same number
+    e = e.replace(lambda a: a.is_Pow and a.base == v and a.exp.is_Float and float(a.exp * 2).is_integer(),
+                  lambda a: v ** sp.Rational(int(float(a.exp * 2)), 2))
+    e = e.replace(lambda a: isinstance(a, sp.log) and a.args[0] == v, lambda a: u)
+    e = e.replace(half, lambda a: v ** (a.exp - sp.Rational(1, 2)) * s)
+    return e.replace(lambda a: a.is_Pow and a.base == v and not a.exp.is_Integer, lambda a: sp.exp(a.exp * u))
+
+
+def _expand(e: Any) -> Any:
+    import sympy as sp
+
+    return sp.expand(e, deep=True, mul=True, multinomial=False, power_exp=False, power_base=False, log=False)
+
+
+class _Hoister:
+    """Replaces every maximal subexpression free of v and u by a placeholder (one per distinct expression)."""
+
+    def __init__(self, variables: tuple) -> None:
+        self.vars = set(variables)
+        self.table: dict[Any, Any] = {}
+
+    def _free(self, e: Any) -> Any:
+        import sympy as sp
+
+        if e.is_Number:
+            return e
+        if e not in self.table:
+            self.table[e] = sp.Symbol(f"_h{len(self.table)}", real=True)
+        return self.table[e]
+
+    def __call__(self, e: Any) -> Any:
+        import sympy as sp
+
+        if not (e.free_symbols & self.vars):
+            # factor sums of symbols (a5 p5 - a5 -> a5 (p5 - 1)); not floats, which factor would rescale
+            return self._free(sp.factor(e) if e.is_Add and not e.has(sp.Float) else sp.factor_terms(e))
+        if e.is_Atom:
+            return e
+        if e.is_Add:
+            groups: dict[Any, list] = {}
+            const = []
+            for a in e.args:
+                ind, dep = a.as_independent(*self.vars, as_Add=False)
+                if dep == 1:
+                    const.append(ind)
+                else:
+                    groups.setdefault(dep, []).append(ind)
+            terms = [self(sp.Add(*const))] if const else []
+            terms += [self(sp.Add(*inds)) * self(dep) for dep, inds in groups.items()]
+            return sp.Add(*terms)
+        if e.is_Mul:
+            ind, dep = e.as_independent(*self.vars, as_Add=False)
+            factors = dep.args if dep.is_Mul else (dep,)
+            return self(ind) * sp.Mul(*[self(f) for f in factors])
+        return e.func(*[self(a) for a in e.args])
+
+
+def _check_names(coef_symbols: Sequence[Any]) -> None:
+    for s in coef_symbols:
+        n = s.name
+        if not n.isidentifier() or n in _RESERVED or _GENERATED_NAME.match(n) or n.startswith("_"):
+            raise ValueError(f"coefficient name {n!r} is not usable in generated code: it must be a Python name "
+                             f"other than {', '.join(sorted(_RESERVED))}, w<i>, t<i> or one starting with _")
+
+
+def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name: str | None = None,
+               doc: str = "") -> str:
+    """Python source of the law ``name(x, coef, form)`` of the ABI and of ``pack_name(V, c)`` (module doc).
+
+    Parameters
+    ----------
+    name : str
+        The law function's name; ``pack_name`` (default ``name + "_pack"``) is its packing.
+    expr : sympy expression
+        ``f`` in the symbols ``v`` and ``V`` of :mod:`peelapprox._law_sympy` and ``coef_symbols``.
+    coef_symbols : sequence of sympy symbols
+        The coefficients, in the order ``pack``'s ``c`` gives them.
+    doc : str
+        First line of the law's docstring.
+
+    Returns
+    -------
+    str
+        Two functions: ``name(x, coef, form)`` returning ``(v, f, v f')`` for ``form == 0`` (x = ln v),
+        ``(f, f', nan)`` for 1 and ``(f, f', f'')`` for 2 (x = v), plain Python on numpy functions (numba
+        compiles it, numpy evaluates it on arrays); ``pack_name(V, c)`` returning ``coef`` (float64 array).
+
+    Raises
+    ------
+    ValueError
+        A coefficient name unusable in code, or a symbol other than v, V and the coefficients.
+    """
+    import sympy as sp
+
+    from ._law_sympy import V, v
+
+    _check_names(coef_symbols)
+    unknown = sorted(s.name for s in expr.free_symbols - {v, V, *coef_symbols})
+    if unknown:
+        raise ValueError(f"expr has symbols {', '.join(unknown)} other than v, V and the coefficients")
+    u, sq = sp.Symbol("u", real=True), sp.Symbol("s", positive=True)
+    F = _in_u(expr, v, u, sq)
+
+    def D(g: Any) -> Any:  # d/dv with u = ln v and s = sqrt(v)
+        return sp.diff(g, v) + (sp.diff(g, u) + sq * sp.diff(g, sq) / 2) / v
+
+    f1 = D(F)
+    outputs = {"f": F, "fp": f1, "fpp": D(f1),
+               "vfp": v * sp.diff(F, v) + sp.diff(F, u) + sq * sp.diff(F, sq) / 2}
+    hoist = _Hoister((v, u, sq))
+    hoisted = {k: hoist(_expand(e)) for k, e in outputs.items()}
+    # number the coef entries in canonical order (deterministic text), then rename the placeholders
+    derived = list(sp.ordered(hoist.table))
+    ks = [sp.Symbol(f"coef[{i}]", real=True) for i in range(len(derived))]  # read in place
+    rename = {hoist.table[d]: ks[i] for i, d in enumerate(derived)}
+    outs = ("f", "vfp", "fp", "fpp")
+    repl, red = sp.cse([hoisted[k].xreplace(rename) for k in outs], symbols=sp.numbered_symbols("w"),
+                       optimizations="basic")
+    red = [sp.Float(e) if e.is_Number else e for e in red]  # homogeneous float tuples for numba
+    defs = dict(repl)
+    used = set().union(*(e.free_symbols for e in red), *(e.free_symbols for _, e in repl))
+
+    p = _printer()
+
+    def stage(out: str, done: set, indent: str) -> list[str]:
+        """The CSE lines ``out`` needs that ``done`` does not hold (in order), then ``out`` itself."""
+        e = red[outs.index(out)]
+        need, stack = set(), list(e.free_symbols)
+        while stack:
+            sym = stack.pop()
+            if sym in defs and sym not in need and sym not in done:
+                need.add(sym)
+                stack.extend(defs[sym].free_symbols)
+        done |= need
+        return [f"{indent}{sym} = {p.doprint(rhs)}" for sym, rhs in repl if sym in need] + [
+            f"{indent}{out} = {p.doprint(e)}"]
+
+    pack_name = pack_name or f"{name}_pack"
+    layout = ", ".join(p.doprint(d) for d in derived)
+    lines = [f"def {name}(x, coef, form):",
+             f'    """{doc or "A peel-force law"} in the ABI of peelapprox._law_abi.',
+             "",
+             f"    coef = {pack_name}(V, c) = [{layout}]",
+             '    """',
+             "    v = numpy.exp(x) if form == 0 else x  # LAW_LNV: x = ln v -> (v, f, v f'); else x = v"]
+    lines += ["    u = x if form == 0 else numpy.log(v)"] if u in used else []
+    lines += ["    s = numpy.sqrt(v)"] if sq in used else []
+    done: set = set()
+    lines += stage("f", done, "    ")
+    lines.append("    if form == 0:")
+    lines += stage("vfp", set(done), "        ")
+    lines.append("        return v, f, vfp")
+    lines += stage("fp", done, "    ")
+    lines.append("    if form == 1:")
+    lines.append("        return f, fp, numpy.nan")
+    lines += stage("fpp", done, "    ")
+    lines.append("    return f, fp, fpp")
+    law = "\n".join(lines) + "\n"
+
+    names = [s.name for s in coef_symbols]
+    plines = [f"def {pack_name}(V, cs=()):",
+              f'    """coef of {name} at the pull speed V from the coefficients cs = ({", ".join(names)})."""']
+    if names:
+        plines.append(f"    {', '.join(names)}{',' if len(names) == 1 else ''} = cs")
+    if derived:
+        repl, red = sp.cse(derived, symbols=sp.numbered_symbols("t"), optimizations="basic")
+        plines += [f"    {sym} = {p.doprint(rhs)}" for sym, rhs in repl]
+        plines.append(f"    return numpy.array([{', '.join(p.doprint(e) for e in red)}], dtype=numpy.float64)")
+    else:
+        plines.append("    return numpy.zeros(0, dtype=numpy.float64)")
+    return law + "\n\n" + "\n".join(plines) + "\n"
+
+
+# ---------------------------------------------------------------------------------------------- the families
+_HEADER = '''"""GENERATED by ``python -m peelapprox._law_codegen`` -- do not edit by hand.
+
+The peel-force families of :mod:`peelapprox._law_families`, rendered by :func:`peelapprox._law_codegen.render_law`
+from their symbolic form in :mod:`peelapprox._law_sympy`: for each family ``law_<name>(x, coef, form)`` in the
+ABI of :mod:`peelapprox._law_abi` and ``law_<name>_pack(V, c)`` giving its ``coef`` from the pull speed V and the
+family's coefficients (in the family's order).  Plain Python on numpy functions: numba compiles the laws
+(:func:`peelapprox._law_codegen.family_kernel`) and numpy evaluates them on arrays (the families' evaluators).
+"""
+
+import numpy
+'''
+
+
+def render_module() -> str:
+    """The source text of :mod:`peelapprox._generated_laws`."""
+    from ._law_families import FAMILIES
+    from ._law_sympy import family_expression
+
+    parts = [_HEADER]
+    for name, fam in FAMILIES.items():
+        expr, syms = family_expression(name)
+        parts.append(render_law(f"law_{name}", expr, syms, doc=f"The {name!r} family ({fam.reference})"))
+    parts.append("#: family name -> (law, pack)\nLAWS = {\n"
+                 + "".join(f"    {name!r}: (law_{name}, law_{name}_pack),\n" for name in FAMILIES) + "}\n")
+    return "\n\n".join(parts)
+
+
+def write_module(path: str | os.PathLike | None = None) -> str:
+    """Render and write :mod:`peelapprox._generated_laws`; return the path."""
+    target = Path(path) if path else Path(__file__).with_name("_generated_laws.py")
+    target.write_text(render_module())
+    return str(target)
+
+
+_FAMILY_KERNELS: dict[str, tuple[Callable, Callable]] = {}
+
+
+def family_kernel(name: str) -> tuple[Any, Callable[..., np.ndarray]]:
+    """The compiled law of the family ``name`` and its packing: ``(law, pack)``.
+
+    ``law`` is compiled for :data:`peelapprox._law_abi.LAW_SIG` by :func:`peelapprox._jit.kernel` (cached on
+    disk); ``pack(V, c)`` gives its ``coef`` (float64 array) from the pull speed V and the coefficients ``c``
+    in the family's order (``tuple(x for _, x in force.coefficients)``).  Memoised per process.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not a family (the message lists them).
+    """
+    from . import _generated_laws as G
+
+    if name not in G.LAWS:
+        raise ValueError(f"unknown peel-force family {name!r}: the families are {', '.join(G.LAWS)}")
+    if name not in _FAMILY_KERNELS:
+        law, pack = G.LAWS[name]
+        _FAMILY_KERNELS[name] = (kernel(signature=LAW_SIG)(law), pack)
+    return _FAMILY_KERNELS[name]
+
+
+# ---------------------------------------------------------------------------------------------- expressions
+_EXPR_HEADER = '''"""GENERATED by peelapprox._law_codegen ({version}) -- the expression peel-force law
+
+    {text}
+
+as ``law(x, coef, form)`` in the ABI of peelapprox._law_abi and ``pack(V)`` giving its coef.
+"""
+
+import numpy
+'''
+
+_EXPRESSION_KERNELS: dict[str, tuple[Any, Callable]] = {}
+
+
+def codegen_version() -> str:
+    """:data:`CODEGEN_VERSION` and the first 12 hex digits of the SHA-256 of this file and
+    :mod:`peelapprox._law_sympy` (a changed renderer gives new file names: no stale kernel)."""
+    h = hashlib.sha256()
+    for f in ("_law_codegen.py", "_law_sympy.py"):
+        h.update(Path(__file__).with_name(f).read_bytes())
+    return f"{CODEGEN_VERSION}-{h.hexdigest()[:12]}"
+
+
+def cache_dir() -> Path:
+    """Where expression laws are written: ``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``."""
+    env = os.environ.get("PEELAPPROX_CACHE_DIR")
+    return Path(env) if env else Path.home() / ".cache" / "peelapprox" / "laws"
+
+
+def _writable(d: Path) -> bool:
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=d, prefix=".probe-"):
+            pass
+        return True
+    except OSError:
+        return False
+
+
+_FALLBACK: dict[str, Path] = {}
+
+
+def _law_dir() -> Path:
+    d = cache_dir()
+    if _writable(d):
+        return d
+    if "dir" not in _FALLBACK:
+        _FALLBACK["dir"] = Path(tempfile.mkdtemp(prefix="peelapprox-laws-"))
+        warnings.warn(f"peelapprox: the law cache directory {str(d)!r} is not writable; expression laws are "
+                      f"written to {str(_FALLBACK['dir'])!r} for this process only (set PEELAPPROX_CACHE_DIR to a "
+                      "writable directory to keep them compiled across processes)", KernelCacheWarning, stacklevel=3)
+    return _FALLBACK["dir"]
+
+
+def expression_source(source: str) -> str:
+    """The module text of the expression law with canonical text ``source`` (``srepr``, see _law_expr)."""
+    import sympy as sp
+
+    e = sp.sympify(source)
+    text = sp.sstr(e)
+    return (_EXPR_HEADER.format(version=codegen_version(), text=text) + "\n\n"
+            + render_law("law", e, (), pack_name="pack", doc=f"f = {text}"))
+
+
+def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
+    """The compiled law of an expression and its packing: ``(law, pack)``, ``pack(V) -> coef``.
+
+    ``source`` is the canonical text of an expression law (``PeelForce.source``: sympy ``srepr`` in the
+    symbols v, V).  The law is rendered into ``<cache_dir()>/law_<sha256>.py`` (hash of ``source`` and
+    :func:`codegen_version`; written once, atomically), imported under a unique module name and compiled for
+    :data:`peelapprox._law_abi.LAW_SIG` with numba's on-disk cache (``__pycache__`` next to it, or
+    ``NUMBA_CACHE_DIR``), so a second process loads it.  Memoised per process.  If the cache directory is not
+    writable, a temporary one is used with a :class:`~peelapprox.errors.KernelCacheWarning`.
+
+    Raises
+    ------
+    TypeError
+        ``source`` is not a string.
+    """
+    if not isinstance(source, str):
+        raise TypeError(f"source must be the canonical text (str) of an expression law, got {type(source).__name__}")
+    hit = _EXPRESSION_KERNELS.get(source)
+    if hit is not None:
+        return hit
+    digest = hashlib.sha256(f"{source}\0{codegen_version()}".encode()).hexdigest()
+    d = _law_dir()
+    path = d / f"law_{digest[:32]}.py"
+    if not path.exists():  # written once: rewriting would change its time stamp and numba's cache key
+        fd, tmp = tempfile.mkstemp(dir=d, prefix=f".{path.stem}-", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as fh:
+                fh.write(expression_source(source))
+            os.chmod(tmp, 0o644)
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    modname = f"peelapprox_law_{digest[:32]}"
+    spec = importlib.util.spec_from_file_location(modname, path)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = mod
+    spec.loader.exec_module(mod)
+    law = kernel(signature=LAW_SIG, outside=True)(mod.law)
+    _EXPRESSION_KERNELS[source] = (law, mod.pack)
+    return _EXPRESSION_KERNELS[source]
+
+
+if __name__ == "__main__":  # pragma: no cover
+    print("wrote", write_module())
