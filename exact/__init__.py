@@ -9,11 +9,12 @@ error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the
 limits) are the validated forms of ``simulate``'s keywords.
 
 The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
-(sampled starts grouped by the attractor they reach) and the largest Lyapunov exponent,
-``lyapunov(params, method=...)`` with the methods "two-trajectory", "tangent", "return-map" and
-"variational" (also ``lyapunov_tangent``, ``lyapunov_return_map``; ``benettin`` is the generic
-two-trajectory method for any flow).  The return-map analysis of a trajectory (``return_map``,
-``periodicity``, ``force_drops``, ``settle_time``) is the core package's: :mod:`peelapprox`.
+(sampled starts grouped by the attractor they reach) and the largest Lyapunov exponent, ``lyapunov(params,
+method=...)`` with the methods "two-trajectory", "tangent", "return-map" and "variational" (also
+``lyapunov_tangent``, ``lyapunov_return_map``; ``benettin`` is the generic two-trajectory method for any
+flow). Each runs the peel-force law ``params.force`` (any law with a compiled kernel; the variational method,
+whose DiffSL model is printed from fvV, the paper's only). The return-map analysis of a trajectory
+(``return_map``, ``periodicity``, ``force_drops``, ``settle_time``) is the core package's: :mod:`peelapprox`.
 """
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure

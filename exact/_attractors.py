@@ -29,6 +29,7 @@ from peelapprox.validate import duration, function, optional, positive, state, s
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
+from ._hybrid_law import HYBRID_LAWS
 from ._simulate import initial_state, simulate
 from ._trajectory import Trajectory
 
@@ -66,6 +67,7 @@ def window_run(
     Parameters
     ----------
     params : PeelParams
+        With any law ``params.force`` the hybrid solver runs (:func:`exact.simulate`).
     t_transient : float
         Seconds integrated from the initial state before the window, discarded, in [0, 1e6] (30).
     window : float
@@ -90,7 +92,7 @@ def window_run(
     peelapprox.ModelBreakdown, peelapprox.SolverBudgetExceeded
         As :func:`exact.simulate` (also for ``max_wall`` seconds of wall time).
     """
-    return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
+    return _window_run(_params("params", params, laws=HYBRID_LAWS), duration("t_transient", t_transient, zero=True),
                        duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
                        optional(positive, "max_wall", max_wall))
 
@@ -143,6 +145,7 @@ def attractors(
     Parameters
     ----------
     params : PeelParams
+        With any law ``params.force`` the hybrid solver runs (:func:`exact.simulate`).
     alpha0s : sequence of float
         Initial peel angles [rad], each in ``STATE_RANGES["alpha"]``, at least one.
     t_transient, window, rtol : float
@@ -171,7 +174,7 @@ def attractors(
         When ``max_wall`` is spent.
     """
     # validate everything up front: inside the loop a ValueError can then only be an infeasible start
-    params = _params("params", params)
+    params = _params("params", params, laws=HYBRID_LAWS)
     kw = dict(t_transient=duration("t_transient", t_transient, zero=True), window=duration("window", window),
               rtol=_rtol("rtol", rtol))
     period_rtol = positive("period_rtol", period_rtol)

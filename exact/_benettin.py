@@ -27,8 +27,9 @@ __all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult"]
 
 def natural_scales(params: PeelParams) -> np.ndarray:
     """The natural sizes ``(1 rad, V/R, f_max)`` of ``(α, ω, F)``: every Lyapunov estimate measures
-    perturbations in ``(δα, δω, δF)`` divided by these (``f_max`` is 1 N when f has no folds)."""
-    bs = branch_structure(params.V)
+    perturbations in ``(δα, δω, δF)`` divided by these (``f_max`` of the law ``params.force`` at V, its
+    :func:`peelapprox.branch_structure`; 1 N when f has no folds)."""
+    bs = branch_structure(params.V, force=params.force)
     return np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
 
 

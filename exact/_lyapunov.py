@@ -46,6 +46,7 @@ from peelapprox.validate import rtol as _rtol
 
 from ._attractors import DEFAULT_MAX_WALL, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
+from ._hybrid_law import HYBRID_LAWS
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
 from ._simulate import initial_state, simulate
 
@@ -67,6 +68,9 @@ def lyapunov(
     Parameters
     ----------
     params : PeelParams
+        With any law ``params.force`` that :func:`exact.simulate` runs (its scales and branches are the law's:
+        :func:`peelapprox.branch_structure` with ``force``); ``"variational"``: the paper's law only (ValueError
+        naming the method and the law otherwise).
     method : {"two-trajectory", "tangent", "return-map", "variational"}
         How (module docstring; costs and agreement in docs/usage.md and docs/dynamics.md).
     t_transient : float
@@ -175,7 +179,7 @@ def _two_trajectory(
     (halving the step while the moved state would leave its branch's level range), ``advance`` postpones the
     renormalisation while the orbits are on different branches.
     """
-    params = _params("params", params)
+    params = _params("params", params, laws=HYBRID_LAWS)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
     tau = _check("tau", tau)
     d0 = _check("d0", d0)
@@ -185,7 +189,7 @@ def _two_trajectory(
     n, n_discard = _check("n", 10000 if n is None else n), _check("n_discard", n_discard)
     alpha0 = state("alpha0", alpha0, "alpha")
     rtol = _rtol("rtol", rtol)
-    bs = branch_structure(params.V)
+    bs = branch_structure(params.V, force=params.force)
     scale = natural_scales(params)
     jumps = [0]
     t_total = t_transient + (n + n_discard) * tau
@@ -300,7 +304,7 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     """Method ``"tangent"`` of :func:`lyapunov` (:func:`lyapunov_tangent`, and a wall budget ``max_wall``)."""
     from ._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
 
-    params = _params("params", params)
+    params = _params("params", params, laws=HYBRID_LAWS)
     T = _check("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     rtol = _rtol("rtol", rtol)
@@ -380,7 +384,7 @@ def lyapunov_return_map(
 def _return_map(params: PeelParams, *, t_transient: float = T_TRANSIENT, n_returns: int = 5000, h: float = 1e-6,
                 rtol: float = 1e-12, alpha0: float = 0.0, max_wall: float | None = DEFAULT_MAX_WALL) -> LyapunovResult:
     """Method ``"return-map"`` of :func:`lyapunov` (:func:`lyapunov_return_map`)."""
-    params = _params("params", params)
+    params = _params("params", params, laws=HYBRID_LAWS)
     h = _check("h", h)
     rtol = _rtol("rtol", rtol)
     t_transient = duration("t_transient", t_transient, zero=True)

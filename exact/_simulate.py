@@ -486,18 +486,22 @@ def domain_status(status: int, cl: CompiledLaw, v: float, ceiling: float) -> tup
 
 
 def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
-                 law_argument: bool = False) -> tuple[Callable, Any]:
+                 law_argument: bool | None = None) -> tuple[Callable, Any]:
     """The hybrid solver's compiled field ``rhs(y, p, out)`` and its parameter vector ``p`` for ``params``
     (``v_floor`` as in :func:`simulate`), e.g. to time one field evaluation in a compiled loop.
 
-    ``law_argument=False``: the field with the paper's law fvV inlined and ``p`` the parameter vector.
-    ``law_argument=True``: the field of the driver that takes the law as a function argument (used with a
-    ``params.force``; also for the paper's law, which the default driver inlines) and ``(p, law, coef)``; the
-    field is called as ``rhs(y, (p, law, coef), out)`` from a loop compiled with ``law`` of type
-    :data:`peelapprox.kernels.LAW_TYPE`.
+    ``law_argument=False``: the field with the paper's law fvV inlined and ``p`` the parameter vector (the
+    paper's law only: ValueError for another ``params.force``).
+    ``law_argument=True``: the field of the driver that takes the law as a function argument (the one
+    :func:`simulate` runs for a ``params.force`` other than the paper's; also for the paper's law, which the
+    default driver inlines) and ``(p, law, coef)``; the field is called as ``rhs(y, (p, law, coef), out)`` from a
+    loop compiled with ``law`` of type :data:`peelapprox.kernels.LAW_TYPE`.
+    ``law_argument=None`` (default): the field :func:`simulate` runs for ``params.force`` -- inlined for the
+    paper's law, the law as an argument for any other.
     """
+    if law_argument is None:
+        law_argument = params.force.kind != "paper" if isinstance(params, PeelParams) else False
     if not law_argument:
         return H._rhs, _param_vector(params, v_floor)
     cl = HL.law_for(params)
     return HL._rhs_law, (_param_vector(params, v_floor, cl.structure, cl.domain), cl.fn, cl.coef)
-

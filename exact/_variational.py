@@ -21,10 +21,13 @@ import numpy as np
 
 from peelapprox import EPS_DEFAULT, T_TRANSIENT, SolverFailure
 from peelapprox.kernels import (
+    ALL_LAWS,
     DIFFSOL_OPTIONS,
+    compiled_law,
     diffsl_inputs,
     diffsl_model,
     regularized_field_jacobian,
+    regularized_law_field,
     regularized_parameters,
 )
 from peelapprox.validate import duration, function, in_range, optional, state
@@ -38,7 +41,15 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from ._benettin import LyapunovResult
 
-__all__ = ["TANGENT_OPTIONS", "lyapunov_variational", "tangent_solve"]
+__all__ = ["TANGENT_OPTIONS", "VARIATIONAL_LAWS", "VARIATIONAL_LAWS_NOTE", "lyapunov_variational", "tangent_solve"]
+
+#: Who refuses a tabulated law, and why (the ``where`` of the refusal): the DiffSL model is printed from the law's
+#: sympy form, which a table does not have.
+VARIATIONAL_LAWS_NOTE = ("lyapunov method 'variational' (lyapunov_variational: its DiffSL model is printed from the "
+                         "law's closed form, which a table lacks; the methods 'two-trajectory', 'tangent' and "
+                         "'return-map' run any law)")
+#: The laws the variational method runs (:func:`peelapprox._law.law_label` names): every law with a closed form.
+VARIATIONAL_LAWS = tuple(x for x in ALL_LAWS if x != "tabulated")
 
 #: pydiffsol options of the tangent model: :data:`peelapprox.kernels.DIFFSOL_OPTIONS` and a
 #: practically unlimited number of error-test failures per solve (the default,
@@ -51,7 +62,12 @@ TANGENT_OPTIONS = dict(DIFFSOL_OPTIONS, max_error_test_failures=100_000)
 def _slow_tangent(params, x, w, scale):
     """A tangent vector with (α, ω, F) part ``w * scale`` and δv on the tangent of the slow manifold
     ``φ_v = 0`` (``∂φ_v/∂X · δX = 0``), so the first step needs no fast relaxation of δv."""
-    Jx = regularized_field_jacobian(np.asarray(x, float), regularized_parameters(params, 1.0))  # eps = 1: ∂φ/∂X
+    y = np.asarray(x, float)
+    cl = compiled_law(params.force, params.V)
+    if cl.inlined:
+        Jx = regularized_field_jacobian(y, regularized_parameters(params, 1.0))  # eps = 1: ∂φ/∂X
+    else:
+        Jx = regularized_law_field()[1](y, regularized_parameters(params, 1.0, ALL_LAWS), cl.fn, cl.coef)
     d = np.zeros(4)
     d[:3] = np.asarray(w, float) * scale
     d[3] = -float(Jx[3, :3] @ d[:3]) / float(Jx[3, 3])
@@ -137,7 +153,8 @@ def lyapunov_variational(
     Raises
     ------
     ValueError
-        Bad arguments (the message names the argument and its range).
+        Bad arguments (the message names the argument and its range); a law ``params.force`` other than the
+        paper's (the message names the method and the law: the DiffSL model is printed from fvV only, for now).
     peelapprox.kernels.PeerUnavailableError
         (an ``ImportError``) pydiffsol is not installed (``pip install peelapprox[bench]``).
     peelapprox.SolverFailure
@@ -147,14 +164,14 @@ def lyapunov_variational(
 
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)
-    _params("params", params)
+    _params("params", params, laws=VARIATIONAL_LAWS, where=VARIATIONAL_LAWS_NOTE)
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
     eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
     a = _atol_vector("regularized", rtol, None)
     alpha0 = state("alpha0", alpha0, "alpha")
     progress = optional(function, "progress", progress)
-    ode = diffsl_model(params.geometry, tangent=True)
+    ode = diffsl_model(params.geometry, tangent=True, force=params.force)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0
     for name, val in TANGENT_OPTIONS.items():
         setattr(ode.options, name, val)

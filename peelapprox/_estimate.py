@@ -137,9 +137,12 @@ def quasi_static_branch_time(
         if min(v_in, v_f) <= V <= max(v_in, v_f):
             raise ValueError(f"k(V - v) vanishes at v = V = {V} between v_in={v_in} and v_f={v_f}")
         integrand = lambda v: float(fpr(v)) / (k * (V - v))  # noqa: E731
-    # the AB integrand is ∝ v^-0.85 near 0: integrate in ln v
+    # the AB integrand is ∝ v^-0.85 near 0: integrate in ln v; a table's f' has a kink at every datum, so its
+    # data inside the interval are break points of the quadrature (each piece is smooth)
+    lo, hi = sorted((math.log(v_in), math.log(v_f)))
+    knots = sorted({math.log(x) for t in params.force.tables for x in t[1] if lo < math.log(x) < hi})
     val, _ = integrate.quad(lambda w: integrand(math.exp(w)) * math.exp(w), math.log(v_in), math.log(v_f),
-                            epsabs=0.0, epsrel=1e-11, limit=200)
+                            epsabs=0.0, epsrel=1e-11, limit=max(200, 4 * len(knots)), points=knots or None)
     return val
 
 

@@ -331,21 +331,28 @@ def test_saved_trajectory_records_the_law(tmp_path):
     assert PeelParams(**old) == p and PeelParams(**old).force is PeelForce.paper()
 
 
+LAW_KINDS = {
+    "power_branches": PeelForce.power_branches(),
+    "expression": PeelForce.expression(PAPER_TEXT),
+    "tabulated": PeelForce.tabulated(np.logspace(-8, 2, 300), PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
+}
 CONSUMERS = {
-    "window_run": lambda p: exact.window_run(p),
-    "lyapunov": lambda p: exact.lyapunov(p),
-    "hybrid_field": lambda p: exact.hybrid_field(p),
+    "estimate": lambda p: pa.estimate(p).v_max,
+    "reduced_segment": lambda p: pa.reduced_segment(p, "AB", F_in=220.0, alpha_in=0.0, alphadot_in=0.0).dt,
+    "initial_state": lambda p: exact.initial_state(p).v,
+    "hybrid_field": lambda p: exact.hybrid_field(p)[0],
+    "branch_structure": lambda p: pa.branch_structure(p.V, force=p.force).f_max,
 }
 
 
+@pytest.mark.parametrize("kind", sorted(LAW_KINDS))
 @pytest.mark.parametrize("name", sorted(CONSUMERS))
-def test_consumers_refuse_other_laws_for_now(name):
-    """Hypothesis: until the consumers honour PeelParams.force, each refuses a non-paper law with a ValueError
-    that says so and points to issue 15 (message text), instead of silently using fvV.  (The power-law branches:
-    the cubic runs in exact.simulate's hybrid solver, tests/test_law_runs.py.)"""
-    p = PeelParams(V=1.0, I=1e-5, force=PeelForce.power_branches())
-    with pytest.raises(ValueError, match=r"not yet supported by .*issue 15"):
-        CONSUMERS[name](p)
+def test_consumers_honour_every_kind_of_law(name, kind):
+    """Hypothesis: every consumer of params takes every kind of law (issue 15 item 2; the refusals of the
+    transition are gone): with fvV written as each kind (the power branches calibrated to it), each returns a
+    value, never a ValueError "not yet supported"."""
+    p = PeelParams(V=1.0, I=1e-5, force=LAW_KINDS[kind])
+    assert CONSUMERS[name](p) is not None
 
 
 # --------------------------------------------------------------------------- bad laws

@@ -92,7 +92,7 @@ def test_a_cubic_whose_jumps_cannot_land_breaks_down_like_fvV():
     """Hypothesis: a cubic whose CD→AB jumps cannot land (f_min = 40 N <= f(0+) = a = 120 N) runs until the
     orbit reaches the CD fold, then stops with the same ModelBreakdown as the paper's law there ("no_landing",
     its finite time and state: the law is data, the breakdown rule is the model's); the paper-only consumers
-    still refuse the cubic (``hybrid_field`` without the law argument: the inlined driver has only fvV)."""
+    still refuse the cubic (``hybrid_field(law_argument=False)``: the inlined driver has only fvV)."""
     from peelapprox import ModelBreakdown
 
     p = PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(a=120, b=200, c=260, d=70))
@@ -100,7 +100,7 @@ def test_a_cubic_whose_jumps_cannot_land_breaks_down_like_fvV():
         exact.simulate(p, 0.1)
     assert e.value.reason == "no_landing" and 0.0 < e.value.t < 0.1 and e.value.state["branch"] == "CD"
     with pytest.raises(ValueError, match="model_block"):
-        exact.hybrid_field(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic()))
+        exact.hybrid_field(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic()), law_argument=False)
 
 
 def test_laws_pass_through_validate_and_model_block():

@@ -261,7 +261,7 @@ def test_lyapunov_variational_reports_a_diffsol_failure_with_time_and_state(monk
                 raise RuntimeError("ODE solver error: Exceeded maximum number of error test failures (41)")
             return self.ode.solve(inp, t)
 
-    monkeypatch.setattr(LV, "diffsl_model", lambda geometry, tangent=False: FailsLater())
+    monkeypatch.setattr(LV, "diffsl_model", lambda geometry, tangent=False, force=None: FailsLater())
     with pytest.raises(SolverFailure, match="error test failures") as info:
         LV.lyapunov_variational(PeelParams(V=2.0, I=1e-4), t_transient=0.0, T=1.0, tau=0.25)
     assert info.value.t == pytest.approx(0.5, abs=1e-12)

@@ -1,4 +1,5 @@
-"""(I, V) parameter sweeps that scale from a laptop to a cluster (an experiment: ``peelapprox sweep``).
+"""(I, V) parameter sweeps of any peel-force law, or over a law coefficient, that scale from a laptop to a
+cluster (an experiment: ``peelapprox sweep``).
 
 A sweep evaluates named *measures* at every point of a grid of roller
 inertias ``I`` and pull speeds ``V``, one task per point, on any
@@ -31,6 +32,17 @@ I and V; defaults as there); ``jumps`` and ``period`` share one windowed run
 the chosen measures read is checked before the first point (a measure
 registered with ``check_options`` checks its own), so invalid options raise
 ValueError naming the option and nothing is written.
+
+Laws
+----
+``force=`` (a :class:`peelapprox.PeelForce`; default the paper's fvV) is the
+peel-force law at every point; ``coef=(name, values)`` sweeps a coefficient of
+a family law as a third grid axis (I x V x values: one I or one V to sweep the
+coefficient instead of it).  The law travels to the workers pickled (plain
+data); the manifest (``force``, ``law``, ``law_key``, ``coef``) and every
+record of such a sweep (``law``, ``law_key``, ``coef``) say which law ran; a
+sweep of the paper's law writes none of these.  See
+:mod:`comparisons.sweep.law`.
 
 Workers
 -------
@@ -86,6 +98,9 @@ Modules
     :class:`SweepResult`, :func:`load_sweep`.
 :mod:`~comparisons.sweep.store`
     The on-disk format.
+:mod:`~comparisons.sweep.law`
+    The sweep's law and its coefficient axis: checks, what the manifest and
+    records say of the law.
 
 ``python -m comparisons.sweep ARGS`` is ``peelapprox sweep ARGS``.
 """

@@ -12,12 +12,13 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import PARAM_RANGES
+from peelapprox import PARAM_RANGES, PeelForce
 from peelapprox.io import jsonable
 from peelapprox.validate import ArgumentTypeError, integer, optional
 from peelapprox.validate import path as _path
 
 from .._worker import SERIAL, Progress, run_tasks, write_line
+from .law import check_coef, check_force, manifest_fields
 from .measures import _OPTION_CHECKS, MEASURES, _ref
 from .result import SweepResult
 from .store import (
@@ -27,6 +28,7 @@ from .store import (
     append_records,
     check_axis,
     is_read_only,
+    point_key,
     rewrite_records,
     truncate_records,
     versions,
@@ -44,7 +46,8 @@ def _progress_line(total: int, done0: int) -> Callable[[int, int, dict], None]:
     prog = Progress(total, done0)
 
     def report(done: int, total: int, rec: dict) -> None:
-        write_line(f"sweep {prog.prefix(done)} I={rec['I']:.4g} V={rec['V']:.4g} {rec['status'][:60]}  "
+        c = f" coef={rec['coef']:.6g}" if "coef" in rec else ""
+        write_line(f"sweep {prog.prefix(done)} I={rec['I']:.4g} V={rec['V']:.4g}{c} {rec['status'][:60]}  "
                    f"{prog.times(done)}")
 
     return report
@@ -62,6 +65,8 @@ def sweep(
     progress: bool | Callable[[int, int, dict], None] | None = True,
     resume: bool = True,
     retry_failed: bool = False,
+    force: PeelForce | None = None,
+    coef: tuple[str, Sequence[float] | np.ndarray] | None = None,
 ) -> SweepResult:
     """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
 
@@ -99,6 +104,16 @@ def sweep(
     retry_failed : bool
         Also compute again the points of ``out`` whose status is an error
         (their records are dropped first); by default they count as finished.
+    force : peelapprox.PeelForce, optional
+        The peel-force law at every point (default: the paper's fvV).  It
+        travels to the workers pickled (plain data); the manifest and every
+        record say which law ran (:mod:`comparisons.sweep.law`).
+    coef : (str, sequence of float), optional
+        ``(name, values)``: a coefficient of the family law ``force`` swept as a
+        third grid axis (I x V x values; one I or one V to sweep the
+        coefficient instead of it), e.g. ``force=PeelForce.cubic(),
+        coef=("c", [250, 300, 350])``.  Each record holds its ``coef`` value and
+        its law; :meth:`SweepResult.values` arrays are then 3-D.
 
     Returns
     -------
@@ -127,6 +142,8 @@ def sweep(
     """
     I_vals = check_axis("I_values", I_values, *PARAM_RANGES["I"])
     V_vals = check_axis("V_values", V_values, *PARAM_RANGES["V"])
+    force = check_force(force)
+    coef_axis = check_coef(force, coef)
     if isinstance(measures, str):
         measures = [m.strip() for m in measures.split(",") if m.strip()]
     if not isinstance(measures, (list, tuple)) or not all(isinstance(m, str) for m in measures):
@@ -147,7 +164,7 @@ def sweep(
     except (TypeError, ValueError) as exc:
         raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
             from None
-    _check_options(measures, options)
+    _check_options(measures, options, force)
     max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
     if max_workers is not None:
         if executor is not None:
@@ -174,7 +191,7 @@ def sweep(
     except OSError as exc:
         raise ValueError(f"out={out!r}: cannot create the directory ({exc})") from None
     plan = dict(out=out, I_vals=I_vals, V_vals=V_vals, measures=measures, options=options, resume=resume,
-                retry_failed=retry_failed)
+                retry_failed=retry_failed, force=force, coef=coef_axis)
     try:
         lock = _lock(out)
     except OSError as exc:
@@ -187,10 +204,10 @@ def sweep(
         lock.close()
 
 
-def _check_options(measures: Sequence[str], options: Mapping) -> None:
+def _check_options(measures: Sequence[str], options: Mapping, force: PeelForce | None = None) -> None:
     """Every option the engine and ``measures`` read, checked before any point (ValueError naming it)."""
     try:
-        make_params(1.0, 1.0, options)
+        make_params(1.0, 1.0, options, force)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"options: invalid PeelParams fields {[k for k in PARAM_OPTIONS if k in options]}: {exc}") \
             from None
@@ -223,40 +240,57 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress) -> 
             "measures": p.measures,
             "options": p.options,
             "measure_refs": refs,
-            "grid_order": "I major: results arrays are [i, j] for I_values[i], V_values[j]",
+            "grid_order": "I major: results arrays are [i, j] for I_values[i], V_values[j]" if p.coef is None else
+                          "I major, then V, then coef: results arrays are [i, j, k] for I_values[i], V_values[j], "
+                          "coef values[k]",
+            **manifest_fields(p.force, p.coef),
             "versions": versions(),
             "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
         write_manifest(out, p.manifest)
+    with_coef = p.coef is not None
     if p.retry:  # drop the failed points' records (and any partial tail) before computing them again
-        rewrite_records(out, [r for r in p.records if (float(r["I"]), float(r["V"])) not in p.retry])
+        rewrite_records(out, [r for r in p.records if point_key(r, with_coef) not in p.retry])
     elif p.partial:  # the last write was cut off: drop it so appends start on a clean line
         truncate_records(out, p.end)
     done, todo, total = p.done, p.todo, p.total
     report = _progress_line(total, len(done)) if progress is True else (progress or None)
 
     with append_records(out) as fh:
-        def write(key: tuple[float, float], rec: dict) -> None:
-            if (float(rec["I"]), float(rec["V"])) != key:  # pragma: no cover - defensive
-                raise RuntimeError(f"executor returned the record of {rec['I'], rec['V']} for {key}")
+        def write(key: tuple[float, ...], rec: dict) -> None:
+            if point_key(rec, with_coef) != key:  # pragma: no cover - defensive
+                raise RuntimeError(f"executor returned the record of {point_key(rec, with_coef)} for {key}")
             write_record(fh, rec)
-            done[(rec["I"], rec["V"])] = rec
+            done[key] = rec
             if report:
                 report(len(done), total, rec)
 
-        lost = run_tasks(run_point, [((I, V), (I, V, p.measures, p.options, task_refs)) for I, V in todo], write,
-                         executor=executor, max_workers=max_workers)
+        lost = run_tasks(run_point, [(key, _task(key, p, task_refs)) for key in todo], write, executor=executor,
+                         max_workers=max_workers)
     if lost:
         hint = ""
         if executor is None and any("BrokenProcessPool" in err for _, err in lost):
             hint = ("; a worker process died (crash, out of memory, killed) or could not start: with the 'spawn' "
                     "start method a script that calls sweep() must do so under `if __name__ == '__main__':`")
-        raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: I={lost[0][0][0]}, "
-                           f"V={lost[0][0][1]}: {lost[0][1]}); {len(done)}/{total} points are in "
+        first = ", ".join(f"{n}={x}" for n, x in zip(("I", "V", "coef"), lost[0][0]))
+        raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: {first}: "
+                           f"{lost[0][1]}); {len(done)}/{total} points are in "
                            f"{os.path.join(out, RESULTS)}; call sweep() again with the same arguments to compute "
                            "the rest" + hint)
     return _result(p)
 
 
+def _task(key: tuple[float, ...], p: Plan, task_refs) -> tuple:
+    """The arguments of :func:`run_point` at ``key``: the paper's law without a coefficient axis passes no law
+    (the records of before); any other law travels pickled, with the point's coefficient value."""
+    args: tuple = (key[0], key[1], p.measures, p.options, task_refs)
+    if p.coef is not None:
+        return (*args, p.force, (p.coef[0], key[2]))
+    if p.force.kind != "paper":
+        return (*args, p.force)
+    return args
+
+
 def _result(p: Plan) -> SweepResult:
-    return SweepResult(p.I_vals, p.V_vals, p.measures, p.options, p.done.values(), manifest=p.manifest, out=p.out)
+    return SweepResult(p.I_vals, p.V_vals, p.measures, p.options, p.done.values(), manifest=p.manifest, out=p.out,
+                       force=p.force, coef=p.coef)

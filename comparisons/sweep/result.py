@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 
+from peelapprox import PeelForce
 from peelapprox.validate import path as _path
 
-from .store import RESERVED, failed, read_manifest, read_records
+from .law import manifest_law
+from .store import RESERVED, failed, point_key, read_manifest, read_records
 
 __all__ = ["SweepResult", "load_sweep"]
 
@@ -19,33 +21,47 @@ def _is_number(v: Any) -> bool:
 
 
 class SweepResult:
-    """Records of a sweep on its (I, V) grid.
+    """Records of a sweep on its (I, V) grid, or its (I, V, coef) grid with a coefficient axis.
 
     Attributes
     ----------
     I_values, V_values : ndarray
         The grid axes, in the order given (``values()`` arrays are indexed
-        ``[i, j]`` for ``I_values[i], V_values[j]``).
+        ``[i, j]`` for ``I_values[i], V_values[j]``; ``[i, j, k]`` with a
+        coefficient axis, ``coef_values[k]``).
     measures : tuple of str
     options : dict
     records : list of dict
         Finished points, in grid order (I major); see :mod:`comparisons.sweep`.
     manifest : dict
     out : str or None
+    force : peelapprox.PeelForce
+        The sweep's law (:mod:`comparisons.sweep.law`; the paper's by default).
+    coef_name : str or None
+        The coefficient of ``force`` swept as a third axis, if any.
+    coef_values : ndarray or None
+        Its values.
     """
 
     def __init__(self, I_values, V_values, measures, options, records: Iterable[dict], *,
-                 manifest: dict | None = None, out: str | None = None):
+                 manifest: dict | None = None, out: str | None = None, force: PeelForce | None = None,
+                 coef: tuple[str, Sequence[float]] | None = None):
         self.I_values = np.asarray(I_values, dtype=float)
         self.V_values = np.asarray(V_values, dtype=float)
         self.measures = tuple(measures)
         self.options = dict(options)
         self.manifest = manifest or {}
         self.out = out
-        index = {(float(I), float(V)): (i, j) for i, I in enumerate(self.I_values) for j, V in enumerate(self.V_values)}
+        self.force = PeelForce.paper() if force is None else force
+        self.coef_name = None if coef is None else str(coef[0])
+        self.coef_values = None if coef is None else np.asarray(coef[1], dtype=float)
+        index: dict = {(float(I), float(V)): (i, j) for i, I in enumerate(self.I_values)
+                       for j, V in enumerate(self.V_values)}
+        if self.coef_values is not None:
+            index = {(*key, float(c)): (*ij, k) for key, ij in index.items() for k, c in enumerate(self.coef_values)}
         by_key: dict = {}
         for rec in records:
-            key = (float(rec["I"]), float(rec["V"]))
+            key = point_key(rec, self.coef_values is not None)
             if key in index and key not in by_key:
                 by_key[key] = rec
         self._index = index
@@ -53,26 +69,28 @@ class SweepResult:
         self.records = [by_key[k] for k in sorted(by_key, key=index.__getitem__)]
 
     @property
-    def shape(self) -> tuple[int, int]:
-        return (self.I_values.size, self.V_values.size)
+    def shape(self) -> tuple[int, ...]:
+        """``(len(I_values), len(V_values))``, and ``len(coef_values)`` with a coefficient axis."""
+        base = (self.I_values.size, self.V_values.size)
+        return base if self.coef_values is None else (*base, self.coef_values.size)
 
     @property
     def complete(self) -> bool:
         """Every grid point has a record."""
-        return len(self.records) == self.I_values.size * self.V_values.size
+        return len(self.records) == int(np.prod(self.shape))
 
-    def missing(self) -> list[tuple[float, float]]:
-        """(I, V) of the points without a record, in grid order."""
+    def missing(self) -> list[tuple[float, ...]]:
+        """(I, V) of the points without a record (``(I, V, coef)`` with a coefficient axis), in grid order."""
         return [k for k in self._index if k not in self._by_key]
 
-    def failed(self) -> list[tuple[float, float]]:
-        """(I, V) of the points whose record is an error (a measure raised), in grid order; see ``retry_failed``
-        of :func:`sweep`."""
-        return [(float(r["I"]), float(r["V"])) for r in self.records if failed(r)]
+    def failed(self) -> list[tuple[float, ...]]:
+        """(I, V) of the points whose record is an error (a measure raised), in grid order (``(I, V, coef)`` with a
+        coefficient axis); see ``retry_failed`` of :func:`sweep`."""
+        return [point_key(r, self.coef_values is not None) for r in self.records if failed(r)]
 
-    def record(self, I: float, V: float) -> dict | None:
-        """The record at exactly (I, V), or None."""
-        return self._by_key.get((float(I), float(V)))
+    def record(self, I: float, V: float, coef: float | None = None) -> dict | None:
+        """The record at exactly (I, V) (and ``coef``, with a coefficient axis), or None."""
+        return self._by_key.get((float(I), float(V)) if coef is None else (float(I), float(V), float(coef)))
 
     def keys(self) -> list[str]:
         """All record keys, ``I, V, status`` first, then in order of first appearance."""
@@ -82,7 +100,8 @@ class SweepResult:
         return list(seen)
 
     def values(self, key: str) -> np.ndarray:
-        """``key`` over the grid as a 2-D array, shape ``(len(I_values), len(V_values))``.
+        """``key`` over the grid as a 2-D array, shape ``(len(I_values), len(V_values))`` (3-D with a coefficient
+        axis: :attr:`shape`).
 
         A float array when every present value is a number (bools become 0/1);
         NaN marks only the points that have no such value: not computed yet,
@@ -107,8 +126,8 @@ class SweepResult:
                 arr[self._by_key_index(rec)] = float(v) if numeric else v
         return arr
 
-    def _by_key_index(self, rec: dict) -> tuple[int, int]:
-        return self._index[(float(rec["I"]), float(rec["V"]))]
+    def _by_key_index(self, rec: dict) -> tuple[int, ...]:
+        return self._index[point_key(rec, self.coef_values is not None)]
 
     def rows(self) -> list[dict]:
         """The records as a list of dicts (copies), in grid order."""
@@ -123,9 +142,11 @@ class SweepResult:
         write_rows(path, self.records, fields=self.keys())
 
     def __repr__(self) -> str:
-        n = self.I_values.size * self.V_values.size
-        return (f"SweepResult({self.I_values.size} I x {self.V_values.size} V, measures={list(self.measures)}, "
-                f"{len(self.records)}/{n} points, out={self.out!r})")
+        n = int(np.prod(self.shape))
+        c = "" if self.coef_values is None else f" x {self.coef_values.size} {self.coef_name}"
+        law = "" if self.force.kind == "paper" and self.coef_values is None else f", force={self.force!r}"
+        return (f"SweepResult({self.I_values.size} I x {self.V_values.size} V{c}, measures={list(self.measures)}, "
+                f"{len(self.records)}/{n} points{law}, out={self.out!r})")
 
 
 def load_sweep(out) -> SweepResult:
@@ -143,5 +164,7 @@ def load_sweep(out) -> SweepResult:
     """
     out = _path("out", out)
     m = read_manifest(out)
-    recs, _, _ = read_records(out)
-    return SweepResult(m["I_values"], m["V_values"], m["measures"], m["options"], recs, manifest=m, out=out)
+    force, coef = manifest_law(m)  # checked by read_manifest
+    recs, _, _ = read_records(out, coef is not None)
+    return SweepResult(m["I_values"], m["V_values"], m["measures"], m["options"], recs, manifest=m, out=out,
+                       force=force, coef=coef)

@@ -18,15 +18,18 @@ import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from typing import IO, Any
 
+from peelapprox import PeelForce
 from peelapprox.io import fmt_number, jsonable
 from peelapprox.validate import reals
+
+from .law import describe, manifest_law
 
 __all__ = [
     "MANIFEST", "RESULTS", "LOCK", "FORMAT", "RESERVED", "TEMPORARY", "GRID_RTOL",
     "versions", "is_read_only", "check_axis", "compare_manifest",
     "read_manifest", "write_manifest", "read_records", "append_records", "write_record", "truncate_records",
     "rewrite_records",
-    "lock", "failed", "Plan",
+    "lock", "failed", "point_key", "Plan",
 ]
 
 MANIFEST = "sweep.json"
@@ -162,9 +165,18 @@ def _describe(vals: Sequence[float]) -> str:
         else str(list(vals))
 
 
-def compare_manifest(m: dict, I_vals, V_vals, measures, options, out: str) -> None:
-    """ValueError naming every difference between a (checked) manifest and the requested sweep."""
+def compare_manifest(m: dict, I_vals, V_vals, measures, options, out: str, force: PeelForce | None = None,
+                     coef: tuple[str, list[float]] | None = None) -> None:
+    """ValueError naming every difference between a (checked) manifest and the requested sweep (its law
+    ``force``, default the paper's, and coefficient axis ``coef`` included: :mod:`comparisons.sweep.law`)."""
     diffs = []
+    old_force, old_coef = manifest_law(m)
+    force = PeelForce.paper() if force is None else force
+    if old_force != force:
+        diffs.append(f"force: existing {old_force!r}, requested {force!r}")
+    if (old_coef is None) != (coef is None) or (old_coef is not None and coef is not None and (
+            old_coef[0] != coef[0] or not _close(old_coef[1], coef[1]))):
+        diffs.append(f"coef: existing {describe(old_coef)}, requested {describe(coef)}")
     for name, old, new in (("I_values", m["I_values"], I_vals), ("V_values", m["V_values"], V_vals)):
         if not _close(old, new):
             diffs.append(f"{name}: existing {_describe(old)}, requested {_describe(new)}")
@@ -216,6 +228,10 @@ def _manifest_problem(m: Any) -> str | None:
         return f"measure_refs must map names to strings, got {_short(refs)}"
     if not isinstance(m.get("versions", {}), dict):
         return f"versions must be a JSON object, got {_short(m.get('versions'))}"
+    try:
+        manifest_law(m)
+    except (TypeError, ValueError) as exc:
+        return str(exc)
     return None
 
 
@@ -244,11 +260,17 @@ def write_manifest(out: str, manifest: dict) -> None:
 
 # --------------------------------------------------------------------------------------------- records
 
-def _record_problem(rec: Any) -> str | None:
-    """Why ``rec`` is not a record, or None.  Values must be JSON scalars that a float array can hold."""
+def point_key(rec: Mapping, coef: bool = False) -> tuple[float, ...]:
+    """The grid point of a record: ``(I, V)``, or ``(I, V, coef)`` in a sweep with a coefficient axis."""
+    return (float(rec["I"]), float(rec["V"]), float(rec["coef"])) if coef else (float(rec["I"]), float(rec["V"]))
+
+
+def _record_problem(rec: Any, coef: bool = False) -> str | None:
+    """Why ``rec`` is not a record, or None.  Values must be JSON scalars that a float array can hold; with a
+    coefficient axis (``coef``) ``rec["coef"]`` must be a finite number."""
     if not isinstance(rec, dict):
         return f"not a JSON object but {type(rec).__name__}"
-    for key in ("I", "V"):
+    for key in ("I", "V", "coef") if coef else ("I", "V"):
         if key not in rec:
             return f"no {key}"
         v = rec[key]
@@ -273,11 +295,11 @@ def _record_problem(rec: Any) -> str | None:
     return None
 
 
-def read_records(out: str) -> tuple[list[dict], int, bool]:
+def read_records(out: str, coef: bool = False) -> tuple[list[dict], int, bool]:
     """Complete records of ``results.jsonl``, the byte length they span, and whether a partial tail follows.
 
     A last line without its newline (the process died while writing it) is ignored.  A malformed complete
-    line raises ValueError naming the line.
+    line raises ValueError naming the line (``coef``: the sweep has a coefficient axis, each record its value).
     """
     path = os.path.join(out, RESULTS)
     try:
@@ -294,7 +316,7 @@ def read_records(out: str) -> tuple[list[dict], int, bool]:
         except (ValueError, RecursionError) as exc:
             why: str | None = f"not JSON: {exc}"
         else:
-            why = _record_problem(rec)
+            why = _record_problem(rec, coef)
         if why:
             raise ValueError(f"{path}, line {n}: malformed record ({why}); repair or remove the line to resume")
         recs.append(rec)
@@ -346,20 +368,25 @@ class Plan:
     holds other files, or holds a malformed or linked file.  Attributes: ``manifest`` (None for a new sweep),
     ``I_vals, V_vals`` (the manifest's exact values), ``records, end, partial`` (:func:`read_records`),
     ``done`` (key -> record of the finished points), ``retry`` (keys of error points to compute again),
-    ``todo`` (keys to compute, grid order), ``total``.
+    ``todo`` (keys to compute, grid order), ``total``; ``force`` and ``coef`` the law and coefficient axis
+    (:mod:`comparisons.sweep.law`; a key is ``(I, V)``, or ``(I, V, c)`` with a coefficient axis:
+    :func:`point_key`).
     """
 
     def __init__(self, out: str, I_vals: list[float], V_vals: list[float], measures: Sequence[str],
-                 options: Mapping[str, Any], resume: bool, retry_failed: bool) -> None:
+                 options: Mapping[str, Any], resume: bool, retry_failed: bool, force: PeelForce | None = None,
+                 coef: tuple[str, list[float]] | None = None) -> None:
         self.out, self.measures, self.options = out, measures, options
+        self.force = PeelForce.paper() if force is None else force
         others = [f for f in os.listdir(out) if f not in (LOCK, *TEMPORARY)]
         if os.path.lexists(os.path.join(out, MANIFEST)):
             if not resume:
                 raise ValueError(f"out={out!r} already holds a sweep and resume=False: refusing to overwrite it; "
                                  "pass resume=True to continue it, or use another directory")
             m = read_manifest(out)
-            compare_manifest(m, I_vals, V_vals, measures, options, out)
+            compare_manifest(m, I_vals, V_vals, measures, options, out, self.force, coef)
             I_vals, V_vals = [float(x) for x in m["I_values"]], [float(x) for x in m["V_values"]]
+            coef = manifest_law(m)[1]
             mine = {k: v for k, v in versions().items() if k != "python"}
             theirs = {k: v for k, v in m.get("versions", {}).items() if k in mine}
             if theirs and theirs != mine:
@@ -371,13 +398,14 @@ class Plan:
                              f"refusing to write into it (found {sorted(others)[:5]})")
         else:
             self.manifest = None
-        self.I_vals, self.V_vals = I_vals, V_vals
-        self.records, self.end, self.partial = read_records(out)
-        grid = [(I, V) for I in I_vals for V in V_vals]
+        self.I_vals, self.V_vals, self.coef = I_vals, V_vals, coef
+        self.records, self.end, self.partial = read_records(out, coef is not None)
+        grid: list[tuple[float, ...]] = [(I, V) for I in I_vals for V in V_vals] if coef is None else \
+            [(I, V, c) for I in I_vals for V in V_vals for c in coef[1]]
         on_grid = set(grid)
         done: dict = {}
         for rec in self.records:
-            key = (float(rec["I"]), float(rec["V"]))
+            key = point_key(rec, coef is not None)
             if key in on_grid and key not in done:
                 done[key] = rec
         self.retry = {k for k, rec in done.items() if failed(rec)} if retry_failed else set()

@@ -12,10 +12,11 @@ from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType, ModuleType
 from typing import Any, cast
 
-from peelapprox import PeelParams
+from peelapprox import PeelForce, PeelParams
 from peelapprox.io import jsonable
 
 from .._worker import error_text
+from .law import LAW_KEYS, law_fields, point_law
 from .measures import MEASURES, Measure, _ref, record_key
 from .store import RESERVED
 
@@ -74,32 +75,46 @@ def _prefixed(name: str, out: Any) -> dict:
     return rec
 
 
-def make_params(I: float, V: float, options: Mapping) -> PeelParams:
-    """The point's :class:`peelapprox.PeelParams`: ``I``, ``V`` and the options :data:`PARAM_OPTIONS`."""
-    return PeelParams(V=V, I=I, **{k: options[k] for k in PARAM_OPTIONS if k in options})
+def make_params(I: float, V: float, options: Mapping, force: PeelForce | None = None) -> PeelParams:
+    """The point's :class:`peelapprox.PeelParams`: ``I``, ``V``, the options :data:`PARAM_OPTIONS` and the law
+    ``force`` (None: the paper's)."""
+    fields: dict[str, Any] = {k: options[k] for k in PARAM_OPTIONS if k in options}
+    if force is not None:
+        fields["force"] = force
+    return PeelParams(V=V, I=I, **fields)
 
 
 def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
-              refs: Mapping[str, str | bytes] | None = None) -> dict:
+              refs: Mapping[str, str | bytes] | None = None, force: PeelForce | None = None,
+              coef: tuple[str, float] | None = None) -> dict:
     """Evaluate ``measures`` at one grid point; never raises for a measure's failure.
 
     Module level and plain-data in/out, so any executor can ship it.  ``refs``
     maps a measure's name to its import reference, or to its cloudpickle bytes.
+    ``force`` is the sweep's law (a :class:`peelapprox.PeelForce`, pickled as
+    plain data; None: the paper's) and ``coef`` = ``(name, value)`` the point's
+    value of a coefficient axis (:mod:`comparisons.sweep.law`).
     Returns the record ``{"I", "V", "status", <measure keys>...}``; ``status``
-    as in the docstring of :mod:`comparisons.sweep`.
+    as in the docstring of :mod:`comparisons.sweep`; for a law other than the
+    paper's or a coefficient axis, ``{"I", "V", ["coef",] "status", "law",
+    "law_key", ...}``.
     """
     refs = refs or {}
     body: dict = {}
     error = reported = None
+    head: dict = {"I": I, "V": V} if coef is None else {"I": I, "V": V, "coef": coef[1]}
     try:
-        params = make_params(I, V, options)
+        law = None if force is None else point_law(force, *(coef or (None, None)))
+        params = make_params(I, V, options, law)
     except Exception as exc:
-        return {"I": I, "V": V, "status": error_text(exc)}
+        return {**head, "status": error_text(exc)}
+    if law is not None and (coef is not None or law.kind != "paper"):
+        body.update(law_fields(law))
     opts = MappingProxyType(dict(options))
     for name in measures:
         try:
             out = _prefixed(name, _resolve(name, refs.get(name))(params, opts))
-            clash = (set(out) & set(body)) | (set(out) & set(RESERVED))
+            clash = (set(out) & set(body)) | (set(out) & {*RESERVED, *LAW_KEYS})
             if clash:
                 raise ValueError(f"measure {name!r} returned keys that are already taken: {sorted(clash)}")
             body.update(out)
@@ -110,7 +125,7 @@ def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
             err = error_text(exc)
             body[f"{name}_status"] = err
             error = error or err
-    return {"I": I, "V": V, "status": error or reported or "ok", **body}
+    return {**head, "status": error or reported or "ok", **body}
 
 
 def _cloudpickle() -> ModuleType | None:

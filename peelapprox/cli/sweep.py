@@ -9,6 +9,7 @@ import sys
 import time
 
 from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler, nonnegative_int, positive_int
+from ._force import add_force_options, force_from_args
 
 __all__ = ["add_parser", "run"]
 
@@ -39,10 +40,25 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sw.add_argument("--R", type=float, default=None, help="roller radius [m] (0.1)")
     sw.add_argument("--retry-failed", action="store_true",
                     help="compute again the points of DIR whose status is an error (else they count as done)")
-    sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label")
+    sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label "
+                                                  "(not with --coef-axis)")
+    add_force_options(sw)
+    sw.add_argument("--coef-axis", type=_coef_axis, metavar="NAME=SPEC",
+                    help="sweep the coefficient NAME of --force-family as a third grid axis (I x V x values; give "
+                         "one --I or --V value to sweep it instead), SPEC as for --I, e.g. c=290,300,310; every "
+                         "record holds its coef and its law")
     sw.add_argument("--format", choices=("md", "csv", "json"), default="md", help="table printed at the end (md)")
     sw.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
     return sw
+
+
+def _coef_axis(text: str) -> tuple[str, str]:
+    """Argparse type of ``--coef-axis``: ``NAME=SPEC`` (SPEC parsed by ``parse_grid`` when the sweep runs)."""
+    name, sep, spec = text.partition("=")
+    name = name.strip()
+    if not sep or not name.isidentifier() or not spec.strip():
+        raise argparse.ArgumentTypeError(f"value must be NAME=SPEC (e.g. c=290,300,310 or c=250:350:5), got {text!r}")
+    return name, spec
 
 
 def _options(args: argparse.Namespace) -> dict:
@@ -57,6 +73,16 @@ def run(args: argparse.Namespace) -> int:
     I_values = parse_grid(args.I, name="--I")
     V_values = parse_grid(args.V, name="--V")
     options = _options(args)
+    force = force_from_args(args)
+    coef = None
+    if args.coef_axis:
+        name, spec = args.coef_axis
+        if args.force_family is None:
+            raise ValueError("--coef-axis sweeps a coefficient of --force-family NAME; there is no --force-family")
+        if args.plot:
+            raise ValueError("--plot draws a 2-D (V, I) grid; with --coef-axis the grid is 3-D: plot from "
+                             "load_sweep(DIR).values(KEY) instead")
+        coef = (name, parse_grid(spec, name=f"--coef-axis {name}"))
     check_output_path(args.out, "dir", "--out", read_only_ok=True)  # a complete sweep is only read
     if args.plot:
         check_sweep_plot_key(args.plot, [m.strip() for m in args.measure.split(",") if m.strip()])
@@ -85,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor, max_workers=max_workers,
-                       options=options, progress=not args.quiet, retry_failed=args.retry_failed)
+                       options=options, progress=not args.quiet, retry_failed=args.retry_failed, force=force,
+                       coef=coef)
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3
