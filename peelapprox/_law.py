@@ -32,7 +32,7 @@ from ._checks import in_range, reals
 from ._law_folds import Folds, find_folds
 
 __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "law_label", "register_paper",
-           "require_paper_force"]
+           "require_law"]
 
 #: The kinds of law, in the order of the module docstring.
 KINDS = ("paper", "family", "expression", "tabulated")
@@ -429,16 +429,15 @@ def law_label(force: Any) -> str:
     return str(force.kind)
 
 
-def require_paper_force(params: Any, where: str | None = None, laws: tuple[str, ...] = ("paper",)) -> None:
-    """ValueError unless ``params.force`` (if any) is one of ``laws`` (:func:`law_label` names; default: the
-    paper's law only): the one check, at every consumer that does not honour every law yet (issue 15).
-    ``where`` names the consumer (default: the caller's caller, i.e. the public function that validated its
-    ``params``)."""
+def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = ALL_LAWS) -> None:
+    """ValueError unless ``params.force`` (if any) is one of ``laws`` (:func:`law_label` names; default: every
+    law): the one check, at each consumer that runs only some laws (the ε-variational Lyapunov method and the
+    diffsol peer need a closed form; a driver with fvV inlined needs the paper's law).  ``where`` names the
+    consumer (default: the caller's caller, i.e. the public function that validated its ``params``)."""
     force = getattr(params, "force", None)
     if force is None or force.kind == "paper" or law_label(force) in laws:
         return
     if where is None:
         where = sys._getframe(2).f_code.co_name
-    other = "the paper's" if tuple(laws) == ("paper",) else ", ".join(repr(x) for x in laws)
-    raise ValueError(f"params.force: force laws other than {other} are not yet supported by {where} (got "
-                     f"{force!r}); see issue 15")
+    raise ValueError(f"params.force: {where} runs the laws {', '.join(repr(x) for x in laws)} only, not "
+                     f"{force!r}")

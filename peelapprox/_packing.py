@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._law import require_paper_force
+from ._law import require_law
 from ._params import PeelParams
 from ._peelforce import peel_force_coefficients
 
@@ -56,7 +56,7 @@ def model_block(params: PeelParams, size: int = N_M, laws: tuple[str, ...] = ("p
     ndarray
         ``(V, I, k, R, l, b, A, geometry, 0, ..., 0)``, float64.
     """
-    require_paper_force(params, "the compiled drivers (model_block)", laws)
+    require_law(params, "the compiled drivers (model_block)", laws)
     if size < N_M:
         raise ValueError(f"size must be at least the model block's length {N_M}, got {size}")
     b, A = peel_force_coefficients(params.V) if params.force.kind == "paper" else (0.0, 0.0)

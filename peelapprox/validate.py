@@ -54,7 +54,7 @@ from ._checks import (
     reals,
     times,
 )
-from ._law import require_paper_force
+from ._law import ALL_LAWS, require_law
 from ._params import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX, PeelParams
 
 __all__ = [
@@ -84,17 +84,16 @@ __all__ = [
 ]
 
 
-def params(name: str, x: Any, *, laws: tuple[str, ...] = ("paper",), where: str | None = None):
+def params(name: str, x: Any, *, laws: tuple[str, ...] = ALL_LAWS, where: str | None = None):
     """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError.
 
-    A ValueError if ``x.force`` is not one of ``laws``, the laws the calling function honours (by their
-    names: ``"paper"``, ``"cubic"``, ... as in ``peelapprox._law.law_label``; default the paper's law only,
-    as most functions still evaluate fvV themselves, issue 15); the message names ``where`` (default: that
-    function).
+    A ValueError if ``x.force`` is not one of ``laws``, the laws the calling function runs (by their names:
+    ``"paper"``, ``"cubic"``, ``"tabulated"``, ... as in ``peelapprox._law.law_label``; default every law);
+    the message names ``where`` (default: that function).
     """
     if not isinstance(x, PeelParams):
         raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
-    require_paper_force(x, where, laws)
+    require_law(x, where, laws)
     return x
 
 

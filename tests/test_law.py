@@ -350,7 +350,7 @@ CONSUMERS = {
 def test_consumers_honour_every_kind_of_law(name, kind):
     """Hypothesis: every consumer of params takes every kind of law (issue 15 item 2; the refusals of the
     transition are gone): with fvV written as each kind (the power branches calibrated to it), each returns a
-    value, never a ValueError "not yet supported"."""
+    value, never a ValueError refusing the law."""
     p = PeelParams(V=1.0, I=1e-5, force=LAW_KINDS[kind])
     assert CONSUMERS[name](p) is not None
 

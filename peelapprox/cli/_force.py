@@ -8,8 +8,9 @@ called by :func:`peelapprox.cli._common.add_params`), at most one of
 * ``--force-family NAME`` with ``--coef NAME=VALUE`` (repeatable): :meth:`PeelForce.family`;
 
 and none means the paper's fvV (:meth:`PeelForce.paper`).  :func:`force_from_args` builds the law; a
-consumer that does not honour it yet raises its own ``ValueError`` ("not yet supported by ...; see issue
-15"), which the CLI prints as one line with exit status 2, as any bad argument.
+consumer that cannot run it (a table where a closed form is needed, a table too short for the run) raises its
+own ``ValueError`` naming ``params.force``, which the CLI prints as one line with exit status 2, as any bad
+argument.
 
 What a subcommand prints and writes records the law it ran (:func:`law_fields`): ``law`` (its ``repr``) and
 ``law_key`` (:attr:`PeelForce.key`) in every CSV row, and in JSON also ``law_spec``,
