@@ -33,7 +33,7 @@ from ._simulate import (
     simulate,
 )
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
-from ._variational import lyapunov_variational
+from ._variational import VARIATIONAL_LAWS, lyapunov_variational
 
 __all__ = [
     "simulate",
@@ -49,6 +49,7 @@ __all__ = [
     "default_atol",
     "hybrid_field",
     "lyapunov_variational",
+    "VARIATIONAL_LAWS",
     "Trajectory",
     "Jumps",
     "Jump",

@@ -38,6 +38,7 @@ API = {
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
         "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "check_lyapunov_options",
+        "VARIATIONAL_LAWS",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",

@@ -298,3 +298,20 @@ def test_compare_out_records_the_papers_law(tmp_path, capsys):
     with open(tmp_path / "compare_rows.csv", newline="") as fh:
         header = next(csv.reader(fh))
     assert header[-2:] == ["law", "law_key"] and "law_spec" not in header
+
+
+def test_dynamics_variational_refuses_a_table_before_running(capsys, tmp_path):
+    """Hypothesis: ``dynamics --lyapunov-method variational`` needs a closed-form law (its DiffSL model), so a
+    table is refused before the window run (one line, exit 2, naming the method and the laws it runs) instead
+    of after a run that may last minutes."""
+    import numpy as np
+
+    from peelapprox import PeelForce
+
+    v = np.exp(np.linspace(np.log(0.02), np.log(10.0), 60))
+    f = PeelForce.cubic().f(v, 1.0)
+    path = tmp_path / "cubic.csv"
+    path.write_text("v,f\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(v, f)))
+    line = _error(["dynamics", "--V", "1.2", "--I", "1e-3", "--force-table", str(path), "--lyapunov-method",
+                   "variational"], capsys)
+    assert "--lyapunov-method variational" in line and "not PeelForce.tabulated" in line

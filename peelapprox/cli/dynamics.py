@@ -65,6 +65,13 @@ def run(args: argparse.Namespace) -> int:
         check_lyapunov_options(method, **options)
     law = force_from_args(args)
     p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=law)
+    if wants_lyapunov and method == "variational":  # the method's laws, checked before the window run
+        from exact import VARIATIONAL_LAWS
+
+        from ..validate import params as check_params
+
+        check_params("params", p, laws=VARIATIONAL_LAWS, where="--lyapunov-method variational (its DiffSL model "
+                     "needs a closed-form law)")
     if args.attractors:  # checked before the run, named as the user wrote it
         from ..validate import states
 
