@@ -25,6 +25,8 @@ DOP853 (:mod:`peelapprox._dop853`).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -177,6 +179,59 @@ def to_fold(law_argument: bool) -> Any:
     return d
 
 
+@dataclass(frozen=True)
+class TangentSystem:
+    """What the tangent integration of one run needs (:func:`tangent_system`).
+
+    Attributes
+    ----------
+    law : CompiledLaw
+        The run's law (``peelapprox.kernels.compiled_law``).
+    p : ndarray
+        The hybrid driver's parameter vector (folds, landings, floors of the law).
+    run : numba dispatcher
+        :func:`to_fold` for the law (inlined fvV or the law as an argument).
+    field : callable
+        ``field(y, out)``: the hybrid field d(t, α, ω, u)/ds at ``y[:4]``.
+    pull : callable
+        ``pull(alpha, v)``: CONSTR's pull force.
+    """
+
+    law: Any
+    p: np.ndarray
+    run: Any
+    field: Callable[[np.ndarray, np.ndarray], None]
+    pull: Callable[[float, float], float]
+
+    def landing(self, br: int) -> float:
+        """Where a jump from the fold of branch ``br`` (0: AB, 1: CD) lands [m/s]; <= 0 if it cannot."""
+        return float(self.p[H.P_VLCD] if br == 0 else self.p[H.P_VLAB])
+
+
+def tangent_system(params) -> TangentSystem:
+    """The :class:`TangentSystem` of ``params`` (its law's compiled driver, field and pull force)."""
+    from ._simulate import _param_vector
+
+    cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
+    law, coef, bs = cl.fn, cl.coef, cl.structure
+    p = _param_vector(params) if cl.inlined else _param_vector(params, None, bs, cl.domain)
+    if cl.inlined:
+        def field(y, out):
+            H._rhs(y, p, out)
+
+        def pull(a, v):
+            return H.pull_force(a, v, p)
+    else:
+        rhs_law = HL.field_law()
+
+        def field(y, out):
+            rhs_law(y, p, law, coef, out)
+
+        def pull(a, v):
+            return HL.pull_force_law(a, v, p, law, coef)
+    return TangentSystem(cl, p, to_fold(not cl.inlined), field, pull)
+
+
 def saltation(dy, g_minus, g_plus) -> np.ndarray:
     """The tangent after a jump: ``S δy⁻`` with the fold event ``u = ln v_fold`` and the reset v := v_land
     (module docstring); ``g_minus``, ``g_plus`` are the desingularised field before and after."""
@@ -228,7 +283,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
     from ._benettin import natural_scales
-    from ._simulate import ATOL_SCALE, _param_vector, domain_status, initial_state, simulate
+    from ._simulate import ATOL_SCALE, domain_status, initial_state, simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
@@ -240,24 +295,9 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
              if t_transient > 0 else initial_state(params, alpha0=alpha0))
     except SolverBudgetExceeded as exc:
         raise wall.reraise(exc) from None
-    cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
-    law, coef, bs = cl.fn, cl.coef, cl.structure
-    p = _param_vector(params) if cl.inlined else _param_vector(params, None, bs, cl.domain)
-    run = to_fold(not cl.inlined)
-    if cl.inlined:
-        def field(y, out):
-            H._rhs(y, p, out)
-
-        def pull(a, v):
-            return H.pull_force(a, v, p)
-    else:
-        rhs_law = HL.field_law()
-
-        def field(y, out):
-            rhs_law(y, p, law, coef, out)
-
-        def pull(a, v):
-            return HL.pull_force_law(a, v, p, law, coef)
+    ts = tangent_system(params)
+    cl, law, coef, bs, p, run, field, pull = ts.law, ts.law.fn, ts.law.coef, ts.law.structure, ts.p, ts.run, \
+        ts.field, ts.pull
     scale = natural_scales(params)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
     # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
@@ -291,7 +331,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
                                law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)
         t += y[0]
         field(y[:4], g_minus)
-        v_land = p[H.P_VLCD] if br == 0 else p[H.P_VLAB]
+        v_land = ts.landing(br)
         if not v_land > 0.0:
             code, what = domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
             raise status_error(code, t=t_transient + t, state=where(t), prefix="tangent integration: ",
