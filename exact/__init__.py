@@ -23,6 +23,7 @@ from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt, default_atol
+from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return
 from ._simulate import (
     ATOL_SCALE,
     STEP_BUDGET,
@@ -50,6 +51,11 @@ __all__ = [
     "hybrid_field",
     "lyapunov_variational",
     "VARIATIONAL_LAWS",
+    "periodic_orbit",
+    "PeriodicOrbit",
+    "section_return",
+    "SectionReturn",
+    "monodromy_fd",
     "Trajectory",
     "Jumps",
     "Jump",

@@ -3,8 +3,8 @@
 On a branch the hybrid solver integrates the desingularised field ``y' = g(y)``, ``y = (t, α, ω, u = ln v)``,
 in the parameter s (``exact._hybrid``); g is smooth through the folds.  A tangent vector δy obeys
 ``δy' = Dg(y) δy``, integrated here together with y by the same compiled DOP853 (state + tangent, 8
-components); ``Dg δy`` is a central directional difference of g (two extra field evaluations, relative
-step 1e-7: accurate to ~1e-9 relative, far below the growth being measured).
+components); ``Dg`` is the analytic Jacobian of the field (:mod:`exact._jacobian`: the chain rule through
+CONSTR, with f'' of the law and the closure's second derivative).
 
 At the fold (the event ``h(y) = u − ln v_fold = 0``) the reset sets v to the landing root and keeps
 (t, α, ω).  The saltation matrix maps the tangent across it,
@@ -54,51 +54,35 @@ from peelapprox.validate import duration, integer, optional, positive
 
 from . import _hybrid as H
 from . import _hybrid_law as HL
+from ._jacobian import jacobian_law, jacobian_paper
 
 DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, V_CEILING = (
     _st.DONE, _st.FOLD, _st.MAX_STEPS, _st.NO_LANDING, _st.NO_ROOT, _st.STEP_FAIL, _st.V_CEILING)
 status_error = _st.status_error
 
-_EPS_FD = 1e-7
-
 
 #: Bound per copy of the driver (:func:`to_fold`): the field ``_FIELD(y, P, out)`` (the hybrid solver's, the
-#: law inlined or as an argument), ``P = _PACK(p, law, coef)``, the tangent field ``_RHS_T`` and ``_dop_t``, its
-#: DOP853 pieces.  Never compiled with these placeholders.
+#: law inlined or as an argument), its Jacobian ``_JAC(y, P, J)``, ``P = _PACK(p, law, coef)``, the tangent
+#: field ``_RHS_T`` and ``_dop_t``, its DOP853 pieces.  Never compiled with these placeholders.
 _FIELD: Any = None
+_JAC: Any = None
 _PACK: Any = None
 _RHS_T: Any = None
 _dop_t: Any = None
 
 
 def _rhs_tangent(y, P, out):
-    """d(y, δy)/ds: the hybrid field and its directional derivative along δy (central difference)."""
+    """d(y, δy)/ds: the hybrid field and its Jacobian (:mod:`exact._jacobian`) applied to δy."""
     g = np.empty(4)
     _FIELD(y[:4], P, g)
-    nrm = 0.0
-    ysz = 0.0
-    for i in range(4):
-        nrm += y[4 + i] * y[4 + i]
-        ysz += y[i] * y[i]
-    nrm = math.sqrt(nrm)
+    J = np.empty((4, 4))
+    _JAC(y[:4], P, J)
     for i in range(4):
         out[i] = g[i]
-    if nrm == 0.0:
-        for i in range(4):
-            out[4 + i] = 0.0
-        return
-    eta = _EPS_FD * max(1.0, math.sqrt(ysz) * 1e-3) / nrm
-    yp = np.empty(4)
-    ym = np.empty(4)
-    for i in range(4):
-        yp[i] = y[i] + eta * y[4 + i]
-        ym[i] = y[i] - eta * y[4 + i]
-    gp = np.empty(4)
-    gm = np.empty(4)
-    _FIELD(yp, P, gp)
-    _FIELD(ym, P, gm)
-    for i in range(4):
-        out[4 + i] = (gp[i] - gm[i]) / (2.0 * eta)
+        acc = 0.0
+        for j in range(4):
+            acc += J[i, j] * y[4 + j]
+        out[4 + i] = acc
 
 
 def _to_fold(y, p, law, coef, br, rtol, atol, t_max, max_steps):
@@ -160,13 +144,13 @@ _A1 = _t.float64[::1]
 TO_FOLD_SIG = _t.UniTuple(_t.int64, 2)(_A1, _A1, LAW_TYPE, _A1, _t.int64, _t.float64, _A1, _t.float64, _t.int64)
 
 
-def _make_to_fold(field, pack, tag: str):
-    rhs_t = kernel(rebind(_rhs_tangent, _FIELD=field), name=f"rhs_tangent_{tag}")
+def _make_to_fold(field, jac, pack, tag: str):
+    rhs_t = kernel(rebind(_rhs_tangent, _FIELD=field, _JAC=jac), name=f"rhs_tangent_{tag}")
     return kernel(rebind(_to_fold, _PACK=pack, _RHS_T=rhs_t, _dop_t=make_dop853(rhs_t)), name=f"to_fold_{tag}")
 
 
-_TO_FOLD = {False: _make_to_fold(H._rhs, pack_inlined, "inlined"),
-            True: _make_to_fold(HL._rhs_law, pack_law, "law")}
+_TO_FOLD = {False: _make_to_fold(H._rhs, jacobian_paper, pack_inlined, "inlined"),
+            True: _make_to_fold(HL._rhs_law, jacobian_law, pack_law, "law")}
 
 
 def to_fold(law_argument: bool) -> Any:

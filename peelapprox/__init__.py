@@ -145,6 +145,8 @@ __all__ = [
     "lyapunov_return_map",
     "LyapunovResult",
     "benettin",
+    "periodic_orbit",
+    "PeriodicOrbit",
     # (I, V) sweeps
     "sweep",
     "load_sweep",
@@ -161,7 +163,8 @@ _LAZY = {name: "comparisons.sweep" for name in
          ("sweep", "load_sweep", "SweepResult", "register_measure", "MEASURES", "parse_grid")}
 # the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
 _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
-                                         "lyapunov_return_map", "LyapunovResult", "benettin")})
+                                         "lyapunov_return_map", "LyapunovResult", "benettin", "periodic_orbit",
+                                         "PeriodicOrbit")})
 
 
 def __getattr__(name: str):

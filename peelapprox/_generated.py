@@ -73,6 +73,34 @@ def closure_exact(alpha, R, l):
     return c, dc
 
 
+def closure_paper_d2(alpha, R, l):
+    """Closure 'paper': c = -cos(theta), dc/dalpha and d2c/dalpha2."""
+    x0 = numpy.sin(alpha)
+    c = x0
+    dc = numpy.cos(alpha)
+    ddc = -x0
+    return c, dc, ddc
+
+
+def closure_exact_d2(alpha, R, l):
+    """Closure 'exact': c = -cos(theta), dc/dalpha and d2c/dalpha2."""
+    x0 = numpy.sin(alpha)
+    x1 = numpy.cos(alpha)
+    x2 = R*l
+    x3 = 2*x1*x2
+    x4 = R**2 + l**2 - x3
+    x5 = l/numpy.sqrt(x4)
+    x6 = x0*x5
+    x7 = -x1
+    x8 = x4**(-1.0)
+    x9 = x2*x8
+    x10 = x0**2*x9
+    c = x6
+    dc = x5*(-x10 - x7)
+    ddc = -x6*(x3*x8 - x9*(3*x10 + x7) + 1)
+    return c, dc, ddc
+
+
 def slow_rates(alpha, omega, F, v, c, V, I, k, R):
     """FLOW1, FLOW2, flow3: (alpha_dot, omega_dot, F_dot) with c = -cos(theta)."""
     x0 = -v

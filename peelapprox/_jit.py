@@ -62,6 +62,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/kernels.py",
     "exact/_hybrid.py",
     "exact/_hybrid_law.py",
+    "exact/_jacobian.py",
     "exact/_regularized.py",
     "exact/_tangent.py",
 )

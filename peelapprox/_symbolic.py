@@ -270,6 +270,17 @@ def render_module() -> str:
                 ["c", "dc"],
             )
         )
+    for geom in ("paper", "exact"):  # with the second derivative: the Jacobian of the hybrid field (tangents)
+        c = -cos_theta_expr(geom, alpha)
+        parts.append(
+            _render_function(
+                f"closure_{geom}_d2",
+                ["alpha", "R", "l"],
+                [c, sp.diff(c, alpha), sp.diff(c, alpha, 2)],
+                f"Closure '{geom}': c = -cos(theta), dc/dalpha and d2c/dalpha2.",
+                ["c", "dc", "ddc"],
+            )
+        )
 
     ad, wd, Fd, g = equations_of_motion(c_)
     parts.append(

@@ -82,7 +82,8 @@ __all__ = [
     "pack_inlined", "pack_law",
     "ALL_LAWS", "CompiledLaw", "compiled_law", "law_domain", "U_ZERO",
     "table_law", "table_coefficients", "family_kernel", "expression_kernel",
-    "closure_paper", "closure_exact", "closure", "slow_rates", "constraint_rate",
+    "closure_paper", "closure_exact", "closure", "closure_d2", "closure_paper_d2", "closure_exact_d2",
+    "slow_rates", "constraint_rate",
     "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",
     "regularized_field_jacobian", "regularized_law_field", "peel_force_coefficients", "branch_inverse_at",
     "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
@@ -104,6 +105,21 @@ constraint_rate = kernel(inline="always")(_g.constraint_rate)
 regularized_rhs = kernel(inline="always")(_g.regularized_rhs)
 #: Its Jacobian, a row-major 16-tuple.
 regularized_jacobian = kernel(inline="always")(_g.regularized_jacobian)
+
+
+#: ``(c, dc/dα, d²c/dα²)`` of the paper's closure.
+closure_paper_d2 = kernel(inline="always")(_g.closure_paper_d2)
+#: ``(c, dc/dα, d²c/dα²)`` of the full geometry.
+closure_exact_d2 = kernel(inline="always")(_g.closure_exact_d2)
+
+
+@kernel(inline="always")
+def closure_d2(alpha, exact_geometry, R, l):
+    """``(c, dc/dα, d²c/dα²)`` of the paper's closure (``exact_geometry == 0``) or of the full geometry (else): the
+    Jacobian of the hybrid field needs the second derivative."""
+    if exact_geometry == 0.0:
+        return closure_paper_d2(alpha, R, l)
+    return closure_exact_d2(alpha, R, l)
 
 
 @kernel(inline="always")

@@ -1,0 +1,397 @@
+"""Stick-slip orbits as objects: the AB→CD section, its return map with the Jacobian from the saltation tangent,
+periodic orbits by Newton, and their Floquet multipliers (issue 16).
+
+**The section** is the AB→CD jump.  There the state lies on the AB fold, ``v = v_max``, so CONSTR fixes
+``F = f_max / (1 + c(α))`` and the section is two-dimensional: ``x = (α, ω)``.  The return map ``P`` takes
+the state at one AB→CD jump to the state at the next: the jump to ``v_land_cd`` on CD, CD to its fold
+``v_min``, the jump to ``v_land_ab``, AB to its fold ``v_max``.  A period-n orbit is a fixed point of ``P^n``.
+
+**The Jacobian** ``DP`` comes from the tangent dynamics of the hybrid solver's desingularised field in the
+parameter s (:mod:`exact._tangent`: state ``(t, α, ω, u = ln v)`` and one tangent, integrated together by the
+package's DOP853, the directional derivative by a central difference), with the saltation matrix at the CD→AB
+jump.  A perturbation ``(δα, δω)`` of the section state starts as ``δy = (0, δα, δω, 0)`` after the AB→CD
+jump (the jump keeps (α, ω) and sets v, so δu = 0); at the next AB fold the field is ``(0, 0, 0, Ġ)`` (dt/ds,
+dα/ds, dω/ds vanish with f'), so the projection of the tangent onto the section along the flow only drops δu:
+``(δα, δω)`` there is the column of ``DP``, and δt the change of the return time.  Two tangent runs give the
+two columns.  Finite differences of ``P`` are the cross-check (:func:`monodromy_fd`).
+
+**Newton** on ``G(z) = P^n(z) - z`` in the scaled coordinates ``z = (α, ω R/V)`` with ``DG = DP^n - 1``;
+a step that does not reduce ``|G|`` is halved (at most 8 times).  Converged when the closing residual
+``|P^n(z) - z| / max(1, |z|)`` is at most ``tol``.  The **nontrivial Floquet multipliers** are the two
+eigenvalues of ``DP^n`` at the orbit (the flow direction and the constraint are removed by the section);
+the orbit is stable if both lie inside the unit circle.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, PeelParams, periodicity
+from peelapprox.errors import SolverFailure
+from peelapprox.kernels import M_R
+from peelapprox.kernels import status as _st
+from peelapprox.validate import duration, in_range, integer, optional
+from peelapprox.validate import params as _params
+
+from ._tangent import TangentSystem, saltation, tangent_system
+
+__all__ = ["PeriodicOrbit", "SectionReturn", "monodromy_fd", "periodic_orbit", "section_return"]
+
+#: Relative tolerance of the tangent runs, whatever the state's ``rtol``: the tangent's directional difference
+#: quotient carries ~1e-9 relative noise, which a tighter error control would chase with ever smaller steps.
+TANGENT_RTOL = 1e-10
+#: Absolute tolerance of the tangent components (unit vectors of the scaled section coordinates
+#: ``(α, ω R/V)`` at the start of a return).
+TANGENT_ATOL = 1e-10
+#: Accepted steps allowed for one leg (one branch stay) of a return.
+LEG_STEPS = 10_000_000
+#: Longest stay on one branch [s] before a return is given up.
+LEG_TIME = 1e4
+
+
+@dataclass(frozen=True)
+class SectionReturn:
+    """One application of the return map ``P`` (module docstring).
+
+    Attributes
+    ----------
+    x : ndarray, shape (2,)
+        ``(α, ω)`` at the next AB→CD jump.
+    jacobian : ndarray, shape (2, 2) or None
+        ``∂x/∂x0`` (None when the tangent was not integrated).
+    time : float
+        The return time [s].
+    dtime : ndarray, shape (2,) or None
+        ``∂(return time)/∂x0``.
+    steps : int
+        Accepted steps (all tangent runs).
+    """
+
+    x: np.ndarray
+    jacobian: np.ndarray | None
+    time: float
+    dtime: np.ndarray | None
+    steps: int
+
+
+def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarray, t0: float) -> int:
+    """Integrate ``y`` (state and tangent) on branch ``br`` to its fold; raise the status's exception else."""
+    law = ts.law
+    status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+    if status != _st.FOLD:
+        v = math.exp(y[3])
+        state = dict(t=t0 + y[0], alpha=float(y[1]), omega=float(y[2]), F=float(ts.pull(y[1], v)), v=v,
+                     branch="AB" if br == 0 else "CD")
+        if status == _st.DONE:
+            raise SolverFailure(f"section return: no fold reached on {state['branch']} within {LEG_TIME:g} s",
+                                t=state["t"], state=state)
+        raise _st.status_error(status, t=state["t"], state=state, prefix="section return: ", limit=LEG_STEPS,
+                               f_zero=law.structure.f_zero, level=BREAKDOWN_LEVEL, v=v, lo=law.domain[0],
+                               hi=law.domain[1],
+                               law=repr(law.force), v_ceiling=math.inf, what="v left the law's domain")
+    return int(n)
+
+
+def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, atol: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, float, float, int]:
+    """``P(x)`` with the tangent ``d = (δα, δω)`` carried along: ``(x', (δα', δω'), δT, T, steps)``."""
+    y = np.array([0.0, x[0], x[1], math.log(ts.landing(0)), 0.0, d[0], d[1], 0.0])
+    steps = _leg(ts, y, 1, rtol, atol, 0.0)
+    t_cd = float(y[0])
+    v_land = ts.landing(1)
+    if not v_land > 0.0:
+        v = math.exp(y[3])
+        raise _st.status_error(_st.NO_LANDING, t=t_cd, state=dict(t=t_cd, alpha=float(y[1]), omega=float(y[2]),
+                               F=float(ts.pull(y[1], v)), v=v, branch="CD"), prefix="section return: ",
+                               f_min=ts.law.structure.f_min, f_zero=ts.law.structure.f_zero)
+    gm, gp = np.empty(4), np.empty(4)
+    ts.field(y[:4], gm)
+    y[0], y[3] = 0.0, math.log(v_land)
+    ts.field(y[:4], gp)
+    y[4:] = saltation(y[4:], gm, gp)
+    steps += _leg(ts, y, 0, rtol, atol, t_cd)
+    return y[1:3].copy(), y[5:7].copy(), float(y[4]), t_cd + float(y[0]), steps
+
+
+def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: bool = True,
+                   system: TangentSystem | None = None) -> SectionReturn:
+    """The return map ``P`` of the AB→CD section at ``x = (α, ω)`` (module docstring).
+
+    Parameters
+    ----------
+    params : PeelParams
+        Any law with folds at ``params.V``.
+    x : sequence of 2 floats
+        ``(α [rad], ω [rad/s])`` at an AB→CD jump.
+    rtol : float
+        Relative tolerance of the state's integration (its absolute tolerances scale with it as in
+        ``exact.simulate``); the tangent runs use ``max(rtol, TANGENT_RTOL)`` and :data:`TANGENT_ATOL`.
+    tangent : bool
+        Also integrate the two tangent columns (``jacobian``, ``dtime``).
+
+    Returns
+    -------
+    SectionReturn
+
+    Raises
+    ------
+    ValueError
+        Bad arguments, or a law without folds at V (no section).
+    ModelBreakdown, SolverBudgetExceeded, SolverFailure
+        The orbit breaks down or does not return.
+    """
+    from ._simulate import ATOL_SCALE
+
+    ts = system or _system(params)
+    x0 = np.asarray(x, dtype=float).reshape(2)
+    scale = np.asarray(ATOL_SCALE["hybrid"])
+    atol = np.concatenate([rtol * scale, np.ones(4)])  # the tangent stays 0: its weights do not matter
+    xn, _, _, T, steps = _one_return(ts, x0, np.zeros(2), rtol, atol)  # the state alone, at rtol
+    if not tangent:
+        return SectionReturn(xn, None, T, None, steps)
+    jrt = max(rtol, TANGENT_RTOL)
+    atol_t = np.concatenate([jrt * scale, np.full(4, TANGENT_ATOL)])
+    cols, dts = [], []
+    s = np.array([1.0, ts.law.V / float(ts.p[M_R])])  # unit vectors of z = (α, ω R/V): balanced columns
+    for i in range(2):
+        d = np.zeros(2)
+        d[i] = s[i]
+        _, dx, dT, _, n = _one_return(ts, x0, d, jrt, atol_t)
+        cols.append(dx / s[i])
+        dts.append(dT / s[i])
+        steps += n
+    return SectionReturn(xn, np.column_stack(cols), T, np.array(dts), steps)
+
+
+def _system(params: PeelParams) -> TangentSystem:
+    ts = tangent_system(params)
+    if not ts.law.structure.has_folds:
+        raise ValueError(f"params: f(v, V={params.V}) has no folds (no stick-slip): there is no AB->CD section")
+    return ts
+
+
+def _section_F(params: PeelParams, ts: TangentSystem, alpha: np.ndarray) -> np.ndarray:
+    """F at the AB→CD jump: ``f_max / (1 + c(α))`` (CONSTR on the fold)."""
+    return float(ts.law.structure.f_max) / (1.0 + np.asarray(params.closure(np.asarray(alpha))[0]))
+
+
+@dataclass(frozen=True)
+class PeriodicOrbit:
+    """A periodic stick-slip orbit: a fixed point of ``P^n`` on the AB→CD section (:func:`periodic_orbit`).
+
+    Attributes
+    ----------
+    params : PeelParams
+    n : int
+        AB→CD jumps per period.
+    period : float
+        Period [s].
+    section_states : ndarray, shape (n, 2)
+        ``(α, ω)`` at the n AB→CD jumps of one period, in order.
+    return_map_values : ndarray, shape (n,)
+        F [N] at those jumps (``f_max / (1 + c(α))``): the return-map values of ``peelapprox.return_map``.
+    itinerary : tuple of str
+        The branch stays of one period, in order (``("CD", "AB") * n`` in this model).
+    multipliers : ndarray of complex, shape (2,)
+        The nontrivial Floquet multipliers (eigenvalues of ``DP^n``), by decreasing modulus.
+    stable : bool
+        Both multipliers inside the unit circle.
+    residual : float
+        The closing residual ``|P^n(z) - z| / max(1, |z|)`` in the scaled coordinates ``z = (α, ω R/V)``.
+    newton : tuple of float
+        The residual at each Newton iterate (the last is ``residual``).
+    monodromy : ndarray, shape (2, 2)
+        ``DP^n`` at the orbit, in ``(α, ω)``.
+    steps, wall_time : int, float
+        Accepted integration steps and seconds spent (all Newton iterations).
+    """
+
+    params: PeelParams
+    n: int
+    period: float
+    section_states: np.ndarray
+    return_map_values: np.ndarray
+    itinerary: tuple[str, ...]
+    multipliers: np.ndarray
+    stable: bool
+    residual: float
+    newton: tuple[float, ...]
+    monodromy: np.ndarray
+    steps: int = 0
+    wall_time: float = 0.0
+    _extra: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def trajectory(self, *, rtol: float = 1e-12, save: str = "steps") -> Any:
+        """One period of the orbit by ``exact.simulate``, from the first AB→CD jump (just after it, on CD)."""
+        from ._simulate import simulate
+
+        a, w = self.section_states[0]
+        return simulate(self.params, self.period, alpha0=float(a), omega0=float(w),
+                        F0=float(self.return_map_values[0]), branch0="CD", rtol=rtol, save=save)
+
+
+def _compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
+             ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, int]:
+    """``(P^n(x), DP^n, period, the n section states, steps)``."""
+    J = np.eye(2)
+    T, steps, states = 0.0, 0, [x.copy()]
+    for _ in range(n):
+        r = section_return(params, x, rtol=rtol, system=ts)
+        assert r.jacobian is not None
+        J = r.jacobian @ J
+        T += r.time
+        steps += r.steps
+        x = r.x
+        states.append(x.copy())
+    return x, J, T, np.array(states[:-1]), steps
+
+
+def _start(params: PeelParams, start: Any, n: int | None, t_transient: float, window: float, max_period: int,
+           rtol: float) -> tuple[np.ndarray, int]:
+    """``(x0, n)``: the section state to start Newton from and the jumps per period (module docstring of
+    :func:`periodic_orbit`)."""
+    from ._simulate import simulate
+    from ._trajectory import State, Trajectory
+
+    if isinstance(start, Trajectory):
+        tr, t0 = start, start.t_transient
+    else:
+        kw: dict = {}
+        if isinstance(start, State):
+            kw = dict(alpha0=start.alpha, omega0=start.omega, F0=start.F, branch0=start.branch)
+        elif start is not None:
+            raise TypeError(f"start must be None, an exact.Trajectory or an exact.State, got {type(start).__name__}")
+        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, **kw)
+        t0 = t_transient
+    j = tr.jumps
+    up = (j.from_branch == 0) & (j.t >= t0)
+    a, w, F = j.alpha[up], j.omega[up], j.F[up]
+    if F.size < 2:
+        raise ValueError(f"start: the run has {F.size} AB->CD jumps after its transient; a periodic orbit needs "
+                         "stick-slip (at least two returns): lengthen window or check params")
+    if n is None:
+        per = periodicity(F, max_period=max_period)
+        if per.period is None:
+            raise ValueError(f"start: the run's return map is {per.kind} for periods up to max_period={max_period}; "
+                             "give n (the jumps per period) to look for an unstable orbit near a recurrence")
+        n = int(per.period)
+    if F.size <= n:
+        raise ValueError(f"n={n} needs more than {n} AB->CD jumps after the transient; the run has {F.size}")
+    z = np.column_stack([a, w * params.R / params.V])
+    gap = np.linalg.norm(z[n:] - z[:-n], axis=1)
+    k = int(np.argmin(gap))  # the nearest recurrence: exact for a periodic attractor, a seed for an unstable one
+    return np.array([a[k], w[k]]), n
+
+
+def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = None, t_transient: float = T_TRANSIENT,
+                   window: float = 20.0, tol: float = 1e-10, rtol: float = 1e-12, max_iter: int = 30,
+                   max_period: int = 32) -> PeriodicOrbit:
+    """A periodic orbit of the hybrid DAE with ``n`` AB→CD jumps per period, by Newton on the section map.
+
+    Parameters
+    ----------
+    params : PeelParams
+        Any law with folds at V.
+    start : None, exact.Trajectory or exact.State
+        Where to look: None runs ``exact.simulate`` from the default start for ``t_transient + window`` s; a
+        State runs from it; a Trajectory is used as it is (its jumps after its own ``t_transient``).  Newton
+        starts from the AB→CD jump whose state comes back nearest after n returns (exact on a periodic
+        attractor; a near-recurrence of a chaotic run seeds an unstable orbit).
+    n : int, optional
+        AB→CD jumps per period (default: the period of the run's return map, ``peelapprox.periodicity``).
+    t_transient, window : float
+        Transient and window of the run that seeds Newton [s].
+    tol : float
+        Closing tolerance of the scaled residual (module docstring), in [1e-14, 1e-3].
+    rtol : float
+        Relative tolerance of the integrations, in [1e-14, 1e-6].
+    max_iter : int
+        Newton iterations, in [1, 200].
+    max_period : int
+        Largest period looked for when ``n`` is None.
+
+    Returns
+    -------
+    PeriodicOrbit
+
+    Raises
+    ------
+    ValueError
+        Bad arguments; no stick-slip or no period found in the run (give n); Newton did not converge within
+        ``max_iter`` (the message gives the residual history).
+    ModelBreakdown, SolverBudgetExceeded, SolverFailure
+        A return breaks down or never comes.
+    """
+    wall0 = time.perf_counter()
+    params = _params("params", params)
+    n = optional(integer, "n", n, 1, 10_000)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    window = duration("window", window)
+    tol = in_range("tol", tol, 1e-14, 1e-3)
+    rtol = in_range("rtol", rtol, 1e-14, 1e-6)
+    max_iter = integer("max_iter", max_iter, 1, 200)
+    max_period = integer("max_period", max_period, 1, 1000)
+    ts = _system(params)
+    x, n = _start(params, start, n, t_transient, window, max_period, min(1e-10, 100 * rtol))
+    s = np.array([1.0, params.V / params.R])  # z = x / s
+    history: list[float] = []
+    steps = 0
+    for _ in range(max_iter):
+        xn, J, T, states, k = _compose(params, ts, x, n, rtol)
+        steps += k
+        z, g = x / s, (xn - x) / s
+        res = float(np.linalg.norm(g) / max(1.0, np.linalg.norm(z)))
+        history.append(res)
+        if res <= tol:
+            break
+        Js = J * s[None, :] / s[:, None]  # DP^n in z
+        dz = np.linalg.solve(Js - np.eye(2), -g)
+        lam = 1.0
+        for _ in range(9):  # halve a step that does not reduce the residual
+            x_try = (z + lam * dz) * s
+            xt = section_return_n(params, ts, x_try, n, rtol)
+            steps += xt[1]
+            r_try = float(np.linalg.norm((xt[0] - x_try) / s) / max(1.0, np.linalg.norm(x_try / s)))
+            if r_try < res:
+                break
+            lam *= 0.5
+        x = x_try
+    else:
+        raise ValueError(f"periodic_orbit: Newton did not close the period-{n} orbit to tol={tol} in "
+                         f"max_iter={max_iter} iterations; residuals {', '.join(f'{r:.3g}' for r in history)}")
+    mu = np.linalg.eigvals(J)
+    mu = mu[np.argsort(-np.abs(mu))]
+    return PeriodicOrbit(params=params, n=n, period=T, section_states=states,
+                         return_map_values=_section_F(params, ts, states[:, 0]), itinerary=("CD", "AB") * n,
+                         multipliers=mu, stable=bool(np.all(np.abs(mu) < 1.0)), residual=history[-1],
+                         newton=tuple(history), monodromy=J, steps=steps, wall_time=time.perf_counter() - wall0)
+
+
+def section_return_n(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
+                     ) -> tuple[np.ndarray, int]:
+    """``(P^n(x), steps)`` without the tangent."""
+    steps = 0
+    for _ in range(n):
+        r = section_return(params, x, rtol=rtol, tangent=False, system=ts)
+        x, steps = r.x, steps + r.steps
+    return x, steps
+
+
+def monodromy_fd(params: PeelParams, x: Any, n: int, *, h: float = 1e-5, rtol: float = 1e-12) -> np.ndarray:
+    """``DP^n`` at ``x = (α, ω)`` by fourth-order central differences of the return map (the cross-check of the
+    tangent's Jacobian): steps ``h`` in α and ``h V/R`` in ω, ``(-P(2e) + 8 P(e) - 8 P(-e) + P(-2e)) / 12e``."""
+    ts = _system(params)
+    x = np.asarray(x, dtype=float).reshape(2)
+    s = np.array([1.0, params.V / params.R])
+    cols = []
+    for i in range(2):
+        e = np.zeros(2)
+        e[i] = h * s[i]
+        Pn = [section_return_n(params, ts, x + k * e, n, rtol)[0] for k in (2, 1, -1, -2)]
+        cols.append((-Pn[0] + 8 * Pn[1] - 8 * Pn[2] + Pn[3]) / (12 * e[i]))
+    return np.column_stack(cols)

@@ -1,0 +1,101 @@
+"""Periodic orbits as objects (issue 16): the section map's Jacobian, Newton's orbits, Floquet multipliers.
+
+Oracles: central differences of the field (for its analytic Jacobian), fourth-order differences of the
+return map (for the tangent's monodromy), the long-run simulation's return map (for the orbit's values),
+and the orbit's own trajectory closing after one period.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+
+import exact
+import exact._hybrid_law as HL
+import exact._simulate as ES
+from exact._jacobian import field_jacobian
+from peelapprox import PeelForce, PeelParams, return_map
+from peelapprox.kernels import LAW_FPP, compiled_law
+
+CUBIC = PeelParams(V=1.2, I=3e-5, force=PeelForce.cubic())  # a stable period-1 orbit
+PAPER = PeelParams(V=1.0, I=1e-5)  # period 3 from alpha0 = 0 after ~2 s (docs/dynamics.md)
+
+
+@njit
+def _jac(y, p, v, f, fp, fpp, J):
+    field_jacobian(y, p, v, f, fp, fpp, J)
+
+
+@pytest.mark.parametrize("params", [PAPER, PAPER.replace(geometry="exact", l=0.3), CUBIC],
+                         ids=["fvV", "fvV-exact-geometry", "cubic"])
+def test_field_jacobian_is_the_derivative_of_the_field(params):
+    """Hypothesis: the analytic Jacobian of the hybrid field (chain rule through CONSTR, f'' of the law, the
+    closure's second derivative) equals central differences of the field (step 1e-6 of each coordinate's
+    size) at states on both branches, to 1e-6 relative to the largest entry (the difference quotient's own
+    error is ~1e-8; a wrong term is off by O(1))."""
+    cl = compiled_law(params.force, params.V)
+    p = ES._param_vector(params, None, cl.structure, cl.domain)
+    rng = np.random.default_rng(3)
+    for v in (0.02, 0.3, 3.0, 12.0):
+        y = np.array([0.0, rng.uniform(-0.2, 0.2), rng.uniform(0, 30), math.log(v)])
+        f, fp, fpp = cl.fn(v, cl.coef, LAW_FPP)
+        J = np.empty((4, 4))
+        _jac(y, p, v, f, fp, fpp, J)
+        fd = np.empty((4, 4))
+        for j in range(4):
+            h = 1e-6 * max(1.0, abs(y[j]))
+            gp, gm = np.empty(4), np.empty(4)
+            yp, ym = y.copy(), y.copy()
+            yp[j] += h
+            ym[j] -= h
+            HL.field_law()(yp, p, cl.fn, cl.coef, gp)
+            HL.field_law()(ym, p, cl.fn, cl.coef, gm)
+            fd[:, j] = (gp - gm) / (2 * h)
+        assert np.abs(J - fd).max() <= 1e-6 * np.abs(fd).max(), (v, J, fd)
+
+
+@pytest.mark.parametrize("params, kw, n", [(CUBIC, {}, 1), (PAPER, dict(t_transient=40.0), 3)], ids=["cubic", "fvV"])
+def test_stable_orbit_closes_matches_the_long_run_and_fd_multipliers(params, kw, n):
+    """Hypothesis: from the default start, Newton finds the attractor the long run settles on: period ``n``,
+    closing residual <= 1e-10 (the issue's bound), stable; its return-map values equal those of a 20 s
+    simulation after the transient at rtol 1e-12 to 1e-8 relative (measured 4e-14); its multipliers equal the
+    eigenvalues of a fourth-order finite-difference monodromy to 1e-6 (measured 1e-8 and 7e-8); and one
+    period of its trajectory ends where it began, (α, ω) to 1e-9 relative (v is not compared: at the fold it
+    moves like the square root of the time to it, so rounding of the period shows there), after n CD→AB jumps."""
+    o = exact.periodic_orbit(params, **kw)
+    assert o.n == n and o.residual <= 1e-10 and o.stable and np.all(np.abs(o.multipliers) < 1)
+    t0 = kw.get("t_transient", 30.0)
+    tr = exact.simulate(params, t0 + 20.0, rtol=1e-12, save="jumps", t_transient=t0)
+    x = return_map(tr)
+    np.testing.assert_allclose(np.sort(x[-n:]), np.sort(o.return_map_values), rtol=1e-8)
+    fd = exact.monodromy_fd(params, o.section_states[0], n)
+    mu_fd = np.linalg.eigvals(fd)
+    assert np.abs(np.sort(np.abs(mu_fd)) - np.sort(np.abs(o.multipliers))).max() <= 1e-6
+    one = o.trajectory()
+    end = np.array([one.final_state.alpha, one.final_state.omega])
+    np.testing.assert_allclose(end, o.section_states[0], rtol=1e-9, atol=1e-12)
+    assert int(np.sum(one.jumps.from_branch == 1)) == n  # n CD→AB jumps in one period
+
+
+def test_unstable_orbit_in_the_chaotic_region():
+    """Hypothesis: at V = 2, I = 1e-4 (chaotic, λ ≈ 4.7 bits/s, docs/dynamics.md) Newton started from the
+    nearest 2-recurrence of the run finds a period-2 orbit that closes to 1e-10 and is unstable (a multiplier
+    outside the unit circle: measured a complex pair of modulus 1.063), as every orbit embedded in a chaotic
+    attractor must be."""
+    o = exact.periodic_orbit(PeelParams(V=2.0, I=1e-4), n=2, t_transient=30.0)
+    assert o.residual <= 1e-10 and not o.stable and np.abs(o.multipliers).max() > 1.0
+
+
+def test_bad_arguments_and_no_section():
+    """Hypothesis: bad arguments are ValueErrors naming them; a law without folds has no section."""
+    with pytest.raises(ValueError, match="tol"):
+        exact.periodic_orbit(CUBIC, tol=0.5)
+    with pytest.raises(ValueError, match="n"):
+        exact.periodic_orbit(CUBIC, n=0)
+    with pytest.raises(TypeError, match="start"):
+        exact.periodic_orbit(CUBIC, start="here")
+    with pytest.raises(ValueError, match="no folds"):
+        exact.periodic_orbit(CUBIC.replace(force=PeelForce.cubic(c=10.0)))
