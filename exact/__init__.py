@@ -21,6 +21,7 @@ from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailur
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin
+from ._continuation import Bifurcation, BranchPoint, OrbitBranch, continue_orbit
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt, default_atol
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return
@@ -56,6 +57,10 @@ __all__ = [
     "section_return",
     "SectionReturn",
     "monodromy_fd",
+    "continue_orbit",
+    "OrbitBranch",
+    "BranchPoint",
+    "Bifurcation",
     "Trajectory",
     "Jumps",
     "Jump",

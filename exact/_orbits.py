@@ -24,6 +24,7 @@ the orbit is stable if both lie inside the unit circle.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -40,7 +41,7 @@ from peelapprox.validate import params as _params
 
 from ._tangent import TangentSystem, saltation, tangent_system
 
-__all__ = ["PeriodicOrbit", "SectionReturn", "monodromy_fd", "periodic_orbit", "section_return"]
+__all__ = ["PeriodicOrbit", "SectionReturn", "monodromy_fd", "periodic_orbit", "section_return", "solve_orbit"]
 
 #: Relative tolerance of the tangent runs, whatever the state's ``rtol``: the tangent's directional difference
 #: quotient carries ~1e-9 relative noise, which a tighter error control would chase with ever smaller steps.
@@ -70,6 +71,9 @@ class SectionReturn:
         ``∂(return time)/∂x0``.
     steps : int
         Accepted steps (all tangent runs).
+    fold_rates : (float, float)
+        ``Ġ = d(F (1 + c))/dt`` on arrival at the CD fold and at the AB fold [N/s]: how transversally the orbit
+        meets the folds (0: it grazes a fold, where the return map's derivative diverges).
     """
 
     x: np.ndarray
@@ -77,6 +81,7 @@ class SectionReturn:
     time: float
     dtime: np.ndarray | None
     steps: int
+    fold_rates: tuple[float, float] = (math.nan, math.nan)
 
 
 def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarray, t0: float) -> int:
@@ -98,8 +103,9 @@ def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarra
 
 
 def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, atol: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray, float, float, int]:
-    """``P(x)`` with the tangent ``d = (δα, δω)`` carried along: ``(x', (δα', δω'), δT, T, steps)``."""
+                ) -> tuple[np.ndarray, np.ndarray, float, float, int, tuple[float, float]]:
+    """``P(x)`` with the tangent ``d = (δα, δω)`` carried along: ``(x', (δα', δω'), δT, T, steps, (Ġ at the CD
+    fold, Ġ at the AB fold))``."""
     y = np.array([0.0, x[0], x[1], math.log(ts.landing(0)), 0.0, d[0], d[1], 0.0])
     steps = _leg(ts, y, 1, rtol, atol, 0.0)
     t_cd = float(y[0])
@@ -111,11 +117,13 @@ def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, at
                                f_min=ts.law.structure.f_min, f_zero=ts.law.structure.f_zero)
     gm, gp = np.empty(4), np.empty(4)
     ts.field(y[:4], gm)
+    rate_cd = float(gm[3])  # Ġ on arrival at the CD fold (< 0: the level falls to f_min)
     y[0], y[3] = 0.0, math.log(v_land)
     ts.field(y[:4], gp)
     y[4:] = saltation(y[4:], gm, gp)
     steps += _leg(ts, y, 0, rtol, atol, t_cd)
-    return y[1:3].copy(), y[5:7].copy(), float(y[4]), t_cd + float(y[0]), steps
+    ts.field(y[:4], gm)
+    return y[1:3].copy(), y[5:7].copy(), float(y[4]), t_cd + float(y[0]), steps, (rate_cd, float(gm[3]))
 
 
 def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: bool = True,
@@ -151,9 +159,9 @@ def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: 
     x0 = np.asarray(x, dtype=float).reshape(2)
     scale = np.asarray(ATOL_SCALE["hybrid"])
     atol = np.concatenate([rtol * scale, np.ones(4)])  # the tangent stays 0: its weights do not matter
-    xn, _, _, T, steps = _one_return(ts, x0, np.zeros(2), rtol, atol)  # the state alone, at rtol
+    xn, _, _, T, steps, rates = _one_return(ts, x0, np.zeros(2), rtol, atol)  # the state alone, at rtol
     if not tangent:
-        return SectionReturn(xn, None, T, None, steps)
+        return SectionReturn(xn, None, T, None, steps, rates)
     jrt = max(rtol, TANGENT_RTOL)
     atol_t = np.concatenate([jrt * scale, np.full(4, TANGENT_ATOL)])
     cols, dts = [], []
@@ -161,11 +169,11 @@ def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: 
     for i in range(2):
         d = np.zeros(2)
         d[i] = s[i]
-        _, dx, dT, _, n = _one_return(ts, x0, d, jrt, atol_t)
+        _, dx, dT, _, n, _ = _one_return(ts, x0, d, jrt, atol_t)
         cols.append(dx / s[i])
         dts.append(dT / s[i])
         steps += n
-    return SectionReturn(xn, np.column_stack(cols), T, np.array(dts), steps)
+    return SectionReturn(xn, np.column_stack(cols), T, np.array(dts), steps, rates)
 
 
 def _system(params: PeelParams) -> TangentSystem:
@@ -207,6 +215,9 @@ class PeriodicOrbit:
         The residual at each Newton iterate (the last is ``residual``).
     monodromy : ndarray, shape (2, 2)
         ``DP^n`` at the orbit, in ``(α, ω)``.
+    fold_rates : ndarray, shape (2 n,)
+        ``Ġ`` [N/s] on arrival at each fold of one period (CD, AB, CD, AB, ...): near 0 the orbit grazes a fold
+        (a non-smooth bifurcation: the multipliers diverge).
     steps, wall_time : int, float
         Accepted integration steps and seconds spent (all Newton iterations).
     """
@@ -222,6 +233,7 @@ class PeriodicOrbit:
     residual: float
     newton: tuple[float, ...]
     monodromy: np.ndarray
+    fold_rates: np.ndarray = field(default_factory=lambda: np.zeros(0))
     steps: int = 0
     wall_time: float = 0.0
     _extra: dict = field(default_factory=dict, repr=False, compare=False)
@@ -236,10 +248,11 @@ class PeriodicOrbit:
 
 
 def _compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
-             ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, int]:
-    """``(P^n(x), DP^n, period, the n section states, steps)``."""
+             ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, int, np.ndarray]:
+    """``(P^n(x), DP^n, period, the n section states, steps, the 2n fold rates)``."""
     J = np.eye(2)
     T, steps, states = 0.0, 0, [x.copy()]
+    rates: list[float] = []
     for _ in range(n):
         r = section_return(params, x, rtol=rtol, system=ts)
         assert r.jacobian is not None
@@ -248,7 +261,8 @@ def _compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol:
         steps += r.steps
         x = r.x
         states.append(x.copy())
-    return x, J, T, np.array(states[:-1]), steps
+        rates.extend(r.fold_rates)
+    return x, J, T, np.array(states[:-1]), steps, np.array(rates)
 
 
 def _start(params: PeelParams, start: Any, n: int | None, t_transient: float, window: float, max_period: int,
@@ -336,13 +350,32 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
     rtol = in_range("rtol", rtol, 1e-14, 1e-6)
     max_iter = integer("max_iter", max_iter, 1, 200)
     max_period = integer("max_period", max_period, 1, 1000)
-    ts = _system(params)
+    ts = _system(params)  # no folds: no section (before the seed run)
     x, n = _start(params, start, n, t_transient, window, max_period, min(1e-10, 100 * rtol))
+    o = solve_orbit(params, x, n, tol=tol, rtol=rtol, max_iter=max_iter, system=ts)
+    return dataclasses.replace(o, wall_time=time.perf_counter() - wall0)
+
+
+def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol: float = 1e-12,
+                max_iter: int = 30, system: TangentSystem | None = None) -> PeriodicOrbit:
+    """Newton on ``P^n(x) = x`` from the section state ``x0 = (α, ω)`` (module docstring); the work of
+    :func:`periodic_orbit` after its start, for callers with a start of their own (continuation).
+
+    Raises
+    ------
+    ValueError
+        Newton did not close the orbit to ``tol`` within ``max_iter`` iterations (the residuals are listed).
+    ModelBreakdown, SolverBudgetExceeded, SolverFailure
+        A return breaks down or never comes.
+    """
+    wall0 = time.perf_counter()
+    ts = system or _system(params)
+    x = np.asarray(x0, dtype=float).reshape(2).copy()
     s = np.array([1.0, params.V / params.R])  # z = x / s
     history: list[float] = []
     steps = 0
     for _ in range(max_iter):
-        xn, J, T, states, k = _compose(params, ts, x, n, rtol)
+        xn, J, T, states, k, rates = _compose(params, ts, x, n, rtol)
         steps += k
         z, g = x / s, (xn - x) / s
         res = float(np.linalg.norm(g) / max(1.0, np.linalg.norm(z)))
@@ -369,7 +402,8 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
     return PeriodicOrbit(params=params, n=n, period=T, section_states=states,
                          return_map_values=_section_F(params, ts, states[:, 0]), itinerary=("CD", "AB") * n,
                          multipliers=mu, stable=bool(np.all(np.abs(mu) < 1.0)), residual=history[-1],
-                         newton=tuple(history), monodromy=J, steps=steps, wall_time=time.perf_counter() - wall0)
+                         newton=tuple(history), monodromy=J, fold_rates=rates, steps=steps,
+                         wall_time=time.perf_counter() - wall0)
 
 
 def section_return_n(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float

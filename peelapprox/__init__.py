@@ -147,6 +147,8 @@ __all__ = [
     "benettin",
     "periodic_orbit",
     "PeriodicOrbit",
+    "continue_orbit",
+    "OrbitBranch",
     # (I, V) sweeps
     "sweep",
     "load_sweep",
@@ -164,7 +166,7 @@ _LAZY = {name: "comparisons.sweep" for name in
 # the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
 _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
                                          "lyapunov_return_map", "LyapunovResult", "benettin", "periodic_orbit",
-                                         "PeriodicOrbit")})
+                                         "PeriodicOrbit", "continue_orbit", "OrbitBranch")})
 
 
 def __getattr__(name: str):

@@ -99,3 +99,58 @@ def test_bad_arguments_and_no_section():
         exact.periodic_orbit(CUBIC, start="here")
     with pytest.raises(ValueError, match="no folds"):
         exact.periodic_orbit(CUBIC.replace(force=PeelForce.cubic(c=10.0)))
+
+
+# --------------------------------------------------------------------------- continuation
+@pytest.fixture(scope="module")
+def cubic_branch():
+    """The cubic's period-1 orbit continued in I from 3e-5 down to 1.9e-5 (it ends in a grazing)."""
+    return exact.continue_orbit(exact.periodic_orbit(CUBIC), "I", stop=1.9e-5)
+
+
+def test_continued_points_are_the_attractors_where_stable(cubic_branch):
+    """Hypothesis: every point of a continued branch is a closed orbit (residual <= 1e-10) and the branch is
+    smooth (its period changes by < 3e-3 s between neighbours: no jump to a coexisting orbit, which the
+    corrector-distance control refuses); where the branch is stable it is the attractor of a long run: at two
+    of its points the return-map value equals a 60 s simulation's after a 40 s transient to 1e-8 relative."""
+    pts = cubic_branch.points
+    assert len(pts) >= 10 and all(p.orbit.residual <= 1e-10 for p in pts)
+    assert np.abs(np.diff([p.orbit.period for p in pts])).max() < 3e-3
+    stable = [p for p in pts if p.orbit.stable]
+    for p in (stable[1], stable[len(stable) // 2]):
+        tr = exact.simulate(p.orbit.params, 60.0, rtol=1e-12, save="jumps", t_transient=40.0)
+        np.testing.assert_allclose(return_map(tr)[-1], p.orbit.return_map_values[0], rtol=1e-8)
+
+
+def test_neimark_sacker_then_grazing_on_the_cubic_branch(cubic_branch):
+    """Hypothesis: along the branch the complex pair of multipliers grows through the unit circle: one
+    Neimark-Sacker bifurcation, located by bisection where |μ| = 1 to 1e-6 (measured 6e-8), at I = 2.112e-5,
+    between the last stable and the first unstable point of the branch; further down the orbit meets the AB
+    fold tangentially (its fold rate Ġ falls below 1e-3 k V, the multipliers diverge): the branch stops with
+    "grazing" near I = 1.997e-5."""
+    b = cubic_branch
+    assert [x.kind for x in b.bifurcations] == ["neimark_sacker"]
+    ns = b.bifurcations[0]
+    assert abs(abs(ns.orbit.multipliers[0]) - 1.0) <= 1e-6 and ns.value == pytest.approx(2.112e-5, rel=1e-3)
+    stable = [p.value for p in b.points if p.orbit.stable]
+    unstable = [p.value for p in b.points if not p.orbit.stable]
+    assert min(stable) > ns.value > max(unstable)  # stable above the bifurcation, unstable below
+    assert b.stopped == "grazing" and b.points[-1].value == pytest.approx(1.997e-5, rel=1e-3)
+    assert np.abs(b.points[-1].orbit.fold_rates).min() < 1e-3 * 1e3 * 1.2
+    rows = b.rows()
+    assert len(rows) == len(b.points) and {"I", "period", "stable", "mu1_abs", "F1"} <= set(rows[0])
+
+
+def test_continuation_arguments():
+    """Hypothesis: an unknown parameter (the message lists the valid ones, a family law's coefficients
+    included), a stop equal to the start, a non-orbit are refused naming the argument; a family coefficient
+    is a parameter."""
+    o = exact.periodic_orbit(CUBIC)
+    with pytest.raises(ValueError, match=r"parameter must be one of V, I, k or .*force\.c"):
+        exact.continue_orbit(o, "R", stop=0.2)
+    with pytest.raises(ValueError, match="stop"):
+        exact.continue_orbit(o, "I", stop=3e-5)
+    with pytest.raises(TypeError, match="orbit"):
+        exact.continue_orbit("orbit", "I", stop=1e-5)  # type: ignore[arg-type]
+    b = exact.continue_orbit(o, "force.c", stop=301.0, max_points=3)
+    assert b.points[-1].orbit.params.force.coefficients[2] == ("c", b.points[-1].value)
