@@ -21,7 +21,8 @@ from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailur
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin
-from ._continuation import Bifurcation, BranchPoint, OrbitBranch, continue_orbit
+from ._continuation import Bifurcation, BranchPoint, OrbitBranch, continue_orbit, with_parameter
+from ._diagram import OrbitDiagram, orbit_diagram
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt, default_atol
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return
@@ -61,6 +62,9 @@ __all__ = [
     "OrbitBranch",
     "BranchPoint",
     "Bifurcation",
+    "orbit_diagram",
+    "with_parameter",
+    "OrbitDiagram",
     "Trajectory",
     "Jumps",
     "Jump",

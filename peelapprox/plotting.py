@@ -7,7 +7,7 @@ from typing import Any, cast
 
 import numpy as np
 
-__all__ = ["plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"]
+__all__ = ["plot_bifurcation", "plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"]
 
 
 def pyplot():
@@ -189,3 +189,65 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
     return fig
 
 
+
+
+_BIFURCATION_MARKERS = {"fold": ("s", "C3"), "period_doubling": ("D", "C1"), "neimark_sacker": ("*", "C4")}
+
+
+def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None = None, *,
+                     title: str | None = None):
+    """The brute-force orbit diagram with continued branches of periodic orbits drawn over it.
+
+    Parameters
+    ----------
+    diagram : exact.OrbitDiagram, optional
+        Grey dots: F at the AB→CD jumps after the transient, at each value of the parameter.
+    branches : sequence of exact.OrbitBranch
+        Each branch's return-map values (F at its n jumps) against the parameter (one colour per starting
+        orbit): solid where the orbit is stable, dashed where it is unstable; its bifurcations marked
+        (square: fold, diamond: period doubling, star: Neimark–Sacker) and its end by grazing or breakdown
+        (cross).
+    path : str, optional
+        Write the figure there (format from the extension) and close it.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(9, 5.5), constrained_layout=True)
+    name = getattr(diagram, "parameter", None)
+    if diagram is not None:
+        for x, F in zip(diagram.values, diagram.returns):
+            ax.plot(np.full(F.size, x), F, ".", color="0.45", ms=2.5, alpha=0.8)
+    k, start = -1, None
+    for br in branches:
+        name = br.parameter
+        if br.points[0].orbit is not start:  # branches continued from one orbit (both ways) share a colour
+            k, start = k + 1, br.points[0].orbit
+        color = f"C{k % 10}"
+        xs = np.array([p.value for p in br.points])
+        stable = np.array([p.orbit.stable for p in br.points])
+        n = br.points[0].orbit.n
+        Fs = np.array([p.orbit.return_map_values for p in br.points])  # (points, n)
+        for i in range(len(xs) - 1):  # each piece solid if both its ends are stable, else dashed
+            style = "-" if stable[i] and stable[i + 1] else "--"
+            for j in range(n):
+                ax.plot(xs[i:i + 2], Fs[i:i + 2, j], style, color=color, lw=1.4,
+                        label=f"period-{n} branch {k + 1}" if i == 0 and j == 0 else None)
+        for b in br.bifurcations:
+            marker, c = _BIFURCATION_MARKERS.get(b.kind, ("o", "k"))
+            ax.plot(np.full(n, b.value), b.orbit.return_map_values, marker, color=c, ms=8, mec="k",
+                    label=b.kind.replace("_", " "))
+        if br.stopped in ("grazing", "breakdown"):
+            ax.plot(np.full(n, xs[-1]), Fs[-1], "x", color="k", ms=8, label=br.stopped)
+    handles, labels = ax.get_legend_handles_labels()
+    uniq = dict(zip(labels, handles))
+    if uniq:
+        ax.legend(uniq.values(), uniq.keys(), loc="best", fontsize=8)
+    ax.set(xlabel=str(name), ylabel="F at the AB→CD jumps [N]", title=title or "orbit diagram and branches")
+    if path:
+        fig.savefig(path, dpi=130)
+        plt.close(fig)
+    return fig

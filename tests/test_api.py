@@ -39,7 +39,8 @@ API = {
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
         "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "check_lyapunov_options",
         "VARIATIONAL_LAWS", "periodic_orbit", "PeriodicOrbit", "section_return", "SectionReturn", "monodromy_fd",
-        "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation",
+        "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation", "orbit_diagram", "OrbitDiagram",
+        "with_parameter",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
@@ -48,7 +49,7 @@ API = {
         "segments", "statistics", "Figure", "FIGURES", "make_figures", "figures_markdown",
     },
     "peelapprox.io": {"TABLE_EXTENSIONS", "fmt_number", "jsonable", "write_csv", "write_rows"},
-    "peelapprox.plotting": {"plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"},
+    "peelapprox.plotting": {"plot_bifurcation", "plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
         "MANIFEST", "RESERVED", "RESULTS", "record_key",

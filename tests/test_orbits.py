@@ -154,3 +154,51 @@ def test_continuation_arguments():
         exact.continue_orbit("orbit", "I", stop=1e-5)  # type: ignore[arg-type]
     b = exact.continue_orbit(o, "force.c", stop=301.0, max_points=3)
     assert b.points[-1].orbit.params.force.coefficients[2] == ("c", b.points[-1].value)
+
+
+# --------------------------------------------------------------------------- command line and picture
+def test_cli_orbit_and_bifurcation(tmp_path, capsys):
+    """Hypothesis: ``peelapprox orbit`` prints the orbit ``periodic_orbit`` finds (period, multipliers' moduli,
+    stability, F at the jump: the same numbers, to the 6 digits printed) and draws one period; ``peelapprox
+    bifurcation`` writes the diagram and the branches (rows of both kinds, every branch row a closed orbit) and
+    a picture; a bad range is a one-line usage error (exit 2)."""
+    from peelapprox.cli import main
+
+    assert main(["orbit", "--V", "1.2", "--I", "3e-5", "--force-family", "cubic", "--format", "json",
+                 "--plot", str(tmp_path / "o.png")]) == 0
+    import json
+
+    row = json.loads(capsys.readouterr().out)
+    o = exact.periodic_orbit(CUBIC)
+    assert row["n"] == 1 and row["stable"] is True
+    assert row["multiplier_1_abs"] == pytest.approx(abs(o.multipliers[0]), rel=1e-9)
+    assert row["F_at_jumps"][0] == pytest.approx(o.return_map_values[0], rel=1e-12)
+    assert (tmp_path / "o.png").stat().st_size > 10_000
+    out = tmp_path / "b.json"
+    assert main(["bifurcation", "--V", "1.2", "--I", "3e-5", "--force-family", "cubic", "--param", "I",
+                 "--range", "2.6e-5:3e-5:4", "--t-transient", "20", "--window", "5", "--out", str(out),
+                 "--plot", str(tmp_path / "b.png")]) == 0
+    rows = json.loads(out.read_text())
+    kinds = {r["kind"] for r in rows}
+    assert "diagram" in kinds and {"branch 1", "branch 2"} <= kinds
+    assert all(r["residual"] <= 1e-10 for r in rows if r["kind"] in ("branch 1", "branch 2"))
+    assert (tmp_path / "b.png").stat().st_size > 10_000
+    with pytest.raises(SystemExit) as e:
+        main(["bifurcation", "--V", "1.2", "--I", "3e-5", "--range", "3:1"])
+    assert e.value.code == 2 and "--range" in capsys.readouterr().err
+
+
+def test_orbit_diagram_values_and_labels():
+    """Hypothesis: the brute-force diagram's returns at each value are the long run's return map after the
+    transient: at I = 2.8e-5 (stable period-1 orbit of the cubic) every return equals the orbit's F at the
+    jump to 1e-8 relative and the label is "period-1"; a law without folds at a value gives "no stick-slip";
+    progress is called once per value."""
+    calls = []
+    d = exact.orbit_diagram(CUBIC, "I", [2.8e-5], t_transient=30.0, window=5.0, rtol=1e-12,
+                            progress=lambda done, total: calls.append((done, total)))
+    o = exact.periodic_orbit(CUBIC.replace(I=2.8e-5))
+    assert d.labels == ("period-1",) and calls == [(1, 1)]
+    np.testing.assert_allclose(d.returns[0], o.return_map_values[0], rtol=1e-8)
+    flat = exact.orbit_diagram(CUBIC.replace(force=PeelForce.cubic(c=10.0)), "I", [3e-5], t_transient=1.0,
+                               window=1.0)
+    assert flat.labels == ("no stick-slip",) and flat.rows()[0]["F"] is None

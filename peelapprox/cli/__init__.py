@@ -18,7 +18,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 
-from . import benchmark, compare, dynamics, estimate, figures, simulate, sweep
+from . import benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
 from ._checks import exit_status, one_line
 
 __all__ = ["build_parser", "main"]
@@ -33,6 +33,8 @@ _benchmark = benchmark.run
 _sweep = sweep.run
 _figures = figures.run
 _dynamics = dynamics.run
+_orbit = orbit.run_orbit
+_bifurcation = orbit.run_bifurcation
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -48,6 +50,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_parser(sub).set_defaults(func=_sweep)
     figures.add_parser(sub).set_defaults(func=_figures)
     dynamics.add_parser(sub).set_defaults(func=_dynamics)
+    orbit.add_orbit_parser(sub).set_defaults(func=_orbit)
+    orbit.add_bifurcation_parser(sub).set_defaults(func=_bifurcation)
     return ap
 
 

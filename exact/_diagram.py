@@ -1,0 +1,115 @@
+"""The brute-force orbit diagram: the return map's values after a transient over a grid of a parameter (issue 16).
+
+:func:`orbit_diagram` runs ``exact.simulate`` at each value of the parameter (V, I, k or a family law's
+coefficient, as :func:`exact.continue_orbit`), drops the transient and keeps F at the AB→CD jumps of the window
+(``peelapprox.return_map``), with the period that ``peelapprox.periodicity`` reads off them.  It is the picture
+the continued branches are drawn over (``peelapprox.plotting.plot_bifurcation``): where the branches say an
+orbit is stable, the diagram should show it.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from peelapprox import WINDOW_DEFAULTS, PeelParams, periodicity, return_map
+from peelapprox.errors import ModelBreakdown
+from peelapprox.validate import duration, function, optional, reals
+
+from ._continuation import with_parameter
+
+__all__ = ["OrbitDiagram", "orbit_diagram"]
+
+
+@dataclass(frozen=True)
+class OrbitDiagram:
+    """The brute-force orbit diagram (:func:`orbit_diagram`).
+
+    Attributes
+    ----------
+    parameter : str
+    values : ndarray
+        The parameter's values, in the order run.
+    returns : tuple of ndarray
+        F [N] at the AB→CD jumps of the window, per value (empty where the run broke down or has no jumps).
+    labels : tuple of str
+        ``"period-n"``, ``"aperiodic"``, ``"no stick-slip"`` or ``"breakdown:<reason>"`` per value.
+    wall_time : float
+    """
+
+    parameter: str
+    values: np.ndarray
+    returns: tuple[np.ndarray, ...]
+    labels: tuple[str, ...]
+    wall_time: float
+
+    def rows(self) -> list[dict]:
+        """One row per (value, return): ``parameter, F, label`` (CSV/JSON)."""
+        out = []
+        for x, F, lab in zip(self.values, self.returns, self.labels):
+            if F.size == 0:
+                out.append({self.parameter: float(x), "F": None, "label": lab})
+            out.extend({self.parameter: float(x), "F": float(f), "label": lab} for f in F)
+        return out
+
+
+def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | np.ndarray, *,
+                  t_transient: float = WINDOW_DEFAULTS["t_transient"], window: float = WINDOW_DEFAULTS["window"],
+                  rtol: float = WINDOW_DEFAULTS["rtol"], alpha0: float = 0.0, max_period: int = 32,
+                  progress: bool | Callable[[int, int], None] = False) -> OrbitDiagram:
+    """The return map after ``t_transient`` over ``values`` of ``parameter`` (module docstring).
+
+    Parameters
+    ----------
+    params : PeelParams
+        The other parameters (and the law).
+    parameter : {"V", "I", "k"} or "force.<coefficient>"
+    values : sequence of float
+    t_transient, window : float
+        Dropped and kept time of each run [s].
+    rtol, alpha0 : float
+        Of each ``exact.simulate`` run.
+    max_period : int
+        Longest period ``periodicity`` looks for.
+    progress : bool or callable
+        True: a line on stderr every ~10 % of the values; a callable ``progress(done, total)``.
+
+    Returns
+    -------
+    OrbitDiagram
+    """
+    from ._simulate import simulate
+
+    wall0 = time.perf_counter()
+    vals = reals("values", values)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    window = duration("window", window)
+    report: Callable[[int, int], None] | None
+    if progress is True:
+        def report(done: int, total: int) -> None:
+            if done == total or done % max(1, total // 10) == 0:
+                print(f"orbit diagram: {done}/{total} values of {parameter}", file=sys.stderr, flush=True)
+    else:
+        report = optional(function, "progress", progress or None)
+    returns, labels = [], []
+    for i, x in enumerate(vals.ravel()):
+        p = with_parameter(params, parameter, float(x))
+        try:
+            tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient)
+            F = return_map(tr)
+            if F.size < 2:
+                label = "no stick-slip"
+            else:
+                per = periodicity(F, max_period=max_period)
+                label = per.label
+        except ModelBreakdown as exc:
+            F, label = np.zeros(0), f"breakdown:{exc.reason}"
+        returns.append(np.asarray(F, dtype=float))
+        labels.append(label)
+        if report is not None:
+            report(i + 1, vals.size)
+    return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
