@@ -221,6 +221,8 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
     if diagram is not None:
         for x, F in zip(diagram.values, diagram.returns):
             ax.plot(np.full(F.size, x), F, ".", color="0.45", ms=2.5, alpha=0.8)
+    branches = list(branches)
+    label_branches = len({id(b.points[0].orbit) for b in branches}) <= 6  # else only the markers are listed
     k, start = -1, None
     for br in branches:
         name = br.parameter
@@ -235,7 +237,7 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
             style = "-" if stable[i] and stable[i + 1] else "--"
             for j in range(n):
                 ax.plot(xs[i:i + 2], Fs[i:i + 2, j], style, color=color, lw=1.4,
-                        label=f"period-{n} branch {k + 1}" if i == 0 and j == 0 else None)
+                        label=f"period-{n} branch {k + 1}" if i == 0 and j == 0 and label_branches else None)
         for b in br.bifurcations:
             marker, c = _BIFURCATION_MARKERS.get(b.kind, ("o", "k"))
             ax.plot(np.full(n, b.value), b.orbit.return_map_values, marker, color=c, ms=8, mec="k",

@@ -76,9 +76,11 @@ def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
     sp.add_argument("--param", default="V", help="V, I, k or force.<coefficient> of a family law (V)")
     sp.add_argument("--range", required=True, metavar="LO:HI[:N]",
                     help="the parameter's range and the diagram's number of values (N = 40)")
-    sp.add_argument("--seeds", metavar="X,X,...",
-                    help="parameter values at which orbits are found and continued both ways (default: the middle "
-                         "of the range)")
+    sp.add_argument("--seeds", metavar="X,X,...|auto",
+                    help="parameter values at which orbits are found and continued both ways; auto (the default): "
+                         "each diagram value whose run is periodic with another period than the value before (at "
+                         "most --max-seeds)")
+    sp.add_argument("--max-seeds", type=positive_int, default=20, help="most automatic seeds (20)")
     sp.add_argument("--max-points", type=positive_int, default=200, help="most orbits per branch (200)")
     sp.add_argument("--out", help="write every diagram point and branch point to this .csv or .json")
     sp.add_argument("--plot", help="draw the diagram and the branches to this image file")
@@ -106,17 +108,31 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     lo, hi, n = _range(args.range)
     p = _params(args)
-    seeds = [0.5 * (lo + hi)] if not args.seeds else [float(x) for x in args.seeds.split(",")]
+    auto = args.seeds in (None, "auto")
+    try:
+        seeds = [] if auto else [float(x) for x in args.seeds.split(",")]
+    except ValueError:
+        raise ValueError(f"--seeds must be numbers X,X,... or auto, got {args.seeds!r}") from None
     for s in seeds:
         if not lo <= s <= hi:
             raise ValueError(f"--seeds must lie in --range [{lo}, {hi}], got {s}")
     diagram = orbit_diagram(p, args.param, np.linspace(lo, hi, n), t_transient=args.t_transient,
                             window=args.window, alpha0=args.alpha0, progress=True)
+    if auto:  # where the brute-force period changes to a periodic one
+        prev = None
+        for x, lab in zip(diagram.values, diagram.labels):
+            if lab.startswith("period-") and lab != prev and len(seeds) < args.max_seeds:
+                seeds.append(float(x))
+            prev = lab
     branches = []
     for s in seeds:
         ps = with_parameter(p, args.param, s)
         say(f"orbit at {args.param} = {s:g} ...")
-        o = periodic_orbit(ps, t_transient=args.t_transient, window=args.window)
+        try:
+            o = periodic_orbit(ps, t_transient=args.t_transient, window=args.window)
+        except (ValueError, RuntimeError) as exc:  # no periodic orbit closes there (or the run breaks down)
+            say(f"  no orbit: {exc}")
+            continue
         for stop in (lo, hi):
             if stop != s:
                 b = continue_orbit(o, args.param, stop=stop, max_points=args.max_points)
