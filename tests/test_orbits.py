@@ -176,7 +176,8 @@ def test_cli_orbit_and_bifurcation(tmp_path, capsys):
     assert (tmp_path / "o.png").stat().st_size > 10_000
     out = tmp_path / "b.json"
     assert main(["bifurcation", "--V", "1.2", "--I", "3e-5", "--force-family", "cubic", "--param", "I",
-                 "--range", "2.6e-5:3e-5:4", "--t-transient", "20", "--window", "5", "--out", str(out),
+                 "--range", "2.6e-5:3e-5:4", "--seeds", "2.8e-5", "--t-transient", "20", "--window", "5",
+                 "--out", str(out),
                  "--plot", str(tmp_path / "b.png")]) == 0
     rows = json.loads(out.read_text())
     kinds = {r["kind"] for r in rows}
