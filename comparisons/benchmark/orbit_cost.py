@@ -4,8 +4,9 @@
 
 For each scene: a run past its transient seeds ``exact.periodic_orbit`` (its jumps give the period n and the
 start); the orbit is then found again from that run, timed (the best of 3, the seed run excluded), with the
-Newton iterations, the closing residual, the multipliers' moduli and the integration steps.  The issue's
-target: one orbit with multipliers for n <= 10 in <= 50 ms.
+Newton iterations, the closing residual, the multipliers' moduli and the integration steps; then a
+200-point continuation (:data:`CONTINUATIONS`), timed.  The issue's targets: one orbit with multipliers for
+n <= 10 in <= 50 ms; a 200-point continuation in <= 10 s.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import exact
 from peelapprox import PeelForce, PeelParams
 from peelapprox.io import fmt_number
 
-__all__ = ["SCENES", "main", "orbit_costs"]
+__all__ = ["CONTINUATIONS", "SCENES", "continuation_costs", "main", "orbit_costs"]
 
 #: (name, params, transient [s], n or None): stable orbits of the cubic and of fvV, and an unstable one.
 SCENES = (
@@ -31,6 +32,25 @@ SCENES = (
     ("fvV V1 I1e-2", PeelParams(V=1.0, I=1e-2), 60.0, None),
     ("fvV V2 I1e-4 (chaotic)", PeelParams(V=2.0, I=1e-4), 30.0, 2),
 )
+
+
+#: (name, params, parameter, stop): 200 equal steps from the orbit at params to stop.
+CONTINUATIONS = (
+    ("cubic period 1 in I", PeelParams(V=1.2, I=3e-5, force=PeelForce.cubic()), "I", 2.2e-5),
+    ("fvV period 8 in V (I = 1e-2)", PeelParams(V=1.0, I=1e-2), "V", 1.1),
+)
+
+
+def continuation_costs() -> list[dict]:
+    """Seconds of a 200-point continuation (:data:`CONTINUATIONS`), the start orbit excluded."""
+    rows = []
+    for name, p, par, stop in CONTINUATIONS:
+        o = exact.periodic_orbit(p)
+        h = abs(stop - float(getattr(p, par))) / 199
+        t0 = time.perf_counter()
+        b = exact.continue_orbit(o, par, stop=stop, step=h, max_step=h, max_points=200)
+        rows.append(dict(branch=name, points=len(b.points), stopped=b.stopped, s=time.perf_counter() - t0))
+    return rows
 
 
 def orbit_costs(rounds: int = 3) -> list[dict]:
@@ -61,8 +81,12 @@ def main(argv: list[str] | None = None) -> int:
         mu = ", ".join(fmt_number(x, 4) for x in r["multiplier_moduli"])
         print(f"{r['scene']:<26} {r['n']:>3} {r['newton_iterations']:>6} {r['residual']:>9.1e} {mu:>18} "
               f"{str(r['stable']):>6} {r['steps']:>7} {fmt_number(r['ms'], 3):>7}")
+    cont = continuation_costs()
+    print(f"\n{'continuation':<32} {'points':>6} {'stopped':>10} {'s':>7}")
+    for r in cont:
+        print(f"{r['branch']:<32} {r['points']:>6} {r['stopped']:>10} {fmt_number(r['s'], 3):>7}")
     if args.json:
-        args.json.write_text(json.dumps(rows, indent=1))
+        args.json.write_text(json.dumps(dict(orbits=rows, continuations=cont), indent=1))
     return 0
 
 
