@@ -40,7 +40,9 @@ class BenettinResult:
     ``exponent`` [1/time unit, natural log] = ``Σ log(d_k/d0) / T`` over the kept intervals; ``running``
     the running estimate after each interval; ``local`` the per-interval rates ``log(d_k/d0)/Δt_k``;
     ``stderr`` the standard error of the mean local rate (intervals treated as independent; a rough
-    convergence indicator); ``time`` the total kept time.
+    convergence indicator; inf with fewer than two intervals); ``time`` the total kept time; ``d0`` the
+    reference size (the two trajectories' distance; 1 for the tangent methods, whose tangent is renormalised
+    to unit size; the finite-difference step of the return-map method).
     """
 
     exponent: float
@@ -59,7 +61,8 @@ class BenettinResult:
         logs, dts = np.asarray(logs, float), np.asarray(dts, float)
         T = float(dts.sum())
         local = logs / dts
-        stderr = float(np.std(local, ddof=1) / math.sqrt(local.size)) if local.size > 1 else math.nan
+        # fewer than two intervals: no spread to estimate an error from (inf, never NaN)
+        stderr = float(np.std(local, ddof=1) / math.sqrt(local.size)) if local.size > 1 else math.inf
         return cls(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local, stderr, T, int(logs.size),
                    float(d0), float(wall_time))
 
@@ -131,8 +134,9 @@ class LyapunovResult:
     ``bits_per_s`` = ``per_s / ln 2`` (the paper's unit); ``benettin`` holds the running estimate and the
     local rates; ``n_jumps`` the jumps the reference orbit made while measured; ``method`` names the
     method that computed it (a sentence, e.g. ``"hybrid two-trajectory (Benettin)"``); ``notes`` any
-    method-specific counts (steps, solves).  ``tau`` is the renormalisation interval (NaN for the methods
-    that renormalise at the jumps or returns)."""
+    method-specific counts (steps, solves).  ``tau`` is the renormalisation interval [s] (for the methods
+    that renormalise at the jumps or returns, the mean time between renormalisations); ``stderr_bits`` is inf
+    when fewer than two intervals were measured (no spread to estimate an error from)."""
 
     per_s: float
     bits_per_s: float

@@ -18,6 +18,7 @@ method's options without running it.  docs/dynamics.md compares the methods.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -286,7 +287,8 @@ def lyapunov_tangent(
     Returns
     -------
     LyapunovResult
-        ``bits_per_s`` and ``per_s`` (``stderr_bits`` is NaN: one estimate, no intervals), ``n_jumps``;
+        ``bits_per_s`` and ``per_s``, ``stderr_bits`` (from the local rates between renormalisations at the
+        jumps), ``tau`` the mean time between them, ``n_jumps``;
         ``notes`` reports the steps taken.
 
     Raises
@@ -312,12 +314,13 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     max_steps = _check("max_steps", max_steps)
     max_wall = optional(positive, "max_wall", max_wall)
     t0 = time.perf_counter()
-    lam, n_jumps, t, steps = lyapunov_saltation(params, t_transient=t_transient, T=T, rtol=rtol,
-                                                alpha0=alpha0, max_steps=max_steps, max_wall=max_wall)
-    b = BenettinResult(lam, np.array([lam]), np.array([lam]), math.nan, t, n_jumps, math.nan,
-                       time.perf_counter() - t0)
+    lam, n_jumps, t, steps, (logs, dts) = lyapunov_saltation(params, t_transient=t_transient, T=T, rtol=rtol,
+                                                             alpha0=alpha0, max_steps=max_steps, max_wall=max_wall)
+    # the record of the renormalisations (the tangent's unit size is d0 = 1); the exponent is the sum of the logs
+    # in the order they came, as lyapunov_saltation formed it
+    b = dataclasses.replace(BenettinResult.from_logs(logs, dts, 1.0, time.perf_counter() - t0), exponent=lam)
     ln2 = math.log(2.0)
-    return LyapunovResult(lam, lam / ln2, math.nan, b, params, math.nan, n_jumps,
+    return LyapunovResult(lam, lam / ln2, b.stderr / ln2, b, params, b.time / b.n, n_jumps,
                           method="tangent dynamics with saltation matrices", notes=[f"steps={steps}"])
 
 
@@ -441,5 +444,5 @@ def _return_map(params: PeelParams, *, t_transient: float = T_TRANSIENT, n_retur
         jumps += 2
     b = BenettinResult.from_logs(logs, dts, h, time.perf_counter() - wall0)
     ln2 = math.log(2.0)
-    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, math.nan, jumps,
+    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, b.time / b.n, jumps,
                           method="tangent map of the AB→CD return map (central differences)")

@@ -255,16 +255,17 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
                        alpha0: float = 0.0, max_steps: int | None = None, max_wall: float | None = None):
     """Largest Lyapunov exponent [1/s] from the tangent dynamics with saltation matrices (module docstring).
 
-    Starts from the state at ``t_transient`` (exact.simulate from ``alpha0``), integrates the tangent for
-    ``T`` seconds, renormalising it after every jump, where its equal-time (α, ω, F) size is measured.
-    Returns ``(exponent_per_s, n_jumps, time, steps)``.  ``T`` must lie in (0, 1e6] s and ``t_transient`` in
-    [0, 1e6] s.  ``max_steps`` (an integer in [1, 1e15]; default ``STEPS_PER_SECOND * (T + 1)``, at most
-    ``MAX_DEFAULT_STEPS`` = 1e9, ~35 min) bounds the accepted steps; exceeding it raises
-    :class:`peelapprox.SolverBudgetExceeded`, a step-size failure :class:`peelapprox.SolverFailure` and a
-    fold with no landing root :class:`peelapprox.ModelBreakdown`, each with the time and state.
-    ``max_wall`` [s] (None: unbounded) bounds the wall time, checked by the transient's run and after every
-    jump (the compiled loop between two jumps is bounded by ``max_steps``); exceeding it raises
-    :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
+    Starts from the state at ``t_transient`` (exact.simulate from ``alpha0``), integrates the tangent for ``T``
+    seconds, renormalising it after every jump, where its equal-time (α, ω, F) size is measured. Returns
+    ``(exponent_per_s, n_jumps, time, steps, (logs, dts))``: the last two are the log growth of the tangent
+    between consecutive renormalisations (at the jumps and at the end) and their durations.  ``T`` must lie in
+    (0, 1e6] s and ``t_transient`` in [0, 1e6] s.  ``max_steps`` (an integer in [1, 1e15]; default
+    ``STEPS_PER_SECOND * (T + 1)``, at most ``MAX_DEFAULT_STEPS`` = 1e9, ~35 min) bounds the accepted steps;
+    exceeding it raises :class:`peelapprox.SolverBudgetExceeded`, a step-size failure
+    :class:`peelapprox.SolverFailure` and a fold with no landing root :class:`peelapprox.ModelBreakdown`, each
+    with the time and state. ``max_wall`` [s] (None: unbounded) bounds the wall time, checked by the transient's
+    run and after every jump (the compiled loop between two jumps is bounded by ``max_steps``); exceeding it
+    raises :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
     from ._benettin import natural_scales
     from ._simulate import ATOL_SCALE, domain_status, initial_state, simulate
@@ -298,13 +299,20 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     y = np.array([0.0, s.alpha, s.omega, math.log(s.v), 0.0, 0.0, 0.0, 1.0])
     y[4:] /= np.linalg.norm(_equal_time_vector(y, field, pull, scale))
     t, logs, n_jumps, steps = 0.0, 0.0, 0, 0
+    seg_logs: list[float] = []  # per renormalisation: the log growth and the time since the last one
+    seg_dts: list[float] = []
+    t_last = 0.0
     g_minus, g_plus = np.empty(4), np.empty(4)
     while t < T:
         status, n = run(y, p, law, coef, br, rtol, atol, T - t, max_steps - steps)
         steps += n
         if status == DONE:
             t += y[0]
-            logs += math.log(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
+            g = math.log(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
+            logs += g
+            if t > t_last:
+                seg_logs.append(g)
+                seg_dts.append(t - t_last)
             break
         if status != FOLD:
             lo, hi = cl.domain
@@ -328,6 +336,12 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
         n_jumps += 1
         d = float(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
         logs += math.log(d)
+        if t > t_last:
+            seg_logs.append(math.log(d))
+            seg_dts.append(t - t_last)
+            t_last = t
+        else:  # two jumps at one instant: one interval
+            seg_logs[-1] += math.log(d)
         y[4:] /= d
         wall.left(t_transient + t, lambda t=t: where(t), t_transient + T)
-    return logs / t, n_jumps, t, steps
+    return logs / t, n_jumps, t, steps, (np.array(seg_logs), np.array(seg_dts))

@@ -202,7 +202,7 @@ def lyapunov_variational(
         t_done += dt
         if progress is not None:
             progress(t_done, t_transient + T)
-    b = BenettinResult.from_logs(logs, np.full(n, T / n), math.nan, time.perf_counter() - wall0)
+    b = BenettinResult.from_logs(logs, np.full(n, T / n), 1.0, time.perf_counter() - wall0)  # unit tangent
     ln2 = math.log(2.0)
     return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, T / n, window_crossings,
                           method=f"variational equations of the ε-regularised system (ε = {eps:g}, diffsol BDF)",
