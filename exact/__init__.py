@@ -20,6 +20,7 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
+from ._basins import BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._continuation import Bifurcation, BranchPoint, OrbitBranch, continue_orbit
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
@@ -61,6 +62,9 @@ __all__ = [
     "OrbitBranch",
     "BranchPoint",
     "Bifurcation",
+    "basins",
+    "BasinResult",
+    "BasinAttractor",
     "Trajectory",
     "Jumps",
     "Jump",
