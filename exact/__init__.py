@@ -20,6 +20,7 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
+from ._basins import BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._continuation import Bifurcation, BranchPoint, OrbitBranch, continue_orbit, with_parameter
 from ._diagram import OrbitDiagram, orbit_diagram
@@ -65,6 +66,9 @@ __all__ = [
     "orbit_diagram",
     "with_parameter",
     "OrbitDiagram",
+    "basins",
+    "BasinResult",
+    "BasinAttractor",
     "Trajectory",
     "Jumps",
     "Jump",

@@ -11,8 +11,8 @@ The (I, V) sweep (``sweep``, ``load_sweep``, ``SweepResult``, ``register_measure
 imported from there on first use (``import peelapprox`` imports no sibling package).  So are the
 dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lyapunov(params, method=...)``),
 ``lyapunov_tangent``, ``lyapunov_return_map``, ``LyapunovResult``, ``benettin``, ``attractors``,
-``Attractor``.  The return-map analysis of a trajectory (``return_map``, ``periodicity``, ``classify``,
-``force_drops``, ``settle_time``) is the core's own.
+``Attractor``, ``periodic_orbit``, ``continue_orbit``, ``basins``.  The return-map analysis of a trajectory
+(``return_map``, ``periodicity``, ``classify``, ``force_drops``, ``settle_time``) is the core's own.
 """
 
 from . import _law_paper  # noqa: F401  (hands the built-in law to PeelForce; see its docstring)
@@ -149,6 +149,8 @@ __all__ = [
     "PeriodicOrbit",
     "continue_orbit",
     "OrbitBranch",
+    "basins",
+    "BasinResult",
     # (I, V) sweeps
     "sweep",
     "load_sweep",
@@ -166,7 +168,8 @@ _LAZY = {name: "comparisons.sweep" for name in
 # the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
 _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
                                          "lyapunov_return_map", "LyapunovResult", "benettin", "periodic_orbit",
-                                         "PeriodicOrbit", "continue_orbit", "OrbitBranch")})
+                                         "PeriodicOrbit", "continue_orbit", "OrbitBranch", "basins",
+                                         "BasinResult")})
 
 
 def __getattr__(name: str):

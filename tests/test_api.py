@@ -22,7 +22,8 @@ API = {
         "EPS_DEFAULT", "GEOMETRIES",
         "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
         "PARAM_RANGES", "PeelParams", "PeelForce", "Folds", "periodic_orbit", "PeriodicOrbit",
-        "continue_orbit", "OrbitBranch", "Periodicity", "ReducedSegment", "RegimeEstimate", "SlopeCriterion",
+        "continue_orbit", "OrbitBranch", "basins", "BasinResult", "Periodicity", "ReducedSegment", "RegimeEstimate",
+        "SlopeCriterion",
         "SolverBudgetExceeded", "SolverFailure", "SweepResult", "VELOCITY_RULE", "V_EQUATIONS", "airy_alpha",
         "alpha_numerical", "attractors", "benettin", "branch_inverse", "branch_structure", "cd_damping_time",
         "classify", "cd_decay_alpha", "crude_branch_time", "estimate", "fixed_point", "force_bounds", "force_drops",
@@ -40,7 +41,7 @@ API = {
         "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "check_lyapunov_options",
         "VARIATIONAL_LAWS", "periodic_orbit", "PeriodicOrbit", "section_return", "SectionReturn", "monodromy_fd",
         "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation", "orbit_diagram", "OrbitDiagram",
-        "with_parameter",
+        "with_parameter", "basins", "BasinResult", "BasinAttractor",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",

@@ -1,0 +1,475 @@
+"""Basins of attraction: label every start of a grid over (α0, F0) or (α0, ω0) by the attractor it reaches.
+
+Each start is one :func:`exact.simulate` run (``save="jumps"``) past a transient; its window's return map
+(:func:`peelapprox.return_map`, the pull force F at the AB→CD jumps) is classified by
+:func:`peelapprox.periodicity`.  Periodic starts are grouped into attractors: two starts reach the same
+attractor when their periods n agree and their sorted return-map cycles agree to :data:`MATCH_RTOL`
+relative (a cycle is the same set of jump forces whatever its phase).  The starts run in this process or on
+a process pool / any :class:`concurrent.futures.Executor` (as the (I, V) sweep of ``comparisons.sweep``);
+the result does not depend on which, nor on the order in which the starts finish.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import multiprocessing as mp
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from peelapprox import (
+    WINDOW_DEFAULTS,
+    ModelBreakdown,
+    PeelParams,
+    SolverBudgetExceeded,
+    SolverFailure,
+    periodicity,
+    return_map,
+)
+from peelapprox.io import fmt_number, jsonable
+from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, states
+from peelapprox.validate import params as _params
+from peelapprox.validate import rtol as _rtol
+
+from ._hybrid_law import HYBRID_LAWS
+from ._orbits import PeriodicOrbit, periodic_orbit
+from ._simulate import initial_state, simulate
+
+__all__ = ["MATCH_RTOL", "CYCLE_DIGITS", "INVALID", "APERIODIC", "BREAKDOWN", "UNDETERMINED", "FAILURE",
+           "BasinAttractor", "BasinResult", "basins"]
+
+#: Two periodic starts reach the same attractor when n is equal and their sorted cycles agree to this (relative).
+MATCH_RTOL = 1e-6
+#: Significant digits of an attractor's stored ``cycle`` (its first start's, rounded): 5e-10 relative, far
+#: below :data:`MATCH_RTOL`, far above the ~1e-12 scatter of a periodic orbit's jump forces at rtol 1e-10.
+CYCLE_DIGITS = 10
+#: Label codes of the starts that reach no periodic attractor (``BasinResult.labels``).
+INVALID, APERIODIC, BREAKDOWN, UNDETERMINED, FAILURE = -1, -2, -3, -4, -5
+_CODE_TEXT = {INVALID: "invalid start", APERIODIC: "aperiodic", BREAKDOWN: "breakdown",
+              UNDETERMINED: "undetermined", FAILURE: "failure"}
+_AXES = ("F0", "omega0")
+
+
+@dataclass(frozen=True)
+class BasinAttractor:
+    """One periodic attractor reached from a basin grid (:func:`basins`).
+
+    Attributes
+    ----------
+    id : int
+        Its index in ``BasinResult.attractors`` and its code in ``BasinResult.labels`` (numbered in the order
+        first reached along the grid, α0 major).
+    n : int
+        AB→CD jumps per period.
+    cycle : tuple of float
+        The sorted return-map cycle [N] (F at the n AB→CD jumps of one period) of its first start, to
+        :data:`CYCLE_DIGITS` significant digits; every start labelled with it agrees to :data:`MATCH_RTOL`.
+    count : int
+        Starts of the grid that reach it.
+    start : (float, float)
+        Its first start ``(α0, F0 or ω0)``.
+    orbit : exact.PeriodicOrbit or None
+        With ``orbits=True``: :func:`exact.periodic_orbit` from the first start's run (n given), with its
+        Floquet multipliers; None when not asked for or when it failed (``orbit_error`` says why).
+    orbit_error : str or None
+    """
+
+    id: int
+    n: int
+    cycle: tuple[float, ...]
+    count: int
+    start: tuple[float, float]
+    orbit: PeriodicOrbit | None = field(default=None, compare=False)
+    orbit_error: str | None = None
+
+    @property
+    def label(self) -> str:
+        """``"period-n"``."""
+        return f"period-{self.n}"
+
+    def describe(self) -> str:
+        """``"period-1: F = 240.0602 N"``: the cycle to 7 digits (up to 3 values; else its range, min … max)."""
+        shown = self.cycle if len(self.cycle) <= 3 else (self.cycle[0], "…", self.cycle[-1])
+        return f"{self.label}: F = {', '.join(c if isinstance(c, str) else fmt_number(c, 7) for c in shown)} N"
+
+
+@dataclass(frozen=True, eq=False)
+class BasinResult:
+    """The basins of a grid of starts (:func:`basins`).
+
+    Attributes
+    ----------
+    params : PeelParams
+    alpha0 : ndarray, shape (m,)
+        Initial peel angles [rad] (first axis).
+    axis : {"F0", "omega0"}
+        The second axis: initial pull force [N] or roller angular velocity [rad/s].
+    values : ndarray, shape (k,)
+        Its values.
+    labels : ndarray of int, shape (m, k)
+        ``labels[i, j]`` for ``alpha0[i]``, ``values[j]``: the attractor id (>= 0), or :data:`INVALID` (-1: no
+        root of CONSTR at the start), :data:`APERIODIC` (-2), :data:`BREAKDOWN` (-3: ``ModelBreakdown``),
+        :data:`UNDETERMINED` (-4: fewer than 2 returns, or too few to decide for ``max_period``),
+        :data:`FAILURE` (-5: the solver failed or ran out of budget, or the executor lost the start).
+    texts : ndarray of str, shape (m, k)
+        Each start's outcome: ``"period-n"``, ``"aperiodic"``, ``"breakdown:<reason>"``, ``"invalid start"``,
+        ``"undetermined:<why>"``, ``"failure:<exception type>"``.
+    cycles : tuple of tuple of float
+        Each start's own sorted cycle (periodic starts; empty otherwise), flattened α0 major.
+    n_returns : ndarray of int, shape (m, k)
+        AB→CD jumps in each start's window (0 for invalid or failed starts).
+    messages : tuple of str
+        Each start's error message ("" when none), flattened α0 major.
+    attractors : tuple of BasinAttractor
+    t_transient, window, rtol : float
+    max_period : int
+    wall_time : float
+        Seconds for the whole grid.
+    """
+
+    params: PeelParams
+    alpha0: np.ndarray
+    axis: str
+    values: np.ndarray
+    labels: np.ndarray
+    texts: np.ndarray
+    cycles: tuple[tuple[float, ...], ...]
+    n_returns: np.ndarray
+    messages: tuple[str, ...]
+    attractors: tuple[BasinAttractor, ...]
+    t_transient: float
+    window: float
+    rtol: float
+    max_period: int
+    wall_time: float = 0.0
+
+    def counts(self) -> dict[str, int]:
+        """Starts per outcome: ``"A<id> period-n"`` for each attractor, then the codes that occur."""
+        out = {f"A{a.id} {a.label}": a.count for a in self.attractors}
+        for code, text in _CODE_TEXT.items():
+            c = int(np.count_nonzero(self.labels == code))
+            if c:
+                out[text] = c
+        return out
+
+    def rows(self) -> list[dict[str, Any]]:
+        """One row per start (α0 major), plain scalars for CSV or JSON (:func:`peelapprox.io.write_rows`):
+        ``alpha0``, the second axis, ``label`` (code), ``outcome`` (text), ``n``, ``cycle`` (the start's sorted
+        cycle, space-separated, full precision), ``n_returns``, ``message``."""
+        rows = []
+        for i, a in enumerate(self.alpha0):
+            for j, v in enumerate(self.values):
+                k = i * len(self.values) + j
+                lab = int(self.labels[i, j])
+                rows.append({"alpha0": float(a), self.axis: float(v), "label": lab, "outcome": str(self.texts[i, j]),
+                             "n": self.attractors[lab].n if lab >= 0 else None,
+                             "cycle": " ".join(repr(c) for c in self.cycles[k]),
+                             "n_returns": int(self.n_returns[i, j]), "message": self.messages[k]})
+        return rows
+
+    def to_json(self) -> str:
+        """The grid, the settings, the attractors (with the orbits' multipliers when computed) and :meth:`rows`
+        as JSON text (strict: no NaN)."""
+        atts = []
+        for a in self.attractors:
+            d: dict[str, Any] = {"id": a.id, "n": a.n, "cycle": list(a.cycle), "count": a.count,
+                                 "start": list(a.start), "orbit_error": a.orbit_error}
+            if a.orbit is not None:
+                d["orbit"] = {"period": a.orbit.period, "stable": a.orbit.stable, "residual": a.orbit.residual,
+                              "multipliers": [[float(m.real), float(m.imag)]
+                                              for m in np.atleast_1d(a.orbit.multipliers)],
+                              "return_map_values": a.orbit.return_map_values}
+            atts.append(d)
+        doc = {"params": repr(self.params), "axis": self.axis, "alpha0": self.alpha0, "values": self.values,
+               "t_transient": self.t_transient, "window": self.window, "rtol": self.rtol,
+               "max_period": self.max_period, "counts": self.counts(), "attractors": atts, "rows": self.rows()}
+        return json.dumps(jsonable(doc), indent=1, allow_nan=False)
+
+    def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
+        """Draw the label map on ``ax`` (a new figure if None), one colour per attractor and grey shades for the
+        other outcomes, with a legend (outcome and count); returns the axes."""
+        from peelapprox.plotting import pyplot
+
+        plt = pyplot()
+        if ax is None:
+            _, ax = plt.subplots(figsize=(9.0, 4.8), layout="constrained")
+        from matplotlib.colors import ListedColormap
+        from matplotlib.patches import Patch
+
+        na = len(self.attractors)
+        tab = plt.get_cmap("tab10" if na <= 10 else "tab20")
+        colours = [tab(i % tab.N) for i in range(na)]
+        greys = {INVALID: "white", APERIODIC: "0.25", BREAKDOWN: "0.55", UNDETERMINED: "0.8", FAILURE: "0.95"}
+        codes = sorted(greys) + list(range(na))  # -5 .. -1, then 0 .. na-1
+        index = {c: k for k, c in enumerate(codes)}
+        img = np.vectorize(index.__getitem__)(self.labels) if self.labels.size else self.labels
+        cmap = ListedColormap([greys[c] for c in sorted(greys)] + colours)
+        ax.pcolormesh(_edges(self.values), _edges(self.alpha0), img, cmap=cmap, vmin=-0.5,
+                      vmax=len(codes) - 0.5, shading="flat", edgecolors="face")
+        counts = self.counts()
+        handles = [Patch(facecolor=colours[a.id], label=f"{a.describe()} ({a.count})") for a in self.attractors]
+        handles += [Patch(facecolor=greys[c], edgecolor="0.5", label=f"{t} ({counts[t]})")
+                    for c, t in _CODE_TEXT.items() if t in counts]
+        ax.legend(handles=handles, fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0)
+        ax.set_xlabel("F0 [N]" if self.axis == "F0" else "ω0 [rad/s]")
+        ax.set_ylabel("α0 [rad]")
+        p = self.params
+        law = "fvV" if p.force.kind == "paper" else p.force.name or repr(p.force)
+        ax.set_title(title or f"basins, {law}, V = {p.V:g} m/s, I = {p.I:g} kg m²")
+        return ax
+
+
+def _edges(x: np.ndarray) -> np.ndarray:
+    """Cell edges around strictly increasing centres (one cell of width 1 around a single value)."""
+    if x.size == 1:
+        return np.array([x[0] - 0.5, x[0] + 0.5])
+    mid = 0.5 * (x[1:] + x[:-1])
+    return np.concatenate([[2 * x[0] - mid[0]], mid, [2 * x[-1] - mid[-1]]])
+
+
+# ---------------------------------------------------------------------------------------------- one start
+def run_start(params: PeelParams, t_transient: float, window: float, rtol: float, max_period: int,
+              alpha0: float, axis: str, value: float) -> dict[str, Any]:
+    """Outcome of one start as plain data (runs in a worker process; never raises for a model outcome).
+
+    Returns ``{"code": INVALID | APERIODIC | BREAKDOWN | UNDETERMINED | FAILURE | 0 (periodic), "text",
+    "n", "cycle" (sorted, the window's last n returns), "n_returns", "message"}``.
+    """
+    kw: dict[str, Any] = {"alpha0": alpha0, axis: value}
+    out: dict[str, Any] = {"code": FAILURE, "text": "failure", "n": None, "cycle": (), "n_returns": 0, "message": ""}
+    try:
+        initial_state(params, **kw)
+    except ValueError as exc:  # no root of CONSTR (or a degenerate geometry) at this start
+        return {**out, "code": INVALID, "text": "invalid start", "message": _msg(exc)}
+    try:
+        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, **kw)
+    except ModelBreakdown as exc:
+        return {**out, "code": BREAKDOWN, "text": f"breakdown:{exc.reason}", "message": _msg(exc)}
+    except (SolverFailure, SolverBudgetExceeded, ValueError, ArithmeticError) as exc:
+        return {**out, "text": f"failure:{type(exc).__name__}", "message": _msg(exc)}
+    x = return_map(tr)
+    out["n_returns"] = int(x.size)
+    if x.size < 2:
+        return {**out, "code": UNDETERMINED, "text": "undetermined:no stick-slip",
+                "message": f"{x.size} AB->CD jumps in the window"}
+    per = periodicity(x, max_period=max_period)
+    if per.period is not None:
+        n = int(per.period)
+        return {**out, "code": 0, "text": f"period-{n}", "n": n, "cycle": tuple(float(c) for c in np.sort(x[-n:]))}
+    if per.kind == "aperiodic":
+        return {**out, "code": APERIODIC, "text": "aperiodic"}
+    return {**out, "code": UNDETERMINED, "text": f"undetermined:{per.kind}",
+            "message": f"{x.size} returns cannot rule out periods up to max_period={max_period}: lengthen window"}
+
+
+def _msg(exc: BaseException) -> str:
+    return " ".join(str(exc).split())[:300]
+
+
+# ---------------------------------------------------------------------------------------------- the grid
+def _axis(name: str, x: Any, quantity: str) -> np.ndarray:
+    a = states(name, x, quantity)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D sequence, got shape {a.shape}")
+    if a.size > 1 and not np.all(np.diff(a) > 0):
+        raise ValueError(f"{name} must be strictly increasing (a grid axis), got {a.tolist()}")
+    return a
+
+
+def _reporter(progress: Any, total: int) -> Callable[[int, dict], None]:
+    """``progress=True``: a line on stderr each time another ~5 % of the starts is done."""
+    if callable(progress):
+        return lambda done, rec: progress(done, total, rec)
+    if not progress:
+        return lambda done, rec: None
+    t0, step = time.perf_counter(), max(1, math.ceil(total / 20))
+
+    def report(done: int, rec: dict) -> None:
+        if done % step == 0 or done == total:
+            el = time.perf_counter() - t0
+            sys.stderr.write(f"basins [{done}/{total}] {100 * done // total}% elapsed {el:.1f} s, "
+                             f"ETA {el / done * (total - done):.1f} s\n")
+            sys.stderr.flush()
+
+    return report
+
+
+def _run_all(tasks: list[tuple], executor: Executor | None, max_workers: int | None,
+             report: Callable[[int, dict], None]) -> list[dict]:
+    """Outcomes of ``run_start(*task)`` in task order, whatever order they finish in."""
+    results: list[dict | None] = [None] * len(tasks)
+    if executor is None and max_workers == 0:
+        serial = []
+        for k, t in enumerate(tasks):
+            serial.append(run_start(*t))
+            report(k + 1, serial[-1])
+        return serial
+    own = executor is None
+    if executor is None:
+        n = max_workers or (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
+        executor = ProcessPoolExecutor(max_workers=max(1, min(n, len(tasks))), mp_context=mp.get_context("spawn"))
+    futs: dict[Future, int] = {}
+    try:
+        for k, t in enumerate(tasks):
+            futs[executor.submit(run_start, *t)] = k
+        done = 0
+        for fut in as_completed(list(futs)):
+            k = futs.pop(fut)
+            try:
+                res = fut.result()
+            except Exception as exc:  # the executor lost the start (a worker died): recorded, not raised
+                res = {"code": FAILURE, "text": f"failure:{type(exc).__name__}", "n": None, "cycle": (),
+                       "n_returns": 0, "message": f"the executor lost this start: {_msg(exc)}"}
+            results[k] = res
+            done += 1
+            report(done, res)
+    finally:
+        for fut in futs:
+            fut.cancel()
+        if own:
+            executor.shutdown(wait=True, cancel_futures=True)
+    return results  # type: ignore[return-value]
+
+
+def _group(outcomes: list[dict], starts: list[tuple[float, float]]) -> tuple[np.ndarray, list[dict]]:
+    """Attractor codes of the periodic outcomes (first reached first, in grid order) and the groups."""
+    codes = np.empty(len(outcomes), dtype=np.int64)
+    groups: list[dict] = []
+    for k, o in enumerate(outcomes):
+        if o["code"] != 0:
+            codes[k] = o["code"]
+            continue
+        cyc = np.asarray(o["cycle"])
+        for g in groups:
+            if g["n"] == o["n"] and np.allclose(cyc, g["cycle"], rtol=MATCH_RTOL, atol=0.0):
+                g["count"] += 1
+                codes[k] = g["id"]
+                break
+        else:
+            codes[k] = len(groups)
+            groups.append({"id": len(groups), "n": o["n"], "cycle": cyc, "count": 1, "first": k, "start": starts[k]})
+    return codes, groups
+
+
+def basins(
+    params: PeelParams,
+    *,
+    alpha0: Sequence[float] | np.ndarray,
+    F0: Sequence[float] | np.ndarray | None = None,
+    omega0: Sequence[float] | np.ndarray | None = None,
+    t_transient: float = WINDOW_DEFAULTS["t_transient"],
+    window: float = WINDOW_DEFAULTS["window"],
+    rtol: float = WINDOW_DEFAULTS["rtol"],
+    max_period: int = 32,
+    orbits: bool = False,
+    executor: Executor | None = None,
+    max_workers: int | None = None,
+    progress: bool | Callable[[int, int, dict], None] | None = True,
+) -> BasinResult:
+    """Label every start of a grid over (α0, F0) or (α0, ω0) by the attractor it reaches.
+
+    Each start runs ``exact.simulate(params, t_transient + window, alpha0=a, F0=F (or omega0=w), rtol=rtol,
+    save="jumps", t_transient=t_transient)`` (the other initial values :func:`exact.initial_state`'s
+    defaults) and its window's return map is classified by :func:`peelapprox.periodicity` (rtol 1e-6).
+    Periodic starts whose n are equal and whose sorted cycles agree to :data:`MATCH_RTOL` reach the same
+    attractor.
+
+    Parameters
+    ----------
+    params : PeelParams
+        With any law the hybrid solver runs (the paper's fvV, a cubic, a table, an expression).
+    alpha0 : sequence of float
+        Initial peel angles [rad]: strictly increasing, each in ``STATE_RANGES["alpha"]``.
+    F0, omega0 : sequence of float
+        The second axis, exactly one of them: initial pull forces [N] (``STATE_RANGES["F"]``) or roller
+        angular velocities [rad/s] (``STATE_RANGES["omega"]``), strictly increasing.
+    t_transient, window : float
+        Seconds discarded, in [0, 1e6], and seconds whose AB→CD jumps are classified, in (0, 1e6]
+        (:data:`peelapprox.WINDOW_DEFAULTS`: 30, 20).
+    rtol : float
+        Relative tolerance of each run, in :data:`peelapprox.RTOL_RANGE` (1e-10).
+    max_period : int
+        Largest period looked for, in [1, 1000]; a window needs ``3 max_period`` returns to call a start
+        aperiodic (else "undetermined").
+    orbits : bool
+        Also find each periodic attractor's :class:`exact.PeriodicOrbit` (:func:`exact.periodic_orbit` seeded
+        by its first start's run, in this process): Floquet multipliers, stability.
+    executor : concurrent.futures.Executor, optional
+        Runs the starts (e.g. a dask ``Client.get_executor()``), used as is and left running; the function
+        shipped is :func:`exact._basins.run_start`, its arguments plain data (PeelParams pickles with its law).
+    max_workers : int, optional
+        Without ``executor``: 0 runs in this process; n > 0 a local spawned process pool of n workers; None
+        (default) one worker per CPU available, at most one per start.
+    progress : bool or callable
+        True: a line on stderr per ~5 % of the starts; a callable gets ``(done, total, outcome)`` after each.
+
+    Returns
+    -------
+    BasinResult
+        The same, bit for bit, in this process or on any executor: the outcomes are put in grid order before
+        they are grouped.
+
+    Raises
+    ------
+    ValueError, TypeError
+        A bad argument (named, with its range).  Nothing a start does raises: an infeasible start, a
+        breakdown, a solver failure are outcomes.
+    """
+    wall0 = time.perf_counter()
+    params = _params("params", params, laws=HYBRID_LAWS)
+    a_ax = _axis("alpha0", alpha0, "alpha")
+    if (F0 is None) == (omega0 is None):
+        raise ValueError("give exactly one of F0 (an (alpha0, F0) grid) and omega0 (an (alpha0, omega0) grid)")
+    axis = "F0" if F0 is not None else "omega0"
+    values = _axis(axis, F0 if F0 is not None else omega0, "F" if axis == "F0" else "omega")
+    t_transient = duration("t_transient", t_transient, zero=True)
+    window = duration("window", window)
+    rtol = _rtol("rtol", rtol)
+    max_period = integer("max_period", max_period, 1, 1000)
+    orbits = flag("orbits", orbits)
+    max_workers = optional(integer, "max_workers", max_workers, 0)
+    if executor is not None:
+        if not callable(getattr(executor, "submit", None)):
+            raise ArgumentTypeError(f"executor must be None or a concurrent.futures.Executor, got {executor!r}")
+        if max_workers is not None:
+            raise ValueError("max_workers applies only to the local process pool (executor=None); size your "
+                             "executor instead")
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")
+
+    starts = [(float(a), float(v)) for a in a_ax for v in values]
+    tasks = [(params, t_transient, window, rtol, max_period, a, axis, v) for a, v in starts]
+    outcomes = _run_all(tasks, executor, max_workers, _reporter(progress, len(tasks)))
+    codes, groups = _group(outcomes, starts)
+    atts = []
+    for g in groups:
+        orbit, err = (_orbit(params, starts[g["first"]], axis, g["n"], t_transient, window, rtol) if orbits
+                      else (None, None))
+        atts.append(BasinAttractor(g["id"], g["n"], tuple(float(f"{c:.{CYCLE_DIGITS}g}") for c in g["cycle"]),
+                                   g["count"], g["start"], orbit, err))
+    shape = (a_ax.size, values.size)
+    return BasinResult(
+        params=params, alpha0=a_ax, axis=axis, values=values, labels=codes.reshape(shape),
+        texts=np.array([o["text"] for o in outcomes], dtype=object).reshape(shape),
+        cycles=tuple(tuple(o["cycle"]) for o in outcomes),
+        n_returns=np.array([o["n_returns"] for o in outcomes], dtype=np.int64).reshape(shape),
+        messages=tuple(o["message"] for o in outcomes), attractors=tuple(atts), t_transient=t_transient,
+        window=window, rtol=rtol, max_period=max_period, wall_time=time.perf_counter() - wall0)
+
+
+def _orbit(params: PeelParams, start: tuple[float, float], axis: str, n: int, t_transient: float, window: float,
+           rtol: float) -> tuple[PeriodicOrbit | None, str | None]:
+    """:func:`exact.periodic_orbit` seeded by the run from ``start`` (None and why, if it fails)."""
+    try:
+        kw: dict[str, Any] = {"alpha0": start[0], axis: start[1]}
+        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, **kw)
+        return periodic_orbit(params, start=tr, n=n), None
+    except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded, ArithmeticError) as exc:
+        return None, f"{type(exc).__name__}: {_msg(exc)}"
