@@ -287,8 +287,9 @@ def lyapunov_tangent(
     Returns
     -------
     LyapunovResult
-        ``bits_per_s`` and ``per_s``, ``stderr_bits`` (from the local rates between renormalisations at the
-        jumps), ``tau`` the mean time between them, ``n_jumps``;
+        ``bits_per_s`` and ``per_s``, ``stderr_bits`` (batch means: the record's intervals between
+        renormalisations at the jumps grouped into :data:`TANGENT_BATCHES` runs of about equal time), ``tau``
+        the mean time of those batches, ``n_jumps``;
         ``notes`` reports the steps taken.
 
     Raises
@@ -299,6 +300,19 @@ def lyapunov_tangent(
         As :func:`exact.simulate`, with the time and state (also when ``max_steps`` is spent).
     """
     return _tangent(params, t_transient=t_transient, T=T, rtol=rtol, alpha0=alpha0, max_steps=max_steps)
+
+
+#: Batches of the tangent method's record (its standard error is that of the batch means).
+TANGENT_BATCHES = 10
+
+
+def _batches(logs: np.ndarray, dts: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(logs, dts)`` summed over ``m`` runs of consecutive intervals of about equal time (fewer if there are
+    fewer intervals)."""
+    if logs.size <= m:
+        return logs, dts
+    edges = np.searchsorted(np.cumsum(dts), np.linspace(0.0, dts.sum(), m + 1)[1:-1], side="right")
+    return (np.array([x.sum() for x in np.split(logs, edges)]), np.array([x.sum() for x in np.split(dts, edges)]))
 
 
 def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float = 50.0, rtol: float = 1e-10,
@@ -316,8 +330,10 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     t0 = time.perf_counter()
     lam, n_jumps, t, steps, (logs, dts) = lyapunov_saltation(params, t_transient=t_transient, T=T, rtol=rtol,
                                                              alpha0=alpha0, max_steps=max_steps, max_wall=max_wall)
-    # the record of the renormalisations (the tangent's unit size is d0 = 1); the exponent is the sum of the logs
-    # in the order they came, as lyapunov_saltation formed it
+    # the record of the renormalisations (the tangent's unit size is d0 = 1) in batches of consecutive intervals
+    # (batch means: the growth between two jumps alternates with the branch, so single intervals are strongly
+    # correlated); the exponent is the sum of the logs in the order they came, as lyapunov_saltation formed it
+    logs, dts = _batches(logs, dts, TANGENT_BATCHES)
     b = dataclasses.replace(BenettinResult.from_logs(logs, dts, 1.0, time.perf_counter() - t0), exponent=lam)
     ln2 = math.log(2.0)
     return LyapunovResult(lam, lam / ln2, b.stderr / ln2, b, params, b.time / b.n, n_jumps,
