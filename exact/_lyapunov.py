@@ -312,6 +312,7 @@ def _batches(logs: np.ndarray, dts: np.ndarray, m: int) -> tuple[np.ndarray, np.
     if logs.size <= m:
         return logs, dts
     edges = np.searchsorted(np.cumsum(dts), np.linspace(0.0, dts.sum(), m + 1)[1:-1], side="right")
+    edges = np.unique(edges[(edges > 0) & (edges < logs.size)])  # no empty batch (a long interval spans several)
     return (np.array([x.sum() for x in np.split(logs, edges)]), np.array([x.sum() for x in np.split(dts, edges)]))
 
 

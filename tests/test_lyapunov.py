@@ -219,3 +219,19 @@ def test_tangent_and_return_map_results_carry_no_nan():
         assert all(math.isfinite(x) for x in (r.per_s, r.bits_per_s, r.stderr_bits, r.tau, r.benettin.d0))
         assert r.tau > 0 and r.stderr_bits > 0 and r.benettin.exponent == r.per_s
         assert abs(r.benettin.running[-1] - r.per_s) <= 1e-12 * abs(r.per_s)
+
+
+def test_tangent_record_short_runs_have_no_empty_batch():
+    """Hypothesis: a run shorter than its batching (T = 0.05 s, a handful of jumps, one long interval) makes
+    no empty batch: every batch has a positive duration, and the standard error is a number or inf (fewer
+    than two batches), never NaN (a 0/0 of an empty batch once made it NaN, with a RuntimeWarning)."""
+    import math
+    import warnings
+
+    from peelapprox import PeelParams
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        for T in (0.05, 0.3):
+            r = exact.lyapunov(PeelParams(V=1.0, I=1e-3), "tangent", t_transient=1.0, T=T)
+            assert not math.isnan(r.stderr_bits) and (r.benettin.local.size == 0 or r.tau > 0)
