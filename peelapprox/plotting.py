@@ -232,7 +232,9 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
         xs = np.array([p.value for p in br.points])
         stable = np.array([p.orbit.stable for p in br.points])
         n = br.points[0].orbit.n
-        Fs = np.array([p.orbit.return_map_values for p in br.points])  # (points, n)
+        # (points, n), each point's values sorted: the set of F at its jumps, as the diagram shows them (the
+        # cyclic order of an orbit's jumps is not kept from point to point)
+        Fs = np.sort(np.array([p.orbit.return_map_values for p in br.points]), axis=1)
         for i in range(len(xs) - 1):  # each piece solid if both its ends are stable, else dashed
             style = "-" if stable[i] and stable[i + 1] else "--"
             for j in range(n):
