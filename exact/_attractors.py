@@ -29,7 +29,6 @@ from peelapprox.validate import duration, function, optional, positive, state, s
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._hybrid_law import HYBRID_LAWS
 from ._simulate import initial_state, simulate
 from ._trajectory import Trajectory
 
@@ -92,7 +91,7 @@ def window_run(
     peelapprox.ModelBreakdown, peelapprox.SolverBudgetExceeded
         As :func:`exact.simulate` (also for ``max_wall`` seconds of wall time).
     """
-    return _window_run(_params("params", params, laws=HYBRID_LAWS), duration("t_transient", t_transient, zero=True),
+    return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
                        duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
                        optional(positive, "max_wall", max_wall))
 
@@ -174,7 +173,7 @@ def attractors(
         When ``max_wall`` is spent.
     """
     # validate everything up front: inside the loop a ValueError can then only be an infeasible start
-    params = _params("params", params, laws=HYBRID_LAWS)
+    params = _params("params", params)
     kw = dict(t_transient=duration("t_transient", t_transient, zero=True), window=duration("window", window),
               rtol=_rtol("rtol", rtol))
     period_rtol = positive("period_rtol", period_rtol)

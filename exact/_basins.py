@@ -38,7 +38,6 @@ from peelapprox.validate import ArgumentTypeError, duration, flag, integer, opti
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._hybrid_law import HYBRID_LAWS
 from ._orbits import PeriodicOrbit, periodic_orbit
 from ._simulate import initial_state, simulate
 
@@ -423,7 +422,7 @@ def basins(
         breakdown, a solver failure are outcomes.
     """
     wall0 = time.perf_counter()
-    params = _params("params", params, laws=HYBRID_LAWS)
+    params = _params("params", params)
     a_ax = _axis("alpha0", alpha0, "alpha")
     if (F0 is None) == (omega0 is None):
         raise ValueError("give exactly one of F0 (an (alpha0, F0) grid) and omega0 (an (alpha0, omega0) grid)")

@@ -28,7 +28,6 @@ from numba import types as _t
 
 from peelapprox import PeelParams
 from peelapprox.kernels import (
-    ALL_LAWS,
     LAW_FP,
     LAW_LNV,
     LAW_TYPE,
@@ -40,13 +39,12 @@ from peelapprox.kernels import (
     pack_law,
     rebind,
 )
+from peelapprox.kernels import status as _st
 
 from . import _hybrid as H
 
-__all__ = ["HYBRID_LAWS", "RUN_SIG", "driver", "field_law", "law_for", "pull_force_law"]
+__all__ = ["RUN_SIG", "domain_status", "driver", "field_law", "law_for", "pull_force_law"]
 
-#: The laws (``PeelParams.force``, by ``peelapprox._law.law_label``) that ``simulate(method="hybrid")`` runs.
-HYBRID_LAWS = ALL_LAWS
 
 _A1 = _t.float64[::1]
 
@@ -152,3 +150,19 @@ def law_for(params: PeelParams) -> CompiledLaw:
                          f"on its fast branch within its domain up to {law.domain[1]!r} m/s: an AB->CD jump could not "
                          "land (extend the table to higher v)")
     return law
+
+
+def domain_status(status: int, cl: CompiledLaw, v: float, ceiling: float) -> tuple[int, str]:
+    """``(status, what)``: a driver's breakdown status re-read as ``LAW_DOMAIN`` where the law's domain, not the
+    model, stopped the run -- the floor on AB (NO_ROOT) or a CD→AB landing (NO_LANDING) at a domain starting above
+    0, the CD ceiling below ``ceiling`` -- with ``what`` happened (the message's first words)."""
+    lo, hi = cl.domain
+    bs = cl.structure
+    if status == _st.NO_ROOT and lo > 0:
+        return _st.LAW_DOMAIN, f"on AB the level F(1 - cos theta) fell to f = {bs.f_zero:.6g} N at the start of the law"
+    if status == _st.NO_LANDING and lo > 0:
+        return _st.LAW_DOMAIN, (f"the CD->AB jump from f_min = {bs.f_min:.6g} N would land below the start of the law "
+                              f"(f = {bs.f_zero:.6g} N there)")
+    if status == _st.V_CEILING and hi < ceiling:
+        return _st.LAW_DOMAIN, f"v = {v:.6g} m/s rose above the end of the law on CD"
+    return status, ""

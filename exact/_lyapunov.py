@@ -47,7 +47,6 @@ from peelapprox.validate import rtol as _rtol
 
 from ._attractors import DEFAULT_MAX_WALL, window_run
 from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
-from ._hybrid_law import HYBRID_LAWS
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
 from ._simulate import initial_state, simulate
 
@@ -180,7 +179,7 @@ def _two_trajectory(
     (halving the step while the moved state would leave its branch's level range), ``advance`` postpones the
     renormalisation while the orbits are on different branches.
     """
-    params = _params("params", params, laws=HYBRID_LAWS)
+    params = _params("params", params)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
     tau = _check("tau", tau)
     d0 = _check("d0", d0)
@@ -321,7 +320,7 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     """Method ``"tangent"`` of :func:`lyapunov` (:func:`lyapunov_tangent`, and a wall budget ``max_wall``)."""
     from ._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
 
-    params = _params("params", params, laws=HYBRID_LAWS)
+    params = _params("params", params)
     T = _check("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     rtol = _rtol("rtol", rtol)
@@ -404,7 +403,7 @@ def lyapunov_return_map(
 def _return_map(params: PeelParams, *, t_transient: float = T_TRANSIENT, n_returns: int = 5000, h: float = 1e-6,
                 rtol: float = 1e-12, alpha0: float = 0.0, max_wall: float | None = DEFAULT_MAX_WALL) -> LyapunovResult:
     """Method ``"return-map"`` of :func:`lyapunov` (:func:`lyapunov_return_map`)."""
-    params = _params("params", params, laws=HYBRID_LAWS)
+    params = _params("params", params)
     h = _check("h", h)
     rtol = _rtol("rtol", rtol)
     t_transient = duration("t_transient", t_transient, zero=True)

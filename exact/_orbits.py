@@ -8,7 +8,7 @@ the state at one AB→CD jump to the state at the next: the jump to ``v_land_cd`
 
 **The Jacobian** ``DP`` comes from the tangent dynamics of the hybrid solver's desingularised field in the
 parameter s (:mod:`exact._tangent`: state ``(t, α, ω, u = ln v)`` and one tangent, integrated together by the
-package's DOP853, the directional derivative by a central difference), with the saltation matrix at the CD→AB
+package's DOP853, with the field's analytic Jacobian, :mod:`exact._jacobian`), with the saltation matrix at the CD→AB
 jump.  A perturbation ``(δα, δω)`` of the section state starts as ``δy = (0, δα, δω, 0)`` after the AB→CD
 jump (the jump keeps (α, ω) and sets v, so δu = 0); at the next AB fold the field is ``(0, 0, 0, Ġ)`` (dt/ds,
 dα/ds, dω/ds vanish with f'), so the projection of the tangent onto the section along the flow only drops δu:
@@ -39,7 +39,7 @@ from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, in_range, integer, optional
 from peelapprox.validate import params as _params
 
-from ._tangent import TangentSystem, saltation, tangent_system
+from ._tangent import TangentSystem, tangent_system
 
 __all__ = ["PeriodicOrbit", "SectionReturn", "monodromy_fd", "periodic_orbit", "section_return", "solve_orbit"]
 
@@ -109,19 +109,14 @@ def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, at
     y = np.array([0.0, x[0], x[1], math.log(ts.landing(0)), 0.0, d[0], d[1], 0.0])
     steps = _leg(ts, y, 1, rtol, atol, 0.0)
     t_cd = float(y[0])
-    v_land = ts.landing(1)
-    if not v_land > 0.0:
+    rate_cd = ts.jump(y, 1)  # Ġ on arrival at the CD fold (< 0: the level falls to f_min)
+    if rate_cd is None:
         v = math.exp(y[3])
         raise _st.status_error(_st.NO_LANDING, t=t_cd, state=dict(t=t_cd, alpha=float(y[1]), omega=float(y[2]),
                                F=float(ts.pull(y[1], v)), v=v, branch="CD"), prefix="section return: ",
                                f_min=ts.law.structure.f_min, f_zero=ts.law.structure.f_zero)
-    gm, gp = np.empty(4), np.empty(4)
-    ts.field(y[:4], gm)
-    rate_cd = float(gm[3])  # Ġ on arrival at the CD fold (< 0: the level falls to f_min)
-    y[0], y[3] = 0.0, math.log(v_land)
-    ts.field(y[:4], gp)
-    y[4:] = saltation(y[4:], gm, gp)
     steps += _leg(ts, y, 0, rtol, atol, t_cd)
+    gm = np.empty(4)
     ts.field(y[:4], gm)
     return y[1:3].copy(), y[5:7].copy(), float(y[4]), t_cd + float(y[0]), steps, (rate_cd, float(gm[3]))
 
@@ -236,7 +231,6 @@ class PeriodicOrbit:
     fold_rates: np.ndarray = field(default_factory=lambda: np.zeros(0))
     steps: int = 0
     wall_time: float = 0.0
-    _extra: dict = field(default_factory=dict, repr=False, compare=False)
 
     def trajectory(self, *, rtol: float = 1e-12, save: str = "steps") -> Any:
         """One period of the orbit by ``exact.simulate``, from the first AB→CD jump (just after it, on CD)."""

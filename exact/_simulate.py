@@ -21,7 +21,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
-from peelapprox.kernels import CompiledLaw, model_block
+from peelapprox.kernels import ALL_LAWS, model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -92,7 +92,7 @@ def initial_state(
         ``F0 (1 - cos θ(α0))`` has no root on the requested branch (or on
         any branch), or if ``1 - cos θ(α0) <= 0``.
     """
-    _params("params", params, laws=HL.HYBRID_LAWS)
+    _params("params", params)
     a0 = state("alpha0", alpha0, "alpha")
     w0 = params.V / params.R if omega0 is None else state("omega0", omega0, "omega")
     law = None if params.force.kind == "paper" else HL.law_for(params)  # another law: its compiled form
@@ -285,7 +285,7 @@ def simulate(
     SolverBudgetExceeded, SolverFailure
         Budget used up / the integrator cannot proceed.
     """
-    _params("params", params, laws=HL.HYBRID_LAWS)
+    _params("params", params)
     opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor)
     t_end = duration("t_end", t_end)
     out, lim = output_options(opts.name, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
@@ -318,7 +318,7 @@ def _param_vector(params: PeelParams, v_floor: float | None = None, bs: BranchSt
     """The kernel's parameter vector (``exact._hybrid`` layout); ``v_floor=None``: the model's breakdown
     criterion, ``BranchStructure.v_breakdown``; ``bs``: the law's branch structure (default: the paper's law's,
     :func:`peelapprox.branch_structure`, and only the paper's law is accepted: the inlined driver's vector)."""
-    laws = ("paper",) if bs is None else HL.HYBRID_LAWS  # another law: b, A unused (0.0), the law driver's
+    laws = ("paper",) if bs is None else ALL_LAWS  # another law: b, A unused (0.0), the law driver's
     if bs is None:
         bs = branch_structure(params.V)
     p = model_block(params, H.N_P, laws)  # the model block (peelapprox.kernels), then the hybrid driver's fields
@@ -460,29 +460,13 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
         else:
             why = ""
         lo, hi = cl.domain
-        status, what = domain_status(status, cl, sd["v"], V_CEILING)
+        status, what = HL.domain_status(status, cl, sd["v"], V_CEILING)
         raise S.status_error(
             status, t=sd["t"], state=sd, partial=build(False),
             prefix=f"hybrid solver at t={sd['t']:.9g} on {sd['branch']}: ",
             f_zero=bs.f_zero, f_min=bs.f_min, level=BREAKDOWN_LEVEL, v=sd["v"], v_ceiling=V_CEILING,
             v_floor=v_floor, why=why, lo=lo, hi=hi, law=repr(params.force), what=what,
         )
-
-
-def domain_status(status: int, cl: CompiledLaw, v: float, ceiling: float) -> tuple[int, str]:
-    """``(status, what)``: a driver's breakdown status re-read as ``LAW_DOMAIN`` where the law's domain, not the
-    model, stopped the run -- the floor on AB (NO_ROOT) or a CD→AB landing (NO_LANDING) at a domain starting above
-    0, the CD ceiling below ``ceiling`` -- with ``what`` happened (the message's first words)."""
-    lo, hi = cl.domain
-    bs = cl.structure
-    if status == S.NO_ROOT and lo > 0:
-        return S.LAW_DOMAIN, f"on AB the level F(1 - cos theta) fell to f = {bs.f_zero:.6g} N at the start of the law"
-    if status == S.NO_LANDING and lo > 0:
-        return S.LAW_DOMAIN, (f"the CD->AB jump from f_min = {bs.f_min:.6g} N would land below the start of the law "
-                              f"(f = {bs.f_zero:.6g} N there)")
-    if status == S.V_CEILING and hi < ceiling:
-        return S.LAW_DOMAIN, f"v = {v:.6g} m/s rose above the end of the law on CD"
-    return status, ""
 
 
 def hybrid_field(params: PeelParams, v_floor: float | None = None, *,

@@ -191,6 +191,21 @@ class TangentSystem:
         """Where a jump from the fold of branch ``br`` (0: AB, 1: CD) lands [m/s]; <= 0 if it cannot."""
         return float(self.p[H.P_VLCD] if br == 0 else self.p[H.P_VLAB])
 
+    def jump(self, y: np.ndarray, br: int) -> float | None:
+        """The jump from the fold of branch ``br`` in place: ``y = (state, tangent)`` at the fold becomes the
+        state at the landing (τ reset to 0) and the tangent mapped by the saltation matrix (:func:`saltation`).
+        Returns ``Ġ`` on arrival at the fold (the field's u-component there), or None, ``y`` untouched, if the
+        jump cannot land."""
+        v_land = self.landing(br)
+        if not v_land > 0.0:
+            return None
+        gm, gp = np.empty(4), np.empty(4)
+        self.field(y[:4], gm)
+        y[0], y[3] = 0.0, math.log(v_land)
+        self.field(y[:4], gp)
+        y[4:] = saltation(y[4:], gm, gp)
+        return float(gm[3])
+
 
 def tangent_system(params) -> TangentSystem:
     """The :class:`TangentSystem` of ``params`` (its law's compiled driver, field and pull force)."""
@@ -268,7 +283,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     raises :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
     from ._benettin import natural_scales
-    from ._simulate import ATOL_SCALE, domain_status, initial_state, simulate
+    from ._simulate import ATOL_SCALE, initial_state, simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
@@ -301,8 +316,16 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     t, logs, n_jumps, steps = 0.0, 0.0, 0, 0
     seg_logs: list[float] = []  # per renormalisation: the log growth and the time since the last one
     seg_dts: list[float] = []
-    t_last = 0.0
-    g_minus, g_plus = np.empty(4), np.empty(4)
+    t_last, pending = 0.0, 0.0  # growth not yet recorded (jumps at one instant make one interval)
+
+    def record(g: float) -> None:
+        nonlocal t_last, pending
+        pending += g
+        if t > t_last:
+            seg_logs.append(pending)
+            seg_dts.append(t - t_last)
+            t_last, pending = t, 0.0
+
     while t < T:
         status, n = run(y, p, law, coef, br, rtol, atol, T - t, max_steps - steps)
         steps += n
@@ -310,38 +333,26 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
             t += y[0]
             g = math.log(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
             logs += g
-            if t > t_last:
-                seg_logs.append(g)
-                seg_dts.append(t - t_last)
+            record(g)
             break
         if status != FOLD:
             lo, hi = cl.domain
-            status, what = domain_status(status, cl, math.exp(y[3]), math.inf)
+            status, what = HL.domain_status(status, cl, math.exp(y[3]), math.inf)
             raise status_error(status, t=t_transient + t + y[0], state=where(t + y[0]), prefix="tangent integration: ",
                                where=f"at t = {t_transient + t + y[0]:.6g} s", limit=int(max_steps),
                                f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]), lo=lo, hi=hi,
                                law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)
         t += y[0]
-        field(y[:4], g_minus)
-        v_land = ts.landing(br)
-        if not v_land > 0.0:
-            code, what = domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
+        if ts.jump(y, br) is None:
+            code, what = HL.domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
             raise status_error(code, t=t_transient + t, state=where(t), prefix="tangent integration: ",
                                where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero, what=what,
                                lo=cl.domain[0], hi=cl.domain[1], law=repr(params.force))
-        y[0], y[3] = 0.0, math.log(v_land)
-        field(y[:4], g_plus)
-        y[4:] = saltation(y[4:], g_minus, g_plus)
         br = 1 - br
         n_jumps += 1
         d = float(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
         logs += math.log(d)
-        if t > t_last:
-            seg_logs.append(math.log(d))
-            seg_dts.append(t - t_last)
-            t_last = t
-        else:  # two jumps at one instant: one interval
-            seg_logs[-1] += math.log(d)
+        record(math.log(d))
         y[4:] /= d
         wall.left(t_transient + t, lambda t=t: where(t), t_transient + T)
     return logs / t, n_jumps, t, steps, (np.array(seg_logs), np.array(seg_dts))

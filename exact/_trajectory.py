@@ -93,14 +93,19 @@ class Jumps:
     def __iter__(self):
         return (self[i] for i in range(len(self)))
 
-    def to_csv(self, path) -> None:
-        """Write one row per jump with a header (branch names spelled out)."""
-        with open(path, "w") as fh:
-            fh.write(",".join(self.FIELDS) + "\n")
+    def to_csv(self, path, extra: dict | None = None) -> None:
+        """Write one row per jump with a header (branch names spelled out), floats in full precision (``repr``);
+        ``extra``: constant columns appended to every row (e.g. the law that produced the run), quoted as CSV
+        needs."""
+        import csv
+
+        extra = dict(extra or {})
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh, lineterminator="\n")
+            w.writerow([*self.FIELDS, *extra])
             for j in self:
-                fh.write(
-                    f"{j.t!r},{j.from_branch},{j.to_branch},{j.alpha!r},{j.omega!r},{j.F!r},{j.v_before!r},{j.v_after!r}\n"
-                )
+                w.writerow([repr(j.t), j.from_branch, j.to_branch, repr(j.alpha), repr(j.omega), repr(j.F),
+                            repr(j.v_before), repr(j.v_after), *extra.values()])
 
 
 @dataclass(frozen=True)

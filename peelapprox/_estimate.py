@@ -20,7 +20,6 @@ import numpy as np
 from scipy import integrate
 
 from ._alpha import cd_damping_time, inertial_frequency, inertial_periods, law_fprime
-from ._law import ALL_LAWS
 from ._law_compiled import branch_structure, fixed_point
 from ._params import PeelParams
 from ._peelforce import BranchStructure, FixedPoint
@@ -55,7 +54,7 @@ VELOCITY_RULE = (
 
 def _checked(params: PeelParams) -> PeelParams:
     """``params`` validated, any law (ValueError naming ``params.force`` for a law whose folds cannot be found)."""
-    return _params("params", params, laws=ALL_LAWS)
+    return _params("params", params)
 
 
 def _law_structure(params: PeelParams) -> BranchStructure:

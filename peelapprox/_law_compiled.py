@@ -38,7 +38,7 @@ from ._law import PeelForce
 from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients
 from ._law_codegen import expression_kernel, family_kernel
 from ._law_table_jit import table_coefficients, table_law
-from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint
+from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint, _check_V
 from ._peelforce import branch_structure as _paper_structure
 from ._peelforce import fixed_point as _paper_fixed_point
 
@@ -242,14 +242,7 @@ def branch_structure(V: float, *, force: PeelForce | None = None) -> BranchStruc
     """
     if force is None or force.kind == "paper":
         return _paper_structure(V)
-    return compiled_law(force, _checked_V(V)).structure
-
-
-def _checked_V(V: float) -> float:
-    from ._params import PARAM_RANGES
-    from .validate import in_range
-
-    return in_range("V", V, *PARAM_RANGES["V"])
+    return compiled_law(force, _check_V(V)).structure
 
 
 def fixed_point(V: float, R: float = 0.1, *, force: PeelForce | None = None) -> FixedPoint:

@@ -60,7 +60,7 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
     (t, F) : tuple of ndarray
         Jump times and F at the jumps.
     """
-    _params("params", params, laws=ALL_LAWS)
+    _params("params", params)
     if params.geometry != "paper":
         raise ValueError("branchwise_reference supports geometry='paper' only")
     s0 = initial_state(params, alpha0=alpha0)

@@ -96,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
         traj.to_npz(out)  # records the law: its params (with force) as dataclasses.asdict
         print(f"wrote {out}", file=sys.stderr)
     if jumps_csv:
-        _write_jumps(jumps_csv, traj.jumps, law)
+        traj.jumps.to_csv(jumps_csv, extra=law_fields(law))  # the run's law on every row
         print(f"wrote {jumps_csv}", file=sys.stderr)
     if plot:
         from ..plotting import plot_trajectory
@@ -104,15 +104,3 @@ def run(args: argparse.Namespace) -> int:
         plot_trajectory(traj, plot)
         print(f"wrote {plot}", file=sys.stderr)
     return 0
-
-
-def _write_jumps(path: str, jumps, law) -> None:
-    """The jumps as ``Jumps.to_csv`` writes them (same columns, floats in full precision), then the columns
-    ``law`` and ``law_key`` (:func:`~peelapprox.cli._force.law_fields`) on every row."""
-    import dataclasses
-
-    from ..io import write_csv
-
-    rec = law_fields(law)
-    with open(path, "w", newline="") as fh:
-        write_csv(fh, [{**dataclasses.asdict(j), **rec} for j in jumps], fields=[*jumps.FIELDS, *rec])
