@@ -18,7 +18,7 @@ from scipy.optimize import brentq
 
 from exact import SolverFailure, initial_state
 from peelapprox import BranchStructure, PeelParams, branch_structure
-from peelapprox.kernels import ALL_LAWS, branch_inverse_at, closure_paper, peel_force_coefficients, slow_rates
+from peelapprox.kernels import branch_inverse_at, closure_paper, peel_force_coefficients, slow_rates
 from peelapprox.validate import params as _params
 
 # the generated model functions themselves, in plain Python: the reference uses no compiled kernel

@@ -12,7 +12,7 @@ import numpy as np
 
 from exact import default_atol, initial_state
 from peelapprox import branch_structure
-from peelapprox.kernels import ALL_LAWS, PeerUnavailableError, import_optional
+from peelapprox.kernels import PeerUnavailableError, import_optional
 from peelapprox.validate import choice, duration, in_range, reals
 from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
