@@ -22,11 +22,20 @@ from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailur
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
 from ._basins import BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
-from ._continuation import Bifurcation, BranchPoint, OrbitBranch, continue_orbit, with_parameter
-from ._diagram import OrbitDiagram, orbit_diagram
+from ._continuation import (
+    Bifurcation,
+    BranchPoint,
+    OrbitBranch,
+    continue_orbit,
+    parameter_value,
+    switch_branch,
+    with_parameter,
+)
+from ._crest import Crest, crest_margin
+from ._diagram import OrbitDiagram, explain, orbit_diagram
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt, default_atol
-from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return
+from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
 from ._simulate import (
     ATOL_SCALE,
     STEP_BUDGET,
@@ -56,6 +65,7 @@ __all__ = [
     "VARIATIONAL_LAWS",
     "periodic_orbit",
     "PeriodicOrbit",
+    "solve_orbit",
     "section_return",
     "SectionReturn",
     "monodromy_fd",
@@ -63,8 +73,13 @@ __all__ = [
     "OrbitBranch",
     "BranchPoint",
     "Bifurcation",
+    "switch_branch",
+    "crest_margin",
+    "Crest",
     "orbit_diagram",
+    "explain",
     "with_parameter",
+    "parameter_value",
     "OrbitDiagram",
     "basins",
     "BasinResult",

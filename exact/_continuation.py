@@ -1,28 +1,46 @@
 """Continuation of a periodic orbit in a parameter, with its bifurcations located (issue 16).
 
 :func:`continue_orbit` follows a :class:`exact.PeriodicOrbit` in V, I, k or a coefficient of a family law
-(``"force.c"``) by **natural continuation**: at each step the parameter moves by ``h``, the section state is
-predicted by the secant through the last two points (the first step keeps it), and Newton (:func:`exact.
-solve_orbit`, n fixed) corrects it.  Step control: a correction in at most 3 Newton iterations grows ``h`` by
-1.5 (up to ``max_step``); a failed one, or one whose corrector moves the state farther than ``max_correction``
-from the prediction (a jump to another, coexisting orbit), halves it, down to ``min_step``, where the branch
-stops.
+(``"force.c"``) by **pseudo-arclength continuation** in ``w = (α, ω R/V, λ/Λ)`` (the first section state,
+scaled, and the parameter λ over the span ``Λ = |stop - start|``): the predictor steps ``h`` along the secant
+through the last two points (from the start, along the branch's tangent, the null vector of ``[DP^n - 1,
+∂P^n/∂λ]``, oriented towards ``stop``), and the corrector (:func:`exact._corrector.bordered_newton`, n fixed)
+solves the closing condition ``P^n(x; λ) = x`` together with ``τ · (w - w_pred) = 0`` (the step orthogonal to
+the secant).  Steps from an orbit with a real multiplier within ``FOLD_NEAR`` (0.25) of +1 are
+pseudo-arclength steps, so the branch passes **folds**, where λ turns back; the others (and the last one onto
+``stop``) are natural (λ fixed: Newton at fixed λ, no ``∂P/∂λ``): near a grazing the branch steepens like a
+square root, which a pseudo-arclength step would follow around the corner where the orbit ceases to exist.
+Step control: a correction in at most 3 Newton iterations grows ``h`` by 1.5 (up to ``max_step``);
+a failed one, or one whose corrector moves the point farther than ``max_correction`` from the prediction (a
+jump to another, coexisting orbit), halves it, down to ``min_step``, where the branch stops.  Steps are
+arclengths measured in units of the parameter (``Λ`` times the arclength in ``w``).
 
 Between two accepted points the nontrivial Floquet multipliers are compared, and a crossing of the unit circle
-is a bifurcation, located by bisection in the parameter (to ``locate_tol`` relative) on the quantity that
-changes sign:
+is a bifurcation, located by bisection along the arclength between the two points (to ``locate_tol`` relative
+in λ and ``GAUGE_TOL`` in the gauge, or 40 halvings) on the quantity that changes sign:
 
-* **fold** (a real multiplier through +1: ``μ - 1``): the branch turns back; natural continuation cannot pass it
-  and stops there (the step falls to ``min_step``);
-* **period doubling** (a real multiplier through -1: ``μ + 1``);
+* **fold** (a real multiplier through +1: ``μ - 1``): the branch turns back in λ (the located λ lies beyond
+  both neighbouring points; where it lies between them, λ does not turn and the crossing is reported as a
+  ``"branch_point"``);
+* **period doubling** (a real multiplier through -1: ``μ + 1``); :func:`switch_branch` starts the doubled
+  (period-2n) branch there;
 * **Neimark-Sacker** (a complex pair through the unit circle: ``|μ| - 1``).
 
-The non-smooth ends of a branch are reported as the reason it stopped: ``"grazing"`` (the orbit meets a fold
-of f tangentially: the rate ``Ġ`` at which its level reaches the fold falls below ``graze_tol k V``; beyond it
-the branch stay no longer ends in a jump there, the itinerary changes, and the multipliers diverge on the way
-in), ``"breakdown"`` (a return breaks down, e.g. a landing no longer exists), ``"no_convergence"`` (Newton fails
-at ``min_step``: the branch folds, or another non-smooth event), ``"stop"`` (the parameter reached ``stop``),
-``"max_points"``.
+The non-smooth ends of a branch are reported as the reason it stopped (``OrbitBranch.stopped``, with the
+parameter value of the event in ``end_value``):
+
+* ``"grazing"``: the orbit meets a fold of f tangentially: the rate ``Ġ`` at which its level reaches the fold
+  falls below ``graze_tol k V``; the multipliers diverge on the way in;
+* ``"crest"``: an interior crest of ``F (1 + c(α))`` on AB reaches f_max (or a trough on CD reaches f_min):
+  beyond it the solution jumps one oscillation earlier, the itinerary changes and this orbit no longer exists
+  (:mod:`exact._crest`).  Detected when the crest margin of an accepted point falls below ``crest_tol``, or,
+  when Newton fails at ``min_step``, when the last two points' margins extrapolate linearly to 0 within two
+  steps or 1e-3 of the span; ``end_value`` is that extrapolation (likewise for a grazing, from ``Ġ²``, and a
+  breakdown, from the lowest level on AB above f(0+));
+* ``"breakdown"``: a return breaks down (e.g. CONSTR loses its root: a landing no longer exists);
+* ``"no_convergence"``: Newton fails at ``min_step`` for another reason;
+* ``"stop"`` (λ reached ``stop``), ``"range"`` (the branch turned back at a fold and left the range
+  ``[start, stop]`` at the start's side), ``"max_points"``.
 """
 
 from __future__ import annotations
@@ -34,47 +52,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peelapprox import PeelForce, PeelParams
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from peelapprox.validate import function, in_range, integer, optional, real
 
-from ._orbits import PeriodicOrbit, solve_orbit
+from ._corrector import PARAMETERS, bordered_newton, branch_tangent, parameter_value, with_parameter
+from ._crest import Crest, crest_margin
+from ._orbits import PeriodicOrbit, minimal_period
 
 __all__ = ["PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "continue_orbit", "parameter_value",
-           "with_parameter"]
-
-#: The parameters of :func:`continue_orbit` besides a family law's coefficients (``"force.<name>"``).
-PARAMETERS = ("V", "I", "k")
-
-
-def _coefficient(params: PeelParams, parameter: str) -> str | None:
-    """The family coefficient named by ``parameter`` (None for V, I, k); ValueError naming the valid ones."""
-    if parameter in PARAMETERS:
-        return None
-    law = params.force
-    name = parameter.removeprefix("force.")
-    coefs = dict(law.coefficients)
-    if not parameter.startswith("force.") or law.kind != "family" or name not in coefs:
-        have = ", ".join(f"force.{c}" for c in coefs) if law.kind == "family" else "none (not a family law)"
-        raise ValueError(f"parameter must be one of {', '.join(PARAMETERS)} or a coefficient of the family law "
-                         f"params.force ({have}), got {parameter!r}")
-    return name
-
-
-def with_parameter(params: PeelParams, parameter: str, value: float) -> PeelParams:
-    """``params`` with ``parameter`` (V, I, k or ``"force.<coefficient>"`` of a family law) set to ``value``."""
-    name = _coefficient(params, parameter)
-    if name is None:
-        return params.replace(**{parameter: value})
-    law = params.force
-    return params.replace(force=PeelForce.family(str(law.name), **{**dict(law.coefficients), name: value}))
-
-
-def parameter_value(params: PeelParams, parameter: str) -> float:
-    """The value of ``parameter`` in ``params`` (:func:`with_parameter`)."""
-    name = _coefficient(params, parameter)
-    return float(getattr(params, parameter) if name is None else dict(params.force.coefficients)[name])
-
+           "switch_branch", "with_parameter"]
 
 @dataclass(frozen=True)
 class BranchPoint:
@@ -97,12 +83,14 @@ class BranchPoint:
 
 @dataclass(frozen=True)
 class Bifurcation:
-    """A bifurcation located on a branch: ``kind`` ("fold", "period_doubling", "neimark_sacker"), the
-    parameter's ``value`` (bisection to ``locate_tol``) and the orbit there."""
+    """A bifurcation located on a branch: ``kind`` ("fold", "period_doubling", "neimark_sacker",
+    "branch_point"), the parameter's ``value`` (bisection to ``locate_tol``), the orbit there and the
+    ``parameter``'s name."""
 
     kind: str
     value: float
     orbit: PeriodicOrbit
+    parameter: str = "V"
 
 
 @dataclass(frozen=True)
@@ -116,10 +104,13 @@ class OrbitBranch:
         In the order continued (the start first).
     bifurcations : tuple of Bifurcation
     stopped : str
-        Why the branch ended: "stop", "max_points", "grazing", "breakdown", "no_convergence".
+        Why the branch ended: "stop", "range", "max_points", "grazing", "crest", "breakdown",
+        "no_convergence" (module docstring).
     message : str
         The detail (the exception's message for "breakdown"/"no_convergence").
     wall_time : float
+    end_value : float
+        The parameter's value at the end: the extrapolated event for "crest", else the last point's.
     """
 
     parameter: str
@@ -128,6 +119,7 @@ class OrbitBranch:
     stopped: str
     message: str
     wall_time: float
+    end_value: float = math.nan
 
     def rows(self) -> list[dict]:
         """Every point as a row (:meth:`BranchPoint.row`), for ``peelapprox.io.write_rows`` (CSV/JSON)."""
@@ -157,12 +149,35 @@ def _gauge(kind: str, o: PeriodicOrbit) -> float:
     return float(min(mu.real - level, key=abs))
 
 
+class _Stepper:
+    """The corrector of one branch: points ``w`` and bordered Newton at a prediction (module docstring)."""
+
+    def __init__(self, orbit: PeriodicOrbit, parameter: str, lam_scale: float, tol: float, rtol: float):
+        self.base, self.parameter, self.ls, self.tol, self.rtol = orbit.params, parameter, lam_scale, tol, rtol
+        self.scale = np.array([1.0, orbit.params.V / orbit.params.R])  # z = (α, ω R/V)
+        self.n = orbit.n
+
+    def w(self, p: BranchPoint) -> np.ndarray:
+        return np.concatenate([p.orbit.section_states[0] / self.scale, [p.value / self.ls]])
+
+    def params_at(self, value: float):
+        return with_parameter(self.base, self.parameter, value)
+
+    def correct(self, w_pred: np.ndarray, tau: np.ndarray, n: int | None = None, max_iter: int = 12) -> BranchPoint:
+        o, lam = bordered_newton(self.params_at, n or self.n, w_pred[:2] * self.scale, float(w_pred[2] * self.ls),
+                                 tau, w_pred, self.scale, self.ls, tol=self.tol, rtol=self.rtol, max_iter=max_iter)
+        return BranchPoint(lam, o)
+
+
+_FAILURES = (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded)
+
+
 def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, step: float | None = None,
                    min_step: float | None = None, max_step: float | None = None, max_points: int = 200,
                    tol: float = 1e-10, rtol: float = 1e-12, locate_tol: float = 1e-8, max_correction: float = 0.02,
-                   graze_tol: float = 1e-3,
+                   graze_tol: float = 1e-3, crest_tol: float = 1e-6,
                    progress: Callable[[int, float], None] | None = None) -> OrbitBranch:
-    """Follow ``orbit`` in ``parameter`` up to ``stop``, locating its bifurcations (module docstring).
+    """Follow ``orbit`` in ``parameter`` towards ``stop``, locating its bifurcations (module docstring).
 
     Parameters
     ----------
@@ -172,8 +187,8 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     stop : float
         The parameter value to continue to (either side of the start).
     step, min_step, max_step : float, optional
-        Initial, smallest and largest step in the parameter (defaults: 1/50, 1/1e5 and 1/10 of
-        ``|stop - start|``).
+        Initial, smallest and largest arclength step, in units of the parameter (defaults: 1/50, 1/1e5 and 1/10
+        of ``|stop - start|``).
     max_points : int
         Most orbits on the branch, in [2, 100000].
     tol, rtol : float
@@ -181,11 +196,15 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     locate_tol : float
         Relative accuracy of a bifurcation's parameter value.
     max_correction : float
-        Largest move of Newton's corrector from the secant prediction, relative to the section state in
-        ``z = (α, ω R/V)``; a larger one is a jump to another orbit: the step is halved instead.
+        Largest move of the corrector from the prediction, relative to ``max(1, |w|)``; a larger one is a jump
+        to another orbit: the step is halved instead.
     graze_tol : float
         The branch stops with "grazing" when the rate ``Ġ`` at which the orbit meets one of its folds
         (``PeriodicOrbit.fold_rates``) falls below ``graze_tol * k V``.
+    crest_tol : float
+        The branch stops with "crest" when an interior crest of the orbit comes within ``crest_tol (f_max -
+        f_min)`` of its fold (:func:`exact._crest.crest_margin`, one run of a period per point); 0 checks only
+        when Newton fails.
     progress : callable, optional
         ``progress(points, value)`` after every accepted point.
 
@@ -213,80 +232,234 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     max_points = integer("max_points", max_points, 2, 100_000)
     max_correction = in_range("max_correction", max_correction, 0.0, 1.0, lo_open=True)
     graze_tol = in_range("graze_tol", graze_tol, 0.0, 1.0)
+    crest_tol = in_range("crest_tol", crest_tol, 0.0, 1.0)
     progress = optional(function, "progress", progress)
 
-    scale = np.array([1.0, orbit.params.V / orbit.params.R])  # z = (α, ω R/V)
+    st = _Stepper(orbit, parameter, span, tol, rtol)
+    e_lam = np.array([0.0, 0.0, 1.0])
     points = [BranchPoint(lam0, orbit)]
+    crests = [crest_margin(orbit) if crest_tol > 0 else _NO_CREST]
     bifs: list[Bifurcation] = []
-    stopped, message = "stop", ""
-    n = orbit.n
-
-    def solve(value: float, x0: np.ndarray) -> PeriodicOrbit:
-        return solve_orbit(with_parameter(orbit.params, parameter, value), x0, n, tol=tol, rtol=rtol, max_iter=8)
-
+    stopped, message, end_value = "max_points", "", math.nan
+    lo_end, hi_end = min(lam0, stop), max(lam0, stop)
     while len(points) < max_points:
         last = points[-1]
-        if (stop - last.value) * sign <= 0:
-            break
-        hv = min(h, abs(stop - last.value))
-        value = last.value + sign * hv
-        x0 = last.orbit.section_states[0]
-        if len(points) >= 2:  # secant predictor
-            prev = points[-2]
-            slope = (x0 - prev.orbit.section_states[0]) / (last.value - prev.value)
-            x0 = x0 + slope * (value - last.value)
+        wl = st.w(last)
+        if len(points) == 1:  # the branch's tangent, towards stop
+            tau = branch_tangent(st.params_at, orbit, lam0, st.scale, span, rtol)
+            tau = tau if tau[2] * sign >= 0 else -tau
+        else:
+            tau = st.w(last) - st.w(points[-2])
+            tau = tau / np.linalg.norm(tau)
+        ahead = [v for e, v in _events_ahead(points, crests).items() if e != "grazing"]
+        if ahead and abs(tau[2]) > 0:  # approach an extrapolated crest or breakdown geometrically, never step over
+            h = min(h, 0.5 * min(abs(v - last.value) for v in ahead) / abs(tau[2]))
+        w_pred, tau_c, final = wl + (h / span) * tau, (tau if _near_fold(last.orbit) else e_lam), False
+        if (w_pred[2] * span - stop) * sign >= 0 and tau[2] * sign > 0:  # the last step: natural, onto stop
+            w_pred = wl + tau * ((stop / span - wl[2]) / tau[2])
+            tau_c, final = e_lam, True
         try:
-            o = solve(value, x0)
-            jump = float(np.linalg.norm((o.section_states[0] - x0) / scale))
-            if jump > max_correction * max(1.0, float(np.linalg.norm(x0 / scale))):
-                raise ValueError(f"the corrector moved the section state by {jump:.3g} (scaled) from the "
-                                 f"prediction: a jump to another orbit, refused (max_correction={max_correction})")
-        except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded) as exc:
-            if h / 2 < hmin:
-                stopped = "breakdown" if isinstance(exc, ModelBreakdown) else "no_convergence"
-                message = str(exc)
-                break
-            h /= 2
-            continue
+            if h < hmin:
+                raise ValueError(f"the step fell below min_step={hmin:.3g} before an extrapolated event")
+            pt = st.correct(w_pred, tau_c)
+            _check_correction(st, pt, w_pred, max_correction)
+        except _FAILURES as exc:
+            if h / 2 >= hmin:
+                h /= 2
+                continue
+            stopped, message, end_value = _failure_end(exc, points, crests, parameter, span)
+            break
+        o = pt.orbit
         if np.min(np.abs(o.fold_rates)) < graze_tol * o.params.k * o.params.V:
             i = int(np.argmin(np.abs(o.fold_rates)))
-            points.append(BranchPoint(value, o))
-            stopped = "grazing"
+            points.append(pt)
+            crests.append(_NO_CREST)
+            stopped, end_value = "grazing", _events_ahead(points, crests).get("grazing", pt.value)
             message = (f"the orbit meets the {'AB' if i % 2 else 'CD'} fold (fold {i + 1} of the period) almost "
-                       f"tangentially at {parameter}={value:.10g}: dG/dt = {o.fold_rates[i]:.3g} N/s there (below "
-                       f"graze_tol * k V); the period-{n} branch ends in a grazing bifurcation, where its "
-                       "multipliers diverge")
+                       f"tangentially at {parameter}={pt.value:.10g}: dG/dt = {o.fold_rates[i]:.3g} N/s there "
+                       f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
+                       "its multipliers diverge")
             break
         kind = _crossing(last.orbit, o)
         if kind is not None:
-            bifs.append(_locate(kind, last, BranchPoint(value, o), solve, locate_tol))
-        points.append(BranchPoint(value, o))
+            bifs.append(_locate(kind, last, pt, st, locate_tol))
+        points.append(pt)
+        crests.append(crest_margin(o) if crest_tol > 0 else _NO_CREST)
         if progress:
-            progress(len(points), value)
+            progress(len(points), pt.value)
+        c = crests[-1]
+        if min(c.margin, c.floor) < crest_tol:
+            event = "crest" if c.margin <= c.floor else "breakdown"
+            stopped, end_value = event, _events_ahead(points, crests).get(event, pt.value)
+            message = _event_message(event, c, end_value, parameter)
+            break
+        if final:
+            stopped = "stop"
+            break
+        if not lo_end - 0.01 * span <= pt.value <= hi_end + 0.01 * span:
+            stopped = "range"
+            message = f"the branch turned back at a fold and left [{lo_end:.10g}, {hi_end:.10g}] at {pt.value:.10g}"
+            break
         h = min(hmax, h * 1.5) if len(o.newton) <= 3 else h
-    else:
-        stopped = "max_points"
-    return OrbitBranch(parameter, tuple(points), tuple(bifs), stopped, message, time.perf_counter() - wall0)
+    if math.isnan(end_value):
+        end_value = points[-1].value
+    return OrbitBranch(parameter, tuple(points), tuple(bifs), stopped, message, time.perf_counter() - wall0,
+                       end_value)
 
 
-def _locate(kind: str, a: BranchPoint, b: BranchPoint, solve: Callable[[float, np.ndarray], PeriodicOrbit],
-            locate_tol: float) -> Bifurcation:
-    """Bisection in the parameter between ``a`` and ``b`` on :func:`_gauge` (module docstring)."""
+_NO_CREST = Crest(math.inf, "", math.nan)
+#: A located bifurcation's orbit has its gauge (``μ ∓ 1`` or ``|μ| - 1``) within this of 0 (or 40 halvings were
+#: spent): at a fold λ is stationary along the branch, so λ alone would stop the bisection with μ still far
+#: from 1.
+GAUGE_TOL = 1e-6
+#: A real multiplier within this distance of +1 makes the next step pseudo-arclength (a fold may be ahead).
+FOLD_NEAR = 0.25
+
+
+def _near_fold(o: PeriodicOrbit) -> bool:
+    mu = o.multipliers
+    return bool(np.any((np.abs(mu.imag) < 1e-12) & (np.abs(mu.real - 1.0) < FOLD_NEAR)))
+
+
+def _check_correction(st: _Stepper, pt: BranchPoint, w_pred: np.ndarray, max_correction: float) -> None:
+    """ValueError when the corrector jumped to another orbit: it moved too far from the prediction, or reached
+    an orbit of a smaller period (a divisor of n) than the branch's."""
+    move = float(np.linalg.norm(st.w(pt) - w_pred))
+    if move > max_correction * max(1.0, float(np.linalg.norm(w_pred))):
+        raise ValueError(f"the corrector moved the point by {move:.3g} (scaled) from the prediction: a jump to "
+                         f"another orbit, refused (max_correction={max_correction})")
+    d = minimal_period(pt.orbit)
+    if d < st.n:
+        raise ValueError(f"the corrector reached an orbit of period {d}, not {st.n}: refused")
+
+
+def _events_ahead(points: list[BranchPoint], crests: list[Crest]) -> dict[str, float]:
+    """The parameter values where the last two points' crest margin ("crest"), floor ("breakdown") and squared
+    slowest fold rate ("grazing": Ġ vanishes like the square root of the distance), falling, extrapolate
+    linearly to 0 (module docstring); only the falling ones."""
+    if len(points) < 2:
+        return {}
+    a, b = points[-2].value, points[-1].value
+    out = {}
+    ra, rb = (float(np.min(np.abs(p.orbit.fold_rates))) ** 2 for p in points[-2:])  # Ġ² ∝ distance to grazing
+    for event, (ma, mb) in (("crest", (crests[-2].margin, crests[-1].margin)),
+                            ("breakdown", (crests[-2].floor, crests[-1].floor)), ("grazing", (ra, rb))):
+        if math.isfinite(ma) and math.isfinite(mb) and mb < ma and b != a:
+            out[event] = b + mb * (b - a) / (ma - mb)
+    return out
+
+
+def _event_message(event: str, c: Crest, value: float, parameter: str, orbit: PeriodicOrbit | None = None) -> str:
+    if event == "grazing" and orbit is not None:
+        return (f"the orbit's slowest arrival at a fold, dG/dt = {np.min(np.abs(orbit.fold_rates)):.3g} N/s, "
+                f"extrapolates to 0 at {parameter} ~ {value:.10g} (dG/dt squared linear): the branch ends in a "
+                "grazing bifurcation, where its multipliers diverge")
+    if event == "breakdown":
+        return (f"the lowest level F (1 + sin alpha) on AB comes within {c.floor:.3g} (f_max - f_min) of f(0+); it "
+                f"reaches it at {parameter} ~ {value:.10g} (linear extrapolation), where CONSTR loses its root and "
+                "the model breaks down")
+    level = "f_max" if c.branch == "AB" else "f_min"
+    return (f"an interior {'crest' if c.branch == 'AB' else 'trough'} of F (1 + sin alpha) on {c.branch} comes within "
+            f"{c.margin:.3g} (f_max - f_min) of {level}; it reaches it at {parameter} ~ {value:.10g} (linear "
+            "extrapolation), where the solution jumps one oscillation earlier and this orbit ends")
+
+
+def _failure_end(exc: Exception, points: list[BranchPoint], crests: list[Crest], parameter: str, span: float
+                 ) -> tuple[str, str, float]:
+    """Why a branch whose corrector fails at the smallest step ends: a crest, breakdown or grazing event
+    extrapolated ahead (within two steps or 1e-3 of the span; past a grazing the corrector's orbits break down),
+    else a breakdown of the corrector's orbit, else no convergence (module docstring)."""
+    if len(points) >= 2:
+        if not math.isfinite(crests[-1].margin + crests[-1].floor):  # crest_tol = 0: measure now
+            crests[-2:] = [crest_margin(p.orbit) for p in points[-2:]]
+        near = abs(points[-1].value - points[-2].value)
+        for event, value in sorted(_events_ahead(points, crests).items(), key=lambda e: abs(e[1] - points[-1].value)):
+            if abs(value - points[-1].value) <= max(2 * near, 1e-3 * span):
+                return event, _event_message(event, crests[-1], value, parameter, points[-1].orbit), value
+    if isinstance(exc, ModelBreakdown):  # with no event ahead: the corrector's orbit breaks down
+        return "breakdown", str(exc), math.nan
+    return "no_convergence", str(exc), math.nan
+
+
+def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: _Stepper, locate_tol: float) -> Bifurcation:
+    """Bisection along the arclength from ``a`` to ``b`` on :func:`_gauge` (module docstring)."""
+    wa, wb = st.w(a), st.w(b)
+    tau = (wb - wa) / np.linalg.norm(wb - wa)
     ga = _gauge(kind, a.orbit)
-    lo, hi, o_best = a, b, b.orbit
-    for _ in range(60):
-        if abs(hi.value - lo.value) <= locate_tol * max(abs(lo.value), abs(hi.value), 1e-300):
+    lo, hi, best = 0.0, 1.0, b
+    pa, pb = a, b
+    for _ in range(40):
+        if (abs(pb.value - pa.value) <= locate_tol * max(abs(pa.value), abs(pb.value), 1e-300)
+                and abs(_gauge(kind, best.orbit)) <= GAUGE_TOL):
             break
-        mid = 0.5 * (lo.value + hi.value)
+        mid = 0.5 * (lo + hi)
         try:
-            om = solve(mid, 0.5 * (lo.orbit.section_states[0] + hi.orbit.section_states[0]))
-        except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded):
+            pm = st.correct(wa + mid * (wb - wa), tau)
+        except _FAILURES:
             break
-        gm = _gauge(kind, om)
+        gm = _gauge(kind, pm.orbit)
         if gm == 0 or math.copysign(1.0, gm) != math.copysign(1.0, ga):
-            hi, o_best = BranchPoint(mid, om), om
+            hi, pb, best = mid, pm, pm
         else:
-            lo, ga = BranchPoint(mid, om), gm
-    value = 0.5 * (lo.value + hi.value)
-    return Bifurcation(kind, value, o_best)
+            lo, pa, ga = mid, pm, gm
+    value = 0.5 * (pa.value + pb.value)
+    if kind == "fold" and min(a.value, b.value) < value < max(a.value, b.value):
+        kind = "branch_point"  # a multiplier through +1 where λ does not turn back: not a fold
+    return Bifurcation(kind, value, best.orbit, st.parameter)
 
+
+def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: float = 1e-10,
+                  rtol: float = 1e-12) -> PeriodicOrbit:
+    """The period-2n orbit born at a period doubling of a period-n branch.
+
+    Solves ``P^{2n}(x; λ) = x`` with ``e · (z - z*) = a`` (:func:`exact._corrector.bordered_newton`): ``z*`` the
+    scaled section state of the orbit at the bifurcation, ``e`` the eigenvector of its multiplier -1, ``a`` the
+    ``amplitude`` (then a/4 and 4a if Newton fails or returns the period-n orbit itself), λ free.  Continue the
+    result with :func:`continue_orbit` (its parameter is ``bifurcation.parameter``; the doubled branch lies on
+    the side of λ where the result is).
+
+    Parameters
+    ----------
+    bifurcation : Bifurcation
+        Of kind "period_doubling" (``OrbitBranch.bifurcations``).
+    amplitude : float
+        Distance from the period-n orbit along ``e`` in scaled section coordinates, in (0, 0.1].
+    tol, rtol : float
+        As :func:`exact.periodic_orbit`.
+
+    Returns
+    -------
+    PeriodicOrbit
+        With ``n`` twice the bifurcating orbit's.
+
+    Raises
+    ------
+    ValueError
+        Not a period doubling, or no doubled orbit found near it.
+    """
+    if not isinstance(bifurcation, Bifurcation) or bifurcation.kind != "period_doubling":
+        raise ValueError(f"bifurcation must be a period_doubling Bifurcation, got {bifurcation!r:.80}")
+    amplitude = in_range("amplitude", amplitude, 0.0, 0.1, lo_open=True)
+    o, lam = bifurcation.orbit, bifurcation.value
+    st = _Stepper(o, bifurcation.parameter, max(abs(lam), 1e-300), tol, rtol)
+    Js = o.monodromy * st.scale[None, :] / st.scale[:, None]
+    mu, vec = np.linalg.eig(Js)
+    e = np.real(vec[:, int(np.argmin(np.abs(mu + 1.0)))])
+    e /= np.linalg.norm(e)
+    z = o.section_states[0] / st.scale
+    tau = np.concatenate([e, [0.0]])
+    errors = []
+    for a in (amplitude, amplitude / 4, 4 * amplitude):
+        w_ref = np.concatenate([z + a * e, [lam / st.ls]])
+        try:
+            pt = st.correct(w_ref, tau, n=2 * o.n, max_iter=20)
+        except _FAILURES as exc:
+            errors.append(f"a={a:.3g}: {exc}")
+            continue
+        d = pt.orbit.section_states
+        sep = float(np.linalg.norm((d[o.n] - d[0]) / st.scale))
+        if sep > 0.5 * a:
+            return pt.orbit
+        errors.append(f"a={a:.3g}: Newton returned the period-{o.n} orbit")
+    raise ValueError(f"no period-{2 * o.n} orbit found near the period doubling at {bifurcation.parameter}="
+                     f"{lam:.10g}: " + "; ".join(errors))

@@ -13,16 +13,18 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from peelapprox import WINDOW_DEFAULTS, PeelParams, periodicity, return_map
-from peelapprox.errors import ModelBreakdown
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from peelapprox.validate import duration, function, optional, reals
 
-from ._continuation import with_parameter
+from ._corrector import with_parameter
+from ._orbits import solve_orbit
 
-__all__ = ["OrbitDiagram", "orbit_diagram"]
+__all__ = ["OrbitDiagram", "explain", "orbit_diagram"]
 
 
 @dataclass(frozen=True)
@@ -113,3 +115,53 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
         if report is not None:
             report(i + 1, vals.size)
     return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
+
+
+def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-6) -> tuple[int | None, ...]:
+    """Which continued branch, if any, explains each value of the brute-force diagram.
+
+    A value whose long run is period n is explained by a branch of period-m orbits, m = n or a divisor of n,
+    that spans it (its points' parameter values lie on both sides of it, or one is equal) when Newton at that
+    value (``solve_orbit``, from the branch's point nearest to it) closes a **stable** orbit whose return-map
+    values, repeated n/m times, equal the run's last n, as sets, to ``rtol`` relative (a run still settling
+    onto a period-m orbit with a multiplier near -1 reads as period 2m).
+
+    Parameters
+    ----------
+    diagram : OrbitDiagram
+    branches : sequence of exact.OrbitBranch
+        In ``diagram.parameter``.
+    rtol : float
+        Agreement of the orbit's and the run's cycle.
+
+    Returns
+    -------
+    tuple of (int or None)
+        Per diagram value, the index into ``branches`` of the first branch that explains it; None where none
+        does or the run is not periodic.
+    """
+    from ._continuation import OrbitBranch
+
+    out: list[int | None] = []
+    for x, F, lab in zip(diagram.values, diagram.returns, diagram.labels):
+        found = None
+        n = int(lab.split("-")[1]) if lab.startswith("period-") else 0
+        for i, b in enumerate(branches if n else ()):
+            if not isinstance(b, OrbitBranch):
+                raise TypeError(f"branches must hold exact.OrbitBranch, got {type(b).__name__}")
+            vals = np.array([p.value for p in b.points])
+            m = b.points[0].orbit.n
+            if n % m or not vals.min() <= x <= vals.max() or F.size < n:
+                continue
+            q = b.points[int(np.argmin(np.abs(vals - x)))]
+            try:
+                o = solve_orbit(with_parameter(q.orbit.params, diagram.parameter, float(x)),
+                                q.orbit.section_states[0], m, max_iter=10)
+            except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded):
+                continue
+            cycle = np.sort(np.tile(o.return_map_values, n // m))
+            if o.stable and np.allclose(cycle, np.sort(F[-n:]), rtol=rtol, atol=0):
+                found = i
+                break
+        out.append(found)
+    return tuple(out)

@@ -150,7 +150,7 @@ def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: 
     """
     from ._simulate import ATOL_SCALE
 
-    ts = system or _system(params)
+    ts = system or system_of(params)
     x0 = np.asarray(x, dtype=float).reshape(2)
     scale = np.asarray(ATOL_SCALE["hybrid"])
     atol = np.concatenate([rtol * scale, np.ones(4)])  # the tangent stays 0: its weights do not matter
@@ -171,7 +171,7 @@ def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: 
     return SectionReturn(xn, np.column_stack(cols), T, np.array(dts), steps, rates)
 
 
-def _system(params: PeelParams) -> TangentSystem:
+def system_of(params: PeelParams) -> TangentSystem:
     ts = tangent_system(params)
     if not ts.law.structure.has_folds:
         raise ValueError(f"params: f(v, V={params.V}) has no folds (no stick-slip): there is no AB->CD section")
@@ -241,7 +241,7 @@ class PeriodicOrbit:
                         F0=float(self.return_map_values[0]), branch0="CD", rtol=rtol, save=save)
 
 
-def _compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
+def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
              ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, int, np.ndarray]:
     """``(P^n(x), DP^n, period, the n section states, steps, the 2n fold rates)``."""
     J = np.eye(2)
@@ -311,7 +311,9 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
         starts from the AB→CD jump whose state comes back nearest after n returns (exact on a periodic
         attractor; a near-recurrence of a chaotic run seeds an unstable orbit).
     n : int, optional
-        AB→CD jumps per period (default: the period of the run's return map, ``peelapprox.periodicity``).
+        AB→CD jumps per period (default: the period of the run's return map, ``peelapprox.periodicity``).  When
+        Newton closes an orbit whose own period is a divisor d of n (a run read as period 2d before it settled),
+        the orbit is returned with n = d.
     t_transient, window : float
         Transient and window of the run that seeds Newton [s].
     tol : float
@@ -344,10 +346,27 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
     rtol = in_range("rtol", rtol, 1e-14, 1e-6)
     max_iter = integer("max_iter", max_iter, 1, 200)
     max_period = integer("max_period", max_period, 1, 1000)
-    ts = _system(params)  # no folds: no section (before the seed run)
+    ts = system_of(params)  # no folds: no section (before the seed run)
     x, n = _start(params, start, n, t_transient, window, max_period, min(1e-10, 100 * rtol))
     o = solve_orbit(params, x, n, tol=tol, rtol=rtol, max_iter=max_iter, system=ts)
+    d = minimal_period(o)
+    if d < n:  # e.g. a slowly settling run read as period 2d: the orbit itself has the smaller period
+        o = solve_orbit(params, o.section_states[0], d, tol=tol, rtol=rtol, max_iter=max_iter, system=ts)
     return dataclasses.replace(o, wall_time=time.perf_counter() - wall0)
+
+
+#: Two section states of an orbit are the same point when they agree to this (scaled, relative).
+SAME_STATE = 1e-6
+
+
+def minimal_period(orbit: PeriodicOrbit) -> int:
+    """The smallest divisor d of ``orbit.n`` with the section state d returns on equal to the first (to
+    :data:`SAME_STATE` in the scaled coordinates): the orbit's own period in AB→CD jumps."""
+    z = orbit.section_states / np.array([1.0, orbit.params.V / orbit.params.R])
+    for d in range(1, orbit.n):
+        if orbit.n % d == 0 and np.linalg.norm(z[d] - z[0]) < SAME_STATE * max(1.0, float(np.linalg.norm(z[0]))):
+            return d
+    return orbit.n
 
 
 def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol: float = 1e-12,
@@ -363,13 +382,13 @@ def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol
         A return breaks down or never comes.
     """
     wall0 = time.perf_counter()
-    ts = system or _system(params)
+    ts = system or system_of(params)
     x = np.asarray(x0, dtype=float).reshape(2).copy()
     s = np.array([1.0, params.V / params.R])  # z = x / s
     history: list[float] = []
     steps = 0
     for _ in range(max_iter):
-        xn, J, T, states, k, rates = _compose(params, ts, x, n, rtol)
+        xn, J, T, states, k, rates = compose(params, ts, x, n, rtol)
         steps += k
         z, g = x / s, (xn - x) / s
         res = float(np.linalg.norm(g) / max(1.0, np.linalg.norm(z)))
@@ -391,6 +410,13 @@ def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol
     else:
         raise ValueError(f"periodic_orbit: Newton did not close the period-{n} orbit to tol={tol} in "
                          f"max_iter={max_iter} iterations; residuals {', '.join(f'{r:.3g}' for r in history)}")
+    return make_orbit(params, ts, J, T, states, rates, history, steps, wall0)
+
+
+def make_orbit(params: PeelParams, ts: TangentSystem, J: np.ndarray, T: float, states: np.ndarray,
+               rates: np.ndarray, history: list[float], steps: int, wall0: float) -> PeriodicOrbit:
+    """The :class:`PeriodicOrbit` of a closed Newton iteration (``compose``'s output at the orbit)."""
+    n = len(states)
     mu = np.linalg.eigvals(J)
     mu = mu[np.argsort(-np.abs(mu))]
     return PeriodicOrbit(params=params, n=n, period=T, section_states=states,
@@ -413,7 +439,7 @@ def section_return_n(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: in
 def monodromy_fd(params: PeelParams, x: Any, n: int, *, h: float = 1e-5, rtol: float = 1e-12) -> np.ndarray:
     """``DP^n`` at ``x = (α, ω)`` by fourth-order central differences of the return map (the cross-check of the
     tangent's Jacobian): steps ``h`` in α and ``h V/R`` in ω, ``(-P(2e) + 8 P(e) - 8 P(-e) + P(-2e)) / 12e``."""
-    ts = _system(params)
+    ts = system_of(params)
     x = np.asarray(x, dtype=float).reshape(2)
     s = np.array([1.0, params.V / params.R])
     cols = []

@@ -11,8 +11,8 @@ The (I, V) sweep (``sweep``, ``load_sweep``, ``SweepResult``, ``register_measure
 imported from there on first use (``import peelapprox`` imports no sibling package).  So are the
 dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lyapunov(params, method=...)``),
 ``lyapunov_tangent``, ``lyapunov_return_map``, ``LyapunovResult``, ``benettin``, ``attractors``,
-``Attractor``, ``periodic_orbit``, ``continue_orbit``, ``basins``.  The return-map analysis of a trajectory
-(``return_map``, ``periodicity``, ``classify``, ``force_drops``, ``settle_time``) is the core's own.
+``Attractor``, ``periodic_orbit``, ``continue_orbit``, ``switch_branch``, ``basins``.  The return-map analysis
+of a trajectory (``return_map``, ``periodicity``, ``classify``, ``force_drops``, ``settle_time``) is the core's own.
 """
 
 from . import _law_paper  # noqa: F401  (hands the built-in law to PeelForce; see its docstring)
@@ -149,6 +149,7 @@ __all__ = [
     "PeriodicOrbit",
     "continue_orbit",
     "OrbitBranch",
+    "switch_branch",
     "basins",
     "BasinResult",
     # (I, V) sweeps
@@ -168,7 +169,7 @@ _LAZY = {name: "comparisons.sweep" for name in
 # the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
 _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
                                          "lyapunov_return_map", "LyapunovResult", "benettin", "periodic_orbit",
-                                         "PeriodicOrbit", "continue_orbit", "OrbitBranch", "basins",
+                                         "PeriodicOrbit", "continue_orbit", "OrbitBranch", "switch_branch", "basins",
                                          "BasinResult")})
 
 

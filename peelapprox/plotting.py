@@ -192,6 +192,7 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
 
 
 _BIFURCATION_MARKERS = {"fold": ("s", "C3"), "period_doubling": ("D", "C1"), "neimark_sacker": ("*", "C4")}
+_END_MARKERS = {"grazing": "x", "crest": "+", "breakdown": "1"}
 
 
 def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None = None, *,
@@ -205,8 +206,8 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
     branches : sequence of exact.OrbitBranch
         Each branch's return-map values (F at its n jumps) against the parameter (one colour per starting
         orbit): solid where the orbit is stable, dashed where it is unstable; its bifurcations marked
-        (square: fold, diamond: period doubling, star: Neimark–Sacker) and its end by grazing or breakdown
-        (cross).
+        (square: fold, diamond: period doubling, star: Neimark–Sacker) and its non-smooth end (``end_value``:
+        x grazing, + crest event, tri breakdown).
     path : str, optional
         Write the figure there (format from the extension) and close it.
     title : str, optional
@@ -244,8 +245,9 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
             marker, c = _BIFURCATION_MARKERS.get(b.kind, ("o", "k"))
             ax.plot(np.full(n, b.value), b.orbit.return_map_values, marker, color=c, ms=8, mec="k",
                     label=b.kind.replace("_", " "))
-        if br.stopped in ("grazing", "breakdown"):
-            ax.plot(np.full(n, xs[-1]), Fs[-1], "x", color="k", ms=8, label=br.stopped)
+        if br.stopped in _END_MARKERS:  # the non-smooth end, at its (extrapolated) parameter value
+            ax.plot(np.full(n, br.end_value), Fs[-1], _END_MARKERS[br.stopped], color="k", ms=7,
+                    label=br.stopped)
     handles, labels = ax.get_legend_handles_labels()
     uniq = dict(zip(labels, handles))
     if uniq:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 
-from . import benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
+from . import basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
 from ._checks import exit_status, one_line
 
 __all__ = ["build_parser", "main"]
@@ -35,6 +35,7 @@ _figures = figures.run
 _dynamics = dynamics.run
 _orbit = orbit.run_orbit
 _bifurcation = orbit.run_bifurcation
+_basins = basins.run
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -52,6 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
     dynamics.add_parser(sub).set_defaults(func=_dynamics)
     orbit.add_orbit_parser(sub).set_defaults(func=_orbit)
     orbit.add_bifurcation_parser(sub).set_defaults(func=_bifurcation)
+    basins.add_parser(sub).set_defaults(func=_basins)
     return ap
 
 

@@ -11,6 +11,7 @@ the run, not after it, when that name cannot be written, and
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from collections.abc import Callable, Sequence
@@ -84,6 +85,22 @@ def finite_float_list(text: str) -> list[float]:
     if not text.strip() or any(not s for s in items):
         raise argparse.ArgumentTypeError(f"value must be a comma list of numbers, got {text!r}")
     return [_argtype(_validate.finite, s) for s in items]
+
+
+def grid_range(text: str, option: str, default_n: int = 40) -> tuple[float, float, int]:
+    """``LO:HI[:N]`` (N values from LO to HI, ``default_n`` when omitted) as ``(lo, hi, n)``; ValueError naming
+    ``option`` unless the numbers are finite, LO < HI and N >= 2."""
+    parts = text.split(":")
+    if len(parts) not in (2, 3):
+        raise ValueError(f"{option} must be LO:HI or LO:HI:N, got {text!r}")
+    try:
+        lo, hi = float(parts[0]), float(parts[1])
+        n = int(parts[2]) if len(parts) == 3 else default_n
+    except ValueError:
+        raise ValueError(f"{option} must be LO:HI[:N] with numbers, got {text!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi and n >= 2):
+        raise ValueError(f"{option} needs finite LO < HI and N >= 2, got {text!r}")
+    return lo, hi, n
 
 
 # --------------------------------------------------------------------------------------------- output paths

@@ -8,7 +8,7 @@ import argparse
 import numpy as np
 
 from .. import WINDOW_DEFAULTS, PeelParams
-from ._checks import check_output_path, nonnegative_float, positive_float, positive_int
+from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float, positive_int
 from ._common import add_params, print_mapping, say, write_table
 from ._force import force_from_args, law_fields
 
@@ -78,35 +78,47 @@ def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
                     help="the parameter's range and the diagram's number of values (N = 40)")
     sp.add_argument("--seeds", metavar="X,X,...|auto",
                     help="parameter values at which orbits are found and continued both ways; auto (the default): "
-                         "each diagram value whose run is periodic with another period than the value before (at "
-                         "most --max-seeds)")
+                         "each periodic diagram value that no branch found so far explains (exact.explain), in "
+                         "order, at most --max-seeds")
     sp.add_argument("--max-seeds", type=positive_int, default=20, help="most automatic seeds (20)")
     sp.add_argument("--max-points", type=positive_int, default=200, help="most orbits per branch (200)")
+    sp.add_argument("--switch", type=nonnegative_int, default=1,
+                    help="levels of period doubling followed: at each period doubling found, the doubled branch "
+                         "is started (exact.switch_branch) and continued, to this depth (1; 0: none)")
     sp.add_argument("--out", help="write every diagram point and branch point to this .csv or .json")
     sp.add_argument("--plot", help="draw the diagram and the branches to this image file")
     return sp
 
 
-def _range(text: str) -> tuple[float, float, int]:
-    parts = text.split(":")
-    if len(parts) not in (2, 3):
-        raise ValueError(f"--range must be LO:HI or LO:HI:N, got {text!r}")
-    try:
-        lo, hi = float(parts[0]), float(parts[1])
-        n = int(parts[2]) if len(parts) == 3 else 40
-    except ValueError:
-        raise ValueError(f"--range must be LO:HI[:N] with numbers, got {text!r}") from None
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and n >= 2):
-        raise ValueError(f"--range needs finite LO < HI and N >= 2, got {text!r}")
-    return lo, hi, n
+def _continue(o, param: str, stop: float, lo: float, hi: float, max_points: int, depth: int, indent: str) -> list:
+    """The branch of ``o`` towards ``stop`` and, to ``depth`` levels, the doubled branches of its period
+    doublings (each continued to the end of the range on the side where it lies)."""
+    from exact import continue_orbit, parameter_value, switch_branch
+
+    b = continue_orbit(o, param, stop=stop, max_points=max_points)
+    say(f"{indent}  period-{o.n} branch to {param} = {stop:g}: {len(b.points)} orbits, stopped: {b.stopped} at "
+        f"{b.end_value:.8g}; " + (", ".join(f"{x.kind} at {x.value:.8g}" for x in b.bifurcations)
+                                  or "no bifurcation"))
+    out = [b]
+    for x in b.bifurcations:
+        if x.kind != "period_doubling" or depth < 1:
+            continue
+        try:
+            o2 = switch_branch(x)
+        except ValueError as exc:
+            say(f"{indent}    no doubled branch: {exc}")
+            continue
+        v2 = parameter_value(o2.params, param)
+        out += _continue(o2, param, hi if v2 > x.value else lo, lo, hi, max_points, depth - 1, indent + "  ")
+    return out
 
 
 def run_bifurcation(args: argparse.Namespace) -> int:
-    from exact import continue_orbit, orbit_diagram, periodic_orbit, with_parameter
+    from exact import explain, initial_state, orbit_diagram, periodic_orbit, with_parameter
 
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    lo, hi, n = _range(args.range)
+    lo, hi, n = grid_range(args.range, "--range")
     p = _params(args)
     auto = args.seeds in (None, "auto")
     try:
@@ -118,32 +130,52 @@ def run_bifurcation(args: argparse.Namespace) -> int:
             raise ValueError(f"--seeds must lie in --range [{lo}, {hi}], got {s}")
     diagram = orbit_diagram(p, args.param, np.linspace(lo, hi, n), t_transient=args.t_transient,
                             window=args.window, alpha0=args.alpha0, progress=True)
-    if auto:  # where the brute-force period changes to a periodic one
-        prev = None
-        for x, lab in zip(diagram.values, diagram.labels):
-            if lab.startswith("period-") and lab != prev and len(seeds) < args.max_seeds:
-                seeds.append(float(x))
-            prev = lab
-    branches = []
-    for s in seeds:
+    branches: list = []
+    explained: list = [None] * n
+
+    def grow(s: float) -> None:
+        """Branches from the orbit at ``s`` both ways; the diagram values they explain."""
         ps = with_parameter(p, args.param, s)
         say(f"orbit at {args.param} = {s:g} ...")
+        start = initial_state(ps, alpha0=args.alpha0) if args.alpha0 else None
         try:
-            o = periodic_orbit(ps, t_transient=args.t_transient, window=args.window)
+            o = periodic_orbit(ps, start=start, t_transient=args.t_transient, window=args.window)
         except (ValueError, RuntimeError) as exc:  # no periodic orbit closes there (or the run breaks down)
             say(f"  no orbit: {exc}")
-            continue
+            return
+        new = []
         for stop in (lo, hi):
             if stop != s:
-                b = continue_orbit(o, args.param, stop=stop, max_points=args.max_points)
-                say(f"  branch to {args.param} = {stop:g}: {len(b.points)} orbits, stopped: {b.stopped}; "
-                    + (", ".join(f"{x.kind} at {x.value:.8g}" for x in b.bifurcations) or "no bifurcation"))
-                branches.append(b)
+                new += _continue(o, args.param, stop, lo, hi, args.max_points, args.switch, "")
+        for j, i in enumerate(explain(diagram, new)):
+            if explained[j] is None and i is not None:
+                explained[j] = len(branches) + i
+        branches.extend(new)
+
+    if auto:  # every periodic value no branch so far explains, in order
+        for j, (x, lab) in enumerate(zip(diagram.values, diagram.labels)):
+            if len(seeds) >= args.max_seeds:
+                break
+            if lab.startswith("period-") and explained[j] is None:
+                seeds.append(float(x))
+                grow(float(x))
+    else:
+        for s in seeds:
+            grow(s)
+    periodic = [j for j, lab in enumerate(diagram.labels) if lab.startswith("period-")]
+    missing = [f"{diagram.values[j]:.6g} ({diagram.labels[j]})" for j in periodic if explained[j] is None]
+    say(f"explained: {len(periodic) - len(missing)} of the {len(periodic)} periodic values of the diagram lie on a "
+        "stable continued branch of the same period (exact.explain)"
+        + (f"; not: {', '.join(missing)}" if missing else ""))
     if out:
         rows = [dict(kind="diagram", **r) for r in diagram.rows()]
+        by_value = {float(x): (None if e is None else e + 1) for x, e in zip(diagram.values, explained)}
+        for r in rows:
+            r["explained_by_branch"] = by_value[r[args.param]]
         for k, b in enumerate(branches):
             rows += [dict(kind=f"branch {k + 1}", **r) for r in b.rows()]
             rows += [dict(kind=f"branch {k + 1} {x.kind}", **{args.param: x.value}) for x in b.bifurcations]
+            rows.append(dict(kind=f"branch {k + 1} end: {b.stopped}", **{args.param: b.end_value}))
         write_table(out, rows, p.force)
     if plot:
         from ..plotting import plot_bifurcation

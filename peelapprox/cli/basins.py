@@ -1,0 +1,87 @@
+"""``peelapprox basins``: which attractor each start of a grid over (α0, F0) or (α0, ω0) reaches
+(:func:`exact.basins`)."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from .. import WINDOW_DEFAULTS, PeelParams
+from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float
+from ._common import add_params, say, write_table
+from ._force import force_from_args
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    w = WINDOW_DEFAULTS
+    sp = sub.add_parser("basins", help="basins of attraction: the attractor (period and cycle, aperiodic, breakdown) "
+                                       "each start of an (alpha0, F0) or (alpha0, omega0) grid reaches")
+    add_params(sp)
+    sp.add_argument("--alpha0", required=True, metavar="LO:HI[:N]",
+                    help="initial peel angles [rad] (N = 11; a negative LO needs the = form: --alpha0=-0.3:0.3)")
+    axis = sp.add_mutually_exclusive_group(required=True)
+    axis.add_argument("--F0", metavar="LO:HI[:N]", help="initial pull forces [N] (N = 11)")
+    axis.add_argument("--omega0", metavar="LO:HI[:N]", help="initial roller speeds [rad/s] (N = 11)")
+    sp.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"],
+                    help=f"seconds discarded per start [s] ({w['t_transient']:g})")
+    sp.add_argument("--window", type=positive_float, default=w["window"],
+                    help=f"seconds classified per start [s] ({w['window']:g})")
+    sp.add_argument("--workers", type=nonnegative_int, default=None,
+                    help="processes (default: one per CPU; 0: in this process)")
+    sp.add_argument("--orbits", action="store_true",
+                    help="also find each attractor's periodic orbit and its Floquet multipliers")
+    sp.add_argument("--format", choices=("table", "json"), default="table", help="what is printed (table)")
+    sp.add_argument("--out", help="write one row per start to this .csv, or everything to this .json")
+    sp.add_argument("--plot", help="draw the label map to this image file")
+    return sp
+
+
+def run(args: argparse.Namespace) -> int:
+    from exact import basins
+
+    out = check_output_path(args.out, "table", "--out") if args.out else None
+    plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
+    p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args))
+    a = np.linspace(*_axis(args.alpha0, "--alpha0"))
+    name, text = ("F0", args.F0) if args.F0 is not None else ("omega0", args.omega0)
+    values = np.linspace(*_axis(text, f"--{name}"))
+    axes = dict(F0=values, omega0=None) if name == "F0" else dict(F0=None, omega0=values)
+    r = basins(p, alpha0=a, F0=axes["F0"], omega0=axes["omega0"], t_transient=args.t_transient,
+               window=args.window, orbits=args.orbits, max_workers=args.workers, progress=True)
+    if args.format == "json":
+        print(r.to_json())
+    else:
+        for a_ in r.attractors:
+            mu = ""
+            if a_.orbit is not None:
+                mu = "  |mu| = " + ", ".join(f"{abs(m):.4g}" for m in a_.orbit.multipliers)
+            cyc = ", ".join(f"{c:.6g}" for c in a_.cycle[:6]) + (" ..." if len(a_.cycle) > 6 else "")
+            print(f"A{a_.id} period-{a_.n}: {a_.count} start{'s' * (a_.count != 1)}, F at the jumps [N]: {cyc}{mu}")
+        others = {k: v for k, v in r.counts().items() if not k.startswith("A")}
+        for k, v in others.items():
+            print(f"{k}: {v} start{'s' * (v != 1)}")
+        print(f"{a.size * values.size} starts in {r.wall_time:.1f} s")
+    if out:
+        if out.endswith(".json"):
+            with open(out, "w") as fh:
+                fh.write(r.to_json())
+            say(f"wrote {out}")
+        else:
+            write_table(out, r.rows(), p.force)
+    if plot:
+        from ..plotting import pyplot
+
+        ax = r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²")
+        ax.figure.savefig(plot, dpi=130)
+        pyplot().close(ax.figure)
+        say(f"wrote {plot}")
+    return 0
+
+
+def _axis(text: str, option: str) -> tuple[float, float, int]:
+    return grid_range(text, option, default_n=11)
+
+
