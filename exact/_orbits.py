@@ -87,7 +87,15 @@ class SectionReturn:
 def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarray, t0: float) -> int:
     """Integrate ``y`` (state and tangent) on branch ``br`` to its fold; raise the status's exception else."""
     law = ts.law
-    status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+    y0 = y.copy()
+    try:
+        status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+    except (ZeroDivisionError, OverflowError) as exc:  # a state the field's Jacobian cannot take (e.g. a wild
+        v0 = math.exp(y0[3])                            # Newton iterate): the return does not exist there
+        raise SolverFailure(f"section return: the tangent integration failed ({type(exc).__name__}: {exc}) "
+                            f"from alpha={y0[1]:.6g} rad, omega={y0[2]:.6g} rad/s on {'AB' if br == 0 else 'CD'}",
+                            t=t0, state=dict(t=t0, alpha=float(y0[1]), omega=float(y0[2]),
+                                             F=float(ts.pull(y0[1], v0)), v=v0)) from None
     if status != _st.FOLD:
         v = math.exp(y[3])
         state = dict(t=t0 + y[0], alpha=float(y[1]), omega=float(y[2]), F=float(ts.pull(y[1], v)), v=v,
