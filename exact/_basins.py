@@ -33,7 +33,7 @@ from peelapprox import (
     periodicity,
     return_map,
 )
-from peelapprox.io import fmt_number, jsonable
+from peelapprox.io import fmt_number, html_table, jsonable
 from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
@@ -223,6 +223,33 @@ class BasinResult:
         law = "fvV" if p.force.kind == "paper" else p.force.name or repr(p.force)
         ax.set_title(title or f"basins, {law}, V = {p.V:g} m/s, I = {p.I:g} kg m²")
         return ax
+
+    def to_xarray(self) -> Any:
+        """The labels as an :class:`xarray.Dataset` over ``(alpha0, F0)`` or ``(alpha0, omega0)`` (coordinates
+        with ``units``): ``label`` (the codes of :attr:`labels`, with CF ``flag_values``/``flag_meanings``),
+        ``outcome`` (:attr:`texts`), ``n`` (the period of the attractor reached, 0 for none) and ``n_returns``;
+        attrs: the parameters (``params_V``, ... ``params_force``), the settings and the attractors (JSON).
+
+        Raises
+        ------
+        ImportError
+            If xarray is not installed (``pip install 'peelapprox[data]'``).
+        """
+        from ._dataout import basins_xarray
+
+        return basins_xarray(self, _CODE_TEXT)
+
+    def __repr__(self) -> str:
+        from ._dataout import basins_summary
+
+        d = basins_summary(self)
+        return (f"BasinResult({d['grid']}, V={self.params.V:g}, I={self.params.I:g}; {d['outcomes']}; "
+                f"wall_time={d['wall time [s]']} s)")
+
+    def _repr_html_(self) -> str:
+        from ._dataout import basins_summary
+
+        return html_table("BasinResult", basins_summary(self))
 
 
 def _edges(x: np.ndarray) -> np.ndarray:
