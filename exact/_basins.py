@@ -33,7 +33,7 @@ from peelapprox import (
     periodicity,
     return_map,
 )
-from peelapprox.io import fmt_number, html_table, jsonable
+from peelapprox.io import fmt_number, jsonable
 from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
@@ -225,16 +225,10 @@ class BasinResult:
         return ax
 
     def to_xarray(self) -> Any:
-        """The labels as an :class:`xarray.Dataset` over ``(alpha0, F0)`` or ``(alpha0, omega0)`` (coordinates
-        with ``units``): ``label`` (the codes of :attr:`labels`, with CF ``flag_values``/``flag_meanings``),
-        ``outcome`` (:attr:`texts`), ``n`` (the period of the attractor reached, 0 for none) and ``n_returns``;
-        attrs: the parameters (``params_V``, ... ``params_force``), the settings and the attractors (JSON).
-
-        Raises
-        ------
-        ImportError
-            If xarray is not installed (``pip install 'peelapprox[data]'``).
-        """
+        """The labels as an :class:`xarray.Dataset` over ``(alpha0, F0 | omega0)`` (coordinates with ``units``):
+        ``label`` (:attr:`labels`, with CF ``flag_values``/``flag_meanings``), ``outcome`` (:attr:`texts`), ``n``
+        (the period reached, 0 for none), ``n_returns``; attrs: the parameters (``params_V``, ...), the settings
+        and the attractors (JSON).  ImportError without xarray (``pip install 'peelapprox[data]'``)."""
         from ._dataout import basins_xarray
 
         return basins_xarray(self, _CODE_TEXT)
@@ -242,14 +236,12 @@ class BasinResult:
     def __repr__(self) -> str:
         from ._dataout import basins_summary
 
-        d = basins_summary(self)
-        return (f"BasinResult({d['grid']}, V={self.params.V:g}, I={self.params.I:g}; {d['outcomes']}; "
-                f"wall_time={d['wall time [s]']} s)")
+        return basins_summary(self, short=True)
 
     def _repr_html_(self) -> str:
         from ._dataout import basins_summary
 
-        return html_table("BasinResult", basins_summary(self))
+        return basins_summary(self, short=False)
 
 
 def _edges(x: np.ndarray) -> np.ndarray:

@@ -125,52 +125,23 @@ class OrbitBranch:
         """Every point as a row (:meth:`BranchPoint.row`), for ``peelapprox.io.write_rows`` (CSV/JSON)."""
         return [p.row(self.parameter) for p in self.points]
 
-    def to_dataframe(self):
-        """:meth:`rows` as a :class:`pandas.DataFrame`, one row per point in the order continued (columns: the
-        parameter, ``n, period, stable, residual``, the multipliers ``mu<i>_abs/_re/_im`` and the return-map
-        values ``F<i>``).  ``df.attrs``: ``units`` (per column), ``parameter``, ``stopped``, ``end_value``,
-        ``message``, ``bifurcations`` (``[{"kind", "value"}]``) and ``params`` (the start's,
-        :func:`peelapprox.io.param_attrs`).
+    def to_dataframe(self) -> object:
+        """:meth:`rows` as a :class:`pandas.DataFrame`, one row per point in the order continued; ``df.attrs``:
+        ``units`` (per column), ``parameter``, ``stopped``, ``end_value``, ``message``, ``bifurcations``
+        (``[{"kind", "value"}]``) and ``params`` (the start's).  ImportError without pandas."""
+        from ._dataout import branch_dataframe
 
-        Raises
-        ------
-        ImportError
-            If pandas is not installed (``pip install 'peelapprox[data]'``).
-        """
-        from peelapprox.io import optional_import, param_attrs
-
-        pd = optional_import("pandas", "OrbitBranch.to_dataframe")
-        df = pd.DataFrame(self.rows())
-        par_unit = {"V": "m/s", "I": "kg m²", "k": "N/m"}.get(self.parameter, "")
-        df.attrs.update({
-            "units": {c: par_unit if c == self.parameter else "s" if c == "period" else
-                      "N" if c[:1] == "F" and c[1:].isdigit() else "" for c in df.columns},
-            "parameter": self.parameter, "stopped": self.stopped, "end_value": self.end_value,
-            "message": self.message, "bifurcations": [{"kind": b.kind, "value": b.value} for b in self.bifurcations],
-            "params": param_attrs(self.points[0].orbit.params) if self.points else {}})
-        return df
-
-    def _summary(self) -> dict:
-        vals = [p.value for p in self.points]
-        o = self.points[0].orbit if self.points else None
-        from peelapprox.io import fmt_number
-
-        return {"parameter": self.parameter, "points": len(self.points),
-                "range": f"{fmt_number(min(vals), 6)} … {fmt_number(max(vals), 6)}" if vals else "–",
-                "n": o.n if o is not None else "–",
-                "stable points": sum(bool(p.orbit.stable) for p in self.points),
-                "bifurcations": ", ".join(f"{b.kind} at {fmt_number(b.value, 6)}" for b in self.bifurcations) or "none",
-                "stopped": f"{self.stopped} at {fmt_number(self.end_value, 6)}", "wall time [s]": self.wall_time}
+        return branch_dataframe(self)
 
     def __repr__(self) -> str:
-        d = self._summary()
-        return (f"OrbitBranch({d['parameter']} in [{d['range']}], period-{d['n']}, {d['points']} points "
-                f"({d['stable points']} stable), bifurcations: {d['bifurcations']}, stopped: {d['stopped']})")
+        from ._dataout import branch_summary
+
+        return branch_summary(self, short=True)
 
     def _repr_html_(self) -> str:
-        from peelapprox.io import html_table
+        from ._dataout import branch_summary
 
-        return html_table("OrbitBranch", self._summary())
+        return branch_summary(self, short=False)
 
 
 def _crossing(a: PeriodicOrbit, b: PeriodicOrbit) -> str | None:

@@ -264,3 +264,13 @@ def test_reprs_are_short_and_carry_the_key_numbers(traj, basin):
     r = repr(res)
     assert r.count("\n") == 0 and "5/6 points" in r
     assert "5/6" in res._repr_html_()
+
+
+def test_datasets_round_trip_through_netcdf(tmp_path, basin):
+    """The attrs are flat scalars and strings, so the Datasets write to netCDF (scipy's engine, netCDF3) and read
+    back equal, values exactly (the labels fit int32, netCDF3's integer)."""
+    res = SweepResult([1e-5, 1e-3], [0.5, 1.0, 2.0], ["jumps", "period"], {"t_transient": 5}, _records())
+    for ds, name in ((res.to_xarray(), "sweep.nc"), (basin.to_xarray(), "basins.nc")):
+        ds.to_netcdf(tmp_path / name, engine="scipy")
+        with xr.open_dataset(tmp_path / name, engine="scipy") as back:
+            assert back.load().identical(ds)
