@@ -224,6 +224,25 @@ class BasinResult:
         ax.set_title(title or f"basins, {law}, V = {p.V:g} m/s, I = {p.I:g} kg m²")
         return ax
 
+    def to_xarray(self) -> Any:
+        """The labels as an :class:`xarray.Dataset` over ``(alpha0, F0 | omega0)`` (coordinates with ``units``):
+        ``label`` (:attr:`labels`, with CF ``flag_values``/``flag_meanings``), ``outcome`` (:attr:`texts`), ``n``
+        (the period reached, 0 for none), ``n_returns``; attrs: the parameters (``params_V``, ...), the settings
+        and the attractors (JSON).  ImportError without xarray (``pip install 'peelapprox[data]'``)."""
+        from ._dataout import basins_xarray
+
+        return basins_xarray(self, _CODE_TEXT)
+
+    def __repr__(self) -> str:
+        from ._dataout import basins_summary
+
+        return basins_summary(self, short=True)
+
+    def _repr_html_(self) -> str:
+        from ._dataout import basins_summary
+
+        return basins_summary(self, short=False)
+
 
 def _edges(x: np.ndarray) -> np.ndarray:
     """Cell edges around strictly increasing centres (one cell of width 1 around a single value)."""

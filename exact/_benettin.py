@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure
+from peelapprox.io import fmt_number, html_table
 from peelapprox.validate import function, integer
 
 __all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult"]
@@ -65,6 +66,15 @@ class BenettinResult:
         stderr = float(np.std(local, ddof=1) / math.sqrt(local.size)) if local.size > 1 else math.inf
         return cls(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local, stderr, T, int(logs.size),
                    float(d0), float(wall_time))
+
+    def __repr__(self) -> str:
+        return (f"BenettinResult(exponent={fmt_number(self.exponent, 4)} ± {fmt_number(self.stderr, 2)}, "
+                f"n={self.n} intervals over {fmt_number(self.time, 4)}, d0={fmt_number(self.d0, 3)}, "
+                f"wall_time={fmt_number(self.wall_time, 3)} s)")
+
+    def _repr_html_(self) -> str:
+        return html_table("BenettinResult", {"exponent": self.exponent, "stderr": self.stderr, "intervals": self.n,
+                                             "time": self.time, "d0": self.d0, "wall time [s]": self.wall_time})
 
 
 def benettin(
@@ -147,4 +157,18 @@ class LyapunovResult:
     n_jumps: int
     method: str = "hybrid two-trajectory (Benettin)"
     notes: list[str] = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        p = self.params
+        return (f"LyapunovResult({fmt_number(self.bits_per_s, 4)} ± {fmt_number(self.stderr_bits, 2)} bits/s, "
+                f"method={self.method!r}, V={p.V:g}, I={p.I:g}, intervals={self.benettin.n}, "
+                f"jumps={self.n_jumps}, tau={fmt_number(self.tau, 3)} s)")
+
+    def _repr_html_(self) -> str:
+        p = self.params
+        return html_table("LyapunovResult", {
+            "λ [bits/s]": f"{fmt_number(self.bits_per_s, 4)} ± {fmt_number(self.stderr_bits, 2)}",
+            "λ [1/s]": self.per_s, "method": self.method, "V [m/s]": p.V, "I [kg m²]": p.I,
+            "force": repr(p.force), "intervals": self.benettin.n, "time [s]": self.benettin.time,
+            "jumps": self.n_jumps, "τ [s]": self.tau, "wall time [s]": self.benettin.wall_time})
 

@@ -126,6 +126,24 @@ class OrbitBranch:
         """Every point as a row (:meth:`BranchPoint.row`), for ``peelapprox.io.write_rows`` (CSV/JSON)."""
         return [p.row(self.parameter) for p in self.points]
 
+    def to_dataframe(self) -> object:
+        """:meth:`rows` as a :class:`pandas.DataFrame`, one row per point in the order continued; ``df.attrs``:
+        ``units`` (per column), ``parameter``, ``stopped``, ``end_value``, ``message``, ``bifurcations``
+        (``[{"kind", "value"}]``) and ``params`` (the start's).  ImportError without pandas."""
+        from ._dataout import branch_dataframe
+
+        return branch_dataframe(self)
+
+    def __repr__(self) -> str:
+        from ._dataout import branch_summary
+
+        return branch_summary(self, short=True)
+
+    def _repr_html_(self) -> str:
+        from ._dataout import branch_summary
+
+        return branch_summary(self, short=False)
+
 
 def _crossing(a: PeriodicOrbit, b: PeriodicOrbit) -> str | None:
     """The bifurcation between two orbits of a branch, by their multipliers (module docstring), or None."""

@@ -34,6 +34,7 @@ import numpy as np
 
 from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, PeelParams, periodicity
 from peelapprox.errors import SolverFailure
+from peelapprox.io import fmt_number, html_table
 from peelapprox.kernels import M_R
 from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, in_range, integer, optional
@@ -247,6 +248,22 @@ class PeriodicOrbit:
         a, w = self.section_states[0]
         return simulate(self.params, self.period, alpha0=float(a), omega0=float(w),
                         F0=float(self.return_map_values[0]), branch0="CD", rtol=rtol, save=save)
+
+    def _summary(self) -> dict:
+        F = self.return_map_values
+        return {"n": self.n, "period [s]": self.period, "stable": self.stable,
+                "|μ|": ", ".join(fmt_number(abs(m), 4) for m in self.multipliers),
+                "F at the AB→CD jumps [N]": ", ".join(fmt_number(x, 7) for x in F[:4]) + (" …" if F.size > 4 else ""),
+                "residual": self.residual, "V [m/s]": self.params.V, "I [kg m²]": self.params.I}
+
+    def __repr__(self) -> str:
+        d = self._summary()
+        return (f"PeriodicOrbit(period-{self.n}, T={fmt_number(self.period, 6)} s, "
+                f"{'stable' if self.stable else 'unstable'}, |mu|=[{d['|μ|']}], F=[{d['F at the AB→CD jumps [N]']}] N, "
+                f"residual={fmt_number(self.residual, 2)}, V={self.params.V:g}, I={self.params.I:g})")
+
+    def _repr_html_(self) -> str:
+        return html_table(f"PeriodicOrbit (period-{self.n})", self._summary())
 
 
 def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float

@@ -50,9 +50,10 @@ API = {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
         "STAT_RUNS", "Scene", "Segment", "StatRow", "TransientCheck", "TransientNotPassed", "check_past_transient",
         "compare", "exact_run", "local_period", "markdown", "run_compare", "run_reduction", "scene_rows",
-        "segments", "statistics", "Figure", "FIGURES", "make_figures", "figures_markdown",
+        "segments", "statistics", "Figure", "FIGURES", "make_figures", "figures_markdown", "RowTable",
     },
-    "peelapprox.io": {"TABLE_EXTENSIONS", "fmt_number", "jsonable", "write_csv", "write_rows"},
+    "peelapprox.io": {"TABLE_EXTENSIONS", "fmt_number", "html_table", "jsonable", "optional_import", "param_attrs",
+                      "write_csv", "write_rows"},
     "peelapprox.plotting": {"plot_bifurcation", "plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
