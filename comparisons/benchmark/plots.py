@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from peelapprox.plotting import pyplot
+from peelapprox.plotting import new_figure
 
 from .report import BenchmarkReport
 from .scenes import BENCH_SCENES
@@ -17,10 +17,9 @@ __all__ = ["plot_work_precision", "plot_eps_study"]
 
 def plot_work_precision(rep: BenchmarkReport, path) -> None:
     """Time vs error, one panel per scene, one line per method family (log-log)."""
-    plt = pyplot()
-
     scenes = [s.name for s in BENCH_SCENES]
-    fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4.2), squeeze=False)
+    fig = new_figure(figsize=(5 * len(scenes), 4.2), layout=None)  # no pyplot: nothing to close
+    axes = fig.subplots(1, len(scenes), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
         rows = [r for r in rep.rows if r.scene == sc and math.isfinite(r.error) and math.isfinite(r.time)]
         keys = sorted({(r.method, r.solver, r.eps) for r in rows}, key=lambda k: (k[0] != "hybrid", k))
@@ -36,14 +35,12 @@ def plot_work_precision(rep: BenchmarkReport, path) -> None:
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 def plot_eps_study(rep: BenchmarkReport, path) -> None:
     """Fold-passage delay vs ε (log-log) with the fitted power laws."""
-    plt = pyplot()
-
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    fig = new_figure(figsize=(5.5, 4.2), layout=None)
+    ax = fig.subplots()
     for key, mk in (("delay_ab", "o"), ("delay_cd", "s")):
         ok = [e for e in rep.eps_rows if e.status == "ok" and getattr(e, key) > 0]
         name = key.replace("delay_", "").upper()
@@ -59,4 +56,3 @@ def plot_eps_study(rep: BenchmarkReport, path) -> None:
     ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -72,11 +72,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             write_table(out, r.rows(), p.force)
     if plot:
-        from ..plotting import pyplot
-
-        ax = r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²")
-        ax.figure.savefig(plot, dpi=130)
-        pyplot().close(ax.figure)
+        r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²").savefig(plot, dpi=130)
         say(f"wrote {plot}")
     return 0
 
