@@ -32,7 +32,7 @@ def pyplot():
     return plt
 
 
-def new_figure(*, figsize: tuple[float, float] | None = None, layout: str | None = "constrained", **kwargs: Any):
+def new_figure(*, figsize: tuple[float, float] | None = None, layout: Any = "constrained", **kwargs: Any):
     """A :class:`matplotlib.figure.Figure` made without pyplot: no backend, no global state, nothing to close.
 
     It is saved with ``fig.savefig(path)`` (the format from the extension), and shown in Jupyter as a cell's
