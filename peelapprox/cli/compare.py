@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
     if args.format in ("table", "md"):
         print(COLUMNS + "\n")
         print(markdown(report, figures_rel="figures" if figdir else None), end="")
-        print(summary(rows))
+        print(f"\n{summary(rows)}")
     elif args.format == "json":
         print(json.dumps({"rows": rows, "statistics": stats, "transients": report.transients,
                           "timings": report.timings}, indent=2))
