@@ -54,7 +54,8 @@ API = {
     },
     "peelapprox.io": {"TABLE_EXTENSIONS", "fmt_number", "html_table", "jsonable", "optional_import", "param_attrs",
                       "write_csv", "write_rows"},
-    "peelapprox.plotting": {"plot_bifurcation", "plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot"},
+    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "new_figure", "plot_bifurcation", "plot_phase_diagram",
+                            "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
         "MANIFEST", "RESERVED", "RESULTS", "record_key",
