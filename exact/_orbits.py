@@ -87,7 +87,7 @@ class SectionReturn:
 def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarray, t0: float) -> int:
     """Integrate ``y`` (state and tangent) on branch ``br`` to its fold; raise the status's exception else."""
     law = ts.law
-    status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+    status, n = ts.run(y, ts.p, law.arg, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
     if status != _st.FOLD:
         v = math.exp(y[3])
         state = dict(t=t0 + y[0], alpha=float(y[1]), omega=float(y[2]), F=float(ts.pull(y[1], v)), v=v,

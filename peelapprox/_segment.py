@@ -345,7 +345,7 @@ def reduced_segment(
         y = y0.copy()
         out = np.empty((cap, 5))
         cnt = np.zeros(5, dtype=np.int64)
-        code = drive(y, q, law.fn, law.coef, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max,
+        code = drive(y, q, law.arg, law.coef, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max,
                      int(max_steps), mode, te, out, cnt)
         if code == OUT_FULL:
             cap *= 4
