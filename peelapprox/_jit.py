@@ -42,7 +42,8 @@ from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
 
-__all__ = ["kernel", "ensure_compiled", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
+__all__ = ["kernel", "ensure_compiled", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
+           "caching_enabled"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 
