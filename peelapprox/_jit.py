@@ -42,7 +42,7 @@ from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
 
-__all__ = ["kernel", "ensure_compiled", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
+__all__ = ["kernel", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
            "caching_enabled"]
 
 _ROOT = Path(__file__).resolve().parent.parent
@@ -189,7 +189,7 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         With ``signature``: compile (or load from the cache) for that signature on first use -- the first call
         from Python, the first conversion to a function-typed argument of a compiled driver, the first compiled
         caller -- instead of now, and never for another (issue 17: importing the package compiles nothing, and a
-        job compiles only the kernels it runs).  :func:`ensure_compiled` forces it.
+        job compiles only the kernels it runs).
 
     Returns
     -------
@@ -226,21 +226,12 @@ def _compile_on_first_use(d: Any, signature: Any) -> None:
             cls_compile(d, signature)
             d.disable_compile()
         del d.compile  # the class method from now on
-        if sig is None:  # ensure_compiled
-            return None
         try:
             return cls_compile(d, sig)  # the entry point when ``sig`` is the fixed signature's arguments
         except RuntimeError:  # other argument types: numba converts them to the one signature, as when eager
             return d.overloads[tuple(d.nopython_signatures[0].args)].entry_point
 
     d.compile = compile_fixed
-
-
-def ensure_compiled(d: Any) -> Any:
-    """Compile (or load) a :func:`kernel` made with ``lazy=True`` for its signature now; returns ``d``."""
-    if "compile" in vars(d):
-        d.compile(None)
-    return d
 
 
 def _unliteral_calls(d: Any) -> Any:

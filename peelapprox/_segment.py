@@ -353,7 +353,7 @@ def reduced_segment(
         break
     n_out = int(cnt[K.C_NOUT])
     rows = out[:n_out]
-    al_e, ad_e = (float(x) for x in K.alpha_of(y, q))
+    al_e, ad_e = K.alpha_at(y, q)
     state = {"t": float(y[0]), "v": float(np.exp(y[1])), "F": float(y[2]), "alpha": al_e, "alphadot": ad_e}
     res = ReducedSegment(
         branch=branch, alpha_model=alpha_model, v_equation=v_equation, dt=float(y[0]), F_in=F_in,
