@@ -27,7 +27,7 @@ import tempfile
 import time
 from pathlib import Path
 
-__all__ = ["ENTRY_POINTS", "measure", "main"]
+__all__ = ["ENTRY_POINTS", "measure", "detail", "main"]
 
 #: name -> (imports, the call): the code a new user's first call runs.
 ENTRY_POINTS: dict[str, tuple[str, str]] = {
