@@ -58,7 +58,7 @@ def _pull_force_P(alpha, v, P):
     return f / (1.0 + c)
 
 
-@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1), nrt=False)
+@kernel(signature=_t.float64(_t.float64, _t.float64, _A1, LAW_TYPE, _A1), nrt=False, lazy=True)
 def pull_force_law(alpha, v, p, law, coef):
     """:func:`exact._hybrid.pull_force` for the law ``law`` with the coefficients ``coef``."""
     return _pull_force_P(alpha, v, (p, law, coef))

@@ -90,7 +90,7 @@ def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarra
     law = ts.law
     y0 = y.copy()
     try:
-        status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+        status, n = ts.run(y, ts.p, law.arg, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
     except (ZeroDivisionError, OverflowError) as exc:  # a state the field's Jacobian cannot take (e.g. a wild
         v0 = math.exp(y0[3])                            # Newton iterate): the return does not exist there
         raise SolverFailure(f"section return: the tangent integration failed ({type(exc).__name__}: {exc}) "

@@ -345,7 +345,7 @@ def _run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, sav
     t_store, max_wall = saveat.t_transient, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
     cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
-    law, coef, bs, law_argument = cl.fn, cl.coef, cl.structure, not cl.inlined
+    law, coef, bs, law_argument = cl.arg, cl.coef, cl.structure, not cl.inlined
     p = _param_vector(params, v_floor, bs, cl.domain)
     run = HL.driver(law_argument)
     st = np.array([s0.t, 0.0, s0.alpha, s0.omega, math.log(s0.v), 0.0, BRANCHES.index(s0.branch)], dtype=float)

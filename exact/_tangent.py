@@ -212,7 +212,7 @@ def tangent_system(params) -> TangentSystem:
     from ._simulate import _param_vector
 
     cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
-    law, coef, bs = cl.fn, cl.coef, cl.structure
+    law, coef, bs = cl.arg, cl.coef, cl.structure
     p = _param_vector(params) if cl.inlined else _param_vector(params, None, bs, cl.domain)
     if cl.inlined:
         def field(y, out):
@@ -296,7 +296,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     except SolverBudgetExceeded as exc:
         raise wall.reraise(exc) from None
     ts = tangent_system(params)
-    cl, law, coef, bs, p, run, field, pull = ts.law, ts.law.fn, ts.law.coef, ts.law.structure, ts.p, ts.run, \
+    cl, law, coef, bs, p, run, field, pull = ts.law, ts.law.arg, ts.law.coef, ts.law.structure, ts.p, ts.run, \
         ts.field, ts.pull
     scale = natural_scales(params)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries

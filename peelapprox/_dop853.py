@@ -265,7 +265,8 @@ def make_dop853(rhs) -> Dop853:
         n_rej = 0
         n_rhs = 0
         while True:
-            K[0, :] = f0
+            for i in range(n):  # not K[0, :] = f0: numba compiles a shape-mismatch message for that (~4 s)
+                K[0, i] = f0[i]
             for s in range(1, _NS):
                 combine(y, h, K, _A[s], s, tmp)
                 rhs(tmp, p, K[s])

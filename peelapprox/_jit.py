@@ -37,11 +37,13 @@ from pathlib import Path
 from typing import Any, Literal
 
 from numba import njit
+from numba.core import types as _nbtypes
 from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
 
-__all__ = ["kernel", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag", "caching_enabled"]
+__all__ = ["kernel", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
+           "caching_enabled"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -148,7 +150,8 @@ def _check_source(fn: Callable) -> None:
 
 
 def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "never", fastmath: bool = False,
-           name: str | None = None, signature: Any = None, nrt: bool = True, outside: bool = False) -> Any:
+           name: str | None = None, signature: Any = None, nrt: bool = True, outside: bool = False,
+           lazy: bool = False) -> Any:
     """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 
     Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.
@@ -183,6 +186,11 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         law in the user's cache, :func:`peelapprox._law_codegen.expression_kernel`): its file is not required
         in :data:`KERNEL_SOURCES`.  Such a file calls numpy only and is named by the hash of its text, so
         numba's own stamp of it keeps the cache right; its index is stamped with :data:`SOURCE_TAG` as well.
+    lazy : bool
+        With ``signature``: compile (or load from the cache) for that signature on first use -- the first call
+        from Python, the first conversion to a function-typed argument of a compiled driver, the first compiled
+        caller -- instead of now, and never for another (issue 17: importing the package compiles nothing, and a
+        job compiles only the kernels it runs).
 
     Returns
     -------
@@ -195,17 +203,69 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
     """
     if fn is None:
         return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name, signature=signature, nrt=nrt,
-                                outside=outside)
+                                outside=outside, lazy=lazy)
     d = _compile(fn, inline, fastmath, name, nrt, outside)
     if signature is not None:
-        d.compile(signature)
-        d.disable_compile()
+        if lazy:
+            _compile_on_first_use(d, signature)
+        else:
+            d.compile(signature)
+            d.disable_compile()
+    return d
+
+
+def _compile_on_first_use(d: Any, signature: Any) -> None:
+    """Make the first compilation request of the dispatcher ``d`` compile ``signature`` (the same cache entry as
+    the eager ``d.compile(signature)``) and disable compiling: every request goes through ``d.compile`` (a call
+    from Python via ``_compile_for_args``, a conversion to a ``FunctionType`` argument via
+    ``get_compile_result``, a compiled caller via ``get_call_template``), so an instance attribute shadowing the
+    method sees them all.  After that first request the class method serves again."""
+    cls_compile = type(d).compile
+
+    def compile_fixed(sig: Any) -> Any:
+        if d._can_compile:
+            cls_compile(d, signature)
+            d.disable_compile()
+        del d.compile  # the class method from now on
+        try:
+            return cls_compile(d, sig)  # the entry point when ``sig`` is the fixed signature's arguments
+        except RuntimeError:  # other argument types: numba converts them to the one signature, as when eager
+            return d.overloads[tuple(d.nopython_signatures[0].args)].entry_point
+
+    d.compile = compile_fixed
+
+
+def _unliteral_calls(d: Any) -> Any:
+    """Make compiled callers of the dispatcher ``d`` compile it for the plain types of their arguments.
+
+    numba compiles a function called from compiled code for the argument types as the caller typed them, literal
+    constants included: ``interp1(y, Fc, x, 3)`` and ``interp1(y, Fc, x, 0)`` were two more compilations of
+    ``interp1`` than ``interp1(y, Fc, x, i)`` (eight extra specialisations in the hybrid driver alone, ~0.1 s
+    each, issue 17).  The literal value still reaches the machine code: LLVM inlines the small callee and
+    propagates the constant.  Returns ``d``.
+    """
+    cls_template = type(d).get_call_template
+
+    def get_call_template(args: Any, kws: Any) -> Any:
+        return cls_template(d, tuple(_nbtypes.unliteral(a) for a in args),
+                            {k: _nbtypes.unliteral(a) for k, a in kws.items()})
+
+    d.get_call_template = get_call_template
     return d
 
 
 def _compile(fn: Callable, inline: Literal["never", "always"], fastmath: bool, name: str | None, nrt: bool,
              outside: bool = False) -> Any:
-    """The dispatcher of :func:`kernel`, stamped (or uncached after one warning), not compiled yet."""
+    """The dispatcher of :func:`kernel`, stamped (or uncached after one warning), not compiled yet; a function
+    compiled on its own (``inline="never"``) is compiled for its callers' plain argument types
+    (:func:`_unliteral_calls`)."""
+    d = _dispatcher(fn, inline, fastmath, name, nrt, outside)
+    return _unliteral_calls(d) if inline == "never" else d
+
+
+def _dispatcher(fn: Callable, inline: Literal["never", "always"], fastmath: bool, name: str | None, nrt: bool,
+                outside: bool) -> Any:
+    """The numba dispatcher of :func:`_compile`."""
     if not outside:
         _check_source(fn)
     if name is not None:  # distinct cache files for the pieces of each vector field (make_dop853)

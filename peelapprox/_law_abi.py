@@ -40,7 +40,7 @@ from ._peelforce import (
 )
 
 __all__ = ["LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "pack_inlined", "pack_law", "paper_law",
-           "paper_coefficients"]
+           "paper_coefficients", "unused_law"]
 
 #: ``law(x, coef, form) -> (float, float, float)`` (module docstring).
 LAW_SIG = types.UniTuple(types.float64, 3)(types.float64, types.float64[::1], types.int64)
@@ -50,7 +50,7 @@ LAW_TYPE = types.FunctionType(LAW_SIG)
 LAW_LNV, LAW_FP, LAW_FPP = 0, 1, 2
 
 
-@kernel(signature=LAW_SIG)
+@kernel(signature=LAW_SIG, lazy=True)  # compiled on first use: the default drivers inline fvV instead (issue 17)
 def paper_law(x, coef, form):
     """fvV at ``x`` in the form ``form`` with ``coef = (b, A) = peel_force_coefficients(V)``: the generated
     ``peel_force_lnv`` / ``peel_force_fp`` / ``peel_force_fpp`` unchanged (the inlined law's arithmetic)."""
@@ -60,6 +60,14 @@ def paper_law(x, coef, form):
         f, fp = peel_force_fp_jit(x, coef[0], coef[1])
         return f, fp, np.nan
     return peel_force_fpp_jit(x, coef[0], coef[1])
+
+
+@kernel(signature=LAW_SIG, lazy=True)
+def unused_law(x, coef, form):
+    """The law argument of a driver with the paper's law inlined, which never calls it
+    (:attr:`peelapprox._law_compiled.CompiledLaw.arg`): a trivial kernel of the law type, so that the default
+    path does not compile :func:`paper_law` (issue 17)."""
+    return np.nan, np.nan, np.nan
 
 
 @kernel(inline="always")

@@ -35,7 +35,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ._law import PeelForce
-from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients
+from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients, unused_law
 from ._law_codegen import expression_kernel, family_kernel
 from ._law_table_jit import table_coefficients, table_law
 from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint, _check_V
@@ -78,6 +78,13 @@ class CompiledLaw:
     structure: BranchStructure
     domain: tuple[float, float]
     inlined: bool
+
+    @property
+    def arg(self) -> Any:
+        """The law argument a compiled driver is passed: :attr:`fn`, or for the paper's law, which the drivers
+        inline and never call through the argument, a trivial kernel of the law type (so that the default path
+        compiles no second copy of fvV: issue 17)."""
+        return unused_law if self.inlined else self.fn
 
     def f(self, v: float) -> float:
         """f(v) [N] through the compiled kernel."""

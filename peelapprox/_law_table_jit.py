@@ -139,7 +139,7 @@ def _pchip_sums(coef, u):
     return F, D, D2
 
 
-@kernel(signature=LAW_SIG)
+@kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a tabulated law (issue 17)
 def table_law(x, coef, form):
     """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox._law_abi`), ``coef`` from
     :func:`table_coefficients`: PCHIP in ``u = ln v`` as scipy evaluates it, continued C¹-linearly in u outside

@@ -345,7 +345,7 @@ def reduced_segment(
         y = y0.copy()
         out = np.empty((cap, 5))
         cnt = np.zeros(5, dtype=np.int64)
-        code = drive(y, q, law.fn, law.coef, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max,
+        code = drive(y, q, law.arg, law.coef, rtol, atol_v, math.log(v_f), x_lo, x_hi, branch == "AB", t_max,
                      int(max_steps), mode, te, out, cnt)
         if code == OUT_FULL:
             cap *= 4
@@ -353,7 +353,7 @@ def reduced_segment(
         break
     n_out = int(cnt[K.C_NOUT])
     rows = out[:n_out]
-    al_e, ad_e = (float(x) for x in K.alpha_of(y, q))
+    al_e, ad_e = K.alpha_at(y, q)
     state = {"t": float(y[0]), "v": float(np.exp(y[1])), "F": float(y[2]), "alpha": al_e, "alphadot": ad_e}
     res = ReducedSegment(
         branch=branch, alpha_model=alpha_model, v_equation=v_equation, dt=float(y[0]), F_in=F_in,

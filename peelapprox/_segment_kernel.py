@@ -170,6 +170,15 @@ def _store(out, row, y, q):
     out[row, 4] = ad
 
 
+def alpha_at(y: np.ndarray, q: np.ndarray) -> tuple[float, float]:
+    """(α, α̇) at the state ``y`` (:func:`alpha_of`) from Python, through the driver's own compiled :func:`_store`
+    (compiled with it, or loaded from the cache): calling :func:`alpha_of` from Python compiled it, and the
+    closed forms it inlines, a second time (issue 17)."""
+    row = np.empty((1, 5))
+    _store(row, 0, y, q)
+    return float(row[0, 3]), float(row[0, 4])
+
+
 #: The pieces :func:`_run` calls, bound per copy (:data:`_RUNS`): the field ``_FIELD(y, P, out)``, ``P =
 #: _PACK(q, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
 _FIELD: Any = None

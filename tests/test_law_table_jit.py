@@ -241,6 +241,7 @@ def test_a_new_table_costs_no_compilation():
     signature each, and numba's compile-event recorder sees no compilation.  The driver's sum equals the law's
     own calls summed in Python (same numbers: tolerance 0)."""
     _drive(table_law, table_coefficients(ONE, 1.0), -5.0, 1e-3, 10)  # compile the driver once, outside
+    _drive(paper_law, paper_coefficients(1.0), -5.0, 1e-3, 1)  # and the paper's law (compiled on first use)
     coefs = [table_coefficients(PeelForce.tabulated(*_table(1.0, n, 1e-3, 30.0)[1:]).tables, 1.0)
              for n in (20, 1000)] + [table_coefficients(TABLES, 1.5)]
     with event.install_recorder("numba:compile") as rec:

@@ -1,0 +1,72 @@
+"""A job compiles only the kernels it runs (issue 17, fast first call).
+
+Each test runs a fresh interpreter with an empty numba cache (``NUMBA_CACHE_DIR`` and ``PEELAPPROX_CACHE_DIR`` in
+a temporary directory), so the repository's own cache is neither used nor touched, and reads numba's own record
+of what was compiled: a dispatcher's ``signatures`` (empty: never compiled nor loaded) and its
+``stats.cache_hits``/``cache_misses``.  No timing: the times are measured by
+``python -m comparisons.benchmark.cold_start``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+#: Prints, as JSON, which of the kernels a plain hybrid simulate must not need were compiled (or loaded).
+PROBE = """
+import json
+from numba.core import event
+rec = event.RecordingListener()
+event.register("numba:compile", rec)
+import peelapprox, exact
+at_import = sum(1 for _, e in rec.buffer if e.is_start)
+import peelapprox._law_abi as A, peelapprox._law_table_jit as T, peelapprox._segment_kernel as SK
+import peelapprox.kernels as K
+import exact._hybrid_law as HL, exact._tangent as TG
+{job}
+others = dict(paper_law=A.paper_law, table_law=T.table_law, pull_force_law=HL.pull_force_law,
+              hybrid_law_driver=HL._DRIVERS[True], field_law=HL._field_law,
+              segment_inlined=SK._RUNS[False], segment_law=SK._RUNS[True],
+              tangent_inlined=TG._TO_FOLD[False], tangent_law=TG._TO_FOLD[True],
+              regularized_field=K.regularized_field, regularized_field_jacobian=K.regularized_field_jacobian,
+              regularized_law_field=K._regularized_field_law)
+d = HL._DRIVERS[False]
+print(json.dumps(dict(at_import=at_import, compiled={{k: len(f.signatures) for k, f in others.items()}},
+                      driver=len(d.signatures), hits=sum(d.stats.cache_hits.values()),
+                      misses=sum(d.stats.cache_misses.values()), n_jumps=int(tr.stats.n_jumps))))
+"""
+
+JOB = "tr = exact.simulate(peelapprox.PeelParams(V=1.0, I=1e-2), 0.5)"
+
+
+def _probe(tmp: Path, job: str = JOB) -> dict:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp / "numba"), PEELAPPROX_CACHE_DIR=str(tmp / "laws"),
+               PYTHONDONTWRITEBYTECODE="1")
+    r = subprocess.run([sys.executable, "-c", PROBE.format(job=job)], cwd=tmp, env=env, capture_output=True,
+                       text=True, timeout=900)
+    assert r.returncode == 0, r.stderr[-3000:]
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_plain_hybrid_simulate_compiles_only_the_hybrid_driver(tmp_path):
+    """Hypothesis: importing ``peelapprox`` and ``exact`` compiles nothing (no numba compile event), and a plain
+    hybrid ``simulate`` of the paper's law compiles its own driver only: the regularised fields, the tangent and
+    segment drivers, the law-argument copies of the hybrid driver and the compiled laws (fvV as a law argument,
+    the table) keep no signature.  A second process with the same cache loads the driver (one cache hit) and
+    compiles nothing (no miss).  Exact counts (numba's dispatcher records); the run itself is a real one (V = 1,
+    I = 1e-2 jumps every ~0.1 s: at least one jump in 0.5 s)."""
+    first = _probe(tmp_path)
+    assert first["at_import"] == 0
+    assert first["compiled"] == dict.fromkeys(first["compiled"], 0), first["compiled"]
+    assert (first["driver"], first["misses"], first["hits"]) == (1, 1, 0)
+    assert first["n_jumps"] >= 1
+    second = _probe(tmp_path)
+    assert second["at_import"] == 0
+    assert (second["driver"], second["misses"], second["hits"]) == (1, 0, 1)
+    assert second["compiled"] == first["compiled"]
