@@ -8,12 +8,8 @@ this case, with F overshooting the fold f_max and undershooting f_min.
     python docs/examples/01_quickstart.py [--out DIR]      # ~3 s after the first compilation
 """
 
-import argparse
-import os
-import tempfile
-from pathlib import Path
-
 import numpy as np
+from _gallery import arguments, output_dir
 
 import exact
 import peelapprox as pa
@@ -21,10 +17,7 @@ from peelapprox.plotting import plot_trajectory
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.environ.get("PEELAPPROX_EXAMPLES_OUT"), help="figure directory (default: temp)")
-    out = Path(ap.parse_args().out or tempfile.mkdtemp(prefix="peelapprox-example-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(arguments(__doc__).parse_args().out)  # --out DIR (docs/examples/_gallery.py)
 
     # The parameters: every argument is checked (a ValueError names a bad one and its valid range).
     p = pa.PeelParams(V=1.0, I=1e-2)

@@ -8,13 +8,9 @@ F = f_min and f_max (the paper's Eq. approxalpha; 4.44 ms and 3.69 ms at I = 1e-
     python docs/examples/02_three_regimes.py [--out DIR]      # ~3 s after the first compilation
 """
 
-import argparse
-import os
-import tempfile
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
+from _gallery import arguments, output_dir
 
 import exact
 import peelapprox as pa
@@ -22,10 +18,7 @@ from comparisons import segments
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.environ.get("PEELAPPROX_EXAMPLES_OUT"), help="figure directory (default: temp)")
-    out = Path(ap.parse_args().out or tempfile.mkdtemp(prefix="peelapprox-example-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(arguments(__doc__).parse_args().out)  # --out DIR (docs/examples/_gallery.py)
 
     fig, axes = plt.subplots(2, 3, figsize=(13, 7), constrained_layout=True)
     for col, I in enumerate((1e-5, 1e-3, 1e-2)):

@@ -13,13 +13,10 @@ the stretch "ab" of the paper's Fig. 4, from its lowest value to above f_max.  W
     python docs/examples/03_approx_vs_exact.py [--out DIR]      # ~3 s after the first compilation
 """
 
-import argparse
-import os
-import tempfile
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+from _gallery import arguments, output_dir
 
 import exact
 import peelapprox as pa
@@ -28,10 +25,7 @@ from peelapprox.plotting import plot_segment
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.environ.get("PEELAPPROX_EXAMPLES_OUT"), help="figure directory (default: temp)")
-    out = Path(ap.parse_args().out or tempfile.mkdtemp(prefix="peelapprox-example-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(arguments(__doc__).parse_args().out)  # --out DIR (docs/examples/_gallery.py)
 
     p = pa.PeelParams(V=1.0, I=1e-2)
     tr = exact.simulate(p, 31.0, t_transient=30.0, rtol=1e-10)

@@ -13,23 +13,16 @@ f_max, at every CD -> AB jump its f_min: the jumps happen at the law's folds, wh
     python docs/examples/04_your_own_tape.py [--out DIR]      # ~4 s (the expression compiles once, ~0.5 s)
 """
 
-import argparse
-import os
-import tempfile
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
+from _gallery import arguments, output_dir
 
 import exact
 import peelapprox as pa
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.environ.get("PEELAPPROX_EXAMPLES_OUT"), help="figure directory (default: temp)")
-    out = Path(ap.parse_args().out or tempfile.mkdtemp(prefix="peelapprox-example-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(arguments(__doc__).parse_args().out)  # --out DIR (docs/examples/_gallery.py)
     V = 1.2  # pull speed [m/s]
 
     # 1. A law as an expression: f', f'' come from sympy; the law is probed for v in [1e-6, 1e3] m/s.

@@ -12,24 +12,18 @@ The paper: chaos at low inertia and small V, odd periods without the period-doub
     python docs/examples/05_sweep_phase_diagram.py [--out DIR] [--workers N]      # ~6 s, 16 exact runs of 50 s
 """
 
-import argparse
-import os
-import tempfile
-from pathlib import Path
-
 import numpy as np
+from _gallery import arguments, output_dir
 
 import peelapprox as pa
 from peelapprox.plotting import plot_phase_diagram
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.environ.get("PEELAPPROX_EXAMPLES_OUT"), help="figure directory (default: temp)")
+    ap = arguments(__doc__)  # --out DIR (docs/examples/_gallery.py)
     ap.add_argument("--workers", type=int, default=0, help="worker processes (default 0: this process)")
     args = ap.parse_args()
-    out = Path(args.out or tempfile.mkdtemp(prefix="peelapprox-example-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(args.out)
 
     I_values = [1e-5, 1e-4, 1e-3, 1e-2]  # roller inertia [kg m²]
     V_values = [1.0, 2.0, 3.0, 4.0]      # pull speed [m/s]

@@ -11,12 +11,8 @@
     python docs/examples/06_orbits_bifurcation.py [--out DIR]      # ~8 s
 """
 
-import argparse
-import os
-import tempfile
-from pathlib import Path
-
 import numpy as np
+from _gallery import arguments, output_dir
 
 import exact
 import peelapprox as pa
@@ -24,10 +20,7 @@ from peelapprox.plotting import plot_bifurcation
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default=os.environ.get("PEELAPPROX_EXAMPLES_OUT"), help="figure directory (default: temp)")
-    out = Path(ap.parse_args().out or tempfile.mkdtemp(prefix="peelapprox-example-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(arguments(__doc__).parse_args().out)  # --out DIR (docs/examples/_gallery.py)
     p = pa.PeelParams(V=1.0, I=1e-2)
 
     # 1. The orbit: seeded from a 30 s run (its period n from the run's return map), then Newton to 1e-10.
