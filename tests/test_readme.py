@@ -12,7 +12,7 @@
   [1e-6, 31.6] m/s, a curve the example command can run on.
 * Nothing is written outside the temporary directory (relative outputs such as ``--out sweep/`` land there).
 
-The default tier costs ~10 s of CPU here (three Python blocks, one process for the cheap commands, started
+The default tier costs ~12 s of CPU (three Python blocks, one process for the eleven cheap commands, started
 together).
 """
 
