@@ -3,7 +3,7 @@
 Public names are re-exported here; the modules are private.
 """
 
-from ._compare import DEFAULT_MODELS, ComparisonRow, compare, run_reduction
+from ._compare import DEFAULT_MODELS, ComparisonRow, RowTable, compare, run_reduction
 from ._figures import FIGURES, Figure, figures_markdown, make_figures
 from ._report import STAT_RUNS, CompareReport, StatRow, markdown, run_compare, statistics
 from ._runs import RUNS, ExactRun, RunSpec, TransientCheck, TransientNotPassed, check_past_transient, exact_run
@@ -12,7 +12,7 @@ from ._segments import Segment, local_period, segments
 
 __all__ = [
     "Segment", "segments", "local_period",
-    "compare", "run_reduction", "ComparisonRow", "DEFAULT_MODELS",
+    "compare", "run_reduction", "ComparisonRow", "RowTable", "DEFAULT_MODELS",
     "RunSpec", "RUNS", "ExactRun", "exact_run", "check_past_transient", "TransientCheck", "TransientNotPassed",
     "Row", "Scene", "SCENES", "scene_rows", "CLAIM",
     "StatRow", "CompareReport", "statistics", "run_compare", "markdown", "STAT_RUNS",

@@ -15,13 +15,15 @@ segments; a reduction that leaves the law's domain (a table's range) is the row 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
+from typing import Any
 
 from peelapprox import ModelBreakdown, SolverBudgetExceeded, reduced_segment
+from peelapprox.io import optional_import
 
 from ._segments import Segment, _crossings, _extrema, local_period, segments
 
-__all__ = ["DEFAULT_MODELS", "ComparisonRow", "compare", "run_reduction"]
+__all__ = ["DEFAULT_MODELS", "ComparisonRow", "RowTable", "compare", "run_reduction"]
 
 #: reductions tried on each branch by default: (alpha_model, v_equation)
 DEFAULT_MODELS: dict[str, tuple[tuple[str, str], ...]] = {
@@ -54,8 +56,36 @@ class ComparisonRow:
     period_approx: float | None
     period_rel_error: float | None
 
+    #: Units of the columns (``RowTable.to_dataframe``): dt in seconds, dF in newtons, errors relative
+    #: (``*_rel_error``: a fraction) or in the quantity's unit.
+    UNITS = {"dt_exact": "s", "dt_approx": "s", "dt_abs_error": "s", "dt_rel_error": "", "dF_exact": "N",
+             "dF_approx": "N", "dF_abs_error": "N", "dF_rel_error": "", "period_exact": "s", "period_approx": "s",
+             "period_rel_error": ""}
+
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+class RowTable(list):
+    """A list of table rows (:class:`ComparisonRow`, :class:`StatRow`, :class:`Row`: dataclasses with
+    ``as_dict``), as :func:`compare` and :func:`statistics` return them, that also turns into a DataFrame."""
+
+    def to_dataframe(self, row_type: type | None = None) -> Any:
+        """One DataFrame row per row (``as_dict()``: the fields, and ``verdict`` for a scene's :class:`Row`),
+        None as NaN in number columns; ``df.attrs["units"]`` where the row type states them (``UNITS``).
+        ``row_type`` gives the columns of an empty table (default: the first row's type).
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        pd = optional_import("pandas", "comparisons' to_dataframe")
+        kind = row_type or (type(self[0]) if self else None)
+        cols = None if self or kind is None else [f.name for f in fields(kind)]
+        df = pd.DataFrame([r.as_dict() for r in self], columns=cols)
+        df.attrs["units"] = dict(getattr(kind, "UNITS", {}))
+        return df
 
 
 def run_reduction(params, branch: str, alpha_model: str, v_equation: str, **seed):
@@ -82,7 +112,7 @@ def _err(a: float | None, e: float | None):
 
 
 def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None = None, *,
-            segs: list[Segment] | None = None, rtol: float = 1e-10) -> list[ComparisonRow]:
+            segs: list[Segment] | None = None, rtol: float = 1e-10) -> RowTable:
     """Every reduction on every segment of an exact trajectory, seeded from exact entry states.
 
     Parameters
@@ -100,12 +130,13 @@ def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None =
 
     Returns
     -------
-    list of ComparisonRow
-        Status ``"ok"`` or ``"breakdown: <reason>"`` / ``"no exit: <budget>"``.
+    RowTable of ComparisonRow
+        A list (``.to_dataframe()`` gives it as a pandas DataFrame).  Status ``"ok"`` or
+        ``"breakdown: <reason>"`` / ``"no exit: <budget>"``.
     """
     models = DEFAULT_MODELS if models is None else models
     params = trajectory.params
-    rows: list[ComparisonRow] = []
+    rows = RowTable()
     for s in (segments(trajectory) if segs is None else segs):
         p_ex = s.local_period()
         for am, ve in models.get(s.branch, ()):

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure, peel_force
-from peelapprox.plotting import pyplot
+from peelapprox.plotting import new_figure
 
 __all__ = ["Figure", "FIGURES", "make_figures", "figures_markdown"]
 
@@ -57,14 +57,13 @@ def _phase(ax, v, F, branch, V, title):
 def _save(fig, out, name):
     path = os.path.join(out, f"{name}.png")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    pyplot().close(fig)
+    fig.savefig(path, dpi=110)  # a figure made without pyplot (new_figure): nothing to close
     return [path]
 
 
 def _fig2(out):
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4.2))
+    fig = new_figure(figsize=(6, 4.2), layout=None)
+    ax = fig.subplots()
     for V, ls in ((1, "-"), (2, "--"), (4, "-."), (6, ":")):
         v = np.logspace(-4, np.log10(30), 800)
         ax.semilogx(v, peel_force(v, V), "k" + ls, label=f"V = {V}")
@@ -79,8 +78,8 @@ def _fig2(out):
 
 
 def _fig3(out):
-    plt = pyplot()
-    fig, axs = plt.subplots(2, 2, figsize=(10, 7))
+    fig = new_figure(figsize=(10, 7), layout=None)
+    axs = fig.subplots(2, 2)
     tr = _sim(0.4, 1e-5, 2.0, t_transient=1.0, alpha0=0.2)
     _phase(axs[0, 0], tr.v, tr.F, tr.branch, 0.4, "(a) V=0.4, I=1e-5: v–F (start α0 = 0.2)")
     tr = _sim(1.0, 1e-5, 1.0, t_transient=0.5)
@@ -100,7 +99,6 @@ def _fig3(out):
 
 
 def _fig4(out):
-    plt = pyplot()
     from peelapprox import periodicity, return_map
 
     tr = _sim(1.0, 1e-2, 40.0, t_transient=30.0)
@@ -108,7 +106,8 @@ def _fig4(out):
     n = periodicity(x).period or 1  # one cycle of the return map (period 8 here)
     t0, t1 = t_k[0], t_k[n] if t_k.size > n else tr.t[-1]
     m = (tr.t >= t0) & (tr.t <= t1)
-    fig, axs = plt.subplots(2, 2, figsize=(10, 7))
+    fig = new_figure(figsize=(10, 7), layout=None)
+    axs = fig.subplots(2, 2)
     _phase(axs[0, 0], tr.v[m], tr.F[m], tr.branch[m], 1.0, "(a) V=1, I=1e-2: v–F, one cycle")
     for ax, y, lab, name in ((axs[0, 1], tr.alpha, "α [rad]", "(b) α(t)"), (axs[1, 0], tr.F, "F [N]",
                              f"(c) F(t) (return map: {_period_label(return_map(tr))})"),
@@ -128,9 +127,9 @@ def _period_label(x):
 
 
 def _fig5(out):
-    plt = pyplot()
     tr = _sim(4.0, 1e-2, 22.0, t_transient=20.0, alpha0=0.3)
-    fig, axs = plt.subplots(2, 2, figsize=(10, 7))
+    fig = new_figure(figsize=(10, 7), layout=None)
+    axs = fig.subplots(2, 2)
     axs[0, 0].plot(tr.t, tr.F, lw=0.6)
     axs[0, 0].set_ylabel("F [N]")
     axs[0, 0].set_title("(a) V=4, I=1e-2: F(t) (start α0 = 0.3, after 20 s)", fontsize=9)
@@ -172,9 +171,9 @@ def fig6_data(Vs=_FIG6_V, Is=(1e-5, 1e-2), *, t_transient=20.0,
 def _fig6(out):
     from peelapprox import force_drops
 
-    plt = pyplot()
     data = fig6_data(_FIG6_V)
-    fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig = new_figure(figsize=(11, 4.2), layout=None)
+    axs = fig.subplots(1, 2)
     ax = axs[0]
     for I, ls in ((1e-2, "--o"), (1e-5, ":s")):
         ax.plot(_FIG6_V, data[I], "k" + ls, label=f"I = {I:g}")
@@ -196,9 +195,9 @@ def _fig6(out):
 
 
 def _fig7(out):
-    plt = pyplot()
     tr = _sim(0.4, 1e-3, 22.0, t_transient=20.0, alpha0=0.2)
-    fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig = new_figure(figsize=(11, 4.2), layout=None)
+    axs = fig.subplots(1, 2)
     _phase(axs[0], tr.v, tr.F, tr.branch, 0.4, "Fig. 7: V=0.4, I=1e-3 in the v–F plane (start α0 = 0.2)")
     G = tr.F * (1 + tr.closure_c)  # the pull side of CONSTR, F (1 - cos θ)
     _phase(axs[1], tr.v, G, tr.branch, 0.4, "the same orbit in the v–F(1+sin α) plane: on f's stable branches")

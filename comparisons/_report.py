@@ -8,12 +8,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
-from peelapprox.io import fmt_number
+from peelapprox.io import fmt_number, html_table, optional_import
 
-from ._compare import compare
+from ._compare import RowTable, compare
 from ._runs import RUNS, RunSpec, exact_run
 from ._scenes import SCENES, Row
 
@@ -43,18 +44,22 @@ class StatRow:
     p90: float | None
     max: float | None
 
+    #: Units of the columns (``RowTable.to_dataframe``): the percentiles are |relative errors| (fractions).
+    UNITS = {"median": "", "p90": "", "max": ""}
+
     def as_dict(self) -> dict:
         return asdict(self)
 
 
-def statistics(runs: Sequence[str | RunSpec] = STAT_RUNS, models=None) -> list[StatRow]:
+def statistics(runs: Sequence[str | RunSpec] = STAT_RUNS, models=None) -> RowTable:
     """Median, 90th percentile and max of |relative error| of Δt, ΔF and the α period, per run, branch and
     reduction, over every complete segment of each run's window (seeded from the exact entries).
 
     ``runs`` are names of :data:`RUNS` or :class:`RunSpec` s (a run of any peel-force law: its reductions use
-    that law); ``models`` as in :func:`compare` (default :data:`DEFAULT_MODELS`).
+    that law); ``models`` as in :func:`compare` (default :data:`DEFAULT_MODELS`).  Returns a
+    :class:`RowTable` of :class:`StatRow` (a list; ``.to_dataframe()`` gives a pandas DataFrame).
     """
-    out: list[StatRow] = []
+    out = RowTable()
     for spec in runs:
         run = exact_run(spec)
         name = run.spec.name
@@ -90,6 +95,43 @@ class CompareReport:
 
     def stat_dicts(self) -> list[dict]:
         return [s.as_dict() for s in self.stats]
+
+    def to_dataframe(self, table: str = "rows") -> Any:
+        """A table of the report as a :class:`pandas.DataFrame`: ``"rows"`` (every scene's :class:`Row`, with
+        its ``verdict``), ``"stats"`` (:class:`StatRow`) or ``"timings"`` (``step, wall_time`` [s]).
+
+        Raises
+        ------
+        ValueError
+            If ``table`` is none of these.
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        if table == "rows":
+            return RowTable(self.rows).to_dataframe(Row)
+        if table == "stats":
+            return RowTable(self.stats).to_dataframe(StatRow)
+        if table == "timings":
+            pd = optional_import("pandas", "CompareReport.to_dataframe")
+            df = pd.DataFrame({"step": list(self.timings), "wall_time": list(self.timings.values())})
+            df.attrs["units"] = {"wall_time": "s"}
+            return df
+        raise ValueError(f"table must be one of 'rows', 'stats', 'timings', got {table!r}")
+
+    def _summary(self) -> dict:
+        verdicts = [r.verdict for r in self.rows]
+        return {"rows": len(self.rows), "within": verdicts.count("within"), "outside": verdicts.count("outside"),
+                "failed": sum(v.startswith("failed") for v in verdicts), "statistics rows": len(self.stats),
+                "runs": ", ".join(self.transients) or "none", "total time [s]": self.timings.get("total")}
+
+    def __repr__(self) -> str:
+        d = self._summary()
+        return (f"CompareReport({d['rows']} rows: {d['within']} within, {d['outside']} outside, {d['failed']} failed "
+                f"the claim; {d['statistics rows']} statistics rows; runs: {d['runs']}; "
+                f"total {fmt_number(d['total time [s]'], 3)} s)")
+
+    def _repr_html_(self) -> str:
+        return html_table("CompareReport", self._summary())
 
 
 def run_compare(scenes: Sequence[str] | None = None, *, statistics_runs: Sequence[str] | None = STAT_RUNS,

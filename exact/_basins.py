@@ -191,19 +191,22 @@ class BasinResult:
                "max_period": self.max_period, "counts": self.counts(), "attractors": atts, "rows": self.rows()}
         return json.dumps(jsonable(doc), indent=1, allow_nan=False)
 
-    def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
-        """Draw the label map on ``ax`` (a new figure if None), one colour per attractor and grey shades for the
-        other outcomes, with a legend (outcome and count); returns the axes."""
-        from peelapprox.plotting import pyplot
-
-        plt = pyplot()
-        if ax is None:
-            _, ax = plt.subplots(figsize=(9.0, 4.8), layout="constrained")
+    def plot(self, ax: Any = None, *, title: str | None = None, fig: Any = None) -> Any:
+        """Draw the label map on ``ax``, or into the (empty) figure ``fig``, or into a new
+        :func:`peelapprox.plotting.new_figure` (neither given), one colour per attractor and grey shades for the
+        other outcomes, with a legend (outcome and count); returns the figure drawn into."""
+        from matplotlib import colormaps
         from matplotlib.colors import ListedColormap
         from matplotlib.patches import Patch
 
+        from peelapprox.plotting import new_figure
+
+        if ax is not None and fig is not None:
+            raise ValueError("ax and fig: give one of them (the figure of ax is where it is drawn)")
+        if ax is None:
+            ax = (fig if fig is not None else new_figure(figsize=(9.0, 4.8))).subplots()
         na = len(self.attractors)
-        tab = plt.get_cmap("tab10" if na <= 10 else "tab20")
+        tab = colormaps["tab10" if na <= 10 else "tab20"]
         colours = [tab(i % tab.N) for i in range(na)]
         greys = {INVALID: "white", APERIODIC: "0.25", BREAKDOWN: "0.55", UNDETERMINED: "0.8", FAILURE: "0.95"}
         codes = sorted(greys) + list(range(na))  # -5 .. -1, then 0 .. na-1
@@ -222,7 +225,26 @@ class BasinResult:
         p = self.params
         law = "fvV" if p.force.kind == "paper" else p.force.name or repr(p.force)
         ax.set_title(title or f"basins, {law}, V = {p.V:g} m/s, I = {p.I:g} kg m²")
-        return ax
+        return ax.figure
+
+    def to_xarray(self) -> Any:
+        """The labels as an :class:`xarray.Dataset` over ``(alpha0, F0 | omega0)`` (coordinates with ``units``):
+        ``label`` (:attr:`labels`, with CF ``flag_values``/``flag_meanings``), ``outcome`` (:attr:`texts`), ``n``
+        (the period reached, 0 for none), ``n_returns``; attrs: the parameters (``params_V``, ...), the settings
+        and the attractors (JSON).  ImportError without xarray (``pip install 'peelapprox[data]'``)."""
+        from ._dataout import basins_xarray
+
+        return basins_xarray(self, _CODE_TEXT)
+
+    def __repr__(self) -> str:
+        from ._dataout import basins_summary
+
+        return basins_summary(self, short=True)
+
+    def _repr_html_(self) -> str:
+        from ._dataout import basins_summary
+
+        return basins_summary(self, short=False)
 
 
 def _edges(x: np.ndarray) -> np.ndarray:

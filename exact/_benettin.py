@@ -20,9 +20,28 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure
+from peelapprox.io import fmt_number, html_table
 from peelapprox.validate import function, integer
 
-__all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult"]
+__all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult", "STDERR_BATCHES", "batch_means"]
+
+#: Batches of every Lyapunov record's standard error (:meth:`BenettinResult.from_logs`, :func:`batch_means`).
+STDERR_BATCHES = 10
+
+
+def batch_means(logs: np.ndarray, dts: np.ndarray, m: int = STDERR_BATCHES) -> tuple[np.ndarray, np.ndarray]:
+    """``(logs, dts)`` summed over ``m`` runs of consecutive intervals of about equal time (all of them, unsummed,
+    when there are at most ``m``; fewer runs when a long interval spans several).
+
+    The one batching of the Lyapunov records: :meth:`BenettinResult.from_logs` takes its standard error from the
+    rates of these runs, and the tangent method keeps its record in them.
+    """
+    logs, dts = np.asarray(logs, float), np.asarray(dts, float)
+    if logs.size <= m:
+        return logs, dts
+    edges = np.searchsorted(np.cumsum(dts), np.linspace(0.0, dts.sum(), m + 1)[1:-1], side="right")
+    edges = np.unique(edges[(edges > 0) & (edges < logs.size)])  # no empty batch (a long interval spans several)
+    return (np.array([x.sum() for x in np.split(logs, edges)]), np.array([x.sum() for x in np.split(dts, edges)]))
 
 
 def natural_scales(params: PeelParams) -> np.ndarray:
@@ -39,8 +58,11 @@ class BenettinResult:
 
     ``exponent`` [1/time unit, natural log] = ``Σ log(d_k/d0) / T`` over the kept intervals; ``running``
     the running estimate after each interval; ``local`` the per-interval rates ``log(d_k/d0)/Δt_k``;
-    ``stderr`` the standard error of the mean local rate (intervals treated as independent; a rough
-    convergence indicator; inf with fewer than two intervals); ``time`` the total kept time; ``d0`` the
+    ``stderr`` the standard error of the exponent by batch means (:func:`batch_means`: the intervals grouped
+    into :data:`STDERR_BATCHES` runs of consecutive intervals of about equal time, the standard error of
+    their rates; successive intervals are correlated, e.g. the growth alternates with the branch, so the
+    spread of single intervals misstates it; inf with fewer than two intervals, never NaN); ``time`` the
+    total kept time; ``d0`` the
     reference size (the two trajectories' distance; 1 for the tangent methods, whose tangent is renormalised
     to unit size; the finite-difference step of the return-map method).
     """
@@ -61,10 +83,22 @@ class BenettinResult:
         logs, dts = np.asarray(logs, float), np.asarray(dts, float)
         T = float(dts.sum())
         local = logs / dts
-        # fewer than two intervals: no spread to estimate an error from (inf, never NaN)
-        stderr = float(np.std(local, ddof=1) / math.sqrt(local.size)) if local.size > 1 else math.inf
+        # batch means: the rates of runs of consecutive intervals, nearly independent where single intervals
+        # are not; fewer than two intervals: no spread to estimate an error from (inf, never NaN)
+        b_logs, b_dts = batch_means(logs, dts, STDERR_BATCHES)
+        rates = b_logs / b_dts
+        stderr = float(np.std(rates, ddof=1) / math.sqrt(rates.size)) if rates.size > 1 else math.inf
         return cls(float(logs.sum() / T), np.cumsum(logs) / np.cumsum(dts), local, stderr, T, int(logs.size),
                    float(d0), float(wall_time))
+
+    def __repr__(self) -> str:
+        return (f"BenettinResult(exponent={fmt_number(self.exponent, 4)} ± {fmt_number(self.stderr, 2)}, "
+                f"n={self.n} intervals over {fmt_number(self.time, 4)}, d0={fmt_number(self.d0, 3)}, "
+                f"wall_time={fmt_number(self.wall_time, 3)} s)")
+
+    def _repr_html_(self) -> str:
+        return html_table("BenettinResult", {"exponent": self.exponent, "stderr": self.stderr, "intervals": self.n,
+                                             "time": self.time, "d0": self.d0, "wall time [s]": self.wall_time})
 
 
 def benettin(
@@ -147,4 +181,18 @@ class LyapunovResult:
     n_jumps: int
     method: str = "hybrid two-trajectory (Benettin)"
     notes: list[str] = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        p = self.params
+        return (f"LyapunovResult({fmt_number(self.bits_per_s, 4)} ± {fmt_number(self.stderr_bits, 2)} bits/s, "
+                f"method={self.method!r}, V={p.V:g}, I={p.I:g}, intervals={self.benettin.n}, "
+                f"jumps={self.n_jumps}, tau={fmt_number(self.tau, 3)} s)")
+
+    def _repr_html_(self) -> str:
+        p = self.params
+        return html_table("LyapunovResult", {
+            "λ [bits/s]": f"{fmt_number(self.bits_per_s, 4)} ± {fmt_number(self.stderr_bits, 2)}",
+            "λ [1/s]": self.per_s, "method": self.method, "V [m/s]": p.V, "I [kg m²]": p.I,
+            "force": repr(p.force), "intervals": self.benettin.n, "time [s]": self.benettin.time,
+            "jumps": self.n_jumps, "τ [s]": self.tau, "wall time [s]": self.benettin.wall_time})
 

@@ -27,7 +27,8 @@ in λ and ``GAUGE_TOL`` in the gauge, or 40 halvings) on the quantity that chang
 * **Neimark-Sacker** (a complex pair through the unit circle: ``|μ| - 1``).
 
 The non-smooth ends of a branch are reported as the reason it stopped (``OrbitBranch.stopped``, with the
-parameter value of the event in ``end_value``):
+parameter value of the event in ``end_value``, the linear extrapolation of the quantity that vanishes there
+when it lies within two steps (or 1e-3 of the span) of the last point, else the last point):
 
 * ``"grazing"``: the orbit meets a fold of f tangentially: the rate ``Ġ`` at which its level reaches the fold
   falls below ``graze_tol k V``; the multipliers diverge on the way in;
@@ -125,6 +126,24 @@ class OrbitBranch:
         """Every point as a row (:meth:`BranchPoint.row`), for ``peelapprox.io.write_rows`` (CSV/JSON)."""
         return [p.row(self.parameter) for p in self.points]
 
+    def to_dataframe(self) -> object:
+        """:meth:`rows` as a :class:`pandas.DataFrame`, one row per point in the order continued; ``df.attrs``:
+        ``units`` (per column), ``parameter``, ``stopped``, ``end_value``, ``message``, ``bifurcations``
+        (``[{"kind", "value"}]``) and ``params`` (the start's).  ImportError without pandas."""
+        from ._dataout import branch_dataframe
+
+        return branch_dataframe(self)
+
+    def __repr__(self) -> str:
+        from ._dataout import branch_summary
+
+        return branch_summary(self, short=True)
+
+    def _repr_html_(self) -> str:
+        from ._dataout import branch_summary
+
+        return branch_summary(self, short=False)
+
 
 def _crossing(a: PeriodicOrbit, b: PeriodicOrbit) -> str | None:
     """The bifurcation between two orbits of a branch, by their multipliers (module docstring), or None."""
@@ -163,9 +182,11 @@ class _Stepper:
     def params_at(self, value: float):
         return with_parameter(self.base, self.parameter, value)
 
-    def correct(self, w_pred: np.ndarray, tau: np.ndarray, n: int | None = None, max_iter: int = 12) -> BranchPoint:
+    def correct(self, w_pred: np.ndarray, tau: np.ndarray, n: int | None = None, max_iter: int = 12,
+                max_dlam: float = math.inf) -> BranchPoint:
         o, lam = bordered_newton(self.params_at, n or self.n, w_pred[:2] * self.scale, float(w_pred[2] * self.ls),
-                                 tau, w_pred, self.scale, self.ls, tol=self.tol, rtol=self.rtol, max_iter=max_iter)
+                                 tau, w_pred, self.scale, self.ls, tol=self.tol, rtol=self.rtol, max_iter=max_iter,
+                                 max_dlam=max_dlam)
         return BranchPoint(lam, o)
 
 
@@ -274,7 +295,8 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
             i = int(np.argmin(np.abs(o.fold_rates)))
             points.append(pt)
             crests.append(_NO_CREST)
-            stopped, end_value = "grazing", _events_ahead(points, crests).get("grazing", pt.value)
+            ev = _events_ahead(points, crests).get("grazing", pt.value)
+            stopped, end_value = "grazing", _near(ev, pt.value, last.value, span)
             message = (f"the orbit meets the {'AB' if i % 2 else 'CD'} fold (fold {i + 1} of the period) almost "
                        f"tangentially at {parameter}={pt.value:.10g}: dG/dt = {o.fold_rates[i]:.3g} N/s there "
                        f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
@@ -290,7 +312,8 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         c = crests[-1]
         if min(c.margin, c.floor) < crest_tol:
             event = "crest" if c.margin <= c.floor else "breakdown"
-            stopped, end_value = event, _events_ahead(points, crests).get(event, pt.value)
+            ev = _events_ahead(points, crests).get(event, pt.value)
+            stopped, end_value = event, _near(ev, pt.value, last.value, span)
             message = _event_message(event, c, end_value, parameter)
             break
         if final:
@@ -312,6 +335,9 @@ _NO_CREST = Crest(math.inf, "", math.nan)
 #: spent): at a fold λ is stationary along the branch, so λ alone would stop the bisection with μ still far
 #: from 1.
 GAUGE_TOL = 1e-6
+#: Largest move of λ per Newton step in :func:`switch_branch`, relative to λ: the doubled orbit at a small
+#: amplitude lies next to the bifurcation (λ - λ* ~ a²); a free λ can otherwise wander where returns fail.
+SWITCH_DLAM = 1e-2
 #: A real multiplier within this distance of +1 makes the next step pseudo-arclength (a fold may be ahead).
 FOLD_NEAR = 0.25
 
@@ -319,6 +345,12 @@ FOLD_NEAR = 0.25
 def _near_fold(o: PeriodicOrbit) -> bool:
     mu = o.multipliers
     return bool(np.any((np.abs(mu.imag) < 1e-12) & (np.abs(mu.real - 1.0) < FOLD_NEAR)))
+
+
+def _near(event: float, value: float, previous: float, span: float) -> float:
+    """An extrapolated event's parameter value if it lies within two steps (or 1e-3 of the span) of the last
+    point ``value``, else ``value``."""
+    return event if abs(event - value) <= max(2 * abs(value - previous), 1e-3 * span) else value
 
 
 def _check_correction(st: _Stepper, pt: BranchPoint, w_pred: np.ndarray, max_correction: float) -> None:
@@ -372,9 +404,8 @@ def _failure_end(exc: Exception, points: list[BranchPoint], crests: list[Crest],
     if len(points) >= 2:
         if not math.isfinite(crests[-1].margin + crests[-1].floor):  # crest_tol = 0: measure now
             crests[-2:] = [crest_margin(p.orbit) for p in points[-2:]]
-        near = abs(points[-1].value - points[-2].value)
         for event, value in sorted(_events_ahead(points, crests).items(), key=lambda e: abs(e[1] - points[-1].value)):
-            if abs(value - points[-1].value) <= max(2 * near, 1e-3 * span):
+            if _near(value, points[-1].value, points[-2].value, span) == value:
                 return event, _event_message(event, crests[-1], value, parameter, points[-1].orbit), value
     if isinstance(exc, ModelBreakdown):  # with no event ahead: the corrector's orbit breaks down
         return "breakdown", str(exc), math.nan
@@ -452,7 +483,7 @@ def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: flo
     for a in (amplitude, amplitude / 4, 4 * amplitude):
         w_ref = np.concatenate([z + a * e, [lam / st.ls]])
         try:
-            pt = st.correct(w_ref, tau, n=2 * o.n, max_iter=20)
+            pt = st.correct(w_ref, tau, n=2 * o.n, max_iter=20, max_dlam=SWITCH_DLAM * max(abs(lam), 1e-300))
         except _FAILURES as exc:
             errors.append(f"a={a:.3g}: {exc}")
             continue

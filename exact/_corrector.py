@@ -17,6 +17,7 @@ closing residual is halved (at most 8 times).
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 
@@ -69,11 +70,12 @@ def _residual(x: np.ndarray, xn: np.ndarray, scale: np.ndarray) -> float:
 
 def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.ndarray, lam0: float,
                     tau: np.ndarray, w_ref: np.ndarray, scale: np.ndarray, lam_scale: float, *, tol: float,
-                    rtol: float, max_iter: int = 8) -> tuple[PeriodicOrbit, float]:
+                    rtol: float, max_iter: int = 8, max_dlam: float = math.inf) -> tuple[PeriodicOrbit, float]:
     """Solve the bordered system of the module docstring from ``(x0, lam0)``: ``(orbit, λ)``.
 
     Converged when the closing residual ``|P^n(x) - x| / max(1, |x|)`` (in ``x / scale``) is at most ``tol`` and
-    the linear condition holds to ``1e-9 max(1, |w_ref|)``.
+    the linear condition holds to ``1e-9 max(1, |w_ref|)``.  A Newton step that would move λ by more than
+    ``max_dlam`` is shortened to it.
 
     Raises
     ------
@@ -110,7 +112,7 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
             dw = np.linalg.solve(A, -np.concatenate([(xn - x) / scale, [c]]))
         except np.linalg.LinAlgError:
             raise ValueError(f"bordered Newton: singular Jacobian at λ={lam:.10g}") from None
-        s = 1.0
+        s = min(1.0, max_dlam / lam_scale / abs(dw[2])) if dw[2] != 0 else 1.0
         for _ in range(9):  # halve a step that does not reduce the closing residual
             wt = w + s * dw
             xt, lt = wt[:2] * scale, float(wt[2] * lam_scale)

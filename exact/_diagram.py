@@ -58,6 +58,48 @@ class OrbitDiagram:
             out.extend({self.parameter: float(x), "F": float(f), "label": lab} for f in F)
         return out
 
+    def to_dataframe(self):
+        """:meth:`rows` as a :class:`pandas.DataFrame`: one row per (value, return), columns ``<parameter>, F,
+        label`` (``F`` NaN where a value has no returns: a breakdown or no stick-slip); ``df.attrs``: ``units``,
+        ``parameter``, ``wall_time``.
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        from peelapprox.io import optional_import
+
+        pd = optional_import("pandas", "OrbitDiagram.to_dataframe")
+        df = pd.DataFrame(self.rows(), columns=[self.parameter, "F", "label"]).astype({"F": float})
+        df.attrs.update({"units": {self.parameter: {"V": "m/s", "I": "kg m²", "k": "N/m"}.get(self.parameter, ""),
+                                   "F": "N", "label": ""},
+                         "parameter": self.parameter, "wall_time": self.wall_time})
+        return df
+
+    def _summary(self) -> dict:
+        from peelapprox.io import fmt_number
+
+        counts: dict[str, int] = {}
+        for lab in self.labels:
+            counts[lab] = counts.get(lab, 0) + 1
+        v = self.values
+        return {"parameter": self.parameter, "values": v.size,
+                "range": f"{fmt_number(v.min(), 6)} … {fmt_number(v.max(), 6)}" if v.size else "–",
+                "returns": sum(F.size for F in self.returns),
+                "labels": ", ".join(f"{k} ×{n}" for k, n in list(counts.items())[:5])
+                + (f", … ({len(counts) - 5} more)" if len(counts) > 5 else ""), "wall time [s]": self.wall_time}
+
+    def __repr__(self) -> str:
+        d = self._summary()
+        return (f"OrbitDiagram({d['parameter']} in [{d['range']}], {d['values']} values, {d['returns']} returns; "
+                f"{d['labels']})")
+
+    def _repr_html_(self) -> str:
+        from peelapprox.io import html_table
+
+        return html_table("OrbitDiagram", self._summary())
+
 
 def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | np.ndarray, *,
                   t_transient: float = WINDOW_DEFAULTS["t_transient"], window: float = WINDOW_DEFAULTS["window"],

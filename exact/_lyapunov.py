@@ -46,7 +46,7 @@ from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
 from ._attractors import DEFAULT_MAX_WALL, window_run
-from ._benettin import BenettinResult, LyapunovResult, benettin, natural_scales
+from ._benettin import STDERR_BATCHES, BenettinResult, LyapunovResult, batch_means, benettin, natural_scales
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
 from ._simulate import initial_state, simulate
 
@@ -106,8 +106,9 @@ def lyapunov(
     Returns
     -------
     LyapunovResult
-        ``bits_per_s``, ``per_s``, ``stderr_bits``, the ``benettin`` record (running estimate, local rates),
-        ``n_jumps``; ``method`` names the method.
+        ``bits_per_s``, ``per_s``, ``stderr_bits`` (batch means of the record's intervals,
+        :meth:`BenettinResult.from_logs`; inf with fewer than two, never NaN), the ``benettin`` record (running
+        estimate, local rates), ``n_jumps``; ``method`` names the method.
 
     Raises
     ------
@@ -301,18 +302,8 @@ def lyapunov_tangent(
     return _tangent(params, t_transient=t_transient, T=T, rtol=rtol, alpha0=alpha0, max_steps=max_steps)
 
 
-#: Batches of the tangent method's record (its standard error is that of the batch means).
-TANGENT_BATCHES = 10
-
-
-def _batches(logs: np.ndarray, dts: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(logs, dts)`` summed over ``m`` runs of consecutive intervals of about equal time (fewer if there are
-    fewer intervals)."""
-    if logs.size <= m:
-        return logs, dts
-    edges = np.searchsorted(np.cumsum(dts), np.linspace(0.0, dts.sum(), m + 1)[1:-1], side="right")
-    edges = np.unique(edges[(edges > 0) & (edges < logs.size)])  # no empty batch (a long interval spans several)
-    return (np.array([x.sum() for x in np.split(logs, edges)]), np.array([x.sum() for x in np.split(dts, edges)]))
+#: Batches of the tangent method's record (its standard error is that of the batch means, as every method's).
+TANGENT_BATCHES = STDERR_BATCHES
 
 
 def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float = 50.0, rtol: float = 1e-10,
@@ -333,7 +324,7 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     # the record of the renormalisations (the tangent's unit size is d0 = 1) in batches of consecutive intervals
     # (batch means: the growth between two jumps alternates with the branch, so single intervals are strongly
     # correlated); the exponent is the sum of the logs in the order they came, as lyapunov_saltation formed it
-    logs, dts = _batches(logs, dts, TANGENT_BATCHES)
+    logs, dts = batch_means(logs, dts, TANGENT_BATCHES)
     b = dataclasses.replace(BenettinResult.from_logs(logs, dts, 1.0, time.perf_counter() - t0), exponent=lam)
     ln2 = math.log(2.0)
     return LyapunovResult(lam, lam / ln2, b.stderr / ln2, b, params, b.time / b.n, n_jumps,
@@ -385,7 +376,7 @@ def lyapunov_return_map(
     Returns
     -------
     LyapunovResult
-        ``bits_per_s``, ``per_s``, ``stderr_bits`` (from the per-return logs), the ``benettin`` record,
+        ``bits_per_s``, ``per_s``, ``stderr_bits`` (batch means of the per-return logs), the ``benettin`` record,
         ``n_jumps``; ``method`` names the method.
 
     Raises

@@ -34,6 +34,7 @@ import numpy as np
 
 from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, PeelParams, periodicity
 from peelapprox.errors import SolverFailure
+from peelapprox.io import fmt_number, html_table
 from peelapprox.kernels import M_R
 from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, in_range, integer, optional
@@ -87,7 +88,15 @@ class SectionReturn:
 def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarray, t0: float) -> int:
     """Integrate ``y`` (state and tangent) on branch ``br`` to its fold; raise the status's exception else."""
     law = ts.law
-    status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+    y0 = y.copy()
+    try:
+        status, n = ts.run(y, ts.p, law.fn, law.coef, br, rtol, atol, LEG_TIME, LEG_STEPS)
+    except (ZeroDivisionError, OverflowError) as exc:  # a state the field's Jacobian cannot take (e.g. a wild
+        v0 = math.exp(y0[3])                            # Newton iterate): the return does not exist there
+        raise SolverFailure(f"section return: the tangent integration failed ({type(exc).__name__}: {exc}) "
+                            f"from alpha={y0[1]:.6g} rad, omega={y0[2]:.6g} rad/s on {'AB' if br == 0 else 'CD'}",
+                            t=t0, state=dict(t=t0, alpha=float(y0[1]), omega=float(y0[2]),
+                                             F=float(ts.pull(y0[1], v0)), v=v0)) from None
     if status != _st.FOLD:
         v = math.exp(y[3])
         state = dict(t=t0 + y[0], alpha=float(y[1]), omega=float(y[2]), F=float(ts.pull(y[1], v)), v=v,
@@ -239,6 +248,22 @@ class PeriodicOrbit:
         a, w = self.section_states[0]
         return simulate(self.params, self.period, alpha0=float(a), omega0=float(w),
                         F0=float(self.return_map_values[0]), branch0="CD", rtol=rtol, save=save)
+
+    def _summary(self) -> dict:
+        F = self.return_map_values
+        return {"n": self.n, "period [s]": self.period, "stable": self.stable,
+                "|μ|": ", ".join(fmt_number(abs(m), 4) for m in self.multipliers),
+                "F at the AB→CD jumps [N]": ", ".join(fmt_number(x, 7) for x in F[:4]) + (" …" if F.size > 4 else ""),
+                "residual": self.residual, "V [m/s]": self.params.V, "I [kg m²]": self.params.I}
+
+    def __repr__(self) -> str:
+        d = self._summary()
+        return (f"PeriodicOrbit(period-{self.n}, T={fmt_number(self.period, 6)} s, "
+                f"{'stable' if self.stable else 'unstable'}, |mu|=[{d['|μ|']}], F=[{d['F at the AB→CD jumps [N]']}] N, "
+                f"residual={fmt_number(self.residual, 2)}, V={self.params.V:g}, I={self.params.I:g})")
+
+    def _repr_html_(self) -> str:
+        return html_table(f"PeriodicOrbit (period-{self.n})", self._summary())
 
 
 def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float

@@ -9,8 +9,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from peelapprox import BRANCHES, PeelParams
+from peelapprox.io import fmt_number, html_table, optional_import, param_attrs
 
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
+
+#: Units of the columns of :meth:`Trajectory.to_dataframe` and :meth:`Jumps.to_dataframe` (``df.attrs["units"]``).
+_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "branch": "", "from_branch": "",
+          "to_branch": "", "v_before": "m/s", "v_after": "m/s"}
+
+
+def _branches(pd, codes: np.ndarray):
+    """Branch codes (0, 1) as a pandas categorical of the names ``"AB"``/``"CD"`` (:data:`BRANCHES`)."""
+    return pd.Categorical.from_codes(np.asarray(codes, dtype=np.int8), categories=list(BRANCHES))
 
 
 @dataclass(frozen=True)
@@ -106,6 +116,39 @@ class Jumps:
             for j in self:
                 w.writerow([repr(j.t), j.from_branch, j.to_branch, repr(j.alpha), repr(j.omega), repr(j.F),
                             repr(j.v_before), repr(j.v_after), *extra.values()])
+
+    def to_dataframe(self):
+        """The jumps as a :class:`pandas.DataFrame`, one row per jump: columns :attr:`FIELDS`, the branches as a
+        categorical of the names ``"AB"``/``"CD"``, the floats the arrays themselves; ``df.attrs["units"]``.
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        pd = optional_import("pandas", "Jumps.to_dataframe")
+        cols = {f: getattr(self, f) for f in self.FIELDS}
+        cols["from_branch"], cols["to_branch"] = _branches(pd, self.from_branch), _branches(pd, self.to_branch)
+        df = pd.DataFrame(cols)
+        df.attrs["units"] = {f: _UNITS[f] for f in self.FIELDS}
+        return df
+
+    def _summary(self) -> dict:
+        n = len(self)
+        out: dict = {"jumps": n, "AB→CD": int(np.count_nonzero(self.from_branch == 0)),
+                     "CD→AB": int(np.count_nonzero(self.from_branch == 1))}
+        if n:
+            out.update({"t [s]": f"{fmt_number(self.t[0], 6)} … {fmt_number(self.t[-1], 6)}",
+                        "F [N]": f"{fmt_number(self.F.min(), 6)} … {fmt_number(self.F.max(), 6)}"})
+        return out
+
+    def __repr__(self) -> str:
+        d = self._summary()
+        rng = f", t {d['t [s]']} s, F {d['F [N]']} N" if len(self) else ""
+        return f"Jumps({d['jumps']} jumps: {d['AB→CD']} AB→CD, {d['CD→AB']} CD→AB{rng})"
+
+    def _repr_html_(self) -> str:
+        return html_table("Jumps", self._summary())
 
 
 @dataclass(frozen=True)
@@ -293,3 +336,35 @@ class Trajectory:
                 status=meta["status"],
                 message=meta["message"],
             )
+
+    def _repr_html_(self) -> str:
+        p, st = self.params, self.stats
+        return html_table("Trajectory", {
+            "V [m/s]": p.V, "I [kg m²]": p.I, "k [N/m]": p.k, "force": repr(p.force), "method": self.method,
+            "t [s]": f"{fmt_number(self.initial_state.t, 6)} … {fmt_number(self.t_end, 6)}",
+            "points": len(self.t), "jumps": len(self.jumps), "steps": st.n_steps,
+            "wall time [s]": st.wall_time, "final state": (f"α={fmt_number(self.final_state.alpha, 6)} rad, "
+                                                           f"F={fmt_number(self.final_state.F, 6)} N, "
+                                                           f"branch {self.final_state.branch}")})
+
+    def to_dataframe(self):
+        """The stored points as a :class:`pandas.DataFrame`: columns ``t, alpha, omega, F, v`` (the arrays
+        themselves, float64) and ``branch`` (a categorical of the names ``"AB"``/``"CD"``), one row per stored
+        point (a jump is two rows at the same ``t``).
+
+        ``df.attrs`` holds ``units`` (per column), ``params`` (:func:`peelapprox.io.param_attrs`: V, I, k, R,
+        l, geometry and the law ``force``, with its ``force_key``) and the run's ``method``, ``solver``,
+        ``rtol``, ``eps``, ``t_transient``, ``t_end``.  The jumps: ``self.jumps.to_dataframe()``.
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        pd = optional_import("pandas", "Trajectory.to_dataframe")
+        cols = ("t", "alpha", "omega", "F", "v")
+        df = pd.DataFrame({**{c: getattr(self, c) for c in cols}, "branch": _branches(pd, self.branch)})
+        df.attrs.update({"units": {c: _UNITS[c] for c in (*cols, "branch")}, "params": param_attrs(self.params),
+                         "method": self.method, "solver": self.solver, "rtol": self.rtol, "eps": self.eps,
+                         "t_transient": self.t_transient, "t_end": self.t_end})
+        return df

@@ -8,8 +8,8 @@ events, jumps and output), never the step itself.
 Method
 ------
 Dormand–Prince 8(5,3) with its 7th-order dense output (Hairer, Nørsett &
-Wanner, *Solving ODEs I*, II.10), using scipy's coefficient tables
-(``scipy.integrate._ivp.dop853_coefficients``) and scipy's step-size
+Wanner, *Solving ODEs I*, II.10), using the package's copy of scipy's coefficient
+tables (:mod:`peelapprox._dop853_tableau`, with its provenance and licence) and scipy's step-size
 controller (safety 0.9, factors in [0.2, 10], error exponent -1/8, no growth
 right after a rejection).  Tolerance semantics are scipy's: a step is accepted
 when the RMS over components of ``err_i / (atol_i + rtol·max(|y_i|, |y_new_i|))``
@@ -38,8 +38,8 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _dop
 
+from . import _dop853_tableau as _dop
 from ._jit import kernel
 
 __all__ = [

@@ -55,6 +55,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_law_codegen.py",  # renders and compiles the laws (expression laws: outside=True)
     "peelapprox/_law_table_jit.py",  # the compiled tabulated law
     "peelapprox/_dop853.py",
+    "peelapprox/_dop853_tableau.py",  # its coefficients, frozen into the kernels
     "peelapprox/_alpha.py",
     "peelapprox/_segment_kernel.py",
     "peelapprox/_packing.py",  # the parameter-vector layouts, frozen into the kernels

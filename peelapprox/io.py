@@ -1,19 +1,26 @@
 """Input and output helpers shared by the three packages: one writer for every table (rows as CSV or JSON,
-chosen by the extension), one JSON normaliser (:func:`jsonable`) and one number formatter for tables and
-messages (:func:`fmt_number`)."""
+chosen by the extension), one JSON normaliser (:func:`jsonable`), one number formatter for tables and
+messages (:func:`fmt_number`), and the pieces every result object's data out and notebook display share: the
+lazy import of an optional dependency (:func:`optional_import`: pandas and xarray for ``to_dataframe`` and
+``to_xarray``, tqdm for progress bars), the parameters as flat metadata (:func:`param_attrs`) and the small HTML
+table of ``_repr_html_`` (:func:`html_table`)."""
 
 from __future__ import annotations
 
 import csv
+import html
+import importlib
 import json
 import math
 import numbers
 from collections.abc import Iterable, Mapping, Sequence
+from types import ModuleType
 from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["TABLE_EXTENSIONS", "fmt_number", "jsonable", "write_csv", "write_rows"]
+__all__ = ["TABLE_EXTENSIONS", "fmt_number", "html_table", "jsonable", "optional_import", "param_attrs", "write_csv",
+           "write_rows"]
 
 #: The file name endings :func:`write_rows` accepts.
 TABLE_EXTENSIONS = (".csv", ".json")
@@ -151,3 +158,46 @@ def write_csv(fh: IO[str], rows: Iterable[Mapping[str, Any]], *, fields: Sequenc
     for r in rows:
         w.writerow(["" if r.get(c) is None else (repr(float(r[c])) if isinstance(r[c], (float, np.floating))
                                                  else r[c]) for c in cols])
+
+
+def optional_import(module: str, purpose: str, extra: str = "data") -> ModuleType:
+    """Import the optional dependency ``module`` when a method needs it (never at ``import peelapprox``).
+
+    Parameters
+    ----------
+    module : str
+        The module, e.g. ``"pandas"``.
+    purpose : str
+        What needs it, for the message, e.g. ``"Trajectory.to_dataframe"``.
+    extra : str
+        The extra of ``pyproject.toml`` that installs it (``data``: pandas and xarray).
+
+    Raises
+    ------
+    ImportError
+        ``"<purpose> needs <module>: pip install 'peelapprox[<extra>]'"`` when it is not installed.
+    """
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise ImportError(f"{purpose} needs {module}: pip install 'peelapprox[{extra}]' (or pip install {module})"
+                          ) from exc
+
+
+def param_attrs(params: Any) -> dict[str, Any]:
+    """The fields of a :class:`peelapprox.PeelParams` as flat metadata (``df.attrs``, xarray attrs: plain
+    scalars a netCDF file can hold): ``V, I, k, R, l, geometry``, the law as ``force`` (its ``repr``) and
+    ``force_key`` (its SHA-256, :attr:`peelapprox.PeelForce.key`)."""
+    out: dict[str, Any] = {n: jsonable(getattr(params, n), scalar=True) for n in ("V", "I", "k", "R", "l", "geometry")}
+    out["force"] = repr(params.force)
+    out["force_key"] = params.force.key
+    return out
+
+
+def html_table(title: str, items: Mapping[str, Any] | Iterable[tuple[str, Any]]) -> str:
+    """A small two-column HTML table (``_repr_html_`` of the result objects): a bold ``title`` and one row per
+    ``(name, value)``, floats by :func:`fmt_number` (4 significant digits), everything escaped."""
+    pairs = items.items() if isinstance(items, Mapping) else items
+    body = "".join(f"<tr><th style='text-align:left'>{html.escape(str(k))}</th>"
+                   f"<td style='text-align:left'>{html.escape(fmt_number(v, 4))}</td></tr>" for k, v in pairs)
+    return f"<table><caption style='text-align:left'><b>{html.escape(title)}</b></caption>{body}</table>"

@@ -181,3 +181,13 @@ def test_cli_basins(tmp_path, capsys):
     with pytest.raises(SystemExit) as e:
         main(args + ["--alpha0", "0.1:0.05"])
     assert e.value.code == 2 and "--alpha0" in capsys.readouterr().err
+
+
+def test_a_return_the_tangent_cannot_take_is_a_solver_failure():
+    """Hypothesis: a section state far from any orbit (a wild Newton iterate of a branch switch, found at V =
+    3.49 and I = 1e-5 before λ's steps were bounded) where the compiled tangent integration divides by zero
+    raises SolverFailure with the (finite) start state, never ZeroDivisionError."""
+    p = pa.PeelParams(V=5.223673296215096, I=1e-5)
+    with pytest.raises(exact.SolverFailure, match="tangent integration failed") as e:
+        exact.section_return(p, [-0.05958918, 51.00845879], tangent=False)
+    assert all(np.isfinite(v) for v in e.value.state.values() if isinstance(v, float))

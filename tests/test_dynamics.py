@@ -163,10 +163,9 @@ def test_saltation_tangent_dynamics_agrees_with_the_two_trajectory_estimate():
     0.374 sqrt(19/60)) = 0.87 bits/s (17 %).  The means of all windows, 5.333 ± 0.084 (tangent, 380 s) and
     5.169 ± 0.116 (two-trajectory, 600 s), differ by 0.16 ± 0.14 (1.2 σ): no systematic difference is left.
     The old check (tangent 20 s with the transient vs two-trajectory 50 s, within 10 %) had a combined sd
-    of 0.54 bits/s (10.5 %) plus the 0.26 bias, so it failed by chance (5.832 vs 5.280).  The standard
-    errors the methods report do not give this spread: the two-trajectory ``stderr_bits`` (1.59 over
-    200 s, 3.13 over 50 s) treats its 5 ms intervals as independent and is ~9× the block-to-block spread;
-    the tangent reports NaN.
+    of 0.54 bits/s (10.5 %) plus the 0.26 bias, so it failed by chance (5.832 vs 5.280).  The spread is
+    measured here rather than taken from the reported ``stderr_bits`` (batch means since issue 17; before,
+    the two-trajectory error treated its correlated 5 ms intervals as independent and was ~9× this spread).
     """
     import math
 

@@ -210,8 +210,8 @@ def test_branches_explain_the_brute_force_periods_at_I_1e_2(tmp_path):
     """Hypothesis (the issue's acceptance in a window): at I = 1e-2 every periodic value of the brute-force
     orbit diagram over V in [0.9, 1.2] (from α0 = 0 after 30 s) lies in the stable range of a continued branch
     of the same period (seeded automatically where the diagram's period changes): the periods 7, 8, 9, 10 of
-    the period-adding windows, whose ends are Neimark–Sacker bifurcations and model breakdowns (measured on
-    [0.5, 1.8]: 27 of 27 values, docs/orbits.md)."""
+    the period-adding windows, whose ends are Neimark–Sacker bifurcations and crest events (measured on
+    [0.5, 2.5]: 41 of 41 values, docs/orbits.md)."""
     import json
 
     from peelapprox.cli import main

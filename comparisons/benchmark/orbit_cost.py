@@ -22,7 +22,7 @@ import exact
 from peelapprox import PeelForce, PeelParams
 from peelapprox.io import fmt_number
 
-__all__ = ["CONTINUATIONS", "SCENES", "continuation_costs", "main", "orbit_costs"]
+__all__ = ["ADAPTIVE", "CONTINUATIONS", "SCENES", "continuation_costs", "main", "orbit_costs"]
 
 #: (name, params, transient [s], n or None): stable orbits of the cubic and of fvV, and an unstable one.
 SCENES = (
@@ -41,14 +41,28 @@ CONTINUATIONS = (
 )
 
 
+#: (name, params, parameter, stop): adaptive steps (the defaults) from the orbit at params towards stop, through
+#: bifurcations and the pseudo-arclength steps round a fold, to the branch's end.
+ADAPTIVE = (
+    ("fvV period 5 in V (I = 1e-3): 2 PD, NS, fold, grazing", PeelParams(V=1.0, I=1e-3), "V", 0.5),
+    ("fvV period 3 in V (I = 1e-5): crest", PeelParams(V=1.0, I=1e-5), "V", 1.5),
+)
+
+
 def continuation_costs() -> list[dict]:
-    """Seconds of a 200-point continuation (:data:`CONTINUATIONS`), the start orbit excluded."""
+    """Seconds of a 200-point continuation (:data:`CONTINUATIONS`) and of the adaptive ones (:data:`ADAPTIVE`),
+    the start orbit excluded."""
     rows = []
     for name, p, par, stop in CONTINUATIONS:
         o = exact.periodic_orbit(p)
         h = abs(stop - float(getattr(p, par))) / 199
         t0 = time.perf_counter()
         b = exact.continue_orbit(o, par, stop=stop, step=h, max_step=h, max_points=200)
+        rows.append(dict(branch=name, points=len(b.points), stopped=b.stopped, s=time.perf_counter() - t0))
+    for name, p, par, stop in ADAPTIVE:
+        o = exact.periodic_orbit(p, t_transient=40.0)
+        t0 = time.perf_counter()
+        b = exact.continue_orbit(o, par, stop=stop, max_points=300)
         rows.append(dict(branch=name, points=len(b.points), stopped=b.stopped, s=time.perf_counter() - t0))
     return rows
 
@@ -82,9 +96,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{r['scene']:<26} {r['n']:>3} {r['newton_iterations']:>6} {r['residual']:>9.1e} {mu:>18} "
               f"{str(r['stable']):>6} {r['steps']:>7} {fmt_number(r['ms'], 3):>7}")
     cont = continuation_costs()
-    print(f"\n{'continuation':<32} {'points':>6} {'stopped':>10} {'s':>7}")
+    print(f"\n{'continuation':<54} {'points':>6} {'stopped':>10} {'s':>7}")
     for r in cont:
-        print(f"{r['branch']:<32} {r['points']:>6} {r['stopped']:>10} {fmt_number(r['s'], 3):>7}")
+        print(f"{r['branch']:<54} {r['points']:>6} {r['stopped']:>10} {fmt_number(r['s'], 3):>7}")
     if args.json:
         args.json.write_text(json.dumps(dict(orbits=rows, continuations=cont), indent=1))
     return 0

@@ -4,10 +4,11 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
-from peelapprox.plotting import pyplot
+from peelapprox.plotting import new_figure
 
 from .report import BenchmarkReport
 from .scenes import BENCH_SCENES
@@ -15,12 +16,13 @@ from .scenes import BENCH_SCENES
 __all__ = ["plot_work_precision", "plot_eps_study"]
 
 
-def plot_work_precision(rep: BenchmarkReport, path) -> None:
-    """Time vs error, one panel per scene, one line per method family (log-log)."""
-    plt = pyplot()
-
+def plot_work_precision(rep: BenchmarkReport, path=None, *, fig: Any = None):
+    """Time vs error, one panel per scene, one line per method family (log-log), into ``fig`` (an empty figure;
+    default a new :func:`peelapprox.plotting.new_figure`), written to ``path`` when given; returns the figure."""
     scenes = [s.name for s in BENCH_SCENES]
-    fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4.2), squeeze=False)
+    if fig is None:
+        fig = new_figure(figsize=(5 * len(scenes), 4.2), layout=None)  # no pyplot: nothing to close
+    axes = fig.subplots(1, len(scenes), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
         rows = [r for r in rep.rows if r.scene == sc and math.isfinite(r.error) and math.isfinite(r.time)]
         keys = sorted({(r.method, r.solver, r.eps) for r in rows}, key=lambda k: (k[0] != "hybrid", k))
@@ -35,15 +37,17 @@ def plot_work_precision(rep: BenchmarkReport, path) -> None:
         ax.grid(True, which="both", alpha=0.3)
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    if path:
+        fig.savefig(path, dpi=110)
+    return fig
 
 
-def plot_eps_study(rep: BenchmarkReport, path) -> None:
-    """Fold-passage delay vs ε (log-log) with the fitted power laws."""
-    plt = pyplot()
-
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+def plot_eps_study(rep: BenchmarkReport, path=None, *, ax: Any = None, fig: Any = None):
+    """Fold-passage delay vs ε (log-log) with the fitted power laws, on ``ax`` or into the (empty) figure ``fig``
+    (default a new :func:`peelapprox.plotting.new_figure`), written to ``path`` when given; returns the figure."""
+    if ax is None:
+        ax = (fig if fig is not None else new_figure(figsize=(5.5, 4.2), layout=None)).subplots()
+    fig = ax.figure
     for key, mk in (("delay_ab", "o"), ("delay_cd", "s")):
         ok = [e for e in rep.eps_rows if e.status == "ok" and getattr(e, key) > 0]
         name = key.replace("delay_", "").upper()
@@ -58,5 +62,6 @@ def plot_eps_study(rep: BenchmarkReport, path) -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    if path:
+        fig.savefig(path, dpi=110)
+    return fig

@@ -2,18 +2,55 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 
 from peelapprox import PeelForce
+from peelapprox.io import html_table, jsonable, optional_import
 from peelapprox.validate import path as _path
 
 from .law import manifest_law
 from .store import RESERVED, failed, point_key, read_manifest, read_records
 
 __all__ = ["SweepResult", "load_sweep"]
+
+
+#: Units and descriptions of the built-in measures' record keys (the variables of :meth:`SweepResult.to_xarray`);
+#: a registered measure's keys get a description naming their measure and no units.
+_KEY_INFO: dict[str, tuple[str, str]] = {
+    "status": ("", "ok, breakdown:<reason>, or error:<exception> (a measure raised)"),
+    "regime_label": ("", "regime of peelapprox.estimate (closed form)"),
+    "regime_inertia": ("", "inertia class of the regime (low/intermediate/high)"),
+    "regime_velocity": ("", "velocity class of the regime"),
+    "regime_fixed_point_stable": ("", "the steady state v = V is stable (1) or not (0)"),
+    "regime_inertia_ratio": ("", "inertial period over the stick (AB) time"),
+    "regime_period_at_mean": ("s", "inertial period of the roller at the mean force"),
+    "regime_cd_damping_time": ("s", "damping time of the oscillation on CD"),
+    "regime_t_ab_crude": ("s", "time on AB, crude estimate"),
+    "regime_t_ab_quasi_static": ("s", "time on AB, quasi-static estimate"),
+    "regime_t_cd_quasi_static": ("s", "time on CD, quasi-static estimate"),
+    "regime_oscillations_per_ab": ("", "inertial oscillations per AB stay"),
+    "regime_force_gap": ("", "relative gap between the force bounds"),
+    "jumps_status": ("", "ok or breakdown:<reason> of the windowed exact run"),
+    "jumps_t_breakdown": ("s", "time of the model breakdown"),
+    "jumps_count": ("", "jumps in the window"),
+    "jumps_n_slips": ("", "AB->CD jumps (slips) in the window"),
+    "jumps_mean_interval": ("s", "mean time between consecutive jumps"),
+    "jumps_mean_period": ("s", "mean time between consecutive AB->CD jumps (stick-slip period)"),
+    "jumps_mean_force_drop": ("N", "mean force drop from an AB->CD jump to the next CD->AB jump"),
+    "period_status": ("", "ok or breakdown:<reason>"),
+    "period_label": ("", "period-n, aperiodic or too short (peelapprox.periodicity of the return map)"),
+    "period": ("", "period n of the return map (AB->CD jumps per period)"),
+    "period_mismatch": ("", "relative mismatch of the return map at the period found"),
+    "period_n_returns": ("", "return-map values in the window"),
+    "lyapunov_status": ("", "ok or breakdown:<reason>"),
+    "lyapunov_bits_per_s": ("bit/s", "largest Lyapunov exponent"),
+    "lyapunov_stderr_bits": ("bit/s", "standard error of the largest Lyapunov exponent"),
+    "lyapunov_n_jumps": ("", "jumps while the exponent was measured"),
+}
 
 
 def _is_number(v: Any) -> bool:
@@ -140,6 +177,56 @@ class SweepResult:
         if not str(path).endswith(".csv"):
             raise ValueError(f"path must end in .csv, got {str(path)!r}")
         write_rows(path, self.records, fields=self.keys())
+
+    def to_xarray(self) -> Any:
+        """The sweep as an :class:`xarray.Dataset` over the grid: dimensions ``I`` [kg m²] and ``V`` [m/s] (and
+        ``coef``, the law coefficient :attr:`coef_name`, with a coefficient axis), one variable per record key
+        (:meth:`values`: float with NaN where a point has no value, else str with ``""``), each with ``units``
+        and ``description`` (the built-in measures' from a table in this module); attrs: ``measures``, ``force``,
+        ``force_key``, ``coef_name``,
+        ``options`` and ``manifest`` (JSON text), ``out``, ``points``/``total``.  Missing points (an unfinished
+        sweep) are NaN / ``""``.
+
+        Raises
+        ------
+        ImportError
+            If xarray is not installed (``pip install 'peelapprox[data]'``).
+        """
+        xr = optional_import("xarray", "SweepResult.to_xarray")
+        dims: tuple[str, ...] = ("I", "V") if self.coef_values is None else ("I", "V", "coef")
+        coords: dict = {"I": ("I", self.I_values, {"units": "kg m²", "description": "moment of inertia of the roller"}),
+                        "V": ("V", self.V_values, {"units": "m/s", "description": "pull speed"})}
+        if self.coef_values is not None:
+            coords["coef"] = ("coef", self.coef_values, {"units": "", "description": f"coefficient "
+                                                         f"{self.coef_name} of the law {self.force!r}"})
+        data = {}
+        for key in self.keys():
+            if key in ("I", "V", "coef", "law", "law_key") or not any(key in r for r in self.records):
+                continue
+            a = self.values(key)
+            if a.dtype == object:
+                a = np.array([("" if x is None else str(x)) for x in a.ravel()], dtype=str).reshape(a.shape)
+            units, what = _KEY_INFO.get(key, ("", f"measure {key.split('_', 1)[0]}: {key}"))
+            data[key] = (dims, a, {"units": units, "description": what})
+        n = int(np.prod(self.shape))
+        attrs = {"measures": " ".join(self.measures), "force": repr(self.force), "force_key": self.force.key,
+                 "coef_name": self.coef_name or "", "options": json.dumps(jsonable(self.options)),
+                 "manifest": json.dumps(jsonable(self.manifest)), "out": self.out or "",
+                 "points": len(self.records), "total": n}
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    def _summary(self) -> dict:
+        n = int(np.prod(self.shape))
+        lo_hi = [f"{a.min():.4g} … {a.max():.4g}" if a.size else "–" for a in (self.I_values, self.V_values)]
+        d = {"grid": " x ".join(str(x) for x in self.shape), "I [kg m²]": lo_hi[0], "V [m/s]": lo_hi[1],
+             "measures": ", ".join(self.measures), "points": f"{len(self.records)}/{n}",
+             "failed": len(self.failed()), "force": repr(self.force), "out": self.out}
+        if self.coef_values is not None:
+            d["coef"] = f"{self.coef_name}: {self.coef_values.min():.4g} … {self.coef_values.max():.4g}"
+        return d
+
+    def _repr_html_(self) -> str:
+        return html_table("SweepResult", self._summary())
 
     def __repr__(self) -> str:
         n = int(np.prod(self.shape))

@@ -1,4 +1,4 @@
-"""Command line: ``peelapprox simulate | folds | estimate | segment ...``.
+"""Command line: ``peelapprox simulate | folds | estimate | segment ...`` (also ``python -m peelapprox``).
 
 The CLI is the only place that ties the three packages (peelapprox, exact,
 comparisons) together; each subcommand lives in its own module here, and its
@@ -16,10 +16,13 @@ stops (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed),
 from __future__ import annotations
 
 import argparse
+import textwrap
 from collections.abc import Sequence
 
+from .._version import __version__
 from . import basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
 from ._checks import exit_status, one_line
+from ._common import HelpFormatter
 
 __all__ = ["build_parser", "main"]
 
@@ -40,8 +43,21 @@ _basins = basins.run
 
 def build_parser() -> argparse.ArgumentParser:
     """The parser of ``peelapprox``: one subparser per subcommand, its handler in ``func``."""
-    ap = argparse.ArgumentParser(prog="peelapprox", description=__doc__.splitlines()[0])
-    sub = ap.add_subparsers(dest="command", required=True)
+    ap = argparse.ArgumentParser(
+        prog="peelapprox", formatter_class=HelpFormatter,
+        description=textwrap.fill(
+            "Stick-slip peeling of an adhesive tape from a roller (De, Maybhate and Ananthakrishna, Phys. Rev. E 69, "
+            "2004): the exact model, the paper's reduced equations and their comparison.  'peelapprox COMMAND "
+            "--help' describes a command, its options (units, defaults) and examples.", 100),
+        epilog="examples:\n"
+               "  peelapprox compare                                  # the paper's scenes, approximate vs exact\n"
+               "  peelapprox simulate --V 1 --I 1e-2 --t-end 20 --plot run.png\n"
+               "  peelapprox dynamics --V 2 --I 1e-4 --lyapunov       # period, force drops, Lyapunov exponent\n"
+               "  python -m peelapprox --version\n\n"
+               "exit status: 0 done, 2 a bad argument or output path, 3 the model or solver stopped (breakdown, "
+               "budget),\n1 writing failed (or, for sweep, a point failed).")
+    ap.add_argument("--version", action="version", version=f"peelapprox {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     simulate.add_parser(sub).set_defaults(func=_simulate)
     estimate.add_folds_parser(sub).set_defaults(func=_folds)
     estimate.add_estimate_parser(sub).set_defaults(func=_estimate)

@@ -1,39 +1,139 @@
-"""What the subcommands share: the model's parameter options (the law's among them), printing a summary,
-writing a table that records the law."""
+"""What the subcommands share: their help (:class:`HelpFormatter`, :func:`subcommand`: a description, examples,
+every default), the model's parameter options (the law's among them, :func:`add_params`, :func:`params_from_args`),
+printing a summary with units (:data:`UNITS`), writing a table that records the law."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import sys
+import textwrap
+from collections.abc import Sequence
+from typing import Any
 
-from .. import PeelForce
-from ..io import fmt_number, write_rows
-from ._force import add_force_options, law_fields
+from .. import GEOMETRIES, PeelForce, PeelParams
+from ..io import fmt_number, write_csv, write_rows
+from ._force import add_force_options, force_from_args, law_fields
 
-__all__ = ["add_params", "print_mapping", "say", "write_table"]
+__all__ = ["FORMATS", "HelpFormatter", "UNITS", "add_format", "add_params", "params_from_args", "print_mapping",
+           "say", "subcommand", "write_table"]
+
+#: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
+#: header and one row), ``json``.
+FORMATS = ("table", "csv", "json")
 
 
-def add_params(sp: argparse.ArgumentParser) -> None:
-    """The options ``--V --I --k --R`` of :class:`peelapprox.PeelParams`, and its law ``force``
-    (:func:`peelapprox.cli._force.add_force_options`; build it with ``force_from_args``)."""
-    sp.add_argument("--V", type=float, required=True, help="pull speed [m/s]")
-    sp.add_argument("--I", type=float, required=True, help="roller inertia [kg m^2]")
-    sp.add_argument("--k", type=float, default=1000.0, help="tape stiffness [N/m] (1000)")
-    sp.add_argument("--R", type=float, default=0.1, help="roller radius [m] (0.1)")
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """The subcommands' help: the description and the examples as written (their lines kept), and every option's
+    default appended to its help, ``(default: X)``, unless the help states it (it says ``default``)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        d = action.default
+        if (not action.option_strings or d is None or d is False or d is argparse.SUPPRESS or "default" in text
+                or isinstance(d, list)):
+            return text
+        shown = fmt_number(d, 6, short_exponent=True) if isinstance(d, float) else str(d)
+        return f"{text} (default: {shown.replace('%', '%%')})"
+
+
+def subcommand(sub: Any, name: str, *, help: str, description: str, examples: Sequence[str],
+               **kwargs: Any) -> argparse.ArgumentParser:
+    """A subparser with a one-line ``help`` (in ``peelapprox --help``), a ``description`` (its paragraphs, split at
+    blank lines, wrapped to 100 columns) and ``examples`` (its epilog, one command a line as written, ``#``
+    comments kept), formatted by :class:`HelpFormatter`."""
+    text = "\n\n".join(textwrap.fill(p, 100) for p in description.split("\n\n"))
+    epilog = "examples:\n" + "\n".join(f"  {e}" for e in examples)
+    return sub.add_parser(name, help=help, description=text, epilog=epilog, formatter_class=HelpFormatter, **kwargs)
+
+
+def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True) -> None:
+    """The options ``--V --I --k --R`` of :class:`peelapprox.PeelParams` and, with ``geometry`` (for the exact
+    model; the reduced equations are the paper's linear closure), ``--l --geometry``, and its law ``force``
+    (:func:`peelapprox.cli._force.add_force_options`); :func:`params_from_args` builds them."""
+    g = sp.add_argument_group("model parameters (PeelParams)")
+    g.add_argument("--V", type=float, required=True, help="pull speed [m/s]")
+    g.add_argument("--I", type=float, required=True, help="roller inertia [kg m^2]")
+    g.add_argument("--k", type=float, default=1000.0, help="tape stiffness [N/m]")
+    g.add_argument("--R", type=float, default=0.1, help="roller radius [m]")
+    if geometry:
+        g.add_argument("--l", type=float, default=1.0, help="roller-motor distance [m] (read by --geometry exact)")
+        g.add_argument("--geometry", choices=GEOMETRIES, default="paper",
+                       help="the closure cos(theta): paper (the paper's sin(alpha) form) or exact (the full geometry "
+                            "with l)")
     add_force_options(sp)
 
 
+def params_from_args(args: argparse.Namespace) -> PeelParams:
+    """The :class:`PeelParams` of the options of :func:`add_params` (``l`` and ``geometry`` at their defaults where
+    the subcommand has no such option)."""
+    extra = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
+    return PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args), **extra)
+
+
+def add_format(sp: argparse.ArgumentParser | argparse._ArgumentGroup, what: str = "the summary") -> None:
+    """``--format`` with the choices :data:`FORMATS` (table)."""
+    sp.add_argument("--format", choices=FORMATS, default="table",
+                    help=f"how {what} is printed: table (key: value [unit] lines), csv (a header and a row) or json")
+
+
+_STATE_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s"}
+_S = "s"
+_N = "N"
+_MS = "m/s"
+#: The unit of a printed key (``table`` output; JSON and CSV carry none: the names are documented in docs/usage.md).
+UNITS: dict[str, str] = {
+    "V": _MS, "I": "kg m^2", "k": "N/m", "R": "m", "l": "m",
+    **{k: _S for k in ("period", "t_end", "t_transient", "window", "settle_time", "wall_time", "wall_time_s",
+                       "compile_time_s", "lyapunov_time", "lyapunov_wall_time", "dt", "period_at_f_min",
+                       "period_at_f_max", "period_at_mean", "cd_damping_time", "t_ab_crude", "t_ab_quasi_static",
+                       "t_cd_quasi_static")},
+    **{k: "rad" for k in ("alpha0", "alpha_in", "alpha_exit", "amplitude")},
+    **{k: "rad/s" for k in ("alphadot_in", "alphadot_exit", "omega0")},
+    **{k: _MS for k in ("v_max", "v_min", "v_inflection", "v_land_cd", "v_land_ab", "v_breakdown", "v_in", "v_f",
+                        "fixed_point_v")},
+    **{k: _N for k in ("f_max", "f_min", "f_zero", "fixed_point_F", "F_in", "F_exit", "dF", "F_mean", "F_max_bound",
+                       "F_min_bound", "dF_ab_quasi_static", "dF_cd_quasi_static", "mean_force_drop",
+                       "force_drop_std", "F_min_at_jumps", "F_max_at_jumps", "F_at_jumps", "F_at_jumps_range", "F0")},
+    **{k: "N s/m" for k in ("fprime_at_V", "fixed_point_fprime")},
+    **{k: "bits/s" for k in ("lyapunov_bits_per_s", "lyapunov_stderr")},
+}
+
+
+def _number(val: Any) -> bool:
+    return isinstance(val, (int, float)) and not isinstance(val, bool)
+
+
+def _text(key: str, val: Any) -> str:
+    """``val`` for a ``key: value`` line, floats to 6 significant digits, with the unit of ``key`` (:data:`UNITS`)
+    after a number or a list of numbers; a state (a dict of ``t, alpha, omega, F, v``) with each unit."""
+    unit = UNITS.get(key)
+    if key == "period" and not _number(val):  # dynamics' period is a label ("period-3", "aperiodic")
+        unit = None
+    if isinstance(val, dict):
+        return ", ".join(f"{k} = {fmt_number(v, 6, nan='nan')}" + (f" {_STATE_UNITS[k]}" if k in _STATE_UNITS and
+                                                                  _number(v) else "") for k, v in val.items())
+    if isinstance(val, (list, tuple)) and val and all(_number(x) for x in val):
+        return "[" + ", ".join(fmt_number(float(x), 6, nan="nan") for x in val) + "]" + (f" {unit}" if unit else "")
+    if isinstance(val, float):
+        return fmt_number(val, 6, nan="nan") + (f" {unit}" if unit else "")
+    if _number(val) and unit:
+        return f"{val} {unit}"
+    return str(val)
+
+
 def print_mapping(row: dict, fmt: str) -> None:
-    """``row`` as JSON or as right-aligned ``key: value`` lines (floats to 6 significant digits)."""
+    """``row`` as JSON, as CSV (a header and one row) or as right-aligned ``key: value [unit]`` lines (floats to 6
+    significant digits, units from :data:`UNITS`)."""
     if fmt == "json":
         print(json.dumps(row, indent=2))
+    elif fmt == "csv":
+        write_csv(sys.stdout, [{k: json.dumps(v) if isinstance(v, (dict, list)) else v for k, v in row.items()}],
+                  fields=list(row))
     else:
         width = max(len(k) for k in row)
         for key, val in row.items():
-            if isinstance(val, float):
-                val = fmt_number(val, 6, nan="nan")
-            print(f"{key:>{width}}: {val}")
+            print(f"{key:>{width}}: {_text(key, val)}")
 
 
 def write_table(path: str, rows: list[dict], law: PeelForce | None = None) -> None:

@@ -24,6 +24,7 @@ import csv
 import dataclasses
 import math
 import re
+import textwrap
 from typing import Any
 
 from .. import PeelForce
@@ -80,8 +81,8 @@ def add_force_options(sp: argparse.ArgumentParser) -> None:
     """The law options (module docstring), in their own group of ``--help``, the three kinds exclusive."""
     g = sp.add_argument_group(
         "peel-force law",
-        "f(v, V) [N]; default the paper's fvV. At most one of --force, --force-table, --force-family. "
-        f"Families and their coefficients (defaults): {families_help()}.")
+        textwrap.fill("f(v, V) [N]; default the paper's fvV. At most one of --force, --force-table, --force-family. "
+                      f"Families and their coefficients (defaults): {families_help()}.", 100))
     kind = g.add_mutually_exclusive_group()
     kind.add_argument("--force", metavar="EXPR",
                       help="a law in v [m/s] and optionally V [m/s], e.g. 'a + b*v - c*v**2 + d*v**3' "

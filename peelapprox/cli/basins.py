@@ -4,36 +4,48 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 import numpy as np
 
-from .. import WINDOW_DEFAULTS, PeelParams
+from .. import WINDOW_DEFAULTS
+from ..io import write_csv
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float
-from ._common import add_params, say, write_table
-from ._force import force_from_args
+from ._common import FORMATS, add_params, params_from_args, say, subcommand, write_table
 
 __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
     w = WINDOW_DEFAULTS
-    sp = sub.add_parser("basins", help="basins of attraction: the attractor (period and cycle, aperiodic, breakdown) "
-                                       "each start of an (alpha0, F0) or (alpha0, omega0) grid reaches")
+    sp = subcommand(
+        sub, "basins", help="basins of attraction: the attractor (period and cycle, aperiodic, breakdown) each start "
+                            "of an (alpha0, F0) or (alpha0, omega0) grid reaches",
+        description="Basins of attraction: every start of a grid over the initial peel angle alpha0 and the initial "
+                    "pull force F0 (or roller speed omega0) is run past a transient and classified by its return "
+                    "map in a window: a periodic attractor (period-n and its cycle of forces, numbered A0, A1, ... "
+                    "across the grid), aperiodic, breakdown (the model stops), undetermined (no stick-slip), an "
+                    "invalid start (no consistent initial state) or a failure; with --orbits each attractor's "
+                    "periodic orbit and Floquet multipliers.",
+        examples=["peelapprox basins --V 1.2 --I 1e-5 --force-family cubic --alpha0=-0.4:0.4:9 --omega0 10:25:7 "
+                  "--plot basins.png",
+                  "peelapprox basins --V 1 --I 1e-2 --alpha0 0:0.3:4 --F0 200:290:4 --orbits --out basins.json"])
     add_params(sp)
     sp.add_argument("--alpha0", required=True, metavar="LO:HI[:N]",
-                    help="initial peel angles [rad] (N = 11; a negative LO needs the = form: --alpha0=-0.3:0.3)")
+                    help="initial peel angles [rad] (default N: 11; a negative LO needs the = form: "
+                         "--alpha0=-0.3:0.3)")
     axis = sp.add_mutually_exclusive_group(required=True)
-    axis.add_argument("--F0", metavar="LO:HI[:N]", help="initial pull forces [N] (N = 11)")
-    axis.add_argument("--omega0", metavar="LO:HI[:N]", help="initial roller speeds [rad/s] (N = 11)")
+    axis.add_argument("--F0", metavar="LO:HI[:N]", help="initial pull forces [N] (default N: 11)")
+    axis.add_argument("--omega0", metavar="LO:HI[:N]", help="initial roller speeds [rad/s] (default N: 11)")
     sp.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"],
-                    help=f"seconds discarded per start [s] ({w['t_transient']:g})")
-    sp.add_argument("--window", type=positive_float, default=w["window"],
-                    help=f"seconds classified per start [s] ({w['window']:g})")
+                    help="time discarded per start [s]")
+    sp.add_argument("--window", type=positive_float, default=w["window"], help="time classified per start [s]")
     sp.add_argument("--workers", type=nonnegative_int, default=None,
                     help="processes (default: one per CPU; 0: in this process)")
     sp.add_argument("--orbits", action="store_true",
                     help="also find each attractor's periodic orbit and its Floquet multipliers")
-    sp.add_argument("--format", choices=("table", "json"), default="table", help="what is printed (table)")
+    sp.add_argument("--format", choices=FORMATS, default="table",
+                    help="what is printed: table (one line an attractor or outcome), csv (one row a start) or json")
     sp.add_argument("--out", help="write one row per start to this .csv, or everything to this .json")
     sp.add_argument("--plot", help="draw the label map to this image file")
     return sp
@@ -44,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
 
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args))
+    p = params_from_args(args)
     a = np.linspace(*_axis(args.alpha0, "--alpha0"))
     name, text = ("F0", args.F0) if args.F0 is not None else ("omega0", args.omega0)
     values = np.linspace(*_axis(text, f"--{name}"))
@@ -53,6 +65,8 @@ def run(args: argparse.Namespace) -> int:
                window=args.window, orbits=args.orbits, max_workers=args.workers, progress=True)
     if args.format == "json":
         print(r.to_json())
+    elif args.format == "csv":
+        write_csv(sys.stdout, r.rows())
     else:
         for a_ in r.attractors:
             mu = ""
@@ -72,11 +86,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             write_table(out, r.rows(), p.force)
     if plot:
-        from ..plotting import pyplot
-
-        ax = r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²")
-        ax.figure.savefig(plot, dpi=130)
-        pyplot().close(ax.figure)
+        r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²").savefig(plot, dpi=130)
         say(f"wrote {plot}")
     return 0
 

@@ -11,17 +11,27 @@ import time
 
 from .. import PeelForce
 from ._checks import check_output_path
-from ._common import write_table
+from ._common import subcommand, write_table
 
 __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
-    bm = sub.add_parser("benchmark", help="work-precision vs the paper's regularised scheme and peers, ε study, "
-                                          "speed targets (minutes)")
-    bm.add_argument("--quick", action="store_true", help="thinner grids, ε = 1e-7 only (< 5 min on 2 cores)")
+    bm = subcommand(
+        sub, "benchmark", help="work-precision vs the paper's regularised scheme and peers, eps study, speed targets "
+                               "(minutes)",
+        description="The solver benchmark: work precision (wall time against error at the jumps) of the hybrid "
+                    "solver, the paper's eps-regularised scheme (scipy's Radau, BDF, LSODA) and the optional peers "
+                    "(SUNDIALS IDA via scikit-sundae, diffsol; pip install 'peelapprox[bench]'); the eps study "
+                    "(the jump delay of the regularised scheme against eps, with its power law); the speed "
+                    "targets.  Minutes; --quick in under 5 minutes on 2 cores.",
+        examples=["peelapprox benchmark --quick --out bench/      # work precision vs the paper's scheme, eps study",
+                  "peelapprox benchmark --no-peers --format json"])
+    bm.add_argument("--quick", action="store_true", help="thinner grids, eps = 1e-7 only (< 5 min on 2 cores)")
     bm.add_argument("--no-peers", action="store_true", help="skip the optional SUNDIALS/diffsol peers")
-    bm.add_argument("--format", choices=("md", "csv", "json"), default="md", help="what to print (md)")
+    bm.add_argument("--format", choices=("table", "md", "csv", "json"), default="table",
+                    help="what is printed: table (markdown tables; md is the same), csv (the work-precision rows) or "
+                         "json (everything)")
     bm.add_argument("--out", metavar="DIR", help="write DIR/benchmark.md, work_precision.{csv,json,png}, "
                                                  "eps_study.{csv,json,png}, ratios.{csv,json}, targets.{csv,json}")
     return bm
@@ -42,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     peers = () if args.no_peers else None
     report = run_benchmark(quick=args.quick, peers=peers, progress=say)
     wp, eps = rows_as_dicts(report)
-    if args.format == "md":
+    if args.format in ("table", "md"):
         print(markdown(report), end="")
     elif args.format == "json":
         print(json.dumps(jsonable({"work_precision": wp, "eps_study": eps, "ratios": report.ratios,

@@ -9,9 +9,9 @@ import sys
 
 from .. import PeelForce
 from ._checks import check_output_path
-from ._common import say, write_table
+from ._common import say, subcommand, write_table
 
-__all__ = ["add_parser", "run"]
+__all__ = ["COLUMNS", "TABLES_HEADER", "add_parser", "run", "summary"]
 
 #: The head of ``DIR/tables.md`` written by ``compare --out DIR``.
 TABLES_HEADER = (
@@ -23,18 +23,51 @@ TABLES_HEADER = (
     "segment's entry state.\n\n")
 
 
+#: What the columns of the printed tables mean (``--help`` and the head of the markdown printed).
+COLUMNS = ("Columns: quantity = the number compared; seed = where the reduction starts (paper: the paper's "
+           "quoted initial data as printed; paper, corrected: with its misprint fixed, docs/paper-notes.md; "
+           "exact: our exact segment's entry state); method = the reduced equations (alpha model + v equation); "
+           "paper approx / paper exact = the paper's numbers; ours approx / ours exact = ours (exact: the full "
+           "model); rel. error = (ours approx - ours exact)/|ours exact|; claim = the agreement the paper claims; "
+           "verdict = within or outside the claim, or failed (the reduction stopped, with its reason).")
+
+
 def add_parser(sub) -> argparse.ArgumentParser:
-    cp = sub.add_parser("compare", help="the paper's approximate-vs-exact scenes, error tables and Figs. 8-9")
+    from .. import ALPHA_MODELS, V_EQUATIONS
+
+    cp = subcommand(
+        sub, "compare", help="the paper's approximate-vs-exact scenes, error tables and Figs. 8-9",
+        description="The paper's approximate-vs-exact scenes (its Sec. V): each scene runs the exact model, "
+                    "picks a segment and compares the reduced equations' numbers with the exact ones and with "
+                    "the paper's; then error statistics over all segments of each run.  Ends with a summary: how "
+                    "many rows are within the paper's claim, outside it, or failed.  Reduced equations: alpha "
+                    f"models {', '.join(ALPHA_MODELS)}; v equations {', '.join(V_EQUATIONS)}.\n\n" + COLUMNS,
+        examples=["peelapprox compare                      # every scene, markdown tables and a summary",
+                  "peelapprox compare --list               # the scenes, their runs, transients and windows",
+                  "peelapprox compare --scene case-II-point-a --scene case-III-bounds --format json",
+                  "peelapprox compare --out docs           # regenerates docs/tables.md and docs/figures/fig8-9"])
     cp.add_argument("--scene", action="append", metavar="NAME",
-                    help="run only this scene (repeatable); default all. Names: see `--list`")
+                    help="run only this scene (repeatable; default: all); names: see --list")
     cp.add_argument("--list", action="store_true", help="list the scenes and exit")
-    cp.add_argument("--format", choices=("md", "csv", "json"), default="md", help="what to print (md)")
+    cp.add_argument("--format", choices=("table", "md", "csv", "json"), default="table",
+                    help="what is printed: table (markdown tables and a summary; md is the same), csv (the rows) or "
+                         "json (rows, statistics, transients, timings)")
     cp.add_argument("--out", metavar="DIR",
                     help="write DIR/tables.md, DIR/compare_rows.{csv,json}, DIR/compare_statistics.{csv,json} "
                          "and DIR/figures/fig8_ab.png, fig8_cd.png, fig9.png")
     cp.add_argument("--no-stats", action="store_true", help="skip the per-regime error statistics")
     cp.add_argument("--no-figures", action="store_true", help="do not draw Figs. 8-9 (with --out)")
     return cp
+
+
+def summary(rows: list[dict]) -> str:
+    """One line: how many rows are within the paper's claim, outside it, failed, and without a claim."""
+    verdicts = [str(r.get("verdict") or "") for r in rows]
+    within, outside = verdicts.count("within"), verdicts.count("outside")
+    failed = sum(v.startswith("failed") for v in verdicts)
+    rest = len(verdicts) - within - outside - failed
+    return (f"Summary: {len(rows)} rows: {within} within the paper's claim, {outside} outside, {failed} failed "
+            f"(the reduction stopped), {rest} without a claim.")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -54,8 +87,10 @@ def run(args: argparse.Namespace) -> int:
     report = run_compare(args.scene, statistics_runs=() if args.no_stats else STAT_RUNS,
                          figures_dir=None if args.no_figures else figdir, progress=say)
     rows, stats = report.row_dicts(), report.stat_dicts()
-    if args.format == "md":
+    if args.format in ("table", "md"):
+        print(COLUMNS + "\n")
         print(markdown(report, figures_rel="figures" if figdir else None), end="")
+        print(f"\n{summary(rows)}")
     elif args.format == "json":
         print(json.dumps({"rows": rows, "statistics": stats, "transients": report.transients,
                           "timings": report.timings}, indent=2))
@@ -67,6 +102,7 @@ def run(args: argparse.Namespace) -> int:
         with open(os.path.join(args.out, "tables.md"), "w") as fh:
             fh.write(TABLES_HEADER)
             fh.write(markdown(report, figures_rel="figures" if figdir else None))
+            fh.write(f"\n{summary(rows)}\n")
         for stem, data in (("compare_rows", rows), ("compare_statistics", stats)):
             for ext in ("csv", "json"):
                 if data:

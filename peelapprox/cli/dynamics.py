@@ -7,11 +7,11 @@ import argparse
 import json
 import sys
 
-from .. import EPS_DEFAULT, WINDOW_DEFAULTS, PeelParams
-from ..io import fmt_number
+from .. import EPS_DEFAULT, WINDOW_DEFAULTS
+from ..io import write_csv
 from ._checks import check_output_path, finite_float_list, nonnegative_float, positive_float, positive_int
-from ._common import add_params, print_mapping, say, write_table
-from ._force import force_from_args, law_fields
+from ._common import add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
+from ._force import law_fields
 
 __all__ = ["LYAPUNOV_ALIASES", "LYAPUNOV_METHODS", "add_parser", "run"]
 
@@ -24,32 +24,43 @@ LYAPUNOV_ALIASES = {"saltation": "tangent", "regularized": "variational"}
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
-    dy = sub.add_parser("dynamics", help="period of the return map, force drops, settle time, attractors, "
-                                         "Lyapunov exponent at one (V, I)")
+    dy = subcommand(
+        sub, "dynamics", help="period of the return map, force drops, settle time, attractors, Lyapunov exponent at "
+                              "one (V, I)",
+        description="The dynamics at one (V, I): one exact run, its return map (F at the AB->CD jumps) after the "
+                    "transient, the map's period (period-n or aperiodic), the force drops, the time the orbit takes "
+                    "to settle; on request the largest Lyapunov exponent [bits/s] with its standard error (batch "
+                    "means), and the attractors reached from several initial peel angles.  Lyapunov methods: "
+                    "two-trajectory (Benettin renormalisation; the default), tangent (tangent dynamics with "
+                    "saltation matrices; alias saltation), return-map (tangent of the jump-to-jump map), "
+                    "variational (variational equations of the eps-system; alias regularized; needs pydiffsol).",
+        examples=["peelapprox dynamics --V 2 --I 1e-4 --lyapunov            # period, force drops, lambda [bits/s]",
+                  "peelapprox dynamics --V 2.5 --I 1e-4 --lyapunov-method tangent",
+                  "peelapprox dynamics --V 1 --I 1e-2 --attractors 0,0.1,-0.2 --format json"])
     add_params(dy)
     w = WINDOW_DEFAULTS
-    dy.add_argument("--alpha0", type=float, default=w["alpha0"])
-    dy.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"],
-                    help=f"discarded [s] ({w['t_transient']:g})")
-    dy.add_argument("--window", type=positive_float, default=w["window"], help=f"analysed [s] ({w['window']:g})")
-    dy.add_argument("--rtol", type=float, default=w["rtol"], help=f"of the window's run ({w['rtol']:g})")
-    dy.add_argument("--max-period", type=positive_int, default=32)
+    dy.add_argument("--alpha0", type=float, default=w["alpha0"], help="initial peel angle [rad]")
+    dy.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"], help="discarded time [s]")
+    dy.add_argument("--window", type=positive_float, default=w["window"], help="analysed time [s]")
+    dy.add_argument("--rtol", type=float, default=w["rtol"], help="relative tolerance of the window's run")
+    dy.add_argument("--max-period", type=positive_int, default=32,
+                    help="longest period of the return map tried [returns]")
     dy.add_argument("--lyapunov", action="store_true", help="also the largest Lyapunov exponent (a few s)")
     dy.add_argument("--lyapunov-method", choices=(*LYAPUNOV_METHODS, *LYAPUNOV_ALIASES), metavar="METHOD",
                     help="how (implies --lyapunov), a method of exact.lyapunov: two-trajectory renormalisation "
                          "(the default), tangent (tangent dynamics with saltation matrices; alias saltation), "
                          "return-map (tangent of the jump-to-jump map, its returns as many as the window's "
                          "return rate gives in --lyapunov-time), variational (variational equations of the "
-                         "ε-system; alias regularized; needs pydiffsol)")
-    dy.add_argument("--lyapunov-time", type=positive_float, default=50.0, help="measured time [s] (50)")
+                         "eps-system; alias regularized; needs pydiffsol)")
+    dy.add_argument("--lyapunov-time", type=positive_float, default=50.0, help="measured time [s]")
     dy.add_argument("--eps", type=float, default=EPS_DEFAULT,
-                    help=f"ε of --lyapunov-method variational ({fmt_number(EPS_DEFAULT, 3, short_exponent=True)})")
+                    help="the regularisation parameter epsilon of --lyapunov-method variational")
     dy.add_argument("--attractors", type=finite_float_list, metavar="A0,A0,...",
-                    help="sample these initial peel angles for coexisting attractors")
-    dy.add_argument("--format", choices=("table", "json"), default="table")
+                    help="sample these initial peel angles [rad] for coexisting attractors")
+    add_format(dy)
     dy.add_argument("--out", help="also write the summary row to this .csv or .json")
     dy.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
-                    help="wall-clock budget of each computation (run, Lyapunov exponent, attractors) [s] (600)")
+                    help="wall-clock budget of each computation (run, Lyapunov exponent, attractors) [s]")
     return dy
 
 
@@ -63,8 +74,8 @@ def run(args: argparse.Namespace) -> int:
     if wants_lyapunov:  # the method's options, checked before the window run (named as the CLI spells them)
         method, options = _lyapunov_options(args, returns=None)
         check_lyapunov_options(method, **options)
-    law = force_from_args(args)
-    p = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=law)
+    p = params_from_args(args)
+    law = p.force
     if wants_lyapunov and method == "variational":  # the method's laws, checked before the window run
         from exact import VARIATIONAL_LAWS
 
@@ -116,6 +127,8 @@ def run(args: argparse.Namespace) -> int:
                      F_max=a.F_range[1]) for a in res]
         if args.format == "json":
             print(json.dumps(rows, indent=2))
+        elif args.format == "csv":
+            write_csv(sys.stdout, rows)
         else:
             print(f"{len(res)} attractor(s) from {len(a0s)} starts:")
             for r in rows:

@@ -7,15 +7,29 @@ import os
 import sys
 
 from ._checks import check_output_path
-from ._common import say
+from ._common import say, subcommand
 
-__all__ = ["add_parser", "run"]
+__all__ = ["DEFAULT_OUT", "add_parser", "run"]
+
+#: Where ``peelapprox figures`` writes without ``--out``: a directory of its own in the working directory (never
+#: into a ``docs/`` that happens to be there).
+DEFAULT_OUT = "peelapprox-figures"
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
-    fg = sub.add_parser("figures", help="the paper's Figs. 2-9 from our exact solutions")
-    fg.add_argument("--only", action="append", metavar="NAME", help="draw only this figure (repeatable): fig2 … fig9")
-    fg.add_argument("--out", default="docs/figures", help="output directory (docs/figures)")
+    fg = subcommand(
+        sub, "figures", help="the paper's Figs. 2-9 from our exact solutions",
+        description="The paper's Figs. 2-9 redrawn from our exact solutions (Fig. 2: f(v, V); 3-5 and 7: orbits in "
+                    "time and in the v-F plane; 6: mean force drops against V; 8-9: the approximate-vs-exact "
+                    "overlays of compare), as PNG files, with a captioned markdown page on request.  All of them "
+                    "take a few minutes.",
+        examples=["peelapprox figures --list",
+                  f"peelapprox figures --only fig4                        # into ./{DEFAULT_OUT}/",
+                  "peelapprox figures --out docs/figures --markdown docs/figures.md   # regenerates the repository's "
+                  "page"])
+    fg.add_argument("--only", action="append", metavar="NAME",
+                    help="draw only this figure (repeatable; default: all): fig2, fig3, ..., fig9 (see --list)")
+    fg.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help="output directory (created)")
     fg.add_argument("--markdown", metavar="PATH", help="also write the captioned page, e.g. docs/figures.md")
     fg.add_argument("--list", action="store_true", help="list the figures and exit")
     return fg

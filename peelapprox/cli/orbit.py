@@ -9,34 +9,42 @@ import numpy as np
 
 from .. import WINDOW_DEFAULTS, PeelParams
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float, positive_int
-from ._common import add_params, print_mapping, say, write_table
-from ._force import force_from_args, law_fields
+from ._common import FORMATS, add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
+from ._force import law_fields
 
 __all__ = ["add_bifurcation_parser", "add_orbit_parser", "run_bifurcation", "run_orbit"]
 
 
 def _seed_options(sp: argparse.ArgumentParser) -> None:
     w = WINDOW_DEFAULTS
-    sp.add_argument("--alpha0", type=float, default=w["alpha0"], help="start of the seed run [rad] (0)")
+    sp.add_argument("--alpha0", type=float, default=w["alpha0"], help="initial peel angle of the seed run [rad]")
     sp.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"],
-                    help=f"transient of the seed run [s] ({w['t_transient']:g})")
-    sp.add_argument("--window", type=positive_float, default=w["window"], help=f"its window [s] ({w['window']:g})")
+                    help="transient of the seed run [s]")
+    sp.add_argument("--window", type=positive_float, default=w["window"],
+                    help="its window [s], where the period is read")
 
 
 def add_orbit_parser(sub) -> argparse.ArgumentParser:
-    sp = sub.add_parser("orbit", help="a periodic orbit by Newton on the AB->CD section: period, Floquet "
-                                      "multipliers, stability, one period drawn")
+    sp = subcommand(
+        sub, "orbit", help="a periodic orbit by Newton on the AB->CD section: period, Floquet multipliers, "
+                           "stability, one period drawn",
+        description="A periodic orbit of the exact model as an object: a seed run gives the period n (AB->CD jumps "
+                    "per period) and a start; Newton's method on the return map to the AB->CD section closes the "
+                    "orbit; its period [s], Floquet multipliers (stable when all |mu| < 1) and the force at its "
+                    "jumps are printed.",
+        examples=["peelapprox orbit --V 1 --I 1e-5 --plot orbit.png     # periodic orbit, multipliers, stability",
+                  "peelapprox orbit --V 1 --I 1e-2 --n 8 --format json"])
     add_params(sp)
     _seed_options(sp)
     sp.add_argument("--n", type=positive_int, help="AB->CD jumps per period (default: the seed run's period)")
-    sp.add_argument("--format", choices=("table", "json"), default="table")
+    add_format(sp)
     sp.add_argument("--out", help="also write the summary row to this .csv or .json")
-    sp.add_argument("--plot", help="draw one period (F, α, v against t and the v-F plane) to this image file")
+    sp.add_argument("--plot", help="draw one period (F, alpha, v against t and the v-F plane) to this image file")
     return sp
 
 
 def _params(args: argparse.Namespace) -> PeelParams:
-    return PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args))
+    return params_from_args(args)
 
 
 def run_orbit(args: argparse.Namespace) -> int:
@@ -62,29 +70,45 @@ def run_orbit(args: argparse.Namespace) -> int:
         from ..plotting import plot_trajectory
 
         mus = ", ".join(f"{abs(m):.4g}" for m in o.multipliers)
-        plot_trajectory(o.trajectory(), plot, title=f"period-{o.n} orbit, V = {p.V} m/s, I = {p.I:g} kg m²: "
-                        f"T = {o.period:.6g} s, |μ| = {mus} ({'stable' if o.stable else 'unstable'})")
+        plot_trajectory(o.trajectory(), plot, cycles=None,
+                        title=f"period-{o.n} orbit, V = {p.V} m/s, I = {p.I:g} kg m²: T = {o.period:.6g} s, "
+                              f"|μ| = {mus} ({'stable' if o.stable else 'unstable'})")
         say(f"wrote {plot}")
     return 0
 
 
 def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
-    sp = sub.add_parser("bifurcation", help="the brute-force orbit diagram over a parameter with continued "
-                                            "branches of periodic orbits drawn over it")
+    sp = subcommand(
+        sub, "bifurcation", help="the brute-force orbit diagram over a parameter with continued branches of "
+                                 "periodic orbits drawn over it",
+        description="The orbit diagram over one parameter (V, I, k or a coefficient of a family law): at each "
+                    "value, F at the AB->CD jumps after the transient; then periodic orbits found at seed values "
+                    "and continued both ways (pseudo-arclength through folds), their bifurcations (fold, period "
+                    "doubling, Neimark-Sacker) and non-smooth ends (grazing, crest event, breakdown) reported; "
+                    "at each period doubling the doubled branch is followed.  Prints one line a branch (--format); "
+                    "progress on stderr.",
+        examples=["peelapprox bifurcation --V 1 --I 1e-2 --param V --range 0.5:1.5:21 --plot bif.png --out bif.csv",
+                  "peelapprox bifurcation --V 1 --I 1e-5 --param I --range 1e-5:1e-4:10 --seeds 2e-5,5e-5",
+                  "peelapprox bifurcation --V 1 --I 1e-5 --force-family cubic --param force.c --range 280:320:9"])
     add_params(sp)
     _seed_options(sp)
-    sp.add_argument("--param", default="V", help="V, I, k or force.<coefficient> of a family law (V)")
+    sp.add_argument("--param", default="V", help="the parameter: V, I, k or force.NAME (a coefficient of "
+                                                 "--force-family)")
     sp.add_argument("--range", required=True, metavar="LO:HI[:N]",
-                    help="the parameter's range and the diagram's number of values (N = 40)")
+                    help="the parameter's range (in its unit: V [m/s], I [kg m^2], k [N/m]) and the diagram's "
+                         "number of values (default N: 40)")
     sp.add_argument("--seeds", metavar="X,X,...|auto",
                     help="parameter values at which orbits are found and continued both ways; auto (the default): "
                          "each periodic diagram value that no branch found so far explains (exact.explain), in "
                          "order, at most --max-seeds")
-    sp.add_argument("--max-seeds", type=positive_int, default=20, help="most automatic seeds (20)")
-    sp.add_argument("--max-points", type=positive_int, default=200, help="most orbits per branch (200)")
+    sp.add_argument("--max-seeds", type=positive_int, default=20, help="most automatic seeds")
+    sp.add_argument("--max-points", type=positive_int, default=200, help="most orbits per branch")
     sp.add_argument("--switch", type=nonnegative_int, default=1,
                     help="levels of period doubling followed: at each period doubling found, the doubled branch "
-                         "is started (exact.switch_branch) and continued, to this depth (1; 0: none)")
+                         "is started (exact.switch_branch) and continued, to this depth (0: none)")
+    sp.add_argument("--format", choices=FORMATS, default="table",
+                    help="how the branches are printed: table (one line a branch: period, points, parameter span "
+                         "[unit of --param], bifurcations, end), csv or json (the same as rows)")
     sp.add_argument("--out", help="write every diagram point and branch point to this .csv or .json")
     sp.add_argument("--plot", help="draw the diagram and the branches to this image file")
     return sp
@@ -167,6 +191,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     say(f"explained: {len(periodic) - len(missing)} of the {len(periodic)} periodic values of the diagram lie on a "
         "stable continued branch of the same period (exact.explain)"
         + (f"; not: {', '.join(missing)}" if missing else ""))
+    _print_branches(branches, args.param, args.format)
     if out:
         rows = [dict(kind="diagram", **r) for r in diagram.rows()]
         by_value = {float(x): (None if e is None else e + 1) for x, e in zip(diagram.values, explained)}
@@ -183,3 +208,27 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         plot_bifurcation(diagram, branches, plot, title=f"{args.param} in [{lo:g}, {hi:g}]")
         say(f"wrote {plot}")
     return 0
+
+
+def _print_branches(branches: list, param: str, fmt: str) -> None:
+    """One row per continued branch on stdout: its period n, orbits, parameter span, bifurcations and end."""
+    import json
+    import sys
+
+    from ..io import write_csv
+
+    rows = [dict(branch=k + 1, n=b.points[0].orbit.n, orbits=len(b.points), start=b.points[0].value,
+                 end=b.end_value, stopped=b.stopped,
+                 bifurcations="; ".join(f"{x.kind} at {x.value:.8g}" for x in b.bifurcations))
+            for k, b in enumerate(branches)]
+    if fmt == "json":
+        print(json.dumps(rows, indent=2))
+    elif fmt == "csv":
+        write_csv(sys.stdout, rows, fields=["branch", "n", "orbits", "start", "end", "stopped", "bifurcations"])
+    else:
+        unit = {"V": " m/s", "I": " kg m^2", "k": " N/m"}.get(param, "")
+        over = f"{param} [{unit.strip()}]" if unit else param
+        print(f"{len(branches)} branch{'es' * (len(branches) != 1)} over {over}:")
+        for r in rows:
+            print(f"  branch {r['branch']}: period-{r['n']}, {r['orbits']} orbits, {param} = {r['start']:.6g} -> "
+                  f"{r['end']:.6g}{unit}, stopped: {r['stopped']}; {r['bifurcations'] or 'no bifurcation'}")

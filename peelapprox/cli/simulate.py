@@ -3,41 +3,54 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
-from .. import GEOMETRIES, PeelParams
-from ._checks import check_output_path, positive_float
-from ._common import add_params
-from ._force import force_from_args, law_fields
+from ._checks import check_output_path, positive_float, positive_int
+from ._common import add_format, add_params, params_from_args, print_mapping, subcommand
+from ._force import law_fields
 
 __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
-    sp = sub.add_parser("simulate", help="integrate the full model (exact solution)")
+    sp = subcommand(
+        sub, "simulate", help="integrate the full model (exact solution)",
+        description="Integrate the full model (the DAE of the paper, its jumps between the branches of f(v, V) "
+                    "included) from an initial state and print a summary of the run: steps, jumps, the force at "
+                    "the jumps, the final state.  Methods: hybrid (the jumps as events, exact as eps -> 0; the "
+                    "default) or regularized (the paper's eps-regularised scheme, by scipy's Radau, BDF or LSODA).",
+        examples=["peelapprox simulate --V 1 --I 1e-2 --t-end 20 --t-transient 10 --plot fig4.png --out run.npz",
+                  "peelapprox simulate --V 4 --I 1e-2 --t-end 200 --jumps-only --jumps-csv jumps.csv",
+                  "peelapprox simulate --V 1.2 --I 1e-5 --t-end 1 --force-family cubic --coef c=280",
+                  "peelapprox simulate --V 1 --I 1e-2 --t-end 1 --method regularized --eps 1e-7 --format json"])
     add_params(sp)
-    sp.add_argument("--l", type=float, default=1.0, help="roller-motor distance [m] (1)")
-    sp.add_argument("--geometry", choices=GEOMETRIES, default="paper")
-    sp.add_argument("--t-end", type=float, required=True, help="final time [s]")
-    sp.add_argument("--alpha0", type=float, default=0.0)
-    sp.add_argument("--omega0", type=float, default=None, help="default V/R")
-    sp.add_argument("--F0", type=float, default=None, help="default 1.01 f(V, V)")
-    sp.add_argument("--branch0", choices=("AB", "CD"), default=None, help="default: lowest-velocity stable root")
-    sp.add_argument("--method", choices=("hybrid", "regularized"), default="hybrid")
-    sp.add_argument("--solver", choices=("Radau", "BDF", "LSODA"), default=None,
-                    help="for --method regularized (Radau)")
-    sp.add_argument("--rtol", type=float, default=1e-8)
-    sp.add_argument("--eps", type=float, default=None, help="regularisation epsilon (regularized only; 1e-7)")
-    sp.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
-                    help="wall-clock budget of the integration [s] (600)")
-    sp.add_argument("--t-transient", type=float, default=0.0, help="store nothing before this time [s]")
-    sp.add_argument("--jumps-only", action="store_true", help="store only the jumps (long runs)")
-    sp.add_argument("--out", help="write the trajectory to this .npz")
-    sp.add_argument("--jumps-csv", help="write the jumps to this CSV")
-    sp.add_argument("--plot", help="write F(t), alpha(t), v(t) and the v-F plane to this image")
-    sp.add_argument("--format", choices=("table", "json"), default="table", help="summary format")
-    sp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    g = sp.add_argument_group("the run")
+    g.add_argument("--t-end", type=float, required=True, help="final time [s]")
+    g.add_argument("--alpha0", type=float, default=0.0, help="initial peel angle [rad]")
+    g.add_argument("--omega0", type=float, default=None, help="initial roller speed [rad/s] (default: V/R)")
+    g.add_argument("--F0", type=float, default=None, help="initial pull force [N] (default: 1.01 f(V, V))")
+    g.add_argument("--branch0", choices=("AB", "CD"), default=None,
+                   help="initial branch of f (default: the lowest-velocity stable root)")
+    g.add_argument("--method", choices=("hybrid", "regularized"), default="hybrid",
+                   help="hybrid: jumps as events; regularized: the paper's eps-scheme")
+    g.add_argument("--solver", choices=("Radau", "BDF", "LSODA"), default=None,
+                   help="scipy solver of --method regularized (default: Radau)")
+    g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the integration")
+    g.add_argument("--eps", type=float, default=None,
+                   help="the paper's regularisation parameter epsilon of --method regularized (default: 1e-7)")
+    g.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
+                   help="wall-clock budget of the integration [s]")
+    g.add_argument("--t-transient", type=float, default=0.0, help="store nothing before this time [s]")
+    g.add_argument("--jumps-only", action="store_true", help="store only the jumps (long runs)")
+    o = sp.add_argument_group("output")
+    add_format(o)
+    o.add_argument("--out", help="write the trajectory to this .npz")
+    o.add_argument("--jumps-csv", help="write the jumps to this CSV")
+    o.add_argument("--plot", help="write F(t), alpha(t), v(t) and the v-F plane to this image (.png, .pdf, .svg, ...)")
+    o.add_argument("--plot-cycles", type=positive_int, default=5, metavar="N",
+                   help="--plot shows the last N stick-slip cycles (AB->CD jump to AB->CD jump)")
+    o.add_argument("--plot-all", action="store_true", help="--plot shows the whole stored run")
+    o.add_argument("--quiet", action="store_true", help="no progress on stderr")
     return sp
 
 
@@ -49,8 +62,8 @@ def run(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "npz", "--out") if args.out else None
     jumps_csv = check_output_path(args.jumps_csv, "file", "--jumps-csv") if args.jumps_csv else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    law = force_from_args(args)
-    params = PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, l=args.l, geometry=args.geometry, force=law)
+    params = params_from_args(args)
+    law = params.force
     traj = simulate(
         params,
         args.t_end,
@@ -87,11 +100,7 @@ def run(args: argparse.Namespace) -> int:
     if len(traj.jumps):
         summary["F_at_jumps_range"] = [float(traj.jumps.F.min()), float(traj.jumps.F.max())]
     summary.update(law_fields(law, spec=args.format == "json"))
-    if args.format == "json":
-        print(json.dumps(summary, indent=2))
-    else:
-        for key, val in summary.items():
-            print(f"{key:>18}: {val}")
+    print_mapping(summary, args.format)
     if out:
         traj.to_npz(out)  # records the law: its params (with force) as dataclasses.asdict
         print(f"wrote {out}", file=sys.stderr)
@@ -101,6 +110,6 @@ def run(args: argparse.Namespace) -> int:
     if plot:
         from ..plotting import plot_trajectory
 
-        plot_trajectory(traj, plot)
+        plot_trajectory(traj, plot, cycles=None if args.plot_all else args.plot_cycles)
         print(f"wrote {plot}", file=sys.stderr)
     return 0

@@ -8,20 +8,50 @@ import os
 import sys
 import time
 
+from .. import GEOMETRIES
 from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler, nonnegative_int, positive_int
+from ._common import subcommand
 from ._force import add_force_options, force_from_args
 
-__all__ = ["add_parser", "run"]
+__all__ = ["MEASURES_HELP", "add_parser", "run"]
+
+
+#: The built-in measures of ``comparisons.sweep`` and what each records (for ``--help``; the parser is built
+#: without loading ``comparisons``: tests/test_cli_conventions.py keeps the names equal to its ``MEASURES``).
+MEASURES_HELP = {
+    "regime": "the paper's regime in closed form (peelapprox.estimate: inertia and velocity labels, periods, times "
+              "[s]); instant",
+    "jumps": "jump statistics of one exact run (count, slips, mean interval and period [s], mean force drop [N]); "
+             "options --t-transient, --t-end or --window, --rtol, --alpha0",
+    "period": "the return map's period over the same run (label, period [returns], mismatch); options as jumps, "
+              "and --period-rtol",
+    "lyapunov": "the largest Lyapunov exponent [bits/s] and its standard error, by the two-trajectory method "
+                "(exact.lyapunov's default; the other methods: peelapprox dynamics --lyapunov-method); options "
+                "--t-transient, --lyapunov-time, --alpha0",
+}
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
-    sw = sub.add_parser("sweep", help="measures over an (I, V) grid on a process pool or a dask cluster; "
-                                      "incremental output, resumes automatically")
+    sw = subcommand(
+        sub, "sweep", help="measures over an (I, V) grid on a process pool or a dask cluster; incremental output, "
+                           "resumes automatically",
+        description="Measures over an (I, V) grid (and optionally a coefficient of a family law as a third axis), "
+                    "one point a task on a local process pool or a dask cluster; every finished point is appended "
+                    "to DIR/results.jsonl, so an interrupted sweep resumes where it stopped.  Measures "
+                    "(--measure, comma-separated; more with comparisons.sweep.register_measure):\n\n"
+                    + "\n\n".join(f"{k}: {v}" for k, v in MEASURES_HELP.items())
+                    + "\n\nOptions left out take each measure's own default (given below).",
+        examples=["peelapprox sweep --I 1e-5:1e-2:4:log --V 1:4:4 --measure period,jumps --out sweep/   # resumable",
+                  "peelapprox sweep --I 1e-4 --V 1.5:3:4 --measure lyapunov --lyapunov-time 20 --out ly/ "
+                  "--plot lyapunov_bits_per_s",
+                  "peelapprox sweep --I 1e-5 --V 1:2:3 --force-family cubic --coef-axis c=290,300,310 "
+                  "--measure period --out cubic/",
+                  "peelapprox sweep --I 1e-5:1e-2:8:log --V 0.5:4:8 --dask-local 4 --out big/"])
     sw.add_argument("--I", required=True, metavar="SPEC",
                     help="roller inertias [kg m^2]: start:stop:num[:log] or a comma list, e.g. 1e-5:1e-2:8:log")
     sw.add_argument("--V", required=True, metavar="SPEC", help="pull speeds [m/s], same syntax, e.g. 0.4:4:10")
     sw.add_argument("--measure", default="regime", metavar="NAMES",
-                    help="comma-separated measures (regime; jumps; others registered via register_measure)")
+                    help=f"comma-separated measures: {', '.join(MEASURES_HELP)} (above), or registered ones")
     sw.add_argument("--out", required=True, metavar="DIR",
                     help="output directory: sweep.json, results.jsonl (one line per point), results.csv; "
                          "an existing DIR with the same grid, measures and options is resumed")
@@ -32,12 +62,23 @@ def add_parser(sub) -> argparse.ArgumentParser:
                        help="start a dask LocalCluster with N single-threaded worker processes")
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
                        help="connect to a running dask scheduler, e.g. tcp://host:8786")
-    sw.add_argument("--t-end", type=float, default=None, help="final time [s] (jumps, period: t_transient + 20)")
-    sw.add_argument("--t-transient", type=float, default=None, help="transient skipped [s] (30)")
-    sw.add_argument("--rtol", type=float, default=None, help="solver tolerance (jumps, period: 1e-10)")
-    sw.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (0)")
-    sw.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (1000)")
-    sw.add_argument("--R", type=float, default=None, help="roller radius [m] (0.1)")
+    m = sw.add_argument_group("options of the measures (left out: the measure's default)")
+    m.add_argument("--t-end", type=float, default=None,
+                   help="final time [s] (jumps, period; default: t_transient + window)")
+    m.add_argument("--window", type=float, default=None, help="measured window [s] (jumps, period; default: 20)")
+    m.add_argument("--t-transient", type=float, default=None, help="transient skipped [s] (default: 30)")
+    m.add_argument("--rtol", type=float, default=None, help="solver tolerance (jumps, period; default: 1e-10)")
+    m.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (default: 0)")
+    m.add_argument("--period-rtol", type=float, default=None,
+                   help="relative tolerance of a repeat of the return map (period; default: 1e-6)")
+    m.add_argument("--lyapunov-time", type=float, default=None, help="measured time [s] (lyapunov; default: 50)")
+    p = sw.add_argument_group("model parameters (PeelParams; V and I are the grid)")
+    p.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (default: 1000)")
+    p.add_argument("--R", type=float, default=None, help="roller radius [m] (default: 0.1)")
+    p.add_argument("--l", type=float, default=None, help="roller-motor distance [m] (read by --geometry exact; "
+                                                        "default: 1)")
+    p.add_argument("--geometry", choices=GEOMETRIES, default=None,
+                   help="the closure cos(theta): paper or exact (default: paper)")
     sw.add_argument("--retry-failed", action="store_true",
                     help="compute again the points of DIR whose status is an error (else they count as done)")
     sw.add_argument("--plot", metavar="KEY", help="draw KEY over (V, I) to DIR/KEY.png, e.g. regime_label "
@@ -47,7 +88,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     help="sweep the coefficient NAME of --force-family as a third grid axis (I x V x values; give "
                          "one --I or --V value to sweep it instead), SPEC as for --I, e.g. c=290,300,310; every "
                          "record holds its coef and its law")
-    sw.add_argument("--format", choices=("md", "csv", "json"), default="md", help="table printed at the end (md)")
+    sw.add_argument("--format", choices=("table", "md", "csv", "json"), default="table",
+                    help="the table printed at the end: table (markdown; md is the same), csv or json")
     sw.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
     return sw
 
@@ -61,10 +103,13 @@ def _coef_axis(text: str) -> tuple[str, str]:
     return name, spec
 
 
+#: The sweep options the command line sets (each only when given: a resumed sweep's options must match).
+_OPTIONS = ("t_end", "window", "t_transient", "rtol", "alpha0", "period_rtol", "lyapunov_time", "k", "R", "l",
+            "geometry")
+
+
 def _options(args: argparse.Namespace) -> dict:
-    return {key: val for key, val in (("t_end", args.t_end), ("t_transient", args.t_transient),
-                                      ("rtol", args.rtol), ("alpha0", args.alpha0), ("k", args.k),
-                                      ("R", args.R)) if val is not None}
+    return {key: getattr(args, key) for key in _OPTIONS if getattr(args, key) is not None}
 
 
 def run(args: argparse.Namespace) -> int:
