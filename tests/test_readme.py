@@ -3,13 +3,14 @@
 * Each ```python block runs as a script of its own in a fresh process, in a temporary working directory, and
   must exit 0 (a block is self-contained: README shows it as something to paste).
 * In ```bash / ```sh / ```console blocks, lines joined at a trailing backslash and split at ``&&``, every
-  command that starts with ``peelapprox`` must exit 0; ``pip install ...`` and ``python -m pytest`` are not run
-  (installing is the environment's business; the tests do not run themselves).  The cheap commands (under
-  ~5 s each) run in the default tier, one after another in one fresh process through ``peelapprox.cli.main``,
-  the console script's own entry point (the import is paid once, not ten times); each is a test of its own.
-  The long ones are marked slow, each in its own process, with their measured cost in ``SLOW``.  The README's
-  ``my_tape.csv`` (your own tape) is written first: the paper's f(v, 1.2) at 30 points per decade of v in
-  [1e-6, 31.6] m/s, a curve the example command can run on.
+  command that starts with ``peelapprox`` (or ``python -m peelapprox``, run as the same) must exit 0;
+  ``pip install ...`` and ``python -m pytest`` are not run (installing is the environment's business; the
+  tests do not run themselves).  The cheap commands (under ~5 s each) run in the default tier, one after
+  another in one fresh process through ``peelapprox.cli.main``, the console script's own entry point (the
+  import is paid once, not ten times); each is a test of its own.  The long ones are marked slow, each in
+  its own process, with their measured cost in ``SLOW``.  The README's ``my_tape.csv`` (your own tape) is
+  written first: the paper's f(v, 1.2) at 30 points per decade of v in [1e-6, 31.6] m/s, a curve the
+  example command can run on.
 * Nothing is written outside the temporary directory (relative outputs such as ``--out sweep/`` land there).
 
 The default tier costs ~12 s of CPU (three Python blocks, one process for the eleven cheap commands, started
@@ -40,6 +41,7 @@ SLOW = {
     "peelapprox dynamics": "Lyapunov exponents over 50-200 s of orbit, 8-12 s each",
     "peelapprox sweep": "16 exact runs of 50 s, ~11 s",
     "peelapprox figures": "the paper's Figs. 2-9, ~9 s",
+    "peelapprox basins": "54 starts of 60 s each with their orbits, ~20 s",
 }
 
 
@@ -57,6 +59,8 @@ def _commands() -> list[str]:
             line = line.removeprefix("$ ")
             for part in line.split("&&"):
                 words = shlex.split(part, comments=True)
+                if words[:3] == ["python", "-m", "peelapprox"]:  # the same command as a module
+                    words = words[2:]
                 if words and words[0] == "peelapprox":
                     commands.append(shlex.join(words))
     return commands

@@ -54,9 +54,10 @@ def main() -> None:
     print(f"F over the window: max {tr.F.max():.2f} N (f_max {bs.f_max:.2f}), min {tr.F.min():.2f} N "
           f"(f_min {bs.f_min:.2f})")
 
-    # F(t), alpha(t), v(t) and the v-F phase plane with f(v, V): the paper's Fig. 4.
+    # F(t), alpha(t), v(t) and the v-F phase plane with f(v, V): the paper's Fig. 4.  cycles= is how many of
+    # the last slips to draw (default 5; cycles=None draws the whole window): here two periods of the orbit.
     path = out / "quickstart.png"
-    plot_trajectory(tr).savefig(path, dpi=110)
+    plot_trajectory(tr, cycles=2 * (per.period or 8)).savefig(path, dpi=110)
     print(f"wrote {path}")
 
 
