@@ -1,0 +1,183 @@
+"""README.md's code runs: every ```python block, and every `peelapprox ...` line of its shell blocks.
+
+* Each ```python block runs as a script of its own in a fresh process, in a temporary working directory, and
+  must exit 0 (a block is self-contained: README shows it as something to paste).
+* In ```bash / ```sh / ```console blocks, lines joined at a trailing backslash and split at ``&&``, every
+  command that starts with ``peelapprox`` (or ``python -m peelapprox``, run as the same) must exit 0;
+  ``pip install ...`` and ``python -m pytest`` are not run (installing is the environment's business; the
+  tests do not run themselves).  The cheap commands (under ~5 s each) run in the default tier, one after
+  another in one fresh process through ``peelapprox.cli.main``, the console script's own entry point (the
+  import is paid once, not ten times); each is a test of its own.  The long ones are marked slow, each in
+  its own process, with their measured cost in ``SLOW``.  The README's ``my_tape.csv`` (your own tape) is
+  written first: the paper's f(v, 1.2) at 30 points per decade of v in [1e-6, 31.6] m/s, a curve the
+  example command can run on.
+* Nothing is written outside the temporary directory (relative outputs such as ``--out sweep/`` land there).
+
+The default tier costs ~12 s of CPU (three Python blocks, one process for the eleven cheap commands, started
+together).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+README = ROOT / "README.md"
+TIMEOUT = 900  # s
+
+# Commands too long for the default tier: a prefix of the command -> why (measured wall time, warm, 2 cores).
+SLOW = {
+    "peelapprox benchmark": "work-precision runs of every solver and the ε study, ~80 s",
+    "peelapprox bifurcation": "a 21-point brute-force diagram and continued branches, ~60 s",
+    "peelapprox dynamics": "Lyapunov exponents over 50-200 s of orbit, 8-12 s each",
+    "peelapprox sweep": "16 exact runs of 50 s, ~11 s",
+    "peelapprox figures": "the paper's Figs. 2-9, ~9 s",
+    "peelapprox basins": "54 starts of 60 s each with their orbits, ~20 s",
+}
+
+
+def _blocks(langs: tuple[str, ...]) -> list[str]:
+    """The fenced code blocks of README.md in those languages, in order."""
+    return [body for lang, body in re.findall(r"^```(\w*)\n(.*?)^```", README.read_text(), re.S | re.M)
+            if lang in langs]
+
+
+def _commands() -> list[str]:
+    """Every ``peelapprox ...`` command of the shell blocks (continuations joined, comments dropped)."""
+    commands = []
+    for block in _blocks(("bash", "sh", "console")):
+        for line in block.replace("\\\n", " ").splitlines():
+            line = line.removeprefix("$ ")
+            for part in line.split("&&"):
+                words = shlex.split(part, comments=True)
+                if words[:3] == ["python", "-m", "peelapprox"]:  # the same command as a module
+                    words = words[2:]
+                if words and words[0] == "peelapprox":
+                    commands.append(shlex.join(words))
+    return commands
+
+
+PYTHON_BLOCKS = _blocks(("python",))
+COMMANDS = _commands()
+CHEAP = [c for c in COMMANDS if not any(c.startswith(prefix) for prefix in SLOW)]
+
+# Runs the cheap commands one by one through the console script's entry point, each with its own stdout and
+# stderr, and writes their exit statuses (and stderr's tail) as JSON to argv[1].
+_DRIVER = """
+import contextlib, io, json, shlex, sys
+from peelapprox.cli import main
+results = {}
+for command in json.loads(sys.argv[2]):
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        try:
+            status = main(shlex.split(command)[1:])
+        except SystemExit as exc:
+            status = exc.code
+    results[command] = [status, err.getvalue()[-2000:]]
+with open(sys.argv[1], "w") as f:
+    json.dump(results, f)
+"""
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ, MPLBACKEND="Agg")
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH")) if p)
+    return env
+
+
+def _write_tape(directory: Path) -> None:
+    """``my_tape.csv`` of the README's ``--force-table`` line: fvV at V = 1.2 m/s, 30 points per decade."""
+    from peelapprox import peel_force
+
+    v = np.logspace(-6, 1.5, 226)
+    np.savetxt(directory / "my_tape.csv", np.c_[v, peel_force(v, 1.2)], delimiter=",", header="v,f", comments="")
+
+
+def _collect(proc: subprocess.Popen) -> tuple[int, str, str]:
+    try:
+        stdout, stderr = proc.communicate(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        stdout, stderr = proc.communicate()
+    return proc.returncode, stdout, stderr
+
+
+@pytest.fixture(scope="module")
+def started(request, tmp_path_factory):
+    """The selected default-tier work of this module, all started at once: each Python block in its own
+    directory and process, and the cheap commands in one process.  ``started(key)`` waits for one of them:
+    ``"block<i>"`` gives ``(status, stdout, stderr)``, ``"commands"`` the same with the driver's results
+    ``{command: [status, stderr tail]}`` in place of stdout."""
+    selected = [item.name for item in request.session.items if item.module is request.module]
+    procs: dict[str, tuple[subprocess.Popen, Path | None]] = {}
+    for i, block in enumerate(PYTHON_BLOCKS):
+        if f"test_python_block[{i}]" in selected:
+            d = tmp_path_factory.mktemp(f"block{i}")
+            procs[f"block{i}"] = (subprocess.Popen([sys.executable, "-c", block], cwd=d, env=_env(), text=True,
+                                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE), None)
+    if any(name.startswith("test_cheap_command") for name in selected):
+        d = tmp_path_factory.mktemp("commands")
+        _write_tape(d)
+        procs["commands"] = (subprocess.Popen([sys.executable, "-c", _DRIVER, str(d / "results.json"),
+                                               json.dumps(CHEAP)], cwd=d, env=_env(), text=True,
+                                              stdout=subprocess.PIPE, stderr=subprocess.PIPE), d / "results.json")
+    done: dict[str, tuple] = {}
+
+    def get(key: str) -> tuple:
+        if key not in done:
+            proc, results = procs[key]
+            status, stdout, stderr = _collect(proc)
+            if results is not None and status == 0:
+                stdout = json.loads(results.read_text())
+            done[key] = (status, stdout, stderr)
+        return done[key]
+
+    yield get
+    for proc, _ in procs.values():
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+
+
+def test_readme_has_code():
+    """The extraction finds what README shows (3 Python blocks and ~18 commands today): a change of fences
+    that hid them from these tests would fail here."""
+    assert len(PYTHON_BLOCKS) >= 3 and len(COMMANDS) >= 15 and len(CHEAP) >= 8
+    assert all(any(c.startswith(prefix) for c in COMMANDS) for prefix in SLOW), "a SLOW entry matches nothing"
+
+
+@pytest.mark.parametrize("index", range(len(PYTHON_BLOCKS)))
+def test_python_block(started, index):
+    """README's ``index``-th Python block runs to the end (exit status 0) as a script of its own."""
+    status, stdout, stderr = started(f"block{index}")
+    assert status == 0, f"README python block {index} failed:\n{PYTHON_BLOCKS[index]}\n{stderr[-3000:]}"
+
+
+@pytest.mark.parametrize("command", CHEAP)
+def test_cheap_command(started, command):
+    """A cheap README command exits 0 (run in the shared driver process; see the module docstring)."""
+    status, results, stderr = started("commands")
+    assert status == 0, f"the driver failed:\n{stderr[-3000:]}"
+    code, err = results[command]
+    assert code in (0, None), f"{command} exited {code}:\n{err}"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", [c for c in COMMANDS if c not in CHEAP])
+def test_slow_command(tmp_path, command):
+    """A long README command exits 0 in its own process (``SLOW`` gives each one's cost)."""
+    proc = subprocess.Popen([sys.executable, "-c", "import sys; from peelapprox.cli import main; sys.exit(main())",
+                             *shlex.split(command)[1:]], cwd=tmp_path, env=_env(), text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    status, stdout, stderr = _collect(proc)
+    assert status == 0, f"{command} exited {status}:\n{stderr[-3000:]}"
