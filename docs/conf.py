@@ -50,6 +50,7 @@ suppress_warnings = ["myst.header"]  # a few chapters open with a level-2 headin
 # API reference: one page per public name (docs/api/*.rst list them; autosummary writes docs/api/generated/)
 autosummary_generate = True
 autosummary_imported_members = True  # the packages re-export names defined in private modules
+autosummary_ignore_module_all = False  # a module listed as a name (peelapprox.kernels.status): its __all__
 autodoc_default_options = {"members": False}
 autodoc_typehints = "none"  # the signature shows the hints; numpydoc's Parameters section describes them
 autodoc_member_order = "bysource"
