@@ -59,6 +59,47 @@ numpydoc_class_members_toctree = False
 numpydoc_attributes_as_param_list = False
 numpydoc_validation_checks: set[str] = set()
 
+
+
+def _constant_docs() -> dict[str, str]:
+    """The ``#:`` description of each re-exported public constant, from the module that defines it.
+
+    autodoc looks for a constant's ``#:`` comment in the module it documents the constant under
+    (``peelapprox`` for ``peelapprox.PARAM_RANGES``), but the comment is where the constant is written
+    (``peelapprox._params``; ``peelapprox.MEASURES`` in ``comparisons.sweep.measures``).  Find that module: a
+    module of the three packages whose attribute of that name is this very object and carries a ``#:``
+    comment.  The API pages' template adds the text (``_templates/autosummary/base.rst``).
+    """
+    import importlib
+    import inspect
+
+    from sphinx.pycode import ModuleAnalyzer
+
+    def attr_docs(modname: str) -> dict:
+        try:
+            return ModuleAnalyzer.for_module(modname).find_attr_docs()
+        except Exception:  # noqa: BLE001 - no source to read (an alias module): nothing to offer
+            return {}
+
+    docs = {}
+    for page in sorted((ROOT / "docs" / "api").glob("*.rst")):
+        if page.stem == "index":
+            continue
+        module = importlib.import_module(page.stem)
+        own = attr_docs(page.stem)
+        for name in module.__all__:
+            obj = getattr(module, name)
+            if inspect.isclass(obj) or inspect.ismodule(obj) or callable(obj) or ("", name) in own:
+                continue
+            for modname in sorted(m for m in sys.modules if m.split(".")[0] in ("peelapprox", "exact", "comparisons")):
+                if getattr(sys.modules[modname], name, None) is obj and ("", name) in (found := attr_docs(modname)):
+                    docs[f"{page.stem}.{name}"] = "\n".join(found[("", name)]).strip()
+                    break
+    return docs
+
+
+autosummary_context = {"constant_docs": _constant_docs()}
+
 html_theme = "pydata_sphinx_theme"
 html_title = f"peelapprox {release}"
 html_static_path = ["_static"]

@@ -215,7 +215,7 @@ def branch_structure(V: float) -> BranchStructure:
     return _branch_structure(_check_V(V))
 
 
-#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times max(|f(0+)|, 1 N)) at which the
+#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times ``max(|f(0+)|, 1 N)``) at which the
 #: model breaks down (BranchStructure.v_breakdown).
 BREAKDOWN_LEVEL = 1e-10
 
