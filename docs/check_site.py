@@ -12,7 +12,8 @@ download its own browser here).  Checks, per page:
   TeX delimiters (``$$``, ``\\(``, ``\\[``) are left in the text outside code, and the pages in
   ``MATH_PAGES`` have formulas at all;
 * images: every ``<img>`` loaded (``complete`` and ``naturalWidth > 0``);
-* the site is self-contained: no request leaves localhost (MathJax is served from ``_static``), and no
+* the site is whole and self-contained: every file a page asks for is served (no 404; the browser's own
+  ``/favicon.ico`` aside), no request leaves localhost (MathJax is served from ``_static``), and no
   JavaScript error was thrown;
 * API reference: each public module's page links every name of its ``__all__`` to an existing page.
 
@@ -101,6 +102,7 @@ def check(site: Path, *, chromium: str, screenshot: Path | None = None) -> list[
     base = f"http://127.0.0.1:{server.server_address[1]}/"
     external: list[str] = []
     errors: list[str] = []
+    missing: list[str] = []
 
     def route(r) -> None:  # noqa: ANN001 - playwright's Route
         if urlparse(r.request.url).hostname in ("127.0.0.1", "localhost"):
@@ -115,6 +117,8 @@ def check(site: Path, *, chromium: str, screenshot: Path | None = None) -> list[
         page = browser.new_page(viewport={"width": 1280, "height": 900})
         page.route("**/*", route)
         page.on("pageerror", lambda e: errors.append(f"{page.url}: {e}"))
+        page.on("response", lambda r: missing.append(f"{r.status} {r.url}")
+                if r.status >= 400 and urlparse(r.url).path != "/favicon.ico" else None)
         for name in pages:
             page.goto(base + name, wait_until="load")
             r = page.evaluate(_PROBE)
@@ -146,8 +150,10 @@ def check(site: Path, *, chromium: str, screenshot: Path | None = None) -> list[
     server.shutdown()
     failures += [f"request outside localhost: {u}" for u in sorted(set(external))]
     failures += [f"JavaScript error: {e}" for e in errors]
+    failures += [f"not served: {m}" for m in sorted(set(missing))]
     print(f"{totals['pages']} pages, {totals['math']} formulas typeset, {totals['images']} images loaded, "
-          f"{len(set(external))} external requests, {len(errors)} JavaScript errors: "
+          f"{len(set(missing))} files not served, {len(set(external))} external requests, "
+          f"{len(errors)} JavaScript errors: "
           + ("PASS" if not failures else f"FAIL ({len(failures)})"))
     return failures
 
