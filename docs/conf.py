@@ -38,7 +38,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "sweep", "**/README.md"]
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "sweep"]
 templates_path = ["_templates"]
 
 # markdown chapters: $...$ / $$...$$ math, heading anchors for the in-page links
