@@ -26,7 +26,7 @@ STAT_RUNS = ("V1-I1e-5", "V1-I1e-3", "V1-I1e-2", "V4-I1e-2")
 
 @dataclass(frozen=True)
 class StatRow:
-    """Distribution of one reduction's |relative error| in one quantity over all segments of one run.
+    """Distribution of one reduction's ``|relative error|`` in one quantity over all segments of one run.
 
     ``n`` segments were tried, ``n_failed`` of them broke down or did not exit (those are not in the
     percentiles); ``n_defined`` had the quantity (a period needs ≥ 2 crossings or extrema).
@@ -52,7 +52,7 @@ class StatRow:
 
 
 def statistics(runs: Sequence[str | RunSpec] = STAT_RUNS, models=None) -> RowTable:
-    """Median, 90th percentile and max of |relative error| of Δt, ΔF and the α period, per run, branch and
+    """Median, 90th percentile and max of ``|relative error|`` of Δt, ΔF and the α period, per run, branch and
     reduction, over every complete segment of each run's window (seeded from the exact entries).
 
     ``runs`` are names of :data:`RUNS` or :class:`RunSpec` s (a run of any peel-force law: its reductions use

@@ -36,7 +36,7 @@ PARAM_RANGES = {
 #: entry states; forces, velocities and angles of the closed forms), closed unless noted:
 #:
 #: * ``"alpha"`` [rad], ``[-π, π]``: one turn (the closures are 2π-periodic; the reduced equations,
-#:   linear in α, are meant for |α| of order 0.1).
+#:   linear in α, are meant for ``|α|`` of order 0.1).
 #: * ``"omega"`` [rad/s], for ω and α̇: ``|ω| <= 1e9``, above every natural rate of the model within
 #:   :data:`PARAM_RANGES` (``V/R <= 1e6``; the inertial frequency ``sqrt(F R/I)`` on the branches,
 #:   F <= 1e3 N, is <= 1e8).  Measured: α̇_in = 1e9 still returns (or fails with a documented

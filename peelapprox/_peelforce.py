@@ -141,7 +141,7 @@ class BranchStructure:
         ``f_min <= f_zero`` (the orbit would have nowhere to land).
     v_breakdown : float
         The AB velocity where ``f(v, V) - f(0+, V) = BREAKDOWN_LEVEL``
-        (1e-10 max(|f(0+)|, 1 N)): a level this close to ``f(0+)`` is
+        (``1e-10 max(|f(0+)|, 1 N)``): a level this close to ``f(0+)`` is
         f(0+) to within the rounding of the solvers' arithmetic, so CONSTR
         has no resolvable root above it (the model's breakdown criterion,
         used by ``exact.simulate``).  Since ``f - f(0+) ≈ 110 v^0.15`` at
@@ -215,7 +215,7 @@ def branch_structure(V: float) -> BranchStructure:
     return _branch_structure(_check_V(V))
 
 
-#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times max(|f(0+)|, 1 N)) at which the
+#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times ``max(|f(0+)|, 1 N)``) at which the
 #: model breaks down (BranchStructure.v_breakdown).
 BREAKDOWN_LEVEL = 1e-10
 

@@ -24,7 +24,7 @@ __all__ = ["EpsRow", "eps_study", "small_eps_check", "fit_power_law"]
 class EpsRow:
     """The regularised scheme's fold-passage delays at one ε: ``delay_ab`` = t_reg − t_hybrid at the first
     AB→CD jump, ``delay_cd`` at the first CD→AB jump [s] (the regularised jump is the inflection crossing,
-    so this is the delay past the fold plus the transit to the inflection); ``err_F`` = max |ΔF|/F there."""
+    so this is the delay past the fold plus the transit to the inflection); ``err_F`` = max ``|ΔF|/F`` there."""
 
     eps: float
     solver: str

@@ -27,7 +27,7 @@ __all__ = ["EXPLANATIONS", "tolerance_table", "pair_long_runs", "robustness_mark
 def tolerance_table(records: Iterable[dict]) -> list[dict]:
     """Per tolerance-sweep point and rtol: outcome, work and jump-time error against the tightest rtol.
 
-    ``err_jump_t`` is the max |t_j - t_j^ref| over the jumps both runs have
+    ``err_jump_t`` is the max ``|t_j - t_j^ref|`` over the jumps both runs have
     (``n_common``); ``dn_jumps`` the difference of jump counts; the
     reference is the run of the same point at the smallest rtol.  Records
     without ``_jump_t`` (read back from JSON) get NaN errors.
