@@ -38,8 +38,9 @@ API_MODULES = (
     "peelapprox.errors", "peelapprox.kernels", "peelapprox.cli", "comparisons.sweep", "comparisons.stress",
     "comparisons.benchmark", "comparisons.benchmark.peers",
 )
-#: Pages that must hold typeset formulas (the landing page states the model's equations).
-MATH_PAGES = ("index.html",)
+#: Pages that must hold typeset formulas (the landing page states the model's equations; the theory page maps
+#: the paper's equations to the code).
+MATH_PAGES = ("index.html", "theory.html")
 #: Chromium's switches for a quiet, offline, sandbox-free headless run.
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
