@@ -103,6 +103,7 @@ autosummary_context = {"constant_docs": _constant_docs()}
 html_theme = "pydata_sphinx_theme"
 html_title = f"peelapprox {release}"
 html_static_path = ["_static"]
+html_css_files = ["peelapprox.css"]
 html_theme_options = {
     "navigation_depth": 2,
     "show_toc_level": 2,
