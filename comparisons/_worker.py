@@ -11,13 +11,12 @@ instead of a crash of the whole run, and report progress on stderr, one line per
 * :func:`run_tasks` — many tasks on a :class:`concurrent.futures.Executor`: in this process, on a local
   spawned process pool, or on any executor (a dask cluster); tasks the executor loses (a worker died) are
   returned, not raised (the sweep's engine).
-* :func:`message`, :func:`error_text` — an exception as record fields; :class:`Progress` and
-  :func:`write_line` — the progress lines.
+* :func:`message`, :func:`error_text` — an exception as record fields; :func:`write_line` — a progress
+  line (the stress suite's; the sweep's is :class:`peelapprox.io.ProgressLine`).
 """
 
 from __future__ import annotations
 
-import math
 import multiprocessing as mp
 import os
 import sys
@@ -27,8 +26,8 @@ from collections.abc import Callable, Hashable, Iterable, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from typing import Any
 
-__all__ = ["spawn_context", "watch_parent", "message", "error_text", "write_line", "hms", "Progress",
-           "TimedWorker", "run_tasks", "SERIAL"]
+__all__ = ["spawn_context", "watch_parent", "message", "error_text", "write_line", "TimedWorker", "run_tasks",
+           "SERIAL"]
 
 #: ``executor`` value of :func:`run_tasks` that runs every task in this process, one after the other.
 SERIAL = "serial"
@@ -74,36 +73,6 @@ def write_line(text: str) -> None:
     """One progress line on stderr, flushed at once."""
     sys.stderr.write(text + "\n")
     sys.stderr.flush()
-
-
-def hms(s: float) -> str:
-    """Seconds as ``m:ss`` or ``h:mm:ss``; ``"?"`` if not finite."""
-    if not math.isfinite(s):
-        return "?"
-    s = int(round(s))
-    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}" if s >= 3600 else f"{s // 60}:{s % 60:02d}"
-
-
-class Progress:
-    """Elapsed time and ETA of a run of ``total`` tasks of which ``done0`` were done before it started.
-
-    ``prefix(done)`` is ``"[done/total]"`` (width of ``total``), ``times(done)`` is
-    ``"elapsed m:ss, ETA m:ss"``, the ETA from the rate of this run's own tasks.
-    """
-
-    def __init__(self, total: int, done0: int = 0):
-        self.t0 = time.perf_counter()
-        self.done0 = done0
-        self.total = total
-
-    def prefix(self, done: int) -> str:
-        return f"[{done:>{len(str(self.total))}}/{self.total}]"
-
-    def times(self, done: int) -> str:
-        el = time.perf_counter() - self.t0
-        n = done - self.done0
-        eta = el / n * (self.total - done) if n else float("nan")
-        return f"elapsed {hms(el)}, ETA {hms(eta)}"
 
 
 # --------------------------------------------------------------------------------------------- one timed worker

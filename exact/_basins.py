@@ -12,10 +12,8 @@ the result does not depend on which, nor on the order in which the starts finish
 from __future__ import annotations
 
 import json
-import math
 import multiprocessing as mp
 import os
-import sys
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
@@ -33,7 +31,7 @@ from peelapprox import (
     periodicity,
     return_map,
 )
-from peelapprox.io import fmt_number, jsonable
+from peelapprox.io import ProgressLine, fmt_number, jsonable
 from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
@@ -305,19 +303,17 @@ def _axis(name: str, x: Any, quantity: str) -> np.ndarray:
 
 
 def _reporter(progress: Any, total: int) -> Callable[[int, dict], None]:
-    """``progress=True``: a line on stderr each time another ~5 % of the starts is done."""
+    """``progress=True``: a line on stderr for the first start, the last, every ~5 % and every start that failed
+    (with its message); one updating line in Jupyter (:class:`peelapprox.io.ProgressLine`)."""
     if callable(progress):
         return lambda done, rec: progress(done, total, rec)
     if not progress:
         return lambda done, rec: None
-    t0, step = time.perf_counter(), max(1, math.ceil(total / 20))
+    line = ProgressLine("basins", total)
 
     def report(done: int, rec: dict) -> None:
-        if done % step == 0 or done == total:
-            el = time.perf_counter() - t0
-            sys.stderr.write(f"basins [{done}/{total}] {100 * done // total}% elapsed {el:.1f} s, "
-                             f"ETA {el / done * (total - done):.1f} s\n")
-            sys.stderr.flush()
+        failed = f"{rec['text']}: {rec.get('message', '')}"[:200] if rec["code"] == FAILURE else None
+        line.update(done, failed=failed)
 
     return report
 
@@ -429,7 +425,8 @@ def basins(
         Without ``executor``: 0 runs in this process; n > 0 a local spawned process pool of n workers; None
         (default) one worker per CPU available, at most one per start.
     progress : bool or callable
-        True: a line on stderr per ~5 % of the starts; a callable gets ``(done, total, outcome)`` after each.
+        True: a line on stderr per ~5 % of the starts (and per failed start; one updating line in Jupyter); a
+        callable gets ``(done, total, outcome)`` after each.
 
     Returns
     -------

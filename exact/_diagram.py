@@ -9,7 +9,6 @@ orbit is stable, the diagram should show it.
 
 from __future__ import annotations
 
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -19,6 +18,7 @@ import numpy as np
 
 from peelapprox import WINDOW_DEFAULTS, PeelParams, periodicity, return_map
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox.io import ProgressLine
 from peelapprox.validate import duration, function, optional, reals
 
 from ._corrector import with_parameter
@@ -120,7 +120,8 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     max_period : int
         Longest period ``periodicity`` looks for.
     progress : bool or callable
-        True: a line on stderr every ~10 % of the values; a callable ``progress(done, total)``.
+        True: a line on stderr every ~5 % of the values (one updating line in Jupyter); a
+        callable ``progress(done, total)``.
 
     Returns
     -------
@@ -132,12 +133,9 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     vals = reals("values", values)
     t_transient = duration("t_transient", t_transient, zero=True)
     window = duration("window", window)
-    report: Callable[[int, int], None] | None
-    if progress is True:
-        def report(done: int, total: int) -> None:
-            if done == total or done % max(1, total // 10) == 0:
-                print(f"orbit diagram: {done}/{total} values of {parameter}", file=sys.stderr, flush=True)
-    else:
+    report: Callable[[int, int], None] | None = None
+    line = ProgressLine(f"orbit diagram over {parameter}", vals.size) if progress is True else None
+    if line is None:
         report = optional(function, "progress", progress or None)
     returns, labels = [], []
     for i, x in enumerate(vals.ravel()):
@@ -154,7 +152,9 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
             F, label = np.zeros(0), f"breakdown:{exc.reason}"
         returns.append(np.asarray(F, dtype=float))
         labels.append(label)
-        if report is not None:
+        if line is not None:
+            line.update(i + 1, f"{parameter}={float(x):.6g} {label}")
+        elif report is not None:
             report(i + 1, vals.size)
     return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
 

@@ -16,13 +16,13 @@ package is a :class:`PeerUnavailableError` (an ``ImportError``) naming the extra
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ._law_compiled import branch_structure
 from ._params import GEOMETRIES
+from .io import optional_import
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._params import PeelParams
@@ -41,15 +41,10 @@ def import_optional(module: str, pip: str, who: str):
     Raises
     ------
     PeerUnavailableError
-        If it does not import; the message names the pip package and the ``bench`` extra.
+        If it does not import; the message names the pip package and the ``bench`` extra
+        (:func:`peelapprox.io.optional_import`'s message).
     """
-    try:
-        return importlib.import_module(module)
-    except ImportError as exc:
-        raise PeerUnavailableError(
-            f"{who} needs the package {pip!r} (import {module}), which is not installed: "
-            f"pip install {pip} (or the 'bench' extra: pip install peelapprox[bench])"
-        ) from exc
+    return optional_import(module, who, "bench", pip=pip, error=PeerUnavailableError)
 
 
 #: pydiffsol ``Ode.options`` changed from their defaults to pass the folds (see the Notes of ``comparisons``'

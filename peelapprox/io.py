@@ -2,8 +2,9 @@
 chosen by the extension), one JSON normaliser (:func:`jsonable`), one number formatter for tables and
 messages (:func:`fmt_number`), and the pieces every result object's data out and notebook display share: the
 lazy import of an optional dependency (:func:`optional_import`: pandas and xarray for ``to_dataframe`` and
-``to_xarray``, tqdm for progress bars), the parameters as flat metadata (:func:`param_attrs`) and the small HTML
-table of ``_repr_html_`` (:func:`html_table`)."""
+``to_xarray``, tqdm for progress bars), the parameters as flat metadata (:func:`param_attrs`), the small HTML
+table of ``_repr_html_`` (:func:`html_table`) and the rate-limited progress line of the long loops
+(:class:`ProgressLine`: a line per ~5 % in a terminal or a log, one updating line in Jupyter)."""
 
 from __future__ import annotations
 
@@ -19,8 +20,10 @@ from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["TABLE_EXTENSIONS", "fmt_number", "html_table", "jsonable", "optional_import", "param_attrs", "write_csv",
-           "write_rows"]
+from ._progress import ProgressLine
+
+__all__ = ["TABLE_EXTENSIONS", "ProgressLine", "fmt_number", "html_table", "jsonable", "optional_import",
+           "param_attrs", "write_csv", "write_rows"]
 
 #: The file name endings :func:`write_rows` accepts.
 TABLE_EXTENSIONS = (".csv", ".json")
@@ -160,7 +163,8 @@ def write_csv(fh: IO[str], rows: Iterable[Mapping[str, Any]], *, fields: Sequenc
                                                  else r[c]) for c in cols])
 
 
-def optional_import(module: str, purpose: str, extra: str = "data") -> ModuleType:
+def optional_import(module: str, purpose: str, extra: str = "data", *, pip: str | None = None,
+                    error: type[ImportError] = ImportError) -> ModuleType:
     """Import the optional dependency ``module`` when a method needs it (never at ``import peelapprox``).
 
     Parameters
@@ -171,17 +175,22 @@ def optional_import(module: str, purpose: str, extra: str = "data") -> ModuleTyp
         What needs it, for the message, e.g. ``"Trajectory.to_dataframe"``.
     extra : str
         The extra of ``pyproject.toml`` that installs it (``data``: pandas and xarray).
+    pip : str, optional
+        Its name on PyPI when that is not ``module``.
+    error : type
+        The ImportError subclass raised (the peers': :class:`peelapprox.kernels.PeerUnavailableError`).
 
     Raises
     ------
     ImportError
-        ``"<purpose> needs <module>: pip install 'peelapprox[<extra>]'"`` when it is not installed.
+        ``"<purpose> needs <module>: pip install 'peelapprox[<extra>]' (or pip install <pip>)"`` when it does not
+        import.
     """
     try:
         return importlib.import_module(module)
     except ImportError as exc:
-        raise ImportError(f"{purpose} needs {module}: pip install 'peelapprox[{extra}]' (or pip install {module})"
-                          ) from exc
+        raise error(f"{purpose} needs {module}: pip install 'peelapprox[{extra}]' (or pip install {pip or module})"
+                    ) from exc
 
 
 def param_attrs(params: Any) -> dict[str, Any]:

@@ -52,8 +52,8 @@ API = {
         "compare", "exact_run", "local_period", "markdown", "run_compare", "run_reduction", "scene_rows",
         "segments", "statistics", "Figure", "FIGURES", "make_figures", "figures_markdown", "RowTable",
     },
-    "peelapprox.io": {"TABLE_EXTENSIONS", "fmt_number", "html_table", "jsonable", "optional_import", "param_attrs",
-                      "write_csv", "write_rows"},
+    "peelapprox.io": {"TABLE_EXTENSIONS", "ProgressLine", "fmt_number", "html_table", "jsonable", "optional_import",
+                      "param_attrs", "write_csv", "write_rows"},
     "peelapprox.plotting": {"TRAJECTORY_CYCLES", "new_figure", "plot_bifurcation", "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {

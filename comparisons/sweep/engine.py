@@ -13,11 +13,11 @@ from typing import Any
 import numpy as np
 
 from peelapprox import PARAM_RANGES, PeelForce
-from peelapprox.io import jsonable
+from peelapprox.io import ProgressLine, jsonable
 from peelapprox.validate import ArgumentTypeError, integer, optional
 from peelapprox.validate import path as _path
 
-from .._worker import SERIAL, Progress, run_tasks, write_line
+from .._worker import SERIAL, run_tasks
 from .law import check_coef, check_force, manifest_fields
 from .measures import _OPTION_CHECKS, MEASURES, _ref
 from .result import SweepResult
@@ -42,13 +42,15 @@ __all__ = ["sweep"]
 
 
 def _progress_line(total: int, done0: int) -> Callable[[int, int, dict], None]:
-    """``progress=True``: one line per finished point on stderr, with the elapsed time and an ETA."""
-    prog = Progress(total, done0)
+    """``progress=True``: a line on stderr for this run's first point, the last, every ~5 % and every failed
+    point (with its status); one updating line in Jupyter (:class:`peelapprox.io.ProgressLine`)."""
+    line = ProgressLine("sweep", total, done0=done0)
 
     def report(done: int, total: int, rec: dict) -> None:
         c = f" coef={rec['coef']:.6g}" if "coef" in rec else ""
-        write_line(f"sweep {prog.prefix(done)} I={rec['I']:.4g} V={rec['V']:.4g}{c} {rec['status'][:60]}  "
-                   f"{prog.times(done)}")
+        status = rec["status"]
+        line.update(done, f"I={rec['I']:.4g} V={rec['V']:.4g}{c}",
+                    failed=None if status == "ok" else status[:200])
 
     return report
 
@@ -93,9 +95,10 @@ def sweep(
         JSON-serialisable settings passed to every measure (see
         :mod:`comparisons.sweep`), checked before the first point.
     progress : bool or callable
-        ``True``: one line per finished point on stderr, with an ETA.  A
-        callable receives ``(done, total, record)`` (``done`` counts resumed
-        points too).
+        ``True``: progress on stderr with an ETA, rate-limited (a line for
+        the first point, the last, every ~5 % and every failed point, with
+        its status; one updating line in Jupyter).  A callable receives
+        ``(done, total, record)`` (``done`` counts resumed points too).
     resume : bool
         With an existing sweep in ``out`` (same grid, measures and options,
         else ValueError naming what differs): skip its finished points.
