@@ -1,7 +1,7 @@
 """Worker processes shared by the experiments that run many points: the stress suite and the (I, V) sweep.
 
 Both run each point in a separate, spawned process, turn whatever a point raises into fields of its record
-instead of a crash of the whole run, and report progress on stderr, one line per finished point.
+instead of a crash of the whole run, and report progress on stderr (rate-limited: ``peelapprox.io.ProgressLine``).
 
 * :func:`watch_parent` — a worker exits when the process that started it dies (e.g. SIGKILL), instead of
   idling (or hanging in a point) as an orphan.
