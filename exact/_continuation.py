@@ -487,9 +487,7 @@ def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: flo
         except _FAILURES as exc:
             errors.append(f"a={a:.3g}: {exc}")
             continue
-        d = pt.orbit.section_states
-        sep = float(np.linalg.norm((d[o.n] - d[0]) / st.scale))
-        if sep > 0.5 * a:
+        if minimal_period(pt.orbit) == 2 * o.n:
             return pt.orbit
         errors.append(f"a={a:.3g}: Newton returned the period-{o.n} orbit")
     raise ValueError(f"no period-{2 * o.n} orbit found near the period doubling at {bifurcation.parameter}="

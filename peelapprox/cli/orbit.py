@@ -7,7 +7,7 @@ import argparse
 
 import numpy as np
 
-from .. import WINDOW_DEFAULTS, PeelParams
+from .. import WINDOW_DEFAULTS
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float, positive_int
 from ._common import FORMATS, add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
 from ._force import law_fields
@@ -43,16 +43,12 @@ def add_orbit_parser(sub) -> argparse.ArgumentParser:
     return sp
 
 
-def _params(args: argparse.Namespace) -> PeelParams:
-    return params_from_args(args)
-
-
 def run_orbit(args: argparse.Namespace) -> int:
     from exact import State, initial_state, periodic_orbit
 
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    p = _params(args)
+    p = params_from_args(args)
     start: State | None = initial_state(p, alpha0=args.alpha0) if args.alpha0 else None
     o = periodic_orbit(p, start=start, n=args.n, t_transient=args.t_transient, window=args.window)
     row: dict = dict(V=p.V, I=p.I, n=o.n, period=o.period, stable=o.stable, residual=o.residual,
@@ -143,7 +139,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     lo, hi, n = grid_range(args.range, "--range")
-    p = _params(args)
+    p = params_from_args(args)
     auto = args.seeds in (None, "auto")
     try:
         seeds = [] if auto else [float(x) for x in args.seeds.split(",")]
