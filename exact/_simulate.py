@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import sys
 import time
 from collections.abc import Callable, Sequence
 from typing import Any, cast
@@ -21,6 +20,7 @@ from peelapprox import (
     peel_force,
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
+from peelapprox.io import ProgressLine
 from peelapprox.kernels import ALL_LAWS, model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
@@ -151,16 +151,13 @@ def compile_kernels() -> float:
 
 
 def _progress_printer(label: str) -> Callable[[float, float], None]:
-    last = [0.0]
+    """``progress=True``: :class:`peelapprox.io.ProgressLine` in per mille of ``t_end`` (a line per 5 %)."""
+    line: list[ProgressLine] = []
 
     def report(t: float, t_end: float) -> None:
-        now = time.perf_counter()
-        if now - last[0] >= 0.5 or t >= t_end:
-            last[0] = now
-            sys.stderr.write(f"\r{label}: t = {t:.6g} / {t_end:.6g} s ({100 * t / t_end:5.1f} %)")
-            if t >= t_end:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
+        if not line:
+            line.append(ProgressLine(label, 1000, count=False))
+        line[0].update(min(1000, max(0, int(1000 * t / t_end))), f"t = {t:.6g} / {t_end:.6g} s")
 
     return report
 

@@ -1,4 +1,4 @@
-"""The one progress reporter of the long loops (sweep, basins, orbit diagram): :class:`ProgressLine`.
+"""The one progress reporter of the long loops (sweep, basins, orbit diagram, a long simulate): :class:`ProgressLine`.
 
 It writes few lines wherever it runs.  To a terminal or a log (any stream that is not Jupyter's) it writes
 one clean line for the first point, for the last, each time another ``every`` fraction of the points is done
@@ -53,6 +53,9 @@ class ProgressLine:
         One updating line (True) or clean lines (False); default :func:`in_jupyter`.
     clock : callable
         Seconds, for the elapsed time and the ETA (a fake clock in tests).
+    count : bool
+        Show ``[done/total]`` (points); False for a run measured in another unit (a simulation's time,
+        reported in per mille of ``t_end`` with the time in ``detail``).
 
     Raises
     ------
@@ -61,7 +64,7 @@ class ProgressLine:
     """
 
     def __init__(self, label: str, total: int, *, done0: int = 0, every: float = 0.05, stream: IO[str] | None = None,
-                 jupyter: bool | None = None, clock: Callable[[], float] = time.perf_counter):
+                 jupyter: bool | None = None, clock: Callable[[], float] = time.perf_counter, count: bool = True):
         if total < 0 or not 0 <= done0 <= total:
             raise ValueError(f"total and done0 must satisfy 0 <= done0 <= total, got total={total}, done0={done0}")
         if not 0 < every <= 1:
@@ -71,7 +74,9 @@ class ProgressLine:
         self.stream = sys.stderr if stream is None else stream
         self.jupyter = in_jupyter() if jupyter is None else bool(jupyter)
         self.clock = clock
+        self.count = bool(count)
         self.t0 = clock()
+        self._written = self.done0  # done at the last written update
         self._open = 0  # Jupyter: width of the line being overwritten (0: none)
         self.lines = 0  # writes so far (a write in Jupyter mode may overwrite the line)
 
@@ -87,8 +92,9 @@ class ProgressLine:
         return f"elapsed {hms(el)}, ETA {hms(eta)}"
 
     def due(self, done: int) -> bool:
-        """Whether an update at ``done`` is written: this run's first point, the last, or a multiple of the step."""
-        return done == self.done0 + 1 or done >= self.total or done % self.step == 0
+        """Whether an update at ``done`` is written: this run's first point, the last, or the first update at or
+        past another multiple of the step since the last written one (callers may skip counts)."""
+        return done == self.done0 + 1 or done >= self.total or done // self.step > self._written // self.step
 
     def update(self, done: int, detail: str = "", *, failed: str | None = None) -> None:
         """Report that ``done`` points are done; ``detail`` describes the latest one, ``failed`` its failure.
@@ -99,7 +105,8 @@ class ProgressLine:
         if failed is None and not self.due(done):
             return
         pct = 100 * done // self.total if self.total else 100
-        text = " ".join(s for s in (f"{self.label} {self.prefix(done)} {pct:3d}%", detail,
+        head = f"{self.label} {self.prefix(done)}" if self.count else self.label
+        text = " ".join(s for s in (f"{head} {pct:3d}%", detail,
                                     f"FAILED: {failed}" if failed is not None else "", self.times(done)) if s)
         if self.jupyter and failed is None and done < self.total:
             self.stream.write("\r" + text.ljust(self._open))
@@ -108,6 +115,7 @@ class ProgressLine:
             self.stream.write(("\r" if self._open else "") + text.ljust(self._open) + "\n")
             self._open = 0
         self.lines += 1
+        self._written = done
         self.stream.flush()
 
     def close(self) -> None:

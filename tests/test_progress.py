@@ -128,3 +128,30 @@ def test_import_optional_is_optional_import():
                                           r"\(or pip install no_such_mod_1\)$") as ei:
         optional_import("no_such_mod_1", "f")
     assert type(ei.value) is ImportError
+
+
+def test_skipped_counts_write_once_per_crossed_step():
+    """A caller that reports irregular counts (a simulation reporting per mille of its time every ~0.3 s) gets a
+    line at the first update past each 5 % multiple, not only at exact multiples: counts 3, 47, 52, 58, 149,
+    151, 990, 1000 of 1000 (step 50) write 52 (crossed 50), 149 (crossed 100), 151 (crossed 150), 990 (crossed
+    200..950 at once: one line) and 1000 — 5 lines, exactly; 3 is neither the first point nor past a step."""
+    out = io.StringIO()
+    line = ProgressLine("simulate", 1000, stream=out, clock=FakeClock(), jupyter=False, count=False)
+    for done in (3, 47, 52, 58, 149, 151, 990, 1000):
+        line.update(done, f"t = {done}")
+    lines = out.getvalue().splitlines()
+    assert [s.split()[2] for s in lines] == ["t", "t", "t", "t", "t"]
+    assert [int(s.split("t = ")[1].split()[0]) for s in lines] == [52, 149, 151, 990, 1000]
+    assert all("[" not in s for s in lines)  # count=False: no [done/total]
+
+
+def test_simulate_progress_true_writes_few_lines_and_ends_at_100(capsys):
+    """``exact.simulate(progress=True)`` reports through ProgressLine: at most 21 lines (one per 5 % crossed plus
+    the end) however long the run, the last one at 100 % with the final time."""
+    import exact
+    from peelapprox import PeelParams
+
+    exact.simulate(PeelParams(V=1.0, I=1e-5), 5.0, progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert 1 <= len(lines) <= 21
+    assert lines[-1].startswith("simulate V=1.0 I=1e-05 100% t = 5 / 5 s")
