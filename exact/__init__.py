@@ -34,7 +34,7 @@ from ._continuation import (
 from ._crest import Crest, crest_margin
 from ._diagram import OrbitDiagram, explain, orbit_diagram
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
-from ._options import Budget, Hybrid, Regularized, SaveAt, default_atol
+from ._options import Budget, Hybrid, Regularized, SaveAt, Smooth, default_atol
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
 from ._simulate import (
     ATOL_SCALE,
@@ -52,6 +52,7 @@ __all__ = [
     "simulate",
     "Hybrid",
     "Regularized",
+    "Smooth",
     "SaveAt",
     "Budget",
     "initial_state",

@@ -33,11 +33,13 @@ from peelapprox.validate import ArgumentTypeError, choice, flag, in_range, integ
 from peelapprox.validate import eps as _eps
 from peelapprox.validate import rtol as _rtol
 
-__all__ = ["Hybrid", "Regularized", "SaveAt", "Budget", "ATOL_SCALE", "ATOL_RANGE", "STEP_BUDGET",
+__all__ = ["Hybrid", "Regularized", "Smooth", "SaveAt", "Budget", "ATOL_SCALE", "ATOL_RANGE", "STEP_BUDGET",
            "default_max_steps", "default_atol", "method_option", "output_options"]
 
-METHODS = ("hybrid", "regularized")
+METHODS = ("hybrid", "regularized", "smooth")
 SOLVERS = ("Radau", "BDF", "LSODA")
+#: Solvers of the model variants' smooth ODE (``method="smooth"``): the stiff ones and two explicit ones.
+SMOOTH_SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
 SAVES = ("steps", "jumps")
 
 #: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
@@ -46,7 +48,8 @@ SAVES = ("steps", "jumps")
 #: the orbits of the paper: α oscillates with amplitude ≥ ~1e-3 rad, segment
 #: durations are ≥ ~1e-4 s; ln v is controlled to ``rtol (1 + |ln v|)``, a
 #: relative accuracy of v at every speed (the regularised v ≥ ~1e-3 m/s on AB).
-ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1.0), "regularized": (1e-4, 1e-3, 1e-2, 1e-6)}
+ATOL_SCALE = {"hybrid": (1e-6, 1e-4, 1e-3, 1.0), "regularized": (1e-4, 1e-3, 1e-2, 1e-6),
+              "smooth": (1e-4, 1e-3, 1e-2, 1e-6)}
 
 #: Valid absolute tolerances, every component: 0 is excluded (τ starts every branch segment at 0, so pure
 #: relative control has no scale there), above 1 (1 s, 1 rad, 1 rad/s, a factor e in v (hybrid, ln v),
@@ -60,7 +63,7 @@ ATOL_RANGE = (1e-100, 1.0)
 #: margin of ~50x, while the cap bounds a default call: hybrid <= 2e7 steps (~35 s measured on
 #: t_end = 1e300), regularised <= 5e5 (~80 s).  A run that needs more raises SolverBudgetExceeded
 #: naming max_steps.
-STEP_BUDGET = {"hybrid": (1e6, 1e6, 2e7), "regularized": (1e5, 1e5, 5e5)}
+STEP_BUDGET = {"hybrid": (1e6, 1e6, 2e7), "regularized": (1e5, 1e5, 5e5), "smooth": (1e5, 1e5, 5e5)}
 
 
 def default_max_steps(method: str, t_end: float) -> int:
@@ -157,6 +160,31 @@ class Regularized(_Method):
     def __post_init__(self) -> None:
         object.__setattr__(self, "solver", choice("solver", self.solver, SOLVERS))
         object.__setattr__(self, "eps", _eps("eps", self.eps))
+        self._check_shared()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Smooth(_Method):
+    """The model variants' smooth ODE (``method="smooth"``): the tape-mass model (``PeelParams(tape_mass=m)``,
+    with or without a load) on a scipy solver, the stiff ones with the analytic Jacobian.
+
+    Parameters
+    ----------
+    solver : {"Radau", "BDF", "LSODA", "DOP853", "RK45"}
+        The scipy solver; default "Radau" (docs/tape-mass.md, "Which integrator").
+    rtol, atol, v_floor
+        As for :class:`Hybrid`; the components are ``(α, ω, F, v)`` (and ``V_p`` under a load, with the
+        tolerance of v) and ``atol=None`` means ``rtol * ATOL_SCALE["smooth"]``.
+    """
+
+    name: ClassVar[str] = "smooth"
+    solver: str = "Radau"
+    rtol: float = 1e-8
+    atol: float | Sequence[float] | None = None
+    v_floor: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "solver", choice("solver", self.solver, SMOOTH_SOLVERS))
         self._check_shared()
 
 
@@ -297,25 +325,61 @@ def _refuse(kind: str, obj: Any, pairs: Sequence[tuple[str, Any]], holds: str) -
                              f"{holds}; give one of them")
 
 
-def method_option(method: Any, *, solver: Any, eps: Any, rtol: Any, atol: Any, v_floor: Any) -> Hybrid | Regularized:
+def method_option(method: Any, *, solver: Any, eps: Any, rtol: Any, atol: Any, v_floor: Any,
+                  params: Any = None) -> Hybrid | Regularized | Smooth:
     """The method object of a ``simulate`` call: ``method`` itself if it is one (then the keywords it holds
-    must be left at their defaults), else the object built from the string and the keywords.
+    must be left at their defaults), else the object built from the string and the keywords.  ``method=None``
+    picks the model's method (``params``: :func:`default_method`); a method the model cannot use is refused.
     """
-    if isinstance(method, (Hybrid, Regularized)):
+    if isinstance(method, (Hybrid, Regularized, Smooth)):
         _refuse("method", method, [("solver", solver), ("eps", eps), ("rtol", rtol), ("atol", atol),
                                    ("v_floor", v_floor)],
                 f"a method object holds rtol, atol, v_floor (and a Regularized eps, solver): e.g. "
                 f"{type(method).__name__}(rtol=...)")
-        return method
-    name = choice("method", method, METHODS)
-    if name == "hybrid":
-        for key, val in (("solver", solver), ("eps", eps)):
-            if val is not None:
-                raise ValueError(f"{key} applies only to method='regularized' (the hybrid method is the eps -> 0 "
-                                 f"limit, integrated by its own DOP853), got {key}={val!r} with method='hybrid'")
-        return Hybrid(rtol=rtol, atol=atol, v_floor=v_floor)
-    return Regularized(solver="Radau" if solver is None else solver, eps=EPS_DEFAULT if eps is None else eps, rtol=rtol,
-                       atol=atol, v_floor=v_floor)
+        opts: Hybrid | Regularized | Smooth = method
+    else:
+        name = default_method(params) if method is None else choice("method", method, METHODS)
+        if name in ("hybrid", "smooth") and eps is not None:
+            raise ValueError(f"eps applies only to method='regularized' (the paper's eps-scheme), got eps={eps!r} "
+                             f"with method={name!r}")
+        if name == "hybrid":
+            if solver is not None:
+                raise ValueError(f"solver applies only to method='regularized' or 'smooth' (the hybrid method is "
+                                 f"the eps -> 0 limit, integrated by its own DOP853), got solver={solver!r} with "
+                                 "method='hybrid'")
+            opts = Hybrid(rtol=rtol, atol=atol, v_floor=v_floor)
+        elif name == "smooth":
+            opts = Smooth(solver="Radau" if solver is None else solver, rtol=rtol, atol=atol, v_floor=v_floor)
+        else:
+            opts = Regularized(solver="Radau" if solver is None else solver, eps=EPS_DEFAULT if eps is None else eps,
+                               rtol=rtol, atol=atol, v_floor=v_floor)
+    if params is not None:
+        _check_method_model(opts.name, params)
+    return opts
+
+
+def default_method(params: Any) -> str:
+    """The method ``simulate`` uses for ``params`` when none is given: ``"hybrid"`` for the paper's massless model
+    under velocity control, ``"smooth"`` for the tape-mass model (``tape_mass``), ``"regularized"`` for the
+    massless tape under a load (the hybrid solver runs velocity control only)."""
+    if params is None or getattr(params, "variant", None) is None:
+        return "hybrid"
+    return "smooth" if params.tape_mass is not None else "regularized"
+
+
+def _check_method_model(name: str, params: Any) -> None:
+    """ValueError if the method ``name`` cannot solve the model of ``params`` (its variant)."""
+    if params.tape_mass is not None and name != "smooth":
+        raise ValueError(f"method={name!r} solves the massless model; with tape_mass={params.tape_mass!r} kg the "
+                         "model is a smooth ODE (its jumps arise from the ribbon's inertia): use method='smooth' "
+                         "(the default for a tape mass)")
+    if params.tape_mass is None and name == "smooth":
+        raise ValueError("method='smooth' solves the tape-mass model: give params.tape_mass (kg), or use "
+                         "method='hybrid' (velocity control) or 'regularized' for the massless tape")
+    if params.loading == "load" and name == "hybrid":
+        raise ValueError("method='hybrid' runs velocity control only; under loading='load' the massless tape is "
+                         "solved by method='regularized' (the paper's eps-scheme with the pull speed a state), "
+                         "a tape mass by method='smooth'")
 
 
 def output_options(method: str, t_end: float, saveat: Any, budget: Any, *, save: Any, t_eval: Any,

@@ -27,43 +27,63 @@ from scipy.optimize import brentq
 
 from peelapprox import BRANCHES, BREAKDOWN_LEVEL
 from peelapprox.errors import ModelBreakdown, SolverFailure, budget_exceeded
-from peelapprox.kernels import ALL_LAWS, compiled_law, regularized_law_field
+from peelapprox.kernels import ALL_LAWS, compiled_law, regularized_law_field, variant_field, variant_parameters
 from peelapprox.kernels import regularized_field as _fun  # the compiled field, Jacobian and parameter vector
 from peelapprox.kernels import regularized_field_jacobian as _jac
 from peelapprox.kernels import regularized_parameters as param_vector
 
+from ._options import Regularized
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 if TYPE_CHECKING:
     from peelapprox import PeelParams
 
-    from ._options import Budget, Regularized, SaveAt
+    from ._options import Budget, SaveAt, Smooth
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
+#: Explicit solvers (no Jacobian), offered for the tape-mass model at large masses (not stiff there).
+_EXPLICIT = {"DOP853": integrate.DOP853, "RK45": integrate.RK45}
 
 
-def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regularized, saveat: SaveAt,
+def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regularized | Smooth, saveat: SaveAt,
                     budget: Budget, progress: Callable[[float, float], None] | None) -> Trajectory:
-    """Driver for ``simulate(method="regularized")``: the options validated, the budget resolved."""
-    solver, eps, rtol, atol, v_floor = method.solver, method.eps, method.rtol, method.atol_vector(), method.v_floor
+    """Driver for ``simulate(method="regularized")`` and, for the model variants (``params.variant``: the tape
+    mass, the constant load), ``method="smooth"``: the options validated, the budget resolved."""
+    solver, rtol, atol, v_floor = method.solver, method.rtol, method.atol_vector(), method.v_floor
+    eps = method.eps if isinstance(method, Regularized) else None
     t_store, te, max_wall = saveat.t_transient, saveat.ts, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
     cl = compiled_law(params.force, params.V)  # the paper's law: fvV inlined in the field (the default)
     bs, (v_lo, v_hi) = cl.structure, cl.domain
     no_root_margin = BREAKDOWN_LEVEL * max(abs(bs.f_zero), 1.0)  # the hybrid solver's criterion (v_breakdown)
-    q = param_vector(params, eps, ("paper",) if cl.inlined else ALL_LAWS)
+    variant = params.variant
+    massive = params.tape_mass is not None  # the tape-mass model: v <= 0 is the front's arrest, not a failure
+    n_y = 4 if variant in (None, "tape") else 5  # (α, ω, F, v[, V_p])
     v_mid = bs.v_inflection
-    if cl.inlined:
+    if variant is not None:
+        vfun, vjac = variant_field(variant)
+        q = variant_parameters(params, eps if eps is not None else cast(float, params.tape_mass),
+                               params.load_mass or 1.0, params.load or 0.0)
+        law, coef = cl.fn, cl.coef
+        fun = lambda t, y: vfun(y, q, law, coef)  # noqa: E731
+        jac = lambda t, y: vjac(y, q, law, coef)  # noqa: E731
+        if n_y == 5:
+            atol = np.append(atol, atol[3])  # V_p [m/s] on the scale of v
+    elif cl.inlined:
+        q = param_vector(params, cast(float, eps), ("paper",))
         fun = lambda t, y: _fun(y, q)  # noqa: E731
         jac = lambda t, y: _jac(y, q)  # noqa: E731
     else:
+        q = param_vector(params, cast(float, eps), ALL_LAWS)
         lfun, ljac = regularized_law_field()
         law, coef = cl.fn, cl.coef
         fun = lambda t, y: lfun(y, q, law, coef)  # noqa: E731
         jac = lambda t, y: ljac(y, q, law, coef)  # noqa: E731
-    y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v])
+    y0 = np.array([s0.alpha, s0.omega, s0.F, s0.v] + ([params.V if s0.Vp is None else s0.Vp] if n_y == 5 else []))
     wall0 = time.perf_counter()
-    ode = _SOLVERS[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, jac=jac)
+    kw = {"jac": jac} if solver in _SOLVERS else {}
+    ode = {**_SOLVERS, **_EXPLICIT}[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, **kw)
+    label = f"{method.name} {solver}"
 
     rows: list[tuple] = []
     brs: list[int] = []
@@ -76,7 +96,7 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
     def store(t, y):
         if len(rows) >= max_points:
             raise budget_exceeded("max_points", max_points, t_end, sdict(t, y), build(False))
-        rows.append((t, y[0], y[1], y[2], y[3]))
+        rows.append((t, *y))
         brs.append(side(y[3]))
 
     def level_gap(y):
@@ -84,21 +104,23 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
         return y[2] * (1.0 + float(params.closure(y[0])[0])) - bs.f_zero
 
     def sdict(t, y):
-        return dict(t=float(t), alpha=float(y[0]), omega=float(y[1]), F=float(y[2]), v=float(y[3]),
-                    branch=BRANCHES[side(y[3])])
+        d = dict(t=float(t), alpha=float(y[0]), omega=float(y[1]), F=float(y[2]), v=float(y[3]),
+                 branch=BRANCHES[side(y[3])])
+        return d if n_y == 4 else {**d, "Vp": float(y[4])}
 
     def build(final=True, last=None):
         """The trajectory so far; ``last = (t, y)``: the final state to report (default the solver's)."""
         t_last, y_last = last if last is not None else (ode.t, ode.y)
-        arr = np.array(rows, dtype=float).reshape(-1, 5)
+        arr = np.array(rows, dtype=float).reshape(-1, 1 + n_y)
         njac = getattr(ode, "njev", 0)
         nlu = getattr(ode, "nlu", 0)
         stats = SolverStats(n_steps=n_steps, n_rejected=-1, n_rhs=int(ode.nfev), n_jumps=n_jumps,
                             wall_time=time.perf_counter() - wall0, n_jac=int(njac), n_lu=int(nlu))
         return Trajectory(
             t=arr[:, 0], alpha=arr[:, 1], omega=arr[:, 2], F=arr[:, 3], v=arr[:, 4], branch=np.array(brs, np.int8),
+            Vp=arr[:, 5] if n_y == 5 else None,
             jumps=Jumps.from_buffer(np.array(jumps, dtype=float).reshape(-1, 8)), stats=stats, params=params,
-            method="regularized", solver=solver, rtol=rtol, atol=atol, eps=eps, initial_state=s0,
+            method=method.name, solver=solver, rtol=rtol, atol=atol, eps=eps, initial_state=s0,
             final_state=State(**sdict(t_last, y_last)), t_end=t_end, t_transient=t_store, status=0 if final else 1,
             message="reached t_end" if final else "stopped early")
 
@@ -111,16 +133,27 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
         t_old, y_old = ode.t, ode.y.copy()
         msg = ode.step()
         if ode.status == "failed":
-            raise SolverFailure(f"regularized {solver} failed after t={t_old:.9g} (v = {y_old[3]:.3g} m/s, "
+            raise SolverFailure(f"{label} failed after t={t_old:.9g} (v = {y_old[3]:.3g} m/s, "
                                 f"F(1 - cos theta) - f(0+, V) = {level_gap(y_old):.3g} N): {msg}", t=float(t_old),
                                 state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
         n_steps += 1
         y = ode.y
         if not np.all(np.isfinite(y)):  # a numerical failure, reported at the last finite state
-            raise SolverFailure(f"regularized {solver}: the state became non-finite after t={t_old:.9g}",
+            raise SolverFailure(f"{label}: the state became non-finite after t={t_old:.9g}",
                                 t=float(t_old), state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
+        if massive and not y[3] > 0.0:  # the tape-mass model: the front decelerated to rest (physical)
+            raise ModelBreakdown(
+                f"model breakdown at t={t_old:.9g}: the peel velocity v fell to 0 (v = {y[3]:.3g} m/s after the "
+                "step): the peel front stops, and the model (a front that only advances, f defined for v > 0) "
+                "ends there", t=float(t_old), state=sdict(t_old, y_old), reason="arrest",
+                partial=build(False, (t_old, y_old)))
+        if not y[2] > 0.0:  # the tape went slack: F = k u > 0 is the tape's tension
+            raise ModelBreakdown(
+                f"model breakdown at t={t_old:.9g}: the pull force F fell to {y[2]:.3g} N <= 0: the tape goes "
+                "slack, outside the model (a taut tape)", t=float(t_old), state=sdict(t_old, y_old),
+                reason="slack", partial=build(False, (t_old, y_old)))
         if not y[3] > 0.0:  # the scheme left the model's domain (f is defined for v > 0): numerical, not physical
-            raise SolverFailure(f"regularized {solver}: v = {y[3]:.3g} <= 0 after t={t_old:.9g}: the regularised "
+            raise SolverFailure(f"{label}: v = {y[3]:.3g} <= 0 after t={t_old:.9g}: the regularised "
                                 "scheme left the model's domain (F(1 - cos theta) - f(0+, V) = "
                                 f"{level_gap(y_old):.3g} N there; near 0 the orbit is approaching the no_root "
                                 "breakdown, else tighten rtol)",
@@ -135,7 +168,7 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
                 f"model breakdown at t={ode.t:.9g}: v fell to {y[3]:.3g} <= v_floor={v_floor} m/s "
                 f"(F(1 - cos theta) -> f(0+, V)={bs.f_zero:.6g} N)",
                 t=float(ode.t), state=sdict(ode.t, y), reason="v_floor", partial=build(False))
-        if side(y[3]) == 0 and level_gap(y) <= no_root_margin:
+        if not massive and side(y[3]) == 0 and level_gap(y) <= no_root_margin:
             raise ModelBreakdown(
                 f"model breakdown at t={ode.t:.9g}: F(1 - cos theta) fell to f(0+, V)={bs.f_zero:.6g} N on AB "
                 f"(within {BREAKDOWN_LEVEL:g}): CONSTR has no root left, the peel front would have to stop",
@@ -156,7 +189,7 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
                 dense = dense or ode.dense_output()
                 ye = dense(te[t_eval_i])
                 if not (np.all(np.isfinite(ye)) and ye[3] > 0.0):  # the interpolant left the domain
-                    raise SolverFailure(f"regularized {solver}: the dense output at t={te[t_eval_i]:.9g} left the "
+                    raise SolverFailure(f"{label}: the dense output at t={te[t_eval_i]:.9g} left the "
                                         "model's domain (v <= 0 or non-finite); tighten rtol", t=float(t_old),
                                         state=sdict(t_old, y_old), partial=build(False, (t_old, y_old)))
                 store(te[t_eval_i], ye)
@@ -173,6 +206,6 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
     if progress:
         progress(t_end, t_end)
     if ode.t != t_end:
-        raise SolverFailure(f"regularized {solver} stopped at t={ode.t} before t_end={t_end}", t=float(ode.t),
+        raise SolverFailure(f"{label} stopped at t={ode.t} before t_end={t_end}", t=float(ode.t),
                             state=sdict(ode.t, ode.y), partial=build(False))
     return build()

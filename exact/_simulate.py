@@ -35,6 +35,7 @@ from ._options import (
     Hybrid,
     Regularized,
     SaveAt,
+    Smooth,
     default_max_steps,
     method_option,
     output_options,
@@ -170,7 +171,7 @@ def simulate(
     omega0: float | None = None,
     F0: float | None = None,
     branch0: str | None = None,
-    method: str | Hybrid | Regularized = "hybrid",
+    method: str | Hybrid | Regularized | Smooth | None = None,
     solver: str | None = None,
     rtol: float = 1e-8,
     atol: None | float | Sequence[float] = None,
@@ -201,17 +202,23 @@ def simulate(
         ``branch0=None`` meaning the lowest-velocity stable root of CONSTR
         (see :func:`initial_state`).  v is always the root of CONSTR on
         ``branch0``, so the start is consistent.
-    method : {"hybrid", "regularized"} or Hybrid or Regularized
-        ``"hybrid"`` (default): the ε → 0 limit, event-driven, compiled DOP853
-        on the desingularised branch dynamics with exact fold jumps (see
-        :mod:`exact._hybrid`).  ``"regularized"``: the paper's scheme, mass
-        matrix ``diag(1, 1, 1, ε)``, integrated by scipy's stiff ``solver``.
-        A method object (:class:`Hybrid`, :class:`Regularized`) holds
+    method : {"hybrid", "regularized", "smooth"} or Hybrid or Regularized or Smooth, optional
+        ``"hybrid"`` (the default for the paper's model): the ε → 0 limit,
+        event-driven, compiled DOP853 on the desingularised branch dynamics
+        with exact fold jumps (see :mod:`exact._hybrid`).  ``"regularized"``:
+        the paper's scheme, mass matrix ``diag(1, 1, 1, ε)``, integrated by
+        scipy's stiff ``solver`` (the default for a massless tape under a load,
+        ``params.loading == "load"``).  ``"smooth"`` (the default, and the only
+        method, for the tape-mass model ``params.tape_mass``): its ODE on a
+        scipy ``solver`` (docs/tape-mass.md).  None: the model's default.
+        A method the model cannot use is a ValueError saying which it can.
+        A method object (:class:`Hybrid`, :class:`Regularized`, :class:`Smooth`) holds
         ``solver``, ``eps``, ``rtol``, ``atol`` and ``v_floor`` itself: those
         keywords must then stay at their defaults (ValueError naming both).
     solver : {"Radau", "BDF", "LSODA"}, optional
         scipy solver for ``method="regularized"`` (analytic Jacobian);
-        default "Radau".  Passing it with the hybrid method is an error.
+        default "Radau"; ``method="smooth"`` also takes "DOP853" and "RK45".
+        Passing it with the hybrid method is an error.
     rtol, atol : float, float or 4 floats
         Local error control per step: RMS over components of
         ``err_i / (atol_i + rtol |y_i|) <= 1``.  Hybrid components are
@@ -283,7 +290,7 @@ def simulate(
         Budget used up / the integrator cannot proceed.
     """
     _params("params", params)
-    opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor)
+    opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor, params=params)
     t_end = duration("t_end", t_end)
     out, lim = output_options(opts.name, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
                               max_points=max_points, max_steps=max_steps, max_jumps=max_jumps, max_wall=max_wall)
@@ -303,7 +310,7 @@ def simulate(
         return traj
     from ._regularized import run_regularized
 
-    return run_regularized(params, t_end, st0, opts, out, lim, progress)
+    return run_regularized(params, t_end, st0, opts, out, lim, progress)  # the ε-scheme and the variants' ODEs
 
 
 #: On CD, v above this [m/s] is a runaway of the pull force (ModelBreakdown "v_ceiling").

@@ -25,7 +25,7 @@ def _branches(pd, codes: np.ndarray):
 
 @dataclass(frozen=True)
 class State:
-    """A point of the orbit: time, ``(α, ω, F, v)`` and the branch name."""
+    """A point of the orbit: time, ``(α, ω, F, v)``, the branch name and, under a load, the pull speed ``Vp``."""
 
     t: float
     alpha: float
@@ -33,9 +33,13 @@ class State:
     F: float
     v: float
     branch: str
+    Vp: float | None = None  # the pull speed [m/s] under a load (loading="load"); None under velocity control
 
     def as_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        d = dataclasses.asdict(self)
+        if d["Vp"] is None:  # velocity control: the dict as before the field existed
+            del d["Vp"]
+        return d
 
 
 @dataclass(frozen=True)
@@ -195,6 +199,9 @@ class Trajectory:
     atol : ndarray
     eps : float or None
         Regularisation parameter (``method="regularized"`` only).
+    Vp : ndarray or None
+        The pull speed [m/s] at the stored points under a load (``params.loading == "load"``); None under
+        velocity control (the pull speed is ``params.V``).
     initial_state, final_state : State
         Where the run started and ended (``final_state`` continues a run).
     status : int
@@ -225,6 +232,7 @@ class Trajectory:
         t_transient: float,
         status: int = 0,
         message: str = "reached t_end",
+        Vp=None,
     ):
         self.t = np.asarray(t, dtype=float)
         self.alpha = np.asarray(alpha, dtype=float)
@@ -246,6 +254,7 @@ class Trajectory:
         self.t_transient = float(t_transient)
         self.status = status
         self.message = message
+        self.Vp = None if Vp is None else np.asarray(Vp, dtype=float)
 
     def __repr__(self) -> str:
         p = self.params
@@ -307,6 +316,7 @@ class Trajectory:
             jumps=jb,
             atol=self.atol,
             meta=np.array(json.dumps(meta)),
+            **({} if self.Vp is None else {"Vp": self.Vp}),  # type: ignore[arg-type]
         )
 
     @classmethod
@@ -321,6 +331,7 @@ class Trajectory:
                 F=z["F"],
                 v=z["v"],
                 branch=z["branch"],
+                Vp=z["Vp"] if "Vp" in z.files else None,
                 jumps=Jumps.from_buffer(z["jumps"]),
                 stats=SolverStats(**meta["stats"]),
                 params=PeelParams(**meta["params"]),

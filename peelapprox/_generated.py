@@ -150,3 +150,143 @@ def regularized_jacobian(alpha, omega, F, v, c, dc, fp, eps, V, I, k, R):
     j32 = x3*x4
     j33 = -fp*x4
     return j00, j01, j02, j03, j10, j11, j12, j13, j20, j21, j22, j23, j30, j31, j32, j33
+
+
+def tape_rhs(alpha, omega, F, v, Vp, c, dc, f, m, I, k, R):
+    """Tape-mass model: (alpha, omega, F, v) rates with the pull speed Vp (= V under velocity control)."""
+    x0 = omega - v/R
+    x1 = I**(-1.0)
+    x2 = (c + 1)**(-1.0)
+    x3 = f*x2
+    x4 = -v
+    d_alpha = x0
+    d_omega = -R*c*x1*x3
+    d_F = k*(Vp + c*(R*omega + x4) + x4)
+    d_v = -x2*(R**2*c**2*f*x1*x2 - R*dc*x0**2 - (F - x3)/m)
+    return d_alpha, d_omega, d_F, d_v
+
+
+def load_rate(F, M, F_L):
+    """Under a load F_L on a mass M: the pull speed's rate."""
+    d_Vp = -(F - F_L)/M
+    return d_Vp,
+
+
+def tape_jacobian(alpha, omega, F, v, c, dc, ddc, f, fp, m, V, I, k, R):
+    """Jacobian of the tape-mass model under velocity control, row-major 16-tuple, in c, its alpha-derivatives dc, ddc, f and f'."""
+    x0 = R**(-1.0)
+    x1 = c + 1
+    x2 = x1**(-1.0)
+    x3 = c*x2
+    x4 = I**(-1.0)
+    x5 = f*x2*x4
+    x6 = fp*x4
+    x7 = m**(-1.0)
+    x8 = dc*f
+    x9 = x8/x1**2
+    x10 = omega - v*x0
+    x11 = R*x10**2
+    x12 = R**2
+    x13 = c**2*x12
+    x14 = dc*x2
+    x15 = 2*x10
+    x16 = x2*x7
+    j00 = 0.0
+    j01 = 1.00000000000000
+    j02 = 0.0
+    j03 = -x0
+    j10 = R*dc*x5*(x3 - 1)
+    j11 = 0.0
+    j12 = 0.0
+    j13 = -R*x3*x6
+    j20 = dc*k*(R*omega - v)
+    j21 = R*c*k
+    j22 = 0.0
+    j23 = -k*x1
+    j30 = x2*(ddc*x11 - 2*x12*x3*x4*x8 + x13*x4*x9 + x14*(-dc*x11 + x13*x5 + x7*(-F + f*x2)) + x7*x9)
+    j31 = R*x14*x15
+    j32 = x16
+    j33 = -x2*(dc*x15 + fp*x16 + x13*x2*x6)
+    return j00, j01, j02, j03, j10, j11, j12, j13, j20, j21, j22, j23, j30, j31, j32, j33
+
+
+def tape_load_jacobian(alpha, omega, F, v, c, dc, ddc, f, fp, Vp, m, M, F_L, I, k, R):
+    """Jacobian of the tape-mass model under a load, state (alpha, omega, F, v, Vp), row-major 25-tuple, in c, its alpha-derivatives dc, ddc, f and f'."""
+    x0 = R**(-1.0)
+    x1 = c + 1
+    x2 = x1**(-1.0)
+    x3 = c*x2
+    x4 = I**(-1.0)
+    x5 = f*x2*x4
+    x6 = fp*x4
+    x7 = m**(-1.0)
+    x8 = dc*f
+    x9 = x8/x1**2
+    x10 = omega - v*x0
+    x11 = R*x10**2
+    x12 = R**2
+    x13 = c**2*x12
+    x14 = dc*x2
+    x15 = 2*x10
+    x16 = x2*x7
+    j00 = 0.0
+    j01 = 1.00000000000000
+    j02 = 0.0
+    j03 = -x0
+    j04 = 0.0
+    j10 = R*dc*x5*(x3 - 1)
+    j11 = 0.0
+    j12 = 0.0
+    j13 = -R*x3*x6
+    j14 = 0.0
+    j20 = dc*k*(R*omega - v)
+    j21 = R*c*k
+    j22 = 0.0
+    j23 = -k*x1
+    j24 = k
+    j30 = x2*(ddc*x11 - 2*x12*x3*x4*x8 + x13*x4*x9 + x14*(-dc*x11 + x13*x5 + x7*(-F + f*x2)) + x7*x9)
+    j31 = R*x14*x15
+    j32 = x16
+    j33 = -x2*(dc*x15 + fp*x16 + x13*x2*x6)
+    j34 = 0.0
+    j40 = 0.0
+    j41 = 0.0
+    j42 = -1/M
+    j43 = 0.0
+    j44 = 0.0
+    return j00, j01, j02, j03, j04, j10, j11, j12, j13, j14, j20, j21, j22, j23, j24, j30, j31, j32, j33, j34, j40, j41, j42, j43, j44
+
+
+def eps_load_jacobian(alpha, omega, F, v, c, dc, ddc, f, fp, Vp, eps, M, F_L, I, k, R):
+    """Jacobian of the eps-regularised massless tape under a load (XDAE), row-major 25-tuple, in c, its alpha-derivatives dc, ddc, f and f'."""
+    x0 = I**(-1.0)
+    x1 = F*dc
+    x2 = R*c
+    x3 = c + 1
+    x4 = eps**(-1.0)
+    j00 = 0.0
+    j01 = 1.00000000000000
+    j02 = 0.0
+    j03 = -1/R
+    j04 = 0.0
+    j10 = -R*x0*x1
+    j11 = 0.0
+    j12 = -x0*x2
+    j13 = 0.0
+    j14 = 0.0
+    j20 = dc*k*(R*omega - v)
+    j21 = k*x2
+    j22 = 0.0
+    j23 = -k*x3
+    j24 = k
+    j30 = x1*x4
+    j31 = 0.0
+    j32 = x3*x4
+    j33 = -fp*x4
+    j34 = 0.0
+    j40 = 0.0
+    j41 = 0.0
+    j42 = -1/M
+    j43 = 0.0
+    j44 = 0.0
+    return j00, j01, j02, j03, j04, j10, j11, j12, j13, j14, j20, j21, j22, j23, j24, j30, j31, j32, j33, j34, j40, j41, j42, j43, j44

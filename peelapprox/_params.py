@@ -10,7 +10,8 @@ from dataclasses import dataclass, field
 from ._checks import ArgumentTypeError, _got, choice, in_range
 from ._law import PeelForce
 
-__all__ = ["EPS_DEFAULT", "EPS_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
+__all__ = ["EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE", "LOAD_MASS_RANGE",
+           "LOAD_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
            "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
 
 #: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
@@ -81,6 +82,24 @@ EPS_RANGE = (1e-15, 1e-2)
 #: Default regularisation ε of the ε-regularised scheme and of the variational Lyapunov exponent: the paper's.
 EPS_DEFAULT = 1e-7
 
+#: Loading modes: ``"velocity"`` (the paper's: the end O' pulled at the constant speed V) or ``"load"`` (a
+#: constant force F_L on a body of mass M at O': ``M V̇_p = F_L - F``, the pull speed ``V_p`` a state).
+LOADINGS = ("velocity", "load")
+#: Standard gravity [m/s²]: a hanging mass M is the load ``F_L = M g`` (the default of ``load``).
+GRAVITY = 9.80665
+#: Valid tape (ribbon) mass m [kg] of the tape-mass model (0 or None: the massless model).  Its fast time scale
+#: is ~ m (1 + sin α)² / f' (the ε of XDAE, docs/tape-mass.md): from 1e-15 kg (EPS_RANGE's floor: the time
+#: scale reaches the rounding of t) to 10 kg (a 10 m ribbon of heavy tape; far above the paper's I/R²).
+TAPE_MASS_RANGE = (1e-15, 10.0)
+#: Valid loading mass M [kg] under ``loading="load"``: 1 mg (the loading is then force control) to 1000 t
+#: (then the pull speed hardly changes within a run: velocity control).
+LOAD_MASS_RANGE = (1e-6, 1e6)
+#: Valid load F_L [N]: the range of the pull force F (:data:`STATE_RANGES`).
+LOAD_RANGE = (1e-3, 1e7)
+
+
+_VARIANT_DEFAULTS = {"tape_mass": None, "loading": "velocity", "load_mass": None, "load": None}
+
 
 @dataclass(frozen=True, repr=False)
 class PeelParams:
@@ -109,6 +128,23 @@ class PeelParams:
         laws than the paper's are refused, for now, by the functions that
         use the parameters (issue 15); the default leaves ``repr``,
         equality and ``hash`` as they were before the field existed.
+    tape_mass : float or None, default None
+        Mass m of the peeled ribbon [kg] (docs/tape-mass.md): the
+        tape-mass model, LAGRAN plus the ribbon's kinetic energy, a smooth
+        ODE whose jumps arise from the dynamics.  None or 0: the paper's
+        massless model (the DAE).  Else in ``TAPE_MASS_RANGE`` = [1e-15, 10].
+    loading : {"velocity", "load"}, default "velocity"
+        ``"velocity"``: the end O' pulled at the constant speed V (the
+        paper).  ``"load"``: a constant force ``load`` on a body of mass
+        ``load_mass`` at O' (docs/constant-load.md): ``M V̇_p = F_L - F``,
+        the pull speed ``V_p`` a state starting at V; the peel-force law is
+        still evaluated at the fixed speed V.
+    load_mass : float or None
+        M [kg], required with ``loading="load"`` (in ``LOAD_MASS_RANGE`` =
+        [1e-6, 1e6]), refused otherwise.
+    load : float or None
+        F_L [N] (``LOAD_RANGE`` = [1e-3, 1e7]); default ``load_mass *
+        GRAVITY``: a hanging mass.  Only with ``loading="load"``.
 
     Raises
     ------
@@ -171,6 +207,10 @@ class PeelParams:
     l: float = 1.0
     geometry: str = field(default="paper")
     force: PeelForce = field(default=PeelForce.paper())
+    tape_mass: float | None = None
+    loading: str = "velocity"
+    load_mass: float | None = None
+    load: float | None = None
 
     def __post_init__(self) -> None:
         for name, (lo, hi) in PARAM_RANGES.items():
@@ -185,18 +225,56 @@ class PeelParams:
             object.__setattr__(self, "force", PeelForce.from_dict(self.force))
         if not isinstance(self.force, PeelForce):
             raise ArgumentTypeError(f"force must be a PeelForce (e.g. PeelForce.paper()), got {_got(self.force)}")
+        self._check_variant()
+
+    def _check_variant(self) -> None:
+        """Validate and normalise the variant fields (issue 18): ``tape_mass`` 0 -> None, the default load."""
+        if self.tape_mass is not None:
+            m = self.tape_mass
+            if not isinstance(m, bool) and isinstance(m, (int, float)) and m == 0:
+                object.__setattr__(self, "tape_mass", None)
+            else:
+                object.__setattr__(self, "tape_mass", in_range("tape_mass", m, *TAPE_MASS_RANGE))
+        object.__setattr__(self, "loading", choice("loading", self.loading, LOADINGS))
+        if self.loading == "velocity":
+            for name in ("load_mass", "load"):
+                if getattr(self, name) is not None:
+                    raise ValueError(f"{name} is used only with loading='load' (a constant load); got {name}="
+                                     f"{getattr(self, name)!r} with loading='velocity'")
+            return
+        if self.load_mass is None:
+            raise ValueError(f"load_mass is required with loading='load': the mass M [kg] at the pulled end, in "
+                             f"[{LOAD_MASS_RANGE[0]:g}, {LOAD_MASS_RANGE[1]:g}]")
+        object.__setattr__(self, "load_mass", in_range("load_mass", self.load_mass, *LOAD_MASS_RANGE))
+        load = self.load_mass * GRAVITY if self.load is None else self.load
+        object.__setattr__(self, "load", in_range("load", load, *LOAD_RANGE))
+
+    @property
+    def variant(self) -> str | None:
+        """The model variant's field name (``peelapprox.kernels.variant_field``): None for the paper's
+        massless model under velocity control, ``"tape"``, ``"tape_load"`` or ``"eps_load"``."""
+        if self.loading == "load":
+            return "tape_load" if self.tape_mass else "eps_load"
+        return "tape" if self.tape_mass else None
 
     def _fields(self) -> tuple:
-        """The fields as before ``force`` existed, then ``force`` if it is not the paper's law."""
+        """The fields as before ``force`` existed, then ``force`` if it is not the paper's law, then the variant
+        fields that are not at their defaults (so the default's ``repr`` and ``hash`` are as before)."""
         base = (self.V, self.I, self.k, self.R, self.l, self.geometry)
         return base if self.force.kind == "paper" else base + (self.force,)
 
+    def _variant_items(self) -> tuple:
+        return tuple((n, getattr(self, n)) for n in ("tape_mass", "loading", "load_mass", "load")
+                     if getattr(self, n) != _VARIANT_DEFAULTS[n])
+
     def __hash__(self) -> int:
-        return hash(self._fields())
+        return hash(self._fields() + self._variant_items())
 
     def __repr__(self) -> str:
         names = ("V", "I", "k", "R", "l", "geometry", "force")
-        return f"PeelParams({', '.join(f'{n}={x!r}' for n, x in zip(names, self._fields()))})"
+        items = [f"{n}={x!r}" for n, x in zip(names, self._fields())]
+        items += [f"{n}={x!r}" for n, x in self._variant_items()]
+        return f"PeelParams({', '.join(items)})"
 
     def closure(self, alpha):
         """``(c, dc/dα)`` with ``c = -cos θ`` for this geometry; scalar or array ``alpha``."""

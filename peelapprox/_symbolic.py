@@ -142,6 +142,127 @@ def lagrange_equations():
     return m1, m2, wdot, fsym, cth, uu
 
 
+# --------------------------------------------------------------------------
+# model variants (issue 18): the tape's mass, the constant load
+# --------------------------------------------------------------------------
+#: Tape (ribbon) mass m [kg], loading-device mass M [kg], load F_L [N], the pull speed as a state V_p [m/s].
+m_tape, M_load, F_load = sp.symbols("m M F_L", positive=True)
+Vp = sp.Symbol("Vp", real=True)
+Vp_dot = sp.Symbol("Vp_dot", real=True)  # its rate: 0 under velocity control, (F_L - F)/M under a load
+
+
+def tape_mass_lagrange_equations(load: bool = False):
+    """Equations of motion of the tape-mass model from LAGRAN plus the ribbon's kinetic energy.
+
+    Generalised coordinates ``(α, u)`` and, under a load, the position ``x_p`` of the pulled end (O') with
+    ``ẋ_p = V_p``.  The kinematics are the paper's Eq. (v) with ``V → ẋ_p``: ``v = ẋ_p - R cos θ α̇ - u̇``,
+    ``ω = α̇ + v/R``.  The Lagrangian is LAGRAN plus the translational kinetic energy of the peeled ribbon
+    (mass ``m``), whose material moves along PO' with the velocity ``ẋ_p - u̇ = v - L̇`` of its end at the
+    spring (the paper lumps the tape's elasticity in ``u`` at O'):
+
+        L = I ω²/2 + m (ẋ_p - u̇)²/2 - k u²/2   [+ M ẋ_p²/2 + F_L x_p under a load]
+
+    with the dissipation function DISSPN, ``∂ℛ/∂q̇ = f(v, V) ∂v/∂q̇``.  Under velocity control ``x_p = V t`` is
+    prescribed (not a coordinate).  Returns the accelerations solved from MOTION1, MOTION2 (and the ``x_p``
+    equation) as a dict ``{"omega_dot", "u_ddot"[, "Vp_dot"]}`` of expressions in ``α(t), u(t)`` and their
+    first derivatives, ``f`` (the symbol ``f``) and ``V_p`` (the symbol; ``V`` under velocity control), with
+    ``c(α) = -cos θ`` an undefined function.
+    """
+    a = sp.Function("alpha")(t)
+    uu = sp.Function("u")(t)
+    ad, ud = sp.diff(a, t), sp.diff(uu, t)
+    cfun = sp.Function("c")(a)
+    coords = [a, uu]
+    if load:
+        xp = sp.Function("x_p")(t)
+        xpd = sp.diff(xp, t)
+        coords.append(xp)
+    else:
+        xpd = V
+    vel = xpd + R * cfun * ad - ud  # Eq. (v), cos θ = -c
+    om = ad + vel / R
+    Lag = I / 2 * om**2 + m_tape / 2 * (xpd - ud) ** 2 - k / 2 * uu**2  # LAGRAN + the ribbon
+    if load:
+        Lag += M_load / 2 * xpd**2 + F_load * xp  # the loading mass and the load's potential -F_L x_p
+    fsym = sp.Symbol("f")
+    eqs = []
+    for q in coords:
+        qd = sp.diff(q, t)
+        eqs.append(sp.diff(sp.diff(Lag, qd), t) - sp.diff(Lag, q) + fsym * sp.diff(vel, qd))  # MOTION1, MOTION2
+    acc = [sp.diff(q, t, 2) for q in coords]
+    accs = sp.symbols(f"acc0:{len(coords)}")
+    sol = sp.solve([e.subs(dict(zip(acc, accs))) for e in eqs], accs, dict=True)[0]
+    omega_dot = sp.diff(om, t).subs(dict(zip(acc, accs))).subs(sol)
+    out = {"omega_dot": omega_dot, "u_ddot": sol[accs[1]], "v": vel}
+    if load:
+        out["Vp_dot"] = sol[accs[2]]
+        out = {kk: e.subs(xpd, Vp) for kk, e in out.items()}
+    return out
+
+
+def tape_mass_rates(c=c_, dc=dc_):
+    """FLOW1, flow3 and the tape-mass model's ω̇ and v̇ in the state ``(α, ω, F, v)`` (and ``V_p``).
+
+    From :func:`tape_mass_lagrange_equations` with ``F = k u`` and ``u̇ = V_p + R c α̇ - v`` (Eq. v):
+
+        α̇ = ω - v/R                                   (FLOW1)
+        I ω̇ = -R c f / (1 + c)                          (FLOW2 with the ribbon's tension f/(1 + c) at P)
+        Ḟ = k (V_p - v) + k c (R ω - v)                 (flow3)
+        m (1 + c)² v̇ = F (1 + c) - f + m (1 + c) [R c' α̇² - R² c² f / (I (1 + c))]
+
+    so ``m → 0`` gives back FLOW2 and CONSTR.  The ribbon's momentum, ``m (V̇_p - ü) = F - f/(1 + c)``, gives
+    ``ü``; the pull speed's rate ``V̇_p`` (the symbol ``Vp_dot``: 0 under velocity control) cancels from v̇.
+    Returns ``(alpha_dot, omega_dot, F_dot, v_dot)`` in terms of ``c``, ``dc`` and the symbol ``f``.
+    """
+    fsym = sp.Symbol("f")
+    alpha_dot = omega - v / R
+    omega_dot = -R * c * fsym / (I * (1 + c))
+    F_dot = k * (Vp - v) + k * c * (omega * R - v)
+    s_dot = Vp_dot + (fsym / (1 + c) - F) / m_tape  # ü: the ribbon's momentum, m (d/dt)(V_p - u̇) = F - f/(1 + c)
+    # v = V_p + R c α̇ - u̇  =>  (1 + c) v̇ = V̇_p + R c' α̇² + R c ω̇ - ü
+    v_dot = (Vp_dot + R * dc * alpha_dot**2 + R * c * omega_dot - s_dot) / (1 + c)
+    return alpha_dot, omega_dot, F_dot, v_dot
+
+
+def variant_system(model: str):
+    """Right-hand side and Jacobian of a model variant's ODE in ``X = (α, ω, F, v[, V_p])``.
+
+    ``model``: ``"tape"`` (tape mass, velocity control, 4 states), ``"tape_load"`` (tape mass under a load, 5
+    states) or ``"eps_load"`` (the massless tape under a load in the paper's ε-regularisation XDAE, 5 states).
+    Under a load ``V̇_p = (F_L - F)/M``.  Written in ``c``, ``dc``, ``ddc`` (``c = -cos θ`` and its α-derivatives)
+    and ``f``, ``fp`` (the peel force and df/dv) so that one rendering serves both closures and every law.
+    Returns ``(rhs, J)`` with ``f`` and ``fp`` as symbols.
+    """
+    if model not in ("tape", "tape_load", "eps_load"):
+        raise ValueError(f"model must be 'tape', 'tape_load' or 'eps_load', got {model!r}")
+    load = model != "tape"
+    cfun = sp.Function("c")(alpha)
+    fv = sp.Function("fv")(v)
+    if model == "eps_load":
+        ad, wd, Fd, g = equations_of_motion(cfun)
+        rates = [ad, wd, Fd.subs(V, Vp), (g.subs(peel_force_expr(v, V), fv)) / eps]
+    else:
+        ad, wd, Fd, vd = tape_mass_rates(cfun, sp.diff(cfun, alpha))
+        rates = [ad, wd, Fd, vd]
+    X = [alpha, omega, F, v]
+    vdot_load = (F_load - F) / M_load
+    if load:
+        rates = [e.subs(Vp_dot, vdot_load) for e in rates] + [vdot_load]
+        X.append(Vp)
+    else:
+        rates = [e.subs({Vp_dot: 0, Vp: V}) for e in rates]
+    fsym, fp = sp.symbols("f fp")
+    rates = [e.subs(sp.Symbol("f"), fv) for e in rates]
+    rhs = sp.Matrix(rates)
+    J = rhs.jacobian(sp.Matrix(X))
+    ddc = sp.Symbol("ddc")
+    back = [(sp.Derivative(cfun, (alpha, 2)), ddc), (sp.Derivative(cfun, alpha), dc_), (cfun, c_),
+            (sp.Derivative(fv, v), fp), (fv, fsym)]
+    for old, new in back:
+        rhs, J = rhs.subs(old, new), J.subs(old, new)
+    return rhs, J
+
+
 def regularized_system():
     """Right-hand side and Jacobian of the ε-regularised XDAE (both closures).
 
@@ -327,7 +448,36 @@ def render_module() -> str:
             names,
         )
     )
+    parts += _render_variants()
     return "\n\n".join(parts)
+
+
+def _render_variants() -> list[str]:
+    """The model variants' kernels (issue 18): the tape-mass rates, the load's rate, the three Jacobians."""
+    ddc, fs, fp = sp.symbols("ddc f fp")
+    rhs, _ = variant_system("tape_load")
+    state = ["alpha", "omega", "F", "v"]
+    parts = [
+        _render_function(
+            "tape_rhs", state + ["Vp", "c", "dc", "f", "m", "I", "k", "R"], list(rhs[:4]),
+            "Tape-mass model: (alpha, omega, F, v) rates with the pull speed Vp (= V under velocity control).",
+            ["d_alpha", "d_omega", "d_F", "d_v"]),
+        _render_function(
+            "load_rate", ["F", "M", "F_L"], [rhs[4]], "Under a load F_L on a mass M: the pull speed's rate.",
+            ["d_Vp"]),
+    ]
+    for model, n, extra, what in (
+        ("tape", 4, ["m", "V"], "tape-mass model under velocity control"),
+        ("tape_load", 5, ["Vp", "m", "M", "F_L"], "tape-mass model under a load, state (alpha, omega, F, v, Vp)"),
+        ("eps_load", 5, ["Vp", "eps", "M", "F_L"], "eps-regularised massless tape under a load (XDAE)"),
+    ):
+        _, J = variant_system(model)
+        parts.append(_render_function(
+            f"{model}_jacobian", state + ["c", "dc", "ddc", "f", "fp"] + extra + ["I", "k", "R"],
+            [sp.sympify(J[i, j]) for i in range(n) for j in range(n)],
+            f"Jacobian of the {what}, row-major {n * n}-tuple, in c, its alpha-derivatives dc, ddc, f and f'.",
+            [f"j{i}{j}" for i in range(n) for j in range(n)]))
+    return parts
 
 
 def write_module(path=None) -> str:

@@ -9,8 +9,9 @@ peel-force law as a function argument with its coefficients as data (:mod:`peela
 :func:`family_kernel` and :func:`expression_kernel` of :mod:`peelapprox._law_codegen`), the ``cos θ`` closures with the
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
 system XDAE and its Jacobian (also as whole fields of the state and a packed parameter vector, the form the
-stiff solvers call).  The model block every driver's parameter vector starts with (:mod:`peelapprox._packing`:
-the index constants ``M_*``, its length ``N_M``, :func:`model_block`), the DOP853 pieces
+stiff solvers call), and the model variants' fields (the tape mass, the constant load:
+:mod:`peelapprox._variant_fields`).  The model block every driver's parameter vector starts with
+(:mod:`peelapprox._packing`: the index constants ``M_*``, its length ``N_M``, :func:`model_block`), the DOP853 pieces
 (:mod:`peelapprox._dop853`), the kernel compiler and the status codes (:mod:`peelapprox._status`) are offered
 here too, so ``exact`` needs no private module of ``peelapprox`` for its kernels.  The same system written in
 DiffSL and JIT-compiled by pydiffsol (optional, the ``bench`` extra; :mod:`peelapprox._diffsl`) is offered here
@@ -71,6 +72,7 @@ from ._law_table_jit import table_coefficients, table_law
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
 from ._peelforce import _invert as branch_inverse_at
 from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
+from ._variant_fields import VARIANT_MODELS, variant_field, variant_parameters
 
 #: Index of ε in the regularised system's parameter vector, after the model block.
 Q_EPS = N_M
@@ -87,6 +89,7 @@ __all__ = [
     "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",
     "regularized_field_jacobian", "regularized_law_field", "peel_force_coefficients", "branch_inverse_at",
     "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
+    "VARIANT_MODELS", "variant_field", "variant_parameters",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",

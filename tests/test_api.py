@@ -19,7 +19,7 @@ API = {
     "peelapprox": {
         "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BREAKDOWN_LEVEL", "EPS_RANGE", "LYAPUNOV_TAU",
         "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "BranchStructure", "FixedPoint",
-        "EPS_DEFAULT", "GEOMETRIES",
+        "EPS_DEFAULT", "GEOMETRIES", "TAPE_MASS_RANGE", "LOADINGS", "LOAD_MASS_RANGE", "LOAD_RANGE", "GRAVITY",
         "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
         "PARAM_RANGES", "PeelParams", "PeelForce", "Folds", "periodic_orbit", "PeriodicOrbit",
         "continue_orbit", "OrbitBranch", "switch_branch", "basins", "BasinResult", "Periodicity", "ReducedSegment",
@@ -35,7 +35,8 @@ API = {
         "wkb_error_bound",
     },
     "exact": {
-        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "STEP_BUDGET", "SaveAt",
+        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "Smooth", "STEP_BUDGET",
+        "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
@@ -72,7 +73,8 @@ API = {
     # the door through which exact (and comparisons) reach the compiled model and integrator
     "peelapprox.kernels": {
         "ALL_LAWS", "CompiledLaw", "pack_inlined", "pack_law",
-        "U_ZERO", "compiled_law", "law_domain", "rebind", "regularized_law_field",
+        "U_ZERO", "compiled_law", "law_domain", "rebind", "regularized_law_field", "VARIANT_MODELS", "variant_field",
+        "variant_parameters",
         "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",
         "LAW_SIG", "LAW_TYPE", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B", "M_GEOM", "M_I", "M_K", "M_L", "M_R",
         "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS", "STEP_FAILED", "branch_inverse_at", "closure",

@@ -241,5 +241,5 @@ def test_wrong_object_types():
         simulate(P, 0.01, saveat="steps")
     with pytest.raises(TypeError, match="budget must be a Budget or None, got dict"):
         simulate(P, 0.01, budget={})
-    with pytest.raises(ArgumentTypeError, match=r"method must be one of \('hybrid', 'regularized'\)"):
+    with pytest.raises(ArgumentTypeError, match=r"method must be one of \('hybrid', 'regularized', 'smooth'\)"):
         simulate(P, 0.01, method=SaveAt(steps=True))

@@ -1,0 +1,150 @@
+"""The model variants' compiled fields (issue 18): the tape-mass model and the constant load.
+
+Three smooth ODE systems in the state ``y = (α, ω, F, v)`` or ``(α, ω, F, v, V_p)``, each with its analytic
+Jacobian, rendered from :func:`peelapprox._symbolic.variant_system` into :mod:`peelapprox._generated`:
+
+=============  ======  ===================================================================================
+model          states  equations
+=============  ======  ===================================================================================
+``"tape"``     4       FLOW1, flow3, the tape-mass model's ω̇ and v̇ (:func:`peelapprox._symbolic.tape_mass_rates`)
+``"tape_load"`` 5      the same with ``V → V_p`` and ``M V̇_p = F_L - F``
+``"eps_load"`` 5       the massless tape under a load: XDAE (``ε v̇ = F(1 - cos θ) - f``) with ``V → V_p``
+=============  ======  ===================================================================================
+
+The peel-force law is an argument (``law(v, coef, LAW_FP)``, :mod:`peelapprox._law_abi`), so every law runs
+through the one compiled field per model; the law is evaluated at the **fixed** pull speed its coefficients
+were packed for (``params.V``), also under a load where the pull speed ``V_p`` varies (docs/constant-load.md).
+The parameter vector is the model block followed by ``(m or ε, M, F_L)`` (:func:`variant_parameters`).
+Each field and Jacobian is compiled on first use for its one signature (loaded from numba's cache after).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import types as _nb
+
+from . import _generated as _g
+from ._jit import kernel
+from ._law import ALL_LAWS
+from ._law_abi import LAW_FP, LAW_TYPE
+from ._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
+
+__all__ = ["VARIANT_MODELS", "Q_MASS", "Q_LOAD_MASS", "Q_LOAD", "variant_parameters", "variant_field"]
+
+#: The variants' names and their numbers of states.
+VARIANT_MODELS = {"tape": 4, "tape_load": 5, "eps_load": 5}
+#: Indices after the model block: the tape mass m (or ε for ``"eps_load"``), the loading mass M, the load F_L.
+Q_MASS, Q_LOAD_MASS, Q_LOAD = N_M, N_M + 1, N_M + 2
+
+_tape_rhs = kernel(inline="always")(_g.tape_rhs)
+_load_rate = kernel(inline="always")(_g.load_rate)
+_regularized_rhs = kernel(inline="always")(_g.regularized_rhs)
+_tape_jac = kernel(inline="always")(_g.tape_jacobian)
+_tape_load_jac = kernel(inline="always")(_g.tape_load_jacobian)
+_eps_load_jac = kernel(inline="always")(_g.eps_load_jacobian)
+_closure_paper_d2 = kernel(inline="always")(_g.closure_paper_d2)
+_closure_exact_d2 = kernel(inline="always")(_g.closure_exact_d2)
+
+
+def variant_parameters(params: Any, mass: float, load_mass: float = 1.0, load: float = 0.0) -> np.ndarray:
+    """The parameter vector of the variant fields: the model block (:func:`model_block`, any law), then ``mass``
+    (the tape mass m [kg], or ε for ``"eps_load"``), ``load_mass`` M [kg] and ``load`` F_L [N] (unused by
+    ``"tape"``)."""
+    q = model_block(params, N_M + 3, ALL_LAWS)
+    q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD] = mass, load_mass, load
+    return q
+
+
+@kernel(inline="always")
+def _closure_d2(alpha, geom, R, l):
+    if geom == 0.0:
+        return _closure_paper_d2(alpha, R, l)
+    return _closure_exact_d2(alpha, R, l)
+
+
+@kernel
+def _tape_field(y, q, law, coef):
+    """The tape-mass model under velocity control: ``(α̇, ω̇, Ḟ, v̇)``."""
+    v = max(y[3], 1e-300)  # implicit-solver iterates may probe v <= 0; accepted steps are checked
+    f, _, _ = law(v, coef, LAW_FP)
+    c, dc, _ = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = _tape_rhs(y[0], y[1], y[2], v, q[M_V], c, dc, f, q[Q_MASS], q[M_I], q[M_K], q[M_R])
+    return np.array([r[0], r[1], r[2], r[3]])
+
+
+@kernel
+def _tape_jacobian(y, q, law, coef):
+    v = max(y[3], 1e-300)
+    f, fp, _ = law(v, coef, LAW_FP)
+    c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    j = _tape_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, q[Q_MASS], q[M_V], q[M_I], q[M_K], q[M_R])
+    out = np.empty((4, 4))
+    for i in range(16):
+        out[i // 4, i % 4] = j[i]
+    return out
+
+
+@kernel
+def _tape_load_field(y, q, law, coef):
+    """The tape-mass model under a load: ``(α̇, ω̇, Ḟ, v̇, V̇_p)``."""
+    v = max(y[3], 1e-300)
+    f, _, _ = law(v, coef, LAW_FP)
+    c, dc, _ = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = _tape_rhs(y[0], y[1], y[2], v, y[4], c, dc, f, q[Q_MASS], q[M_I], q[M_K], q[M_R])
+    return np.array([r[0], r[1], r[2], r[3], _load_rate(y[2], q[Q_LOAD_MASS], q[Q_LOAD])[0]])
+
+
+@kernel
+def _tape_load_jacobian(y, q, law, coef):
+    v = max(y[3], 1e-300)
+    f, fp, _ = law(v, coef, LAW_FP)
+    c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    j = _tape_load_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, y[4], q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD],
+                       q[M_I], q[M_K], q[M_R])
+    out = np.empty((5, 5))
+    for i in range(25):
+        out[i // 5, i % 5] = j[i]
+    return out
+
+
+@kernel
+def _eps_load_field(y, q, law, coef):
+    """The ε-regularised massless tape under a load: ``(α̇, ω̇, Ḟ, v̇, V̇_p)``."""
+    v = max(y[3], 1e-300)
+    f, _, _ = law(v, coef, LAW_FP)
+    c, _, _ = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = _regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_MASS], y[4], q[M_I], q[M_K], q[M_R])
+    return np.array([r[0], r[1], r[2], r[3], _load_rate(y[2], q[Q_LOAD_MASS], q[Q_LOAD])[0]])
+
+
+@kernel
+def _eps_load_jacobian(y, q, law, coef):
+    v = max(y[3], 1e-300)
+    f, fp, _ = law(v, coef, LAW_FP)
+    c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    j = _eps_load_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, y[4], q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD],
+                      q[M_I], q[M_K], q[M_R])
+    out = np.empty((5, 5))
+    for i in range(25):
+        out[i // 5, i % 5] = j[i]
+    return out
+
+
+_FIELDS = {"tape": (_tape_field, _tape_jacobian), "tape_load": (_tape_load_field, _tape_load_jacobian),
+           "eps_load": (_eps_load_field, _eps_load_jacobian)}
+
+
+def variant_field(model: str) -> tuple[Any, Any]:
+    """``(field, jacobian)`` of a variant (module docstring): ``field(y, q, law, coef)`` -> rates (a new array),
+    ``jacobian(y, q, law, coef)`` -> the (n, n) Jacobian; compiled for that one signature on first use."""
+    if model not in _FIELDS:
+        raise ValueError(f"model must be one of {sorted(_FIELDS)}, got {model!r}")
+    a1 = _nb.float64[::1]
+    fun, jac = _FIELDS[model]
+    for d, ret in ((fun, a1), (jac, _nb.float64[:, ::1])):
+        if not d.signatures:
+            d.compile(ret(a1, a1, LAW_TYPE, a1))
+            d.disable_compile()
+    return fun, jac
