@@ -70,7 +70,7 @@ def mass_limit(V: float = 1.0, I: float = 1e-5, masses: Sequence[float] = (1e1, 
     ``tape_mass=None``: massless tape, the ε-scheme at ε = 1e-7 on both sides; else the tape-mass model
     (``method="smooth"``) at that m on both sides.
     """
-    base = dict(V=V, I=I, tape_mass=tape_mass)
+    base: dict[str, Any] = dict(V=V, I=I, tape_mass=tape_mass)
     kw: dict[str, Any] = dict(solver=solver, rtol=rtol)
     if tape_mass is None:
         kw.update(method="regularized", eps=EPS)
@@ -109,6 +109,8 @@ def load_roots(F_L: float, V: float) -> list[tuple[str, float]]:
     """The speeds ``V*`` with ``f(V*, V) = F_L`` on each branch of the law at V: ``[(branch, V*), ...]`` with
     branch ``"AB"``, ``"unstable"`` (between the folds) or ``"CD"``; none below ``f(0+, V)``."""
     bs = branch_structure(V)
+    if bs.f_max is None or bs.f_min is None or bs.v_max is None or bs.v_min is None:
+        raise ValueError(f"V must give the law folds (stick-slip under velocity control), got V={V!r}")
     out = []
     if bs.f_zero < F_L < bs.f_max:
         out.append(("AB", float(branch_inverse(F_L, V, "AB"))))
@@ -164,22 +166,24 @@ def classify(V: float, I: float, F_L: float, M: float, t_end: float, *, rtol: fl
     final v (below / above the law's inflection), with ``duration`` = the last jump's time (0: no jump).
     A :class:`ModelBreakdown` is ``"breakdown:<reason>"`` at its t.  A solver failure (LSODA at rtol 1e-6 can
     step v below 0 on deep AB, where v ~ 1e-5 m/s and f' is large) is retried once at ``rtol * 1e-3`` (up to
-    2e6 steps and ``max_wall`` s); failing again it is ``"unresolved:<exception>"``, not a physical verdict.
+    4e6 steps, 2e6 at first, and ``max_wall`` s each); failing again it is ``"unresolved:<exception>"``, not
+    a physical verdict.
     ``keep=True`` adds the trajectory under ``"trajectory"``.
     """
     p = PeelParams(V=V, I=I, loading="load", load_mass=M, load=F_L)
     bs = branch_structure(V)
     row: dict[str, Any] = dict(V=V, I=I, M=M, F_L=F_L, t_end=t_end, f_min=bs.f_min, f_max=bs.f_max)
     t0 = time.perf_counter()
-    for tol, steps in ((rtol, None), (rtol * 1e-3, 2_000_000)):  # a solver failure: once more, tighter
+    for tol, steps in ((rtol, 2_000_000), (rtol * 1e-3, 4_000_000)):  # a solver failure: once more, tighter
         try:
             tr = simulate(p, t_end, method="regularized", solver="LSODA", eps=EPS, rtol=tol, max_steps=steps,
                           max_wall=max_wall)
             break
         except (ModelBreakdown, SolverFailure, SolverBudgetExceeded) as exc:
             failed: Any = exc
-            if isinstance(exc, ModelBreakdown) or steps is not None:
-                cls = f"breakdown:{exc.reason}" if isinstance(exc, ModelBreakdown) else f"unresolved:{type(exc).__name__}"
+            if isinstance(exc, ModelBreakdown) or tol != rtol:
+                cls = (f"breakdown:{exc.reason}" if isinstance(exc, ModelBreakdown)
+                       else f"unresolved:{type(exc).__name__}")
                 return {**row, "cls": cls, "rtol": tol, "t_stop": float(failed.t), "n_jumps": -1,
                         "duration": math.nan, "Vp_end": math.nan, "v_end": math.nan, "F_end": math.nan,
                         "wall": time.perf_counter() - t0}
@@ -231,16 +235,64 @@ def stick_slip_duration(V: float = 1.0, I: float = 1e-5, masses: Sequence[float]
     return rows, dict(C=C, p=p, max_rel_residual=res, n=len(ok), F_L=F_L)
 
 
-def load_figures(out: Path, progress: Say = _quiet) -> list[Path]:
-    """docs/figures/load_*.png: F(t), V_p(t) and v(t) of a transient case and of the phase diagram's longest
-    run (``load_runs.png``), the 1/M limit (``load_limit.png``); from fresh runs."""
+_MARKERS = {"stick-slip": ("o", "C3"), "transient->AB": ("v", "C0"), "transient->CD": ("^", "C2"),
+            "runaway": (">", "C1")}
+
+
+def _plot_tables(plt: Any, tables: Path, out: Path) -> list[Path]:
+    """``load_limit.png`` and ``load_phase.png`` from the tables the other parts wrote (those present)."""
+    import json
+
+    paths = []
+    if (tables / "load_limit.json").is_file():
+        rows = json.loads((tables / "load_limit.json").read_text())
+        fig, ax = plt.subplots(figsize=(6, 4))
+        for case, ls in zip(dict.fromkeys(r["case"] for r in rows), ("-", "--")):
+            sel = [r for r in rows if r["case"] == case]
+            M = [r["M"] for r in sel]
+            for key, lab, c in (("dt_jump", "max |Δt_jump| [s]", "C0"), ("dF_jump", "max |ΔF_jump| [N]", "C1"),
+                                ("dVp", "max |V_p − V| [m/s]", "C2")):
+                ax.loglog(M, [r[key] for r in sel], ls, marker="o", ms=3, color=c, label=f"{lab}, {case}")
+        ax.set_xlabel("loading mass M [kg]")
+        ax.set_ylabel("deviation from velocity control")
+        ax.legend(fontsize=6)
+        ax.set_title("Load mode → velocity control as 1/M (V = 1, I = 1e-5, 0.2 s)", fontsize=9)
+        fig.tight_layout()
+        paths.append(out / "load_limit.png")
+        fig.savefig(paths[-1], dpi=80)
+        plt.close(fig)
+    if (tables / "load_phase.json").is_file():
+        rows = [r for r in json.loads((tables / "load_phase.json").read_text()) if r["I"] == 1e-5]
+        fig, ax = plt.subplots(figsize=(6, 4))
+        for cls in dict.fromkeys(r["cls"] for r in rows):
+            mk, c = _MARKERS.get(cls, ("x", "k"))
+            sel = [r for r in rows if r["cls"] == cls]
+            ax.semilogx([r["M"] for r in sel], [r["F_L"] for r in sel], mk, color=c, ms=8, ls="", label=cls)
+        for level, lab in ((rows[0]["f_min"], "f_min"), (rows[0]["f_max"], "f_max")):
+            ax.axhline(level, color="k", lw=0.6, ls=":")
+            ax.text(ax.get_xlim()[0], level, f" {lab}", fontsize=7, va="bottom")
+        ax.set_xlabel("loading mass M [kg]")
+        ax.set_ylabel("load F_L [N]")
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1, 1))
+        ax.set_title("Constant load from V_p(0) = V = 1 (I = 1e-5): end state", fontsize=9)
+        fig.tight_layout()
+        paths.append(out / "load_phase.png")
+        fig.savefig(paths[-1], dpi=80)
+        plt.close(fig)
+    return paths
+
+
+def load_figures(out: Path, tables: Path | None = None, progress: Say = _quiet) -> list[Path]:
+    """docs/figures/load_*.png: F(t), V_p(t) and v(t) of two transient runs, one ending on AB and one on CD
+    (``load_runs.png``, fresh runs), and from the tables in ``tables`` (if written) the 1/M limit
+    (``load_limit.png``) and the phase diagram (``load_phase.png``)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     out.mkdir(parents=True, exist_ok=True)
-    paths = []
+    paths = [] if tables is None else _plot_tables(plt, tables, out)
     cases = [(236.0, 25.0, 10.0, "F_L = 236 N, M = 25 kg: stick-slip, then slow steady peeling (AB)"),
              (260.0, 10.0, 8.0, "F_L = 260 N, M = 10 kg: stick-slip, then fast steady peeling (CD)")]
     fig, axes = plt.subplots(3, 2, figsize=(10, 6.5), sharex="col")
@@ -298,7 +350,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _write(out, "load_duration", rows, say)
         _write(out, "load_duration_fit", [fit], say)
     if "figures" in parts:
-        for path in load_figures(a.figures, progress=say):
+        for path in load_figures(a.figures, out, progress=say):
             say(f"wrote {path}")
     return 0
 
