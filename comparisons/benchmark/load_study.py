@@ -44,8 +44,8 @@ from peelapprox.kernels import (
 
 from .eps import fit_power_law
 
-__all__ = ["mass_limit", "fixed_points", "classify", "phase_diagram", "stick_slip_duration", "load_figures",
-           "main"]
+__all__ = ["mass_limit", "fixed_points", "classify", "phase_diagram", "stick_slip_duration", "balanced_load",
+           "cycle_means", "load_figures", "main"]
 
 Say = Callable[[str], None]
 EPS = 1e-7  #: the paper's ε, for the massless tape (method="regularized")
@@ -220,17 +220,47 @@ def phase_diagram(V: float = 1.0, I_values: Sequence[float] = (1e-5,),
     return rows
 
 
-def stick_slip_duration(V: float = 1.0, I: float = 1e-5, masses: Sequence[float] = (1, 3, 10, 30, 100), *,
+def balanced_load(V: float = 1.0, I: float = 1e-5) -> float:
+    """The long-run mean pull force of velocity-controlled stick-slip at V [N]: the hybrid solver (ε → 0,
+    rtol 1e-9) over [1, 41] s (the first second dropped); 238.601 N at V = 1, I = 1e-5 (its 10 s windows agree
+    to 0.07 N)."""
+    return _mean_force(simulate(PeelParams(V=V, I=I), 41.0, rtol=1e-9, t_transient=1.0))
+
+
+def cycle_means(tr: Any) -> np.ndarray:
+    """Per stick-slip cycle (from one AB→CD jump to the next): ``(t_mid, ⟨V_p⟩, ⟨F⟩)``, time means over the
+    stored steps; shape (n_cycles, 3).  Their slope d⟨F⟩/d⟨V_p⟩ is the cycle-averaged force's dependence on
+    the pull speed, which decides whether stick-slip under a load can be stationary (docs/constant-load.md)."""
+    up = tr.jumps.t[tr.jumps.from_branch == 0]
+    out = []
+    for a, b in zip(up[:-1], up[1:]):
+        w = (tr.t >= a) & (tr.t <= b)
+        t = tr.t[w]
+        out.append((0.5 * (a + b), np.trapezoid(tr.Vp[w], t) / (b - a), np.trapezoid(tr.F[w], t) / (b - a)))
+    return np.array(out, dtype=float).reshape(-1, 3)
+
+
+def stick_slip_duration(V: float = 1.0, I: float = 1e-5, masses: Sequence[float] = (1, 3, 10, 30), *,
+                        F_L: float | None = None,
                         progress: Say = _quiet) -> tuple[list[dict[str, Any]], dict[str, float]]:
-    """How long stick-slip lasts at the balanced load ``F_L = ⟨F⟩`` (the velocity-controlled run's mean over
-    0.2 s) against M, and the power law ``duration = C M^p`` fitted to it."""
-    ref = simulate(PeelParams(V=V, I=I), 0.2, method="regularized", solver="LSODA", eps=EPS, rtol=1e-10)
-    F_L = _mean_force(ref)
+    """How long stick-slip lasts at the balanced load ``F_L = ⟨F⟩`` (default :func:`balanced_load`) against M
+    (horizon ``3 + 0.4 M`` s), and the power law ``duration = C M^p`` fitted to the transient ones.  Each row
+    adds ``dFdVp``: the least-squares slope of the cycle means (:func:`cycle_means`) ⟨F⟩ against ⟨V_p⟩ over the
+    cycles with ⟨V_p⟩ above the AB fold's speed v_max (0.506 m/s at V = 1; NaN below 5 cycles)."""
+    F_L = balanced_load(V, I) if F_L is None else F_L
+    v_ab = float(branch_structure(V).v_max or 0.0)
     rows = []
     for M in masses:
         progress(f"duration: M = {M:g} kg (F_L = {F_L:.6g} N)")
-        rows.append(classify(V, I, F_L, M, 3.0 + 0.4 * M))
+        row = classify(V, I, F_L, M, 3.0 + 0.4 * M, keep=True)
+        cyc = cycle_means(row.pop("trajectory")) if "trajectory" in row else np.empty((0, 3))
+        above = cyc[cyc[:, 1] > v_ab]  # cycles while V_p is above the AB fold's speed
+        row["dFdVp"] = float(np.polyfit(above[:, 1], above[:, 2], 1)[0]) if len(above) >= 5 else math.nan
+        row["n_cycles"] = len(cyc)
+        rows.append(row)
     ok = [r for r in rows if r["cls"].startswith("transient") and r["duration"] > 0]
+    if len(ok) < 3:
+        return rows, dict(C=math.nan, p=math.nan, max_rel_residual=math.nan, n=len(ok), F_L=F_L)
     C, p, res = fit_power_law(np.array([r["M"] for r in ok]), np.array([r["duration"] for r in ok]))
     return rows, dict(C=C, p=p, max_rel_residual=res, n=len(ok), F_L=F_L)
 
@@ -293,17 +323,19 @@ def load_figures(out: Path, tables: Path | None = None, progress: Say = _quiet) 
 
     out.mkdir(parents=True, exist_ok=True)
     paths = [] if tables is None else _plot_tables(plt, tables, out)
-    cases = [(236.0, 25.0, 10.0, "F_L = 236 N, M = 25 kg: stick-slip, then slow steady peeling (AB)"),
-             (260.0, 10.0, 8.0, "F_L = 260 N, M = 10 kg: stick-slip, then fast steady peeling (CD)")]
-    fig, axes = plt.subplots(3, 2, figsize=(10, 6.5), sharex="col")
+    F_b = 238.60124090927533  # balanced_load(1.0, 1e-5), not recomputed here
+    cases = [(F_b, 10.0, 4.0, "F_L = ⟨F⟩ = 238.6 N, M = 10 kg:\ntransient, ends in slow peeling (AB)"),
+             (285.0, 10.0, 3.0, "F_L = 285 N, M = 10 kg:\ntransient, ends in fast peeling (CD)"),
+             (F_b, 1.0, 5.0, "F_L = ⟨F⟩ = 238.6 N, M = 1 kg:\nstick-slip persists (V_p settles near 2.9 m/s)")]
+    fig, axes = plt.subplots(3, 3, figsize=(12, 6.5), sharex="col")
     for col, (F_L, M, T, title) in enumerate(cases):
-        progress(f"figure: F_L={F_L} M={M} ({T} s)")
+        progress(f"figure: F_L={F_L:.6g} M={M} ({T} s)")
         tr = classify(1.0, 1e-5, F_L, M, T, keep=True)["trajectory"]
-        axes[0, col].plot(tr.t, tr.F, lw=0.5)
+        axes[0, col].plot(tr.t, tr.F, lw=0.4)
         axes[0, col].axhline(F_L, color="k", ls=":", lw=0.8)
         axes[0, col].set_title(title, fontsize=9)
-        axes[1, col].plot(tr.t, tr.Vp, lw=0.8)
-        axes[2, col].semilogy(tr.t, tr.v, lw=0.5)
+        axes[1, col].plot(tr.t, tr.Vp, lw=0.6)
+        axes[2, col].semilogy(tr.t, np.maximum(tr.v, 1e-6), lw=0.4)
         axes[2, col].set_xlabel("t [s]")
     for ax, lab in zip(axes[:, 0], ("F [N]", "V_p [m/s]", "v [m/s]")):
         ax.set_ylabel(lab)
