@@ -269,11 +269,19 @@ _MARKERS = {"stick-slip": ("o", "C3"), "transient->AB": ("v", "C0"), "transient-
             "runaway": (">", "C1")}
 
 
+def _save(plt: Any, fig: Any, path: Path, paths: list[Path]) -> None:
+    """Lay out, write (80 dpi) and close ``fig``; append ``path`` to ``paths``."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    paths.append(path)
+
+
 def _plot_tables(plt: Any, tables: Path, out: Path) -> list[Path]:
     """``load_limit.png`` and ``load_phase.png`` from the tables the other parts wrote (those present)."""
     import json
 
-    paths = []
+    paths: list[Path] = []
     if (tables / "load_limit.json").is_file():
         rows = json.loads((tables / "load_limit.json").read_text())
         fig, ax = plt.subplots(figsize=(6, 4))
@@ -287,10 +295,7 @@ def _plot_tables(plt: Any, tables: Path, out: Path) -> list[Path]:
         ax.set_ylabel("deviation from velocity control")
         ax.legend(fontsize=6)
         ax.set_title("Load mode → velocity control as 1/M (V = 1, I = 1e-5, 0.2 s)", fontsize=9)
-        fig.tight_layout()
-        paths.append(out / "load_limit.png")
-        fig.savefig(paths[-1], dpi=80)
-        plt.close(fig)
+        _save(plt, fig, out / "load_limit.png", paths)
     if (tables / "load_phase.json").is_file():
         rows = [r for r in json.loads((tables / "load_phase.json").read_text()) if r["I"] == 1e-5]
         fig, ax = plt.subplots(figsize=(6, 4))
@@ -305,17 +310,14 @@ def _plot_tables(plt: Any, tables: Path, out: Path) -> list[Path]:
         ax.set_ylabel("load F_L [N]")
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1, 1))
         ax.set_title("Constant load from V_p(0) = V = 1 (I = 1e-5): end state", fontsize=9)
-        fig.tight_layout()
-        paths.append(out / "load_phase.png")
-        fig.savefig(paths[-1], dpi=80)
-        plt.close(fig)
+        _save(plt, fig, out / "load_phase.png", paths)
     return paths
 
 
 def load_figures(out: Path, tables: Path | None = None, progress: Say = _quiet) -> list[Path]:
-    """docs/figures/load_*.png: F(t), V_p(t) and v(t) of two transient runs, one ending on AB and one on CD
-    (``load_runs.png``, fresh runs), and from the tables in ``tables`` (if written) the 1/M limit
-    (``load_limit.png``) and the phase diagram (``load_phase.png``)."""
+    """docs/figures/load_*.png: F(t), V_p(t) and v(t) of two transient runs, one ending on AB and one on CD,
+    and of a persistent one (``load_runs.png``, fresh runs), and from the tables in ``tables`` (if written)
+    the 1/M limit (``load_limit.png``) and the phase diagram (``load_phase.png``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -340,10 +342,7 @@ def load_figures(out: Path, tables: Path | None = None, progress: Say = _quiet) 
     for ax, lab in zip(axes[:, 0], ("F [N]", "V_p [m/s]", "v [m/s]")):
         ax.set_ylabel(lab)
     fig.suptitle("Constant load, massless tape (V = 1 law, I = 1e-5 kg m², ε = 1e-7)", fontsize=10)
-    fig.tight_layout()
-    paths.append(out / "load_runs.png")
-    fig.savefig(paths[-1], dpi=80)
-    plt.close(fig)
+    _save(plt, fig, out / "load_runs.png", paths)
     return paths
 
 
