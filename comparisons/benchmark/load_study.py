@@ -158,7 +158,8 @@ def fixed_points(V: float = 1.0, I: float = 1e-5, loads: Sequence[float] = (150,
 
 
 def classify(V: float, I: float, F_L: float, M: float, t_end: float, *, rtol: float = 1e-6,
-             tail: float = 0.25, keep: bool = False, max_wall: float = 300.0) -> dict[str, Any]:
+             tail: float = 0.25, keep: bool = False, max_wall: float = 300.0,
+             max_steps: int | None = None) -> dict[str, Any]:
     """Run the massless tape under the load (ε = 1e-7, LSODA) from the default initial state and classify it.
 
     Jumps in the last ``tail`` fraction of ``[0, t_end]``: ``"stick-slip"``, or ``"runaway"`` if V_p is then
@@ -166,15 +167,15 @@ def classify(V: float, I: float, F_L: float, M: float, t_end: float, *, rtol: fl
     final v (below / above the law's inflection), with ``duration`` = the last jump's time (0: no jump).
     A :class:`ModelBreakdown` is ``"breakdown:<reason>"`` at its t.  A solver failure (LSODA at rtol 1e-6 can
     step v below 0 on deep AB, where v ~ 1e-5 m/s and f' is large) is retried once at ``rtol * 1e-3`` (up to
-    4e6 steps, 2e6 at first, and ``max_wall`` s each); failing again it is ``"unresolved:<exception>"``, not
-    a physical verdict.
+    2e6 steps; ``max_steps`` at first, None: ``simulate``'s default; and ``max_wall`` s each); failing again it
+    is ``"unresolved:<exception>"``, not a physical verdict.
     ``keep=True`` adds the trajectory under ``"trajectory"``.
     """
     p = PeelParams(V=V, I=I, loading="load", load_mass=M, load=F_L)
     bs = branch_structure(V)
     row: dict[str, Any] = dict(V=V, I=I, M=M, F_L=F_L, t_end=t_end, f_min=bs.f_min, f_max=bs.f_max)
     t0 = time.perf_counter()
-    for tol, steps in ((rtol, 2_000_000), (rtol * 1e-3, 4_000_000)):  # a solver failure: once more, tighter
+    for tol, steps in ((rtol, max_steps), (rtol * 1e-3, 2_000_000)):  # a solver failure: once more, tighter
         try:
             tr = simulate(p, t_end, method="regularized", solver="LSODA", eps=EPS, rtol=tol, max_steps=steps,
                           max_wall=max_wall)
@@ -252,7 +253,7 @@ def stick_slip_duration(V: float = 1.0, I: float = 1e-5, masses: Sequence[float]
     rows = []
     for M in masses:
         progress(f"duration: M = {M:g} kg (F_L = {F_L:.6g} N)")
-        row = classify(V, I, F_L, M, 3.0 + 0.4 * M, keep=True)
+        row = classify(V, I, F_L, M, 3.0 + 0.4 * M, keep=True, max_steps=2_000_000)
         cyc = cycle_means(row.pop("trajectory")) if "trajectory" in row else np.empty((0, 3))
         above = cyc[cyc[:, 1] > v_ab]  # cycles while V_p is above the AB fold's speed
         row["dFdVp"] = float(np.polyfit(above[:, 1], above[:, 2], 1)[0]) if len(above) >= 5 else math.nan
@@ -332,7 +333,7 @@ def load_figures(out: Path, tables: Path | None = None, progress: Say = _quiet) 
     fig, axes = plt.subplots(3, 3, figsize=(12, 6.5), sharex="col")
     for col, (F_L, M, T, title) in enumerate(cases):
         progress(f"figure: F_L={F_L:.6g} M={M} ({T} s)")
-        tr = classify(1.0, 1e-5, F_L, M, T, keep=True)["trajectory"]
+        tr = classify(1.0, 1e-5, F_L, M, T, keep=True, max_steps=2_000_000)["trajectory"]
         axes[0, col].plot(tr.t, tr.F, lw=0.4)
         axes[0, col].axhline(F_L, color="k", ls=":", lw=0.8)
         axes[0, col].set_title(title, fontsize=9)
