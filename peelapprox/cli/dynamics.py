@@ -33,7 +33,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     "means), and the attractors reached from several initial peel angles.  Lyapunov methods: "
                     "two-trajectory (Benettin renormalisation; the default), tangent (tangent dynamics with "
                     "saltation matrices; alias saltation), return-map (tangent of the jump-to-jump map), "
-                    "variational (variational equations of the eps-system; alias regularized; needs pydiffsol).",
+                    "variational (variational equations of the eps-system; alias regularized; needs pydiffsol).  "
+                    "Model variants (--tape-mass, --loading load): the run is exact.simulate's with the model's "
+                    "method; a measure that does not run a variant says so (exit status 2).",
         examples=["peelapprox dynamics --V 2 --I 1e-4 --lyapunov            # period, force drops, lambda [bits/s]",
                   "peelapprox dynamics --V 2.5 --I 1e-4 --lyapunov-method tangent",
                   "peelapprox dynamics --V 1 --I 1e-2 --attractors 0,0.1,-0.2 --format json"])
