@@ -391,9 +391,7 @@ class Trajectory:
             If pandas is not installed (``pip install 'peelapprox[data]'``).
         """
         pd = optional_import("pandas", "Trajectory.to_dataframe")
-        cols: tuple[str, ...] = ("t", "alpha", "omega", "F", "v")
-        if self.Vp is not None:
-            cols += ("Vp",)
+        cols = ["t", "alpha", "omega", "F", "v"] + ([] if self.Vp is None else ["Vp"])
         df = pd.DataFrame({**{c: getattr(self, c) for c in cols}, "branch": _branches(pd, self.branch)})
         var = _variant_fields(self.params)
         df.attrs.update({"units": {c: _UNITS[c] for c in (*cols, "branch")},

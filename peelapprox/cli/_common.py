@@ -107,8 +107,8 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
     A ValueError (exit status 2) if the subcommand refuses the variant options (``add_params(variants=...)``) and
     one is given, naming the options and why; PeelParams' own ValueError names a variant field out of range
     (``tape_mass``, ``load_mass``, ``load``; as the options: ``--tape-mass`` ...)."""
-    extra = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
-    given = {k: getattr(args, k, d) for k, (_, d) in _VARIANT_OPTIONS.items()
+    extra: dict[str, Any] = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
+    given: dict[str, Any] = {k: getattr(args, k, d) for k, (_, d) in _VARIANT_OPTIONS.items()
              if getattr(args, k, d) != d and not (k == "tape_mass" and getattr(args, k) == 0.0)}  # 0: massless
     why = getattr(args, "variants_refused", None)
     if given and why is not None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import Any
 
 from ._checks import check_output_path, positive_float, positive_int
 from ._common import add_format, add_params, params_from_args, print_mapping, subcommand
@@ -91,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.quiet,
     )
     s = traj.stats
-    summary = {
+    summary: dict[str, Any] = {
         "V": params.V,
         "I": params.I,
         **{k: v for k, v in (("tape_mass", params.tape_mass), ("loading", params.loading),
