@@ -16,7 +16,7 @@ from ..io import fmt_number, write_csv, write_rows
 from ._force import add_force_options, force_from_args, law_fields
 
 __all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "REDUCED_ONLY", "UNITS", "add_format", "add_params",
-           "params_from_args", "print_mapping",
+           "params_from_args", "print_mapping", "variant_summary",
            "say", "subcommand", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
@@ -125,6 +125,14 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
             if msg.startswith(k + " ") or msg.startswith(k + "="):
                 raise ValueError(opt + msg[len(k):]) from None
         raise
+
+
+def variant_summary(params: PeelParams) -> dict[str, Any]:
+    """The variant fields of ``params`` that are set (``tape_mass`` [kg], ``loading``, ``load_mass`` [kg],
+    ``load`` [N]) for a summary; ``{}`` for the paper's model (its summaries as before the variants)."""
+    if params.variant is None:
+        return {}
+    return {k: getattr(params, k) for k in _VARIANT_OPTIONS if getattr(params, k) is not None}
 
 
 def add_format(sp: argparse.ArgumentParser | argparse._ArgumentGroup, what: str = "the summary") -> None:

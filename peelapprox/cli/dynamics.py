@@ -10,7 +10,16 @@ import sys
 from .. import EPS_DEFAULT, WINDOW_DEFAULTS
 from ..io import write_csv
 from ._checks import check_output_path, finite_float_list, nonnegative_float, positive_float, positive_int
-from ._common import add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
+from ._common import (
+    add_format,
+    add_params,
+    params_from_args,
+    print_mapping,
+    say,
+    subcommand,
+    variant_summary,
+    write_table,
+)
 from ._force import law_fields
 
 __all__ = ["LYAPUNOV_ALIASES", "LYAPUNOV_METHODS", "add_parser", "run"]
@@ -90,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
 
         states("--attractors", args.attractors, "alpha")
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
+    row.update(variant_summary(p))  # the model variant, if any
     try:
         # one run from t = 0: the window's jumps for the return map and force drops, all of them for the
         # settle time

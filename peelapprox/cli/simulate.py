@@ -7,7 +7,7 @@ import sys
 from typing import Any
 
 from ._checks import check_output_path, positive_float, positive_int
-from ._common import add_format, add_params, params_from_args, print_mapping, subcommand
+from ._common import add_format, add_params, params_from_args, print_mapping, subcommand, variant_summary
 from ._force import law_fields
 
 __all__ = ["add_parser", "run"]
@@ -95,9 +95,7 @@ def run(args: argparse.Namespace) -> int:
     summary: dict[str, Any] = {
         "V": params.V,
         "I": params.I,
-        **{k: v for k, v in (("tape_mass", params.tape_mass), ("loading", params.loading),
-                             ("load_mass", params.load_mass), ("load", params.load))
-           if params.variant and v is not None},
+        **variant_summary(params),
         "method": traj.method,
         "solver": traj.solver,
         "rtol": traj.rtol,
