@@ -63,7 +63,8 @@ API = {
     },
     "peelapprox.validate": {
         "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",
-        "interval", "nonnegative", "optional", "optional_finite", "params", "path", "positive", "real", "reals",
+        "interval", "nonnegative", "optional", "optional_finite", "paper_model", "params", "path", "positive", "real",
+        "reals",
         "state", "states", "times", "rtol", "eps",
     },
     "peelapprox.errors": {
