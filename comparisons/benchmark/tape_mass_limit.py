@@ -34,7 +34,8 @@ from peelapprox import PeelParams
 
 from .eps import fit_power_law
 
-__all__ = ["LIMIT_MASSES", "LIMIT_SCENES", "MATCH_CASES", "convergence", "eps_match", "main", "plot_limit", "ribbon_rotation"]
+__all__ = ["LIMIT_MASSES", "LIMIT_SCENES", "MATCH_CASES", "convergence", "eps_match", "main", "plot_limit",
+           "ribbon_rotation"]
 
 #: (name, V, I): the paper's scene and one with large excursions of α (I = 1e-2).
 LIMIT_SCENES = (("V1 I1e-5", 1.0, 1e-5), ("V1 I1e-2", 1.0, 1e-2))
