@@ -120,28 +120,36 @@ def eps_match(masses=(1e-8, 1e-6), cases=MATCH_CASES, say=print) -> list[dict]:
 
 
 def ribbon_rotation(m: float = 1e-3, scenes=LIMIT_SCENES, t_end: float = 0.5, say=print) -> list[dict]:
-    """The size of the term the model neglects: the ribbon's transverse (rotational) kinetic energy
-    ``m L² θ̇² / 6`` (a rod of length L swinging about O') against the translational one it keeps,
-    ``m (V - u̇)² / 2``, along the tape-mass model's orbit (200 001 points over ``t_end``, θ̇ and u̇ = Ḟ/k by finite
-    differences), averaged on each branch; and the ribbon's moment of inertia about O' seen by α,
-    ``m L² (dθ/dα)² / 3``, against the roller's I (at α = 0: ``m l² / 3``)."""
+    """The size of the term the model neglects: the ribbon's transverse (rotational) kinetic energy against the
+    translational one it keeps, along the tape-mass model's orbit (200 001 points over ``t_end``), averaged on each
+    branch; and the ribbon's moment of inertia seen by α against the roller's I.
+
+    The ribbon is the straight segment PO'.  Its direction φ = atan2(-R sin α, l - R cos α) turns at
+    ``φ̇ = -R sin θ α̇ / L`` (P moves at R α̇ along the roller, O' only along the ribbon), so a uniform rod
+    turning about O' carries ``m L² φ̇² / 6 = m R² sin²θ α̇² / 6`` (exact geometry for sin θ and L); the
+    translational term is ``m (V - u̇)² / 2`` with ``u̇ = V + R c α̇ - v`` (Eq. v) and ``α̇ = ω - v/R`` (FLOW1),
+    all from the stored states.  Seen by α the rotation is an added moment of inertia ``m R² sin²θ / 3``
+    (``m R² / 3`` at α = 0).  (Not θ̇: θ is measured from the roller's tangent at P, which turns with α.)"""
     rows = []
     for name, V, I in scenes:
         p = PeelParams(V=V, I=I, tape_mass=m)
         tr = exact.simulate(p, t_end, rtol=1e-9, t_eval=np.linspace(0.0, t_end, 200_001))
-        a, t = tr.alpha, tr.t
+        a = tr.alpha
         L = np.sqrt(p.l**2 + p.R**2 - 2 * p.l * p.R * np.cos(a))
-        th = np.arctan2(p.l * np.cos(a) - p.R, -p.l * np.sin(a))
-        e_rot = m * L**2 * np.gradient(th, t) ** 2 / 6
-        e_tr = m * (V - np.gradient(tr.F, t) / p.k) ** 2 / 2
-        row: dict = dict(scene=name, mass=m, inertia_ratio=m * p.l**2 / (3 * I))
+        sin_th = (p.l * np.cos(a) - p.R) / L
+        a_dot = tr.omega - tr.v / p.R
+        c = np.asarray(p.closure(a)[0])
+        u_dot = V + p.R * c * a_dot - tr.v
+        e_rot = m * (p.R * sin_th * a_dot) ** 2 / 6
+        e_tr = m * (V - u_dot) ** 2 / 2
+        row: dict = dict(scene=name, mass=m, inertia_ratio=m * p.R**2 / (3 * I))
         for b, br in ((0, "AB"), (1, "CD")):
             sel = tr.branch == b
             row[f"rot_over_trans_{br}"] = float(e_rot[sel].mean() / e_tr[sel].mean())
             row[f"time_fraction_{br}"] = float(sel.mean())
         rows.append(row)
         say(f"ribbon rotation {name} m={m:g}: <E_rot>/<E_trans> on AB {row['rot_over_trans_AB']:.3g}, on CD "
-            f"{row['rot_over_trans_CD']:.3g}; m l^2/(3 I) = {row['inertia_ratio']:.3g}")
+            f"{row['rot_over_trans_CD']:.3g}; m R^2/(3 I) = {row['inertia_ratio']:.3g}")
     return rows
 
 
