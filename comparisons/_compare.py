@@ -20,6 +20,7 @@ from typing import Any
 
 from peelapprox import ModelBreakdown, SolverBudgetExceeded, reduced_segment
 from peelapprox.io import optional_import
+from peelapprox.validate import params as _params
 
 from ._segments import Segment, _crossings, _extrema, local_period, segments
 
@@ -133,9 +134,17 @@ def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None =
     RowTable of ComparisonRow
         A list (``.to_dataframe()`` gives it as a pandas DataFrame).  Status ``"ok"`` or
         ``"breakdown: <reason>"`` / ``"no exit: <budget>"``.
+
+    Raises
+    ------
+    ValueError
+        A trajectory of a model variant (``trajectory.params.tape_mass`` / ``.loading``): the reduced
+        equations are derived for the massless model under velocity control
+        (:func:`peelapprox.validate.paper_model`).
     """
     models = DEFAULT_MODELS if models is None else models
-    params = trajectory.params
+    # the reductions are the paper's massless constant-V equations: a variant's trajectory is refused here
+    params = _params("trajectory.params", trajectory.params, where="compare", variants=False)
     rows = RowTable()
     for s in (segments(trajectory) if segs is None else segs):
         p_ex = s.local_period()

@@ -40,6 +40,8 @@ METHODS = ("hybrid", "regularized", "smooth")
 SOLVERS = ("Radau", "BDF", "LSODA")
 #: Solvers of the model variants' smooth ODE (``method="smooth"``): the stiff ones and two explicit ones.
 SMOOTH_SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
+#: The default solver of ``method="smooth"`` (measured: docs/tape-mass.md, "Which integrator").
+SMOOTH_DEFAULT = "LSODA"
 SAVES = ("steps", "jumps")
 
 #: Default absolute tolerances are ``rtol * ATOL_SCALE`` for the integrated
@@ -61,9 +63,12 @@ ATOL_RANGE = (1e-100, 1.0)
 #: physical grid of the stress suite needs at most ~1.5e4 hybrid steps per simulated second (I = 1e-6,
 #: rtol 1e-8; 1.3-1.8 us each) and the regularised scheme ~1e3 (~150 us each), so the rate leaves a
 #: margin of ~50x, while the cap bounds a default call: hybrid <= 2e7 steps (~35 s measured on
-#: t_end = 1e300), regularised <= 5e5 (~80 s).  A run that needs more raises SolverBudgetExceeded
-#: naming max_steps.
-STEP_BUDGET = {"hybrid": (1e6, 1e6, 2e7), "regularized": (1e5, 1e5, 5e5), "smooth": (1e5, 1e5, 5e5)}
+#: t_end = 1e300), regularised <= 5e5 (~80 s).  The tape-mass model (``"smooth"``, default LSODA at
+#: rtol 1e-8) needs 1.8e4-1.3e5 steps per simulated second over m = 1e-9 ... 1e-1 kg (V = 1, I = 1e-5 and V = 2,
+#: I = 1e-4; 9-19 us each; ``python -m comparisons.benchmark.tape_mass``), so its rate leaves a margin of ~8x
+#: (rtol 1e-10 needs ~2.5x more steps) and its cap ~60 s of LSODA (Radau and BDF take 10-20x longer per step:
+#: give them ``max_wall``).  A run that needs more raises SolverBudgetExceeded naming max_steps.
+STEP_BUDGET = {"hybrid": (1e6, 1e6, 2e7), "regularized": (1e5, 1e5, 5e5), "smooth": (1e6, 1e5, 5e6)}
 
 
 def default_max_steps(method: str, t_end: float) -> int:
@@ -170,15 +175,17 @@ class Smooth(_Method):
 
     Parameters
     ----------
-    solver : {"Radau", "BDF", "LSODA", "DOP853", "RK45"}
-        The scipy solver; default "Radau" (docs/tape-mass.md, "Which integrator").
+    solver : {"LSODA", "Radau", "BDF", "DOP853", "RK45"}
+        The scipy solver; default "LSODA", the fastest at every tape mass measured (1e-9 … 1e-1 kg): it switches
+        itself between Adams (non-stiff, large m) and BDF (stiff, small m) by its stiffness estimate
+        (docs/tape-mass.md, "Which integrator").
     rtol, atol, v_floor
         As for :class:`Hybrid`; the components are ``(α, ω, F, v)`` (and ``V_p`` under a load, with the
         tolerance of v) and ``atol=None`` means ``rtol * ATOL_SCALE["smooth"]``.
     """
 
     name: ClassVar[str] = "smooth"
-    solver: str = "Radau"
+    solver: str = "LSODA"
     rtol: float = 1e-8
     atol: float | Sequence[float] | None = None
     v_floor: float | None = None
@@ -349,7 +356,7 @@ def method_option(method: Any, *, solver: Any, eps: Any, rtol: Any, atol: Any, v
                                  "method='hybrid'")
             opts = Hybrid(rtol=rtol, atol=atol, v_floor=v_floor)
         elif name == "smooth":
-            opts = Smooth(solver="Radau" if solver is None else solver, rtol=rtol, atol=atol, v_floor=v_floor)
+            opts = Smooth(solver=SMOOTH_DEFAULT if solver is None else solver, rtol=rtol, atol=atol, v_floor=v_floor)
         else:
             opts = Regularized(solver="Radau" if solver is None else solver, eps=EPS_DEFAULT if eps is None else eps,
                                rtol=rtol, atol=atol, v_floor=v_floor)

@@ -217,7 +217,9 @@ def simulate(
         keywords must then stay at their defaults (ValueError naming both).
     solver : {"Radau", "BDF", "LSODA"}, optional
         scipy solver for ``method="regularized"`` (analytic Jacobian);
-        default "Radau"; ``method="smooth"`` also takes "DOP853" and "RK45".
+        default "Radau".  ``method="smooth"`` also takes "DOP853" and "RK45";
+        its default is "LSODA", the fastest at every tape mass measured
+        (docs/tape-mass.md, "Which integrator").
         Passing it with the hybrid method is an error.
     rtol, atol : float, float or 4 floats
         Local error control per step: RMS over components of
@@ -247,7 +249,8 @@ def simulate(
         scales the step budget with the horizon (:func:`default_max_steps`:
         1e6 steps per simulated second within [1e6, 2e7] for the hybrid
         method, ~35 s of work at most; 1e5/s within [1e5, 5e5] for the
-        regularised one, ~80 s).
+        regularised one, ~80 s; 1e6/s within [1e5, 5e6] for the tape-mass
+        model, ~60 s of its default LSODA).
     max_wall : float, optional
         Wall-clock budget [s] of the integration (checked between hybrid
         kernel calls, at most 250,000 steps (~0.4 s) apart, and at every step

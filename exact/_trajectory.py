@@ -14,8 +14,19 @@ from peelapprox.io import fmt_number, html_table, optional_import, param_attrs
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 
 #: Units of the columns of :meth:`Trajectory.to_dataframe` and :meth:`Jumps.to_dataframe` (``df.attrs["units"]``).
-_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "branch": "", "from_branch": "",
-          "to_branch": "", "v_before": "m/s", "v_after": "m/s"}
+_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "Vp": "m/s", "branch": "",
+          "from_branch": "", "to_branch": "", "v_before": "m/s", "v_after": "m/s"}
+
+
+#: The variant fields of PeelParams and their units (the repr, the DataFrame's attrs).
+_VARIANT_UNITS = {"tape_mass": "kg", "loading": "", "load_mass": "kg", "load": "N"}
+
+
+def _variant_fields(params) -> dict:
+    """The variant fields of ``params`` that are set (issue 18): ``{}`` for the paper's model."""
+    if params.variant is None:
+        return {}
+    return {n: getattr(params, n) for n in _VARIANT_UNITS if getattr(params, n) is not None}
 
 
 def _branches(pd, codes: np.ndarray):
@@ -258,8 +269,10 @@ class Trajectory:
 
     def __repr__(self) -> str:
         p = self.params
+        var = "".join(f", {n}={v!r}" + (f" {_VARIANT_UNITS[n]}" if _VARIANT_UNITS[n] else "")
+                      for n, v in _variant_fields(p).items())  # the model variant, if any
         return (
-            f"Trajectory(V={p.V}, I={p.I}, method={self.method!r}, t=[{self.initial_state.t}, {self.t_end}], "
+            f"Trajectory(V={p.V}, I={p.I}{var}, method={self.method!r}, t=[{self.initial_state.t}, {self.t_end}], "
             f"points={len(self.t)}, jumps={len(self.jumps)}, steps={self.stats.n_steps}, "
             f"wall_time={self.stats.wall_time:.3g}s)"
         )
@@ -351,7 +364,9 @@ class Trajectory:
     def _repr_html_(self) -> str:
         p, st = self.params, self.stats
         return html_table("Trajectory", {
-            "V [m/s]": p.V, "I [kg m²]": p.I, "k [N/m]": p.k, "force": repr(p.force), "method": self.method,
+            "V [m/s]": p.V, "I [kg m²]": p.I, "k [N/m]": p.k, "force": repr(p.force),
+            **{f"{n} [{_VARIANT_UNITS[n]}]" if _VARIANT_UNITS[n] else n: v for n, v in _variant_fields(p).items()},
+            "method": self.method,
             "t [s]": f"{fmt_number(self.initial_state.t, 6)} … {fmt_number(self.t_end, 6)}",
             "points": len(self.t), "jumps": len(self.jumps), "steps": st.n_steps,
             "wall time [s]": st.wall_time, "final state": (f"α={fmt_number(self.final_state.alpha, 6)} rad, "
@@ -360,12 +375,15 @@ class Trajectory:
 
     def to_dataframe(self):
         """The stored points as a :class:`pandas.DataFrame`: columns ``t, alpha, omega, F, v`` (the arrays
-        themselves, float64) and ``branch`` (a categorical of the names ``"AB"``/``"CD"``), one row per stored
-        point (a jump is two rows at the same ``t``).
+        themselves, float64), under a load (``params.loading == "load"``) also ``Vp`` (the pull speed [m/s]), and
+        ``branch`` (a categorical of the names ``"AB"``/``"CD"``), one row per stored point (a jump is two rows
+        at the same ``t``).
 
         ``df.attrs`` holds ``units`` (per column), ``params`` (:func:`peelapprox.io.param_attrs`: V, I, k, R,
-        l, geometry and the law ``force``, with its ``force_key``) and the run's ``method``, ``solver``,
-        ``rtol``, ``eps``, ``t_transient``, ``t_end``.  The jumps: ``self.jumps.to_dataframe()``.
+        l, geometry and the law ``force``, with its ``force_key``; for a model variant also the fields set of
+        ``tape_mass`` [kg], ``loading``, ``load_mass`` [kg], ``load`` [N], their units in ``variant_units``) and
+        the run's ``method``, ``solver``, ``rtol``, ``eps``, ``t_transient``, ``t_end``.  The jumps:
+        ``self.jumps.to_dataframe()``.
 
         Raises
         ------
@@ -373,9 +391,13 @@ class Trajectory:
             If pandas is not installed (``pip install 'peelapprox[data]'``).
         """
         pd = optional_import("pandas", "Trajectory.to_dataframe")
-        cols = ("t", "alpha", "omega", "F", "v")
+        cols = ["t", "alpha", "omega", "F", "v"] + ([] if self.Vp is None else ["Vp"])
         df = pd.DataFrame({**{c: getattr(self, c) for c in cols}, "branch": _branches(pd, self.branch)})
-        df.attrs.update({"units": {c: _UNITS[c] for c in (*cols, "branch")}, "params": param_attrs(self.params),
+        var = _variant_fields(self.params)
+        df.attrs.update({"units": {c: _UNITS[c] for c in (*cols, "branch")},
+                         "params": {**param_attrs(self.params), **var},
                          "method": self.method, "solver": self.solver, "rtol": self.rtol, "eps": self.eps,
                          "t_transient": self.t_transient, "t_end": self.t_end})
+        if var:
+            df.attrs["variant_units"] = {n: _VARIANT_UNITS[n] for n in var}
         return df

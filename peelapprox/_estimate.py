@@ -13,6 +13,7 @@ mode to a monotonic rise.  :func:`estimate` collects them with a regime label.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
@@ -53,8 +54,12 @@ VELOCITY_RULE = (
 
 
 def _checked(params: PeelParams) -> PeelParams:
-    """``params`` validated, any law (ValueError naming ``params.force`` for a law whose folds cannot be found)."""
-    return _params("params", params)
+    """``params`` validated, any law (ValueError naming ``params.force`` for a law whose folds cannot be found),
+    the paper's model only (ValueError naming ``params.tape_mass`` / ``params.loading`` for a variant)."""
+    f = sys._getframe(1)
+    while f.f_back is not None and f.f_code.co_name.startswith("_"):  # the public function that was called
+        f = f.f_back
+    return _params("params", params, where=f.f_code.co_name, variants=False)
 
 
 def _law_structure(params: PeelParams) -> BranchStructure:

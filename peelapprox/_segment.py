@@ -240,7 +240,7 @@ def reduced_segment(
         If v does not reach ``v_f`` before ``t_max`` or within ``max_steps``.
     """
     t_wall = time.perf_counter()
-    params = _params("params", params)
+    params = _params("params", params, variants=False)
     branch = choice("branch", branch, BRANCHES)
     alpha_model = choice("alpha_model", alpha_model, ALPHA_MODELS)
     v_equation = choice("v_equation", v_equation, V_EQUATIONS)

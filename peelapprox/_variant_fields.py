@@ -23,15 +23,17 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numba import types as _nb
 
 from . import _generated as _g
-from ._jit import kernel
+from ._jit import kernel, rebind
 from ._law import ALL_LAWS
-from ._law_abi import LAW_FP, LAW_TYPE
+from ._law_abi import LAW_FP, LAW_TYPE, paper_law
 from ._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
 
-__all__ = ["VARIANT_MODELS", "Q_MASS", "Q_LOAD_MASS", "Q_LOAD", "variant_parameters", "variant_field"]
+__all__ = ["VARIANT_MODELS", "Q_MASS", "Q_LOAD_MASS", "Q_LOAD", "variant_parameters", "variant_field",
+           "bound_variant_field"]
 
 #: The variants' names and their numbers of states.
 VARIANT_MODELS = {"tape": 4, "tape_load": 5, "eps_load": 5}
@@ -148,3 +150,55 @@ def variant_field(model: str) -> tuple[Any, Any]:
             d.compile(ret(a1, a1, LAW_TYPE, a1))
             d.disable_compile()
     return fun, jac
+
+
+
+# The fields with the paper's law bound in (the default law): each body inlined into a module-level copy that
+# reads the law as a global (``_rebind``), so the law call is static and numba caches the copy.
+def _paper_copy(fn: Any, name: str) -> Any:
+    body = kernel(inline="always", name=f"{name}_body")(fn.py_func)
+
+    def bound(y, q, coef):  # pragma: no cover - compiled
+        return _BODY(y, q, _LAW, coef)  # noqa: F821 - globals of the rebound copy
+
+    bound.__qualname__ = bound.__name__ = name
+    return kernel(rebind(bound, _BODY=body, _LAW=paper_law), name=name)
+
+
+_PAPER = {m: (_paper_copy(f, f"variant_{m}_field_paper"), _paper_copy(j, f"variant_{m}_jacobian_paper"))
+          for m, (f, j) in {"tape": (_tape_field, _tape_jacobian), "tape_load": (_tape_load_field, _tape_load_jacobian),
+                            "eps_load": (_eps_load_field, _eps_load_jacobian)}.items()}
+_BOUND: dict[tuple[str, int], tuple[Any, Any, Any]] = {}
+
+
+def bound_variant_field(model: str, law: Any) -> tuple[Any, Any]:
+    """``(field, jacobian)`` of a variant with the peel-force ``law`` (``CompiledLaw.fn``) bound in:
+    ``field(y, q, coef)``, ``jacobian(y, q, coef)``.
+
+    Passing the law as an argument from Python (:func:`variant_field`) costs ~65 µs per call (numba types the
+    function argument at every call); with the law bound in, ~1 µs (docs/tape-mass.md, "Which integrator").  The
+    paper's law (:func:`peelapprox._law_abi.paper_law`) is bound in cached kernels (compiled once per machine);
+    another law in a closure compiled once per process (~2 s) and kept.
+    """
+    fun, jac = variant_field(model)
+    if law is paper_law:
+        bf, bj = _PAPER[model]
+        a1 = _nb.float64[::1]
+        for d, ret in ((bf, a1), (bj, _nb.float64[:, ::1])):
+            if not d.signatures:
+                d.compile(ret(a1, a1, a1))
+                d.disable_compile()
+        return bf, bj
+    key = (model, id(law))
+    if key not in _BOUND:
+
+        @njit(cache=False)  # a closure over the law: numba cannot cache it
+        def bfun(y, q, coef):  # pragma: no cover - compiled
+            return fun(y, q, law, coef)
+
+        @njit(cache=False)
+        def bjac(y, q, coef):  # pragma: no cover - compiled
+            return jac(y, q, law, coef)
+
+        _BOUND[key] = (bfun, bjac, law)  # the law kept alive, so its id stays unique
+    return _BOUND[key][0], _BOUND[key][1]

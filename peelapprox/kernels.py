@@ -72,7 +72,7 @@ from ._law_table_jit import table_coefficients, table_law
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
 from ._peelforce import _invert as branch_inverse_at
 from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
-from ._variant_fields import VARIANT_MODELS, variant_field, variant_parameters
+from ._variant_fields import VARIANT_MODELS, bound_variant_field, variant_field, variant_parameters
 
 #: Index of ε in the regularised system's parameter vector, after the model block.
 Q_EPS = N_M
@@ -89,7 +89,7 @@ __all__ = [
     "regularized_rhs", "regularized_jacobian", "regularized_parameters", "Q_EPS", "regularized_field",
     "regularized_field_jacobian", "regularized_law_field", "peel_force_coefficients", "branch_inverse_at",
     "MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block",
-    "VARIANT_MODELS", "variant_field", "variant_parameters",
+    "VARIANT_MODELS", "variant_field", "variant_parameters", "bound_variant_field",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",

@@ -110,7 +110,8 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     path : str, optional
         Also write the figure there (format from the extension).
     title : str, optional
-        Default: V, I, k, the method and the span shown.
+        Default: V, I, k, the model variant if any (its tape mass, its load), the method and the span
+        shown.
     cycles : int or None
         Show the last ``cycles`` stick-slip cycles (AB→CD jump to AB→CD jump; default
         :data:`TRAJECTORY_CYCLES`): seconds of stick-slip at a few cycles per 0.1 s are a solid block of
@@ -124,6 +125,11 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     -------
     matplotlib.figure.Figure
         The figure drawn into (that of ``ax`` when given).
+
+    Notes
+    -----
+    Under a load (``traj.Vp`` not None: ``params.loading == "load"``), the F(t) panel also shows the pull
+    speed V_p(t) on a twin axis (right, dashed), with the load's speed scale.
     """
     if cycles is not None:
         from .validate import integer
@@ -137,6 +143,12 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     t, F, alpha, v = t_all[m], np.asarray(traj.F)[m], np.asarray(traj.alpha)[m], np.asarray(traj.v)[m]
     ax[0, 0].plot(t, F, lw=0.8, color="C0")
     ax[0, 0].set(xlabel="t [s]", ylabel="F [N]", title="pull force F(t)")
+    Vp = getattr(traj, "Vp", None)
+    if Vp is not None:  # under a load the pull speed is a state: on a twin axis of the force panel
+        tw = ax[0, 0].twinx()
+        tw.plot(t, np.asarray(Vp, float)[m], lw=0.8, ls="--", color="C4")
+        tw.set_ylabel("$V_p$ [m/s]", color="C4")
+        ax[0, 0].set_title("pull force F(t), pull speed $V_p(t)$ (dashed)")
     ax[0, 1].plot(t, alpha, lw=0.8, color="C2")
     ax[0, 1].set(xlabel="t [s]", ylabel=r"$\alpha$ [rad]", title=r"peel angle $\alpha(t)$")
     ax[1, 0].semilogy(t, v, lw=0.8, color="C3")
@@ -159,9 +171,25 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     ax[1, 1].set(xlabel="v [m/s]", ylabel="F [N]", title="v–F phase plane")
     ax[1, 1].legend(loc="best", fontsize=8)
     span = f"t = {lo:.4g}–{hi:.4g} s" + (f", the last {shown} of {total} cycles" if shown < total else "")
-    fig.suptitle(title or f"V = {p.V:g} m/s, I = {p.I:g} kg m², k = {p.k:g} N/m, {traj.method}; {span}")
+    fig.suptitle(title or f"V = {p.V:g} m/s, I = {p.I:g} kg m², k = {p.k:g} N/m{_model_label(p)}, {traj.method}; "
+                          f"{span}")
     _save(fig, path)
     return fig
+
+
+def _model_label(params: Any) -> str:
+    """A model variant of ``params`` in words, for a title, with a leading ``", "``: ``", tape mass m = 0.0001
+    kg"``, ``", load F_L = 245 N on M = 25 kg"`` (both, for a massive tape under a load); ``""`` for the paper's
+    model (its titles as before the variants existed)."""
+    parts = []
+    m = getattr(params, "tape_mass", None)
+    if m:
+        parts.append(f"tape mass m = {m:g} kg")
+    if getattr(params, "loading", "velocity") == "load":
+        if not m:
+            parts.append("massless tape")
+        parts.append(f"load F_L = {params.load:.4g} N on M = {params.load_mass:g} kg")
+    return "".join(", " + x for x in parts)
 
 
 def plot_segment(seg: Any, path: str | None = None, *, exact: Any = None, title: str | None = None,

@@ -30,6 +30,7 @@ Decisions recorded here once:
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 import numpy as np
@@ -72,6 +73,7 @@ __all__ = [
     "flag",
     "function",
     "params",
+    "paper_model",
     "reals",
     "times",
     "interval",
@@ -84,17 +86,41 @@ __all__ = [
 ]
 
 
-def params(name: str, x: Any, *, laws: tuple[str, ...] = ALL_LAWS, where: str | None = None):
+def params(name: str, x: Any, *, laws: tuple[str, ...] = ALL_LAWS, where: str | None = None,
+           variants: bool = True):
     """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError.
 
     A ValueError if ``x.force`` is not one of ``laws``, the laws the calling function runs (by their names:
     ``"paper"``, ``"cubic"``, ``"tabulated"``, ... as in ``peelapprox._law.law_label``; default every law);
-    the message names ``where`` (default: that function).
+    the message names ``where`` (default: that function).  With ``variants=False`` (the paper's reduced
+    equations), also a ValueError for a model variant (:func:`paper_model`).
     """
     if not isinstance(x, PeelParams):
         raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
     require_law(x, where, laws)
+    if not variants:
+        paper_model(name, x, where=where or sys._getframe(1).f_code.co_name)
     return x
+
+
+def paper_model(name: str, x: PeelParams, *, where: str) -> PeelParams:
+    """``x`` if it is the paper's model (massless tape, constant pull speed: ``x.variant is None``), else a
+    ValueError naming ``<name>.tape_mass`` / ``<name>.loading``: the one check of every entry point of the
+    paper's reduced equations (``where``: estimate, reduced_segment, the alpha forms, the comparison harness).
+
+    Those equations (approxalpha, approxvdot, fullvdot, the Airy and WKB forms, the branch-time estimates) are
+    derived branch-wise from the massless DAE (CONSTR: F (1 + sin α) = f(v, V)) under velocity control; a tape
+    mass replaces CONSTR by an equation of motion for v, and a load makes the pull speed a state, so neither
+    has those branches.  The full model runs both: ``exact.simulate`` (docs/tape-mass.md, docs/constant-load.md).
+    """
+    if x.variant is None:
+        return x
+    got = ", ".join(f"{n}={v!r}" for n, v in (("tape_mass", x.tape_mass), ("loading", x.loading),
+                                                ("load_mass", x.load_mass), ("load", x.load)) if v is not None)
+    raise ValueError(
+        f"{name}.tape_mass / {name}.loading: {where} solves the paper's reduced branch-wise equations "
+        f"(approxalpha, approxvdot, Airy), derived for the massless DAE under velocity control (tape_mass=None, "
+        f"loading='velocity'); got {got} (variant {x.variant!r}). Run the full model instead: exact.simulate")
 
 
 def state(name: str, x: Any, quantity: str) -> float:

@@ -63,7 +63,8 @@ API = {
     },
     "peelapprox.validate": {
         "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",
-        "interval", "nonnegative", "optional", "optional_finite", "params", "path", "positive", "real", "reals",
+        "interval", "nonnegative", "optional", "optional_finite", "paper_model", "params", "path", "positive", "real",
+        "reals",
         "state", "states", "times", "rtol", "eps",
     },
     "peelapprox.errors": {
@@ -74,7 +75,7 @@ API = {
     "peelapprox.kernels": {
         "ALL_LAWS", "CompiledLaw", "pack_inlined", "pack_law",
         "U_ZERO", "compiled_law", "law_domain", "rebind", "regularized_law_field", "VARIANT_MODELS", "variant_field",
-        "variant_parameters",
+        "variant_parameters", "bound_variant_field",
         "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",
         "LAW_SIG", "LAW_TYPE", "MAX_REJECTIONS", "MODEL_FIELDS", "M_A", "M_B", "M_GEOM", "M_I", "M_K", "M_L", "M_R",
         "M_V", "N_M", "N_STAGES", "PeerUnavailableError", "Q_EPS", "STEP_FAILED", "branch_inverse_at", "closure",

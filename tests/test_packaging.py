@@ -39,8 +39,9 @@ def test_license_is_an_spdx_string_matching_the_license_file():
 
 def test_citation_file_names_the_paper_and_the_library():
     """Hypothesis: CITATION.cff is valid YAML of CFF 1.2.0 for the software (its licence that of pyproject.toml)
-    with the paper as preferred citation: its title, three authors, journal, volume and year as printed in the
-    paper (exact strings)."""
+    with the paper as preferred citation: its title and three authors as printed in the paper's TeX, the journal,
+    volume, article number and year as the citing literature gives them (Phys. Rev. E 70, 046223 (2004); the
+    TeX carries no journal reference), exact strings."""
     yaml = pytest.importorskip("yaml")
     cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     assert cff["cff-version"] == "1.2.0" and cff["type"] == "software" and cff["title"].startswith("peelapprox")
@@ -48,7 +49,8 @@ def test_citation_file_names_the_paper_and_the_library():
     paper = cff["preferred-citation"]
     assert paper["title"] == "Dynamics of stick-slip in peeling of an adhesive tape"
     assert [a["family-names"] for a in paper["authors"]] == ["De", "Maybhate", "Ananthakrishna"]
-    assert (paper["journal"], paper["volume"], paper["year"]) == ("Physical Review E", 69, 2004)
+    assert (paper["journal"], paper["volume"], paper["start"], paper["year"]) == ("Physical Review E", 70, "046223",
+                                                                                2004)
 
 
 def test_no_module_imports_scipys_private_dop853_coefficients():

@@ -46,8 +46,8 @@ def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
         prog="peelapprox", formatter_class=HelpFormatter,
         description=textwrap.fill(
-            "Stick-slip peeling of an adhesive tape from a roller (De, Maybhate and Ananthakrishna, Phys. Rev. E 69, "
-            "2004): the exact model, the paper's reduced equations and their comparison.  'peelapprox COMMAND "
+            "Stick-slip peeling of an adhesive tape from a roller (De, Maybhate and Ananthakrishna, Phys. Rev. E 70, "
+            "046223 (2004)): the exact model, the paper's reduced equations and their comparison.  'peelapprox COMMAND "
             "--help' describes a command, its options (units, defaults) and examples.", 100),
         epilog="examples:\n"
                "  peelapprox compare                                  # the paper's scenes, approximate vs exact\n"

@@ -11,11 +11,12 @@ import textwrap
 from collections.abc import Sequence
 from typing import Any
 
-from .. import GEOMETRIES, PeelForce, PeelParams
+from .. import GEOMETRIES, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
 from ..io import fmt_number, write_csv, write_rows
 from ._force import add_force_options, force_from_args, law_fields
 
-__all__ = ["FORMATS", "HelpFormatter", "UNITS", "add_format", "add_params", "params_from_args", "print_mapping",
+__all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "REDUCED_ONLY", "UNITS", "add_format", "add_params",
+           "params_from_args", "print_mapping", "variant_summary",
            "say", "subcommand", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
@@ -47,10 +48,16 @@ def subcommand(sub: Any, name: str, *, help: str, description: str, examples: Se
     return sub.add_parser(name, help=help, description=text, epilog=epilog, formatter_class=HelpFormatter, **kwargs)
 
 
-def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True) -> None:
+def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True, variants: str | None = None) -> None:
     """The options ``--V --I --k --R`` of :class:`peelapprox.PeelParams` and, with ``geometry`` (for the exact
-    model; the reduced equations are the paper's linear closure), ``--l --geometry``, and its law ``force``
-    (:func:`peelapprox.cli._force.add_force_options`); :func:`params_from_args` builds them."""
+    model; the reduced equations are the paper's linear closure), ``--l --geometry``, its law ``force``
+    (:func:`peelapprox.cli._force.add_force_options`) and the model variant (issue 18): ``--tape-mass
+    --loading --load-mass --load``; :func:`params_from_args` builds them.
+
+    ``variants``: None if the subcommand runs the variants; else why it does not (e.g. "runs the paper's reduced
+    equations, derived for the massless tape under velocity control"): the variant options are still there,
+    and :func:`params_from_args` refuses them with that reason (exit status 2), rather than ignoring them.
+    """
     g = sp.add_argument_group("model parameters (PeelParams)")
     g.add_argument("--V", type=float, required=True, help="pull speed [m/s]")
     g.add_argument("--I", type=float, required=True, help="roller inertia [kg m^2]")
@@ -61,14 +68,71 @@ def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True) -> None:
         g.add_argument("--geometry", choices=GEOMETRIES, default="paper",
                        help="the closure cos(theta): paper (the paper's sin(alpha) form) or exact (the full geometry "
                             "with l)")
+    title = "model variant (docs/tape-mass.md, docs/constant-load.md)"
+    if variants is not None:
+        title += f"; refused here: this command {variants}"
+    v = sp.add_argument_group(title)
+    v.add_argument("--tape-mass", type=float, default=None, metavar="KG",
+                   help=f"mass m of the peeled ribbon [kg], in [{TAPE_MASS_RANGE[0]:g}, {TAPE_MASS_RANGE[1]:g}]: "
+                        "the tape-mass model, a smooth ODE (method smooth) (default: none, the paper's massless "
+                        "tape; 0 is the same)")
+    v.add_argument("--loading", choices=LOADINGS, default="velocity",
+                   help="velocity: the end pulled at the constant speed V (the paper); load: a constant force "
+                        "--load on a body of mass --load-mass, its speed V_p a state starting at V")
+    v.add_argument("--load-mass", type=float, default=None, metavar="KG",
+                   help=f"mass M at the pulled end [kg], in [{LOAD_MASS_RANGE[0]:g}, {LOAD_MASS_RANGE[1]:g}]; "
+                        "required with --loading load (default: none)")
+    v.add_argument("--load", type=float, default=None, metavar="N",
+                   help=f"the load F_L [N], in [{LOAD_RANGE[0]:g}, {LOAD_RANGE[1]:g}], with --loading load "
+                        "(default: --load-mass times g = 9.80665 m/s^2, a hanging mass)")
+    sp.set_defaults(variants_refused=variants)
     add_force_options(sp)
+
+
+#: Why a subcommand refuses the model variants (``add_params(variants=...)``).
+REDUCED_ONLY = ("runs the paper's reduced equations, derived for the massless tape under velocity control "
+                "(tape_mass none, --loading velocity)")
+HYBRID_ONLY = ("finds periodic orbits of the hybrid solver, the paper's massless model under velocity control "
+               "(tape_mass none, --loading velocity)")
+
+#: The variant options of :func:`add_params` as the CLI spells them, and their defaults.
+_VARIANT_OPTIONS = {"tape_mass": ("--tape-mass", None), "loading": ("--loading", "velocity"),
+                    "load_mass": ("--load-mass", None), "load": ("--load", None)}
 
 
 def params_from_args(args: argparse.Namespace) -> PeelParams:
     """The :class:`PeelParams` of the options of :func:`add_params` (``l`` and ``geometry`` at their defaults where
-    the subcommand has no such option)."""
-    extra = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
-    return PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args), **extra)
+    the subcommand has no such option).
+
+    A ValueError (exit status 2) if the subcommand refuses the variant options (``add_params(variants=...)``) and
+    one is given, naming the options and why; PeelParams' own ValueError names a variant field out of range
+    (``tape_mass``, ``load_mass``, ``load``; as the options: ``--tape-mass`` ...)."""
+    extra: dict[str, Any] = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
+    given: dict[str, Any] = {k: getattr(args, k, d) for k, (_, d) in _VARIANT_OPTIONS.items()
+             if getattr(args, k, d) != d and not (k == "tape_mass" and getattr(args, k) == 0.0)}  # 0: massless
+    why = getattr(args, "variants_refused", None)
+    if given and why is not None:
+        shown = " ".join(f"{_VARIANT_OPTIONS[k][0]} {v:g}" if isinstance(v, float) else f"{_VARIANT_OPTIONS[k][0]} {v}"
+                         for k, v in given.items())
+        raise ValueError(f"{shown}: the model variants (tape mass, constant load) are not available here: this "
+                         f"command {why}; drop {', '.join(_VARIANT_OPTIONS[k][0] for k in given)} (peelapprox "
+                         f"simulate runs the variants)")
+    try:
+        return PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args), **extra, **given)
+    except ValueError as exc:  # a variant field named as the option (--tape-mass, ...)
+        msg = str(exc)
+        for k, (opt, _) in _VARIANT_OPTIONS.items():
+            if msg.startswith(k + " ") or msg.startswith(k + "="):
+                raise ValueError(opt + msg[len(k):]) from None
+        raise
+
+
+def variant_summary(params: PeelParams) -> dict[str, Any]:
+    """The variant fields of ``params`` that are set (``tape_mass`` [kg], ``loading``, ``load_mass`` [kg],
+    ``load`` [N]) for a summary; ``{}`` for the paper's model (its summaries as before the variants)."""
+    if params.variant is None:
+        return {}
+    return {k: getattr(params, k) for k in _VARIANT_OPTIONS if getattr(params, k) is not None}
 
 
 def add_format(sp: argparse.ArgumentParser | argparse._ArgumentGroup, what: str = "the summary") -> None:
@@ -77,21 +141,21 @@ def add_format(sp: argparse.ArgumentParser | argparse._ArgumentGroup, what: str 
                     help=f"how {what} is printed: table (key: value [unit] lines), csv (a header and a row) or json")
 
 
-_STATE_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s"}
+_STATE_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "Vp": "m/s"}
 _S = "s"
 _N = "N"
 _MS = "m/s"
 #: The unit of a printed key (``table`` output; JSON and CSV carry none: the names are documented in docs/usage.md).
 UNITS: dict[str, str] = {
-    "V": _MS, "I": "kg m^2", "k": "N/m", "R": "m", "l": "m",
+    "V": _MS, "I": "kg m^2", "k": "N/m", "R": "m", "l": "m", "tape_mass": "kg", "load_mass": "kg", "load": _N,
     **{k: _S for k in ("period", "t_end", "t_transient", "window", "settle_time", "wall_time", "wall_time_s",
                        "compile_time_s", "lyapunov_time", "lyapunov_wall_time", "dt", "period_at_f_min",
                        "period_at_f_max", "period_at_mean", "cd_damping_time", "t_ab_crude", "t_ab_quasi_static",
                        "t_cd_quasi_static")},
     **{k: "rad" for k in ("alpha0", "alpha_in", "alpha_exit", "amplitude")},
     **{k: "rad/s" for k in ("alphadot_in", "alphadot_exit", "omega0")},
-    **{k: _MS for k in ("v_max", "v_min", "v_inflection", "v_land_cd", "v_land_ab", "v_breakdown", "v_in", "v_f",
-                        "fixed_point_v")},
+    **{k: _MS for k in ("Vp_range", "v_max", "v_min", "v_inflection", "v_land_cd", "v_land_ab", "v_breakdown",
+                        "v_in", "v_f", "fixed_point_v")},
     **{k: _N for k in ("f_max", "f_min", "f_zero", "fixed_point_F", "F_in", "F_exit", "dF", "F_mean", "F_max_bound",
                        "F_min_bound", "dF_ab_quasi_static", "dF_cd_quasi_static", "mean_force_drop",
                        "force_drop_std", "F_min_at_jumps", "F_max_at_jumps", "F_at_jumps", "F_at_jumps_range", "F0")},

@@ -11,7 +11,7 @@ import numpy as np
 from .. import WINDOW_DEFAULTS
 from ..io import write_csv
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float
-from ._common import FORMATS, add_params, params_from_args, say, subcommand, write_table
+from ._common import FORMATS, HYBRID_ONLY, add_params, params_from_args, say, subcommand, write_table
 
 __all__ = ["add_parser", "run"]
 
@@ -57,6 +57,9 @@ def run(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     p = params_from_args(args)
+    if args.orbits and p.variant is not None:
+        raise ValueError(f"--orbits with --tape-mass / --loading load: --orbits {HYBRID_ONLY}; drop --orbits to "
+                         "classify the variant's attractors by runs alone")
     a = np.linspace(*_axis(args.alpha0, "--alpha0"))
     name, text = ("F0", args.F0) if args.F0 is not None else ("omega0", args.omega0)
     values = np.linspace(*_axis(text, f"--{name}"))

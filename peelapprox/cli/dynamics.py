@@ -10,7 +10,16 @@ import sys
 from .. import EPS_DEFAULT, WINDOW_DEFAULTS
 from ..io import write_csv
 from ._checks import check_output_path, finite_float_list, nonnegative_float, positive_float, positive_int
-from ._common import add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
+from ._common import (
+    add_format,
+    add_params,
+    params_from_args,
+    print_mapping,
+    say,
+    subcommand,
+    variant_summary,
+    write_table,
+)
 from ._force import law_fields
 
 __all__ = ["LYAPUNOV_ALIASES", "LYAPUNOV_METHODS", "add_parser", "run"]
@@ -33,7 +42,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     "means), and the attractors reached from several initial peel angles.  Lyapunov methods: "
                     "two-trajectory (Benettin renormalisation; the default), tangent (tangent dynamics with "
                     "saltation matrices; alias saltation), return-map (tangent of the jump-to-jump map), "
-                    "variational (variational equations of the eps-system; alias regularized; needs pydiffsol).",
+                    "variational (variational equations of the eps-system; alias regularized; needs pydiffsol).  "
+                    "Model variants (--tape-mass, --loading load): the run is exact.simulate's with the model's "
+                    "method; a measure that does not run a variant says so (exit status 2).",
         examples=["peelapprox dynamics --V 2 --I 1e-4 --lyapunov            # period, force drops, lambda [bits/s]",
                   "peelapprox dynamics --V 2.5 --I 1e-4 --lyapunov-method tangent",
                   "peelapprox dynamics --V 1 --I 1e-2 --attractors 0,0.1,-0.2 --format json"])
@@ -88,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
 
         states("--attractors", args.attractors, "alpha")
     row: dict = dict(V=args.V, I=args.I, alpha0=args.alpha0, t_transient=args.t_transient, window=args.window)
+    row.update(variant_summary(p))  # the model variant, if any
     try:
         # one run from t = 0: the window's jumps for the return map and force drops, all of them for the
         # settle time

@@ -8,7 +8,7 @@ import sys
 
 from .. import ALPHA_MODELS, V_EQUATIONS
 from ._checks import check_output_path
-from ._common import add_format, add_params, params_from_args, print_mapping, subcommand, write_table
+from ._common import REDUCED_ONLY, add_format, add_params, params_from_args, print_mapping, subcommand, write_table
 from ._force import add_force_options, force_from_args, law_fields
 
 __all__ = ["add_estimate_parser", "add_folds_parser", "add_segment_parser", "run_estimate", "run_folds", "run_segment"]
@@ -54,7 +54,7 @@ def add_estimate_parser(sub) -> argparse.ArgumentParser:
                     "intermediate, high) and velocity (stable, low, high) with the rules that set them.",
         examples=["peelapprox estimate --V 1 --I 1e-2 --format json",
                   "peelapprox estimate --V 4 --I 1e-5 --alpha-min -0.3 --alpha-max 0.3 --out estimate.csv"])
-    add_params(es, geometry=False)
+    add_params(es, geometry=False, variants=REDUCED_ONLY)
     es.add_argument("--alpha-min", type=float, default=None,
                     help="peel angle [rad] of the force bound f_max/(1+sin alpha_min) (default: no bound)")
     es.add_argument("--alpha-max", type=float, default=None,
@@ -88,7 +88,7 @@ def add_segment_parser(sub) -> argparse.ArgumentParser:
                   "--alphadot-in -160 --v-in 15.54 --v-f 8.7 --alpha-model airy2 --plot cd.png",
                   "peelapprox segment --V 1 --I 1e-2 --branch AB --F-in 200 --alpha-in 0 --alphadot-in 0 "
                   "--format json"])
-    add_params(sg, geometry=False)
+    add_params(sg, geometry=False, variants=REDUCED_ONLY)
     sg.add_argument("--branch", choices=("AB", "CD"), required=True, help="AB: v rises to v_max; CD: v falls to v_min")
     sg.add_argument("--F-in", type=float, required=True, help="pull force at entry [N]")
     sg.add_argument("--alpha-in", type=float, default=None,

@@ -8,6 +8,7 @@ import argparse
 import numpy as np
 
 from .. import WINDOW_DEFAULTS
+from . import _common
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float, positive_int
 from ._common import FORMATS, add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
 from ._force import law_fields
@@ -34,7 +35,7 @@ def add_orbit_parser(sub) -> argparse.ArgumentParser:
                     "jumps are printed.",
         examples=["peelapprox orbit --V 1 --I 1e-5 --plot orbit.png     # periodic orbit, multipliers, stability",
                   "peelapprox orbit --V 1 --I 1e-2 --n 8 --format json"])
-    add_params(sp)
+    add_params(sp, variants=_common.HYBRID_ONLY)
     _seed_options(sp)
     sp.add_argument("--n", type=positive_int, help="AB->CD jumps per period (default: the seed run's period)")
     add_format(sp)
@@ -86,7 +87,7 @@ def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
         examples=["peelapprox bifurcation --V 1 --I 1e-2 --param V --range 0.5:1.5:21 --plot bif.png --out bif.csv",
                   "peelapprox bifurcation --V 1 --I 1e-5 --param I --range 1e-5:1e-4:10 --seeds 2e-5,5e-5",
                   "peelapprox bifurcation --V 1 --I 1e-5 --force-family cubic --param force.c --range 280:320:9"])
-    add_params(sp)
+    add_params(sp, variants=_common.HYBRID_ONLY)
     _seed_options(sp)
     sp.add_argument("--param", default="V", help="the parameter: V, I, k or force.NAME (a coefficient of "
                                                  "--force-family)")

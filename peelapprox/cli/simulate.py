@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import Any
 
 from ._checks import check_output_path, positive_float, positive_int
-from ._common import add_format, add_params, params_from_args, print_mapping, subcommand
+from ._common import add_format, add_params, params_from_args, print_mapping, subcommand, variant_summary
 from ._force import law_fields
 
 __all__ = ["add_parser", "run"]
@@ -18,11 +19,18 @@ def add_parser(sub) -> argparse.ArgumentParser:
         description="Integrate the full model (the DAE of the paper, its jumps between the branches of f(v, V) "
                     "included) from an initial state and print a summary of the run: steps, jumps, the force at "
                     "the jumps, the final state.  Methods: hybrid (the jumps as events, exact as eps -> 0; the "
-                    "default) or regularized (the paper's eps-regularised scheme, by scipy's Radau, BDF or LSODA).",
+                    "default for the paper's model), regularized (the paper's eps-regularised scheme, by scipy's "
+                    "Radau, BDF or LSODA; the default for a massless tape under --loading load) or smooth (the "
+                    "tape-mass model's ODE, --tape-mass, by scipy's Radau, BDF, LSODA, DOP853 or RK45; its only "
+                    "method).  The model variants: --tape-mass (the peeled ribbon's mass, docs/tape-mass.md) and "
+                    "--loading load --load-mass [--load] (a constant load instead of a constant pull speed; the "
+                    "pull speed Vp is then a state, in the summary and the plot; docs/constant-load.md).",
         examples=["peelapprox simulate --V 1 --I 1e-2 --t-end 20 --t-transient 10 --plot fig4.png --out run.npz",
                   "peelapprox simulate --V 4 --I 1e-2 --t-end 200 --jumps-only --jumps-csv jumps.csv",
                   "peelapprox simulate --V 1.2 --I 1e-5 --t-end 1 --force-family cubic --coef c=280",
-                  "peelapprox simulate --V 1 --I 1e-2 --t-end 1 --method regularized --eps 1e-7 --format json"])
+                  "peelapprox simulate --V 1 --I 1e-2 --t-end 1 --method regularized --eps 1e-7 --format json",
+                  "peelapprox simulate --V 1 --I 1e-5 --t-end 0.05 --tape-mass 1e-4 --solver LSODA",
+                  "peelapprox simulate --V 1 --I 1e-5 --t-end 0.05 --loading load --load-mass 25 --load 245"])
     add_params(sp)
     g = sp.add_argument_group("the run")
     g.add_argument("--t-end", type=float, required=True, help="final time [s]")
@@ -31,10 +39,13 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g.add_argument("--F0", type=float, default=None, help="initial pull force [N] (default: 1.01 f(V, V))")
     g.add_argument("--branch0", choices=("AB", "CD"), default=None,
                    help="initial branch of f (default: the lowest-velocity stable root)")
-    g.add_argument("--method", choices=("hybrid", "regularized"), default="hybrid",
-                   help="hybrid: jumps as events; regularized: the paper's eps-scheme")
-    g.add_argument("--solver", choices=("Radau", "BDF", "LSODA"), default=None,
-                   help="scipy solver of --method regularized (default: Radau)")
+    g.add_argument("--method", choices=("hybrid", "regularized", "smooth"), default=None,
+                   help="hybrid: jumps as events; regularized: the paper's eps-scheme; smooth: the tape-mass "
+                        "model's ODE (default: the model's: hybrid, smooth with --tape-mass, regularized with "
+                        "--loading load and no tape mass)")
+    g.add_argument("--solver", choices=("Radau", "BDF", "LSODA", "DOP853", "RK45"), default=None,
+                   help="scipy solver of --method regularized (Radau, BDF, LSODA) or smooth (all five) "
+                        "(default: Radau)")
     g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the integration")
     g.add_argument("--eps", type=float, default=None,
                    help="the paper's regularisation parameter epsilon of --method regularized (default: 1e-7)")
@@ -81,9 +92,10 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.quiet,
     )
     s = traj.stats
-    summary = {
+    summary: dict[str, Any] = {
         "V": params.V,
         "I": params.I,
+        **variant_summary(params),
         "method": traj.method,
         "solver": traj.solver,
         "rtol": traj.rtol,
@@ -97,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
         "compile_time_s": round(s.compile_time, 3),
         "final_state": traj.final_state.as_dict(),
     }
+    if traj.Vp is not None and len(traj.Vp):
+        summary["Vp_range"] = [float(traj.Vp.min()), float(traj.Vp.max())]
     if len(traj.jumps):
         summary["F_at_jumps_range"] = [float(traj.jumps.F.min()), float(traj.jumps.F.max())]
     summary.update(law_fields(law, spec=args.format == "json"))
