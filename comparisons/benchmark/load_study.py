@@ -207,7 +207,7 @@ def classify(V: float, I: float, F_L: float, M: float, t_end: float, *, rtol: fl
 
 def phase_diagram(V: float = 1.0, I_values: Sequence[float] = (1e-5,),
                   loads: Sequence[float] = (180, 210, 236, 260, 285, 300), masses: Sequence[float] = (0.1, 1, 10, 30),
-                  *, t_end: Callable[[float], float] = lambda M: 3.0 + 0.3 * M,
+                  *, t_end: Callable[[float], float] = lambda M: 3.0 + 0.5 * M,
                   progress: Say = _quiet) -> list[dict[str, Any]]:
     """:func:`classify` over the grid ``I × M × F_L`` (``t_end(M)``: the horizon, longer for heavier loads)."""
     rows = []
