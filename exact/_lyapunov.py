@@ -78,7 +78,9 @@ def lyapunov(
     params : PeelParams
         With any law ``params.force`` that :func:`exact.simulate` runs (its scales and branches are the law's:
         :func:`peelapprox.branch_structure` with ``force``); ``"variational"``: the paper's law only (ValueError
-        naming the method and the law otherwise).
+        naming the method and the law otherwise).  A model variant (``params.tape_mass``,
+        ``params.loading="load"``) takes ``"two-trajectory"`` only, on its own method (``"smooth"``,
+        ``"regularized"``); the other methods are a ValueError naming the model they support.
     method : {"two-trajectory", "tangent", "return-map", "variational"}
         How (module docstring; costs and agreement in docs/usage.md and docs/dynamics.md).
     t_transient : float
@@ -102,7 +104,8 @@ def lyapunov(
         method            options (defaults)
         ================  =========================================================================
         two-trajectory    ``tau`` (0.005 s), ``n`` (10000) or ``T`` (n = max(2, round(T/tau));
-                          giving both is an error), ``n_discard`` (200), ``d0`` (1e-7)
+                          giving both is an error), ``n_discard`` (200), ``d0`` (1e-7), ``solver``
+                          (None; a model variant's scipy solver, docs/tape-mass-dynamics.md)
         tangent           ``T`` (50 s), ``max_steps`` (5e6 per simulated second, at most 1e9)
         return-map        ``n_returns`` (5000), ``h`` (1e-6); no ``T``: the method renormalises once per
                           return and its length is a count of returns, whose times are known only as

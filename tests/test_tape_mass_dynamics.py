@@ -127,3 +127,17 @@ def test_sweep_runs_a_variant_from_its_options():
     assert rec["status"] == "ok" and rec["n_returns"] == return_map(tr).size
     with pytest.raises(ValueError, match="solver"):
         measure_period(p, {**opts, "solver": "Euler"})
+
+
+def test_basins_run_the_variant_method_and_refuse_its_orbits():
+    """basins passes solver to each start's simulate: the start (α0 = 0, ω0 = V/R, the default initial state)
+    counts the returns of the same window as window_run (one deterministic run); orbits=True (periodic_orbit,
+    the massless model's) and solver with the hybrid method are ValueErrors before any start."""
+    res = exact.basins(TAPE, alpha0=[0.0], omega0=[10.0], solver="LSODA", max_workers=0, progress=False, **SHORT)
+    tr = exact.window_run(TAPE, solver="LSODA", **SHORT)
+    assert res.n_returns[0, 0] == return_map(tr).size
+    with pytest.raises(ValueError, match="orbits=True"):
+        exact.basins(TAPE, alpha0=[0.0], omega0=[10.0], orbits=True, max_workers=0, progress=False, **SHORT)
+    with pytest.raises(ValueError, match="solver"):
+        exact.basins(PeelParams(V=1.0, I=1e-2), alpha0=[0.0], omega0=[10.0], solver="LSODA", max_workers=0,
+                     progress=False)
