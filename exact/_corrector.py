@@ -42,7 +42,8 @@ FD_STEP = 1e-7
 
 
 def _coefficient(params: PeelParams, parameter: str) -> str | None:
-    """The family coefficient named by ``parameter`` (None for V, I, k); ValueError naming the valid ones."""
+    """The family coefficient named by ``parameter`` (None for V, I, k and the variants' parameters); ValueError
+    naming the valid ones."""
     if parameter in PARAMETERS or parameter in VARIANT_PARAMETERS:
         return None
     law = params.force
@@ -50,9 +51,9 @@ def _coefficient(params: PeelParams, parameter: str) -> str | None:
     coefs = dict(law.coefficients)
     if not parameter.startswith("force.") or law.kind != "family" or name not in coefs:
         have = ", ".join(f"force.{c}" for c in coefs) if law.kind == "family" else "none (not a family law)"
-        raise ValueError(f"parameter must be one of {', '.join(PARAMETERS + VARIANT_PARAMETERS)} or a coefficient "
-                         f"of the family law "
-                         f"params.force ({have}), got {parameter!r}")
+        raise ValueError(f"parameter must be one of {', '.join(PARAMETERS)} or a coefficient of the family law "
+                         f"params.force ({have}) — or, for with_parameter and orbit_diagram, a model variant's "
+                         f"{', '.join(VARIANT_PARAMETERS)} — got {parameter!r}")
     return name
 
 

@@ -193,7 +193,12 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         does or the run is not periodic.
     """
     from ._continuation import OrbitBranch
+    from ._corrector import VARIANT_PARAMETERS
 
+    if diagram.parameter in VARIANT_PARAMETERS:
+        raise ValueError(f"diagram: explain reads a diagram against continued branches of the paper's massless, "
+                         f"velocity-controlled model, which continue_orbit does not follow in a model variant's "
+                         f"parameter; got a diagram over {diagram.parameter!r}")
     out: list[int | None] = []
     for x, F, lab in zip(diagram.values, diagram.returns, diagram.labels):
         found = None

@@ -141,3 +141,11 @@ def test_basins_run_the_variant_method_and_refuse_its_orbits():
     with pytest.raises(ValueError, match="solver"):
         exact.basins(PeelParams(V=1.0, I=1e-2), alpha0=[0.0], omega0=[10.0], solver="LSODA", max_workers=0,
                      progress=False)
+
+
+def test_explain_refuses_a_diagram_over_a_variant_parameter():
+    """No continued branch lives in a variant's parameter: explain refuses the diagram (ValueError naming
+    it) instead of returning None for every value."""
+    d = exact.OrbitDiagram("tape_mass", np.array([0.0]), (np.zeros(0),), ("no stick-slip",), 0.0)
+    with pytest.raises(ValueError, match="diagram.*'tape_mass'"):
+        exact.explain(d, [])

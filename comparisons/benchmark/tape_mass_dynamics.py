@@ -117,7 +117,8 @@ def _windows(out: Path, span: float) -> None:
     data = {}
     for m in (0.0, 1e-5, 1e-3, 1e-2):
         V, I = REGIMES[0][1:]
-        tr = exact.simulate(_params(V, I, m), 1.0 + span, rtol=RTOL, t_transient=1.0, solver=_solver(m))
+        tr = exact.simulate(_params(V, I, m), 1.0 + span, rtol=RTOL, t_transient=1.0, solver=_solver(m),
+                            max_steps=10**7, max_wall=600.0)
         k = max(1, tr.t.size // 4000)
         data[str(m)] = {"t": tr.t[::k].tolist(), "F": tr.F[::k].tolist()}
         print(f"window F(t) m={m:g}: {tr.t.size} points", file=sys.stderr, flush=True)
@@ -203,7 +204,8 @@ def main(argv: list[str] | None = None) -> int:
         return _lyapunov_only(out, 0.2 if a.quick else a.lyapunov_time)
     tt, win = (0.3, 0.3) if a.quick else (a.t_transient, a.window)
     if a.only_diagram:
-        _diagram(out, tt, win)
+        if not a.no_diagram:  # --only-diagram --no-diagram: the F(t) windows alone
+            _diagram(out, tt, win)
         _windows(out, 0.3 if a.quick else 0.5)
         return 0
     lyap_T = None if a.no_lyapunov else (0.2 if a.quick else a.lyapunov_time)
