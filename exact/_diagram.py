@@ -39,7 +39,8 @@ class OrbitDiagram:
     returns : tuple of ndarray
         F [N] at the AB→CD jumps of the window, per value (empty where the run broke down or has no jumps).
     labels : tuple of str
-        ``"period-n"``, ``"aperiodic"``, ``"no stick-slip"`` or ``"breakdown:<reason>"`` per value.
+        ``"period-n"``, ``"aperiodic"``, ``"no stick-slip"``, ``"breakdown:<reason>"``, ``"budget:<name>"`` or
+        ``"solver_failure"`` per value (a failed value does not stop the diagram).
     wall_time : float
     """
 
@@ -160,6 +161,10 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
                 label = per.label
         except ModelBreakdown as exc:
             F, label = np.zeros(0), f"breakdown:{exc.reason}"
+        except SolverBudgetExceeded as exc:  # one value's budget, not the whole diagram (e.g. a tiny tape mass)
+            F, label = np.zeros(0), f"budget:{exc.budget}"
+        except SolverFailure:
+            F, label = np.zeros(0), "solver_failure"
         returns.append(np.asarray(F, dtype=float))
         labels.append(label)
         if line is not None:
