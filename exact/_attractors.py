@@ -29,10 +29,11 @@ from peelapprox.validate import duration, function, optional, positive, state, s
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
+from ._options import method_option
 from ._simulate import initial_state, simulate
 from ._trajectory import Trajectory
 
-__all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors"]
+__all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors", "paper_model_only"]
 
 #: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
 #: attractors): their work grows with counts (n, n_returns, starts) that no step budget bounds.
@@ -47,6 +48,18 @@ def states_alpha(name: str, x) -> np.ndarray:
     return a
 
 
+def paper_model_only(params: PeelParams, what: str, instead: str = "") -> None:
+    """Refuse a model variant (``params.variant``: a tape mass or a constant load) for ``what``, a tool built on
+    the hybrid solver's jumps (its section returns, tangent dynamics and saltation matrices), with a ValueError
+    naming ``params`` and the model it supports (``instead``: what to use for the variant)."""
+    if params.variant is not None:
+        raise ValueError(
+            f"{what} supports the paper's massless, velocity-controlled model only (params.tape_mass=None, "
+            f"params.loading='velocity': the hybrid method's jumps and saltation matrices), got params with "
+            f"tape_mass={params.tape_mass!r}, loading={params.loading!r} (variant {params.variant!r})"
+            + (f"; {instead}" if instead else ""))
+
+
 # ---------------------------------------------------------------------------------------------- windows
 def window_run(
     params: PeelParams,
@@ -56,6 +69,8 @@ def window_run(
     rtol: float = WINDOW_DEFAULTS["rtol"],
     alpha0: float = WINDOW_DEFAULTS["alpha0"],
     max_wall: float | None = None,
+    method: str | None = None,
+    solver: str | None = None,
 ) -> Trajectory:
     """The jumps of the exact solution over ``[t_transient, t_transient + window]`` (``save="jumps"``).
 
@@ -66,7 +81,9 @@ def window_run(
     Parameters
     ----------
     params : PeelParams
-        With any law ``params.force`` the hybrid solver runs (:func:`exact.simulate`).
+        With any law ``params.force`` the hybrid solver runs (:func:`exact.simulate`); a model variant (a tape
+        mass, a constant load: ``params.variant``) runs its own method (``"smooth"``, ``"regularized"``), whose
+        jumps are the crossings of the inflection velocity (docs/tape-mass-dynamics.md).
     t_transient : float
         Seconds integrated from the initial state before the window, discarded, in [0, 1e6] (30).
     window : float
@@ -77,6 +94,9 @@ def window_run(
         Initial peel angle; the rest of the initial state is :func:`exact.initial_state`'s (0).
     max_wall : float, optional
         Wall-clock budget [s] of the run; None: unbounded.
+    method, solver : str, optional
+        :func:`exact.simulate`'s (None: the model's method and the method's solver; a method or solver the
+        model cannot use is simulate's ValueError).
 
     Returns
     -------
@@ -93,13 +113,13 @@ def window_run(
     """
     return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
                        duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
-                       optional(positive, "max_wall", max_wall))
+                       optional(positive, "max_wall", max_wall), method, solver)
 
 
 @functools.lru_cache(maxsize=2)
-def _window_run(params, t_transient, window, rtol, alpha0, max_wall=None):
+def _window_run(params, t_transient, window, rtol, alpha0, max_wall=None, method=None, solver=None):
     return simulate(params, t_transient + window, alpha0=alpha0, rtol=rtol, t_transient=t_transient, save="jumps",
-                    max_wall=max_wall)
+                    max_wall=max_wall, method=method, solver=solver)
 
 
 # ---------------------------------------------------------------------------------------------- attractors
@@ -130,6 +150,8 @@ def attractors(
     match_rtol: float = 1e-4,
     progress: Callable[[str], None] | None = None,
     max_wall: float | None = DEFAULT_MAX_WALL,
+    method: str | None = None,
+    solver: str | None = None,
 ) -> list[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
@@ -144,7 +166,8 @@ def attractors(
     Parameters
     ----------
     params : PeelParams
-        With any law ``params.force`` the hybrid solver runs (:func:`exact.simulate`).
+        With any law ``params.force`` the hybrid solver runs (:func:`exact.simulate`); a model variant, its own
+        method (:func:`window_run`).
     alpha0s : sequence of float
         Initial peel angles [rad], each in ``STATE_RANGES["alpha"]``, at least one.
     t_transient, window, rtol : float
@@ -158,6 +181,8 @@ def attractors(
     max_wall : float or None
         Wall-clock budget [s] of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``; None:
         unbounded).
+    method, solver : str, optional
+        Of each start's :func:`window_run` (None: the model's method and its solver).
 
     Returns
     -------
@@ -176,6 +201,7 @@ def attractors(
     params = _params("params", params)
     kw = dict(t_transient=duration("t_transient", t_transient, zero=True), window=duration("window", window),
               rtol=_rtol("rtol", rtol))
+    method_option(method, solver=solver, eps=None, rtol=kw["rtol"], atol=None, v_floor=None, params=params)
     period_rtol = positive("period_rtol", period_rtol)
     match_rtol = positive("match_rtol", match_rtol)
     alpha0s = [float(a) for a in np.atleast_1d(states_alpha("alpha0s", alpha0s))]
@@ -187,7 +213,7 @@ def attractors(
         try:
             s0 = initial_state(params, alpha0=a0)
             tr = window_run(params, alpha0=a0, max_wall=wall.left(0.0, s0.__dict__, kw["t_transient"] + kw["window"]),
-                            **kw)
+                            method=method, solver=solver, **kw)
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         except (ModelBreakdown, ValueError) as exc:

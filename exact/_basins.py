@@ -36,6 +36,8 @@ from peelapprox.validate import ArgumentTypeError, duration, flag, integer, opti
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
+from ._attractors import paper_model_only
+from ._options import method_option
 from ._orbits import PeriodicOrbit, periodic_orbit
 from ._simulate import initial_state, simulate
 
@@ -255,7 +257,7 @@ def _edges(x: np.ndarray) -> np.ndarray:
 
 # ---------------------------------------------------------------------------------------------- one start
 def run_start(params: PeelParams, t_transient: float, window: float, rtol: float, max_period: int,
-              alpha0: float, axis: str, value: float) -> dict[str, Any]:
+              alpha0: float, axis: str, value: float, solver: str | None = None) -> dict[str, Any]:
     """Outcome of one start as plain data (runs in a worker process; never raises for a model outcome).
 
     Returns ``{"code": INVALID | APERIODIC | BREAKDOWN | UNDETERMINED | FAILURE | 0 (periodic), "text",
@@ -268,7 +270,8 @@ def run_start(params: PeelParams, t_transient: float, window: float, rtol: float
     except ValueError as exc:  # no root of CONSTR (or a degenerate geometry) at this start
         return {**out, "code": INVALID, "text": "invalid start", "message": _msg(exc)}
     try:
-        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, **kw)
+        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, solver=solver,
+                      **kw)
     except ModelBreakdown as exc:
         return {**out, "code": BREAKDOWN, "text": f"breakdown:{exc.reason}", "message": _msg(exc)}
     except (SolverFailure, SolverBudgetExceeded, ValueError, ArithmeticError) as exc:
@@ -389,6 +392,7 @@ def basins(
     executor: Executor | None = None,
     max_workers: int | None = None,
     progress: bool | Callable[[int, int, dict], None] | None = True,
+    solver: str | None = None,
 ) -> BasinResult:
     """Label every start of a grid over (α0, F0) or (α0, ω0) by the attractor it reaches.
 
@@ -401,7 +405,9 @@ def basins(
     Parameters
     ----------
     params : PeelParams
-        With any law the hybrid solver runs (the paper's fvV, a cubic, a table, an expression).
+        With any law the hybrid solver runs (the paper's fvV, a cubic, a table, an expression); a model variant
+        (a tape mass, a constant load) runs its own method (:func:`exact.simulate`'s default), ``orbits`` then
+        refused (the periodic orbits are the massless model's).
     alpha0 : sequence of float
         Initial peel angles [rad]: strictly increasing, each in ``STATE_RANGES["alpha"]``.
     F0, omega0 : sequence of float
@@ -427,6 +433,9 @@ def basins(
     progress : bool or callable
         True: a line on stderr per ~5 % of the starts (and per failed start; one updating line in Jupyter); a
         callable gets ``(done, total, outcome)`` after each.
+    solver : str, optional
+        The scipy solver of a model variant's runs (:func:`exact.simulate`'s ``solver``; None: its default);
+        with the massless model's hybrid method a ValueError.
 
     Returns
     -------
@@ -452,6 +461,9 @@ def basins(
     rtol = _rtol("rtol", rtol)
     max_period = integer("max_period", max_period, 1, 1000)
     orbits = flag("orbits", orbits)
+    method_option(None, solver=solver, eps=None, rtol=rtol, atol=None, v_floor=None, params=params)
+    if orbits:
+        paper_model_only(params, "basins(orbits=True) (exact.periodic_orbit)", "pass orbits=False")
     max_workers = optional(integer, "max_workers", max_workers, 0)
     if executor is not None:
         if not callable(getattr(executor, "submit", None)):
@@ -463,7 +475,7 @@ def basins(
         raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")
 
     starts = [(float(a), float(v)) for a in a_ax for v in values]
-    tasks = [(params, t_transient, window, rtol, max_period, a, axis, v) for a, v in starts]
+    tasks = [(params, t_transient, window, rtol, max_period, a, axis, v, solver) for a, v in starts]
     outcomes = _run_all(tasks, executor, max_workers, _reporter(progress, len(tasks)))
     codes, groups = _group(outcomes, starts)
     atts = []

@@ -16,12 +16,16 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure
 from peelapprox.io import fmt_number, html_table
 from peelapprox.validate import function, integer
+
+if TYPE_CHECKING:
+    from ._options import Regularized, Smooth
 
 __all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult", "STDERR_BATCHES", "batch_means"]
 
@@ -196,3 +200,69 @@ class LyapunovResult:
             "force": repr(p.force), "intervals": self.benettin.n, "time [s]": self.benettin.time,
             "jumps": self.n_jumps, "τ [s]": self.tau, "wall time [s]": self.benettin.wall_time})
 
+
+
+def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float, n: int, n_discard: int,
+                           d0: float, alpha0: float, rtol: float, solver: str | None,
+                           max_wall: float | None) -> LyapunovResult:
+    """The two-trajectory method of :func:`exact.lyapunov` for a model variant (``params.variant``: the tape
+    mass, the constant load), on the variant's method of :func:`exact.simulate` (``"smooth"``, or
+    ``"regularized"`` for a massless tape under a load) with ``solver``.
+
+    The variants' states are smooth ODE states ``(α, ω, F, v[, V_p])`` (v, and the pull speed V_p under a load,
+    independent of CONSTR), so each interval restarts the driver from the full state and the distance is
+    measured in ``(Δα/1 rad, Δω/(V/R), ΔF/f_max, Δv/V[, ΔV_p/V])``; there is no branch to wait for (the jumps are
+    fast but continuous transits).  Arguments checked by the caller (:func:`exact.lyapunov`).
+    """
+    from peelapprox.errors import SolverBudgetExceeded, WallBudget
+
+    from ._options import method_option, output_options
+    from ._regularized import run_regularized
+    from ._simulate import initial_state
+    from ._trajectory import State
+
+    # a variant's method: smooth, or regularized under a load (never the hybrid one)
+    opts = cast("Regularized | Smooth", method_option(None, solver=solver, eps=None, rtol=rtol, atol=None,
+                                                      v_floor=None, params=params))
+    wall = WallBudget(max_wall)
+    under_load = params.loading == "load"
+    scale = np.concatenate([natural_scales(params), [params.V] * (2 if under_load else 1)])
+    jumps = [0]
+    t_total = t_transient + (n + n_discard) * tau
+
+    def run(x: np.ndarray, dt: float) -> tuple[np.ndarray, int]:
+        s0 = State(0.0, float(x[0]), float(x[1]), float(x[2]), float(x[3]), "AB",
+                   float(x[4]) if under_load else None)
+        out, lim = output_options(opts.name, dt, None, None, save="jumps", t_eval=None, t_transient=0.0,
+                                  max_points=5_000_000, max_steps=int(max(1e5, 2e6 * dt)), max_jumps=20_000_000,
+                                  max_wall=wall.left(0.0, s0.__dict__, t_total))
+        try:
+            tr = run_regularized(params, dt, s0, opts, out, lim, None)
+        except SolverBudgetExceeded as exc:
+            raise wall.reraise(exc) from None
+        s = tr.final_state
+        return np.array([s.alpha, s.omega, s.F, s.v] + ([s.Vp] if under_load else []), dtype=float), len(tr.jumps)
+
+    def distance(a: np.ndarray, b: np.ndarray) -> float:
+        return float(np.linalg.norm((a - b) / scale))
+
+    def rescale(ref: np.ndarray, pert: np.ndarray, factor: float) -> np.ndarray:
+        return ref + factor * (pert - ref)
+
+    def advance(ref: np.ndarray, pert: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        ref, nj = run(ref, tau)
+        pert, _ = run(pert, tau)
+        jumps[0] += nj
+        return ref, pert, tau
+
+    s0 = initial_state(params, alpha0=alpha0)
+    ref = np.array([s0.alpha, s0.omega, s0.F, s0.v] + ([params.V] if under_load else []), dtype=float)
+    if t_transient > 0:
+        ref, _ = run(ref, t_transient)
+    pert = ref.copy()
+    pert[2] += d0 * scale[2]  # along F, as the massless method
+    res = benettin(advance, ref, pert, distance, rescale, n, n_discard=n_discard)
+    ln2 = math.log(2.0)
+    return LyapunovResult(res.exponent, res.exponent / ln2, res.stderr / ln2, res, params, tau, jumps[0],
+                          method=f"{opts.name} {opts.solver} two-trajectory (Benettin)",
+                          notes=[f"variant={params.variant}"])

@@ -56,7 +56,7 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from peelapprox.validate import function, in_range, integer, optional, real
 
-from ._corrector import PARAMETERS, bordered_newton, branch_tangent, parameter_value, with_parameter
+from ._corrector import PARAMETERS, VARIANT_PARAMETERS, bordered_newton, branch_tangent, parameter_value, with_parameter
 from ._crest import Crest, crest_margin
 from ._orbits import PeriodicOrbit, minimal_period
 
@@ -241,6 +241,11 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     wall0 = time.perf_counter()
     if not isinstance(orbit, PeriodicOrbit):
         raise TypeError(f"orbit must be an exact.PeriodicOrbit, got {type(orbit).__name__}")
+    if parameter in VARIANT_PARAMETERS:
+        raise ValueError(f"parameter={parameter!r}: continue_orbit follows orbits of the paper's massless, "
+                         f"velocity-controlled model (the hybrid section map with saltation matrices) in "
+                         f"{', '.join(PARAMETERS)} or a family coefficient; over a model variant's parameter use "
+                         f"exact.orbit_diagram(params, {parameter!r}, values)")
     lam0 = parameter_value(orbit.params, parameter)
     stop = real("stop", stop)
     span = abs(stop - lam0)

@@ -27,17 +27,24 @@ from peelapprox import PeelForce, PeelParams
 
 from ._orbits import PeriodicOrbit, compose, make_orbit, section_return_n, system_of
 
-__all__ = ["PARAMETERS", "bordered_newton", "branch_tangent", "parameter_value", "with_parameter"]
+__all__ = ["PARAMETERS", "VARIANT_PARAMETERS", "bordered_newton", "branch_tangent", "parameter_value",
+           "with_parameter"]
 
 #: The parameters of :func:`exact.continue_orbit` besides a family law's coefficients (``"force.<name>"``).
 PARAMETERS = ("V", "I", "k")
+#: The model variants' parameters (``PeelParams`` fields, with their ranges): :func:`with_parameter` and
+#: :func:`exact.orbit_diagram` take them (a brute-force diagram over the tape mass or the load), the
+#: continuation does not (its section map is the massless model's).  ``"load_mass"`` and ``"load"`` set
+#: ``loading="load"``; ``"tape_mass"`` 0 is the massless model (``tape_mass=None``).
+VARIANT_PARAMETERS = ("tape_mass", "load_mass", "load")
 #: Relative forward-difference step of ``∂P^n/∂λ``.
 FD_STEP = 1e-7
 
 
 def _coefficient(params: PeelParams, parameter: str) -> str | None:
-    """The family coefficient named by ``parameter`` (None for V, I, k); ValueError naming the valid ones."""
-    if parameter in PARAMETERS:
+    """The family coefficient named by ``parameter`` (None for V, I, k and the variants' parameters); ValueError
+    naming the valid ones."""
+    if parameter in PARAMETERS or parameter in VARIANT_PARAMETERS:
         return None
     law = params.force
     name = parameter.removeprefix("force.")
@@ -45,13 +52,23 @@ def _coefficient(params: PeelParams, parameter: str) -> str | None:
     if not parameter.startswith("force.") or law.kind != "family" or name not in coefs:
         have = ", ".join(f"force.{c}" for c in coefs) if law.kind == "family" else "none (not a family law)"
         raise ValueError(f"parameter must be one of {', '.join(PARAMETERS)} or a coefficient of the family law "
-                         f"params.force ({have}), got {parameter!r}")
+                         f"params.force ({have}) — or, for with_parameter and orbit_diagram, a model variant's "
+                         f"{', '.join(VARIANT_PARAMETERS)} — got {parameter!r}")
     return name
 
 
 def with_parameter(params: PeelParams, parameter: str, value: float) -> PeelParams:
-    """``params`` with ``parameter`` (V, I, k or ``"force.<coefficient>"`` of a family law) set to ``value``."""
+    """``params`` with ``parameter`` (V, I, k, a variant's ``tape_mass``, ``load_mass`` or ``load``
+    (:data:`VARIANT_PARAMETERS`), or ``"force.<coefficient>"`` of a family law) set to ``value``.
+
+    ``tape_mass`` 0 gives the massless model (``tape_mass=None``); ``load_mass`` and ``load`` switch on
+    ``loading="load"``.  The value is checked by :class:`peelapprox.PeelParams` (ValueError naming the field
+    and its range)."""
     name = _coefficient(params, parameter)
+    if parameter == "tape_mass":
+        return params.replace(tape_mass=None if value == 0 else value)
+    if parameter in ("load_mass", "load"):
+        return params.replace(loading="load", **{parameter: value})
     if name is None:
         return params.replace(**{parameter: value})
     law = params.force
@@ -61,7 +78,10 @@ def with_parameter(params: PeelParams, parameter: str, value: float) -> PeelPara
 def parameter_value(params: PeelParams, parameter: str) -> float:
     """The value of ``parameter`` in ``params`` (:func:`with_parameter`)."""
     name = _coefficient(params, parameter)
-    return float(getattr(params, parameter) if name is None else dict(params.force.coefficients)[name])
+    if name is None:
+        x = getattr(params, parameter)
+        return 0.0 if x is None else float(x)  # tape_mass None: the massless model
+    return float(dict(params.force.coefficients)[name])
 
 
 def _residual(x: np.ndarray, xn: np.ndarray, scale: np.ndarray) -> float:

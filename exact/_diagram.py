@@ -39,7 +39,8 @@ class OrbitDiagram:
     returns : tuple of ndarray
         F [N] at the AB→CD jumps of the window, per value (empty where the run broke down or has no jumps).
     labels : tuple of str
-        ``"period-n"``, ``"aperiodic"``, ``"no stick-slip"`` or ``"breakdown:<reason>"`` per value.
+        ``"period-n"``, ``"aperiodic"``, ``"no stick-slip"``, ``"breakdown:<reason>"``, ``"budget:<name>"`` or
+        ``"solver_failure"`` per value (a failed value does not stop the diagram).
     wall_time : float
     """
 
@@ -72,7 +73,8 @@ class OrbitDiagram:
 
         pd = optional_import("pandas", "OrbitDiagram.to_dataframe")
         df = pd.DataFrame(self.rows(), columns=[self.parameter, "F", "label"]).astype({"F": float})
-        df.attrs.update({"units": {self.parameter: {"V": "m/s", "I": "kg m²", "k": "N/m"}.get(self.parameter, ""),
+        df.attrs.update({"units": {self.parameter: {"V": "m/s", "I": "kg m²", "k": "N/m", "tape_mass": "kg",
+                                                               "load_mass": "kg", "load": "N"}.get(self.parameter, ""),
                                    "F": "N", "label": ""},
                          "parameter": self.parameter, "wall_time": self.wall_time})
         return df
@@ -104,14 +106,19 @@ class OrbitDiagram:
 def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | np.ndarray, *,
                   t_transient: float = WINDOW_DEFAULTS["t_transient"], window: float = WINDOW_DEFAULTS["window"],
                   rtol: float = WINDOW_DEFAULTS["rtol"], alpha0: float = 0.0, max_period: int = 32,
-                  progress: bool | Callable[[int, int], None] = False) -> OrbitDiagram:
+                  progress: bool | Callable[[int, int], None] = False, method: str | None = None,
+                  solver: str | None = None) -> OrbitDiagram:
     """The return map after ``t_transient`` over ``values`` of ``parameter`` (module docstring).
 
     Parameters
     ----------
     params : PeelParams
-        The other parameters (and the law).
-    parameter : {"V", "I", "k"} or "force.<coefficient>"
+        The other parameters (and the law, and the model variant: a tape mass or a constant load, whose runs
+        use the variant's method).
+    parameter : {"V", "I", "k", "tape_mass", "load_mass", "load"} or "force.<coefficient>"
+        A model variant's parameter (:func:`exact.with_parameter`) gives the diagram over it: over
+        ``"tape_mass"``, 0 is the massless model (the hybrid method) and m > 0 the tape-mass model
+        (``method="smooth"``), its jumps the crossings of the inflection velocity.
     values : sequence of float
     t_transient, window : float
         Dropped and kept time of each run [s].
@@ -122,6 +129,9 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     progress : bool or callable
         True: a line on stderr every ~5 % of the values (one updating line in Jupyter); a
         callable ``progress(done, total)``.
+    method, solver : str, optional
+        Of each ``exact.simulate`` run (None: each run's model's method and its default solver; ``solver``
+        is passed to the runs of a model variant only, the massless model's hybrid method having its own).
 
     Returns
     -------
@@ -141,7 +151,8 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     for i, x in enumerate(vals.ravel()):
         p = with_parameter(params, parameter, float(x))
         try:
-            tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient)
+            tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient,
+                          method=method, solver=solver if p.variant is not None else None)
             F = return_map(tr)
             if F.size < 2:
                 label = "no stick-slip"
@@ -150,6 +161,10 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
                 label = per.label
         except ModelBreakdown as exc:
             F, label = np.zeros(0), f"breakdown:{exc.reason}"
+        except SolverBudgetExceeded as exc:  # one value's budget, not the whole diagram (e.g. a tiny tape mass)
+            F, label = np.zeros(0), f"budget:{exc.budget}"
+        except SolverFailure:
+            F, label = np.zeros(0), "solver_failure"
         returns.append(np.asarray(F, dtype=float))
         labels.append(label)
         if line is not None:
@@ -183,7 +198,12 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         does or the run is not periodic.
     """
     from ._continuation import OrbitBranch
+    from ._corrector import VARIANT_PARAMETERS
 
+    if diagram.parameter in VARIANT_PARAMETERS:
+        raise ValueError(f"diagram: explain reads a diagram against continued branches of the paper's massless, "
+                         f"velocity-controlled model, which continue_orbit does not follow in a model variant's "
+                         f"parameter; got a diagram over {diagram.parameter!r}")
     out: list[int | None] = []
     for x, F, lab in zip(diagram.values, diagram.returns, diagram.labels):
         found = None

@@ -45,8 +45,16 @@ from peelapprox.validate import (
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._attractors import DEFAULT_MAX_WALL, window_run
-from ._benettin import STDERR_BATCHES, BenettinResult, LyapunovResult, batch_means, benettin, natural_scales
+from ._attractors import DEFAULT_MAX_WALL, paper_model_only, window_run
+from ._benettin import (
+    STDERR_BATCHES,
+    BenettinResult,
+    LyapunovResult,
+    batch_means,
+    benettin,
+    natural_scales,
+    variant_two_trajectory,
+)
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
 from ._simulate import initial_state, simulate
 
@@ -70,7 +78,9 @@ def lyapunov(
     params : PeelParams
         With any law ``params.force`` that :func:`exact.simulate` runs (its scales and branches are the law's:
         :func:`peelapprox.branch_structure` with ``force``); ``"variational"``: the paper's law only (ValueError
-        naming the method and the law otherwise).
+        naming the method and the law otherwise).  A model variant (``params.tape_mass``,
+        ``params.loading="load"``) takes ``"two-trajectory"`` only, on its own method (``"smooth"``,
+        ``"regularized"``); the other methods are a ValueError naming the model they support.
     method : {"two-trajectory", "tangent", "return-map", "variational"}
         How (module docstring; costs and agreement in docs/usage.md and docs/dynamics.md).
     t_transient : float
@@ -94,7 +104,8 @@ def lyapunov(
         method            options (defaults)
         ================  =========================================================================
         two-trajectory    ``tau`` (0.005 s), ``n`` (10000) or ``T`` (n = max(2, round(T/tau));
-                          giving both is an error), ``n_discard`` (200), ``d0`` (1e-7)
+                          giving both is an error), ``n_discard`` (200), ``d0`` (1e-7), ``solver``
+                          (None; a model variant's scipy solver, docs/tape-mass-dynamics.md)
         tangent           ``T`` (50 s), ``max_steps`` (5e6 per simulated second, at most 1e9)
         return-map        ``n_returns`` (5000), ``h`` (1e-6); no ``T``: the method renormalises once per
                           return and its length is a count of returns, whose times are known only as
@@ -129,6 +140,9 @@ def lyapunov(
     hence d0 = 1e-7, rtol = 1e-12.  ``d0`` must lie in :data:`D0_RANGE` = [1e-12, 1].
     """
     method = check_lyapunov_options(method, **options)
+    if _params("params", params).variant is not None and method != "two-trajectory":
+        paper_model_only(params, f"lyapunov method={method!r}",
+                         "a model variant (a tape mass, a constant load) takes method='two-trajectory' only")
     common: dict[str, Any] = dict(t_transient=t_transient, alpha0=alpha0)
     if rtol is not None:
         common["rtol"] = rtol
@@ -171,8 +185,10 @@ def _two_trajectory(
     alpha0: float = 0.0,
     rtol: float = 1e-12,
     max_wall: float | None = DEFAULT_MAX_WALL,
+    solver: str | None = None,
 ) -> LyapunovResult:
-    """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver.
+    """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver, or for
+    a model variant (``params.variant``) on its method with ``solver`` (:func:`exact._benettin.variant_two_trajectory`).
 
     ``n`` renormalisation intervals are measured (10000 by default), or ``max(2, round(T/tau))`` of them when
     ``T`` is given (:func:`lyapunov` refuses both).  The two orbits' state is ``(α, ω, F, branch)``; ``run``
@@ -190,6 +206,13 @@ def _two_trajectory(
     n, n_discard = _check("n", 10000 if n is None else n), _check("n_discard", n_discard)
     alpha0 = state("alpha0", alpha0, "alpha")
     rtol = _rtol("rtol", rtol)
+    if params.variant is not None:
+        return variant_two_trajectory(params, t_transient=t_transient, tau=tau, n=n, n_discard=n_discard, d0=d0,
+                                      alpha0=alpha0, rtol=rtol, solver=solver, max_wall=wall.limit)
+    if solver is not None:
+        raise ValueError(f"lyapunov: solver applies to a model variant's method (params.tape_mass, "
+                         f"params.loading='load'), not to the hybrid method of the paper's model; got "
+                         f"solver={solver!r}")
     bs = branch_structure(params.V, force=params.force)
     scale = natural_scales(params)
     jumps = [0]
@@ -312,6 +335,8 @@ def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float =
     from ._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
 
     params = _params("params", params)
+    paper_model_only(params, "lyapunov method 'tangent' (saltation matrices at the hybrid jumps)",
+                     "use method='two-trajectory'")
     T = _check("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     rtol = _rtol("rtol", rtol)
@@ -395,6 +420,8 @@ def _return_map(params: PeelParams, *, t_transient: float = T_TRANSIENT, n_retur
                 rtol: float = 1e-12, alpha0: float = 0.0, max_wall: float | None = DEFAULT_MAX_WALL) -> LyapunovResult:
     """Method ``"return-map"`` of :func:`lyapunov` (:func:`lyapunov_return_map`)."""
     params = _params("params", params)
+    paper_model_only(params, "lyapunov method 'return-map' (the hybrid AB->CD section map)",
+                     "use method='two-trajectory'")
     h = _check("h", h)
     rtol = _rtol("rtol", rtol)
     t_transient = duration("t_transient", t_transient, zero=True)

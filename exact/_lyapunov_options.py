@@ -19,11 +19,15 @@ D0_RANGE = (1e-12, 1.0)
 #: The methods of :func:`lyapunov` and the options each takes besides the common ``t_transient``, ``alpha0``,
 #: ``rtol`` and ``max_wall`` (their defaults: the table of :func:`lyapunov`).
 METHODS: dict[str, tuple[str, ...]] = {
-    "two-trajectory": ("tau", "n", "T", "n_discard", "d0"),
+    "two-trajectory": ("tau", "n", "T", "n_discard", "d0", "solver"),
     "tangent": ("T", "max_steps"),
     "return-map": ("n_returns", "h"),
     "variational": ("eps", "T", "tau", "progress"),
 }
+
+#: The scipy solvers of a model variant's method (:func:`exact.simulate`'s ``solver``; the two-trajectory
+#: method's option ``solver``, for ``params.variant`` only).
+SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
 
 #: The check of each option of :data:`METHODS`, ``check(name, value) -> value``: the one the methods apply
 #: (the variational method's, in ``exact._variational``, are the same validators).
@@ -38,6 +42,7 @@ _OPTION_CHECKS: dict[str, Callable[[str, Any], Any]] = {
     "h": lambda name, x: positive(name, x, hi=1.0),
     "eps": _eps,
     "progress": lambda name, x: optional(function, name, x),
+    "solver": lambda name, x: optional(choice, name, x, SOLVERS),
 }
 
 

@@ -40,6 +40,7 @@ from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, in_range, integer, optional
 from peelapprox.validate import params as _params
 
+from ._attractors import paper_model_only
 from ._tangent import TangentSystem, tangent_system
 
 __all__ = ["PeriodicOrbit", "SectionReturn", "monodromy_fd", "periodic_orbit", "section_return", "solve_orbit"]
@@ -364,6 +365,8 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
     """
     wall0 = time.perf_counter()
     params = _params("params", params)
+    paper_model_only(params, "periodic_orbit (Newton on the hybrid AB->CD section map with saltation matrices)",
+                     "use exact.orbit_diagram or exact.attractors for the variant's periods")
     n = optional(integer, "n", n, 1, 10_000)
     t_transient = duration("t_transient", t_transient, zero=True)
     window = duration("window", window)

@@ -157,7 +157,7 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
                 "peel front has stopped (the pull cannot keep it moving), and the model (a front that only "
                 "advances) ends there", t=float(ode.t), state=sdict(ode.t, y), reason="arrest",
                 partial=build(False))
-        if massive and not y[3] > 0.0:  # the tape-mass model: the front decelerated to rest (physical)
+        if variant is not None and not y[3] > 0.0:  # a variant's front decelerated to rest within the step
             raise ModelBreakdown(
                 f"model breakdown at t={t_old:.9g}: the peel velocity v fell to 0 (v = {y[3]:.3g} m/s after the "
                 "step): the peel front stops, and the model (a front that only advances, f defined for v > 0) "

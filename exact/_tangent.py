@@ -209,8 +209,12 @@ class TangentSystem:
 
 def tangent_system(params) -> TangentSystem:
     """The :class:`TangentSystem` of ``params`` (its law's compiled driver, field and pull force)."""
+    from ._attractors import paper_model_only
     from ._simulate import _param_vector
 
+    paper_model_only(params, "the hybrid tangent dynamics (section returns, periodic_orbit, solve_orbit, "
+                     "continue_orbit, lyapunov methods 'tangent' and 'return-map')",
+                     "use exact.orbit_diagram, exact.attractors or lyapunov(method='two-trajectory')")
     cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
     law, coef, bs = cl.arg, cl.coef, cl.structure
     p = _param_vector(params) if cl.inlined else _param_vector(params, None, bs, cl.domain)

@@ -165,6 +165,11 @@ def lyapunov_variational(
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)
     _params("params", params, laws=VARIATIONAL_LAWS, where=VARIATIONAL_LAWS_NOTE)
+    if params.variant is not None:
+        from ._attractors import paper_model_only
+
+        paper_model_only(params, "lyapunov method 'variational' (the paper's eps-scheme)",
+                         "use method='two-trajectory'")
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
     eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)

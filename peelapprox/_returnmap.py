@@ -2,7 +2,9 @@
 
 Everything here reads the *jump sequence* of an exact (hybrid, ε → 0) trajectory, the natural Poincaré
 section of stick-slip: the pull force at the AB→CD jumps, ``x_k = F(t_k)``, is the return map whose
-periods the paper reports ("period 4 at V = 2, I = 1e-5", "period 8 at V = 1, I = 1e-2", ...).
+periods the paper reports ("period 4 at V = 2, I = 1e-5", "period 8 at V = 1, I = 1e-2", ...).  A model
+variant's trajectory (a tape mass, a constant load: ``method="smooth"`` or ``"regularized"``) is read the same
+way: its jumps are the crossings of the inflection velocity of f, F there (docs/tape-mass-dynamics.md).
 
 * :func:`return_map` — ``x_k``, the F values at AB→CD jumps.
 * :func:`periodicity` — period-n (n <= 32) of ``x_k`` to a stated tolerance, or aperiodic.

@@ -3,7 +3,7 @@ comparisons.stress.variants: a fast subset in the default tier, the whole grid (
 
 Hypothesis: every run ends in a result, a documented ModelBreakdown or a SolverBudgetExceeded (``max_wall``
 bounds the stiffest ones), with finite numbers everywhere (result, jumps, V_p, the exception's time and state).
-The known findings (scipy's Radau giving up, SolverFailure; reported to the solver's owner) are listed in
+The known findings (the solver giving up at m = 1e-12 kg, SolverFailure) are listed in
 :data:`KNOWN_SOLVER_FAILURES` and docs/robustness.md; any other non-allowed ending fails."""
 
 from __future__ import annotations
@@ -26,34 +26,18 @@ from comparisons.stress.variants import (
     variant_grid,
 )
 
-#: (group, V, I, tape_mass, load_mass, where) of the grid points where scipy's Radau stopped with a SolverFailure
-#: instead of a breakdown or a budget (``python -m comparisons.stress.variants --out stress_variants``, 2 shared
-#: cores; docs/robustness.md, "Model variants"): under a load below the folds (and a few above) the peel front
-#: arrests, v falls to ~1e-17 m/s and the step size underflows before the driver's v <= 0 check ("arrest"); at
-#: m = 1e-12 kg (ε_eff ~ 1e-12) Radau cannot resolve a CD->AB landing.  Reported to the solver's owner.
+#: (group, V, I, tape_mass, load_mass, where) of the grid points where the solver stops with a SolverFailure
+#: instead of a breakdown or a budget (``python -m comparisons.stress.variants --out stress_variants``;
+#: docs/robustness.md, "Model variants"): at m = 1e-12 kg (ε_eff ~ 1e-12) LSODA cannot resolve the fast
+#: transits at V = 1 m/s; the failure's message says to use the massless model there.  (The arrests under a load
+#: that the first run found are ModelBreakdown("arrest") since the driver's V_ARREST.)
 KNOWN_SOLVER_FAILURES: set[tuple] = {
     ("tape", 1.0, 1e-06, 1e-12, None, ""),
     ("tape", 1.0, 0.0001, 1e-12, None, ""),
     ("tape", 1.0, 0.01, 1e-12, None, ""),
-    ("load", 1.0, 1e-06, None, 1e-06, "below"),
-    ("load", 1.0, 0.0001, None, 1e-06, "below"),
-    ("load", 1.0, 0.01, None, 1e-06, "below"),
-    ("load", 1.0, 1e-06, None, 0.001, "below"),
-    ("load", 1.0, 0.0001, None, 0.001, "below"),
-    ("load", 1.0, 0.01, None, 0.001, "below"),
-    ("load", 1.0, 0.01, None, 0.001, "above"),
-    ("load", 1.0, 0.0001, None, 1.0, "below"),
-    ("load", 1.0, 1e-06, 0.0001, 1e-06, "below"),
-    ("load", 1.0, 0.0001, 0.0001, 1e-06, "below"),
-    ("load", 1.0, 0.01, 0.0001, 1e-06, "below"),
-    ("load", 1.0, 0.0001, 0.0001, 0.001, "below"),
-    ("load", 1.0, 0.01, 0.0001, 0.001, "below"),
-    ("load", 1.0, 0.01, 0.0001, 0.001, "above"),
-    ("load", 1.0, 0.0001, 0.0001, 1.0, "below"),
 }
-#: The two signatures of that finding: a point that hit max_wall on a loaded machine may reach it on a faster
-#: one, so a solver failure with one of these messages is the same finding, not a new one.
-KNOWN_MESSAGES = ("Required step size is less than spacing between numbers", "left the model's domain")
+#: The signature of that finding (a point that hit max_wall on a loaded machine may fail on a faster one).
+KNOWN_MESSAGES = ("at so small a tape mass the model is the massless one",)
 
 
 def _key(r: dict) -> tuple:
@@ -94,22 +78,24 @@ def test_load_levels_straddle_the_fold_window():
 
 
 @pytest.mark.parametrize("point", [
-    VariantPoint("tape", 4.0, 1e-4, tape_mass=1e-12, t_end=0.05, max_wall=1.0),     # the stiffest: max_wall
+    VariantPoint("tape", 4.0, 1e-4, tape_mass=1e-12, t_end=0.05, max_wall=1.0),     # the stiffest
     VariantPoint("tape", 1.0, 1e-4, tape_mass=10.0, t_end=0.01, max_wall=5.0),      # a 10 kg ribbon
     VariantPoint("load", 1.0, 1e-4, loading="load", load_mass=1e6, load=428.5, where="above", t_end=0.005,
                  max_wall=5.0),                                                      # the heaviest, above f_max
     VariantPoint("load", 1.0, 1e-4, tape_mass=1e-4, loading="load", load_mass=1e-6, load=242.5, where="inside",
                  t_end=0.05, max_wall=1.0),                                          # the lightest, m > 0
     VariantPoint("load", 1.0, 1e-4, loading="load", load_mass=1e-6, load=99.71, where="below", t_end=0.05,
-                 max_wall=2.0),                                                      # a known solver failure
+                 max_wall=2.0),                                                      # the front arrests
 ], ids=["m=1e-12,V=4", "m=10", "M=1e6,above", "M=1e-6,m=1e-4,inside", "M=1e-6,below"])
 def test_fast_subset_ends_in_an_allowed_outcome(point):
     """The grid's corners, in this process with a small max_wall: an allowed ending (or a known finding), never
     NaN; a run that cannot finish within max_wall ends in budget:max_wall (not a hang)."""
     rec = run_variant_point(point)
     _check(rec)
-    if point.tape_mass == 1e-12:
-        assert rec["outcome"] == "budget:max_wall" and rec["t_reached"] < point.t_end
+    if point.tape_mass == 1e-12:  # the stiffest: LSODA reaches t_end in ~0.5 s; max_wall bounds a slow machine
+        assert rec["outcome"] in ("ok", "budget:max_wall")
+    if point.where == "below":  # a load below the folds: F(1 + sin α) falls to f(0+), the front stops
+        assert rec["outcome"] == "breakdown:arrest"
 
 
 @pytest.mark.slow

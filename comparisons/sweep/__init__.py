@@ -24,11 +24,16 @@ the exact solution), ``"period"`` (period of the return map) and
 Options
 -------
 ``options`` is one JSON-serialisable dict passed to every measure.  The engine
-itself reads ``k, R, l, geometry`` (the :class:`peelapprox.PeelParams` fields other than
-I and V; defaults as there); ``jumps`` and ``period`` share one windowed run
+itself reads ``k, R, l, geometry`` and the model variant's ``tape_mass, loading,
+load_mass, load`` (the :class:`peelapprox.PeelParams` fields other than I and V;
+defaults as there: a sweep of (I, V) for a given variant, one sweep per value to
+sweep the tape mass); ``jumps`` and ``period`` share one windowed run
 (``window_run``, one exact run per point) and read ``t_transient`` (30 s),
 ``t_end`` (t_transient + 20 s), ``rtol`` (1e-10) and ``alpha0`` (0);
-``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).  Every option
+``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).  ``solver``
+(None: the method's default, Radau) is the scipy solver of a variant's runs
+(``jumps``, ``period``, ``lyapunov``; ignored by the massless model's hybrid
+method).  Every option
 the chosen measures read is checked before the first point (a measure
 registered with ``check_options`` checks its own), so invalid options raise
 ValueError naming the option and nothing is written.

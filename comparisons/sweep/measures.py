@@ -36,7 +36,7 @@ from peelapprox import (
     force_drops,
     return_map,
 )
-from peelapprox.validate import duration, in_range, positive, state
+from peelapprox.validate import choice, duration, in_range, optional, positive, state
 from peelapprox.validate import rtol as _rtol
 
 from .store import RESERVED
@@ -148,7 +148,7 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     and the breakdown time ``t_breakdown``.
     """
     try:  # the same windowed run (and defaults) as the `period` measure: computed once per point
-        traj = window_run(params, **_window_options(options))
+        traj = window_run(params, **_window_options(options), **_solver(params, options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}", "t_breakdown": float(exc.t)}
     t = np.asarray(traj.jumps.t, dtype=float)
@@ -164,15 +164,28 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     }
 
 
+#: The scipy solvers of a model variant's method (option ``solver``).
+SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
+
+
+def _solver(params: PeelParams, options: Mapping) -> dict:
+    """``{"solver": options["solver"]}`` for a model variant's runs (``params.variant``), else ``{}`` (the
+    hybrid method has its own integrator); the option checked (ValueError naming it and the solvers)."""
+    solver = optional(choice, "solver", options.get("solver"), SOLVERS)
+    return {"solver": solver} if solver is not None and params.variant is not None else {}
+
+
 def _check_window_options(options: Mapping) -> None:
     """The options of the windowed run (:func:`_window_options` checks them)."""
     _window_options(options)
 
 
 def _window_options(options) -> dict:
-    """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted),
+    """The :func:`window_run` arguments from sweep options (``t_end`` = t_transient + window also accepted;
+    ``solver`` checked here, passed by :func:`_solver`),
     checked by the same validators as :func:`window_run` (ValueError/TypeError naming the option and its valid
     range; the sweep calls this before the first point)."""
+    optional(choice, "solver", options.get("solver"), SOLVERS)
     kw = dict(WINDOW_DEFAULTS)
     kw.update({key: options[key] for key in kw if options.get(key) is not None})
     kw["t_transient"] = duration("t_transient", kw["t_transient"], zero=True)
@@ -202,7 +215,8 @@ def _lyapunov_options(options) -> dict:
     return {"t_transient": duration("t_transient", options.get("t_transient", T_TRANSIENT), zero=True),
             "lyapunov_time": in_range("lyapunov_time", options.get("lyapunov_time", 50.0), 2 * LYAPUNOV_TAU,
                                       TIME_MAX),
-            "alpha0": state("alpha0", options.get("alpha0", 0.0), "alpha")}
+            "alpha0": state("alpha0", options.get("alpha0", 0.0), "alpha"),
+            "solver": optional(choice, "solver", options.get("solver"), SOLVERS)}
 
 
 def measure_period(params: PeelParams, options) -> dict:
@@ -213,7 +227,7 @@ def measure_period(params: PeelParams, options) -> dict:
     kw = _period_options(options)
     period_rtol = kw.pop("period_rtol")
     try:
-        tr = window_run(params, **kw)
+        tr = window_run(params, **kw, **_solver(params, options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
     p = classify(tr, period_rtol=period_rtol)
@@ -227,7 +241,8 @@ def measure_lyapunov(params: PeelParams, options) -> dict:
     intervals of 0.005 s)."""
     kw = _lyapunov_options(options)
     try:
-        r = lyapunov(params, t_transient=kw["t_transient"], T=kw["lyapunov_time"], alpha0=kw["alpha0"])
+        r = lyapunov(params, t_transient=kw["t_transient"], T=kw["lyapunov_time"], alpha0=kw["alpha0"],
+                     **_solver(params, options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
     return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}

@@ -23,7 +23,9 @@ from .store import RESERVED
 __all__ = ["PARAM_OPTIONS", "run_point", "make_params", "worker_refs"]
 
 #: Options the engine turns into :class:`peelapprox.PeelParams` fields.
-PARAM_OPTIONS = ("k", "R", "l", "geometry")
+#: The PeelParams fields a sweep's options set (besides I, V and the law): the model variant's too (a tape mass,
+#: a constant load), so a sweep of (I, V) runs for a given variant; one sweep per tape mass sweeps m.
+PARAM_OPTIONS = ("k", "R", "l", "geometry", "tape_mass", "loading", "load_mass", "load")
 
 
 def _import_ref(ref: str) -> Callable:
