@@ -165,9 +165,10 @@ def classify(V: float, I: float, F_L: float, M: float, t_end: float, *, rtol: fl
     Jumps in the last ``tail`` fraction of ``[0, t_end]``: ``"stick-slip"``, or ``"runaway"`` if V_p is then
     above the CD fixed point's speed and still rising.  Else ``"transient->AB"`` / ``"transient->CD"`` by the
     final v (below / above the law's inflection), with ``duration`` = the last jump's time (0: no jump).
-    A :class:`ModelBreakdown` is ``"breakdown:<reason>"`` at its t.  A solver failure or an ``"arrest"`` (LSODA
-    at rtol 1e-6 can step v below 0 on deep AB, where v ~ 1e-5 m/s and f' is large, which the driver reports as
-    the front's arrest) is retried once at ``rtol * 1e-3`` (up to
+    A :class:`ModelBreakdown` is ``"breakdown:<reason>"`` at its t.  A solver failure (LSODA at rtol 1e-6 can
+    step v below 0 on deep AB, where v ~ 1e-5 m/s and f' is large: the driver reports that overshoot as a
+    SolverFailure, since the field at rest would accelerate the front again) or an ``"arrest"`` is retried once
+    at ``rtol * 1e-3`` (up to
     2e6 steps; ``max_steps`` at first, None: ``simulate``'s default; and ``max_wall`` s each); failing again it
     is ``"unresolved:<exception>"``, not a physical verdict.
     ``keep=True`` adds the trajectory under ``"trajectory"``.
