@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -171,6 +172,7 @@ def simulate(
     omega0: float | None = None,
     F0: float | None = None,
     branch0: str | None = None,
+    Vp0: float | None = None,
     method: str | Hybrid | Regularized | Smooth | None = None,
     solver: str | None = None,
     rtol: float = 1e-8,
@@ -202,6 +204,9 @@ def simulate(
         ``branch0=None`` meaning the lowest-velocity stable root of CONSTR
         (see :func:`initial_state`).  v is always the root of CONSTR on
         ``branch0``, so the start is consistent.
+    Vp0 : float, optional
+        Initial pull speed [m/s] under a load (``params.loading == "load"``), in
+        [0, 1e3]; default ``params.V``.  A ValueError under velocity control.
     method : {"hybrid", "regularized", "smooth"} or Hybrid or Regularized or Smooth, optional
         ``"hybrid"`` (the default for the paper's model): the ε → 0 limit,
         event-driven, compiled DOP853 on the desingularised branch dynamics
@@ -305,6 +310,11 @@ def simulate(
         raise TypeError(f"progress must be None, a bool or a callable (t, t_end), got {type(progress).__name__}")
 
     st0 = initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
+    if Vp0 is not None:
+        if params.loading != "load":
+            raise ValueError(f"Vp0 (the initial pull speed) applies only under loading='load'; got Vp0={Vp0!r} with "
+                             "loading='velocity' (the pull speed is params.V)")
+        st0 = dataclasses.replace(st0, Vp=in_range("Vp0", Vp0, 0.0, VP0_MAX))
     if isinstance(opts, Hybrid):
         ct = compile_kernels()
         traj = _run_hybrid(params, t_end, st0, opts, out, lim, progress)
@@ -315,6 +325,9 @@ def simulate(
 
     return run_regularized(params, t_end, st0, opts, out, lim, progress)  # the ε-scheme and the variants' ODEs
 
+
+#: Largest initial pull speed ``Vp0`` [m/s] under a load: the model's velocities stay below 1e3 m/s (STATE_RANGES).
+VP0_MAX = 1e3
 
 #: On CD, v above this [m/s] is a runaway of the pull force (ModelBreakdown "v_ceiling").
 V_CEILING = 1e3
