@@ -60,6 +60,15 @@ def variant_parameters(params: Any, mass: float, load_mass: float = 1.0, load: f
 
 
 @kernel(inline="always")
+def _square(j, n):
+    """The row-major ``n * n`` tuple ``j`` as an (n, n) array."""
+    out = np.empty((n, n))
+    for i in range(n * n):
+        out[i // n, i % n] = j[i]
+    return out
+
+
+@kernel(inline="always")
 def _closure_d2(alpha, geom, R, l):
     if geom == 0.0:
         return _closure_paper_d2(alpha, R, l)
@@ -82,10 +91,7 @@ def _tape_jacobian(y, q, law, coef):
     f, fp, _ = law(v, coef, LAW_FP)
     c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     j = _tape_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, q[Q_MASS], q[M_V], q[M_I], q[M_K], q[M_R])
-    out = np.empty((4, 4))
-    for i in range(16):
-        out[i // 4, i % 4] = j[i]
-    return out
+    return _square(j, 4)
 
 
 @kernel
@@ -105,10 +111,7 @@ def _tape_load_jacobian(y, q, law, coef):
     c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     j = _tape_load_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, y[4], q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD],
                        q[M_I], q[M_K], q[M_R])
-    out = np.empty((5, 5))
-    for i in range(25):
-        out[i // 5, i % 5] = j[i]
-    return out
+    return _square(j, 5)
 
 
 @kernel
@@ -128,10 +131,7 @@ def _eps_load_jacobian(y, q, law, coef):
     c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     j = _eps_load_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, y[4], q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD],
                       q[M_I], q[M_K], q[M_R])
-    out = np.empty((5, 5))
-    for i in range(25):
-        out[i // 5, i % 5] = j[i]
-    return out
+    return _square(j, 5)
 
 
 _FIELDS = {"tape": (_tape_field, _tape_jacobian), "tape_load": (_tape_load_field, _tape_load_jacobian),

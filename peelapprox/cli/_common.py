@@ -16,7 +16,7 @@ from ..io import fmt_number, write_csv, write_rows
 from ._force import add_force_options, force_from_args, law_fields
 
 __all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "REDUCED_ONLY", "UNITS", "add_format", "add_params",
-           "params_from_args", "print_mapping", "variant_summary",
+           "add_variant_options", "params_from_args", "print_mapping", "variant_summary",
            "say", "subcommand", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
@@ -48,6 +48,25 @@ def subcommand(sub: Any, name: str, *, help: str, description: str, examples: Se
     return sub.add_parser(name, help=help, description=text, epilog=epilog, formatter_class=HelpFormatter, **kwargs)
 
 
+def add_variant_options(v: Any, *, loading_default: str | None = "velocity") -> None:
+    """The model variant's options ``--tape-mass --loading --load-mass --load`` (issue 18) in the argument group
+    ``v``; ``loading_default=None`` for a command that records only the options given (``sweep``)."""
+    v.add_argument("--tape-mass", type=float, default=None, metavar="KG",
+                   help=f"mass m of the peeled ribbon [kg], in [{TAPE_MASS_RANGE[0]:g}, {TAPE_MASS_RANGE[1]:g}]: "
+                        "the tape-mass model, a smooth ODE (method smooth) (default: none, the paper's massless "
+                        "tape; 0 is the same)")
+    v.add_argument("--loading", choices=LOADINGS, default=loading_default,
+                   help="velocity: the end pulled at the constant speed V (the paper); load: a constant force "
+                        "--load on a body of mass --load-mass, its speed V_p a state starting at V (default: "
+                        "velocity)")
+    v.add_argument("--load-mass", type=float, default=None, metavar="KG",
+                   help=f"mass M at the pulled end [kg], in [{LOAD_MASS_RANGE[0]:g}, {LOAD_MASS_RANGE[1]:g}]; "
+                        "required with --loading load (default: none)")
+    v.add_argument("--load", type=float, default=None, metavar="N",
+                   help=f"the load F_L [N], in [{LOAD_RANGE[0]:g}, {LOAD_RANGE[1]:g}], with --loading load "
+                        "(default: --load-mass times g = 9.80665 m/s^2, a hanging mass)")
+
+
 def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True, variants: str | None = None) -> None:
     """The options ``--V --I --k --R`` of :class:`peelapprox.PeelParams` and, with ``geometry`` (for the exact
     model; the reduced equations are the paper's linear closure), ``--l --geometry``, its law ``force``
@@ -71,20 +90,7 @@ def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True, variants: 
     title = "model variant (docs/tape-mass.md, docs/constant-load.md)"
     if variants is not None:
         title += f"; refused here: this command {variants}"
-    v = sp.add_argument_group(title)
-    v.add_argument("--tape-mass", type=float, default=None, metavar="KG",
-                   help=f"mass m of the peeled ribbon [kg], in [{TAPE_MASS_RANGE[0]:g}, {TAPE_MASS_RANGE[1]:g}]: "
-                        "the tape-mass model, a smooth ODE (method smooth) (default: none, the paper's massless "
-                        "tape; 0 is the same)")
-    v.add_argument("--loading", choices=LOADINGS, default="velocity",
-                   help="velocity: the end pulled at the constant speed V (the paper); load: a constant force "
-                        "--load on a body of mass --load-mass, its speed V_p a state starting at V")
-    v.add_argument("--load-mass", type=float, default=None, metavar="KG",
-                   help=f"mass M at the pulled end [kg], in [{LOAD_MASS_RANGE[0]:g}, {LOAD_MASS_RANGE[1]:g}]; "
-                        "required with --loading load (default: none)")
-    v.add_argument("--load", type=float, default=None, metavar="N",
-                   help=f"the load F_L [N], in [{LOAD_RANGE[0]:g}, {LOAD_RANGE[1]:g}], with --loading load "
-                        "(default: --load-mass times g = 9.80665 m/s^2, a hanging mass)")
+    add_variant_options(sp.add_argument_group(title))
     sp.set_defaults(variants_refused=variants)
     add_force_options(sp)
 

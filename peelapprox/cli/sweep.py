@@ -8,9 +8,9 @@ import os
 import sys
 import time
 
-from .. import GEOMETRIES, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE
+from .. import GEOMETRIES
 from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler, nonnegative_int, positive_int
-from ._common import subcommand
+from ._common import add_variant_options, subcommand
 from ._force import add_force_options, force_from_args
 
 __all__ = ["MEASURES_HELP", "add_parser", "run"]
@@ -80,20 +80,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
     p.add_argument("--geometry", choices=GEOMETRIES, default=None,
                    help="the closure cos(theta): paper or exact (default: paper)")
     v = sw.add_argument_group("model variant at every point (docs/tape-mass.md, docs/constant-load.md; the measures "
-                              "jumps, period and lyapunov run it, regime refuses it)")
-    v.add_argument("--tape-mass", type=float, default=None, metavar="KG",
-                   help=f"mass m of the peeled ribbon [kg], in [{TAPE_MASS_RANGE[0]:g}, {TAPE_MASS_RANGE[1]:g}] "
-                        "(default: none, the paper's massless tape); to sweep m, one sweep per mass into its own "
-                        "--out")
-    v.add_argument("--loading", choices=LOADINGS, default=None,
-                   help="velocity (the paper) or load: a constant --load on a body of mass --load-mass "
-                        "(default: velocity)")
-    v.add_argument("--load-mass", type=float, default=None, metavar="KG",
-                   help=f"mass M at the pulled end [kg], in [{LOAD_MASS_RANGE[0]:g}, {LOAD_MASS_RANGE[1]:g}], "
-                        "with --loading load")
-    v.add_argument("--load", type=float, default=None, metavar="N",
-                   help=f"the load F_L [N], in [{LOAD_RANGE[0]:g}, {LOAD_RANGE[1]:g}] (default: --load-mass "
-                        "times g)")
+                              "jumps, period and lyapunov run it, regime refuses it; to sweep m, one sweep per "
+                              "mass into its own --out)")
+    add_variant_options(v, loading_default=None)
     v.add_argument("--solver", choices=("LSODA", "Radau", "BDF", "DOP853", "RK45"), default=None,
                    help="the variant's scipy solver (default: the method's, LSODA for a tape mass)")
     sw.add_argument("--retry-failed", action="store_true",
