@@ -62,6 +62,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_segment_kernel.py",
     "peelapprox/_packing.py",  # the parameter-vector layouts, frozen into the kernels
     "peelapprox/_variant_fields.py",  # the tape-mass and load fields (issue 18)
+    "peelapprox/_model_jit.py",  # the model's inline kernels (closures, rates, XDAE)
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "peelapprox/kernels.py",
     "exact/_hybrid.py",

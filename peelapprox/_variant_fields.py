@@ -30,6 +30,7 @@ from . import _generated as _g
 from ._jit import kernel, rebind
 from ._law import ALL_LAWS
 from ._law_abi import LAW_FP, LAW_TYPE, paper_law
+from ._model_jit import closure_d2, regularized_rhs
 from ._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
 
 __all__ = ["VARIANT_MODELS", "Q_MASS", "Q_LOAD_MASS", "Q_LOAD", "variant_parameters", "variant_field",
@@ -42,12 +43,9 @@ Q_MASS, Q_LOAD_MASS, Q_LOAD = N_M, N_M + 1, N_M + 2
 
 _tape_rhs = kernel(inline="always")(_g.tape_rhs)
 _load_rate = kernel(inline="always")(_g.load_rate)
-_regularized_rhs = kernel(inline="always")(_g.regularized_rhs)
 _tape_jac = kernel(inline="always")(_g.tape_jacobian)
 _tape_load_jac = kernel(inline="always")(_g.tape_load_jacobian)
 _eps_load_jac = kernel(inline="always")(_g.eps_load_jacobian)
-_closure_paper_d2 = kernel(inline="always")(_g.closure_paper_d2)
-_closure_exact_d2 = kernel(inline="always")(_g.closure_exact_d2)
 
 
 def variant_parameters(params: Any, mass: float, load_mass: float = 1.0, load: float = 0.0) -> np.ndarray:
@@ -68,19 +66,12 @@ def _square(j, n):
     return out
 
 
-@kernel(inline="always")
-def _closure_d2(alpha, geom, R, l):
-    if geom == 0.0:
-        return _closure_paper_d2(alpha, R, l)
-    return _closure_exact_d2(alpha, R, l)
-
-
 @kernel
 def _tape_field(y, q, law, coef):
     """The tape-mass model under velocity control: ``(α̇, ω̇, Ḟ, v̇)``."""
     v = max(y[3], 1e-300)  # implicit-solver iterates may probe v <= 0; accepted steps are checked
     f, _, _ = law(v, coef, LAW_FP)
-    c, dc, _ = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    c, dc, _ = closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     r = _tape_rhs(y[0], y[1], y[2], v, q[M_V], c, dc, f, q[Q_MASS], q[M_I], q[M_K], q[M_R])
     return np.array([r[0], r[1], r[2], r[3]])
 
@@ -89,7 +80,7 @@ def _tape_field(y, q, law, coef):
 def _tape_jacobian(y, q, law, coef):
     v = max(y[3], 1e-300)
     f, fp, _ = law(v, coef, LAW_FP)
-    c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    c, dc, ddc = closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     j = _tape_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, q[Q_MASS], q[M_V], q[M_I], q[M_K], q[M_R])
     return _square(j, 4)
 
@@ -99,7 +90,7 @@ def _tape_load_field(y, q, law, coef):
     """The tape-mass model under a load: ``(α̇, ω̇, Ḟ, v̇, V̇_p)``."""
     v = max(y[3], 1e-300)
     f, _, _ = law(v, coef, LAW_FP)
-    c, dc, _ = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    c, dc, _ = closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     r = _tape_rhs(y[0], y[1], y[2], v, y[4], c, dc, f, q[Q_MASS], q[M_I], q[M_K], q[M_R])
     return np.array([r[0], r[1], r[2], r[3], _load_rate(y[2], q[Q_LOAD_MASS], q[Q_LOAD])[0]])
 
@@ -108,7 +99,7 @@ def _tape_load_field(y, q, law, coef):
 def _tape_load_jacobian(y, q, law, coef):
     v = max(y[3], 1e-300)
     f, fp, _ = law(v, coef, LAW_FP)
-    c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    c, dc, ddc = closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     j = _tape_load_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, y[4], q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD],
                        q[M_I], q[M_K], q[M_R])
     return _square(j, 5)
@@ -119,8 +110,8 @@ def _eps_load_field(y, q, law, coef):
     """The ε-regularised massless tape under a load: ``(α̇, ω̇, Ḟ, v̇, V̇_p)``."""
     v = max(y[3], 1e-300)
     f, _, _ = law(v, coef, LAW_FP)
-    c, _, _ = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
-    r = _regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_MASS], y[4], q[M_I], q[M_K], q[M_R])
+    c, _, _ = closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    r = regularized_rhs(y[0], y[1], y[2], v, c, f, q[Q_MASS], y[4], q[M_I], q[M_K], q[M_R])
     return np.array([r[0], r[1], r[2], r[3], _load_rate(y[2], q[Q_LOAD_MASS], q[Q_LOAD])[0]])
 
 
@@ -128,7 +119,7 @@ def _eps_load_field(y, q, law, coef):
 def _eps_load_jacobian(y, q, law, coef):
     v = max(y[3], 1e-300)
     f, fp, _ = law(v, coef, LAW_FP)
-    c, dc, ddc = _closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
+    c, dc, ddc = closure_d2(y[0], q[M_GEOM], q[M_R], q[M_L])
     j = _eps_load_jac(y[0], y[1], y[2], v, c, dc, ddc, f, fp, y[4], q[Q_MASS], q[Q_LOAD_MASS], q[Q_LOAD],
                       q[M_I], q[M_K], q[M_R])
     return _square(j, 5)
@@ -143,13 +134,18 @@ def variant_field(model: str) -> tuple[Any, Any]:
     ``jacobian(y, q, law, coef)`` -> the (n, n) Jacobian; compiled for that one signature on first use."""
     if model not in _FIELDS:
         raise ValueError(f"model must be one of {sorted(_FIELDS)}, got {model!r}")
-    a1 = _nb.float64[::1]
     fun, jac = _FIELDS[model]
-    for d, ret in ((fun, a1), (jac, _nb.float64[:, ::1])):
-        if not d.signatures:
-            d.compile(ret(a1, a1, LAW_TYPE, a1))
-            d.disable_compile()
+    _compile_once(fun, jac, _nb.float64[::1], _nb.float64[::1], LAW_TYPE, _nb.float64[::1])
     return fun, jac
+
+
+def _compile_once(fun: Any, jac: Any, *args: Any) -> None:
+    """Compile a field (returning a 1-d array) and its Jacobian (a 2-d array) for the one signature ``args``, on
+    first use only, and allow no other."""
+    for d, ret in ((fun, _nb.float64[::1]), (jac, _nb.float64[:, ::1])):
+        if not d.signatures:
+            d.compile(ret(*args))
+            d.disable_compile()
 
 
 
@@ -183,11 +179,7 @@ def bound_variant_field(model: str, law: Any) -> tuple[Any, Any]:
     fun, jac = variant_field(model)
     if law is paper_law:
         bf, bj = _PAPER[model]
-        a1 = _nb.float64[::1]
-        for d, ret in ((bf, a1), (bj, _nb.float64[:, ::1])):
-            if not d.signatures:
-                d.compile(ret(a1, a1, a1))
-                d.disable_compile()
+        _compile_once(bf, bj, _nb.float64[::1], _nb.float64[::1], _nb.float64[::1])
         return bf, bj
     key = (model, id(law))
     if key not in _BOUND:

@@ -28,7 +28,6 @@ from typing import Any
 import numpy as np
 from numba import types as _nb
 
-from . import _generated as _g
 from . import _status as status
 from ._diffsl import (
     DIFFSL_INPUTS,
@@ -69,6 +68,18 @@ from ._law_abi import (
 from ._law_codegen import expression_kernel, family_kernel
 from ._law_compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
 from ._law_table_jit import table_coefficients, table_law
+from ._model_jit import (
+    closure,
+    closure_d2,
+    closure_exact,
+    closure_exact_d2,
+    closure_paper,
+    closure_paper_d2,
+    constraint_rate,
+    regularized_jacobian,
+    regularized_rhs,
+    slow_rates,
+)
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
 from ._peelforce import _invert as branch_inverse_at
 from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
@@ -95,43 +106,6 @@ __all__ = [
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
     "diffsl_inputs", "diffsl_model", "import_optional",
 ]
-
-#: ``(c, dc/dα)`` of the paper's closure ``cos θ = -sin α`` at ``(alpha, R, l)``.
-closure_paper = kernel(inline="always")(_g.closure_paper)
-#: ``(c, dc/dα)`` of the full geometry ``cos θ = -l sin α / L``.
-closure_exact = kernel(inline="always")(_g.closure_exact)
-#: FLOW1, FLOW2, flow3: ``(α̇, ω̇, Ḟ)``.
-slow_rates = kernel(inline="always")(_g.slow_rates)
-#: Eq. (vdot)'s numerator ``Ġ`` for ``G = F (1 + c)``.
-constraint_rate = kernel(inline="always")(_g.constraint_rate)
-#: XDAE with ``M = diag(1, 1, 1, ε)``, last row divided by ε.
-regularized_rhs = kernel(inline="always")(_g.regularized_rhs)
-#: Its Jacobian, a row-major 16-tuple.
-regularized_jacobian = kernel(inline="always")(_g.regularized_jacobian)
-
-
-#: ``(c, dc/dα, d²c/dα²)`` of the paper's closure.
-closure_paper_d2 = kernel(inline="always")(_g.closure_paper_d2)
-#: ``(c, dc/dα, d²c/dα²)`` of the full geometry.
-closure_exact_d2 = kernel(inline="always")(_g.closure_exact_d2)
-
-
-@kernel(inline="always")
-def closure_d2(alpha, exact_geometry, R, l):
-    """``(c, dc/dα, d²c/dα²)`` of the paper's closure (``exact_geometry == 0``) or of the full geometry (else): the
-    Jacobian of the hybrid field needs the second derivative."""
-    if exact_geometry == 0.0:
-        return closure_paper_d2(alpha, R, l)
-    return closure_exact_d2(alpha, R, l)
-
-
-@kernel(inline="always")
-def closure(alpha, exact_geometry, R, l):
-    """``(c, dc/dα)`` of the paper's closure (``exact_geometry == 0``) or of the full geometry (else)."""
-    if exact_geometry == 0.0:
-        return closure_paper(alpha, R, l)
-    return closure_exact(alpha, R, l)
-
 
 def regularized_parameters(params, eps: float, laws: tuple[str, ...] = ("paper",)) -> np.ndarray:
     """The parameter vector ``q`` of :func:`regularized_field` / :func:`regularized_field_jacobian`: the model
