@@ -30,6 +30,8 @@ from __future__ import annotations
 
 import hashlib
 import inspect
+import pickle  # only its exception, for numba's cache files (numba unpickles them itself)
+import struct
 import types
 import warnings
 from collections.abc import Callable
@@ -115,7 +117,37 @@ def _stamp_with_tag(dispatcher: Any) -> bool:
     if cf is None or not hasattr(cf, "_source_stamp"):
         return False
     cf._source_stamp = (cf._source_stamp, SOURCE_TAG)
+    _corrupt_is_miss(cf)
     return True
+
+
+#: What unpickling a truncated or garbled cache file raises (pickle's own errors and those of the objects it
+#: rebuilds from damaged bytes).
+_CORRUPT = (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError, IndexError,
+            KeyError, struct.error, UnicodeDecodeError, MemoryError)
+
+
+def _corrupt_is_miss(cf: Any) -> None:
+    """Make a corrupt numba cache file (a truncated index, a garbled data file) a cache miss, as a missing one
+    is, instead of an ``UnpicklingError`` out of the user's call: numba then compiles and writes the files anew.
+    Wraps numba's private ``_load_index`` and ``_load_data`` of the dispatcher's cache file (numba 0.58-0.68)."""
+    load_index, load_data = getattr(cf, "_load_index", None), getattr(cf, "_load_data", None)
+    if load_index is None or load_data is None:
+        return
+
+    def _load_index() -> Any:
+        try:
+            return load_index()
+        except _CORRUPT:
+            return {}
+
+    def _load_data(name: Any) -> Any:
+        try:
+            return load_data(name)
+        except _CORRUPT:
+            return None
+
+    cf._load_index, cf._load_data = _load_index, _load_data
 
 
 def _renamed(fn: Callable, name: str) -> Callable:

@@ -86,7 +86,9 @@ class PeelForce:
     tables : tuple of (V or None, v tuple, f tuple)
         A tabulated law's tables.
     display : str
-        What ``repr`` shows for an expression law (the text and constants as given); not compared.
+        What ``repr`` shows of an expression or a table, derived from the canonical content (an expression:
+        its canonical text, constants substituted); a ``display`` passed in (e.g. by :meth:`from_dict`) is
+        ignored; not compared.
 
     Notes
     -----
@@ -120,7 +122,7 @@ class PeelForce:
         elif kind == "expression":
             if not isinstance(source, str):
                 raise TypeError(f"source of an expression law must be a string, got {type(source).__name__}")
-            source = _law_expr.canonical(_sympify(source), {})
+            source = _law_expr.from_stored(source)
         elif kind == "tabulated":
             tables = _law_table.check_tables(tables, _hooks()["V_range"])
         extra = [name for name, e in empty.items() if not e and name not in needs]
@@ -128,8 +130,8 @@ class PeelForce:
             raise ValueError(f"a {kind!r} law takes no {', '.join(extra)}")
         for name, value in (("coefficients", coef or ()), ("source", source), ("tables", tables or ())):
             object.__setattr__(self, name, value)
-        if not self.display:
-            object.__setattr__(self, "display", self._default_display())
+        # what repr shows is derived from the canonical content, never taken from stored data
+        object.__setattr__(self, "display", self._default_display())
 
     @classmethod
     def paper(cls) -> PeelForce:
@@ -198,9 +200,7 @@ class PeelForce:
             [1e-6, 1e3] m/s; V in 0.01, 0.1, 1, 10 m/s if the law depends on V), the point named.
         """
         text = _law_expr.canonical(expr, constants)
-        shown = ", ".join([repr(expr if isinstance(expr, str) else str(expr))]
-                          + [f"{k}={_num(float(val))}" for k, val in constants.items()])
-        return _restore("expression", None, (), text, (), shown)  # checked: no second parse and probe
+        return _restore("expression", None, (), text, ())  # checked: no second parse and probe
 
     @classmethod
     def tabulated(cls, v: Any = None, f: Any = None, *, V: float | None = None, tables: Any = None) -> PeelForce:
@@ -402,19 +402,15 @@ class PeelForce:
         return find_folds(fn, V, window, (lo, hi), repr(self), FOLD_GRID_DENSITY)
 
 
-def _sympify(text: str) -> Any:
-    import sympy as sp
-
-    return sp.sympify(text)
-
-
 def _restore(kind: str, name: str | None, coefficients: tuple, source: str | None, tables: tuple,
-             display: str) -> PeelForce:
-    """Unpickle a law without validating it again (it was validated when first built)."""
+             display: str = "") -> PeelForce:
+    """Unpickle a law (sent between this package's own processes) without validating it again (it was validated
+    when first built); what ``repr`` shows is derived again, never taken from the data (``display`` is ignored)."""
     law = object.__new__(PeelForce)
     for field_name, value in (("kind", kind), ("name", name), ("coefficients", coefficients), ("source", source),
-                              ("tables", tables), ("display", display)):
+                              ("tables", tables)):
         object.__setattr__(law, field_name, value)
+    object.__setattr__(law, "display", law._default_display())
     return law
 
 

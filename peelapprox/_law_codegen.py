@@ -33,11 +33,12 @@ import it.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import os
 import re
+import stat
 import sys
 import tempfile
+import types
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -352,50 +353,120 @@ def cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "peelapprox" / "laws"
 
 
-def _writable(d: Path) -> bool:
+#: The largest law module read back from the cache [bytes] (a rendered law is a few kB).
+MAX_MODULE_BYTES = 1 << 20
+
+
+def _unsafe_dir(d: Path) -> str | None:
+    """Why ``d`` may not hold code this process runs (None: it may): it must be a real directory (not a
+    symbolic link), owned by this user and writable by no one else, so that nobody else can plant or replace a
+    law module or numba's cache files (pickles) in it.  Created (mode 0700) if missing."""
     try:
-        d.mkdir(parents=True, exist_ok=True)
+        d.mkdir(parents=True, exist_ok=True, mode=0o700)
+        st = os.lstat(d)
+    except OSError as exc:
+        return f"cannot be created or read ({exc.strerror or exc})"
+    if stat.S_ISLNK(st.st_mode):
+        return "is a symbolic link"
+    if not stat.S_ISDIR(st.st_mode):
+        return "is not a directory"
+    if hasattr(os, "geteuid") and st.st_uid != os.geteuid():
+        return f"is owned by another user (uid {st.st_uid})"
+    if st.st_mode & 0o022:
+        return f"is writable by {'group' if st.st_mode & 0o020 else 'others'} (mode {stat.S_IMODE(st.st_mode):o})"
+    try:
         with tempfile.NamedTemporaryFile(dir=d, prefix=".probe-"):
             pass
-        return True
-    except OSError:
-        return False
+    except OSError as exc:
+        return f"is not writable ({exc.strerror or exc})"
+    return None
 
 
 _FALLBACK: dict[str, Path] = {}
 
 
 def _law_dir() -> Path:
+    """The verified cache directory (:func:`cache_dir` and its ``__pycache__``, where numba writes), else a
+    private temporary one for this process, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why."""
     d = cache_dir()
-    if _writable(d):
+    why = _unsafe_dir(d)
+    if why is None:  # numba's cache files (pickles it loads) go to __pycache__ beside the module
+        why = _unsafe_dir(d / "__pycache__")
+        if why is not None:
+            why = f"has a __pycache__ that {why}"
+    if why is None:
         return d
     if "dir" not in _FALLBACK:
-        _FALLBACK["dir"] = Path(tempfile.mkdtemp(prefix="peelapprox-laws-"))
-        warnings.warn(f"peelapprox: the law cache directory {str(d)!r} is not writable; expression laws are "
-                      f"written to {str(_FALLBACK['dir'])!r} for this process only (set PEELAPPROX_CACHE_DIR to a "
-                      "writable directory to keep them compiled across processes)", KernelCacheWarning, stacklevel=3)
+        _FALLBACK["dir"] = Path(tempfile.mkdtemp(prefix="peelapprox-laws-"))  # mode 0700, new
+        warnings.warn(f"peelapprox: the law cache directory {str(d)!r} {why}; expression laws are written to "
+                      f"{str(_FALLBACK['dir'])!r} for this process only (set PEELAPPROX_CACHE_DIR to a directory of "
+                      "yours that only you can write to keep them compiled across processes)",
+                      KernelCacheWarning, stacklevel=3)
     return _FALLBACK["dir"]
 
 
+def _read_verified(path: Path) -> bytes | None:
+    """The bytes of the law module at ``path`` if it is a regular file of this user's that no one else can write
+    (never through a symbolic link: ``O_NOFOLLOW``), else None."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return None
+    with os.fdopen(fd, "rb") as fh:
+        st = os.fstat(fh.fileno())
+        if (not stat.S_ISREG(st.st_mode) or st.st_mode & 0o022 or st.st_size > MAX_MODULE_BYTES
+                or (hasattr(os, "geteuid") and st.st_uid != os.geteuid())):
+            return None
+        return fh.read(MAX_MODULE_BYTES + 1)
+
+
+def _write_atomic(d: Path, path: Path, text: bytes) -> None:
+    """Write ``text`` to ``path`` by a new file renamed over it (a link or a planted file is replaced, not
+    followed)."""
+    fd, tmp = tempfile.mkstemp(dir=d, prefix=f".{path.stem}-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
 def expression_source(source: str) -> str:
-    """The module text of the expression law with canonical text ``source`` (``srepr``, see _law_expr)."""
+    """The module text of the expression law with canonical text ``source`` (see _law_expr; parsed, never
+    evaluated)."""
     import sympy as sp
 
-    e = sp.sympify(source)
+    from ._law_expr import from_text
+
+    e = from_text(source)
     text = sp.sstr(e)
     return (_EXPR_HEADER.format(version=codegen_version(), text=text) + "\n\n"
             + render_law("law", e, (), pack_name="pack", doc=f"f = {text}"))
 
 
+def _run_module(code: Any, namespace: dict[str, Any]) -> None:
+    """Run the module code this process rendered from a law (:func:`expression_source`), never text read from a
+    file or given by a user: the one place the package executes generated Python (numba compiles its ``law``)."""
+    exec(code, namespace)  # noqa: S102 - generated here from a parsed, whitelisted sympy tree
+
+
 def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     """The compiled law of an expression and its packing: ``(law, pack)``, ``pack(V) -> coef``.
 
-    ``source`` is the canonical text of an expression law (``PeelForce.source``: sympy ``srepr`` in the
-    symbols v, V).  The law is rendered into ``<cache_dir()>/law_<sha256>.py`` (hash of ``source`` and
-    :func:`codegen_version`; written once, atomically), imported under a unique module name and compiled for
-    :data:`peelapprox._law_abi.LAW_SIG` with numba's on-disk cache (``__pycache__`` next to it, or
-    ``NUMBA_CACHE_DIR``), so a second process loads it.  Memoised per process.  If the cache directory is not
-    writable, a temporary one is used with a :class:`~peelapprox.errors.KernelCacheWarning`.
+    ``source`` is the canonical text of an expression law (``PeelForce.source``, in the grammar of
+    :mod:`peelapprox._law_grammar`: parsed, never evaluated).  The law is rendered (sympy) into module text in
+    this process; ``<cache_dir()>/law_<sha256>.py`` (hash of ``source`` and :func:`codegen_version`) must hold
+    exactly that text, else it is written anew, atomically (a planted, replaced or truncated file, or a link,
+    is replaced with a :class:`~peelapprox.errors.KernelCacheWarning`).  The module is built from the rendered
+    text, not from the file, which names it for numba's on-disk cache (``__pycache__`` next to it, or
+    ``NUMBA_CACHE_DIR``): a second process renders again (tens of ms), loads the compiled law and compiles
+    nothing.  The cache directory and its ``__pycache__`` must be real directories of this user's that no one
+    else can write; otherwise (a link, another owner, group- or world-writable, unwritable) a private temporary
+    directory is used for this process, with a :class:`~peelapprox.errors.KernelCacheWarning` naming why.
+    Memoised per process.
 
     Raises
     ------
@@ -410,22 +481,23 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     digest = hashlib.sha256(f"{source}\0{codegen_version()}".encode()).hexdigest()
     d = _law_dir()
     path = d / f"law_{digest[:32]}.py"
-    if not path.exists():  # written once: rewriting would change its time stamp and numba's cache key
-        fd, tmp = tempfile.mkstemp(dir=d, prefix=f".{path.stem}-", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as fh:
-                fh.write(expression_source(source))
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+    text = expression_source(source).encode()
+    on_disk = _read_verified(path)
+    if on_disk != text:  # missing, or planted/replaced/truncated: written anew (a changed time stamp is a numba miss)
+        if on_disk is not None or os.path.lexists(path):
+            warnings.warn(f"peelapprox: the cached law module {str(path)!r} did not match the law it is named after "
+                          "(replaced, truncated or not a regular file of yours); it is written anew",
+                          KernelCacheWarning, stacklevel=2)
+            Path(path).unlink(missing_ok=True)
+        _write_atomic(d, path, text)
+    # the module is built from the text rendered here, not read back from the file (which only names it for numba's
+    # on-disk cache, in the verified directory): what runs is what this process generated from the law
     modname = f"peelapprox_law_{digest[:32]}"
-    spec = importlib.util.spec_from_file_location(modname, path)
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
+    mod = types.ModuleType(modname)
+    mod.__file__ = str(path)
+    code = compile(text, str(path), "exec")
     sys.modules[modname] = mod
-    spec.loader.exec_module(mod)
+    _run_module(code, mod.__dict__)
     law = kernel(signature=LAW_SIG, outside=True)(mod.law)
     _EXPRESSION_KERNELS[source] = (law, mod.pack)
     return _EXPRESSION_KERNELS[source]

@@ -1,11 +1,13 @@
 """Expression peel-force laws: a sympy expression in ``v`` (and ``V``), canonical form, numpy evaluation.
 
 :func:`canonical` turns what the user typed (a string or a sympy expression, with named constants) into
-the canonical text of the law — sympy's ``srepr`` of the expression with the constants substituted, in
-the symbols ``v`` and ``V`` (both positive) — and checks it; :class:`ExpressionLaw` rebuilds the
-expression from that text and evaluates f, f' and f'' (derivatives by sympy) through ``sympy.lambdify``
-to numpy.  The canonical text is plain data: it is what a :class:`peelapprox.PeelForce` keeps, pickles
-and hashes (its SHA-256 is the law's ``key``, for caches of compiled code).
+the canonical text of the law -- the expression with the constants substituted, printed in the grammar of
+:mod:`peelapprox._law_grammar` (floats exact), in the symbols ``v`` and ``V`` (both positive) -- and checks
+it; :class:`ExpressionLaw` rebuilds the expression from that text by the same grammar (parsed, never
+evaluated) and evaluates f, f' and f'' (derivatives by sympy) through ``sympy.lambdify`` to numpy (lambdify
+prints the checked sympy tree as numpy code: only whitelisted nodes reach it).  The canonical text is plain
+data: it is what a :class:`peelapprox.PeelForce` keeps, shows, stores and hashes (its SHA-256 is the law's
+``key``, for caches of compiled code); :func:`from_stored` reads it back from a file, whatever wrote it.
 
 sympy is imported inside the functions only: ``import peelapprox`` does not import it.
 
@@ -22,7 +24,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical"]
+from . import _law_grammar
+
+__all__ = ["PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical", "from_stored", "from_text"]
 
 #: The peel velocities [m/s] on which an expression law is probed and may be evaluated.
 V_DOMAIN = (1e-6, 1e3)
@@ -38,76 +42,129 @@ def _symbols():
     return sp.Symbol("v", positive=True), sp.Symbol("V", positive=True)
 
 
+def _number(x: float) -> Any:
+    """A constant as sympy number: an integral float is the integer (a=150 and a=150.0 are one law)."""
+    import sympy as sp
+
+    return sp.Integer(int(x)) if float(x).is_integer() else sp.Float(float(x))
+
+
+def _integral_floats(e: Any) -> Any:
+    import sympy as sp
+
+    return e.xreplace({x: sp.Integer(int(x)) for x in e.atoms(sp.Float) if float(x).is_integer()})
+
+
+def _grammar_round_trip(e: Any, label: str) -> str:
+    """The canonical text of ``e``, checked to parse back to ``e`` itself (at most two printings)."""
+    v, V = _symbols()
+    for _ in range(3):
+        text = _law_grammar.canonical_text(e)
+        back, _used = _law_grammar.parse(text, {"v": v, "V": V})
+        back = _integral_floats(back)
+        if back == e:
+            return text
+        e = back
+    raise ValueError(f"expression {label}: its canonical text {_law_grammar.shorten(text)} does not read back as "
+                     "the same expression; write it differently (e.g. expanded)")
+
+
 def canonical(expr: Any, constants: dict[str, Any]) -> str:
-    """The canonical text (``srepr``) of ``expr`` with ``constants`` substituted; checked.
+    """The canonical text of ``expr`` with ``constants`` substituted; checked.
+
+    The text is ``expr`` printed in the grammar of :mod:`peelapprox._law_grammar` (sympy's string form, floats
+    exact), which :func:`from_text` parses back to the same expression: what a law stores and hashes.  A string
+    is parsed by that grammar, never evaluated; a sympy expression is printed and parsed the same way, so
+    both meet the same whitelist.
 
     Raises
     ------
     TypeError
         ``expr`` is neither a string nor a sympy expression, or a constant is not a real number.
     ValueError
-        The string does not parse; a constant is named ``v`` or ``V``, is not finite, or does not occur in
-        the expression; the expression holds symbols other than ``v``, ``V`` and the constants (named), an
-        undefined function, or does not depend on ``v``; or f, f' or f'' is non-finite or complex at a
-        point of the probe (named).
+        The text is outside the grammar (too long, a forbidden node, name or function: named, with what is
+        allowed); a constant is named ``v`` or ``V``, is not finite, or does not occur in the expression; the
+        expression does not depend on ``v``; or f, f' or f'' is non-finite or complex at a point of the probe
+        (named).
     """
     import sympy as sp
-    from sympy.core.function import AppliedUndef
-    from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
 
     from ._checks import real
 
     v, V = _symbols()
+    values: dict[str, Any] = {}
     for name, value in constants.items():
         if name in ("v", "V"):
             raise ValueError(f"constant {name!r} clashes with the law's variable {name} (v: peel velocity, "
                              "V: pull speed, m/s)")
+        if not (isinstance(name, str) and name.isidentifier()) or name in _law_grammar.FUNCTIONS:
+            raise ValueError(f"constant name {_law_grammar.shorten(str(name), 40)} must be an identifier other than "
+                             "a function's name")
         x = real(name, value)
-        if not math.isfinite(x):
-            raise ValueError(f"constant {name} must be finite, got {value!r}")
-    names = {name: sp.Symbol(name, real=True) for name in constants}
+        if not math.isfinite(x) or abs(x) > _law_grammar.MAX_LITERAL:
+            raise ValueError(f"constant {name} must be finite and at most {_law_grammar.MAX_LITERAL:g} in "
+                             f"magnitude, got {value!r}")
+        values[name] = _number(x)
     if isinstance(expr, str):
-        try:
-            e = parse_expr(expr, local_dict={"v": v, "V": V, **names},
-                           transformations=standard_transformations + (convert_xor,))
-        except Exception as exc:  # sympy raises SyntaxError, TokenError, TypeError, ... on bad text
-            raise ValueError(f"expression {expr!r} does not parse: {exc}") from None
+        label = _law_grammar.shorten(expr)
+        text = expr
     elif isinstance(expr, sp.Basic):
-        by_name = {"v": v, "V": V, **names}
-        e = expr.xreplace({s: by_name[s.name] for s in expr.free_symbols if s.name in by_name})
+        label = _law_grammar.shorten(str(expr))
+        text = _law_grammar.canonical_text(expr)
     else:
         raise TypeError(f"expression must be a string or a sympy expression, got {type(expr).__name__}")
-    if not isinstance(e, sp.Expr):
-        raise ValueError(f"expression {expr!r} is not a scalar expression (got {type(e).__name__})")
-    undef = sorted(str(a.func) for a in e.atoms(AppliedUndef))
-    if undef:
-        raise ValueError(f"expression {expr!r} calls undefined function(s) {', '.join(undef)}")
-    unused = sorted(n for n, s in names.items() if s not in e.free_symbols)
+    e, used = _law_grammar.parse(text, {"v": v, "V": V, **values})
+    unused = sorted(set(values) - used)
     if unused:
-        raise ValueError(f"constant(s) {', '.join(unused)} do not occur in the expression {expr!r}")
-    e = e.xreplace({s: sp.Float(float(val)) for s, val in ((names[n], constants[n]) for n in names)})
-    # one canonical number: an integral float is the integer (a=150 and a=150.0, "150.0*v" and "150*v" are one law)
-    e = e.xreplace({x: sp.Integer(int(x)) for x in e.atoms(sp.Float) if float(x).is_integer()})
-    unknown = sorted(s.name for s in e.free_symbols - {v, V})
-    if unknown:
-        raise ValueError(f"unknown symbol(s) {', '.join(unknown)} in the expression {expr!r}: a law may use v "
-                         "(peel velocity, m/s) and V (pull speed, m/s); give constants as keywords, e.g. "
-                         f"{unknown[0]}=1.0")
+        raise ValueError(f"constant(s) {', '.join(unused)} do not occur in the expression {label}")
+    if not isinstance(e, sp.Expr):
+        raise ValueError(f"expression {label} is not a scalar expression (got {type(e).__name__})")
+    e = _integral_floats(e)
     if v not in e.free_symbols:
-        raise ValueError(f"expression {expr!r} does not depend on v: a peel force must vary with the peel velocity")
-    text = sp.srepr(e)
-    ExpressionLaw(text).probe(str(expr))
-    return text
+        raise ValueError(f"expression {label} does not depend on v (it is {_law_grammar.shorten(str(e), 60)}): a peel "
+                         "force must vary with the peel velocity")
+    ExpressionLaw(e).probe(label)  # before printing: a complex law is named by the point where it is complex
+    return _grammar_round_trip(e, label)
+
+
+def from_stored(text: Any) -> str:
+    """The canonical text of a stored expression law (a manifest, an ``.npz``): parsed by the grammar, never
+    evaluated; the ``srepr`` text peelapprox 0.2 stored is read too (``legacy=True``).  Checked as
+    :func:`canonical` checks a new law.
+
+    Raises
+    ------
+    TypeError
+        ``text`` is not a string.
+    ValueError
+        As :func:`canonical`.
+    """
+    import sympy as sp
+
+    if not isinstance(text, str):
+        raise TypeError(f"source of an expression law must be a string, got {type(text).__name__}")
+    v, V = _symbols()
+    e, _used = _law_grammar.parse(text, {"v": v, "V": V}, legacy=True)
+    if not isinstance(e, sp.Expr):
+        raise ValueError(f"stored expression {_law_grammar.shorten(text)} is not a scalar expression")
+    return canonical(e, {})
+
+
+def from_text(text: str) -> Any:
+    """The sympy expression of a canonical text (:func:`canonical`), by the grammar: never evaluated."""
+    v, V = _symbols()
+    return _law_grammar.parse(text, {"v": v, "V": V})[0]
 
 
 class ExpressionLaw:
     """The evaluator of an expression law, rebuilt from its canonical text."""
 
-    def __init__(self, text: str):
+    def __init__(self, text: Any):
+        """From the canonical text (or the checked sympy expression itself, at construction)."""
         import sympy as sp
 
         v, V = _symbols()
-        e = sp.sympify(text)
+        e = from_text(text) if isinstance(text, str) else text
         self.depends_on_V = V in e.free_symbols
         d1 = sp.diff(e, v)
         self.exprs = (e, d1, sp.diff(d1, v))

@@ -94,7 +94,9 @@ def law_expression(force: Any) -> sp.Expr:
         values = dict(force.coefficients)
         return expr.xreplace({s: sp.Float(float(values[s.name])) for s in syms})
     if kind == "expression":
-        return sp.sympify(str(force.source))
+        from ._law_expr import from_text
+
+        return from_text(str(force.source))
     if kind == "tabulated":
         raise ValueError("a tabulated peel-force law has no closed form: law_expression takes a 'paper', "
                          "'family' or 'expression' law")

@@ -443,7 +443,7 @@ def render_module() -> str:
         _render_function(
             "regularized_jacobian",
             ["alpha", "omega", "F", "v", "c", "dc", "fp", "eps", "V", "I", "k", "R"],
-            [sp.sympify(J[i, j]) for i in range(4) for j in range(4)],
+            [J[i, j] for i in range(4) for j in range(4)],
             "Jacobian of regularized_rhs, row-major 16-tuple, in terms of c, dc/dalpha and f'(v).",
             names,
         )
@@ -474,7 +474,7 @@ def _render_variants() -> list[str]:
         _, J = variant_system(model)
         parts.append(_render_function(
             f"{model}_jacobian", state + ["c", "dc", "ddc", "f", "fp"] + extra + ["I", "k", "R"],
-            [sp.sympify(J[i, j]) for i in range(n) for j in range(n)],
+            [J[i, j] for i in range(n) for j in range(n)],
             f"Jacobian of the {what}, row-major {n * n}-tuple, in c, its alpha-derivatives dc, ddc, f and f'.",
             [f"j{i}{j}" for i in range(n) for j in range(n)]))
     return parts

@@ -113,7 +113,7 @@ def test_the_law_options_are_mutually_exclusive(flags, capsys):
                                                    "coefficients are a, b, c, d"),
     (["--force-family", "nope"], "the families are paper, cubic, power_branches"),
     (["--force-family", "cubic", "--coef", "a=1", "--coef", "a=2"], "--coef a is given twice"),
-    (["--force", "a*v + w", "--const", "a=1"], "unknown symbol(s) w"),
+    (["--force", "a*v + w", "--const", "a=1"], "unknown symbol 'w'"),
     (["--coef", "a"], "argument --coef: value must be NAME=VALUE"),
     (["--force-family", "cubic", "--coef", "a=x"], "argument --coef: value of a must be a real number, got 'x'"),
 ])
