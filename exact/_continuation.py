@@ -56,8 +56,9 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from peelapprox.validate import function, in_range, integer, optional, real
 
+from ._branch_end import NO_CREST, event_message, events_ahead, failure_end, near
 from ._corrector import PARAMETERS, VARIANT_PARAMETERS, bordered_newton, branch_tangent, parameter_value, with_parameter
-from ._crest import Crest, crest_margin
+from ._crest import crest_margin
 from ._orbits import PeriodicOrbit, minimal_period
 
 __all__ = ["PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "continue_orbit", "parameter_value",
@@ -264,7 +265,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     st = _Stepper(orbit, parameter, span, tol, rtol)
     e_lam = np.array([0.0, 0.0, 1.0])
     points = [BranchPoint(lam0, orbit)]
-    crests = [crest_margin(orbit) if crest_tol > 0 else _NO_CREST]
+    crests = [crest_margin(orbit) if crest_tol > 0 else NO_CREST]
     bifs: list[Bifurcation] = []
     stopped, message, end_value = "max_points", "", math.nan
     lo_end, hi_end = min(lam0, stop), max(lam0, stop)
@@ -277,7 +278,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         else:
             tau = st.w(last) - st.w(points[-2])
             tau = tau / np.linalg.norm(tau)
-        ahead = [v for e, v in _events_ahead(points, crests).items() if e != "grazing"]
+        ahead = [v for e, v in events_ahead(points, crests).items() if e != "grazing"]
         if ahead and abs(tau[2]) > 0:  # approach an extrapolated crest or breakdown geometrically, never step over
             h = min(h, 0.5 * min(abs(v - last.value) for v in ahead) / abs(tau[2]))
         w_pred, tau_c, final = wl + (h / span) * tau, (tau if _near_fold(last.orbit) else e_lam), False
@@ -293,15 +294,15 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
             if h / 2 >= hmin:
                 h /= 2
                 continue
-            stopped, message, end_value = _failure_end(exc, points, crests, parameter, span)
+            stopped, message, end_value = failure_end(exc, points, crests, parameter, span)
             break
         o = pt.orbit
         if np.min(np.abs(o.fold_rates)) < graze_tol * o.params.k * o.params.V:
             i = int(np.argmin(np.abs(o.fold_rates)))
             points.append(pt)
-            crests.append(_NO_CREST)
-            ev = _events_ahead(points, crests).get("grazing", pt.value)
-            stopped, end_value = "grazing", _near(ev, pt.value, last.value, span)
+            crests.append(NO_CREST)
+            ev = events_ahead(points, crests).get("grazing", pt.value)
+            stopped, end_value = "grazing", near(ev, pt.value, last.value, span)
             message = (f"the orbit meets the {'AB' if i % 2 else 'CD'} fold (fold {i + 1} of the period) almost "
                        f"tangentially at {parameter}={pt.value:.10g}: dG/dt = {o.fold_rates[i]:.3g} N/s there "
                        f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
@@ -311,15 +312,15 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         if kind is not None:
             bifs.append(_locate(kind, last, pt, st, locate_tol))
         points.append(pt)
-        crests.append(crest_margin(o) if crest_tol > 0 else _NO_CREST)
+        crests.append(crest_margin(o) if crest_tol > 0 else NO_CREST)
         if progress:
             progress(len(points), pt.value)
         c = crests[-1]
         if min(c.margin, c.floor) < crest_tol:
             event = "crest" if c.margin <= c.floor else "breakdown"
-            ev = _events_ahead(points, crests).get(event, pt.value)
-            stopped, end_value = event, _near(ev, pt.value, last.value, span)
-            message = _event_message(event, c, end_value, parameter)
+            ev = events_ahead(points, crests).get(event, pt.value)
+            stopped, end_value = event, near(ev, pt.value, last.value, span)
+            message = event_message(event, c, end_value, parameter)
             break
         if final:
             stopped = "stop"
@@ -335,7 +336,6 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
                        end_value)
 
 
-_NO_CREST = Crest(math.inf, "", math.nan)
 #: A located bifurcation's orbit has its gauge (``μ ∓ 1`` or ``|μ| - 1``) within this of 0 (or 40 halvings were
 #: spent): at a fold λ is stationary along the branch, so λ alone would stop the bisection with μ still far
 #: from 1.
@@ -352,12 +352,6 @@ def _near_fold(o: PeriodicOrbit) -> bool:
     return bool(np.any((np.abs(mu.imag) < 1e-12) & (np.abs(mu.real - 1.0) < FOLD_NEAR)))
 
 
-def _near(event: float, value: float, previous: float, span: float) -> float:
-    """An extrapolated event's parameter value if it lies within two steps (or 1e-3 of the span) of the last
-    point ``value``, else ``value``."""
-    return event if abs(event - value) <= max(2 * abs(value - previous), 1e-3 * span) else value
-
-
 def _check_correction(st: _Stepper, pt: BranchPoint, w_pred: np.ndarray, max_correction: float) -> None:
     """ValueError when the corrector jumped to another orbit: it moved too far from the prediction, or reached
     an orbit of a smaller period (a divisor of n) than the branch's."""
@@ -368,53 +362,6 @@ def _check_correction(st: _Stepper, pt: BranchPoint, w_pred: np.ndarray, max_cor
     d = minimal_period(pt.orbit)
     if d < st.n:
         raise ValueError(f"the corrector reached an orbit of period {d}, not {st.n}: refused")
-
-
-def _events_ahead(points: list[BranchPoint], crests: list[Crest]) -> dict[str, float]:
-    """The parameter values where the last two points' crest margin ("crest"), floor ("breakdown") and squared
-    slowest fold rate ("grazing": Ġ vanishes like the square root of the distance), falling, extrapolate
-    linearly to 0 (module docstring); only the falling ones."""
-    if len(points) < 2:
-        return {}
-    a, b = points[-2].value, points[-1].value
-    out = {}
-    ra, rb = (float(np.min(np.abs(p.orbit.fold_rates))) ** 2 for p in points[-2:])  # Ġ² ∝ distance to grazing
-    for event, (ma, mb) in (("crest", (crests[-2].margin, crests[-1].margin)),
-                            ("breakdown", (crests[-2].floor, crests[-1].floor)), ("grazing", (ra, rb))):
-        if math.isfinite(ma) and math.isfinite(mb) and mb < ma and b != a:
-            out[event] = b + mb * (b - a) / (ma - mb)
-    return out
-
-
-def _event_message(event: str, c: Crest, value: float, parameter: str, orbit: PeriodicOrbit | None = None) -> str:
-    if event == "grazing" and orbit is not None:
-        return (f"the orbit's slowest arrival at a fold, dG/dt = {np.min(np.abs(orbit.fold_rates)):.3g} N/s, "
-                f"extrapolates to 0 at {parameter} ~ {value:.10g} (dG/dt squared linear): the branch ends in a "
-                "grazing bifurcation, where its multipliers diverge")
-    if event == "breakdown":
-        return (f"the lowest level F (1 + sin alpha) on AB comes within {c.floor:.3g} (f_max - f_min) of f(0+); it "
-                f"reaches it at {parameter} ~ {value:.10g} (linear extrapolation), where CONSTR loses its root and "
-                "the model breaks down")
-    level = "f_max" if c.branch == "AB" else "f_min"
-    return (f"an interior {'crest' if c.branch == 'AB' else 'trough'} of F (1 + sin alpha) on {c.branch} comes within "
-            f"{c.margin:.3g} (f_max - f_min) of {level}; it reaches it at {parameter} ~ {value:.10g} (linear "
-            "extrapolation), where the solution jumps one oscillation earlier and this orbit ends")
-
-
-def _failure_end(exc: Exception, points: list[BranchPoint], crests: list[Crest], parameter: str, span: float
-                 ) -> tuple[str, str, float]:
-    """Why a branch whose corrector fails at the smallest step ends: a crest, breakdown or grazing event
-    extrapolated ahead (within two steps or 1e-3 of the span; past a grazing the corrector's orbits break down),
-    else a breakdown of the corrector's orbit, else no convergence (module docstring)."""
-    if len(points) >= 2:
-        if not math.isfinite(crests[-1].margin + crests[-1].floor):  # crest_tol = 0: measure now
-            crests[-2:] = [crest_margin(p.orbit) for p in points[-2:]]
-        for event, value in sorted(_events_ahead(points, crests).items(), key=lambda e: abs(e[1] - points[-1].value)):
-            if _near(value, points[-1].value, points[-2].value, span) == value:
-                return event, _event_message(event, crests[-1], value, parameter, points[-1].orbit), value
-    if isinstance(exc, ModelBreakdown):  # with no event ahead: the corrector's orbit breaks down
-        return "breakdown", str(exc), math.nan
-    return "no_convergence", str(exc), math.nan
 
 
 def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: _Stepper, locate_tol: float) -> Bifurcation:
