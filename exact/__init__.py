@@ -28,7 +28,6 @@ from ._continuation import (
     OrbitBranch,
     continue_orbit,
     parameter_value,
-    switch_branch,
     with_parameter,
 )
 from ._crest import Crest, crest_margin
@@ -45,6 +44,7 @@ from ._simulate import (
     initial_state,
     simulate,
 )
+from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import VARIATIONAL_LAWS, lyapunov_variational
 

@@ -1,0 +1,132 @@
+"""Every call bounded in wall time, every grid size and start checked before the work starts.
+
+Each test replays a call that used to run for minutes (or to fail late, or with the wrong exception) and
+asserts that it now returns, or raises what it should, quickly.  The wall-clock bound asserted is
+:data:`BOUND` = 30 s against budgets of 0.5 s: the machine running the tests is shared and noisy, and what is
+tested is that the call is bounded (minutes before), not how fast it is.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import pytest
+
+import exact
+from exact import Bifurcation, State
+from peelapprox import PeelForce, PeelParams, SolverBudgetExceeded
+
+#: Seconds a bounded call may take here, whatever its budget (module docstring: boundedness, not speed).
+BOUND = 30.0
+#: The wall budget given to the calls under test [s].
+BUDGET = 0.5
+PAPER = PeelParams(V=1.0, I=1e-5)  # a stable period-3 orbit (docs/dynamics.md), Newton in well under a second
+
+
+@pytest.fixture(scope="module")
+def orbit():
+    return exact.periodic_orbit(PAPER)
+
+
+def _timed(fn, *args, **kwargs):
+    t0 = time.perf_counter()
+    out = fn(*args, **kwargs)
+    return out, time.perf_counter() - t0
+
+
+# ---------------------------------------------------------------------------------------------- continuation
+def test_continue_orbit_ends_with_max_wall_and_the_points_so_far(orbit):
+    """The continuation that ran over 330 s (steps of at most 1e-7 in V towards 1.1, up to 1e5 points) ends
+    with ``stopped="max_wall"`` once its 0.5 s are spent, within :data:`BOUND`: its points are orbits of the
+    branch (each closes to the default tol 1e-10, the corrector's own criterion), start at V = 1 and stay in
+    [1, 1.1], and the message names the budget."""
+    b, took = _timed(exact.continue_orbit, orbit, "V", stop=1.1, min_step=1e-9, max_step=1e-7, max_points=100_000,
+                     max_wall=BUDGET)
+    assert took < BOUND
+    assert b.stopped == "max_wall" and "max_wall=0.5 s" in b.message
+    assert 1 <= len(b.points) < 100_000
+    assert b.points[0].value == 1.0
+    assert all(1.0 <= p.value <= 1.1 for p in b.points)
+    assert all(p.orbit.residual <= 1e-10 for p in b.points)
+    assert b.end_value == b.points[-1].value
+
+
+@pytest.mark.parametrize("parameter, stop, exc, match", [
+    (None, 2.0, TypeError, r"parameter must be one of V, I, k .*got None"),
+    ("q", 2.0, ValueError, r"parameter must be one of V, I, k .*got 'q'"),
+    ("V", math.nan, ValueError, r"stop must be finite and in \(-inf, inf\), got nan"),
+    ("V", math.inf, ValueError, r"stop must be finite"),
+    ("V", -1.0, ValueError, r"stop must be a valid value of V, got -1.0: V must be finite and in \[1e-6, 100\]"),
+    ("V", 1.0, ValueError, r"stop must differ from the start's V=1.0"),
+])
+def test_continue_orbit_checks_parameter_and_stop(orbit, parameter, stop, exc, match):
+    """A bad ``parameter`` (None used to be an AttributeError) or ``stop`` (NaN used to read "stop must differ")
+    is refused by name, with the valid values, before any step: categorical, the exception type and message."""
+    with pytest.raises(exc, match=match):
+        exact.continue_orbit(orbit, parameter, stop=stop)
+
+
+def test_switch_branch_raises_max_wall(orbit):
+    """switch_branch returns one orbit or nothing, so a spent budget is ``SolverBudgetExceeded`` naming max_wall
+    (categorical), raised at the first check: a budget of 1 µs is spent before Newton's first iteration, so the
+    call returns within :data:`BOUND` whatever the bifurcation (here a stand-in at the period-3 orbit)."""
+    bif = Bifurcation("period_doubling", 1.0, orbit, "V")
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"switch_branch: more than 1e-06 s of wall time") as info:
+        exact.switch_branch(bif, max_wall=1e-6)
+    assert time.perf_counter() - t0 < BOUND
+    assert info.value.budget == "max_wall" and info.value.limit == 1e-6
+
+
+# ---------------------------------------------------------------------------------------------- periodic orbits
+_S0 = State(t=0.0, alpha=0.0, omega=0.0, F=250.0, v=1.0, branch="AB")
+
+
+@pytest.mark.parametrize("change, match", [
+    (dict(t=math.nan), r"start\.t must be finite and in \[0, 1e6\], got nan"),
+    (dict(v=math.nan), r"start\.v must be finite and in \(1e-150, 1000\], got nan"),
+    (dict(v=-1.0), r"start\.v must be finite and in \(1e-150, 1000\], got -1.0"),
+    (dict(Vp=1.0), r"start\.Vp must be None under velocity control"),
+    (dict(alpha=4.0), r"start\.alpha must be finite and in \[-3\.14159, 3\.14159\], got 4.0"),
+    (dict(branch="XY"), r"start\.branch must be one of \('AB', 'CD'\)"),
+])
+def test_periodic_orbit_checks_a_start_state(change, match):
+    """A start State with a field out of its range used to be run (NaN t, NaN or negative v, a pull speed under
+    velocity control silently ignored): now a ValueError naming ``start.<field>`` and its range (categorical)."""
+    with pytest.raises(ValueError, match=match):
+        exact.periodic_orbit(PAPER, start=dataclasses.replace(_S0, **change))
+
+
+@pytest.mark.parametrize("other, match", [
+    (PAPER.replace(I=2e-5), r"start\.params must be params .*I=2e-05 \(params: 1e-05\)"),
+    (PAPER.replace(force=PeelForce.cubic()), r"start\.params\.force must be params\.force"),
+])
+def test_periodic_orbit_checks_a_start_trajectory(other, match):
+    """A start Trajectory run with other parameters or another law used to seed Newton with another model's
+    orbit: now a ValueError naming ``start.params`` (or its ``force``) and the fields that differ."""
+    tr = exact.simulate(other, 0.1, save="jumps")
+    with pytest.raises(ValueError, match=match):
+        exact.periodic_orbit(PAPER, start=tr)
+
+
+def test_periodic_orbit_raises_max_wall():
+    """A seed run of 1e5 s (hours) under a 0.5 s budget raises ``SolverBudgetExceeded`` naming max_wall within
+    :data:`BOUND` (categorical)."""
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"more than 0.5 s of wall time \(max_wall\)") as info:
+        exact.periodic_orbit(PAPER, t_transient=1e5, max_wall=BUDGET)
+    assert time.perf_counter() - t0 < BOUND
+    assert info.value.budget == "max_wall"
+
+
+@pytest.mark.parametrize("bad, exc", [(0.0, ValueError), (-1.0, ValueError), (math.nan, ValueError),
+                                      (math.inf, ValueError), ("1", TypeError)])
+def test_max_wall_is_checked(orbit, bad, exc):
+    """max_wall must be a positive finite number or None, refused by name before any work (categorical)."""
+    for call in (lambda: exact.continue_orbit(orbit, "V", stop=1.1, max_wall=bad),
+                 lambda: exact.switch_branch(Bifurcation("period_doubling", 1.0, orbit, "V"), max_wall=bad),
+                 lambda: exact.periodic_orbit(PAPER, max_wall=bad)):
+        with pytest.raises(exc, match=r"max_wall must be"):
+            call()
