@@ -31,7 +31,7 @@ from ._continuation import (
     with_parameter,
 )
 from ._crest import Crest, crest_margin
-from ._diagram import OrbitDiagram, explain, orbit_diagram
+from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt, Smooth, default_atol
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
@@ -78,6 +78,7 @@ __all__ = [
     "crest_margin",
     "Crest",
     "orbit_diagram",
+    "MAX_DIAGRAM_VALUES",
     "explain",
     "with_parameter",
     "parameter_value",

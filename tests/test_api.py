@@ -44,7 +44,7 @@ API = {
         "VARIATIONAL_LAWS", "periodic_orbit", "PeriodicOrbit", "solve_orbit", "section_return", "SectionReturn",
         "monodromy_fd",
         "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation", "switch_branch", "crest_margin", "Crest",
-        "orbit_diagram", "OrbitDiagram", "explain",
+        "orbit_diagram", "OrbitDiagram", "explain", "MAX_DIAGRAM_VALUES",
         "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor",
     },
     "comparisons": {

@@ -12,6 +12,7 @@ import dataclasses
 import math
 import time
 
+import numpy as np
 import pytest
 
 import exact
@@ -130,3 +131,31 @@ def test_max_wall_is_checked(orbit, bad, exc):
                  lambda: exact.periodic_orbit(PAPER, max_wall=bad)):
         with pytest.raises(exc, match=r"max_wall must be"):
             call()
+
+
+# ---------------------------------------------------------------------------------------------- orbit diagram
+def test_orbit_diagram_refuses_a_grid_too_large_at_once():
+    """The diagram of 1e6 values (the CLI's ``--range 0.9:1.1:1000000``, over 300 s) is refused before any run,
+    naming ``values`` and the limit :data:`exact.MAX_DIAGRAM_VALUES` (1e5), within :data:`BOUND`; a value the
+    parameter cannot take is refused up front too (it used to fail at its turn)."""
+    big = np.linspace(0.9, 1.1, 1_000_000)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"values must hold at most MAX_DIAGRAM_VALUES = 100000 values.*got 1000000"):
+        exact.orbit_diagram(PAPER, "V", big)
+    assert time.perf_counter() - t0 < BOUND
+    assert exact.MAX_DIAGRAM_VALUES == 100_000
+    with pytest.raises(ValueError, match=r"values must be valid values of V, got -1.0"):
+        exact.orbit_diagram(PAPER, "V", [1.0, -1.0])
+
+
+def test_orbit_diagram_returns_what_it_has_when_max_wall_is_spent():
+    """200 values of 50 s runs (minutes) under a 0.5 s budget: the diagram comes back within :data:`BOUND` with
+    all 200 values in order, the ones not run labelled ``budget:max_wall`` with no returns (at least the last:
+    a run takes far more than 0.5 s / 200), the others labelled as usual."""
+    vals = np.linspace(0.9, 1.1, 200)
+    d, took = _timed(exact.orbit_diagram, PAPER, "V", vals, max_wall=BUDGET)
+    assert took < BOUND
+    assert np.array_equal(d.values, vals) and len(d.labels) == len(d.returns) == 200
+    cut = [i for i, lab in enumerate(d.labels) if lab == "budget:max_wall"]
+    assert cut and cut == list(range(cut[0], 200))
+    assert all(d.returns[i].size == 0 for i in cut)
