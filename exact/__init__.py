@@ -20,7 +20,7 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
-from ._basins import BasinAttractor, BasinResult, basins
+from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._continuation import (
     Bifurcation,
@@ -84,6 +84,7 @@ __all__ = [
     "parameter_value",
     "OrbitDiagram",
     "basins",
+    "MAX_BASIN_STARTS",
     "BasinResult",
     "BasinAttractor",
     "Trajectory",

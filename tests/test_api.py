@@ -45,7 +45,7 @@ API = {
         "monodromy_fd",
         "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation", "switch_branch", "crest_margin", "Crest",
         "orbit_diagram", "OrbitDiagram", "explain", "MAX_DIAGRAM_VALUES",
-        "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor",
+        "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor", "MAX_BASIN_STARTS",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",

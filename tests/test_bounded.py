@@ -159,3 +159,32 @@ def test_orbit_diagram_returns_what_it_has_when_max_wall_is_spent():
     cut = [i for i, lab in enumerate(d.labels) if lab == "budget:max_wall"]
     assert cut and cut == list(range(cut[0], 200))
     assert all(d.returns[i].size == 0 for i in cut)
+
+
+# ---------------------------------------------------------------------------------------------- basins
+def test_basins_refuses_a_grid_too_large_at_once():
+    """A 2000 x 1000 grid (2e6 starts) is refused before any run, naming both axes and the limit
+    :data:`exact.MAX_BASIN_STARTS` (1e6), within :data:`BOUND` (the axes' lengths are read before they are
+    converted)."""
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"alpha0 x F0: the grid must hold at most MAX_BASIN_STARTS = 1000000 "
+                                         r"starts .*got 2000 x 1000 = 2000000"):
+        exact.basins(PAPER, alpha0=np.linspace(-0.3, 0.3, 2000), F0=np.linspace(200, 280, 1000))
+    assert time.perf_counter() - t0 < BOUND
+    assert exact.MAX_BASIN_STARTS == 10**6
+
+
+@pytest.mark.parametrize("workers", [0, 2], ids=["serial", "pool"])
+def test_basins_returns_every_start_when_max_wall_is_spent(workers):
+    """100 starts of 50 s runs (~0.2 s each) under a 0.5 s budget, in this process and on a pool of 2 spawned
+    workers: the result comes back within :data:`BOUND` with all 100 starts, those the budget left out or cut
+    labelled FAILURE with the text ``failure:max_wall`` (at least the last half: 0.5 s cannot run 50), the others
+    as usual; an attractor's orbit is found, or its ``orbit_error`` names max_wall (the budget is spent before
+    or during its search)."""
+    r, took = _timed(exact.basins, PAPER, alpha0=np.linspace(-0.3, 0.3, 10), F0=np.linspace(200.0, 280.0, 10),
+                     max_wall=BUDGET, max_workers=workers, progress=False, orbits=True)
+    assert took < BOUND
+    assert r.labels.shape == (10, 10)
+    cut = r.texts == "failure:max_wall"
+    assert cut.sum() >= 50 and np.all(r.labels[cut] == exact._basins.FAILURE)
+    assert all(a.orbit is not None or "max_wall" in (a.orbit_error or "") for a in r.attractors)
