@@ -59,7 +59,7 @@ API = {
                             "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
-        "MANIFEST", "RESERVED", "RESULTS", "record_key",
+        "MANIFEST", "RESERVED", "RESULTS", "record_key", "MAX_SWEEP_POINTS", "check_grid_size",
     },
     "peelapprox.validate": {
         "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",

@@ -188,3 +188,51 @@ def test_basins_returns_every_start_when_max_wall_is_spent(workers):
     cut = r.texts == "failure:max_wall"
     assert cut.sum() >= 50 and np.all(r.labels[cut] == exact._basins.FAILURE)
     assert all(a.orbit is not None or "max_wall" in (a.orbit_error or "") for a in r.attractors)
+
+
+# ---------------------------------------------------------------------------------------------- sweep
+def test_sweep_refuses_a_grid_too_large_at_once(tmp_path):
+    """``--I 1e-5:1e-3:100000000`` (over 200 s without even writing the manifest) is refused by parse_grid
+    before the values are made, and a 1e7-value axis given to the library before it is converted, naming the
+    option or axes and :data:`comparisons.sweep.MAX_SWEEP_POINTS` (1e6), within :data:`BOUND`; nothing is
+    written."""
+    from comparisons.sweep import MAX_SWEEP_POINTS, parse_grid, sweep
+
+    assert MAX_SWEEP_POINTS == 10**6
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"--I: num must be at most MAX_SWEEP_POINTS = 1000000 .*got 100000000"):
+        parse_grid("1e-5:1e-3:100000000", name="--I")
+    big = np.ones(10**7)  # the size check comes first: the values are not even looked at
+    with pytest.raises(ValueError, match=r"I_values x V_values: a sweep must hold at most MAX_SWEEP_POINTS = "
+                                         r"1000000 points .*got 10000000 x 2 = 20000000"):
+        sweep(big, [1.0, 2.0], out=tmp_path / "s")
+    with pytest.raises(ValueError, match=r"I_values x V_values x coef values: .*got 1000 x 1000 x 2 = 2000000"):
+        sweep(np.geomspace(1e-5, 1e-3, 1000), np.linspace(1.0, 2.0, 1000), "period", out=tmp_path / "s",
+              force=PeelForce.cubic(), coef=("c", [290.0, 300.0]))
+    assert time.perf_counter() - t0 < BOUND
+    assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("workers", [0, 2], ids=["serial", "pool"])
+def test_sweep_writes_its_manifest_first_and_stops_at_max_wall(tmp_path, workers):
+    """20 points of the period measure (a 50 s run each, ~0.2 s) under a 0.5 s budget, in this process and on a
+    pool of 2 spawned workers: the manifest exists before the first point is reported; the call raises
+    ``SolverBudgetExceeded`` naming max_wall within :data:`BOUND`, with the points done recorded (fewer than 20:
+    0.5 s cannot run them) and none of the points it cut; the same call without a budget then completes the
+    sweep, recording each point once (categorical counts)."""
+    from comparisons.sweep import sweep
+
+    out = tmp_path / "s"
+    seen: list[bool] = []
+    args = (np.geomspace(1e-5, 1e-3, 10), [1.0, 2.0], "period")
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"sweep: the wall-clock budget max_wall=0.5 s was spent") as info:
+        sweep(*args, out=out, max_workers=workers, max_wall=BUDGET,
+              progress=lambda done, total, rec: seen.append((out / "sweep.json").exists()))
+    assert time.perf_counter() - t0 < BOUND
+    assert info.value.budget == "max_wall" and all(seen) and (out / "sweep.json").exists()
+    done = len(info.value.partial.records)
+    assert done < 20 and len((out / "results.jsonl").read_text().splitlines()) == done
+    res = sweep(*args, out=out, max_workers=0, max_wall=None, progress=False)
+    assert len(res.records) == 20 and len((out / "results.jsonl").read_text().splitlines()) == 20
+    assert all(r["status"] == "ok" for r in res.records)
