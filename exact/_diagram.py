@@ -218,7 +218,8 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
 
 
-def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-6) -> tuple[int | None, ...]:
+def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-6,
+            max_wall: float | None = DEFAULT_MAX_WALL) -> tuple[int | None, ...]:
     """Which continued branch, if any, explains each value of the brute-force diagram.
 
     A value whose long run is period n is explained by a branch of period-m orbits, m = n or a divisor of n,
@@ -234,12 +235,15 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         In ``diagram.parameter``.
     rtol : float
         Agreement of the orbit's and the run's cycle.
+    max_wall : float or None
+        Wall-clock budget [s] of all the Newton solves (None: unbounded; default :data:`exact.DEFAULT_MAX_WALL`):
+        once it is spent the values left are not examined (None), like values no branch explains.
 
     Returns
     -------
     tuple of (int or None)
         Per diagram value, the index into ``branches`` of the first branch that explains it; None where none
-        does or the run is not periodic.
+        does, the run is not periodic, or ``max_wall`` was spent before the value was examined.
     """
     from ._continuation import OrbitBranch
     from ._corrector import VARIANT_PARAMETERS
@@ -248,10 +252,13 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         raise ValueError(f"diagram: explain reads a diagram against continued branches of the paper's massless, "
                          f"velocity-controlled model, which continue_orbit does not follow in a model variant's "
                          f"parameter; got a diagram over {diagram.parameter!r}")
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     out: list[int | None] = []
     for x, F, lab in zip(diagram.values, diagram.returns, diagram.labels):
         found = None
         n = int(lab.split("-")[1]) if lab.startswith("period-") else 0
+        if wall.limit is not None and time.perf_counter() - wall.t0 >= wall.limit:
+            n = 0  # the budget is spent: not examined
         for i, b in enumerate(branches if n else ()):
             if not isinstance(b, OrbitBranch):
                 raise TypeError(f"branches must hold exact.OrbitBranch, got {type(b).__name__}")
@@ -262,7 +269,7 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
             q = b.points[int(np.argmin(np.abs(vals - x)))]
             try:
                 o = solve_orbit(with_parameter(q.orbit.params, diagram.parameter, float(x)),
-                                q.orbit.section_states[0], m, max_iter=10)
+                                q.orbit.section_states[0], m, max_iter=10, wall=wall)
             except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded):
                 continue
             cycle = np.sort(np.tile(o.return_map_values, n // m))

@@ -8,8 +8,10 @@ tested is that the call is bounded (minutes before), not how fast it is.
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import math
+import re
 import time
 
 import numpy as np
@@ -236,3 +238,68 @@ def test_sweep_writes_its_manifest_first_and_stops_at_max_wall(tmp_path, workers
     res = sweep(*args, out=out, max_workers=0, max_wall=None, progress=False)
     assert len(res.records) == 20 and len((out / "results.jsonl").read_text().splitlines()) == 20
     assert all(r["status"] == "ok" for r in res.records)
+
+
+# ---------------------------------------------------------------------------------------------- the command line
+def _cli(argv: list[str]) -> tuple[int, float]:
+    """``peelapprox ARGV``: the exit status (``SystemExit`` taken as its code) and the seconds it took."""
+    from peelapprox.cli import main
+
+    t0 = time.perf_counter()
+    try:
+        rc = main(argv)
+    except SystemExit as exc:
+        rc = int(exc.code or 0)
+    return rc, time.perf_counter() - t0
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["bifurcation", "--V", "1", "--I", "1e-5", "--range", "0.9:1.1:1000000"],
+     r"--range: N must be at most 100000 .*got 1000000"),
+    (["sweep", "--I", "1e-5:1e-3:100000000", "--V", "1"], r"--I: num must be at most MAX_SWEEP_POINTS = 1000000"),
+    (["sweep", "--I", "1e-5:1e-3:1000:log", "--V", "1:2:2000"],
+     r"--I x --V: a sweep must hold at most MAX_SWEEP_POINTS = 1000000 points .*got 1000 x 2000 = 2000000"),
+    (["basins", "--V", "1", "--I", "1e-5", "--alpha0", "0:0.3:2000", "--F0", "200:280:1000"],
+     r"--alpha0 x --F0: the grid must hold at most 1000000 starts .*got 2000 x 1000 = 2000000"),
+])
+def test_cli_refuses_a_grid_too_large_at_once(tmp_path, capsys, argv, match):
+    """The command lines that ran for minutes (``bifurcation --range 0.9:1.1:1000000``, ``sweep --I
+    1e-5:1e-3:100000000``) and their kin exit with status 2 (a bad argument) within :data:`BOUND`, the message
+    naming the option and the limit; the sweep's directory is not even created (categorical)."""
+    out = tmp_path / "s"
+    rc, took = _cli(argv + (["--out", str(out)] if argv[0] == "sweep" else []))
+    assert rc == 2 and took < BOUND
+    assert re.search(match, capsys.readouterr().err)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv, after", [
+    (["orbit", "--V", "1", "--I", "1e-5", "--t-transient", "100000"], "error: more than 0.5 s of wall time"),
+    (["bifurcation", "--V", "1", "--I", "1e-5", "--range", "0.9:1.1:100"], "stopped: the --max-wall budget"),
+    (["basins", "--V", "1", "--I", "1e-5", "--alpha0", "0:0.3:10", "--F0", "200:280:10", "--workers", "0"],
+     "stopped: the --max-wall budget"),
+    (["sweep", "--I", "1e-5:1e-3:10:log", "--V", "1:2:2", "--measure", "period", "--workers", "0", "--quiet"],
+     "error: sweep: the wall-clock budget max_wall=0.5 s was spent"),
+])
+def test_cli_max_wall_bounds_each_command(tmp_path, capsys, argv, after):
+    """Each of orbit, bifurcation, basins and sweep, given work for minutes and ``--max-wall 0.5``, ends within
+    :data:`BOUND` with exit status 3 (a solver stop) and says why on stderr; the sweep leaves its manifest in its
+    directory for the same command to resume (categorical)."""
+    out = tmp_path / "s"
+    rc, took = _cli(argv + ["--max-wall", str(BUDGET)] + (["--out", str(out)] if argv[0] == "sweep" else []))
+    assert rc == 3 and took < BOUND
+    assert after in capsys.readouterr().err
+    if argv[0] == "sweep":
+        assert (out / "sweep.json").exists()
+
+
+@pytest.mark.parametrize("command", ["orbit", "bifurcation", "basins", "sweep", "simulate", "dynamics"])
+def test_every_cli_max_wall_defaults_to_600_seconds(command):
+    """``--max-wall`` of every subcommand that runs the exact model defaults to 600 s and says so in its help
+    (exact value and text)."""
+    from peelapprox.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    action = next(a for a in sub._actions if "--max-wall" in a.option_strings)
+    assert action.default == 600.0
+    assert "(default: 600)" in " ".join(sub.format_help().split())
