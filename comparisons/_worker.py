@@ -23,14 +23,16 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Hashable, Iterable, Sequence
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from typing import Any
 
 __all__ = ["spawn_context", "watch_parent", "message", "error_text", "write_line", "TimedWorker", "run_tasks",
-           "SERIAL"]
+           "SERIAL", "DEADLINE_TEXT"]
 
 #: ``executor`` value of :func:`run_tasks` that runs every task in this process, one after the other.
 SERIAL = "serial"
+#: The error text of a task :func:`run_tasks` did not start because its ``deadline`` had passed.
+DEADLINE_TEXT = "not run: the deadline passed before it began"
 
 
 def spawn_context() -> Any:
@@ -207,7 +209,7 @@ def _local_pool(max_workers: int | None, n_tasks: int) -> ProcessPoolExecutor:
 
 def run_tasks(fn: Callable[..., Any], tasks: Sequence[tuple[Hashable, Iterable[Any]]],
               on_result: Callable[[Any, Any], None], *, executor: None | str | Executor = None,
-              max_workers: int | None = None) -> list[tuple[Any, str]]:
+              max_workers: int | None = None, deadline: float | None = None) -> list[tuple[Any, str]]:
     """Run ``fn(*args)`` for every ``(key, args)`` of ``tasks``; ``on_result(key, value)`` as each one finishes.
 
     Parameters
@@ -223,16 +225,23 @@ def run_tasks(fn: Callable[..., Any], tasks: Sequence[tuple[Hashable, Iterable[A
         Executor: used as is and left running.
     max_workers : int, optional
         Size of the local pool.
+    deadline : float, optional
+        A ``time.time()`` after which no task is started: the tasks not begun are cancelled (returned as lost,
+        :data:`DEADLINE_TEXT`); the running ones are waited for (bound them with the deadline themselves).
 
     Returns
     -------
     list of (key, error text)
-        The tasks the executor lost (a worker died, a task was cancelled): not values, to run again.
-        An exception of ``on_result`` cancels the tasks not yet finished and propagates.
+        The tasks the executor lost (a worker died, a task was cancelled, the deadline passed before it began):
+        not values, to run again.  An exception of ``on_result`` cancels the tasks not yet finished and
+        propagates.
     """
     lost: list[tuple[Any, str]] = []
     if executor == SERIAL:
         for key, args in tasks:
+            if deadline is not None and time.time() >= deadline:
+                lost.append((key, DEADLINE_TEXT))
+                continue
             on_result(key, fn(*args))
         return lost
     if not tasks:
@@ -244,14 +253,23 @@ def run_tasks(fn: Callable[..., Any], tasks: Sequence[tuple[Hashable, Iterable[A
     try:
         for key, args in tasks:
             futs[ex.submit(fn, *args)] = key
-        for fut in as_completed(futs):
-            key = futs.pop(fut)
-            try:
-                value = fut.result()
-            except Exception as exc:  # the executor lost the task (worker died, cancelled): not a result
-                lost.append((key, error_text(exc)))
-                continue
-            on_result(key, value)
+        pending, expired = set(futs), False
+        while pending:
+            timeout = None if deadline is None or expired else max(0.0, deadline - time.time())
+            finished, pending = wait(pending, timeout=timeout, return_when=FIRST_COMPLETED)
+            if deadline is not None and not expired and time.time() >= deadline:
+                expired = True  # cancel the tasks not begun (a cancelled future is never "finished" by wait)
+                cancelled = {fut for fut in pending if fut.cancel()}
+                pending -= cancelled
+                lost.extend((futs.pop(fut), DEADLINE_TEXT) for fut in cancelled)
+            for fut in finished:
+                key = futs.pop(fut)
+                try:
+                    value = fut.result()
+                except Exception as exc:  # the executor lost the task (worker died, cancelled): not a result
+                    lost.append((key, error_text(exc)))
+                    continue
+                on_result(key, value)
     finally:
         for fut in futs:
             fut.cancel()

@@ -20,7 +20,7 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
-from ._basins import BasinAttractor, BasinResult, basins
+from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._continuation import (
     Bifurcation,
@@ -28,11 +28,10 @@ from ._continuation import (
     OrbitBranch,
     continue_orbit,
     parameter_value,
-    switch_branch,
     with_parameter,
 )
 from ._crest import Crest, crest_margin
-from ._diagram import OrbitDiagram, explain, orbit_diagram
+from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._options import Budget, Hybrid, Regularized, SaveAt, Smooth, default_atol
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
@@ -45,6 +44,7 @@ from ._simulate import (
     initial_state,
     simulate,
 )
+from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import VARIATIONAL_LAWS, lyapunov_variational
 
@@ -78,11 +78,13 @@ __all__ = [
     "crest_margin",
     "Crest",
     "orbit_diagram",
+    "MAX_DIAGRAM_VALUES",
     "explain",
     "with_parameter",
     "parameter_value",
     "OrbitDiagram",
     "basins",
+    "MAX_BASIN_STARTS",
     "BasinResult",
     "BasinAttractor",
     "Trajectory",

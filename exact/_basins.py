@@ -7,50 +7,49 @@ attractor when their periods n agree and their sorted return-map cycles agree to
 relative (a cycle is the same set of jump forces whatever its phase).  The starts run in this process or on
 a process pool / any :class:`concurrent.futures.Executor` (as the (I, V) sweep of ``comparisons.sweep``);
 the result does not depend on which, nor on the order in which the starts finish.
+
+Every call is bounded: a grid of at most :data:`MAX_BASIN_STARTS` starts (refused before any run) and a
+wall-clock budget ``max_wall`` for all of it (:mod:`exact._basins_run`: the starts it leaves out or cuts are
+failures, ``"failure:max_wall"``).
 """
 
 from __future__ import annotations
 
 import json
-import multiprocessing as mp
-import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from peelapprox import (
-    WINDOW_DEFAULTS,
-    ModelBreakdown,
-    PeelParams,
-    SolverBudgetExceeded,
-    SolverFailure,
-    periodicity,
-    return_map,
-)
-from peelapprox.io import ProgressLine, fmt_number, jsonable
-from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, states
+from peelapprox import WINDOW_DEFAULTS, ModelBreakdown, PeelParams, SolverBudgetExceeded, SolverFailure
+from peelapprox.errors import WallBudget
+from peelapprox.io import fmt_number, jsonable
+from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, positive, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._attractors import paper_model_only
+from ._attractors import DEFAULT_MAX_WALL, paper_model_only
+from ._basins_run import APERIODIC, BREAKDOWN, FAILURE, INVALID, UNDETERMINED, msg, reporter, run_all
 from ._options import method_option
 from ._orbits import PeriodicOrbit, periodic_orbit
-from ._simulate import initial_state, simulate
+from ._simulate import simulate
 
 __all__ = ["MATCH_RTOL", "CYCLE_DIGITS", "INVALID", "APERIODIC", "BREAKDOWN", "UNDETERMINED", "FAILURE",
-           "BasinAttractor", "BasinResult", "basins"]
+           "MAX_BASIN_STARTS", "BasinAttractor", "BasinResult", "basins"]
 
 #: Two periodic starts reach the same attractor when n is equal and their sorted cycles agree to this (relative).
 MATCH_RTOL = 1e-6
 #: Significant digits of an attractor's stored ``cycle`` (its first start's, rounded): 5e-10 relative, far
 #: below :data:`MATCH_RTOL`, far above the ~1e-12 scatter of a periodic orbit's jump forces at rtol 1e-10.
 CYCLE_DIGITS = 10
-#: Label codes of the starts that reach no periodic attractor (``BasinResult.labels``).
-INVALID, APERIODIC, BREAKDOWN, UNDETERMINED, FAILURE = -1, -2, -3, -4, -5
+#: Most starts of one :func:`basins` grid: a 1000 x 1000 picture, each start a run of ``t_transient + window``
+#: (50 s of model time, ~0.1-1 s of wall time): days of computing on a cluster, while the pictures of
+#: docs/dynamics.md have ~100 starts.  A larger grid is a typo, refused before the first run (the executor would
+#: otherwise hold a future per start).
+MAX_BASIN_STARTS = 1_000_000
 _CODE_TEXT = {INVALID: "invalid start", APERIODIC: "aperiodic", BREAKDOWN: "breakdown",
               UNDETERMINED: "undetermined", FAILURE: "failure"}
 _AXES = ("F0", "omega0")
@@ -116,10 +115,11 @@ class BasinResult:
         ``labels[i, j]`` for ``alpha0[i]``, ``values[j]``: the attractor id (>= 0), or :data:`INVALID` (-1: no
         root of CONSTR at the start), :data:`APERIODIC` (-2), :data:`BREAKDOWN` (-3: ``ModelBreakdown``),
         :data:`UNDETERMINED` (-4: fewer than 2 returns, or too few to decide for ``max_period``),
-        :data:`FAILURE` (-5: the solver failed or ran out of budget, or the executor lost the start).
+        :data:`FAILURE` (-5: the solver failed or ran out of budget, the call's ``max_wall`` left the start out
+        or cut it, or the executor lost the start).
     texts : ndarray of str, shape (m, k)
         Each start's outcome: ``"period-n"``, ``"aperiodic"``, ``"breakdown:<reason>"``, ``"invalid start"``,
-        ``"undetermined:<why>"``, ``"failure:<exception type>"``.
+        ``"undetermined:<why>"``, ``"failure:<exception type>"``, ``"failure:max_wall"`` (the call's budget).
     cycles : tuple of tuple of float
         Each start's own sorted cycle (periodic starts; empty otherwise), flattened α0 major.
     n_returns : ndarray of int, shape (m, k)
@@ -255,46 +255,6 @@ def _edges(x: np.ndarray) -> np.ndarray:
     return np.concatenate([[2 * x[0] - mid[0]], mid, [2 * x[-1] - mid[-1]]])
 
 
-# ---------------------------------------------------------------------------------------------- one start
-def run_start(params: PeelParams, t_transient: float, window: float, rtol: float, max_period: int,
-              alpha0: float, axis: str, value: float, solver: str | None = None) -> dict[str, Any]:
-    """Outcome of one start as plain data (runs in a worker process; never raises for a model outcome).
-
-    Returns ``{"code": INVALID | APERIODIC | BREAKDOWN | UNDETERMINED | FAILURE | 0 (periodic), "text",
-    "n", "cycle" (sorted, the window's last n returns), "n_returns", "message"}``.
-    """
-    kw: dict[str, Any] = {"alpha0": alpha0, axis: value}
-    out: dict[str, Any] = {"code": FAILURE, "text": "failure", "n": None, "cycle": (), "n_returns": 0, "message": ""}
-    try:
-        initial_state(params, **kw)
-    except ValueError as exc:  # no root of CONSTR (or a degenerate geometry) at this start
-        return {**out, "code": INVALID, "text": "invalid start", "message": _msg(exc)}
-    try:
-        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, solver=solver,
-                      **kw)
-    except ModelBreakdown as exc:
-        return {**out, "code": BREAKDOWN, "text": f"breakdown:{exc.reason}", "message": _msg(exc)}
-    except (SolverFailure, SolverBudgetExceeded, ValueError, ArithmeticError) as exc:
-        return {**out, "text": f"failure:{type(exc).__name__}", "message": _msg(exc)}
-    x = return_map(tr)
-    out["n_returns"] = int(x.size)
-    if x.size < 2:
-        return {**out, "code": UNDETERMINED, "text": "undetermined:no stick-slip",
-                "message": f"{x.size} AB->CD jumps in the window"}
-    per = periodicity(x, max_period=max_period)
-    if per.period is not None:
-        n = int(per.period)
-        return {**out, "code": 0, "text": f"period-{n}", "n": n, "cycle": tuple(float(c) for c in np.sort(x[-n:]))}
-    if per.kind == "aperiodic":
-        return {**out, "code": APERIODIC, "text": "aperiodic"}
-    return {**out, "code": UNDETERMINED, "text": f"undetermined:{per.kind}",
-            "message": f"{x.size} returns cannot rule out periods up to max_period={max_period}: lengthen window"}
-
-
-def _msg(exc: BaseException) -> str:
-    return " ".join(str(exc).split())[:300]
-
-
 # ---------------------------------------------------------------------------------------------- the grid
 def _axis(name: str, x: Any, quantity: str) -> np.ndarray:
     a = states(name, x, quantity)
@@ -303,59 +263,6 @@ def _axis(name: str, x: Any, quantity: str) -> np.ndarray:
     if a.size > 1 and not np.all(np.diff(a) > 0):
         raise ValueError(f"{name} must be strictly increasing (a grid axis), got {a.tolist()}")
     return a
-
-
-def _reporter(progress: Any, total: int) -> Callable[[int, dict], None]:
-    """``progress=True``: a line on stderr for the first start, the last, every ~5 % and every start that failed
-    (with its message); one updating line in Jupyter (:class:`peelapprox.io.ProgressLine`)."""
-    if callable(progress):
-        return lambda done, rec: progress(done, total, rec)
-    if not progress:
-        return lambda done, rec: None
-    line = ProgressLine("basins", total)
-
-    def report(done: int, rec: dict) -> None:
-        failed = f"{rec['text']}: {rec.get('message', '')}"[:200] if rec["code"] == FAILURE else None
-        line.update(done, failed=failed)
-
-    return report
-
-
-def _run_all(tasks: list[tuple], executor: Executor | None, max_workers: int | None,
-             report: Callable[[int, dict], None]) -> list[dict]:
-    """Outcomes of ``run_start(*task)`` in task order, whatever order they finish in."""
-    results: list[dict | None] = [None] * len(tasks)
-    if executor is None and max_workers == 0:
-        serial = []
-        for k, t in enumerate(tasks):
-            serial.append(run_start(*t))
-            report(k + 1, serial[-1])
-        return serial
-    own = executor is None
-    if executor is None:
-        n = max_workers or (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-        executor = ProcessPoolExecutor(max_workers=max(1, min(n, len(tasks))), mp_context=mp.get_context("spawn"))
-    futs: dict[Future, int] = {}
-    try:
-        for k, t in enumerate(tasks):
-            futs[executor.submit(run_start, *t)] = k
-        done = 0
-        for fut in as_completed(list(futs)):
-            k = futs.pop(fut)
-            try:
-                res = fut.result()
-            except Exception as exc:  # the executor lost the start (a worker died): recorded, not raised
-                res = {"code": FAILURE, "text": f"failure:{type(exc).__name__}", "n": None, "cycle": (),
-                       "n_returns": 0, "message": f"the executor lost this start: {_msg(exc)}"}
-            results[k] = res
-            done += 1
-            report(done, res)
-    finally:
-        for fut in futs:
-            fut.cancel()
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
-    return results  # type: ignore[return-value]
 
 
 def _group(outcomes: list[dict], starts: list[tuple[float, float]]) -> tuple[np.ndarray, list[dict]]:
@@ -393,6 +300,7 @@ def basins(
     max_workers: int | None = None,
     progress: bool | Callable[[int, int, dict], None] | None = True,
     solver: str | None = None,
+    max_wall: float | None = DEFAULT_MAX_WALL,
 ) -> BasinResult:
     """Label every start of a grid over (α0, F0) or (α0, ω0) by the attractor it reaches.
 
@@ -412,7 +320,8 @@ def basins(
         Initial peel angles [rad]: strictly increasing, each in ``STATE_RANGES["alpha"]``.
     F0, omega0 : sequence of float
         The second axis, exactly one of them: initial pull forces [N] (``STATE_RANGES["F"]``) or roller
-        angular velocities [rad/s] (``STATE_RANGES["omega"]``), strictly increasing.
+        angular velocities [rad/s] (``STATE_RANGES["omega"]``), strictly increasing.  The grid holds at most
+        :data:`MAX_BASIN_STARTS` (1e6) starts.
     t_transient, window : float
         Seconds discarded, in [0, 1e6], and seconds whose AB→CD jumps are classified, in (0, 1e6]
         (:data:`peelapprox.WINDOW_DEFAULTS`: 30, 20).
@@ -426,7 +335,7 @@ def basins(
         by its first start's run, in this process): Floquet multipliers, stability.
     executor : concurrent.futures.Executor, optional
         Runs the starts (e.g. a dask ``Client.get_executor()``), used as is and left running; the function
-        shipped is :func:`exact._basins.run_start`, its arguments plain data (PeelParams pickles with its law).
+        shipped is :func:`exact._basins_run.run_start`, its arguments plain data (PeelParams pickles with its law).
     max_workers : int, optional
         Without ``executor``: 0 runs in this process; n > 0 a local spawned process pool of n workers; None
         (default) one worker per CPU available, at most one per start.
@@ -436,6 +345,13 @@ def basins(
     solver : str, optional
         The scipy solver of a model variant's runs (:func:`exact.simulate`'s ``solver``; None: its default);
         with the massless model's hybrid method a ValueError.
+    max_wall : float or None
+        Wall-clock budget [s] of the whole call, the starts and the orbits (None: unbounded; default
+        :data:`exact.DEFAULT_MAX_WALL`, 3600 s): a start is run with what is left of it as its ``max_wall``,
+        and once it is spent the starts not run are cancelled.  A start it leaves out or cuts is a failure,
+        ``"failure:max_wall"``, and an orbit it cuts an ``orbit_error``: like every other failure of a start,
+        an outcome, not an exception, so the result holds every start that finished.  The deadline is a time of
+        the system clock, shared by the workers of a cluster to their clocks' skew.
 
     Returns
     -------
@@ -446,16 +362,18 @@ def basins(
     Raises
     ------
     ValueError, TypeError
-        A bad argument (named, with its range).  Nothing a start does raises: an infeasible start, a
-        breakdown, a solver failure are outcomes.
+        A bad argument (named, with its range; a grid of more than :data:`MAX_BASIN_STARTS` starts).  Nothing a
+        start does raises: an infeasible start, a breakdown, a solver failure, a spent budget are outcomes.
     """
     wall0 = time.perf_counter()
     params = _params("params", params)
-    a_ax = _axis("alpha0", alpha0, "alpha")
     if (F0 is None) == (omega0 is None):
         raise ValueError("give exactly one of F0 (an (alpha0, F0) grid) and omega0 (an (alpha0, omega0) grid)")
     axis = "F0" if F0 is not None else "omega0"
+    _check_size(axis, alpha0, F0 if F0 is not None else omega0)
+    a_ax = _axis("alpha0", alpha0, "alpha")
     values = _axis(axis, F0 if F0 is not None else omega0, "F" if axis == "F0" else "omega")
+    _check_size(axis, a_ax, values)
     t_transient = duration("t_transient", t_transient, zero=True)
     window = duration("window", window)
     rtol = _rtol("rtol", rtol)
@@ -473,14 +391,16 @@ def basins(
                              "executor instead")
     if not (progress is None or isinstance(progress, bool) or callable(progress)):
         raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
 
     starts = [(float(a), float(v)) for a in a_ax for v in values]
     tasks = [(params, t_transient, window, rtol, max_period, a, axis, v, solver) for a, v in starts]
-    outcomes = _run_all(tasks, executor, max_workers, _reporter(progress, len(tasks)))
+    deadline = None if wall.limit is None else time.time() + wall.limit - (time.perf_counter() - wall.t0)
+    outcomes = run_all(tasks, executor, max_workers, reporter(progress, len(tasks)), deadline)
     codes, groups = _group(outcomes, starts)
     atts = []
     for g in groups:
-        orbit, err = (_orbit(params, starts[g["first"]], axis, g["n"], t_transient, window, rtol) if orbits
+        orbit, err = (_orbit(params, starts[g["first"]], axis, g["n"], t_transient, window, rtol, wall) if orbits
                       else (None, None))
         atts.append(BasinAttractor(g["id"], g["n"], tuple(float(f"{c:.{CYCLE_DIGITS}g}") for c in g["cycle"]),
                                    g["count"], g["start"], orbit, err))
@@ -494,12 +414,27 @@ def basins(
         window=window, rtol=rtol, max_period=max_period, wall_time=time.perf_counter() - wall0)
 
 
+def _check_size(axis: str, alpha0: Any, values: Any) -> None:
+    """ValueError naming both axes unless the grid holds at most :data:`MAX_BASIN_STARTS` starts; their lengths
+    are read before the axes are converted (a typo's 1e9 values would take minutes), and read again after."""
+    m, k = (np.size(x) if isinstance(x, np.ndarray) else len(x) if hasattr(x, "__len__") else 0
+            for x in (alpha0, values))
+    if m * k > MAX_BASIN_STARTS:
+        raise ValueError(f"alpha0 x {axis}: the grid must hold at most MAX_BASIN_STARTS = {MAX_BASIN_STARTS} starts "
+                         f"(a 1000 x 1000 picture, days of runs: more is most likely a typo), got {m} x {k} = "
+                         f"{m * k}")
+
+
 def _orbit(params: PeelParams, start: tuple[float, float], axis: str, n: int, t_transient: float, window: float,
-           rtol: float) -> tuple[PeriodicOrbit | None, str | None]:
-    """:func:`exact.periodic_orbit` seeded by the run from ``start`` (None and why, if it fails)."""
+           rtol: float, wall: WallBudget) -> tuple[PeriodicOrbit | None, str | None]:
+    """:func:`exact.periodic_orbit` seeded by the run from ``start``, within what is left of ``wall`` (None and
+    why, if it fails)."""
+    if wall.limit is not None and time.perf_counter() - wall.t0 >= wall.limit:
+        return None, f"max_wall: the call's max_wall={wall.limit:g} s was spent before this orbit was looked for"
     try:
         kw: dict[str, Any] = {"alpha0": start[0], axis: start[1]}
-        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, **kw)
-        return periodic_orbit(params, start=tr, n=n), None
+        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient,
+                      max_wall=wall.left(0.0, {"t": 0.0}, t_transient + window), **kw)
+        return periodic_orbit(params, start=tr, n=n, max_wall=wall.left(0.0, {"t": 0.0}, 0.0)), None
     except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded, ArithmeticError) as exc:
-        return None, f"{type(exc).__name__}: {_msg(exc)}"
+        return None, f"{type(exc).__name__}: {msg(exc)}"

@@ -23,7 +23,7 @@ in λ and ``GAUGE_TOL`` in the gauge, or 40 halvings) on the quantity that chang
   both neighbouring points; where it lies between them, λ does not turn and the crossing is reported as a
   ``"branch_point"``);
 * **period doubling** (a real multiplier through -1: ``μ + 1``); :func:`switch_branch` starts the doubled
-  (period-2n) branch there;
+  (period-2n) branch there (:mod:`exact._switch`);
 * **Neimark-Sacker** (a complex pair through the unit circle: ``|μ| - 1``).
 
 The non-smooth ends of a branch are reported as the reason it stopped (``OrbitBranch.stopped``, with the
@@ -41,7 +41,10 @@ when it lies within two steps (or 1e-3 of the span) of the last point, else the 
 * ``"breakdown"``: a return breaks down (e.g. CONSTR loses its root: a landing no longer exists);
 * ``"no_convergence"``: Newton fails at ``min_step`` for another reason;
 * ``"stop"`` (λ reached ``stop``), ``"range"`` (the branch turned back at a fold and left the range
-  ``[start, stop]`` at the start's side), ``"max_points"``.
+  ``[start, stop]`` at the start's side), ``"max_points"``, ``"max_wall"`` (the call's wall-clock budget was
+  spent: the branch holds the points accepted so far, and every bifurcation on it is located to ``locate_tol``;
+  the budget is checked before each Newton iteration of the corrector, the returns of one iteration being
+  compiled runs bounded by their step budget).
 """
 
 from __future__ import annotations
@@ -53,15 +56,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
-from peelapprox.validate import function, in_range, integer, optional, real
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure, WallBudget
+from peelapprox.validate import finite, function, in_range, integer, optional, positive
 
-from ._corrector import PARAMETERS, VARIANT_PARAMETERS, bordered_newton, branch_tangent, parameter_value, with_parameter
-from ._crest import Crest, crest_margin
+from ._attractors import DEFAULT_MAX_WALL
+from ._branch_end import NO_CREST, event_message, events_ahead, failure_end, near
+from ._corrector import (
+    PARAMETERS,
+    VARIANT_PARAMETERS,
+    bordered_newton,
+    branch_tangent,
+    check_parameter,
+    parameter_value,
+    with_parameter,
+)
+from ._crest import crest_margin
 from ._orbits import PeriodicOrbit, minimal_period
 
-__all__ = ["PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "continue_orbit", "parameter_value",
-           "switch_branch", "with_parameter"]
+__all__ = ["FAILURES", "PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "Stepper", "continue_orbit",
+           "parameter_value", "with_parameter"]
 
 @dataclass(frozen=True)
 class BranchPoint:
@@ -105,7 +118,7 @@ class OrbitBranch:
         In the order continued (the start first).
     bifurcations : tuple of Bifurcation
     stopped : str
-        Why the branch ended: "stop", "range", "max_points", "grazing", "crest", "breakdown",
+        Why the branch ended: "stop", "range", "max_points", "max_wall", "grazing", "crest", "breakdown",
         "no_convergence" (module docstring).
     message : str
         The detail (the exception's message for "breakdown"/"no_convergence").
@@ -168,13 +181,15 @@ def _gauge(kind: str, o: PeriodicOrbit) -> float:
     return float(min(mu.real - level, key=abs))
 
 
-class _Stepper:
+class Stepper:
     """The corrector of one branch: points ``w`` and bordered Newton at a prediction (module docstring)."""
 
-    def __init__(self, orbit: PeriodicOrbit, parameter: str, lam_scale: float, tol: float, rtol: float):
+    def __init__(self, orbit: PeriodicOrbit, parameter: str, lam_scale: float, tol: float, rtol: float,
+                 wall: WallBudget | None = None):
         self.base, self.parameter, self.ls, self.tol, self.rtol = orbit.params, parameter, lam_scale, tol, rtol
         self.scale = np.array([1.0, orbit.params.V / orbit.params.R])  # z = (α, ω R/V)
         self.n = orbit.n
+        self.wall = wall
 
     def w(self, p: BranchPoint) -> np.ndarray:
         return np.concatenate([p.orbit.section_states[0] / self.scale, [p.value / self.ls]])
@@ -186,18 +201,29 @@ class _Stepper:
                 max_dlam: float = math.inf) -> BranchPoint:
         o, lam = bordered_newton(self.params_at, n or self.n, w_pred[:2] * self.scale, float(w_pred[2] * self.ls),
                                  tau, w_pred, self.scale, self.ls, tol=self.tol, rtol=self.rtol, max_iter=max_iter,
-                                 max_dlam=max_dlam)
+                                 max_dlam=max_dlam, wall=self.wall)
         return BranchPoint(lam, o)
 
 
-_FAILURES = (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded)
+FAILURES = (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded)
+
+
+def _out_of_wall(exc: BaseException) -> bool:
+    """Whether ``exc`` is the call's wall budget running out (the section returns have no wall clock of their own:
+    a ``max_wall`` exception inside a continuation is always the call's)."""
+    return isinstance(exc, SolverBudgetExceeded) and exc.budget == "max_wall"
+
+
+def _spent(wall: WallBudget) -> bool:
+    return wall.limit is not None and time.perf_counter() - wall.t0 >= wall.limit
 
 
 def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, step: float | None = None,
                    min_step: float | None = None, max_step: float | None = None, max_points: int = 200,
                    tol: float = 1e-10, rtol: float = 1e-12, locate_tol: float = 1e-8, max_correction: float = 0.02,
                    graze_tol: float = 1e-3, crest_tol: float = 1e-6,
-                   progress: Callable[[int, float], None] | None = None) -> OrbitBranch:
+                   progress: Callable[[int, float], None] | None = None,
+                   max_wall: float | None = DEFAULT_MAX_WALL) -> OrbitBranch:
     """Follow ``orbit`` in ``parameter`` towards ``stop``, locating its bifurcations (module docstring).
 
     Parameters
@@ -205,17 +231,20 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     orbit : PeriodicOrbit
         The start (``exact.periodic_orbit``).
     parameter : {"V", "I", "k"} or "force.<coefficient>"
+        A coefficient of the family law ``orbit.params.force``.
     stop : float
-        The parameter value to continue to (either side of the start).
+        The parameter value to continue to (either side of the start): finite, a valid value of ``parameter``
+        (``PeelParams``' range), not the start's.
     step, min_step, max_step : float, optional
         Initial, smallest and largest arclength step, in units of the parameter (defaults: 1/50, 1/1e5 and 1/10
         of ``|stop - start|``).
     max_points : int
         Most orbits on the branch, in [2, 100000].
     tol, rtol : float
-        Newton's closing tolerance and the integration's (:func:`exact.periodic_orbit`).
+        Newton's closing tolerance, in [1e-14, 1e-3], and the integration's, in [1e-14, 1e-6]
+        (:func:`exact.periodic_orbit`).
     locate_tol : float
-        Relative accuracy of a bifurcation's parameter value.
+        Relative accuracy of a bifurcation's parameter value, in (0, 1).
     max_correction : float
         Largest move of the corrector from the prediction, relative to ``max(1, |w|)``; a larger one is a jump
         to another orbit: the step is halved instead.
@@ -228,6 +257,11 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         when Newton fails.
     progress : callable, optional
         ``progress(points, value)`` after every accepted point.
+    max_wall : float or None
+        Wall-clock budget [s] of the whole continuation (None: unbounded; default
+        :data:`exact.DEFAULT_MAX_WALL`, 3600 s).  When it is spent the branch ends like any other, with
+        ``stopped="max_wall"`` and the points accepted so far (a budget is a reason a branch ends, as
+        ``max_points`` is, not an error); continue from ``branch.points[-1].orbit`` to go on.
 
     Returns
     -------
@@ -236,18 +270,23 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     Raises
     ------
     ValueError, TypeError
-        Bad arguments (named).
+        Bad arguments (named, with the valid values: ``parameter`` lists the parameters of ``orbit``'s law).
     """
     wall0 = time.perf_counter()
     if not isinstance(orbit, PeriodicOrbit):
         raise TypeError(f"orbit must be an exact.PeriodicOrbit, got {type(orbit).__name__}")
-    if parameter in VARIANT_PARAMETERS:
+    if isinstance(parameter, str) and parameter in VARIANT_PARAMETERS:
         raise ValueError(f"parameter={parameter!r}: continue_orbit follows orbits of the paper's massless, "
                          f"velocity-controlled model (the hybrid section map with saltation matrices) in "
                          f"{', '.join(PARAMETERS)} or a family coefficient; over a model variant's parameter use "
                          f"exact.orbit_diagram(params, {parameter!r}, values)")
+    parameter = check_parameter(orbit.params, parameter)
     lam0 = parameter_value(orbit.params, parameter)
-    stop = real("stop", stop)
+    stop = finite("stop", stop)
+    try:
+        with_parameter(orbit.params, parameter, stop)
+    except ValueError as exc:
+        raise ValueError(f"stop must be a valid value of {parameter}, got {stop!r}: {exc}") from None
     span = abs(stop - lam0)
     if not span > 0:
         raise ValueError(f"stop must differ from the start's {parameter}={lam0}, got {stop}")
@@ -259,16 +298,23 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     max_correction = in_range("max_correction", max_correction, 0.0, 1.0, lo_open=True)
     graze_tol = in_range("graze_tol", graze_tol, 0.0, 1.0)
     crest_tol = in_range("crest_tol", crest_tol, 0.0, 1.0)
+    tol = in_range("tol", tol, 1e-14, 1e-3)
+    rtol = in_range("rtol", rtol, 1e-14, 1e-6)
+    locate_tol = in_range("locate_tol", locate_tol, 0.0, 1.0, lo_open=True, hi_open=True)
     progress = optional(function, "progress", progress)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
 
-    st = _Stepper(orbit, parameter, span, tol, rtol)
+    st = Stepper(orbit, parameter, span, tol, rtol, wall)
     e_lam = np.array([0.0, 0.0, 1.0])
     points = [BranchPoint(lam0, orbit)]
-    crests = [crest_margin(orbit) if crest_tol > 0 else _NO_CREST]
+    crests = [crest_margin(orbit) if crest_tol > 0 else NO_CREST]
     bifs: list[Bifurcation] = []
     stopped, message, end_value = "max_points", "", math.nan
     lo_end, hi_end = min(lam0, stop), max(lam0, stop)
     while len(points) < max_points:
+        if _spent(wall):
+            stopped, message = "max_wall", _wall_message(wall, points, parameter)
+            break
         last = points[-1]
         wl = st.w(last)
         if len(points) == 1:  # the branch's tangent, towards stop
@@ -277,7 +323,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         else:
             tau = st.w(last) - st.w(points[-2])
             tau = tau / np.linalg.norm(tau)
-        ahead = [v for e, v in _events_ahead(points, crests).items() if e != "grazing"]
+        ahead = [v for e, v in events_ahead(points, crests).items() if e != "grazing"]
         if ahead and abs(tau[2]) > 0:  # approach an extrapolated crest or breakdown geometrically, never step over
             h = min(h, 0.5 * min(abs(v - last.value) for v in ahead) / abs(tau[2]))
         w_pred, tau_c, final = wl + (h / span) * tau, (tau if _near_fold(last.orbit) else e_lam), False
@@ -289,19 +335,22 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
                 raise ValueError(f"the step fell below min_step={hmin:.3g} before an extrapolated event")
             pt = st.correct(w_pred, tau_c)
             _check_correction(st, pt, w_pred, max_correction)
-        except _FAILURES as exc:
+        except FAILURES as exc:
+            if _out_of_wall(exc):
+                stopped, message = "max_wall", _wall_message(wall, points, parameter)
+                break
             if h / 2 >= hmin:
                 h /= 2
                 continue
-            stopped, message, end_value = _failure_end(exc, points, crests, parameter, span)
+            stopped, message, end_value = failure_end(exc, points, crests, parameter, span)
             break
         o = pt.orbit
         if np.min(np.abs(o.fold_rates)) < graze_tol * o.params.k * o.params.V:
             i = int(np.argmin(np.abs(o.fold_rates)))
             points.append(pt)
-            crests.append(_NO_CREST)
-            ev = _events_ahead(points, crests).get("grazing", pt.value)
-            stopped, end_value = "grazing", _near(ev, pt.value, last.value, span)
+            crests.append(NO_CREST)
+            ev = events_ahead(points, crests).get("grazing", pt.value)
+            stopped, end_value = "grazing", near(ev, pt.value, last.value, span)
             message = (f"the orbit meets the {'AB' if i % 2 else 'CD'} fold (fold {i + 1} of the period) almost "
                        f"tangentially at {parameter}={pt.value:.10g}: dG/dt = {o.fold_rates[i]:.3g} N/s there "
                        f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
@@ -309,17 +358,21 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
             break
         kind = _crossing(last.orbit, o)
         if kind is not None:
-            bifs.append(_locate(kind, last, pt, st, locate_tol))
+            try:
+                bifs.append(_locate(kind, last, pt, st, locate_tol))
+            except SolverBudgetExceeded:  # the wall budget, mid-bisection: end before the unlocated crossing
+                stopped, message = "max_wall", _wall_message(wall, points, parameter)
+                break
         points.append(pt)
-        crests.append(crest_margin(o) if crest_tol > 0 else _NO_CREST)
+        crests.append(crest_margin(o) if crest_tol > 0 else NO_CREST)
         if progress:
             progress(len(points), pt.value)
         c = crests[-1]
         if min(c.margin, c.floor) < crest_tol:
             event = "crest" if c.margin <= c.floor else "breakdown"
-            ev = _events_ahead(points, crests).get(event, pt.value)
-            stopped, end_value = event, _near(ev, pt.value, last.value, span)
-            message = _event_message(event, c, end_value, parameter)
+            ev = events_ahead(points, crests).get(event, pt.value)
+            stopped, end_value = event, near(ev, pt.value, last.value, span)
+            message = event_message(event, c, end_value, parameter)
             break
         if final:
             stopped = "stop"
@@ -335,14 +388,16 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
                        end_value)
 
 
-_NO_CREST = Crest(math.inf, "", math.nan)
+def _wall_message(wall: WallBudget, points: list[BranchPoint], parameter: str) -> str:
+    return (f"the wall-clock budget max_wall={wall.limit:g} s was spent after {len(points)} orbit"
+            f"{'s' * (len(points) != 1)}, the last at {parameter}={points[-1].value:.10g}: continue from "
+            "branch.points[-1].orbit with a larger max_wall, or None")
+
+
 #: A located bifurcation's orbit has its gauge (``μ ∓ 1`` or ``|μ| - 1``) within this of 0 (or 40 halvings were
 #: spent): at a fold λ is stationary along the branch, so λ alone would stop the bisection with μ still far
 #: from 1.
 GAUGE_TOL = 1e-6
-#: Largest move of λ per Newton step in :func:`switch_branch`, relative to λ: the doubled orbit at a small
-#: amplitude lies next to the bifurcation (λ - λ* ~ a²); a free λ can otherwise wander where returns fail.
-SWITCH_DLAM = 1e-2
 #: A real multiplier within this distance of +1 makes the next step pseudo-arclength (a fold may be ahead).
 FOLD_NEAR = 0.25
 
@@ -352,13 +407,7 @@ def _near_fold(o: PeriodicOrbit) -> bool:
     return bool(np.any((np.abs(mu.imag) < 1e-12) & (np.abs(mu.real - 1.0) < FOLD_NEAR)))
 
 
-def _near(event: float, value: float, previous: float, span: float) -> float:
-    """An extrapolated event's parameter value if it lies within two steps (or 1e-3 of the span) of the last
-    point ``value``, else ``value``."""
-    return event if abs(event - value) <= max(2 * abs(value - previous), 1e-3 * span) else value
-
-
-def _check_correction(st: _Stepper, pt: BranchPoint, w_pred: np.ndarray, max_correction: float) -> None:
+def _check_correction(st: Stepper, pt: BranchPoint, w_pred: np.ndarray, max_correction: float) -> None:
     """ValueError when the corrector jumped to another orbit: it moved too far from the prediction, or reached
     an orbit of a smaller period (a divisor of n) than the branch's."""
     move = float(np.linalg.norm(st.w(pt) - w_pred))
@@ -370,54 +419,7 @@ def _check_correction(st: _Stepper, pt: BranchPoint, w_pred: np.ndarray, max_cor
         raise ValueError(f"the corrector reached an orbit of period {d}, not {st.n}: refused")
 
 
-def _events_ahead(points: list[BranchPoint], crests: list[Crest]) -> dict[str, float]:
-    """The parameter values where the last two points' crest margin ("crest"), floor ("breakdown") and squared
-    slowest fold rate ("grazing": Ġ vanishes like the square root of the distance), falling, extrapolate
-    linearly to 0 (module docstring); only the falling ones."""
-    if len(points) < 2:
-        return {}
-    a, b = points[-2].value, points[-1].value
-    out = {}
-    ra, rb = (float(np.min(np.abs(p.orbit.fold_rates))) ** 2 for p in points[-2:])  # Ġ² ∝ distance to grazing
-    for event, (ma, mb) in (("crest", (crests[-2].margin, crests[-1].margin)),
-                            ("breakdown", (crests[-2].floor, crests[-1].floor)), ("grazing", (ra, rb))):
-        if math.isfinite(ma) and math.isfinite(mb) and mb < ma and b != a:
-            out[event] = b + mb * (b - a) / (ma - mb)
-    return out
-
-
-def _event_message(event: str, c: Crest, value: float, parameter: str, orbit: PeriodicOrbit | None = None) -> str:
-    if event == "grazing" and orbit is not None:
-        return (f"the orbit's slowest arrival at a fold, dG/dt = {np.min(np.abs(orbit.fold_rates)):.3g} N/s, "
-                f"extrapolates to 0 at {parameter} ~ {value:.10g} (dG/dt squared linear): the branch ends in a "
-                "grazing bifurcation, where its multipliers diverge")
-    if event == "breakdown":
-        return (f"the lowest level F (1 + sin alpha) on AB comes within {c.floor:.3g} (f_max - f_min) of f(0+); it "
-                f"reaches it at {parameter} ~ {value:.10g} (linear extrapolation), where CONSTR loses its root and "
-                "the model breaks down")
-    level = "f_max" if c.branch == "AB" else "f_min"
-    return (f"an interior {'crest' if c.branch == 'AB' else 'trough'} of F (1 + sin alpha) on {c.branch} comes within "
-            f"{c.margin:.3g} (f_max - f_min) of {level}; it reaches it at {parameter} ~ {value:.10g} (linear "
-            "extrapolation), where the solution jumps one oscillation earlier and this orbit ends")
-
-
-def _failure_end(exc: Exception, points: list[BranchPoint], crests: list[Crest], parameter: str, span: float
-                 ) -> tuple[str, str, float]:
-    """Why a branch whose corrector fails at the smallest step ends: a crest, breakdown or grazing event
-    extrapolated ahead (within two steps or 1e-3 of the span; past a grazing the corrector's orbits break down),
-    else a breakdown of the corrector's orbit, else no convergence (module docstring)."""
-    if len(points) >= 2:
-        if not math.isfinite(crests[-1].margin + crests[-1].floor):  # crest_tol = 0: measure now
-            crests[-2:] = [crest_margin(p.orbit) for p in points[-2:]]
-        for event, value in sorted(_events_ahead(points, crests).items(), key=lambda e: abs(e[1] - points[-1].value)):
-            if _near(value, points[-1].value, points[-2].value, span) == value:
-                return event, _event_message(event, crests[-1], value, parameter, points[-1].orbit), value
-    if isinstance(exc, ModelBreakdown):  # with no event ahead: the corrector's orbit breaks down
-        return "breakdown", str(exc), math.nan
-    return "no_convergence", str(exc), math.nan
-
-
-def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: _Stepper, locate_tol: float) -> Bifurcation:
+def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: Stepper, locate_tol: float) -> Bifurcation:
     """Bisection along the arclength from ``a`` to ``b`` on :func:`_gauge` (module docstring)."""
     wa, wb = st.w(a), st.w(b)
     tau = (wb - wa) / np.linalg.norm(wb - wa)
@@ -431,7 +433,9 @@ def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: _Stepper, locate_tol:
         mid = 0.5 * (lo + hi)
         try:
             pm = st.correct(wa + mid * (wb - wa), tau)
-        except _FAILURES:
+        except FAILURES as exc:
+            if _out_of_wall(exc):
+                raise
             break
         gm = _gauge(kind, pm.orbit)
         if gm == 0 or math.copysign(1.0, gm) != math.copysign(1.0, ga):
@@ -442,58 +446,3 @@ def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: _Stepper, locate_tol:
     if kind == "fold" and min(a.value, b.value) < value < max(a.value, b.value):
         kind = "branch_point"  # a multiplier through +1 where λ does not turn back: not a fold
     return Bifurcation(kind, value, best.orbit, st.parameter)
-
-
-def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: float = 1e-10,
-                  rtol: float = 1e-12) -> PeriodicOrbit:
-    """The period-2n orbit born at a period doubling of a period-n branch.
-
-    Solves ``P^{2n}(x; λ) = x`` with ``e · (z - z*) = a`` (:func:`exact._corrector.bordered_newton`): ``z*`` the
-    scaled section state of the orbit at the bifurcation, ``e`` the eigenvector of its multiplier -1, ``a`` the
-    ``amplitude`` (then a/4 and 4a if Newton fails or returns the period-n orbit itself), λ free.  Continue the
-    result with :func:`continue_orbit` (its parameter is ``bifurcation.parameter``; the doubled branch lies on
-    the side of λ where the result is).
-
-    Parameters
-    ----------
-    bifurcation : Bifurcation
-        Of kind "period_doubling" (``OrbitBranch.bifurcations``).
-    amplitude : float
-        Distance from the period-n orbit along ``e`` in scaled section coordinates, in (0, 0.1].
-    tol, rtol : float
-        As :func:`exact.periodic_orbit`.
-
-    Returns
-    -------
-    PeriodicOrbit
-        With ``n`` twice the bifurcating orbit's.
-
-    Raises
-    ------
-    ValueError
-        Not a period doubling, or no doubled orbit found near it.
-    """
-    if not isinstance(bifurcation, Bifurcation) or bifurcation.kind != "period_doubling":
-        raise ValueError(f"bifurcation must be a period_doubling Bifurcation, got {bifurcation!r:.80}")
-    amplitude = in_range("amplitude", amplitude, 0.0, 0.1, lo_open=True)
-    o, lam = bifurcation.orbit, bifurcation.value
-    st = _Stepper(o, bifurcation.parameter, max(abs(lam), 1e-300), tol, rtol)
-    Js = o.monodromy * st.scale[None, :] / st.scale[:, None]
-    mu, vec = np.linalg.eig(Js)
-    e = np.real(vec[:, int(np.argmin(np.abs(mu + 1.0)))])
-    e /= np.linalg.norm(e)
-    z = o.section_states[0] / st.scale
-    tau = np.concatenate([e, [0.0]])
-    errors = []
-    for a in (amplitude, amplitude / 4, 4 * amplitude):
-        w_ref = np.concatenate([z + a * e, [lam / st.ls]])
-        try:
-            pt = st.correct(w_ref, tau, n=2 * o.n, max_iter=20, max_dlam=SWITCH_DLAM * max(abs(lam), 1e-300))
-        except _FAILURES as exc:
-            errors.append(f"a={a:.3g}: {exc}")
-            continue
-        if minimal_period(pt.orbit) == 2 * o.n:
-            return pt.orbit
-        errors.append(f"a={a:.3g}: Newton returned the period-{o.n} orbit")
-    raise ValueError(f"no period-{2 * o.n} orbit found near the period doubling at {bifurcation.parameter}="
-                     f"{lam:.10g}: " + "; ".join(errors))

@@ -24,11 +24,13 @@ from collections.abc import Callable
 import numpy as np
 
 from peelapprox import PeelForce, PeelParams
+from peelapprox.errors import WallBudget
+from peelapprox.validate import ArgumentTypeError
 
-from ._orbits import PeriodicOrbit, compose, make_orbit, section_return_n, system_of
+from ._orbits import PeriodicOrbit, check_wall, compose, make_orbit, section_return_n, system_of
 
-__all__ = ["PARAMETERS", "VARIANT_PARAMETERS", "bordered_newton", "branch_tangent", "parameter_value",
-           "with_parameter"]
+__all__ = ["PARAMETERS", "VARIANT_PARAMETERS", "bordered_newton", "branch_tangent", "check_parameter",
+           "parameter_value", "with_parameter"]
 
 #: The parameters of :func:`exact.continue_orbit` besides a family law's coefficients (``"force.<name>"``).
 PARAMETERS = ("V", "I", "k")
@@ -39,6 +41,20 @@ PARAMETERS = ("V", "I", "k")
 VARIANT_PARAMETERS = ("tape_mass", "load_mass", "load")
 #: Relative forward-difference step of ``∂P^n/∂λ``.
 FD_STEP = 1e-7
+
+
+def check_parameter(params: PeelParams, parameter: object) -> str:
+    """``parameter`` if it names a parameter of a continuation of ``params``' orbits: V, I, k or a coefficient
+    ``"force.<name>"`` of its family law; ArgumentTypeError for a non-string (None), ValueError for another name,
+    each listing the valid ones."""
+    if not isinstance(parameter, str):
+        law = params.force
+        coefs = ", ".join(f"force.{c}" for c, _ in law.coefficients) if law.kind == "family" else ""
+        raise ArgumentTypeError(f"parameter must be one of {', '.join(PARAMETERS)}"
+                                + (f" or a coefficient of the family law params.force ({coefs})" if coefs else "")
+                                + f" (a str), got {parameter!r} ({type(parameter).__name__})")
+    _coefficient(params, parameter)
+    return parameter
 
 
 def _coefficient(params: PeelParams, parameter: str) -> str | None:
@@ -90,19 +106,21 @@ def _residual(x: np.ndarray, xn: np.ndarray, scale: np.ndarray) -> float:
 
 def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.ndarray, lam0: float,
                     tau: np.ndarray, w_ref: np.ndarray, scale: np.ndarray, lam_scale: float, *, tol: float,
-                    rtol: float, max_iter: int = 8, max_dlam: float = math.inf) -> tuple[PeriodicOrbit, float]:
+                    rtol: float, max_iter: int = 8, max_dlam: float = math.inf, wall: WallBudget | None = None
+                    ) -> tuple[PeriodicOrbit, float]:
     """Solve the bordered system of the module docstring from ``(x0, lam0)``: ``(orbit, λ)``.
 
     Converged when the closing residual ``|P^n(x) - x| / max(1, |x|)`` (in ``x / scale``) is at most ``tol`` and
     the linear condition holds to ``1e-9 max(1, |w_ref|)``.  A Newton step that would move λ by more than
-    ``max_dlam`` is shortened to it.
+    ``max_dlam`` is shortened to it.  ``wall``, the caller's wall-clock budget, is checked before each iteration
+    and each halved step (:func:`exact._orbits.check_wall`).
 
     Raises
     ------
     ValueError
         No convergence in ``max_iter`` iterations (the residuals listed) or a singular bordered Jacobian.
     ModelBreakdown, SolverBudgetExceeded, SolverFailure
-        A return breaks down or never comes.
+        A return breaks down or never comes; ``wall`` is spent (``budget="max_wall"``).
     """
     wall0 = time.perf_counter()
     x, lam = np.asarray(x0, dtype=float).copy(), float(lam0)
@@ -110,6 +128,7 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
     steps = 0
     eye = np.eye(2)
     for _ in range(max_iter):
+        check_wall(wall, "continuation", x)
         p = params_at(lam)
         ts = system_of(p)
         xn, J, T, states, k, rates = compose(p, ts, x, n, rtol)
@@ -134,6 +153,7 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
             raise ValueError(f"bordered Newton: singular Jacobian at λ={lam:.10g}") from None
         s = min(1.0, max_dlam / lam_scale / abs(dw[2])) if dw[2] != 0 else 1.0
         for _ in range(9):  # halve a step that does not reduce the closing residual
+            check_wall(wall, "continuation", x)
             wt = w + s * dw
             xt, lt = wt[:2] * scale, float(wt[2] * lam_scale)
             pt = params_at(lt)

@@ -5,6 +5,9 @@ coefficient, as :func:`exact.continue_orbit`), drops the transient and keeps F a
 (``peelapprox.return_map``), with the period that ``peelapprox.periodicity`` reads off them.  It is the picture
 the continued branches are drawn over (``peelapprox.plotting.plot_bifurcation``): where the branches say an
 orbit is stable, the diagram should show it.
+
+Every call is bounded: at most :data:`MAX_DIAGRAM_VALUES` values (refused before any run) and a wall-clock budget
+``max_wall`` for all the runs together.
 """
 
 from __future__ import annotations
@@ -17,14 +20,21 @@ from typing import Any
 import numpy as np
 
 from peelapprox import WINDOW_DEFAULTS, PeelParams, periodicity, return_map
-from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure, WallBudget
 from peelapprox.io import ProgressLine
-from peelapprox.validate import duration, function, optional, reals
+from peelapprox.validate import duration, function, optional, positive, reals
+from peelapprox.validate import params as _params
 
+from ._attractors import DEFAULT_MAX_WALL
 from ._corrector import with_parameter
 from ._orbits import solve_orbit
 
-__all__ = ["OrbitDiagram", "explain", "orbit_diagram"]
+__all__ = ["MAX_DIAGRAM_VALUES", "OrbitDiagram", "explain", "orbit_diagram"]
+
+#: Most values of one :func:`orbit_diagram`: each is a run of ``t_transient + window`` (50 s of model time by
+#: default, ~0.1-1 s of wall time), so 1e5 values are a day of computing; the diagrams of docs/orbits.md have
+#: 20-400.  A larger grid is a typo (one zero too many), refused before the first run.
+MAX_DIAGRAM_VALUES = 100_000
 
 
 @dataclass(frozen=True)
@@ -40,7 +50,8 @@ class OrbitDiagram:
         F [N] at the AB→CD jumps of the window, per value (empty where the run broke down or has no jumps).
     labels : tuple of str
         ``"period-n"``, ``"aperiodic"``, ``"no stick-slip"``, ``"breakdown:<reason>"``, ``"budget:<name>"`` or
-        ``"solver_failure"`` per value (a failed value does not stop the diagram).
+        ``"solver_failure"`` per value (a failed value does not stop the diagram); ``"budget:max_wall"`` for the
+        value whose run the call's ``max_wall`` cut and every value after it, not run.
     wall_time : float
     """
 
@@ -107,7 +118,7 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
                   t_transient: float = WINDOW_DEFAULTS["t_transient"], window: float = WINDOW_DEFAULTS["window"],
                   rtol: float = WINDOW_DEFAULTS["rtol"], alpha0: float = 0.0, max_period: int = 32,
                   progress: bool | Callable[[int, int], None] = False, method: str | None = None,
-                  solver: str | None = None) -> OrbitDiagram:
+                  solver: str | None = None, max_wall: float | None = DEFAULT_MAX_WALL) -> OrbitDiagram:
     """The return map after ``t_transient`` over ``values`` of ``parameter`` (module docstring).
 
     Parameters
@@ -120,6 +131,7 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
         ``"tape_mass"``, 0 is the massless model (the hybrid method) and m > 0 the tape-mass model
         (``method="smooth"``), its jumps the crossings of the inflection velocity.
     values : sequence of float
+        At most :data:`MAX_DIAGRAM_VALUES` (1e5), each a valid value of ``parameter`` (PeelParams' range).
     t_transient, window : float
         Dropped and kept time of each run [s].
     rtol, alpha0 : float
@@ -132,27 +144,53 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     method, solver : str, optional
         Of each ``exact.simulate`` run (None: each run's model's method and its default solver; ``solver``
         is passed to the runs of a model variant only, the massless model's hybrid method having its own).
+    max_wall : float or None
+        Wall-clock budget [s] of all the runs together (None: unbounded; default :data:`exact.DEFAULT_MAX_WALL`,
+        3600 s), passed on to each run as what is left of it.  When it is spent the diagram is returned as
+        it stands, the rest of its values labelled ``"budget:max_wall"`` (a value whose run fails is a label, not
+        an error, and so is the budget).
 
     Returns
     -------
     OrbitDiagram
+        With every value given, in order (those the budget left out labelled ``"budget:max_wall"``).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A bad argument (named): more than :data:`MAX_DIAGRAM_VALUES` values, a value ``parameter`` cannot take.
     """
     from ._simulate import simulate
 
     wall0 = time.perf_counter()
+    params = _params("params", params)
+    count = np.size(values) if isinstance(values, np.ndarray) else len(values) if hasattr(values, "__len__") else 0
+    if count > MAX_DIAGRAM_VALUES:  # before converting them: a typo's 1e9 values would take minutes
+        raise ValueError(f"values must hold at most MAX_DIAGRAM_VALUES = {MAX_DIAGRAM_VALUES} values (1e5 runs are "
+                         f"about a day at ~1 s each: more is most likely a typo), got {count}")
     vals = reals("values", values)
+    if vals.size > MAX_DIAGRAM_VALUES:
+        raise ValueError(f"values must hold at most MAX_DIAGRAM_VALUES = {MAX_DIAGRAM_VALUES} values, got {vals.size}")
+    for x in {float(vals.min()), float(vals.max())}:  # the parameters' ranges are intervals: the ends decide
+        try:
+            with_parameter(params, parameter, x)
+        except ValueError as exc:
+            raise ValueError(f"values must be valid values of {parameter}, got {x!r}: {exc}") from None
     t_transient = duration("t_transient", t_transient, zero=True)
     window = duration("window", window)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     report: Callable[[int, int], None] | None = None
     line = ProgressLine(f"orbit diagram over {parameter}", vals.size) if progress is True else None
     if line is None:
         report = optional(function, "progress", progress or None)
-    returns, labels = [], []
-    for i, x in enumerate(vals.ravel()):
+    returns: list[np.ndarray] = []
+    labels: list[str] = []
+    for x in vals.ravel():
         p = with_parameter(params, parameter, float(x))
         try:
+            left = wall.left(0.0, {"t": 0.0}, t_transient + window)
             tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient,
-                          method=method, solver=solver if p.variant is not None else None)
+                          method=method, solver=solver if p.variant is not None else None, max_wall=left)
             F = return_map(tr)
             if F.size < 2:
                 label = "no stick-slip"
@@ -167,14 +205,21 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
             F, label = np.zeros(0), "solver_failure"
         returns.append(np.asarray(F, dtype=float))
         labels.append(label)
+        if label == "budget:max_wall":  # the call's budget (each run's max_wall is what is left of it)
+            rest = vals.size - len(labels)
+            returns += [np.zeros(0)] * rest
+            labels += [label] * rest
         if line is not None:
-            line.update(i + 1, f"{parameter}={float(x):.6g} {label}")
+            line.update(len(labels), f"{parameter}={float(x):.6g} {label}")
         elif report is not None:
-            report(i + 1, vals.size)
+            report(len(labels), vals.size)
+        if len(labels) == vals.size:
+            break
     return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
 
 
-def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-6) -> tuple[int | None, ...]:
+def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-6,
+            max_wall: float | None = DEFAULT_MAX_WALL) -> tuple[int | None, ...]:
     """Which continued branch, if any, explains each value of the brute-force diagram.
 
     A value whose long run is period n is explained by a branch of period-m orbits, m = n or a divisor of n,
@@ -190,12 +235,15 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         In ``diagram.parameter``.
     rtol : float
         Agreement of the orbit's and the run's cycle.
+    max_wall : float or None
+        Wall-clock budget [s] of all the Newton solves (None: unbounded; default :data:`exact.DEFAULT_MAX_WALL`):
+        once it is spent the values left are not examined (None), like values no branch explains.
 
     Returns
     -------
     tuple of (int or None)
         Per diagram value, the index into ``branches`` of the first branch that explains it; None where none
-        does or the run is not periodic.
+        does, the run is not periodic, or ``max_wall`` was spent before the value was examined.
     """
     from ._continuation import OrbitBranch
     from ._corrector import VARIANT_PARAMETERS
@@ -204,10 +252,13 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         raise ValueError(f"diagram: explain reads a diagram against continued branches of the paper's massless, "
                          f"velocity-controlled model, which continue_orbit does not follow in a model variant's "
                          f"parameter; got a diagram over {diagram.parameter!r}")
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     out: list[int | None] = []
     for x, F, lab in zip(diagram.values, diagram.returns, diagram.labels):
         found = None
         n = int(lab.split("-")[1]) if lab.startswith("period-") else 0
+        if wall.limit is not None and time.perf_counter() - wall.t0 >= wall.limit:
+            n = 0  # the budget is spent: not examined
         for i, b in enumerate(branches if n else ()):
             if not isinstance(b, OrbitBranch):
                 raise TypeError(f"branches must hold exact.OrbitBranch, got {type(b).__name__}")
@@ -218,7 +269,7 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
             q = b.points[int(np.argmin(np.abs(vals - x)))]
             try:
                 o = solve_orbit(with_parameter(q.orbit.params, diagram.parameter, float(x)),
-                                q.orbit.section_states[0], m, max_iter=10)
+                                q.orbit.section_states[0], m, max_iter=10, wall=wall)
             except (ValueError, ModelBreakdown, SolverFailure, SolverBudgetExceeded):
                 continue
             cycle = np.sort(np.tile(o.return_map_values, n // m))

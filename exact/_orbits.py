@@ -32,18 +32,20 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, PeelParams, periodicity
-from peelapprox.errors import SolverFailure
+from peelapprox import BREAKDOWN_LEVEL, T_TRANSIENT, PeelParams
+from peelapprox.errors import SolverBudgetExceeded, SolverFailure, WallBudget
 from peelapprox.io import fmt_number, html_table
 from peelapprox.kernels import M_R
 from peelapprox.kernels import status as _st
-from peelapprox.validate import duration, in_range, integer, optional
+from peelapprox.validate import duration, in_range, integer, optional, positive
 from peelapprox.validate import params as _params
 
-from ._attractors import paper_model_only
+from ._attractors import DEFAULT_MAX_WALL, paper_model_only
+from ._orbit_start import check_start, seed
 from ._tangent import TangentSystem, tangent_system
 
-__all__ = ["PeriodicOrbit", "SectionReturn", "monodromy_fd", "periodic_orbit", "section_return", "solve_orbit"]
+__all__ = ["PeriodicOrbit", "SectionReturn", "check_wall", "monodromy_fd", "periodic_orbit", "section_return",
+           "solve_orbit"]
 
 #: Relative tolerance of the tangent runs, whatever the state's ``rtol``: the tangent's directional difference
 #: quotient carries ~1e-9 relative noise, which a tighter error control would chase with ever smaller steps.
@@ -285,46 +287,9 @@ def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: 
     return x, J, T, np.array(states[:-1]), steps, np.array(rates)
 
 
-def _start(params: PeelParams, start: Any, n: int | None, t_transient: float, window: float, max_period: int,
-           rtol: float) -> tuple[np.ndarray, int]:
-    """``(x0, n)``: the section state to start Newton from and the jumps per period (module docstring of
-    :func:`periodic_orbit`)."""
-    from ._simulate import simulate
-    from ._trajectory import State, Trajectory
-
-    if isinstance(start, Trajectory):
-        tr, t0 = start, start.t_transient
-    else:
-        kw: dict = {}
-        if isinstance(start, State):
-            kw = dict(alpha0=start.alpha, omega0=start.omega, F0=start.F, branch0=start.branch)
-        elif start is not None:
-            raise TypeError(f"start must be None, an exact.Trajectory or an exact.State, got {type(start).__name__}")
-        tr = simulate(params, t_transient + window, rtol=rtol, save="jumps", t_transient=t_transient, **kw)
-        t0 = t_transient
-    j = tr.jumps
-    up = (j.from_branch == 0) & (j.t >= t0)
-    a, w, F = j.alpha[up], j.omega[up], j.F[up]
-    if F.size < 2:
-        raise ValueError(f"start: the run has {F.size} AB->CD jumps after its transient; a periodic orbit needs "
-                         "stick-slip (at least two returns): lengthen window or check params")
-    if n is None:
-        per = periodicity(F, max_period=max_period)
-        if per.period is None:
-            raise ValueError(f"start: the run's return map is {per.kind} for periods up to max_period={max_period}; "
-                             "give n (the jumps per period) to look for an unstable orbit near a recurrence")
-        n = int(per.period)
-    if F.size <= n:
-        raise ValueError(f"n={n} needs more than {n} AB->CD jumps after the transient; the run has {F.size}")
-    z = np.column_stack([a, w * params.R / params.V])
-    gap = np.linalg.norm(z[n:] - z[:-n], axis=1)
-    k = int(np.argmin(gap))  # the nearest recurrence: exact for a periodic attractor, a seed for an unstable one
-    return np.array([a[k], w[k]]), n
-
-
 def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = None, t_transient: float = T_TRANSIENT,
                    window: float = 20.0, tol: float = 1e-10, rtol: float = 1e-12, max_iter: int = 30,
-                   max_period: int = 32) -> PeriodicOrbit:
+                   max_period: int = 32, max_wall: float | None = DEFAULT_MAX_WALL) -> PeriodicOrbit:
     """A periodic orbit of the hybrid DAE with ``n`` AB→CD jumps per period, by Newton on the section map.
 
     Parameters
@@ -335,7 +300,10 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
         Where to look: None runs ``exact.simulate`` from the default start for ``t_transient + window`` s; a
         State runs from it; a Trajectory is used as it is (its jumps after its own ``t_transient``).  Newton
         starts from the AB→CD jump whose state comes back nearest after n returns (exact on a periodic
-        attractor; a near-recurrence of a chaotic run seeds an unstable orbit).
+        attractor; a near-recurrence of a chaotic run seeds an unstable orbit).  A State's fields must lie in
+        their ranges (``t`` in [0, 1e6], ``alpha``, ``omega``, ``F``, ``v`` in ``STATE_RANGES``, ``branch`` "AB"
+        or "CD", ``Vp`` None under velocity control); a Trajectory must be a run of ``params`` (same parameters
+        and peel-force law).
     n : int, optional
         AB→CD jumps per period (default: the period of the run's return map, ``peelapprox.periodicity``).  When
         Newton closes an orbit whose own period is a divisor d of n (a run read as period 2d before it settled),
@@ -350,6 +318,9 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
         Newton iterations, in [1, 200].
     max_period : int
         Largest period looked for when ``n`` is None.
+    max_wall : float or None
+        Wall-clock budget [s] of the whole call, the seed run's and every Newton iteration's (checked before
+        each); None: unbounded.  Default :data:`exact.DEFAULT_MAX_WALL` (3600 s).
 
     Returns
     -------
@@ -358,10 +329,11 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
     Raises
     ------
     ValueError
-        Bad arguments; no stick-slip or no period found in the run (give n); Newton did not converge within
-        ``max_iter`` (the message gives the residual history).
+        Bad arguments (``start.<field>`` for a bad start); no stick-slip or no period found in the run (give
+        n); Newton did not converge within ``max_iter`` (the message gives the residual history).
     ModelBreakdown, SolverBudgetExceeded, SolverFailure
-        A return breaks down or never comes.
+        A return breaks down or never comes; ``SolverBudgetExceeded`` with ``budget="max_wall"`` when
+        ``max_wall`` is spent.
     """
     wall0 = time.perf_counter()
     params = _params("params", params)
@@ -374,13 +346,31 @@ def periodic_orbit(params: PeelParams, *, start: Any = None, n: int | None = Non
     rtol = in_range("rtol", rtol, 1e-14, 1e-6)
     max_iter = integer("max_iter", max_iter, 1, 200)
     max_period = integer("max_period", max_period, 1, 1000)
+    check_start(params, start)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
     ts = system_of(params)  # no folds: no section (before the seed run)
-    x, n = _start(params, start, n, t_transient, window, max_period, min(1e-10, 100 * rtol))
-    o = solve_orbit(params, x, n, tol=tol, rtol=rtol, max_iter=max_iter, system=ts)
+    try:
+        x, n = seed(params, start, n, t_transient, window, max_period, min(1e-10, 100 * rtol),
+                    wall.left(0.0, {"t": 0.0}, t_transient + window))
+    except SolverBudgetExceeded as exc:
+        raise wall.reraise(exc) from None
+    o = solve_orbit(params, x, n, tol=tol, rtol=rtol, max_iter=max_iter, system=ts, wall=wall)
     d = minimal_period(o)
     if d < n:  # e.g. a slowly settling run read as period 2d: the orbit itself has the smaller period
-        o = solve_orbit(params, o.section_states[0], d, tol=tol, rtol=rtol, max_iter=max_iter, system=ts)
+        o = solve_orbit(params, o.section_states[0], d, tol=tol, rtol=rtol, max_iter=max_iter, system=ts, wall=wall)
     return dataclasses.replace(o, wall_time=time.perf_counter() - wall0)
+
+
+def check_wall(wall: WallBudget | None, what: str, x: np.ndarray) -> None:
+    """:class:`peelapprox.SolverBudgetExceeded` (``budget="max_wall"``, the section state ``x = (α, ω)`` at t = 0 of
+    the return about to start) once ``wall`` is spent: the check between the returns of a Newton iteration (a
+    return is one compiled run, bounded by its step budget, without a wall clock of its own)."""
+    if wall is None or wall.limit is None or time.perf_counter() - wall.t0 < wall.limit:
+        return
+    state = {"t": 0.0, "alpha": float(x[0]), "omega": float(x[1])}
+    raise SolverBudgetExceeded(f"{what}: more than {wall.limit:g} s of wall time (max_wall) at the section state "
+                               f"alpha={x[0]:.6g} rad, omega={x[1]:.6g} rad/s; pass a larger max_wall, or None",
+                               budget="max_wall", limit=wall.limit, t=0.0, state=state)
 
 
 #: Two section states of an orbit are the same point when they agree to this (scaled, relative).
@@ -398,16 +388,18 @@ def minimal_period(orbit: PeriodicOrbit) -> int:
 
 
 def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol: float = 1e-12,
-                max_iter: int = 30, system: TangentSystem | None = None) -> PeriodicOrbit:
+                max_iter: int = 30, system: TangentSystem | None = None, wall: WallBudget | None = None
+                ) -> PeriodicOrbit:
     """Newton on ``P^n(x) = x`` from the section state ``x0 = (α, ω)`` (module docstring); the work of
-    :func:`periodic_orbit` after its start, for callers with a start of their own (continuation).
+    :func:`periodic_orbit` after its start, for callers with a start of their own (continuation).  ``wall``: the
+    caller's wall-clock budget, checked before each Newton iteration (:func:`check_wall`).
 
     Raises
     ------
     ValueError
         Newton did not close the orbit to ``tol`` within ``max_iter`` iterations (the residuals are listed).
     ModelBreakdown, SolverBudgetExceeded, SolverFailure
-        A return breaks down or never comes.
+        A return breaks down or never comes; ``wall`` is spent (``budget="max_wall"``).
     """
     wall0 = time.perf_counter()
     ts = system or system_of(params)
@@ -416,6 +408,7 @@ def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol
     history: list[float] = []
     steps = 0
     for _ in range(max_iter):
+        check_wall(wall, "periodic_orbit", x)
         xn, J, T, states, k, rates = compose(params, ts, x, n, rtol)
         steps += k
         z, g = x / s, (xn - x) / s

@@ -44,8 +44,8 @@ API = {
         "VARIATIONAL_LAWS", "periodic_orbit", "PeriodicOrbit", "solve_orbit", "section_return", "SectionReturn",
         "monodromy_fd",
         "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation", "switch_branch", "crest_margin", "Crest",
-        "orbit_diagram", "OrbitDiagram", "explain",
-        "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor",
+        "orbit_diagram", "OrbitDiagram", "explain", "MAX_DIAGRAM_VALUES",
+        "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor", "MAX_BASIN_STARTS",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
@@ -59,7 +59,7 @@ API = {
                             "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
-        "MANIFEST", "RESERVED", "RESULTS", "record_key",
+        "MANIFEST", "RESERVED", "RESULTS", "record_key", "MAX_SWEEP_POINTS", "check_grid_size",
     },
     "peelapprox.validate": {
         "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",

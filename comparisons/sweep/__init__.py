@@ -30,7 +30,10 @@ defaults as there: a sweep of (I, V) for a given variant, one sweep per value to
 sweep the tape mass); ``jumps`` and ``period`` share one windowed run
 (``window_run``, one exact run per point) and read ``t_transient`` (30 s),
 ``t_end`` (t_transient + 20 s), ``rtol`` (1e-10) and ``alpha0`` (0);
-``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).  ``solver``
+``lyapunov`` reads ``t_transient`` and ``lyapunov_time`` (50 s).  The engine
+adds ``max_wall``, the seconds left of the sweep's wall-clock budget when the
+point starts (absent without a budget), which the built-in measures pass on to
+their runs (a user option of that name is refused).  ``solver``
 (None: the method's default, Radau) is the scipy solver of a variant's runs
 (``jumps``, ``period``, ``lyapunov``; ignored by the massless model's hybrid
 method).  Every option
@@ -48,6 +51,15 @@ data); the manifest (``force``, ``law``, ``law_key``, ``coef``) and every
 record of such a sweep (``law``, ``law_key``, ``coef``) say which law ran; a
 sweep of the paper's law writes none of these.  See
 :mod:`comparisons.sweep.law`.
+
+Bounds
+------
+A grid holds at most :data:`MAX_SWEEP_POINTS` (1e6) points, checked before
+anything is built or written (:func:`check_grid_size`, also the CLI's check of
+``--I x --V``).  ``max_wall`` (default 3600 s, None: unbounded) bounds a call:
+once it is spent no point starts, the points it cut are not recorded, and
+``SolverBudgetExceeded`` says how many points are done; the same call again
+resumes.  Within the limit, the manifest is written before the first point.
 
 Workers
 -------
@@ -92,7 +104,7 @@ Modules
 :mod:`~comparisons.sweep.measures`
     :data:`MEASURES`, :func:`register_measure` and the built-in measures.
 :mod:`~comparisons.sweep.grid`
-    :func:`parse_grid`.
+    :func:`parse_grid`, :data:`MAX_SWEEP_POINTS`, :func:`check_grid_size`.
 :mod:`~comparisons.sweep.task`
     One grid point in a worker (``run_point``) and how measures reach the
     workers (by import reference or by value).
@@ -111,10 +123,10 @@ Modules
 """
 
 from .engine import sweep
-from .grid import parse_grid
+from .grid import MAX_SWEEP_POINTS, check_grid_size, parse_grid
 from .measures import MEASURES, record_key, register_measure
 from .result import SweepResult, load_sweep
 from .store import MANIFEST, RESERVED, RESULTS
 
 __all__ = ["MEASURES", "register_measure", "sweep", "load_sweep", "SweepResult", "parse_grid",
-           "record_key", "RESERVED", "MANIFEST", "RESULTS"]
+           "record_key", "RESERVED", "MANIFEST", "RESULTS", "MAX_SWEEP_POINTS", "check_grid_size"]

@@ -1,10 +1,12 @@
 """The sweep itself: :func:`sweep` checks its arguments and every option, then computes the points left in
-``out`` (resume, retry of failed points) on an executor and appends each record as it finishes."""
+``out`` (resume, retry of failed points) on an executor and appends each record as it finishes, within its
+wall-clock budget ``max_wall``."""
 
 from __future__ import annotations
 
 import datetime as _dt
 import os
+import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
 from types import MappingProxyType
@@ -12,12 +14,14 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import PARAM_RANGES, PeelForce
+from exact import DEFAULT_MAX_WALL
+from peelapprox import PARAM_RANGES, PeelForce, SolverBudgetExceeded
 from peelapprox.io import ProgressLine, jsonable
-from peelapprox.validate import ArgumentTypeError, integer, optional
+from peelapprox.validate import ArgumentTypeError, integer, optional, positive
 from peelapprox.validate import path as _path
 
 from .._worker import SERIAL, run_tasks
+from .grid import check_grid_size, grid_length
 from .law import check_coef, check_force, manifest_fields
 from .measures import _OPTION_CHECKS, MEASURES, _ref
 from .result import SweepResult
@@ -36,7 +40,7 @@ from .store import (
     write_record,
 )
 from .store import lock as _lock
-from .task import PARAM_OPTIONS, make_params, run_point, worker_refs
+from .task import NOT_RUN, PARAM_OPTIONS, make_params, run_point, worker_refs
 
 __all__ = ["sweep"]
 
@@ -69,13 +73,15 @@ def sweep(
     retry_failed: bool = False,
     force: PeelForce | None = None,
     coef: tuple[str, Sequence[float] | np.ndarray] | None = None,
+    max_wall: float | None = DEFAULT_MAX_WALL,
 ) -> SweepResult:
     """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
 
     Parameters
     ----------
     I_values, V_values : sequence of float
-        Grid axes (finite, > 0, no repeats); every pair is one task.
+        Grid axes (finite, > 0, no repeats); every pair is one task.  The grid (with ``coef``, times its
+        values) holds at most :data:`~comparisons.sweep.grid.MAX_SWEEP_POINTS` (1e6) points.
     measures : str or sequence of str
         Names in :data:`MEASURES` (``"regime,jumps"`` is split at commas).
     out : path
@@ -117,6 +123,18 @@ def sweep(
         coefficient instead of it), e.g. ``force=PeelForce.cubic(),
         coef=("c", [250, 300, 350])``.  Each record holds its ``coef`` value and
         its law; :meth:`SweepResult.values` arrays are then 3-D.
+    max_wall : float or None
+        Wall-clock budget [s] of this call (None: unbounded; default
+        :data:`exact.DEFAULT_MAX_WALL`, 3600 s).  Each point's measures get what
+        is left of it as the option ``max_wall`` (the built-ins pass it on to
+        their runs); once it is spent no point is started, and the points it
+        cut are not recorded.  The records written stay in ``out``, and the
+        call raises ``SolverBudgetExceeded`` (``budget="max_wall"``, a
+        RuntimeError, ``partial`` the :class:`SweepResult` so far): calling
+        :func:`sweep` again with the same arguments computes the rest.  The
+        deadline is a time of the system clock, shared by the workers of a
+        cluster to their clocks' skew; a registered measure that ignores the
+        option ends its point in its own time.
 
     Returns
     -------
@@ -135,18 +153,29 @@ def sweep(
         ``out`` is locked by another sweep; or tasks were lost to the
         executor (a worker died): the records written stay, and calling
         :func:`sweep` again computes the lost points.
+    peelapprox.SolverBudgetExceeded
+        ``max_wall`` was spent (a RuntimeError; above).
 
     Notes
     -----
     A point whose measure raises is recorded with ``status = "error: ..."``
     and the sweep goes on; such points count as finished on resume unless
     ``retry_failed=True``.  Nothing is written before every argument and
-    option has been checked.
+    option has been checked; with every point left to compute, the manifest
+    is written before the first one.
     """
+    t0 = time.time()
+    sizes = {"I_values": grid_length(I_values), "V_values": grid_length(V_values)}
+    if isinstance(coef, (tuple, list)) and len(coef) == 2:
+        sizes["coef values"] = grid_length(coef[1])
+    check_grid_size(sizes)  # before the axes are converted: a typo's 1e8 values would take minutes
     I_vals = check_axis("I_values", I_values, *PARAM_RANGES["I"])
     V_vals = check_axis("V_values", V_values, *PARAM_RANGES["V"])
     force = check_force(force)
     coef_axis = check_coef(force, coef)
+    check_grid_size({"I_values": len(I_vals), "V_values": len(V_vals),
+                     **({"coef values": len(coef_axis[1])} if coef_axis else {})})
+    max_wall = optional(positive, "max_wall", max_wall)
     if isinstance(measures, str):
         measures = [m.strip() for m in measures.split(",") if m.strip()]
     if not isinstance(measures, (list, tuple)) or not all(isinstance(m, str) for m in measures):
@@ -167,6 +196,9 @@ def sweep(
     except (TypeError, ValueError) as exc:
         raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
             from None
+    if "max_wall" in options:
+        raise ValueError("options: max_wall is the sweep's own argument, sweep(max_wall=...) (the engine passes "
+                         "each point's measures what is left of it), not an option")
     _check_options(measures, options, force)
     max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
     if max_workers is not None:
@@ -201,8 +233,9 @@ def sweep(
         if not is_read_only(exc):
             raise
         return _sweep_read_only(exc, **plan)
+    deadline = None if max_wall is None else t0 + max_wall
     try:
-        return _sweep_locked(Plan(**plan), refs, task_refs, executor, max_workers, progress)
+        return _sweep_locked(Plan(**plan), refs, task_refs, executor, max_workers, progress, deadline, max_wall)
     finally:
         lock.close()
 
@@ -233,7 +266,8 @@ def _sweep_read_only(exc: OSError, **plan) -> SweepResult:
     raise ValueError(f"out={p.out!r} is not writable ({exc}) and {left}: make it writable or use another directory")
 
 
-def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress) -> SweepResult:
+def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress, deadline: float | None = None,
+                  max_wall: float | None = None) -> SweepResult:
     out = p.out
     if p.manifest is None:
         p.manifest = {
@@ -259,17 +293,27 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress) -> 
     done, todo, total = p.done, p.todo, p.total
     report = _progress_line(total, len(done)) if progress is True else (progress or None)
 
+    cut: list[tuple[float, ...]] = []
     with append_records(out) as fh:
         def write(key: tuple[float, ...], rec: dict) -> None:
             if point_key(rec, with_coef) != key:  # pragma: no cover - defensive
                 raise RuntimeError(f"executor returned the record of {point_key(rec, with_coef)} for {key}")
+            if rec["status"] == NOT_RUN:  # left out or cut by max_wall: not recorded, computed on resume
+                cut.append(key)
+                return
             write_record(fh, rec)
             done[key] = rec
             if report:
                 report(len(done), total, rec)
 
-        lost = run_tasks(run_point, [(key, _task(key, p, task_refs)) for key in todo], write, executor=executor,
-                         max_workers=max_workers)
+        lost = run_tasks(run_point, [(key, _task(key, p, task_refs, deadline)) for key in todo], write,
+                         executor=executor, max_workers=max_workers, deadline=deadline)
+    if deadline is not None and max_wall is not None and (cut or lost) and time.time() >= deadline:
+        raise SolverBudgetExceeded(
+            f"sweep: the wall-clock budget max_wall={max_wall:g} s was spent with {len(done)}/{total} points done "
+            f"(in {os.path.join(out, RESULTS)}; {len(cut) + len(lost)} not run or cut, not recorded): call sweep() "
+            "again with the same arguments to compute the rest, with a larger max_wall or None",
+            budget="max_wall", limit=max_wall, t=0.0, state={"t": 0.0}, partial=_result(p))
     if lost:
         hint = ""
         if executor is None and any("BrokenProcessPool" in err for _, err in lost):
@@ -283,10 +327,14 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress) -> 
     return _result(p)
 
 
-def _task(key: tuple[float, ...], p: Plan, task_refs) -> tuple:
+def _task(key: tuple[float, ...], p: Plan, task_refs, deadline: float | None = None) -> tuple:
     """The arguments of :func:`run_point` at ``key``: the paper's law without a coefficient axis passes no law
-    (the records of before); any other law travels pickled, with the point's coefficient value."""
+    (the records of before); any other law travels pickled, with the point's coefficient value; and the sweep's
+    ``deadline``, when it has one."""
     args: tuple = (key[0], key[1], p.measures, p.options, task_refs)
+    if deadline is not None:
+        law = p.force if p.coef is not None or p.force.kind != "paper" else None
+        return (*args, law, None if p.coef is None else (p.coef[0], key[2]), deadline)
     if p.coef is not None:
         return (*args, p.force, (p.coef[0], key[2]))
     if p.force.kind != "paper":

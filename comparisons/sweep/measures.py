@@ -114,7 +114,13 @@ def record_key(name: str, key: str) -> str:
 
 # --------------------------------------------------------------------------------------------- built-in measures
 # ``jumps`` and ``period`` share the one windowed exact run, :func:`exact.window_run` (its last call is cached,
-# so the two measures of a point compute it once).
+# so the two measures of a point compute it once).  Each passes its runs the engine's option ``max_wall``, what
+# is left of the sweep's wall-clock budget (absent: no budget), the same for every measure of a point.
+
+def _wall(options: Mapping) -> dict:
+    """``{"max_wall": seconds}`` from the engine's option ``max_wall`` (the sweep's budget left), else ``{}``."""
+    return {"max_wall": options["max_wall"]} if options.get("max_wall") is not None else {}
+
 
 def _measure_regime(params: PeelParams, options: Mapping) -> dict:
     """Regime label of :func:`peelapprox.estimate` and its closed-form time scales (a few ms)."""
@@ -148,7 +154,7 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     and the breakdown time ``t_breakdown``.
     """
     try:  # the same windowed run (and defaults) as the `period` measure: computed once per point
-        traj = window_run(params, **_window_options(options), **_solver(params, options))
+        traj = window_run(params, **_window_options(options), **_solver(params, options), **_wall(options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}", "t_breakdown": float(exc.t)}
     t = np.asarray(traj.jumps.t, dtype=float)
@@ -227,7 +233,7 @@ def measure_period(params: PeelParams, options) -> dict:
     kw = _period_options(options)
     period_rtol = kw.pop("period_rtol")
     try:
-        tr = window_run(params, **kw, **_solver(params, options))
+        tr = window_run(params, **kw, **_solver(params, options), **_wall(options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
     p = classify(tr, period_rtol=period_rtol)
@@ -242,7 +248,7 @@ def measure_lyapunov(params: PeelParams, options) -> dict:
     kw = _lyapunov_options(options)
     try:
         r = lyapunov(params, t_transient=kw["t_transient"], T=kw["lyapunov_time"], alpha0=kw["alpha0"],
-                     **_solver(params, options))
+                     **_solver(params, options), **_wall(options))
     except ModelBreakdown as exc:
         return {"status": f"breakdown:{exc.reason}"}
     return {"status": "ok", "bits_per_s": r.bits_per_s, "stderr_bits": r.stderr_bits, "n_jumps": r.n_jumps}

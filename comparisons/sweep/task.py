@@ -1,18 +1,23 @@
 """One grid point of a sweep, as it runs in a worker, and how the measures reach the workers.
 
 :func:`run_point` evaluates the measures at one (I, V) and returns its record; it never raises for a
-measure's failure (the point's status says it).  Workers get each measure by its import reference
+measure's failure (the point's status says it).  Under the sweep's wall-clock budget (a deadline, a
+``time.time()``) the measures get what is left of it as the option ``max_wall`` [s]; a point that begins after
+the deadline, or whose measure the deadline cut (``SolverBudgetExceeded``, ``budget="max_wall"``, once the
+deadline has passed), returns the status :data:`NOT_RUN`, which the engine does not record: the point is
+computed when the sweep is resumed.  Workers get each measure by its import reference
 ``module:qualname``, or by value (cloudpickle bytes) if they could not import it (:func:`worker_refs`).
 """
 
 from __future__ import annotations
 
 import importlib
+import time
 from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType, ModuleType
 from typing import Any, cast
 
-from peelapprox import PeelForce, PeelParams
+from peelapprox import PeelForce, PeelParams, SolverBudgetExceeded
 from peelapprox.io import jsonable
 
 from .._worker import error_text
@@ -20,7 +25,10 @@ from .law import LAW_KEYS, law_fields, point_law
 from .measures import MEASURES, Measure, _ref, record_key
 from .store import RESERVED
 
-__all__ = ["PARAM_OPTIONS", "run_point", "make_params", "worker_refs"]
+__all__ = ["NOT_RUN", "PARAM_OPTIONS", "run_point", "make_params", "worker_refs"]
+
+#: The status of a point the sweep's wall-clock budget left out or cut (module docstring): never recorded.
+NOT_RUN = "not run: max_wall"
 
 #: Options the engine turns into :class:`peelapprox.PeelParams` fields.
 #: The PeelParams fields a sweep's options set (besides I, V and the law): the model variant's too (a tape mass,
@@ -88,14 +96,15 @@ def make_params(I: float, V: float, options: Mapping, force: PeelForce | None = 
 
 def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
               refs: Mapping[str, str | bytes] | None = None, force: PeelForce | None = None,
-              coef: tuple[str, float] | None = None) -> dict:
+              coef: tuple[str, float] | None = None, deadline: float | None = None) -> dict:
     """Evaluate ``measures`` at one grid point; never raises for a measure's failure.
 
     Module level and plain-data in/out, so any executor can ship it.  ``refs``
     maps a measure's name to its import reference, or to its cloudpickle bytes.
     ``force`` is the sweep's law (a :class:`peelapprox.PeelForce`, pickled as
     plain data; None: the paper's) and ``coef`` = ``(name, value)`` the point's
-    value of a coefficient axis (:mod:`comparisons.sweep.law`).
+    value of a coefficient axis (:mod:`comparisons.sweep.law`).  ``deadline``:
+    the sweep's, a ``time.time()`` (module docstring; None: unbounded).
     Returns the record ``{"I", "V", "status", <measure keys>...}``; ``status``
     as in the docstring of :mod:`comparisons.sweep`; for a law other than the
     paper's or a coefficient axis, ``{"I", "V", ["coef",] "status", "law",
@@ -105,6 +114,9 @@ def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
     body: dict = {}
     error = reported = None
     head: dict = {"I": I, "V": V} if coef is None else {"I": I, "V": V, "coef": coef[1]}
+    left = None if deadline is None else deadline - time.time()
+    if left is not None and left <= 0:
+        return {**head, "status": NOT_RUN}
     try:
         law = None if force is None else point_law(force, *(coef or (None, None)))
         params = make_params(I, V, options, law)
@@ -112,7 +124,7 @@ def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
         return {**head, "status": error_text(exc)}
     if law is not None and (coef is not None or law.kind != "paper"):
         body.update(law_fields(law))
-    opts = MappingProxyType(dict(options))
+    opts = MappingProxyType(dict(options) if left is None else {**options, "max_wall": left})
     for name in measures:
         try:
             out = _prefixed(name, _resolve(name, refs.get(name))(params, opts))
@@ -124,6 +136,9 @@ def run_point(I: float, V: float, measures: Sequence[str], options: Mapping,
             if reported is None and isinstance(own, str) and own != "ok":
                 reported = own
         except Exception as exc:
+            if (deadline is not None and isinstance(exc, SolverBudgetExceeded) and exc.budget == "max_wall"
+                    and time.time() >= deadline):  # the sweep's budget, not the point's: computed on resume
+                return {**head, "status": NOT_RUN}
             err = error_text(exc)
             body[f"{name}_status"] = err
             error = error or err

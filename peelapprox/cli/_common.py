@@ -1,6 +1,7 @@
 """What the subcommands share: their help (:class:`HelpFormatter`, :func:`subcommand`: a description, examples,
 every default), the model's parameter options (the law's among them, :func:`add_params`, :func:`params_from_args`),
-printing a summary with units (:data:`UNITS`), writing a table that records the law."""
+the wall-clock budget ``--max-wall`` (:func:`add_max_wall_option`, :func:`wall_left`), printing a summary with
+units (:data:`UNITS`), writing a table that records the law."""
 
 from __future__ import annotations
 
@@ -8,16 +9,19 @@ import argparse
 import json
 import sys
 import textwrap
+import time
 from collections.abc import Sequence
 from typing import Any
 
 from .. import GEOMETRIES, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
+from ..errors import WallBudget
 from ..io import fmt_number, write_csv, write_rows
+from ._checks import positive_float
 from ._force import add_force_options, force_from_args, law_fields
 
-__all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "REDUCED_ONLY", "UNITS", "add_format", "add_params",
-           "add_variant_options", "params_from_args", "print_mapping", "variant_summary",
-           "say", "subcommand", "write_table"]
+__all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "MAX_WALL", "REDUCED_ONLY", "UNITS", "add_format",
+           "add_max_wall_option", "add_params", "add_variant_options", "params_from_args", "print_mapping",
+           "variant_summary", "say", "subcommand", "wall_left", "wall_spent", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
 #: header and one row), ``json``.
@@ -46,6 +50,32 @@ def subcommand(sub: Any, name: str, *, help: str, description: str, examples: Se
     text = "\n\n".join(textwrap.fill(p, 100) for p in description.split("\n\n"))
     epilog = "examples:\n" + "\n".join(f"  {e}" for e in examples)
     return sub.add_parser(name, help=help, description=text, epilog=epilog, formatter_class=HelpFormatter, **kwargs)
+
+
+#: The default ``--max-wall`` of every subcommand [s]: ten minutes, the longest a command run by hand should block
+#: unasked (the library's calls default to ``exact.DEFAULT_MAX_WALL``, an hour).
+MAX_WALL = 600.0
+
+
+def add_max_wall_option(parser: argparse.ArgumentParser | argparse._ArgumentGroup, default: float = MAX_WALL,
+                        what: str = "the whole command", spent: str = "") -> None:
+    """``--max-wall S``: the wall-clock budget [s] of ``what``, a positive number of seconds (``default`` 600);
+    ``spent`` says what happens when it is spent (appended to the help)."""
+    parser.add_argument("--max-wall", type=positive_float, default=default, metavar="S",
+                        help=f"wall-clock budget of {what} [s]" + (f"; {spent}" if spent else ""))
+
+
+def wall_spent(wall: WallBudget) -> bool:
+    """Whether the command's budget ``wall`` (of ``--max-wall``) is spent."""
+    return wall.limit is not None and time.perf_counter() - wall.t0 >= wall.limit
+
+
+def wall_left(wall: WallBudget) -> float | None:
+    """The seconds left of ``wall`` to pass on as a library call's ``max_wall`` (None: unbounded), at least 1 ms:
+    a call made as it runs out still starts, and stops at its own first check."""
+    if wall.limit is None:
+        return None
+    return max(1e-3, wall.limit - (time.perf_counter() - wall.t0))
 
 
 def add_variant_options(v: Any, *, loading_default: str | None = "velocity") -> None:

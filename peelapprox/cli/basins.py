@@ -11,7 +11,16 @@ import numpy as np
 from .. import WINDOW_DEFAULTS
 from ..io import write_csv
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float
-from ._common import FORMATS, HYBRID_ONLY, add_params, params_from_args, say, subcommand, write_table
+from ._common import (
+    FORMATS,
+    HYBRID_ONLY,
+    add_max_wall_option,
+    add_params,
+    params_from_args,
+    say,
+    subcommand,
+    write_table,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -33,7 +42,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     add_params(sp)
     sp.add_argument("--alpha0", required=True, metavar="LO:HI[:N]",
                     help="initial peel angles [rad] (default N: 11; a negative LO needs the = form: "
-                         "--alpha0=-0.3:0.3)")
+                         "--alpha0=-0.3:0.3); the grid holds at most 1000000 starts (exact.MAX_BASIN_STARTS)")
     axis = sp.add_mutually_exclusive_group(required=True)
     axis.add_argument("--F0", metavar="LO:HI[:N]", help="initial pull forces [N] (default N: 11)")
     axis.add_argument("--omega0", metavar="LO:HI[:N]", help="initial roller speeds [rad/s] (default N: 11)")
@@ -48,24 +57,34 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     help="what is printed: table (one line an attractor or outcome), csv (one row a start) or json")
     sp.add_argument("--out", help="write one row per start to this .csv, or everything to this .json")
     sp.add_argument("--plot", help="draw the label map to this image file")
+    add_max_wall_option(sp, what="the whole grid and the orbits",
+                        spent="when it is spent the starts not run are failures (failure:max_wall), what was "
+                              "computed is printed and written, and the exit status is 3")
     return sp
 
 
 def run(args: argparse.Namespace) -> int:
-    from exact import basins
+    from exact import MAX_BASIN_STARTS, basins
 
+    a_spec = _axis(args.alpha0, "--alpha0")
+    name, text = ("F0", args.F0) if args.F0 is not None else ("omega0", args.omega0)
+    v_spec = _axis(text, f"--{name}")
+    if a_spec[2] * v_spec[2] > MAX_BASIN_STARTS:  # before the axes are made
+        raise ValueError(f"--alpha0 x --{name}: the grid must hold at most {MAX_BASIN_STARTS} starts "
+                         f"(exact.MAX_BASIN_STARTS: a 1000 x 1000 picture is days of runs, more is most likely a "
+                         f"typo), got {a_spec[2]} x {v_spec[2]} = {a_spec[2] * v_spec[2]}")
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     p = params_from_args(args)
     if args.orbits and p.variant is not None:
         raise ValueError(f"--orbits with --tape-mass / --loading load: --orbits {HYBRID_ONLY}; drop --orbits to "
                          "classify the variant's attractors by runs alone")
-    a = np.linspace(*_axis(args.alpha0, "--alpha0"))
-    name, text = ("F0", args.F0) if args.F0 is not None else ("omega0", args.omega0)
-    values = np.linspace(*_axis(text, f"--{name}"))
+    a = np.linspace(*a_spec)
+    values = np.linspace(*v_spec)
     axes = dict(F0=values, omega0=None) if name == "F0" else dict(F0=None, omega0=values)
     r = basins(p, alpha0=a, F0=axes["F0"], omega0=axes["omega0"], t_transient=args.t_transient,
-               window=args.window, orbits=args.orbits, max_workers=args.workers, progress=True)
+               window=args.window, orbits=args.orbits, max_workers=args.workers, progress=True,
+               max_wall=args.max_wall)
     if args.format == "json":
         print(r.to_json())
     elif args.format == "csv":
@@ -91,6 +110,11 @@ def run(args: argparse.Namespace) -> int:
     if plot:
         r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²").savefig(plot, dpi=130)
         say(f"wrote {plot}")
+    cut = int(np.count_nonzero(r.texts == "failure:max_wall"))
+    if cut:
+        say(f"stopped: the --max-wall budget of {args.max_wall:g} s was spent; {cut} of the {r.texts.size} starts "
+            "were not run or were cut (failure:max_wall)")
+        return 3
     return 0
 
 

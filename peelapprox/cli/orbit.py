@@ -8,9 +8,22 @@ import argparse
 import numpy as np
 
 from .. import WINDOW_DEFAULTS
+from ..errors import WallBudget
 from . import _common
 from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float, positive_int
-from ._common import FORMATS, add_format, add_params, params_from_args, print_mapping, say, subcommand, write_table
+from ._common import (
+    FORMATS,
+    add_format,
+    add_max_wall_option,
+    add_params,
+    params_from_args,
+    print_mapping,
+    say,
+    subcommand,
+    wall_left,
+    wall_spent,
+    write_table,
+)
 from ._force import law_fields
 
 __all__ = ["add_bifurcation_parser", "add_orbit_parser", "run_bifurcation", "run_orbit"]
@@ -41,6 +54,8 @@ def add_orbit_parser(sub) -> argparse.ArgumentParser:
     add_format(sp)
     sp.add_argument("--out", help="also write the summary row to this .csv or .json")
     sp.add_argument("--plot", help="draw one period (F, alpha, v against t and the v-F plane) to this image file")
+    add_max_wall_option(sp, what="the seed run and Newton's method",
+                        spent="when it is spent the command stops with exit status 3")
     return sp
 
 
@@ -51,7 +66,8 @@ def run_orbit(args: argparse.Namespace) -> int:
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     p = params_from_args(args)
     start: State | None = initial_state(p, alpha0=args.alpha0) if args.alpha0 else None
-    o = periodic_orbit(p, start=start, n=args.n, t_transient=args.t_transient, window=args.window)
+    o = periodic_orbit(p, start=start, n=args.n, t_transient=args.t_transient, window=args.window,
+                       max_wall=args.max_wall)
     row: dict = dict(V=p.V, I=p.I, n=o.n, period=o.period, stable=o.stable, residual=o.residual,
                      newton_iterations=len(o.newton))
     for i, mu in enumerate(o.multipliers):
@@ -93,7 +109,7 @@ def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
                                                  "--force-family)")
     sp.add_argument("--range", required=True, metavar="LO:HI[:N]",
                     help="the parameter's range (in its unit: V [m/s], I [kg m^2], k [N/m]) and the diagram's "
-                         "number of values (default N: 40)")
+                         "number of values (default N: 40; at most 100000, exact.MAX_DIAGRAM_VALUES)")
     sp.add_argument("--seeds", metavar="X,X,...|auto",
                     help="parameter values at which orbits are found and continued both ways; auto (the default): "
                          "each periodic diagram value that no branch found so far explains (exact.explain), in "
@@ -108,15 +124,21 @@ def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
                          "[unit of --param], bifurcations, end), csv or json (the same as rows)")
     sp.add_argument("--out", help="write every diagram point and branch point to this .csv or .json")
     sp.add_argument("--plot", help="draw the diagram and the branches to this image file")
+    add_max_wall_option(sp, what="the whole command (the diagram's runs, the orbits, the branches)",
+                        spent="when it is spent the diagram's values left are labelled budget:max_wall, no branch "
+                              "is started and a running one ends (stopped: max_wall); what was computed is "
+                              "printed and written, and the exit status is 3")
     return sp
 
 
-def _continue(o, param: str, stop: float, lo: float, hi: float, max_points: int, depth: int, indent: str) -> list:
+def _continue(o, param: str, stop: float, lo: float, hi: float, max_points: int, depth: int, indent: str,
+              wall: WallBudget) -> list:
     """The branch of ``o`` towards ``stop`` and, to ``depth`` levels, the doubled branches of its period
-    doublings (each continued to the end of the range on the side where it lies)."""
-    from exact import continue_orbit, parameter_value, switch_branch
+    doublings (each continued to the end of the range on the side where it lies), within the command's budget
+    ``wall``."""
+    from exact import SolverBudgetExceeded, continue_orbit, parameter_value, switch_branch
 
-    b = continue_orbit(o, param, stop=stop, max_points=max_points)
+    b = continue_orbit(o, param, stop=stop, max_points=max_points, max_wall=wall_left(wall))
     say(f"{indent}  period-{o.n} branch to {param} = {stop:g}: {len(b.points)} orbits, stopped: {b.stopped} at "
         f"{b.end_value:.8g}; " + (", ".join(f"{x.kind} at {x.value:.8g}" for x in b.bifurcations)
                                   or "no bifurcation"))
@@ -124,22 +146,29 @@ def _continue(o, param: str, stop: float, lo: float, hi: float, max_points: int,
     for x in b.bifurcations:
         if x.kind != "period_doubling" or depth < 1:
             continue
+        if wall_spent(wall):
+            say(f"{indent}    no doubled branch: --max-wall spent")
+            continue
         try:
-            o2 = switch_branch(x)
-        except ValueError as exc:
+            o2 = switch_branch(x, max_wall=wall_left(wall))
+        except (ValueError, SolverBudgetExceeded) as exc:
             say(f"{indent}    no doubled branch: {exc}")
             continue
         v2 = parameter_value(o2.params, param)
-        out += _continue(o2, param, hi if v2 > x.value else lo, lo, hi, max_points, depth - 1, indent + "  ")
+        out += _continue(o2, param, hi if v2 > x.value else lo, lo, hi, max_points, depth - 1, indent + "  ", wall)
     return out
 
 
 def run_bifurcation(args: argparse.Namespace) -> int:
-    from exact import explain, initial_state, orbit_diagram, periodic_orbit, with_parameter
+    from exact import MAX_DIAGRAM_VALUES, explain, initial_state, orbit_diagram, periodic_orbit, with_parameter
 
+    wall = WallBudget(args.max_wall)
+    lo, hi, n = grid_range(args.range, "--range")
+    if n > MAX_DIAGRAM_VALUES:  # before the values are made
+        raise ValueError(f"--range: N must be at most {MAX_DIAGRAM_VALUES} (exact.MAX_DIAGRAM_VALUES: 1e5 runs are "
+                         f"about a day at ~1 s each, more is most likely a typo), got {n} in {args.range!r}")
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
-    lo, hi, n = grid_range(args.range, "--range")
     p = params_from_args(args)
     auto = args.seeds in (None, "auto")
     try:
@@ -150,25 +179,29 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         if not lo <= s <= hi:
             raise ValueError(f"--seeds must lie in --range [{lo}, {hi}], got {s}")
     diagram = orbit_diagram(p, args.param, np.linspace(lo, hi, n), t_transient=args.t_transient,
-                            window=args.window, alpha0=args.alpha0, progress=True)
+                            window=args.window, alpha0=args.alpha0, progress=True, max_wall=wall_left(wall))
     branches: list = []
     explained: list = [None] * n
 
     def grow(s: float) -> None:
         """Branches from the orbit at ``s`` both ways; the diagram values they explain."""
+        if wall_spent(wall):
+            say(f"orbit at {args.param} = {s:g}: not looked for, --max-wall spent")
+            return
         ps = with_parameter(p, args.param, s)
         say(f"orbit at {args.param} = {s:g} ...")
         start = initial_state(ps, alpha0=args.alpha0) if args.alpha0 else None
         try:
-            o = periodic_orbit(ps, start=start, t_transient=args.t_transient, window=args.window)
+            o = periodic_orbit(ps, start=start, t_transient=args.t_transient, window=args.window,
+                               max_wall=wall_left(wall))
         except (ValueError, RuntimeError) as exc:  # no periodic orbit closes there (or the run breaks down)
             say(f"  no orbit: {exc}")
             return
         new = []
         for stop in (lo, hi):
             if stop != s:
-                new += _continue(o, args.param, stop, lo, hi, args.max_points, args.switch, "")
-        for j, i in enumerate(explain(diagram, new)):
+                new += _continue(o, args.param, stop, lo, hi, args.max_points, args.switch, "", wall)
+        for j, i in enumerate(explain(diagram, new, max_wall=wall_left(wall))):
             if explained[j] is None and i is not None:
                 explained[j] = len(branches) + i
         branches.extend(new)
@@ -204,6 +237,10 @@ def run_bifurcation(args: argparse.Namespace) -> int:
 
         plot_bifurcation(diagram, branches, plot, title=f"{args.param} in [{lo:g}, {hi:g}]")
         say(f"wrote {plot}")
+    if wall_spent(wall) or "budget:max_wall" in diagram.labels or any(b.stopped == "max_wall" for b in branches):
+        say(f"stopped: the --max-wall budget of {args.max_wall:g} s was spent; the output holds what was computed "
+            "(diagram values labelled budget:max_wall, branches stopped: max_wall)")
+        return 3
     return 0
 
 

@@ -10,7 +10,7 @@ import time
 
 from .. import GEOMETRIES
 from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler, nonnegative_int, positive_int
-from ._common import add_variant_options, subcommand
+from ._common import add_max_wall_option, add_variant_options, subcommand
 from ._force import add_force_options, force_from_args
 
 __all__ = ["MEASURES_HELP", "add_parser", "run"]
@@ -48,7 +48,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                   "--measure period --out cubic/",
                   "peelapprox sweep --I 1e-5:1e-2:8:log --V 0.5:4:8 --dask-local 4 --out big/"])
     sw.add_argument("--I", required=True, metavar="SPEC",
-                    help="roller inertias [kg m^2]: start:stop:num[:log] or a comma list, e.g. 1e-5:1e-2:8:log")
+                    help="roller inertias [kg m^2]: start:stop:num[:log] or a comma list, e.g. 1e-5:1e-2:8:log; "
+                         "the grid (--I x --V, x --coef-axis) holds at most 1000000 points")
     sw.add_argument("--V", required=True, metavar="SPEC", help="pull speeds [m/s], same syntax, e.g. 0.4:4:10")
     sw.add_argument("--measure", default="regime", metavar="NAMES",
                     help=f"comma-separated measures: {', '.join(MEASURES_HELP)} (above), or registered ones")
@@ -97,6 +98,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sw.add_argument("--format", choices=("table", "md", "csv", "json"), default="table",
                     help="the table printed at the end: table (markdown; md is the same), csv or json")
     sw.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
+    add_max_wall_option(sw, what="this run",
+                        spent="when it is spent no point is started, the points done stay in DIR, the exit status "
+                              "is 3, and the same command again resumes the rest")
     return sw
 
 
@@ -119,10 +123,11 @@ def _options(args: argparse.Namespace) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from comparisons.sweep import MANIFEST, RESULTS, load_sweep, parse_grid, sweep
+    from comparisons.sweep import MANIFEST, RESULTS, check_grid_size, load_sweep, parse_grid, sweep
 
     I_values = parse_grid(args.I, name="--I")
     V_values = parse_grid(args.V, name="--V")
+    check_grid_size({"--I": I_values.size, "--V": V_values.size})
     options = _options(args)
     force = force_from_args(args)
     coef = None
@@ -134,6 +139,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError("--plot draws a 2-D (V, I) grid; with --coef-axis the grid is 3-D: plot from "
                              "load_sweep(DIR).values(KEY) instead")
         coef = (name, parse_grid(spec, name=f"--coef-axis {name}"))
+        check_grid_size({"--I": I_values.size, "--V": V_values.size, f"--coef-axis {name}": coef[1].size})
     check_output_path(args.out, "dir", "--out", read_only_ok=True)  # a complete sweep is only read
     if args.plot:
         check_sweep_plot_key(args.plot, [m.strip() for m in args.measure.split(",") if m.strip()])
@@ -163,7 +169,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor, max_workers=max_workers,
                        options=options, progress=not args.quiet, retry_failed=args.retry_failed, force=force,
-                       coef=coef)
+                       coef=coef, max_wall=args.max_wall)
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3

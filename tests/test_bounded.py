@@ -1,0 +1,305 @@
+"""Every call bounded in wall time, every grid size and start checked before the work starts.
+
+Each test replays a call that used to run for minutes (or to fail late, or with the wrong exception) and
+asserts that it now returns, or raises what it should, quickly.  The wall-clock bound asserted is
+:data:`BOUND` = 30 s against budgets of 0.5 s: the machine running the tests is shared and noisy, and what is
+tested is that the call is bounded (minutes before), not how fast it is.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import re
+import time
+
+import numpy as np
+import pytest
+
+import exact
+from exact import Bifurcation, State
+from peelapprox import PeelForce, PeelParams, SolverBudgetExceeded
+
+#: Seconds a bounded call may take here, whatever its budget (module docstring: boundedness, not speed).
+BOUND = 30.0
+#: The wall budget given to the calls under test [s].
+BUDGET = 0.5
+PAPER = PeelParams(V=1.0, I=1e-5)  # a stable period-3 orbit (docs/dynamics.md), Newton in well under a second
+
+
+@pytest.fixture(scope="module")
+def orbit():
+    return exact.periodic_orbit(PAPER)
+
+
+def _timed(fn, *args, **kwargs):
+    t0 = time.perf_counter()
+    out = fn(*args, **kwargs)
+    return out, time.perf_counter() - t0
+
+
+# ---------------------------------------------------------------------------------------------- continuation
+def test_continue_orbit_ends_with_max_wall_and_the_points_so_far(orbit):
+    """The continuation that ran over 330 s (steps of at most 1e-7 in V towards 1.1, up to 1e5 points) ends
+    with ``stopped="max_wall"`` once its 0.5 s are spent, within :data:`BOUND`: its points are orbits of the
+    branch (each closes to the default tol 1e-10, the corrector's own criterion), start at V = 1 and stay in
+    [1, 1.1], and the message names the budget."""
+    b, took = _timed(exact.continue_orbit, orbit, "V", stop=1.1, min_step=1e-9, max_step=1e-7, max_points=100_000,
+                     max_wall=BUDGET)
+    assert took < BOUND
+    assert b.stopped == "max_wall" and "max_wall=0.5 s" in b.message
+    assert 1 <= len(b.points) < 100_000
+    assert b.points[0].value == 1.0
+    assert all(1.0 <= p.value <= 1.1 for p in b.points)
+    assert all(p.orbit.residual <= 1e-10 for p in b.points)
+    assert b.end_value == b.points[-1].value
+
+
+@pytest.mark.parametrize("parameter, stop, exc, match", [
+    (None, 2.0, TypeError, r"parameter must be one of V, I, k .*got None"),
+    ("q", 2.0, ValueError, r"parameter must be one of V, I, k .*got 'q'"),
+    ("V", math.nan, ValueError, r"stop must be finite and in \(-inf, inf\), got nan"),
+    ("V", math.inf, ValueError, r"stop must be finite"),
+    ("V", -1.0, ValueError, r"stop must be a valid value of V, got -1.0: V must be finite and in \[1e-6, 100\]"),
+    ("V", 1.0, ValueError, r"stop must differ from the start's V=1.0"),
+])
+def test_continue_orbit_checks_parameter_and_stop(orbit, parameter, stop, exc, match):
+    """A bad ``parameter`` (None used to be an AttributeError) or ``stop`` (NaN used to read "stop must differ")
+    is refused by name, with the valid values, before any step: categorical, the exception type and message."""
+    with pytest.raises(exc, match=match):
+        exact.continue_orbit(orbit, parameter, stop=stop)
+
+
+def test_switch_branch_raises_max_wall(orbit):
+    """switch_branch returns one orbit or nothing, so a spent budget is ``SolverBudgetExceeded`` naming max_wall
+    (categorical), raised at the first check: a budget of 1 µs is spent before Newton's first iteration, so the
+    call returns within :data:`BOUND` whatever the bifurcation (here a stand-in at the period-3 orbit)."""
+    bif = Bifurcation("period_doubling", 1.0, orbit, "V")
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"switch_branch: more than 1e-06 s of wall time") as info:
+        exact.switch_branch(bif, max_wall=1e-6)
+    assert time.perf_counter() - t0 < BOUND
+    assert info.value.budget == "max_wall" and info.value.limit == 1e-6
+
+
+# ---------------------------------------------------------------------------------------------- periodic orbits
+_S0 = State(t=0.0, alpha=0.0, omega=0.0, F=250.0, v=1.0, branch="AB")
+
+
+@pytest.mark.parametrize("change, match", [
+    (dict(t=math.nan), r"start\.t must be finite and in \[0, 1e6\], got nan"),
+    (dict(v=math.nan), r"start\.v must be finite and in \(1e-150, 1000\], got nan"),
+    (dict(v=-1.0), r"start\.v must be finite and in \(1e-150, 1000\], got -1.0"),
+    (dict(Vp=1.0), r"start\.Vp must be None under velocity control"),
+    (dict(alpha=4.0), r"start\.alpha must be finite and in \[-3\.14159, 3\.14159\], got 4.0"),
+    (dict(branch="XY"), r"start\.branch must be one of \('AB', 'CD'\)"),
+])
+def test_periodic_orbit_checks_a_start_state(change, match):
+    """A start State with a field out of its range used to be run (NaN t, NaN or negative v, a pull speed under
+    velocity control silently ignored): now a ValueError naming ``start.<field>`` and its range (categorical)."""
+    with pytest.raises(ValueError, match=match):
+        exact.periodic_orbit(PAPER, start=dataclasses.replace(_S0, **change))
+
+
+@pytest.mark.parametrize("other, match", [
+    (PAPER.replace(I=2e-5), r"start\.params must be params .*I=2e-05 \(params: 1e-05\)"),
+    (PAPER.replace(force=PeelForce.cubic()), r"start\.params\.force must be params\.force"),
+])
+def test_periodic_orbit_checks_a_start_trajectory(other, match):
+    """A start Trajectory run with other parameters or another law used to seed Newton with another model's
+    orbit: now a ValueError naming ``start.params`` (or its ``force``) and the fields that differ."""
+    tr = exact.simulate(other, 0.1, save="jumps")
+    with pytest.raises(ValueError, match=match):
+        exact.periodic_orbit(PAPER, start=tr)
+
+
+def test_periodic_orbit_raises_max_wall():
+    """A seed run of 1e5 s (hours) under a 0.5 s budget raises ``SolverBudgetExceeded`` naming max_wall within
+    :data:`BOUND` (categorical)."""
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"more than 0.5 s of wall time \(max_wall\)") as info:
+        exact.periodic_orbit(PAPER, t_transient=1e5, max_wall=BUDGET)
+    assert time.perf_counter() - t0 < BOUND
+    assert info.value.budget == "max_wall"
+
+
+@pytest.mark.parametrize("bad, exc", [(0.0, ValueError), (-1.0, ValueError), (math.nan, ValueError),
+                                      (math.inf, ValueError), ("1", TypeError)])
+def test_max_wall_is_checked(orbit, bad, exc):
+    """max_wall must be a positive finite number or None, refused by name before any work (categorical)."""
+    for call in (lambda: exact.continue_orbit(orbit, "V", stop=1.1, max_wall=bad),
+                 lambda: exact.switch_branch(Bifurcation("period_doubling", 1.0, orbit, "V"), max_wall=bad),
+                 lambda: exact.periodic_orbit(PAPER, max_wall=bad)):
+        with pytest.raises(exc, match=r"max_wall must be"):
+            call()
+
+
+# ---------------------------------------------------------------------------------------------- orbit diagram
+def test_orbit_diagram_refuses_a_grid_too_large_at_once():
+    """The diagram of 1e6 values (the CLI's ``--range 0.9:1.1:1000000``, over 300 s) is refused before any run,
+    naming ``values`` and the limit :data:`exact.MAX_DIAGRAM_VALUES` (1e5), within :data:`BOUND`; a value the
+    parameter cannot take is refused up front too (it used to fail at its turn)."""
+    big = np.linspace(0.9, 1.1, 1_000_000)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"values must hold at most MAX_DIAGRAM_VALUES = 100000 values.*got 1000000"):
+        exact.orbit_diagram(PAPER, "V", big)
+    assert time.perf_counter() - t0 < BOUND
+    assert exact.MAX_DIAGRAM_VALUES == 100_000
+    with pytest.raises(ValueError, match=r"values must be valid values of V, got -1.0"):
+        exact.orbit_diagram(PAPER, "V", [1.0, -1.0])
+
+
+def test_orbit_diagram_returns_what_it_has_when_max_wall_is_spent():
+    """200 values of 50 s runs (minutes) under a 0.5 s budget: the diagram comes back within :data:`BOUND` with
+    all 200 values in order, the ones not run labelled ``budget:max_wall`` with no returns (at least the last:
+    a run takes far more than 0.5 s / 200), the others labelled as usual."""
+    vals = np.linspace(0.9, 1.1, 200)
+    d, took = _timed(exact.orbit_diagram, PAPER, "V", vals, max_wall=BUDGET)
+    assert took < BOUND
+    assert np.array_equal(d.values, vals) and len(d.labels) == len(d.returns) == 200
+    cut = [i for i, lab in enumerate(d.labels) if lab == "budget:max_wall"]
+    assert cut and cut == list(range(cut[0], 200))
+    assert all(d.returns[i].size == 0 for i in cut)
+
+
+# ---------------------------------------------------------------------------------------------- basins
+def test_basins_refuses_a_grid_too_large_at_once():
+    """A 2000 x 1000 grid (2e6 starts) is refused before any run, naming both axes and the limit
+    :data:`exact.MAX_BASIN_STARTS` (1e6), within :data:`BOUND` (the axes' lengths are read before they are
+    converted)."""
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"alpha0 x F0: the grid must hold at most MAX_BASIN_STARTS = 1000000 "
+                                         r"starts .*got 2000 x 1000 = 2000000"):
+        exact.basins(PAPER, alpha0=np.linspace(-0.3, 0.3, 2000), F0=np.linspace(200, 280, 1000))
+    assert time.perf_counter() - t0 < BOUND
+    assert exact.MAX_BASIN_STARTS == 10**6
+
+
+@pytest.mark.parametrize("workers", [0, 2], ids=["serial", "pool"])
+def test_basins_returns_every_start_when_max_wall_is_spent(workers):
+    """100 starts of 50 s runs (~0.2 s each) under a 0.5 s budget, in this process and on a pool of 2 spawned
+    workers: the result comes back within :data:`BOUND` with all 100 starts, those the budget left out or cut
+    labelled FAILURE with the text ``failure:max_wall`` (at least the last half: 0.5 s cannot run 50), the others
+    as usual; an attractor's orbit is found, or its ``orbit_error`` names max_wall (the budget is spent before
+    or during its search)."""
+    r, took = _timed(exact.basins, PAPER, alpha0=np.linspace(-0.3, 0.3, 10), F0=np.linspace(200.0, 280.0, 10),
+                     max_wall=BUDGET, max_workers=workers, progress=False, orbits=True)
+    assert took < BOUND
+    assert r.labels.shape == (10, 10)
+    cut = r.texts == "failure:max_wall"
+    assert cut.sum() >= 50 and np.all(r.labels[cut] == exact._basins.FAILURE)
+    assert all(a.orbit is not None or "max_wall" in (a.orbit_error or "") for a in r.attractors)
+
+
+# ---------------------------------------------------------------------------------------------- sweep
+def test_sweep_refuses_a_grid_too_large_at_once(tmp_path):
+    """``--I 1e-5:1e-3:100000000`` (over 200 s without even writing the manifest) is refused by parse_grid
+    before the values are made, and a 1e7-value axis given to the library before it is converted, naming the
+    option or axes and :data:`comparisons.sweep.MAX_SWEEP_POINTS` (1e6), within :data:`BOUND`; nothing is
+    written."""
+    from comparisons.sweep import MAX_SWEEP_POINTS, parse_grid, sweep
+
+    assert MAX_SWEEP_POINTS == 10**6
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"--I: num must be at most MAX_SWEEP_POINTS = 1000000 .*got 100000000"):
+        parse_grid("1e-5:1e-3:100000000", name="--I")
+    big = np.ones(10**7)  # the size check comes first: the values are not even looked at
+    with pytest.raises(ValueError, match=r"I_values x V_values: a sweep must hold at most MAX_SWEEP_POINTS = "
+                                         r"1000000 points .*got 10000000 x 2 = 20000000"):
+        sweep(big, [1.0, 2.0], out=tmp_path / "s")
+    with pytest.raises(ValueError, match=r"I_values x V_values x coef values: .*got 1000 x 1000 x 2 = 2000000"):
+        sweep(np.geomspace(1e-5, 1e-3, 1000), np.linspace(1.0, 2.0, 1000), "period", out=tmp_path / "s",
+              force=PeelForce.cubic(), coef=("c", [290.0, 300.0]))
+    assert time.perf_counter() - t0 < BOUND
+    assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("workers", [0, 2], ids=["serial", "pool"])
+def test_sweep_writes_its_manifest_first_and_stops_at_max_wall(tmp_path, workers):
+    """20 points of the period measure (a 50 s run each, ~0.2 s) under a 0.5 s budget, in this process and on a
+    pool of 2 spawned workers: the manifest exists before the first point is reported; the call raises
+    ``SolverBudgetExceeded`` naming max_wall within :data:`BOUND`, with the points done recorded (fewer than 20:
+    0.5 s cannot run them) and none of the points it cut; the same call without a budget then completes the
+    sweep, recording each point once (categorical counts)."""
+    from comparisons.sweep import sweep
+
+    out = tmp_path / "s"
+    seen: list[bool] = []
+    args = (np.geomspace(1e-5, 1e-3, 10), [1.0, 2.0], "period")
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"sweep: the wall-clock budget max_wall=0.5 s was spent") as info:
+        sweep(*args, out=out, max_workers=workers, max_wall=BUDGET,
+              progress=lambda done, total, rec: seen.append((out / "sweep.json").exists()))
+    assert time.perf_counter() - t0 < BOUND
+    assert info.value.budget == "max_wall" and all(seen) and (out / "sweep.json").exists()
+    done = len(info.value.partial.records)
+    assert done < 20 and len((out / "results.jsonl").read_text().splitlines()) == done
+    res = sweep(*args, out=out, max_workers=0, max_wall=None, progress=False)
+    assert len(res.records) == 20 and len((out / "results.jsonl").read_text().splitlines()) == 20
+    assert all(r["status"] == "ok" for r in res.records)
+
+
+# ---------------------------------------------------------------------------------------------- the command line
+def _cli(argv: list[str]) -> tuple[int, float]:
+    """``peelapprox ARGV``: the exit status (``SystemExit`` taken as its code) and the seconds it took."""
+    from peelapprox.cli import main
+
+    t0 = time.perf_counter()
+    try:
+        rc = main(argv)
+    except SystemExit as exc:
+        rc = int(exc.code or 0)
+    return rc, time.perf_counter() - t0
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["bifurcation", "--V", "1", "--I", "1e-5", "--range", "0.9:1.1:1000000"],
+     r"--range: N must be at most 100000 .*got 1000000"),
+    (["sweep", "--I", "1e-5:1e-3:100000000", "--V", "1"], r"--I: num must be at most MAX_SWEEP_POINTS = 1000000"),
+    (["sweep", "--I", "1e-5:1e-3:1000:log", "--V", "1:2:2000"],
+     r"--I x --V: a sweep must hold at most MAX_SWEEP_POINTS = 1000000 points .*got 1000 x 2000 = 2000000"),
+    (["basins", "--V", "1", "--I", "1e-5", "--alpha0", "0:0.3:2000", "--F0", "200:280:1000"],
+     r"--alpha0 x --F0: the grid must hold at most 1000000 starts .*got 2000 x 1000 = 2000000"),
+])
+def test_cli_refuses_a_grid_too_large_at_once(tmp_path, capsys, argv, match):
+    """The command lines that ran for minutes (``bifurcation --range 0.9:1.1:1000000``, ``sweep --I
+    1e-5:1e-3:100000000``) and their kin exit with status 2 (a bad argument) within :data:`BOUND`, the message
+    naming the option and the limit; the sweep's directory is not even created (categorical)."""
+    out = tmp_path / "s"
+    rc, took = _cli(argv + (["--out", str(out)] if argv[0] == "sweep" else []))
+    assert rc == 2 and took < BOUND
+    assert re.search(match, capsys.readouterr().err)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv, after", [
+    (["orbit", "--V", "1", "--I", "1e-5", "--t-transient", "100000"], "error: more than 0.5 s of wall time"),
+    (["bifurcation", "--V", "1", "--I", "1e-5", "--range", "0.9:1.1:100"], "stopped: the --max-wall budget"),
+    (["basins", "--V", "1", "--I", "1e-5", "--alpha0", "0:0.3:10", "--F0", "200:280:10", "--workers", "0"],
+     "stopped: the --max-wall budget"),
+    (["sweep", "--I", "1e-5:1e-3:10:log", "--V", "1:2:2", "--measure", "period", "--workers", "0", "--quiet"],
+     "error: sweep: the wall-clock budget max_wall=0.5 s was spent"),
+])
+def test_cli_max_wall_bounds_each_command(tmp_path, capsys, argv, after):
+    """Each of orbit, bifurcation, basins and sweep, given work for minutes and ``--max-wall 0.5``, ends within
+    :data:`BOUND` with exit status 3 (a solver stop) and says why on stderr; the sweep leaves its manifest in its
+    directory for the same command to resume (categorical)."""
+    out = tmp_path / "s"
+    rc, took = _cli(argv + ["--max-wall", str(BUDGET)] + (["--out", str(out)] if argv[0] == "sweep" else []))
+    assert rc == 3 and took < BOUND
+    assert after in capsys.readouterr().err
+    if argv[0] == "sweep":
+        assert (out / "sweep.json").exists()
+
+
+@pytest.mark.parametrize("command", ["orbit", "bifurcation", "basins", "sweep", "simulate", "dynamics"])
+def test_every_cli_max_wall_defaults_to_600_seconds(command):
+    """``--max-wall`` of every subcommand that runs the exact model defaults to 600 s and says so in its help
+    (exact value and text)."""
+    from peelapprox.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    action = next(a for a in sub._actions if "--max-wall" in a.option_strings)
+    assert action.default == 600.0
+    assert "(default: 600)" in " ".join(sub.format_help().split())
