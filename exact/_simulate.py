@@ -22,7 +22,7 @@ from peelapprox import (
 )
 from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
 from peelapprox.io import ProgressLine
-from peelapprox.kernels import ALL_LAWS, model_block
+from peelapprox.kernels import ALL_LAWS, BuildExpired, caller_budget, model_block
 from peelapprox.kernels import status as S
 from peelapprox.validate import choice, duration, in_range, optional, state
 from peelapprox.validate import params as _params
@@ -309,21 +309,30 @@ def simulate(
     elif progress is not None and not callable(progress):
         raise TypeError(f"progress must be None, a bool or a callable (t, t_end), got {type(progress).__name__}")
 
-    st0 = initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
-    if Vp0 is not None:
-        if params.loading != "load":
-            raise ValueError(f"Vp0 (the initial pull speed) applies only under loading='load'; got Vp0={Vp0!r} with "
-                             "loading='velocity' (the pull speed is params.V)")
-        st0 = dataclasses.replace(st0, Vp=in_range("Vp0", Vp0, 0.0, VP0_MAX))
-    if isinstance(opts, Hybrid):
-        ct = compile_kernels()
-        traj = _run_hybrid(params, t_end, st0, opts, out, lim, progress)
-        if ct:
-            traj.stats = SolverStats(**{**traj.stats.__dict__, "compile_time": ct})
-        return traj
-    from ._regularized import run_regularized
+    st0 = None
+    try:
+        with caller_budget(lim.max_wall):  # an expression law compiled for this run is bounded by max_wall too
+            st0 = initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
+            if Vp0 is not None:
+                if params.loading != "load":
+                    raise ValueError(f"Vp0 (the initial pull speed) applies only under loading='load'; got Vp0={Vp0!r} "
+                                     "with loading='velocity' (the pull speed is params.V)")
+                st0 = dataclasses.replace(st0, Vp=in_range("Vp0", Vp0, 0.0, VP0_MAX))
+            if isinstance(opts, Hybrid):
+                ct = compile_kernels()
+                traj = _run_hybrid(params, t_end, st0, opts, out, lim, progress)
+                if ct:
+                    traj.stats = SolverStats(**{**traj.stats.__dict__, "compile_time": ct})
+                return traj
+            from ._regularized import run_regularized
 
-    return run_regularized(params, t_end, st0, opts, out, lim, progress)  # the ε-scheme and the variants' ODEs
+            return run_regularized(params, t_end, st0, opts, out, lim, progress)  # the ε-scheme, the variants' ODEs
+    except BuildExpired:
+        raise SolverBudgetExceeded(f"more than {lim.max_wall:g} s of wall time (max_wall) compiling the peel-force "
+                                   f"law {params.force!r} before the run started; pass a larger max_wall, or None "
+                                   "(a law is compiled once per machine, then loaded from the cache)", budget="max_wall",
+                                   limit=float(lim.max_wall or 0.0), t=0.0 if st0 is None else st0.t,
+                                   state={"t": 0.0} if st0 is None else dataclasses.asdict(st0)) from None
 
 
 #: Largest initial pull speed ``Vp0`` [m/s] under a load: the model's velocities stay below 1e3 m/s (STATE_RANGES).

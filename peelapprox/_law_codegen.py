@@ -46,8 +46,10 @@ from typing import Any
 
 import numpy as np
 
+from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
 from ._jit import kernel
 from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
+from ._law_grammar import shorten
 from .errors import KernelCacheWarning
 
 __all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "expression_source",
@@ -468,16 +470,38 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     directory is used for this process, with a :class:`~peelapprox.errors.KernelCacheWarning` naming why.
     Memoised per process.
 
+    Bounded in wall time: :data:`peelapprox._deadline.LAW_BUILD_SECONDS`, or the caller's budget
+    (:func:`peelapprox._deadline.caller_budget`, e.g. ``simulate``'s ``max_wall``) if that is nearer.
+
     Raises
     ------
     TypeError
         ``source`` is not a string.
+    ValueError
+        ``source`` is not a law of the grammar, or rendering and compiling it took longer than
+        ``LAW_BUILD_SECONDS``.
+    peelapprox._deadline.Expired
+        The caller's budget ran out (the caller turns it into its budget exception).
     """
     if not isinstance(source, str):
         raise TypeError(f"source must be the canonical text (str) of an expression law, got {type(source).__name__}")
     hit = _EXPRESSION_KERNELS.get(source)
     if hit is not None:
         return hit
+    try:
+        with time_limit(LAW_BUILD_SECONDS):
+            law, pack = _build_kernel(source)
+    except Expired as exc:
+        if exc.caller:  # the caller's max_wall: its own budget exception (exact.simulate turns it into one)
+            raise
+        raise ValueError(f"expression law {shorten(source)}: rendering and compiling it took more than "
+                         f"{LAW_BUILD_SECONDS:g} s; write it in a simpler form (expanded, fewer factors)") from None
+    _EXPRESSION_KERNELS[source] = (law, pack)
+    return _EXPRESSION_KERNELS[source]
+
+
+def _build_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
+    """:func:`expression_kernel`'s work: render, verify or write the module, compile."""
     digest = hashlib.sha256(f"{source}\0{codegen_version()}".encode()).hexdigest()
     d = _law_dir()
     path = d / f"law_{digest[:32]}.py"
@@ -498,9 +522,7 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     code = compile(text, str(path), "exec")
     sys.modules[modname] = mod
     _run_module(code, mod.__dict__)
-    law = kernel(signature=LAW_SIG, outside=True)(mod.law)
-    _EXPRESSION_KERNELS[source] = (law, mod.pack)
-    return _EXPRESSION_KERNELS[source]
+    return kernel(signature=LAW_SIG, outside=True)(mod.law), mod.pack
 
 
 if __name__ == "__main__":  # pragma: no cover

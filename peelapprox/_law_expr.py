@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from . import _law_grammar
+from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
 
 __all__ = ["PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical", "from_stored", "from_text"]
 
@@ -113,6 +114,20 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
         text = _law_grammar.canonical_text(expr)
     else:
         raise TypeError(f"expression must be a string or a sympy expression, got {type(expr).__name__}")
+    try:
+        with time_limit(LAW_BUILD_SECONDS):
+            return _checked_text(text, values, label)
+    except Expired:
+        raise ValueError(f"expression {label}: building it (sympy's derivatives f' and f'' and the probe) took "
+                         f"more than {LAW_BUILD_SECONDS:g} s; write it in a simpler form (expanded, fewer factors)"
+                         ) from None
+
+
+def _checked_text(text: str, values: dict[str, Any], label: str) -> str:
+    """:func:`canonical`'s work on the text, once the constants are checked."""
+    import sympy as sp
+
+    v, V = _symbols()
     e, used = _law_grammar.parse(text, {"v": v, "V": V, **values})
     unused = sorted(set(values) - used)
     if unused:

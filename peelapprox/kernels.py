@@ -29,6 +29,8 @@ import numpy as np
 from numba import types as _nb
 
 from . import _status as status
+from ._deadline import Expired as BuildExpired
+from ._deadline import caller_budget
 from ._diffsl import (
     DIFFSL_INPUTS,
     DIFFSL_TANGENT_INPUTS,
@@ -105,6 +107,7 @@ __all__ = [
     "state_at", "workspace",
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
     "diffsl_inputs", "diffsl_model", "import_optional",
+    "BuildExpired", "caller_budget",  # a public call's max_wall handed down to the law compilation it triggers
 ]
 
 def regularized_parameters(params, eps: float, laws: tuple[str, ...] = ("paper",)) -> np.ndarray:

@@ -221,6 +221,39 @@ def test_long_input_is_not_echoed_whole():
     assert len(str(exc.value)) < 400 and "700001 characters" in str(exc.value)
 
 
+# ------------------------------------------------------------------------------------- bounded law builds
+def test_a_law_costly_to_differentiate_is_stopped(monkeypatch):
+    """Hypothesis: within the grammar's size limits sympy can still take minutes (f'' of a product of 39
+    binomials: over 5 min measured); the build is interrupted at LAW_BUILD_SECONDS (here 1 s) with a ValueError
+    saying so, returning within 10 s (the interval timer lands within milliseconds; 10 s allows a noisy
+    machine)."""
+    import peelapprox._law_expr as E
+
+    monkeypatch.setattr(E, "LAW_BUILD_SECONDS", 1.0)
+    text = "150 + 300*v - 300*v**2 + 80*v**3 + 1e-9*" + "*".join(f"(v+{i})" for i in range(1, 40))
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="took more than 1 s"):
+        PeelForce.expression(text)
+    assert time.perf_counter() - t0 < 10.0
+
+
+def test_simulate_max_wall_bounds_the_law_compilation(law_dir):
+    """Hypothesis: ``simulate(max_wall=0.05)`` with an expression law not yet compiled (an empty cache: numba
+    takes ~0.3 s) stops in the compilation with SolverBudgetExceeded(budget="max_wall") at t = 0, instead of
+    running past its budget (the probe: 210 s against max_wall=2); a later run with a budget compiles and
+    runs to t_end (exact: the last stored time is t_end)."""
+    from exact import simulate
+    from peelapprox.errors import SolverBudgetExceeded
+
+    params = PeelParams(V=1.0, I=1e-5, force=PeelForce.expression("153 + 300*v - 300*v**2 + 80*v**3"))
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match="compiling the peel-force law") as exc:
+        simulate(params, 0.01, max_wall=0.05)
+    assert time.perf_counter() - t0 < 10.0 and exc.value.budget == "max_wall" and exc.value.t == 0.0
+    tr = simulate(params, 0.01, max_wall=120.0)
+    assert tr.t[-1] == 0.01 and np.all(np.isfinite(tr.F))
+
+
 # ------------------------------------------------------------------------------------------ the law cache
 @pytest.fixture
 def law_dir(tmp_path, monkeypatch):

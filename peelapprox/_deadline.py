@@ -1,0 +1,93 @@
+"""Wall-clock limits on work that has no clock of its own: sympy's algebra and numba's compilation of a law.
+
+A solver checks its wall budget between steps; differentiating a law with sympy or compiling it with numba is
+one long call that checks nothing.  :func:`time_limit` bounds such a call: in the main thread of a POSIX
+process it arms an interval timer (``signal.setitimer``) whose handler raises :class:`Expired` inside the
+running code (sympy and numba's front end are Python, so the exception lands within milliseconds; a single
+LLVM optimisation pass is not interrupted but is itself bounded by the size limits of the expression grammar).
+Elsewhere (another thread, Windows, a caller's own timer already armed) it cannot interrupt and checks the
+clock when the call returns instead.  The previous signal handler and timer are restored on exit.
+
+:func:`caller_budget` hands a public call's ``max_wall`` (e.g. :func:`exact.simulate`'s) down to the law
+compilation it triggers without threading it through every signature: the nearer of the two deadlines
+applies, and :attr:`Expired.caller` says whether the caller's was the one that expired.
+"""
+
+from __future__ import annotations
+
+import contextvars
+import signal
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+__all__ = ["LAW_BUILD_SECONDS", "Expired", "caller_budget", "time_limit"]
+
+#: The longest a law may take to be built (sympy: parse, derivatives, probe) or compiled (render, numba) [s]:
+#: the families and the paper's law written out take well under 1 s; a law needing a minute of algebra is one
+#: to write differently (expanded, fewer factors).
+LAW_BUILD_SECONDS = 60.0
+
+#: The caller's deadline (``time.perf_counter()`` value), if a public call set one (:func:`caller_budget`).
+_CALLER: contextvars.ContextVar[float | None] = contextvars.ContextVar("peelapprox_caller_deadline", default=None)
+
+
+class Expired(Exception):  # noqa: N818 - an event, not an error the user sees (callers turn it into theirs)
+    """The time limit of :func:`time_limit` ran out; ``seconds`` is the limit that applied, ``caller`` is True
+    when it was the caller's budget (:func:`caller_budget`) rather than the limit of the call itself."""
+
+    def __init__(self, seconds: float, caller: bool) -> None:
+        super().__init__(f"more than {seconds:g} s")
+        self.seconds = seconds
+        self.caller = caller
+
+
+@contextmanager
+def caller_budget(max_wall: float | None) -> Iterator[None]:
+    """Make ``max_wall`` seconds from now the deadline of every :func:`time_limit` inside (None: no change)."""
+    if max_wall is None:
+        yield
+        return
+    deadline = time.perf_counter() + max_wall
+    outer = _CALLER.get()
+    token = _CALLER.set(deadline if outer is None else min(outer, deadline))
+    try:
+        yield
+    finally:
+        _CALLER.reset(token)
+
+
+def _can_interrupt() -> bool:
+    return (hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
+            and signal.getitimer(signal.ITIMER_REAL)[0] == 0.0)
+
+
+@contextmanager
+def time_limit(seconds: float) -> Iterator[None]:
+    """Raise :class:`Expired` if the body runs longer than ``seconds`` or past the caller's deadline.
+
+    Interrupts the body where it can (module docstring), else raises when the body returns late.
+    """
+    now = time.perf_counter()
+    outer = _CALLER.get()
+    caller = outer is not None and outer - now < seconds
+    limit = (outer - now) if caller and outer is not None else seconds
+    if limit <= 0.0:
+        raise Expired(0.0, caller)
+    if not _can_interrupt():
+        yield
+        if time.perf_counter() - now > limit:
+            raise Expired(limit, caller)
+        return
+
+    def _expire(signum: int, frame: object) -> None:
+        raise Expired(limit, caller)
+
+    previous = signal.signal(signal.SIGALRM, _expire)
+    signal.setitimer(signal.ITIMER_REAL, limit)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
