@@ -105,12 +105,12 @@ def coefficients(family: Family, given: dict) -> tuple[tuple[str, float], ...]:
     Raises ValueError naming an unknown coefficient (with the valid names), a non-finite one, or one of
     ``family.positive`` that is not > 0; TypeError (ArgumentTypeError) for a non-number.
     """
-    from ._checks import in_range, real
+    from ._checks import in_range, real, shown
 
     unknown = sorted(set(given) - set(family.names))
     if unknown:
-        raise ValueError(f"unknown coefficient(s) {', '.join(unknown)} of the {family.name!r} peel-force "
-                         f"family: its coefficients are {', '.join(family.names)}")
+        raise ValueError(f"unknown coefficient(s) {', '.join(shown(n) for n in unknown)} of the {family.name!r} "
+                         f"peel-force family: its coefficients are {', '.join(family.names)}")
     out = []
     for name, default in family.defaults:
         x = given.get(name, default)

@@ -28,6 +28,7 @@ import textwrap
 from typing import Any
 
 from .. import PeelForce
+from ..validate import shown
 
 __all__ = ["TABLE_COLUMNS", "add_force_options", "families_help", "force_from_args", "law_fields", "name_value",
            "read_force_table"]
@@ -65,7 +66,7 @@ def name_value(text: str) -> tuple[str, int | float]:
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or not name.isidentifier():
-        raise argparse.ArgumentTypeError(f"value must be NAME=VALUE (e.g. a=150), got {text!r}")
+        raise argparse.ArgumentTypeError(f"value must be NAME=VALUE (e.g. a=150), got {shown(text)}")
     try:
         return name, int(value)
     except ValueError:
@@ -73,7 +74,7 @@ def name_value(text: str) -> tuple[str, int | float]:
     try:
         x = float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"value of {name} must be a real number, got {value.strip()!r}") from None
+        raise argparse.ArgumentTypeError(f"value of {name} must be a real number, got {shown(value.strip())}") from None
     return name, x
 
 
