@@ -11,7 +11,9 @@ import textwrap
 from collections.abc import Sequence
 from typing import Any
 
-from .. import GEOMETRIES, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
+from .. import GEOMETRIES, GRAVITY, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
+from .._checks import interval
+from .._params import default_load_masses
 from ..io import fmt_number, write_csv, write_rows
 from ._force import add_force_options, force_from_args, law_fields
 
@@ -111,8 +113,9 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
     the subcommand has no such option).
 
     A ValueError (exit status 2) if the subcommand refuses the variant options (``add_params(variants=...)``) and
-    one is given, naming the options and why; PeelParams' own ValueError names a variant field out of range
-    (``tape_mass``, ``load_mass``, ``load``; as the options: ``--tape-mass`` ...)."""
+    one is given, naming the options and why; PeelParams' own ValueError names a field out of range, as its option
+    (``--I``, ``--tape-mass``, ...); with ``--loading load`` and no ``--load``, a default load ``--load-mass`` times g
+    outside LOAD_RANGE is a ValueError saying that the default was used."""
     extra: dict[str, Any] = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
     given: dict[str, Any] = {k: getattr(args, k, d) for k, (_, d) in _VARIANT_OPTIONS.items()
              if getattr(args, k, d) != d and not (k == "tape_mass" and getattr(args, k) == 0.0)}  # 0: massless
@@ -123,14 +126,33 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
         raise ValueError(f"{shown}: the model variants (tape mass, constant load) are not available here: this "
                          f"command {why}; drop {', '.join(_VARIANT_OPTIONS[k][0] for k in given)} (peelapprox "
                          f"simulate runs the variants)")
+    _check_default_load(args)
     try:
         return PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args), **extra, **given)
-    except ValueError as exc:  # a variant field named as the option (--tape-mass, ...)
+    except ValueError as exc:  # a field named as its option (--I, --tape-mass, ...)
         msg = str(exc)
-        for k, (opt, _) in _VARIANT_OPTIONS.items():
+        options = {**{k: f"--{k}" for k in ("V", "I", "k", "R", "l", "geometry")},
+                   **{k: opt for k, (opt, _) in _VARIANT_OPTIONS.items()}}
+        for k, opt in options.items():
             if msg.startswith(k + " ") or msg.startswith(k + "="):
                 raise ValueError(opt + msg[len(k):]) from None
         raise
+
+
+def _check_default_load(args: argparse.Namespace) -> None:
+    """With ``--loading load``, ``--load-mass M`` in its range and no ``--load``: a ValueError unless the default
+    load M g lies in LOAD_RANGE, saying that the default was used (the user gave no --load) and which --load-mass
+    gives a valid one (:func:`peelapprox._params.default_load_masses`)."""
+    M = getattr(args, "load_mass", None)
+    if getattr(args, "loading", None) != "load" or getattr(args, "load", None) is not None or M is None:
+        return
+    if not LOAD_MASS_RANGE[0] <= M <= LOAD_MASS_RANGE[1]:
+        return  # PeelParams names --load-mass and its range
+    load = M * GRAVITY
+    if not LOAD_RANGE[0] <= load <= LOAD_RANGE[1]:
+        raise ValueError(f"--load was not given, so its default --load-mass times g = {M:g} kg * {GRAVITY:g} m/s^2 = "
+                         f"{load:.6g} N was used; the load must be in {interval(*LOAD_RANGE)} N: give --load, or a "
+                         f"--load-mass in {interval(*default_load_masses())} kg")
 
 
 def variant_summary(params: PeelParams) -> dict[str, Any]:
