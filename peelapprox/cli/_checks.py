@@ -111,9 +111,10 @@ def grid_range(text: str, option: str, default_n: int = 40) -> tuple[float, floa
 # --------------------------------------------------------------------------------------------- output paths
 
 #: What an output option writes: ``"file"`` (any name), ``"table"`` (``.csv``/``.json``, by
-#: :func:`peelapprox.io.write_rows`), ``"npz"`` (numpy's ``.npz``, appended when missing, as numpy
-#: does), ``"image"`` (a matplotlib format by extension, ``.png`` appended when there is none, as
-#: matplotlib does) or ``"dir"`` (a directory, created with its parents).
+#: :func:`peelapprox.io.write_rows`), ``"npz"`` (numpy's ``.npz``: appended to a name without an extension, as
+#: numpy does; any other extension is refused, since numpy would write ``x.txt.npz`` for ``x.txt``), ``"image"``
+#: (a matplotlib format by extension, ``.png`` appended when there is none, as matplotlib does) or ``"dir"`` (a
+#: directory, created with its parents).
 OUTPUT_KINDS = ("file", "table", "npz", "image", "dir")
 
 
@@ -126,7 +127,13 @@ def _image_formats() -> list[str]:
 def _file_name(path: str, kind: str, option: str) -> str:
     """The name a ``kind`` writer really writes for ``path`` (or ValueError for a name it refuses)."""
     if kind == "npz":
-        return path if path.endswith(".npz") else path + ".npz"
+        if path.endswith(".npz"):  # numpy's test, case-sensitive: it writes x.NPZ.npz for x.NPZ
+            return path
+        ext = os.path.splitext(path)[1]
+        if ext:
+            raise ValueError(f"{option} {shown(path)}: the file is numpy's .npz, so the name must end in .npz (or "
+                             f"have no extension: .npz is then appended), not {shown(ext)}")
+        return path + ".npz"
     if kind == "table":
         from ..io import TABLE_EXTENSIONS
 
@@ -174,8 +181,9 @@ def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool =
     ValueError
         Naming ``option`` and the path: an empty path; a file output that is
         an existing directory, or whose directory is missing, not a directory
-        or not writable; a name the writer refuses (extension); a directory
-        output that is an existing file, or that cannot be created.
+        or not writable; a name the writer refuses (extension) or the file
+        system cannot hold (too long); a directory output that is an existing
+        file, or that cannot be created.
     """
     if kind not in OUTPUT_KINDS:
         raise ValueError(f"kind must be one of {OUTPUT_KINDS}, got {shown(kind)}")
@@ -209,7 +217,19 @@ def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool =
         raise ValueError(f"{option} {shown(path)}: {shown(parent)} is not a directory")
     if not _writable_dir(parent) or (os.path.exists(name) and not os.access(name, os.W_OK)):
         raise ValueError(f"{option} {shown(path)}: not writable")
+    longest = _name_max(parent)
+    if len(os.fsencode(os.path.basename(name))) > longest:
+        raise ValueError(f"{option} {shown(path)}: the file name is longer than the {longest} bytes the file system "
+                         "allows")
     return name
+
+
+def _name_max(directory: str) -> int:
+    """The longest file name [bytes] in ``directory`` (``pathconf``), 255 where the system does not say."""
+    try:
+        return int(os.pathconf(directory, "PC_NAME_MAX"))
+    except (AttributeError, ValueError, OSError):
+        return 255
 
 
 def check_sweep_plot_key(key: str, measures: Sequence[str]) -> None:
