@@ -23,7 +23,14 @@ from ..validate import shown
 
 __all__ = [
     "DASK_CONNECT_TIMEOUT_S",
+    "EXIT_INTERNAL",
+    "EXIT_INTERRUPTED",
+    "EXIT_OK",
+    "EXIT_STOP",
+    "EXIT_USAGE",
+    "EXIT_WRITE",
     "MESSAGE_LIMIT",
+    "TRACEBACK_ENV",
     "OUTPUT_KINDS",
     "check_output_path",
     "check_sweep_plot_key",
@@ -306,17 +313,37 @@ def _loaded(module: str, name: str) -> tuple[type, ...]:
     return (found,) if isinstance(found, type) else ()
 
 
+#: Exit status of the command line (:func:`exit_status`, :func:`peelapprox.cli.main`): the run completed.
+EXIT_OK = 0
+#: Writing failed after the checks (an ``OSError``: disk full, a path changed meanwhile); for ``sweep``, a point
+#: failed.
+EXIT_WRITE = 1
+#: A usage error: a bad argument or output path, a missing optional package (a ``ValueError``).
+EXIT_USAGE = 2
+#: The model or the solver stopped (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed).
+EXIT_STOP = 3
+#: An internal error: any other exception, a bug of peelapprox, reported on one line (the traceback only with
+#: :data:`TRACEBACK_ENV` set), so that a script can tell it from the user's errors and the model's stops.
+EXIT_INTERNAL = 4
+#: Interrupted by the user (Ctrl-C, SIGINT): 128 + 2, the shells' convention.
+EXIT_INTERRUPTED = 130
+#: The environment variable that makes :func:`peelapprox.cli.main` re-raise an internal error with its
+#: traceback (set it to 1).
+TRACEBACK_ENV = "PEELAPPROX_TRACEBACK"
+
+
 def exit_status(exc: BaseException) -> int | None:
-    """2 for a bad argument, output path or missing optional package; 3 when the model or solver stopped; 1
-    when writing failed after the checks (disk full, a path changed meanwhile); None for anything else."""
+    """:data:`EXIT_USAGE` (2) for a bad argument, output path or missing optional package; :data:`EXIT_STOP` (3)
+    when the model or solver stopped; :data:`EXIT_WRITE` (1) when writing failed after the checks (disk full, a
+    path changed meanwhile); None for anything else (an internal error, :data:`EXIT_INTERNAL`)."""
     from .._diffsl import PeerUnavailableError
     from ..errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
     if isinstance(exc, (ValueError, PeerUnavailableError)):
-        return 2
+        return EXIT_USAGE
     if isinstance(exc, (ModelBreakdown, SolverBudgetExceeded, SolverFailure,
                         *_loaded("comparisons", "TransientNotPassed"))):
-        return 3
+        return EXIT_STOP
     if isinstance(exc, OSError):
-        return 1
+        return EXIT_WRITE
     return None

@@ -6,24 +6,56 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import textwrap
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NoReturn
 
 from .. import GEOMETRIES, GRAVITY, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
 from .._checks import interval
 from .._params import default_load_masses
 from ..io import fmt_number, write_csv, write_rows
+from ._checks import clip
 from ._force import add_force_options, force_from_args, law_fields
 
-__all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "REDUCED_ONLY", "UNITS", "add_format", "add_params",
-           "add_variant_options", "params_from_args", "print_mapping", "variant_summary",
+__all__ = ["FORMATS", "HYBRID_ONLY", "NEGATIVE_NUMBER", "ArgumentParser", "HelpFormatter", "REDUCED_ONLY", "UNITS",
+           "add_format", "add_params", "add_variant_options", "params_from_args", "print_mapping", "variant_summary",
            "say", "subcommand", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
 #: header and one row), ``json``.
 FORMATS = ("table", "csv", "json")
+
+
+#: A negative number as an option's value: ``-1``, ``-1.5``, ``-.5``, ``-1e-5``, ``-1.5E+3``, ``-inf``, ``-nan``.
+#: argparse's own rule (``^-\d+$|^-\d*\.\d+$`` before Python 3.13) misses the exponent form, so ``--I -1e-5``
+#: was read as an unknown option ``-1e-5`` and ``--I`` as missing its value ("expected one argument").
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse's parser with the command line's two rules for its own errors (its subparsers are of this class
+    too, ``add_subparsers`` makes them so):
+
+    * an option's value may be a negative number in any float notation (:data:`NEGATIVE_NUMBER`), e.g.
+      ``--alpha0 -1e-3``, as it may be a positive one;
+    * its one-line error (exit status 2, after the usage) echoes what the user passed cut to a few hundred
+      characters (:func:`~peelapprox.cli._checks.clip`), and "expected one argument" says how to pass a value
+      that starts with ``-`` (``--opt=VALUE``).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
+    def error(self, message: str) -> NoReturn:
+        m = re.match(r"argument (\S+): expected one argument$", message)
+        if m:
+            opt = m.group(1).split("/")[-1]
+            message += f" (a value that starts with '-' is written {opt}=VALUE)"
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog}: error: {clip(message)}\n")
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
