@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, cast
 
@@ -154,13 +155,22 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regular
     last_report = time.perf_counter()
     while ode.status == "running":
         t_old, y_old = ode.t, ode.y.copy()
+        first_try = n_steps == 0 and "first_step" not in kw
         with np.errstate(invalid="ignore", over="ignore"):  # explicit trial steps may overflow: rejected by scipy
-            msg = ode.step()
-        if ode.status == "failed" and n_steps == 0 and "first_step" not in kw:
-            kw["first_step"] = fast_first_step()  # the first step failed: once more from the start, on the fast scale
-            if kw["first_step"] is not None:
-                ode = {**_SOLVERS, **_EXPLICIT}[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, **kw)
-                continue
+            if first_try:  # its warnings wait: a failed first try is retried below, and is not the run
+                with warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always")  # recorded, not acted on: the filters act when re-issued below
+                    msg = ode.step()
+            else:
+                msg = ode.step()
+        if first_try:
+            if ode.status == "failed":
+                kw["first_step"] = fast_first_step()  # once more from the start, on the fast time scale
+                if kw["first_step"] is not None:
+                    ode = {**_SOLVERS, **_EXPLICIT}[solver](fun, s0.t, y0, t_end, rtol=rtol, atol=atol, **kw)
+                    continue
+            for w in caught:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         if ode.status == "failed":
             hint = ("; at so small a tape mass the model is the massless one to ~m^(2/3) (docs/tape-mass.md): use "
                     "tape_mass=None" if massive and cast(float, params.tape_mass) < 1e-9 else "")
