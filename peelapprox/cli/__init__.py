@@ -20,20 +20,24 @@ user's input in it cut to a few hundred characters, with the exit status
   and all;
 * 130: interrupted (Ctrl-C).
 
-An option's value may be a negative number in any notation (``--alpha0 -1e-3``); another value that starts
-with ``-`` is written ``--option=VALUE``.
+A warning (e.g. scipy's about a stiff step) is one line too, ``peelapprox <command>: warning: <Category>:
+<message>``.  An option's value may be a negative number in any notation (``--alpha0 -1e-3``); another value
+that starts with ``-`` is written ``--option=VALUE``.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import sys
 import textwrap
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from .._version import __version__
 from . import basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
-from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, exit_status, one_line
+from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, clip, exit_status, one_line
 from ._common import ArgumentParser, HelpFormatter
 
 __all__ = ["build_parser", "main"]
@@ -87,6 +91,19 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _warning_line(command: str) -> Callable[..., None]:
+    """A ``warnings.showwarning`` that prints a warning as one line, ``peelapprox <command>: warning: <Category>:
+    <message>`` (cut as an error is), instead of Python's two lines with a source line of the library that
+    issued it (scipy's ``solver._y, solver.t = integrator.run(``), which read like part of a traceback."""
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None,
+             line: str | None = None) -> None:
+        text = clip(" ".join(str(message).split()))
+        print(f"peelapprox {command}: warning: {category.__name__}: {text}", file=sys.stderr if file is None else file)
+
+    return show
+
+
 def _internal_error(command: str, exc: BaseException) -> str:
     """The one line of an internal error (module docstring)."""
     return (f"peelapprox {command}: internal error: {type(exc).__name__}: {one_line(exc)} (a bug: please report "
@@ -106,7 +123,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = ap.parse_args(argv)
         command = args.command
-        return args.func(args)
+        with warnings.catch_warnings():  # restores Python's printer when the command returns
+            warnings.showwarning = _warning_line(command)
+            return args.func(args)
     except KeyboardInterrupt:
         ap.exit(EXIT_INTERRUPTED, f"peelapprox {command}: interrupted\n")
     except Exception as exc:
