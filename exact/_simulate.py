@@ -13,6 +13,7 @@ import numpy as np
 from peelapprox import (
     BRANCHES,
     BREAKDOWN_LEVEL,
+    STATE_RANGES,
     TIME_MAX,
     BranchStructure,
     PeelParams,
@@ -24,7 +25,7 @@ from peelapprox.errors import SolverBudgetExceeded, budget_exceeded
 from peelapprox.io import ProgressLine
 from peelapprox.kernels import ALL_LAWS, BuildExpired, caller_budget, model_block
 from peelapprox.kernels import status as S
-from peelapprox.validate import choice, duration, in_range, optional, state
+from peelapprox.validate import choice, duration, in_range, interval, optional, shown, state
 from peelapprox.validate import params as _params
 
 from . import _hybrid as H
@@ -92,7 +93,11 @@ def initial_state(
     ValueError
         Naming the argument and its valid range, if the level
         ``F0 (1 - cos θ(α0))`` has no root on the requested branch (or on
-        any branch), or if ``1 - cos θ(α0) <= 0``.
+        any branch), or if ``1 - cos θ(α0) <= 0``; or, when F0 is not given,
+        if the default ``1.01 f(V, V)`` is outside ``STATE_RANGES["F"]`` (a
+        law in other units than newtons, or with coefficients like 1e300).
+        A message about a value the caller did not pass says that the
+        default was used.
     """
     _params("params", params)
     a0 = state("alpha0", alpha0, "alpha")
@@ -101,16 +106,28 @@ def initial_state(
     if law is None:
         fVV = float(peel_force(params.V, params.V))
     elif F0 is None and not law.domain[0] <= params.V <= law.domain[1]:
-        raise ValueError(f"F0=None starts at 1.01 f(V, V), but v=V={params.V!r} m/s is outside the domain "
-                         f"{law.domain} m/s of params.force={params.force!r}: give F0")
+        raise ValueError(f"F0 was not given, and its default 1.01 f(V, V) needs f at v=V={params.V!r} m/s, outside "
+                         f"the domain {law.domain} m/s of params.force={shown(params.force)}: give F0")
     else:
         fVV = law.f(params.V)
-    F = 1.01 * fVV if F0 is None else state("F0", F0, "F")
+    if F0 is None:
+        F = 1.01 * fVV
+        f_lo, f_hi = STATE_RANGES["F"]
+        if not (math.isfinite(F) and f_lo <= F <= f_hi):
+            raise ValueError(f"F0 was not given, so its default 1.01 f(V, V) = {F:.6g} N was used (f of params.force="
+                             f"{shown(params.force)} at V={params.V!r} m/s), outside STATE_RANGES['F'] = "
+                             f"{interval(f_lo, f_hi)} N, the pull forces the solvers are built for: give F0 in that "
+                             "range, or a law in newtons whose f(V, V) lies in it")
+        f0 = f"F0 (not given: the default 1.01 f(V, V) = {F!r} N)"
+    else:
+        F = state("F0", F0, "F")
+        f0 = f"F0={F!r}"
     t0 = in_range("t0", t0, 0.0, TIME_MAX)
     branch0 = optional(choice, "branch0", branch0, BRANCHES)
+    at = f"alpha0={a0!r}" + (" (the default)" if a0 == 0.0 else "")
     c = float(params.closure(a0)[0])
     if not (1.0 + c > 0.0):
-        raise ValueError(f"alpha0={a0} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
+        raise ValueError(f"alpha0={a0!r} makes 1 - cos(theta) = {1 + c} <= 0: alpha0 must keep 1 + sin(alpha0) > 0")
     G = F * (1.0 + c)
     bs = branch_structure(params.V) if law is None else law.structure
     if branch0 is None:
@@ -120,15 +137,15 @@ def initial_state(
                 break
         else:
             raise ValueError(
-                f"F0={F} gives F0*(1 - cos theta)={G}, below f(0+, V)={bs.f_zero}: no stable root of CONSTR; "
-                f"F0 must exceed {bs.f_zero / (1 + c)} at alpha0={a0}"
+                f"{f0} gives F0*(1 - cos theta)={G}, below f(0+, V)={bs.f_zero}: no stable root of CONSTR; "
+                f"F0 must exceed {bs.f_zero / (1 + c)} at {at}"
             )
     if branch0 not in BRANCHES:
         raise ValueError(f"branch0 must be 'AB' or 'CD' (or None for the lowest root), got {branch0!r}")
     lo, hi = bs.level_range(branch0)  # raises for CD without folds
     if not bs.has_root(G, branch0):
         raise ValueError(
-            f"F0={F} at alpha0={a0} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
+            f"{f0} at {at} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
             f"valid F0 range on {branch0}: ({lo / (1 + c)}, {hi / (1 + c)})"
         )
     v = branch_inverse(G, params.V, branch0) if law is None else law.branch_root(G, branch0)
@@ -330,8 +347,8 @@ def simulate(
     except BuildExpired:
         raise SolverBudgetExceeded(f"more than {lim.max_wall:g} s of wall time (max_wall) compiling the peel-force "
                                    f"law {params.force!r} before the run started; pass a larger max_wall, or None "
-                                   "(a law is compiled once per machine, then loaded from the cache)", budget="max_wall",
-                                   limit=float(lim.max_wall or 0.0), t=0.0 if st0 is None else st0.t,
+                                   "(a law is compiled once per machine, then loaded from the cache)",
+                                   budget="max_wall", limit=float(lim.max_wall or 0.0), t=0.0 if st0 is None else st0.t,
                                    state={"t": 0.0} if st0 is None else dataclasses.asdict(st0)) from None
 
 

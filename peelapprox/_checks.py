@@ -43,11 +43,49 @@ def interval(lo: float = -math.inf, hi: float = math.inf, *, lo_open: bool = Fal
     return f"{left}{_bound(lo)}, {_bound(hi)}{right}"
 
 
+#: Characters of a value :func:`shown` keeps in a message: a user's text (a path, an expression, an option's value)
+#: can be any size (a 700 KB expression was echoed whole), and a message is read on one line.
+SHOWN_LIMIT = 200
+
+
+def shown(value: Any, limit: int = SHOWN_LIMIT) -> str:
+    """``repr(value)`` for a message, cut after ``limit`` characters with ``... (N characters)`` appended.
+
+    N is the length of the value itself for ``str``/``bytes`` (what the user typed) and of its ``repr``
+    otherwise, so the reader knows how much was left out.  ``repr`` is the value as Python writes it
+    (quotes and escapes included: a trailing space or a control character is visible).
+
+    Parameters
+    ----------
+    value : object
+        What the user passed.
+    limit : int
+        Characters of the ``repr`` kept (at least 1).
+
+    Returns
+    -------
+    str
+        ``repr(value)`` if it has at most ``limit`` characters, else its first ``limit`` characters followed
+        by ``"... (N characters)"``.
+
+    Examples
+    --------
+    >>> shown("abc")
+    "'abc'"
+    >>> shown("x" * 700_000, limit=5)
+    "'xxxx... (700000 characters)"
+    """
+    r = repr(value)
+    limit = max(1, int(limit))
+    if len(r) <= limit:
+        return r
+    n = len(value) if isinstance(value, (str, bytes)) else len(r)
+    return f"{r[:limit]}... ({n} characters)"
+
+
 def _got(x: Any) -> str:
-    """``repr(x)``, shortened, with the type for values whose repr hides it (``'abc' (str)``)."""
-    r = repr(x)
-    if len(r) > 60:
-        r = r[:57] + "..."
+    """:func:`shown` (60 characters), with the type for values whose repr hides it (``'abc' (str)``)."""
+    r = shown(x, 60)
     if isinstance(x, (str, bytes, bool, np.bool_)) or x is None:
         return r if x is None else f"{r} ({type(x).__name__})"
     return r

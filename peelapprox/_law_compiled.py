@@ -34,10 +34,13 @@ from typing import Any, cast
 import numpy as np
 from scipy.optimize import brentq
 
+from ._checks import shown
 from ._law import PeelForce
 from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients, unused_law
 from ._law_codegen import expression_kernel, family_kernel
+from ._law_families import packed
 from ._law_table_jit import table_coefficients, table_law
+from ._params import STATE_RANGES
 from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint, _check_V
 from ._peelforce import branch_structure as _paper_structure
 from ._peelforce import fixed_point as _paper_fixed_point
@@ -140,10 +143,10 @@ def _kernel(force: PeelForce, V: float) -> tuple[Callable, np.ndarray, bool]:
         return LAWS["paper"], paper_coefficients(V), True
     if force.kind == "family":
         fn, pack = family_kernel(str(force.name))
-        return fn, pack(V, tuple(x for _, x in force.coefficients)), False
+        return fn, packed(f"params.force={shown(force)}", pack, V, tuple(x for _, x in force.coefficients)), False
     if force.kind == "expression":
         fn, pack = expression_kernel(str(force.source))
-        return fn, pack(V), False
+        return fn, packed(f"params.force={shown(force)}", pack, V), False
     return table_law, table_coefficients(force.tables, V), False
 
 
@@ -201,14 +204,20 @@ def compiled_law(force: PeelForce, V: float) -> CompiledLaw:
     Raises
     ------
     ValueError
-        Naming ``params.force``: a law whose folds cannot be found (:meth:`PeelForce.folds`), or V outside a
-        tabulated law's speeds.
+        Naming ``params.force``: a law whose folds cannot be found (:meth:`PeelForce.folds`), V outside a
+        tabulated law's speeds, or a table starting below ``STATE_RANGES["v"]`` (1e-150 m/s, where the
+        compiled f'' would divide by an underflowed v^2).
     """
     key = (force, float(V))
     out = _CACHE.get(key)
     if out is None:
-        fn, coef, inlined = _kernel(force, V)
         domain = law_domain(force)
+        v_lo = STATE_RANGES["v"][0]
+        if force.kind == "tabulated" and domain[0] < v_lo:
+            raise ValueError(f"params.force: the table starts at v={domain[0]!r} m/s, below the model's velocities "
+                             f"STATE_RANGES['v'] = ({v_lo:g}, {STATE_RANGES['v'][1]:g}] m/s (v^2 underflows in f'' "
+                             "there): give the table's v in m/s, within that range")
+        fn, coef, inlined = _kernel(force, V)
         try:
             bs = law_structure(force, V, fn, coef, domain)
         except ValueError as e:

@@ -34,12 +34,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from . import _generated_laws
 
-__all__ = ["FAMILIES", "Family"]
+__all__ = ["FAMILIES", "Family", "packed"]
 
 #: An evaluator: (v array, V float, coefficient tuple in the family's order, order 0|1|2) -> array.
 Evaluator = Callable[[np.ndarray, float, tuple, int], np.ndarray]
@@ -72,10 +73,31 @@ def _generated(name: str) -> Evaluator:
     law, pack = _generated_laws.LAWS[name]
 
     def evaluate(v: np.ndarray, V: float, c: tuple, order: int) -> np.ndarray:
-        out = np.asarray(law(v, pack(V, c), 2 if order == 2 else 1)[order], dtype=float)
+        out = np.asarray(law(v, packed(f"the {name!r} family", pack, V, c), 2 if order == 2 else 1)[order],
+                         dtype=float)
         return out if out.shape == np.shape(v) else np.broadcast_to(out, np.shape(v)).copy()
 
     return evaluate
+
+
+def packed(what: str, pack: Callable[..., Any], V: float, *args: Any) -> np.ndarray:
+    """``pack(V, *args)``, the coefficient vector a generated law is evaluated with (:mod:`peelapprox._generated_laws`,
+    an expression's kernel), or a ValueError naming ``what`` (the family, ``params.force``) and V.
+
+    The pack is plain Python arithmetic on the user's coefficients: a power ``V**q`` beyond the float range raises
+    ``OverflowError``, a quotient by an underflowed square (``a3/v3**2`` with ``v3 = 1e-200``)
+    ``ZeroDivisionError``, and a product may overflow to inf silently.  Each of them means that these
+    coefficients give no finite law at this V, which is the user's input, not a bug: a ValueError.
+    """
+    try:
+        out = np.asarray(pack(V, *args), dtype=float)
+    except (OverflowError, ZeroDivisionError) as exc:
+        raise ValueError(f"{what}: its coefficients give no finite law at V={V!r} m/s ({type(exc).__name__}: "
+                         f"{exc}); use coefficients of ordinary size (a force in N, velocities in m/s)") from None
+    if not np.all(np.isfinite(out)):
+        raise ValueError(f"{what}: its coefficients give no finite law at V={V!r} m/s (a term overflows); use "
+                         "coefficients of ordinary size (a force in N, velocities in m/s)")
+    return out
 
 
 FAMILIES: dict[str, Family] = {
@@ -105,12 +127,12 @@ def coefficients(family: Family, given: dict) -> tuple[tuple[str, float], ...]:
     Raises ValueError naming an unknown coefficient (with the valid names), a non-finite one, or one of
     ``family.positive`` that is not > 0; TypeError (ArgumentTypeError) for a non-number.
     """
-    from ._checks import in_range, real
+    from ._checks import in_range, real, shown
 
     unknown = sorted(set(given) - set(family.names))
     if unknown:
-        raise ValueError(f"unknown coefficient(s) {', '.join(unknown)} of the {family.name!r} peel-force "
-                         f"family: its coefficients are {', '.join(family.names)}")
+        raise ValueError(f"unknown coefficient(s) {', '.join(shown(n) for n in unknown)} of the {family.name!r} "
+                         f"peel-force family: its coefficients are {', '.join(family.names)}")
     out = []
     for name, default in family.defaults:
         x = given.get(name, default)

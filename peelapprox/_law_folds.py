@@ -95,6 +95,11 @@ def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tu
     if not np.all(np.isfinite(d)):
         i = int(np.flatnonzero(~np.isfinite(d))[0])
         raise ValueError(f"the peel-force law {label} has f' = {d[i]} at v={vg[i]!r} m/s, V={V!r} m/s")
+    # Brent's method in units of the law's own size: its inverse quadratic steps multiply three values of the
+    # function, which underflow for a law scaled by 1e-100 (f' ~ 1e-108: products ~ 1e-324), and it then stalls
+    # ("failed to converge").  Dividing by the power of two nearest the largest |f'| (or |f|) makes the search
+    # scale-free, and bitwise the same as before for an ordinary law (a power of two scales without rounding).
+    d_scale = _power_of_two(float(np.max(np.abs(d))))
     nz = np.flatnonzero(d != 0)
     if nz.size == 0:
         raise ValueError(f"the peel-force law {label} has f' = 0 throughout v in [{window[0]:g}, {window[1]:g}] m/s "
@@ -103,7 +108,7 @@ def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tu
     extrema = []
     for c in np.flatnonzero(s[:-1] != s[1:]):
         i, j = nz[c], nz[c + 1]
-        x = brentq(lambda x: at(x, 1), w[i], w[j], xtol=1e-15, rtol=_RTOL)
+        x = _root(lambda x: at(x, 1) / d_scale, w[i], w[j], label, V)
         v = min(max(math.exp(x), domain[0]), domain[1])
         extrema.append(("max" if s[c] > 0 else "min", v, at(math.log(v), 0)))
     kinds = [k for k, _, _ in extrema]
@@ -118,10 +123,27 @@ def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tu
                          f"minimum in v at V={V!r} (stick-slip) or none (no stick-slip); found {found}")
     (_, v_max, f_max), (_, v_min, f_min) = extrema
     lo, hi = math.log(domain[0]), math.log(domain[1])
+    f_scale = _power_of_two(max(abs(f_max), abs(f_min)))
     v_land_cd = None
     if at(hi, 0) > f_max:
-        v_land_cd = math.exp(brentq(lambda x: at(x, 0) - f_max, math.log(v_min), hi, xtol=1e-15, rtol=_RTOL))
+        v_land_cd = math.exp(_root(lambda x: (at(x, 0) - f_max) / f_scale, math.log(v_min), hi, label, V))
     v_land_ab = None
     if at(lo, 0) < f_min:
-        v_land_ab = math.exp(brentq(lambda x: at(x, 0) - f_min, lo, math.log(v_max), xtol=1e-15, rtol=_RTOL))
+        v_land_ab = math.exp(_root(lambda x: (at(x, 0) - f_min) / f_scale, lo, math.log(v_max), label, V))
     return Folds(V, True, v_max, f_max, v_min, f_min, v_land_cd, v_land_ab)
+
+
+def _power_of_two(x: float) -> float:
+    """The power of two ``2^(e-1) <= x < 2^e`` (1.0 for 0 or a non-finite x; never overflows, even for the largest
+    float)."""
+    return math.ldexp(1.0, math.frexp(x)[1] - 1) if x > 0 and math.isfinite(x) else 1.0
+
+
+def _root(g: Callable[[float], float], a: float, b: float, label: str, V: float) -> float:
+    """Brent's method for ``g = 0`` on ``[a, b]`` (ln v; xtol 1e-15, rtol 4 ulp); a ValueError naming the law
+    where it does not converge (a law too irregular to have well-defined folds), never scipy's RuntimeError."""
+    try:
+        return float(brentq(g, a, b, xtol=1e-15, rtol=_RTOL))
+    except RuntimeError as exc:
+        raise ValueError(f"the folds of the peel-force law {label} at V={V!r} m/s could not be located between "
+                         f"v={math.exp(a):.6g} and {math.exp(b):.6g} m/s ({exc})") from None

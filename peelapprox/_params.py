@@ -7,7 +7,7 @@ import types
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from ._checks import ArgumentTypeError, _got, choice, in_range
+from ._checks import ArgumentTypeError, _got, choice, in_range, interval
 from ._law import PeelForce
 
 __all__ = ["EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE", "LOAD_MASS_RANGE",
@@ -96,6 +96,12 @@ TAPE_MASS_RANGE = (1e-15, 10.0)
 LOAD_MASS_RANGE = (1e-6, 1e6)
 #: Valid load F_L [N]: the range of the pull force F (:data:`STATE_RANGES`).
 LOAD_RANGE = (1e-3, 1e7)
+
+
+def default_load_masses() -> tuple[float, float]:
+    """The loading masses M [kg] (within :data:`LOAD_MASS_RANGE`) whose default load ``M g`` lies in
+    :data:`LOAD_RANGE`: what a user who gives no load may pass."""
+    return max(LOAD_MASS_RANGE[0], LOAD_RANGE[0] / GRAVITY), min(LOAD_MASS_RANGE[1], LOAD_RANGE[1] / GRAVITY)
 
 
 _VARIANT_DEFAULTS = {"tape_mass": None, "loading": "velocity", "load_mass": None, "load": None}
@@ -246,8 +252,17 @@ class PeelParams:
             raise ValueError(f"load_mass is required with loading='load': the mass M [kg] at the pulled end, in "
                              f"[{LOAD_MASS_RANGE[0]:g}, {LOAD_MASS_RANGE[1]:g}]")
         object.__setattr__(self, "load_mass", in_range("load_mass", self.load_mass, *LOAD_MASS_RANGE))
-        load = self.load_mass * GRAVITY if self.load is None else self.load
-        object.__setattr__(self, "load", in_range("load", load, *LOAD_RANGE))
+        if self.load is not None:
+            object.__setattr__(self, "load", in_range("load", self.load, *LOAD_RANGE))
+            return
+        load = self.load_mass * GRAVITY  # the default: a hanging mass
+        lo, hi = LOAD_RANGE
+        if not lo <= load <= hi:
+            raise ValueError(
+                f"load was not given, so its default load_mass * g = {self.load_mass!r} kg * {GRAVITY} m/s^2 = "
+                f"{load:.6g} N was used, outside LOAD_RANGE = {interval(lo, hi)} N: give load, or a load_mass in "
+                f"{interval(*default_load_masses())} kg")
+        object.__setattr__(self, "load", load)
 
     @property
     def variant(self) -> str | None:

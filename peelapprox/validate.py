@@ -26,6 +26,9 @@ Decisions recorded here once:
   a unit mix-up, and numpy refuses ``np.zeros(3.0)`` for the same reason).  Counts are bounded above by
   :data:`MAX_COUNT` so that no budget overflows numba's int64 or means "forever".
 * ranges are closed unless stated open; bounds are printed with ``[``/``]`` or ``(``/``)`` accordingly.
+* **what the user passed is shown, shortened**: a message echoes a value through :func:`shown`, its ``repr``
+  cut after 200 characters with ``... (N characters)`` appended, so that a 700 KB expression or path gives a
+  one-line message that still says what was passed.
 """
 
 from __future__ import annotations
@@ -53,6 +56,7 @@ from ._checks import (
     positive,
     real,
     reals,
+    shown,
     times,
 )
 from ._law import ALL_LAWS, require_law
@@ -83,6 +87,7 @@ __all__ = [
     "rtol",
     "eps",
     "path",
+    "shown",
 ]
 
 

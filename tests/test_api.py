@@ -65,7 +65,7 @@ API = {
         "ArgumentTypeError", "MAX_COUNT", "choice", "duration", "finite", "flag", "function", "in_range", "integer",
         "interval", "nonnegative", "optional", "optional_finite", "paper_model", "params", "path", "positive", "real",
         "reals",
-        "state", "states", "times", "rtol", "eps",
+        "state", "states", "times", "rtol", "eps", "shown",
     },
     "peelapprox.errors": {
         "KernelCacheWarning", "ModelBreakdown", "SolverBudgetExceeded", "SolverFailure", "WallBudget",

@@ -236,14 +236,19 @@ def test_argument_types():
             fn(text)
 
 
-def test_unexpected_exceptions_still_propagate(monkeypatch):
-    """Hypothesis: main() turns only user errors into messages; a bug (here a KeyError raised by the subcommand)
-    propagates with its traceback."""
+def test_unexpected_exceptions_are_internal_errors(monkeypatch, capsys):
+    """Hypothesis: main() turns a bug (here a KeyError raised by the subcommand) into one line and exit status 4
+    (an internal error, no traceback); with PEELAPPROX_TRACEBACK=1 it propagates with its traceback.
+    tests/test_named_errors.py checks the line word for word."""
     from peelapprox import cli
 
     def boom(args):
         raise KeyError("a bug")
 
     monkeypatch.setattr(cli, "_folds", boom)  # build_parser binds the subcommand's function when main() runs
+    monkeypatch.delenv("PEELAPPROX_TRACEBACK", raising=False)
+    code, _out, err = _fails(["folds", "--V", "1"], capsys)
+    assert code == 4 and "Traceback" not in err and "internal error: KeyError: 'a bug'" in err
+    monkeypatch.setenv("PEELAPPROX_TRACEBACK", "1")
     with pytest.raises(KeyError, match="a bug"):
         cli.main(["folds", "--V", "1"])

@@ -109,7 +109,7 @@ def test_the_law_options_are_mutually_exclusive(flags, capsys):
     (["--force-family", "cubic", "--const", "a=1"], "there is no --force"),
     (["--coef", "a=1"], "--coef sets a coefficient of --force-family NAME; there is no --force-family"),
     (["--force", "a*v", "--coef", "a=1"], "there is no --force-family"),
-    (["--force-family", "cubic", "--coef", "z=1"], "unknown coefficient(s) z of the 'cubic' peel-force family: its "
+    (["--force-family", "cubic", "--coef", "z=1"], "unknown coefficient(s) 'z' of the 'cubic' peel-force family: its "
                                                    "coefficients are a, b, c, d"),
     (["--force-family", "nope"], "the families are paper, cubic, power_branches"),
     (["--force-family", "cubic", "--coef", "a=1", "--coef", "a=2"], "--coef a is given twice"),

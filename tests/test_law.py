@@ -388,7 +388,7 @@ def _bad_analytic():
         "unused constant": (lambda: PeelForce.expression("v + 200", a=1), "a do not occur"),
         "no v": (lambda: PeelForce.expression("200 + V"), "does not depend on v"),
         "unknown family": (lambda: PeelForce.family("hong_yue"), "unknown peel-force family 'hong_yue'"),
-        "unknown coefficient": (lambda: PeelForce.family("cubic", e=1), "unknown coefficient.*e of the 'cubic'"),
+        "unknown coefficient": (lambda: PeelForce.family("cubic", e=1), "unknown coefficient.*'e' of the 'cubic'"),
         "three extrema": (lambda: PeelForce.expression("200 + 30*sin(2*log(v))").folds(1.0),
                           "exactly one local maximum .*found a local m"),
         "min before max": (lambda: PeelForce.cubic(a=500, b=-300, c=-300, d=-80).folds(1.0),

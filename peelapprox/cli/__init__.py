@@ -6,23 +6,39 @@ handler imports what it needs (the solvers, the harness) lazily, through their
 public names, when it runs.
 
 Output paths are checked before any computation and reported exactly as
-written (:mod:`peelapprox.cli._checks`).  A user error is one line on stderr,
-``peelapprox <command>: error: <message>``, never a traceback; exit status 2
-for a usage error (a bad argument or output path), 3 when the model or solver
-stops (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed),
-1 when writing fails (OSError) or, for ``sweep``, when a point failed.
+written (:mod:`peelapprox.cli._checks`).  Nothing ends in a traceback: an
+error is one line on stderr, ``peelapprox <command>: error: <message>``, the
+user's input in it cut to a few hundred characters, with the exit status
+
+* 0: done;
+* 1: writing failed (OSError) or, for ``sweep``, a point failed;
+* 2: a usage error: a bad argument or output path (ValueError, argparse's errors);
+* 3: the model or solver stopped (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed);
+* 4: an internal error, any other exception: a bug of peelapprox, reported as
+  ``peelapprox <command>: internal error: <Type>: <message> (a bug: please report it; set
+  PEELAPPROX_TRACEBACK=1 to see the traceback)``; with ``PEELAPPROX_TRACEBACK=1`` it is re-raised, traceback
+  and all;
+* 130: interrupted (Ctrl-C).
+
+A warning (e.g. scipy's about a stiff step) is one line too, ``peelapprox <command>: warning: <Category>:
+<message>``.  An option's value may be a negative number in any notation (``--alpha0 -1e-3``); another value
+that starts with ``-`` is written ``--option=VALUE``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import textwrap
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from .._version import __version__
 from . import basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
-from ._checks import exit_status, one_line
-from ._common import HelpFormatter
+from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, clip, exit_status, one_line
+from ._common import ArgumentParser, HelpFormatter
 
 __all__ = ["build_parser", "main"]
 
@@ -43,7 +59,7 @@ _basins = basins.run
 
 def build_parser() -> argparse.ArgumentParser:
     """The parser of ``peelapprox``: one subparser per subcommand, its handler in ``func``."""
-    ap = argparse.ArgumentParser(
+    ap = ArgumentParser(
         prog="peelapprox", formatter_class=HelpFormatter,
         description=textwrap.fill(
             "Stick-slip peeling of an adhesive tape from a roller (De, Maybhate and Ananthakrishna, Phys. Rev. E 70, "
@@ -55,7 +71,9 @@ def build_parser() -> argparse.ArgumentParser:
                "  peelapprox dynamics --V 2 --I 1e-4 --lyapunov       # period, force drops, Lyapunov exponent\n"
                "  python -m peelapprox --version\n\n"
                "exit status: 0 done, 2 a bad argument or output path, 3 the model or solver stopped (breakdown, "
-               "budget),\n1 writing failed (or, for sweep, a point failed).")
+               "budget),\n1 writing failed (or, for sweep, a point failed), 4 an internal error (a bug: one line, "
+               f"the traceback\nwith {TRACEBACK_ENV}=1), 130 interrupted.  A negative value is written as it is "
+               "(--alpha0 -1e-3);\nanother value that starts with '-' as --option=VALUE.")
     ap.add_argument("--version", action="version", version=f"peelapprox {__version__}")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     simulate.add_parser(sub).set_defaults(func=_simulate)
@@ -73,19 +91,47 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _warning_line(command: str) -> Callable[..., None]:
+    """A ``warnings.showwarning`` that prints a warning as one line, ``peelapprox <command>: warning: <Category>:
+    <message>`` (cut as an error is), instead of Python's two lines with a source line of the library that
+    issued it (scipy's ``solver._y, solver.t = integrator.run(``), which read like part of a traceback."""
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None,
+             line: str | None = None) -> None:
+        text = clip(" ".join(str(message).split()))
+        print(f"peelapprox {command}: warning: {category.__name__}: {text}", file=sys.stderr if file is None else file)
+
+    return show
+
+
+def _internal_error(command: str, exc: BaseException) -> str:
+    """The one line of an internal error (module docstring)."""
+    return (f"peelapprox {command}: internal error: {type(exc).__name__}: {one_line(exc)} (a bug: please report "
+            f"it; set {TRACEBACK_ENV}=1 to see the traceback)\n")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
-    User errors end in ``SystemExit`` with one line on stderr (module docstring
-    for the statuses); any other exception is a bug and propagates with its
-    traceback.
+    Every error ends in ``SystemExit`` with one line on stderr and the status of the module docstring: a user
+    error (2), a stop of the model or solver (3), a failed write (1), an interruption (130), and any other
+    exception, a bug, as an internal error (4), re-raised with its traceback only when the environment variable
+    ``PEELAPPROX_TRACEBACK`` is ``1``.
     """
     ap = build_parser()
-    args = ap.parse_args(argv)
+    command = "(no command)"
     try:
-        return args.func(args)
+        args = ap.parse_args(argv)
+        command = args.command
+        with warnings.catch_warnings():  # restores Python's printer when the command returns
+            warnings.showwarning = _warning_line(command)
+            return args.func(args)
+    except KeyboardInterrupt:
+        ap.exit(EXIT_INTERRUPTED, f"peelapprox {command}: interrupted\n")
     except Exception as exc:
         status = exit_status(exc)
-        if status is None:  # not a user error or a documented stop: a bug, with its traceback
+        if status is not None:
+            ap.exit(status, f"peelapprox {command}: error: {one_line(exc)}\n")
+        if os.environ.get(TRACEBACK_ENV, "").strip() == "1":
             raise
-        ap.exit(status, f"peelapprox {args.command}: error: {one_line(exc)}\n")
+        ap.exit(EXIT_INTERNAL, _internal_error(command, exc))

@@ -13,16 +13,28 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import sys
 from collections.abc import Callable, Sequence
 
 from .. import validate as _validate
+from .._checks import SHOWN_LIMIT
+from ..validate import shown
 
 __all__ = [
     "DASK_CONNECT_TIMEOUT_S",
+    "EXIT_INTERNAL",
+    "EXIT_INTERRUPTED",
+    "EXIT_OK",
+    "EXIT_STOP",
+    "EXIT_USAGE",
+    "EXIT_WRITE",
+    "MESSAGE_LIMIT",
+    "TRACEBACK_ENV",
     "OUTPUT_KINDS",
     "check_output_path",
     "check_sweep_plot_key",
+    "clip",
     "connect_dask_scheduler",
     "exit_status",
     "finite_float_list",
@@ -41,7 +53,7 @@ def _argtype(check: Callable[[str, float], object], text: str):
     try:
         x = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"value must be a real number, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"value must be a real number, got {shown(text)}") from None
     try:
         return check("value", x)
     except ValueError as exc:
@@ -65,7 +77,7 @@ def _int_at_least(text: str, lo: int) -> int:
     except ValueError:
         n = lo - 1
     if n < lo:
-        raise argparse.ArgumentTypeError(f"value must be an integer >= {lo}, got {text!r}")
+        raise argparse.ArgumentTypeError(f"value must be an integer >= {lo}, got {shown(text)}")
     return n
 
 
@@ -83,7 +95,7 @@ def finite_float_list(text: str) -> list[float]:
     """Argparse type: a comma list of finite floats, at least one (:func:`peelapprox.validate.finite`)."""
     items = [s.strip() for s in text.split(",")]
     if not text.strip() or any(not s for s in items):
-        raise argparse.ArgumentTypeError(f"value must be a comma list of numbers, got {text!r}")
+        raise argparse.ArgumentTypeError(f"value must be a comma list of numbers, got {shown(text)}")
     return [_argtype(_validate.finite, s) for s in items]
 
 
@@ -92,23 +104,24 @@ def grid_range(text: str, option: str, default_n: int = 40) -> tuple[float, floa
     ``option`` unless the numbers are finite, LO < HI and N >= 2."""
     parts = text.split(":")
     if len(parts) not in (2, 3):
-        raise ValueError(f"{option} must be LO:HI or LO:HI:N, got {text!r}")
+        raise ValueError(f"{option} must be LO:HI or LO:HI:N, got {shown(text)}")
     try:
         lo, hi = float(parts[0]), float(parts[1])
         n = int(parts[2]) if len(parts) == 3 else default_n
     except ValueError:
-        raise ValueError(f"{option} must be LO:HI[:N] with numbers, got {text!r}") from None
+        raise ValueError(f"{option} must be LO:HI[:N] with numbers, got {shown(text)}") from None
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi and n >= 2):
-        raise ValueError(f"{option} needs finite LO < HI and N >= 2, got {text!r}")
+        raise ValueError(f"{option} needs finite LO < HI and N >= 2, got {shown(text)}")
     return lo, hi, n
 
 
 # --------------------------------------------------------------------------------------------- output paths
 
 #: What an output option writes: ``"file"`` (any name), ``"table"`` (``.csv``/``.json``, by
-#: :func:`peelapprox.io.write_rows`), ``"npz"`` (numpy's ``.npz``, appended when missing, as numpy
-#: does), ``"image"`` (a matplotlib format by extension, ``.png`` appended when there is none, as
-#: matplotlib does) or ``"dir"`` (a directory, created with its parents).
+#: :func:`peelapprox.io.write_rows`), ``"npz"`` (numpy's ``.npz``: appended to a name without an extension, as
+#: numpy does; any other extension is refused, since numpy would write ``x.txt.npz`` for ``x.txt``), ``"image"``
+#: (a matplotlib format by extension, ``.png`` appended when there is none, as matplotlib does) or ``"dir"`` (a
+#: directory, created with its parents).
 OUTPUT_KINDS = ("file", "table", "npz", "image", "dir")
 
 
@@ -121,12 +134,18 @@ def _image_formats() -> list[str]:
 def _file_name(path: str, kind: str, option: str) -> str:
     """The name a ``kind`` writer really writes for ``path`` (or ValueError for a name it refuses)."""
     if kind == "npz":
-        return path if path.endswith(".npz") else path + ".npz"
+        if path.endswith(".npz"):  # numpy's test, case-sensitive: it writes x.NPZ.npz for x.NPZ
+            return path
+        ext = os.path.splitext(path)[1]
+        if ext:
+            raise ValueError(f"{option} {shown(path)}: the file is numpy's .npz, so the name must end in .npz (or "
+                             f"have no extension: .npz is then appended), not {shown(ext)}")
+        return path + ".npz"
     if kind == "table":
         from ..io import TABLE_EXTENSIONS
 
         if not path.endswith(TABLE_EXTENSIONS):
-            raise ValueError(f"{option} must end in {' or '.join(TABLE_EXTENSIONS)}, got {path!r}")
+            raise ValueError(f"{option} must end in {' or '.join(TABLE_EXTENSIONS)}, got {shown(path)}")
         return path
     if kind == "image":
         ext = os.path.splitext(path)[1][1:].lower()
@@ -134,7 +153,7 @@ def _file_name(path: str, kind: str, option: str) -> str:
             return path.rstrip(".") + ".png"
         formats = _image_formats()
         if ext not in formats:
-            raise ValueError(f"{option} {path!r}: unknown image format {ext!r}; known: {', '.join(formats)}")
+            raise ValueError(f"{option} {shown(path)}: unknown image format {shown(ext)}; known: {', '.join(formats)}")
         return path
     return path
 
@@ -169,42 +188,55 @@ def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool =
     ValueError
         Naming ``option`` and the path: an empty path; a file output that is
         an existing directory, or whose directory is missing, not a directory
-        or not writable; a name the writer refuses (extension); a directory
-        output that is an existing file, or that cannot be created.
+        or not writable; a name the writer refuses (extension) or the file
+        system cannot hold (too long); a directory output that is an existing
+        file, or that cannot be created.
     """
     if kind not in OUTPUT_KINDS:
-        raise ValueError(f"kind must be one of {OUTPUT_KINDS}, got {kind!r}")
+        raise ValueError(f"kind must be one of {OUTPUT_KINDS}, got {shown(kind)}")
     if not path:
         raise ValueError(f"{option} must not be empty")
     if kind == "dir":
         if os.path.exists(path):
             if not os.path.isdir(path):
-                raise ValueError(f"{option} {path!r} exists and is not a directory")
+                raise ValueError(f"{option} {shown(path)} exists and is not a directory")
             if not read_only_ok and not _writable_dir(path):
-                raise ValueError(f"{option} {path!r}: directory is not writable")
+                raise ValueError(f"{option} {shown(path)}: directory is not writable")
             return path
         parent = os.path.dirname(os.path.normpath(path))
         while parent and not os.path.exists(parent):  # the nearest existing ancestor: makedirs creates the rest
             parent = os.path.dirname(parent)
         parent = parent or "."
         if not os.path.isdir(parent):
-            raise ValueError(f"{option} {path!r}: cannot create it, {parent!r} is not a directory")
+            raise ValueError(f"{option} {shown(path)}: cannot create it, {shown(parent)} is not a directory")
         if not _writable_dir(parent):
-            raise ValueError(f"{option} {path!r}: cannot create it, directory {parent!r} is not writable")
+            raise ValueError(f"{option} {shown(path)}: cannot create it, directory {shown(parent)} is not writable")
         return path
     if os.path.isdir(path):
-        raise ValueError(f"{option} {path!r} is a directory, expected a file name")
+        raise ValueError(f"{option} {shown(path)} is a directory, expected a file name")
     name = _file_name(path, kind, option)
     if os.path.isdir(name):
-        raise ValueError(f"{option} {path!r} would write {name!r}, which is a directory")
+        raise ValueError(f"{option} {shown(path)} would write {shown(name)}, which is a directory")
     parent = os.path.dirname(name) or "."
     if not os.path.exists(parent):
-        raise ValueError(f"{option} {path!r}: directory {parent!r} does not exist")
+        raise ValueError(f"{option} {shown(path)}: directory {shown(parent)} does not exist")
     if not os.path.isdir(parent):
-        raise ValueError(f"{option} {path!r}: {parent!r} is not a directory")
+        raise ValueError(f"{option} {shown(path)}: {shown(parent)} is not a directory")
     if not _writable_dir(parent) or (os.path.exists(name) and not os.access(name, os.W_OK)):
-        raise ValueError(f"{option} {path!r}: not writable")
+        raise ValueError(f"{option} {shown(path)}: not writable")
+    longest = _name_max(parent)
+    if len(os.fsencode(os.path.basename(name))) > longest:
+        raise ValueError(f"{option} {shown(path)}: the file name is longer than the {longest} bytes the file system "
+                         "allows")
     return name
+
+
+def _name_max(directory: str) -> int:
+    """The longest file name [bytes] in ``directory`` (``pathconf``), 255 where the system does not say."""
+    try:
+        return int(os.pathconf(directory, "PC_NAME_MAX"))
+    except (AttributeError, ValueError, OSError):
+        return 255
 
 
 def check_sweep_plot_key(key: str, measures: Sequence[str]) -> None:
@@ -218,10 +250,10 @@ def check_sweep_plot_key(key: str, measures: Sequence[str]) -> None:
     from comparisons.sweep import RESERVED, record_key
 
     if os.sep in key or (os.altsep and os.altsep in key):
-        raise ValueError(f"--plot {key!r}: a record key has no path separator (the plot goes to DIR/KEY.png)")
+        raise ValueError(f"--plot {shown(key)}: a record key has no path separator (the plot goes to DIR/KEY.png)")
     if key in RESERVED or any(record_key(m, key) == key for m in measures):
         return
-    raise ValueError(f"--plot {key!r} is not a key of the measures {list(measures)}: keys are "
+    raise ValueError(f"--plot {shown(key)} is not a key of the measures {list(measures)}: keys are "
                      f"{', '.join(RESERVED)} or start with {', '.join(m + '_' for m in measures)}")
 
 
@@ -245,15 +277,30 @@ def connect_dask_scheduler(address: str):
     try:
         return Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
     except ValueError as exc:
-        raise ValueError(f"--dask-scheduler {address!r}: {one_line(exc)}") from None
+        raise ValueError(f"--dask-scheduler {shown(address)}: {one_line(exc)}") from None
     except Exception as exc:  # noqa: BLE001 - whatever a wrong address provokes in dask (timeout, garbage reply)
-        raise OSError(f"--dask-scheduler {address!r}: cannot connect to a dask scheduler "
+        raise OSError(f"--dask-scheduler {shown(address)}: cannot connect to a dask scheduler "
                       f"({type(exc).__name__}: {one_line(exc)})") from None
 
 
+#: Longest message :func:`one_line` prints [characters]: ten lines of a wide terminal.
+MESSAGE_LIMIT = 2000
+
+
+def clip(text: str, limit: int = SHOWN_LIMIT) -> str:
+    """``text`` with every run of more than ``limit`` non-blank characters cut as :func:`peelapprox.validate.shown`
+    cuts a value (its first ``limit`` characters, then ``... (N characters)``): what a message echoes of a
+    user's input (an option's value, a path, a name) stays short even where the message did not use ``shown``."""
+    return re.sub(rf"\S{{{limit + 1},}}", lambda m: f"{m.group()[:limit]}... ({len(m.group())} characters)", text)
+
+
 def one_line(exc: BaseException) -> str:
-    """The exception's message on one line (whitespace runs, newlines included, become one space)."""
-    return " ".join(str(exc).split()) or type(exc).__name__
+    """The exception's message on one line (whitespace runs, newlines included, become one space), each overlong
+    word cut (:func:`clip`) and the whole at most :data:`MESSAGE_LIMIT` characters (then ``... (N characters)``)."""
+    text = clip(" ".join(str(exc).split())) or type(exc).__name__
+    if len(text) > MESSAGE_LIMIT:
+        text = f"{text[:MESSAGE_LIMIT]}... ({len(text)} characters)"
+    return text
 
 
 # --------------------------------------------------------------------------------------------- exit statuses
@@ -266,17 +313,37 @@ def _loaded(module: str, name: str) -> tuple[type, ...]:
     return (found,) if isinstance(found, type) else ()
 
 
+#: Exit status of the command line (:func:`exit_status`, :func:`peelapprox.cli.main`): the run completed.
+EXIT_OK = 0
+#: Writing failed after the checks (an ``OSError``: disk full, a path changed meanwhile); for ``sweep``, a point
+#: failed.
+EXIT_WRITE = 1
+#: A usage error: a bad argument or output path, a missing optional package (a ``ValueError``).
+EXIT_USAGE = 2
+#: The model or the solver stopped (ModelBreakdown, SolverBudgetExceeded, SolverFailure, TransientNotPassed).
+EXIT_STOP = 3
+#: An internal error: any other exception, a bug of peelapprox, reported on one line (the traceback only with
+#: :data:`TRACEBACK_ENV` set), so that a script can tell it from the user's errors and the model's stops.
+EXIT_INTERNAL = 4
+#: Interrupted by the user (Ctrl-C, SIGINT): 128 + 2, the shells' convention.
+EXIT_INTERRUPTED = 130
+#: The environment variable that makes :func:`peelapprox.cli.main` re-raise an internal error with its
+#: traceback (set it to 1).
+TRACEBACK_ENV = "PEELAPPROX_TRACEBACK"
+
+
 def exit_status(exc: BaseException) -> int | None:
-    """2 for a bad argument, output path or missing optional package; 3 when the model or solver stopped; 1
-    when writing failed after the checks (disk full, a path changed meanwhile); None for anything else."""
+    """:data:`EXIT_USAGE` (2) for a bad argument, output path or missing optional package; :data:`EXIT_STOP` (3)
+    when the model or solver stopped; :data:`EXIT_WRITE` (1) when writing failed after the checks (disk full, a
+    path changed meanwhile); None for anything else (an internal error, :data:`EXIT_INTERNAL`)."""
     from .._diffsl import PeerUnavailableError
     from ..errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
     if isinstance(exc, (ValueError, PeerUnavailableError)):
-        return 2
+        return EXIT_USAGE
     if isinstance(exc, (ModelBreakdown, SolverBudgetExceeded, SolverFailure,
                         *_loaded("comparisons", "TransientNotPassed"))):
-        return 3
+        return EXIT_STOP
     if isinstance(exc, OSError):
-        return 1
+        return EXIT_WRITE
     return None

@@ -7,25 +7,58 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import textwrap
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NoReturn
 
-from .. import GEOMETRIES, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
+from .. import GEOMETRIES, GRAVITY, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
+from .._checks import interval
+from .._params import default_load_masses
 from ..errors import WallBudget
 from ..io import fmt_number, write_csv, write_rows
-from ._checks import positive_float
+from ._checks import clip, positive_float
 from ._force import add_force_options, force_from_args, law_fields
 
-__all__ = ["FORMATS", "HYBRID_ONLY", "HelpFormatter", "MAX_WALL", "REDUCED_ONLY", "UNITS", "add_format",
-           "add_max_wall_option", "add_params", "add_variant_options", "params_from_args", "print_mapping",
-           "variant_summary", "say", "subcommand", "wall_left", "wall_spent", "write_table"]
+__all__ = ["FORMATS", "HYBRID_ONLY", "MAX_WALL", "NEGATIVE_NUMBER", "ArgumentParser", "HelpFormatter", "REDUCED_ONLY",
+           "UNITS", "add_format", "add_max_wall_option", "add_params", "add_variant_options", "params_from_args",
+           "print_mapping", "variant_summary", "say", "subcommand", "wall_left", "wall_spent", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
 #: header and one row), ``json``.
 FORMATS = ("table", "csv", "json")
+
+
+#: A negative number as an option's value: ``-1``, ``-1.5``, ``-.5``, ``-1e-5``, ``-1.5E+3``, ``-inf``, ``-nan``.
+#: argparse's own rule (``^-\d+$|^-\d*\.\d+$`` before Python 3.13) misses the exponent form, so ``--I -1e-5``
+#: was read as an unknown option ``-1e-5`` and ``--I`` as missing its value ("expected one argument").
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse's parser with the command line's two rules for its own errors (its subparsers are of this class
+    too, ``add_subparsers`` makes them so):
+
+    * an option's value may be a negative number in any float notation (:data:`NEGATIVE_NUMBER`), e.g.
+      ``--alpha0 -1e-3``, as it may be a positive one;
+    * its one-line error (exit status 2, after the usage) echoes what the user passed cut to a few hundred
+      characters (:func:`~peelapprox.cli._checks.clip`), and "expected one argument" says how to pass a value
+      that starts with ``-`` (``--opt=VALUE``).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
+    def error(self, message: str) -> NoReturn:
+        m = re.match(r"argument (\S+): expected one argument$", message)
+        if m:
+            opt = m.group(1).split("/")[-1]
+            message += f" (a value that starts with '-' is written {opt}=VALUE)"
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog}: error: {clip(message)}\n")
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
@@ -141,8 +174,9 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
     the subcommand has no such option).
 
     A ValueError (exit status 2) if the subcommand refuses the variant options (``add_params(variants=...)``) and
-    one is given, naming the options and why; PeelParams' own ValueError names a variant field out of range
-    (``tape_mass``, ``load_mass``, ``load``; as the options: ``--tape-mass`` ...)."""
+    one is given, naming the options and why; PeelParams' own ValueError names a field out of range, as its option
+    (``--I``, ``--tape-mass``, ...); with ``--loading load`` and no ``--load``, a default load ``--load-mass`` times g
+    outside LOAD_RANGE is a ValueError saying that the default was used."""
     extra: dict[str, Any] = {k: getattr(args, k) for k in ("l", "geometry") if getattr(args, k, None) is not None}
     given: dict[str, Any] = {k: getattr(args, k, d) for k, (_, d) in _VARIANT_OPTIONS.items()
              if getattr(args, k, d) != d and not (k == "tape_mass" and getattr(args, k) == 0.0)}  # 0: massless
@@ -153,14 +187,33 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
         raise ValueError(f"{shown}: the model variants (tape mass, constant load) are not available here: this "
                          f"command {why}; drop {', '.join(_VARIANT_OPTIONS[k][0] for k in given)} (peelapprox "
                          f"simulate runs the variants)")
+    _check_default_load(args)
     try:
         return PeelParams(V=args.V, I=args.I, k=args.k, R=args.R, force=force_from_args(args), **extra, **given)
-    except ValueError as exc:  # a variant field named as the option (--tape-mass, ...)
+    except ValueError as exc:  # a field named as its option (--I, --tape-mass, ...)
         msg = str(exc)
-        for k, (opt, _) in _VARIANT_OPTIONS.items():
+        options = {**{k: f"--{k}" for k in ("V", "I", "k", "R", "l", "geometry")},
+                   **{k: opt for k, (opt, _) in _VARIANT_OPTIONS.items()}}
+        for k, opt in options.items():
             if msg.startswith(k + " ") or msg.startswith(k + "="):
                 raise ValueError(opt + msg[len(k):]) from None
         raise
+
+
+def _check_default_load(args: argparse.Namespace) -> None:
+    """With ``--loading load``, ``--load-mass M`` in its range and no ``--load``: a ValueError unless the default
+    load M g lies in LOAD_RANGE, saying that the default was used (the user gave no --load) and which --load-mass
+    gives a valid one (:func:`peelapprox._params.default_load_masses`)."""
+    M = getattr(args, "load_mass", None)
+    if getattr(args, "loading", None) != "load" or getattr(args, "load", None) is not None or M is None:
+        return
+    if not LOAD_MASS_RANGE[0] <= M <= LOAD_MASS_RANGE[1]:
+        return  # PeelParams names --load-mass and its range
+    load = M * GRAVITY
+    if not LOAD_RANGE[0] <= load <= LOAD_RANGE[1]:
+        raise ValueError(f"--load was not given, so its default --load-mass times g = {M:g} kg * {GRAVITY:g} m/s^2 = "
+                         f"{load:.6g} N was used; the load must be in {interval(*LOAD_RANGE)} N: give --load, or a "
+                         f"--load-mass in {interval(*default_load_masses())} kg")
 
 
 def variant_summary(params: PeelParams) -> dict[str, Any]:

@@ -22,15 +22,19 @@ from __future__ import annotations
 import argparse
 import csv
 import dataclasses
+import errno
 import math
+import os
 import re
+import stat
 import textwrap
 from typing import Any
 
 from .. import PeelForce
+from ..validate import shown
 
-__all__ = ["TABLE_COLUMNS", "add_force_options", "families_help", "force_from_args", "law_fields", "name_value",
-           "read_force_table"]
+__all__ = ["MAX_TABLE_BYTES", "TABLE_COLUMNS", "add_force_options", "families_help", "force_from_args", "law_fields",
+           "name_value", "read_force_table"]
 
 #: The headers ``--force-table`` accepts: one table, or several grouped by the pull speed V [m/s].
 TABLE_COLUMNS = (("v", "f"), ("V", "v", "f"))
@@ -65,7 +69,7 @@ def name_value(text: str) -> tuple[str, int | float]:
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or not name.isidentifier():
-        raise argparse.ArgumentTypeError(f"value must be NAME=VALUE (e.g. a=150), got {text!r}")
+        raise argparse.ArgumentTypeError(f"value must be NAME=VALUE (e.g. a=150), got {shown(text)}")
     try:
         return name, int(value)
     except ValueError:
@@ -73,7 +77,7 @@ def name_value(text: str) -> tuple[str, int | float]:
     try:
         x = float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"value of {name} must be a real number, got {value.strip()!r}") from None
+        raise argparse.ArgumentTypeError(f"value of {name} must be a real number, got {shown(value.strip())}") from None
     return name, x
 
 
@@ -139,14 +143,73 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
 
 # --------------------------------------------------------------------------------------------- the table file
 
-def _data_lines(fh) -> list[tuple[int, str]]:
+#: Largest ``--force-table`` file read [bytes], 16 MiB: a measured peel-force curve has hundreds to a few thousand
+#: rows of ~30 bytes, so 16 MiB (about 500,000 rows, parsed and checked in a few seconds) is far beyond any real
+#: table, while a path to a huge file (a log, a disk image) is refused at once instead of filling the memory.
+MAX_TABLE_BYTES = 16 * 1024 * 1024
+
+_FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def _read_regular(path: str, where: str) -> bytes:
+    """The bytes of the regular file ``path``, at most :data:`MAX_TABLE_BYTES`, or a ValueError beginning with
+    ``where``.
+
+    The file is opened without blocking (``O_NONBLOCK``: opening a FIFO for reading would otherwise wait for a
+    writer forever) and its kind is read from the open descriptor (``fstat``), so the file checked is the file
+    read.  A FIFO, a device, a socket or a directory is refused, and so is a file of more than
+    :data:`MAX_TABLE_BYTES` (by its size, and again by what is read: a file growing meanwhile is caught too).
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        if exc.errno == errno.EISDIR:
+            raise ValueError(f"{where}: is a directory; a table must be a regular file (a CSV on disk)") from None
+        raise ValueError(f"{where}: cannot read it ({exc.strerror or exc})") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        kind = next((what for test, what in _FILE_KINDS if test(st.st_mode)), "not a regular file")
+        raise ValueError(f"{where}: is {kind}; a table must be a regular file (a CSV on disk)")
+    limit = f"{MAX_TABLE_BYTES // (1024 * 1024)} MiB"
+    if st.st_size > MAX_TABLE_BYTES:
+        os.close(fd)
+        raise ValueError(f"{where}: {st.st_size} bytes, more than the {limit} a table may have (a measured curve "
+                         "is a few thousand rows; is this the right file?)")
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            data = fh.read(MAX_TABLE_BYTES + 1)
+        except OSError as exc:
+            raise ValueError(f"{where}: cannot read it ({exc.strerror or exc})") from None
+    if len(data) > MAX_TABLE_BYTES:
+        raise ValueError(f"{where}: more than the {limit} a table may have (a measured curve is a few thousand "
+                         "rows; is this the right file?)")
+    return data
+
+
+def _data_lines(text: str) -> list[tuple[int, str]]:
     """``(line number, text)`` of the lines that are not blank or comments (``#`` to the end of a line)."""
     out = []
-    for n, line in enumerate(fh, start=1):
-        text = line.split("#", 1)[0].strip()
-        if text:
-            out.append((n, text))
+    for n, line in enumerate(re.split(r"\r\n|\r|\n", text), start=1):  # universal newlines, as open() reads
+        line = line.split("#", 1)[0].strip()
+        if line:
+            out.append((n, line))
     return out
+
+
+def _csv_rows(lines: list[tuple[int, str]], where: str) -> list[list[str]]:
+    """The cells of each data line (:mod:`csv`), a csv error (e.g. a field over csv's size limit, an unclosed
+    quote) as a ValueError naming the file line."""
+    rows = []
+    for lineno, text in lines:
+        try:
+            cells = next(csv.reader([text]), [])
+        except csv.Error as exc:
+            raise ValueError(f"{where} line {lineno}: not a CSV row ({exc})") from None
+        rows.append(cells)
+    return rows
 
 
 def read_force_table(path: str) -> PeelForce:
@@ -154,30 +217,34 @@ def read_force_table(path: str) -> PeelForce:
 
     The first data line is the header, ``v,f`` (one table, used at every V) or ``V,v,f`` in any order
     (one table per distinct V, the rows of a V in file order, the tables in order of first appearance).
-    ``#`` starts a comment (whole line or its end); blank lines are skipped.
+    ``#`` starts a comment (whole line or its end); blank lines are skipped.  The file is UTF-8 text (a
+    byte-order mark before the header, as spreadsheets write it, is skipped), a regular file of at most
+    :data:`MAX_TABLE_BYTES`.
 
     Raises
     ------
     ValueError
-        Naming the file (and for a cell its line and column): unreadable, no header, a header other than
-        those of :data:`TABLE_COLUMNS`, a row with too few or too many cells, a cell that is not a number;
-        or :meth:`PeelForce.tabulated`'s error (which names the offending point ``v[i]``/``f[i]``), with
-        the file line of that point added.
+        Naming the file (and for a cell its line and column): missing or unreadable; not a regular file (a
+        FIFO, a device, a directory: refused without waiting on it); larger than :data:`MAX_TABLE_BYTES`; not
+        UTF-8 text; no header, a header other than those of :data:`TABLE_COLUMNS`; a line that is not a CSV
+        row (csv's error, e.g. a field longer than its limit); a row with too few or too many cells, a cell
+        that is not a number; or :meth:`PeelForce.tabulated`'s error (which names the offending point
+        ``v[i]``/``f[i]``), with the file line of that point added.
     """
-    where = f"--force-table {path!r}"
+    where = f"--force-table {shown(path)}"
+    data = _read_regular(path, where)
     try:
-        with open(path, newline="") as fh:
-            lines = _data_lines(fh)
-    except OSError as exc:
-        raise ValueError(f"{where}: cannot read it ({exc.strerror or exc})") from None
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ValueError(f"{where}: not a text file ({exc.reason})") from None
+        line = data[:exc.start].count(b"\n") + 1
+        raise ValueError(f"{where} line {line}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    lines = _data_lines(text)
     if not lines:
         raise ValueError(f"{where}: no header (expected {' or '.join(','.join(c) for c in TABLE_COLUMNS)})")
-    rows = list(csv.reader([text for _, text in lines]))
+    rows = _csv_rows(lines, where)
     header = [h.strip() for h in rows[0]]
     if sorted(header) not in [sorted(c) for c in TABLE_COLUMNS] or len(set(header)) != len(header):
-        raise ValueError(f"{where} line {lines[0][0]}: header {','.join(header)!r}: expected the columns "
+        raise ValueError(f"{where} line {lines[0][0]}: header {shown(','.join(header))}: expected the columns "
                          f"{' or '.join(','.join(c) for c in TABLE_COLUMNS)} (V is the pull speed, v the peel "
                          "velocity [m/s], f the force [N])")
     col = {name: i for i, name in enumerate(header)}
@@ -192,7 +259,8 @@ def read_force_table(path: str) -> PeelForce:
             try:
                 vals[name] = float(cell)
             except ValueError:
-                raise ValueError(f"{where} line {lineno} column {i + 1} ({name}): not a number: {cell!r}") from None
+                raise ValueError(f"{where} line {lineno} column {i + 1} ({name}): not a number: "
+                                 f"{shown(cell)}") from None
         V = vals.get("V")
         if V is not None and not math.isfinite(V):
             raise ValueError(f"{where} line {lineno} column {col['V'] + 1} (V): must be finite, got {V!r}")

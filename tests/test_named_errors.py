@@ -1,0 +1,339 @@
+"""Named errors instead of tracebacks: each reproducer of a probe of the package gives the right exception class
+and a message naming the argument (and the default, when the user passed none); the command line never prints a
+traceback.
+
+Reproducers: ``--force-table`` on a FIFO (blocked forever), on ``/dev/zero`` (a MemoryError after 5.6 GB), on a
+CSV with a field over csv's limit (``_csv.Error``) and on a file with a UTF-8 byte-order mark (refused); a law
+scaled by 1e300 (``ZeroDivisionError`` in the solver) and coefficients from 1e-300 to 1e300 (``OverflowError``,
+``ZeroDivisionError``, scipy's ``RuntimeError``); a 700 KB input echoed whole; ``--loading load --load-mass 1e-6``
+blaming a ``--load`` the user never gave; ``--out x.txt`` writing ``x.txt.npz``; a bug printing its traceback;
+``--I -1e-5`` read as an unknown option; ``tape_mass=1e-15``, the documented minimum, failing at t = 0.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import threading
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import exact
+from peelapprox import ModelBreakdown, PeelForce, PeelParams, SolverBudgetExceeded, SolverFailure, estimate
+from peelapprox.cli import main
+from peelapprox.cli._checks import EXIT_INTERNAL, MESSAGE_LIMIT, TRACEBACK_ENV
+from peelapprox.cli._force import MAX_TABLE_BYTES, read_force_table
+from peelapprox.validate import shown
+
+SIM = ["simulate", "--V", "1", "--I", "1e-2", "--t-end", "0.01", "--quiet"]
+V5, F5 = [0.1, 0.5, 1.0, 2.0, 5.0], [100.0, 200.0, 150.0, 120.0, 300.0]  # an N-shaped table, 5 points
+
+
+def _cli(argv: list[str], capsys) -> tuple[int, str, str]:
+    """``main(argv)`` -> (exit status, stdout, stderr); a SystemExit is caught, a return value is the status."""
+    try:
+        code = main(argv)
+    except SystemExit as exc:
+        code = exc.code
+    cap = capsys.readouterr()
+    return int(code or 0), cap.out, cap.err
+
+
+def _one_error_line(err: str, command: str = "simulate") -> str:
+    """The last stderr line, which must be the CLI's error line, with no traceback anywhere."""
+    assert "Traceback" not in err, err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith(f"peelapprox {command}: "), err
+    return last
+
+
+def _table(path, text: str | bytes) -> str:
+    if isinstance(text, str):
+        text = text.encode()
+    path.write_bytes(text)
+    return str(path)
+
+
+# ------------------------------------------------------------------------------------------------ table files
+
+def test_fifo_is_refused_without_waiting(tmp_path):
+    """Hypothesis: a FIFO given as ``--force-table`` is a ValueError naming the path and saying it is a FIFO, within
+    a few seconds (it blocked forever: ``open`` waits for a writer).  The read runs in a thread joined with a 10 s
+    timeout, so the test cannot hang; the refusal takes microseconds, 10 s is a slow shared machine's margin."""
+    fifo = tmp_path / "table.fifo"
+    os.mkfifo(fifo)
+    out: dict[str, BaseException] = {}
+
+    def read() -> None:
+        try:
+            read_force_table(str(fifo))
+        except BaseException as exc:  # noqa: BLE001 - handed to the test thread
+            out["exc"] = exc
+
+    th = threading.Thread(target=read, daemon=True)
+    th.start()
+    th.join(10.0)
+    if th.is_alive():  # unblock the reader (open for writing pairs with it) before failing
+        fd = os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
+        os.close(fd)
+        pytest.fail("read_force_table blocked on a FIFO")
+    exc = out.get("exc")
+    assert isinstance(exc, ValueError), exc
+    assert str(fifo) in str(exc) and "FIFO" in str(exc) and "regular file" in str(exc)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero")
+def test_device_and_directory_are_refused(tmp_path):
+    """Hypothesis: ``/dev/zero`` (a MemoryError after 5.6 GB) and a directory are ValueErrors naming the path and
+    its kind, read without reading a byte."""
+    with pytest.raises(ValueError, match=r"'/dev/zero': is a character device; a table must be a regular file"):
+        read_force_table("/dev/zero")
+    with pytest.raises(ValueError, match=r"is a directory; a table must be a regular file"):
+        read_force_table(str(tmp_path))
+
+
+def test_size_limit(tmp_path):
+    """Hypothesis: a file one byte over MAX_TABLE_BYTES (16 MiB) is refused by its size, with the limit and the
+    reason in the message; the limit is 16 MiB exactly (no tolerance: a count of bytes)."""
+    assert MAX_TABLE_BYTES == 16 * 1024 * 1024
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_TABLE_BYTES + 1)  # sparse: no 16 MiB written
+    with pytest.raises(ValueError, match=r"16777217 bytes, more than the 16 MiB a table may have \(a measured curve"):
+        read_force_table(str(big))
+
+
+def test_csv_error_names_file_and_line(tmp_path, capsys):
+    """Hypothesis: a field longer than csv's limit (131072 characters; here 200,000) on line 3 is a ValueError
+    naming the file and line 3 (it was a ``_csv.Error`` traceback), and on the CLI one line with exit status 2
+    whose length stays below MESSAGE_LIMIT."""
+    path = _table(tmp_path / "wide.csv", "v,f\n0.1,100\n0.5,\"" + "1" * 200_000 + "\"\n")
+    with pytest.raises(ValueError, match=r"wide\.csv' line 3: not a CSV row \(field larger than field limit"):
+        read_force_table(path)
+    code, out, err = _cli(SIM + ["--force-table", path], capsys)
+    line = _one_error_line(err)
+    assert code == 2 and out == "" and "line 3" in line and len(line) < MESSAGE_LIMIT
+
+
+def test_byte_order_mark_is_accepted(tmp_path):
+    """Hypothesis: a UTF-8 byte-order mark before the header (as spreadsheets write it) is skipped: the law equals
+    the one of the same file without it (equality of the plain data: exact)."""
+    body = "v,f\n" + "".join(f"{v},{f}\n" for v, f in zip(V5, F5))
+    with_bom = read_force_table(_table(tmp_path / "bom.csv", b"\xef\xbb\xbf" + body.encode()))
+    assert with_bom == read_force_table(_table(tmp_path / "plain.csv", body)) == PeelForce.tabulated(V5, F5)
+
+
+def test_not_utf8_names_line(tmp_path):
+    """Hypothesis: a byte that is not UTF-8 (Latin-1 é) is a ValueError naming the file and its line."""
+    path = _table(tmp_path / "latin1.csv", b"v,f\n0.1,100\n0.5,2\xe900\n")
+    with pytest.raises(ValueError, match=r"latin1\.csv' line 3: not UTF-8 text"):
+        read_force_table(path)
+
+
+# ------------------------------------------------------------------------------------------------ huge and tiny laws
+
+def test_law_scaled_by_1e300_names_the_default_start():
+    """Hypothesis: ``PeelForce.cubic(c=-1e300)`` and a table scaled by 1e300 ran into ZeroDivisionError in the
+    solver; now ``exact.simulate`` raises a ValueError saying that F0 was not given, its default 1.01 f(V, V) and
+    the valid range of F (and ``estimate`` names F and its range); ``initial_state`` with an F0 in range says
+    there is no root (the level is below f(0+))."""
+    for law in (PeelForce.cubic(c=-1e300), PeelForce.tabulated(V5, [f * 1e300 for f in F5])):
+        p = PeelParams(V=1.0, I=1e-2, force=law)
+        with pytest.raises(ValueError, match=r"F0 was not given, so its default 1\.01 f\(V, V\) = .* N was used .*"
+                                             r"outside STATE_RANGES\['F'\] = \[0\.001, 1e7\] N"):
+            exact.simulate(p, 0.01)
+    p = PeelParams(V=1.0, I=1e-2, force=PeelForce.tabulated(V5, [f * 1e300 for f in F5]))
+    with pytest.raises(ValueError, match=r"F must be finite and in \[0\.001, 1e7\]"):
+        estimate(p)
+    with pytest.raises(ValueError, match=r"F0=100\.0 gives .* below f\(0\+, V\)=.* at alpha0=0\.0 \(the default\)"):
+        exact.initial_state(p, F0=100.0)
+
+
+def test_tiny_law_folds_and_tiny_table():
+    """Hypothesis: the folds of a table scaled by 1e-104 in f and 1000 in v (scipy's brentq gave RuntimeError
+    "failed to converge": its interpolation underflows) are the data's extrema, v_max = 500 and v_min = 2000 m/s to
+    1e-12 relative (PCHIP puts the folds at the data, the root to 4 ulp in ln v); a table at v ~ 1e-281 m/s
+    (ZeroDivisionError in the compiled f'') is a ValueError naming params.force and the range of v."""
+    fo = PeelForce.tabulated([v * 1000 for v in V5], [f * 1e-104 for f in F5]).folds(1.0)
+    assert fo.has_folds and abs(fo.v_max / 500.0 - 1) < 1e-12 and abs(fo.v_min / 2000.0 - 1) < 1e-12
+    tiny = PeelParams(V=1.0, I=1e-3, force=PeelForce.tabulated([v * 1e-281 for v in V5], F5))
+    with pytest.raises(ValueError, match=r"params\.force: the table starts at v=1e-282 m/s, below the model's "
+                                         r"velocities STATE_RANGES\['v'\]"):
+        estimate(tiny)
+
+
+def test_family_pack_overflow_is_a_value_error():
+    """Hypothesis: paper-family coefficients whose packed terms overflow (V**q6 with q6 = 9447) or divide by an
+    underflowed square (a3/v3**2, v3 = 1e-208) gave OverflowError / ZeroDivisionError from plain Python
+    arithmetic; now a ValueError naming the family and V."""
+    for coef in ({"a6": 3.8e243, "q6": 9447.0}, {"v3": 7.4e-208}):
+        law = PeelForce.paper_family(**coef)
+        with pytest.raises(ValueError, match=r"the 'paper' family: its coefficients give no finite law at V=14\.9"):
+            law.f(1.0, 14.9)
+        with pytest.raises(ValueError, match=r"params\.force=PeelForce\.paper_family\(.*no finite law at V=14\.9"):
+            estimate(PeelParams(V=14.9, I=1e-3, force=law))
+
+
+_MAG = st.tuples(st.sampled_from([-1.0, 1.0]), st.floats(-300.0, 300.0)).map(lambda t: t[0] * 10.0 ** t[1])
+_NAMED = (ValueError, TypeError, ModelBreakdown, SolverFailure, SolverBudgetExceeded)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(family=st.sampled_from(["cubic", "power_branches", "paper"]), data=st.data(), logV=st.floats(-6.0, 2.0))
+def test_any_coefficient_magnitude_gives_a_named_outcome(family, data, logV):
+    """Property: for any family and coefficients of any sign and magnitude in 1e-300..1e300 (each coefficient
+    drawn or left at its default), constructing the law, its folds, ``estimate`` and a 1 ms ``exact.simulate``
+    either succeed or raise a named exception of the package (ValueError/TypeError for bad input; the model's
+    stops); never ZeroDivisionError, OverflowError or scipy's RuntimeError.  No tolerance: classes of outcome."""
+    from peelapprox._law_families import FAMILIES
+
+    names = FAMILIES[family].names
+    coefs = {n: data.draw(_MAG, label=n) for n in names if data.draw(st.booleans(), label=f"set {n}")}
+    V = 10.0**logV
+    try:
+        law = PeelForce.family(family, **coefs)
+    except (ValueError, TypeError):
+        return
+    p = PeelParams(V=V, I=1e-3, force=law)
+    for step in (lambda: law.folds(V), lambda: law.f(np.geomspace(1e-9, 1e3, 20), V), lambda: estimate(p),
+                 lambda: exact.simulate(p, 1e-3, max_wall=5.0, save="jumps")):
+        try:
+            step()
+        except _NAMED:
+            pass
+
+
+@pytest.mark.parametrize("V", [0.01, 1.0])
+def test_lightest_tape_starts(V):
+    """Hypothesis: at the documented minimum tape mass, 1e-15 kg, the smooth model's default LSODA failed its first
+    step (SolverFailure "after t=0" at V = 0.01 and 1 m/s, I = 1e-4); retried on the fast time scale it reaches
+    t_end = 1 ms (exact: the last stored time is t_end)."""
+    tr = exact.simulate(PeelParams(V=V, I=1e-4, tape_mass=1e-15), 1e-3)
+    assert tr.t[-1] == 1e-3 and tr.final_state.t == 1e-3
+
+
+# ------------------------------------------------------------------------------------------------ messages
+
+def test_shown_cuts_long_values():
+    """Hypothesis: ``shown`` is ``repr`` up to its limit, then the first ``limit`` characters and the length of the
+    value (characters of a str; of the repr otherwise)."""
+    assert shown("abc") == "'abc'"
+    assert shown("x" * 700_000) == "'" + "x" * 199 + "... (700000 characters)"
+    assert shown(list(range(100)), 10) == "[0, 1, 2, ... (390 characters)"
+
+
+_LONG = "x" * 700_000
+
+
+@pytest.mark.parametrize("option,extra", [
+    ("--force-family", ["--force-family", _LONG]),
+    ("--force-family", ["--force-family", "cubic", "--coef", _LONG + "=1"]),
+    ("--const", ["--force", "v", "--const", "a=" + _LONG]),
+    ("--geometry", ["--geometry", _LONG]),
+    ("--force-table", ["--force-table", _LONG]),
+    ("--out", ["--out", "/nonexistent/" + _LONG + ".npz"]),
+    ("--out", ["--out", _LONG]),
+], ids=["family", "coef-name", "const-value", "geometry", "table-path", "out-dir", "out-name"])
+def test_long_inputs_are_cut_in_messages(option, extra, capsys):
+    """Hypothesis: a 700 KB option value (echoed whole before: 700 KB of stderr) gives an error line naming the
+    option, shorter than MESSAGE_LIMIT (2000 characters) and saying how much was left out ("... (N characters)");
+    exit status 2 (a usage error), no traceback, nothing on stdout."""
+    code, out, err = _cli(SIM + extra, capsys)
+    line = _one_error_line(err)
+    assert code == 2 and out == ""
+    assert len(line) < MESSAGE_LIMIT and len(err) < MESSAGE_LIMIT + 2000  # the line and argparse's usage lines
+    assert option in line and "characters)" in line
+
+
+def test_default_load_is_named(capsys):
+    """Hypothesis: ``--loading load --load-mass 1e-6`` (no --load) says that --load was not given, the default
+    --load-mass times g = 9.80665e-06 N that was used, the range of the load and the range of --load-mass that
+    gives a valid default (1e-3/9.80665 = 1.01972e-4 kg up); PeelParams says the same in its own names."""
+    code, _out, err = _cli(SIM + ["--loading", "load", "--load-mass", "1e-6"], capsys)
+    line = _one_error_line(err)
+    assert code == 2
+    assert ("--load was not given, so its default --load-mass times g = 1e-06 kg * 9.80665 m/s^2 = 9.80665e-06 N "
+            "was used; the load must be in [0.001, 1e7] N: give --load, or a --load-mass in [0.000101972, 1e6] kg"
+            in line)
+    with pytest.raises(ValueError, match=r"^load was not given, so its default load_mass \* g = 1e-06 kg"):
+        PeelParams(V=1.0, I=1e-2, loading="load", load_mass=1e-6)
+
+
+def test_out_with_another_suffix_is_refused(tmp_path, capsys):
+    """Hypothesis: ``--out x.txt`` (numpy wrote x.txt.npz silently) is refused before the run, exit status 2,
+    naming the path and the suffix; nothing is written."""
+    code, out, err = _cli(SIM + ["--out", str(tmp_path / "x.txt")], capsys)
+    line = _one_error_line(err)
+    assert code == 2 and out == ""
+    assert "x.txt'" in line and "must end in .npz" in line and "'.txt'" in line
+    assert os.listdir(tmp_path) == []
+
+
+def test_negative_option_values(capsys):
+    """Hypothesis: ``--I -1e-5`` reaches the range check (argparse read it as an unknown option: "expected one
+    argument"): the message names --I, its range and the value; other values that start with '-' get the hint
+    ``--opt=VALUE``."""
+    code, _out, err = _cli(["simulate", "--V", "1", "--I", "-1e-5", "--t-end", "1"], capsys)
+    assert code == 2 and "--I must be finite and in [1e-12, 1e6], got -1e-05" in _one_error_line(err)
+    code, _out, err = _cli(SIM + ["--alpha0", "-1.5E-3", "--F0", "-inf"], capsys)
+    assert code == 2 and "F0" in _one_error_line(err) and "got -inf" in err
+    code, _out, err = _cli(SIM + ["--force", "-v"], capsys)
+    assert code == 2 and "(a value that starts with '-' is written --force=VALUE)" in _one_error_line(err)
+
+
+# ------------------------------------------------------------------------------------------------ internal errors
+
+def _boom(args):
+    raise KeyError("a bug")
+
+
+def test_internal_error_is_one_line(monkeypatch, capsys):
+    """Hypothesis: an exception that is neither a user error nor a documented stop (here a KeyError raised by the
+    subcommand) is one line, ``peelapprox folds: internal error: KeyError: 'a bug' (a bug: ...)``, exit status
+    EXIT_INTERNAL = 4, no traceback; with PEELAPPROX_TRACEBACK=1 it propagates (its traceback)."""
+    from peelapprox import cli
+
+    monkeypatch.setattr(cli, "_folds", _boom)  # build_parser binds the subcommand's function when main() runs
+    monkeypatch.delenv(TRACEBACK_ENV, raising=False)
+    code, out, err = _cli(["folds", "--V", "1"], capsys)
+    assert code == EXIT_INTERNAL == 4 and out == ""
+    assert _one_error_line(err, "folds") == ("peelapprox folds: internal error: KeyError: 'a bug' (a bug: please "
+                                             "report it; set PEELAPPROX_TRACEBACK=1 to see the traceback)")
+    monkeypatch.setenv(TRACEBACK_ENV, "1")
+    with pytest.raises(KeyError, match="a bug"):
+        main(["folds", "--V", "1"])
+
+
+def test_warning_is_one_line(monkeypatch, capsys):
+    """Hypothesis: a warning issued while a command runs (scipy's LSODA warns in the fast transits of a light tape)
+    is one stderr line ``peelapprox folds: warning: UserWarning: <message>``, without Python's second line (the
+    source line of the library, which reads like part of a traceback); the command's status is unchanged (0)."""
+    import warnings
+
+    from peelapprox import cli
+
+    def warn(args):
+        warnings.warn("lsoda: Repeated error test failures\n(internal error).", UserWarning, stacklevel=1)
+        return 0
+
+    monkeypatch.setattr(cli, "_folds", warn)
+    code, _out, err = _cli(["folds", "--V", "1"], capsys)
+    assert code == 0
+    assert err == "peelapprox folds: warning: UserWarning: lsoda: Repeated error test failures (internal error).\n"
+
+
+def test_read_error_of_a_table_is_usage_error(tmp_path, capsys):
+    """Hypothesis: an unreadable table (mode 000; skipped as root, who reads anything) is exit status 2 naming the
+    path, not an OSError traceback."""
+    if os.geteuid() == 0:
+        pytest.skip("root reads files of mode 000")
+    path = _table(tmp_path / "locked.csv", "v,f\n")
+    os.chmod(path, 0)
+    try:
+        code, _out, err = _cli(SIM + ["--force-table", path], capsys)
+    finally:
+        os.chmod(path, stat.S_IRUSR | stat.S_IWUSR)
+    assert code == 2 and "cannot read it" in _one_error_line(err)
