@@ -22,7 +22,7 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["LAW_BUILD_SECONDS", "Expired", "caller_budget", "time_limit"]
+__all__ = ["LAW_BUILD_SECONDS", "Expired", "WallSpent", "caller_budget", "time_limit"]
 
 #: The longest a law may take to be built (sympy: parse, derivatives, probe) or compiled (render, numba) [s]:
 #: the families and the paper's law written out take well under 1 s; a law needing a minute of algebra is one
@@ -63,9 +63,20 @@ def _can_interrupt() -> bool:
             and signal.getitimer(signal.ITIMER_REAL)[0] == 0.0)
 
 
+class WallSpent(BaseException):
+    """A whole command's wall budget is spent (the CLI's ``--max-wall``): a ``BaseException``, as
+    ``KeyboardInterrupt`` is, so that no ``except Exception`` on the way (a benchmark row, a sweep point, a law
+    build's own :class:`Expired`) takes it for its own failure."""
+
+    def __init__(self, seconds: float, caller: bool = False) -> None:
+        super().__init__(f"more than {seconds:g} s")
+        self.seconds = seconds
+
+
 @contextmanager
-def time_limit(seconds: float) -> Iterator[None]:
-    """Raise :class:`Expired` if the body runs longer than ``seconds`` or past the caller's deadline.
+def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator[None]:
+    """Raise ``error(limit, caller)`` (:class:`Expired`) if the body runs longer than ``seconds`` or past the
+    caller's deadline.
 
     Interrupts the body where it can (module docstring), else raises when the body returns late.
     """
@@ -74,15 +85,15 @@ def time_limit(seconds: float) -> Iterator[None]:
     caller = outer is not None and outer - now < seconds
     limit = (outer - now) if caller and outer is not None else seconds
     if limit <= 0.0:
-        raise Expired(0.0, caller)
+        raise error(0.0, caller)
     if not _can_interrupt():
         yield
         if time.perf_counter() - now > limit:
-            raise Expired(limit, caller)
+            raise error(limit, caller)
         return
 
     def _expire(signum: int, frame: object) -> None:
-        raise Expired(limit, caller)
+        raise error(limit, caller)
 
     previous = signal.signal(signal.SIGALRM, _expire)
     signal.setitimer(signal.ITIMER_REAL, limit)

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from . import _law_expr, _law_families, _law_table
-from ._checks import in_range, reals
+from ._checks import in_range, reals, shown
 from ._law_folds import Folds, find_folds
 
 __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "law_label", "register_paper",
@@ -115,7 +115,7 @@ class PeelForce:
         needs = {"paper": (), "family": ("name",), "expression": ("source",), "tabulated": ("tables",)}[kind]
         if kind == "family":
             if family not in _law_families.FAMILIES:
-                raise ValueError(f"unknown peel-force family {family!r}: the families are "
+                raise ValueError(f"unknown peel-force family {shown(family)}: the families are "
                                  f"{', '.join(_law_families.FAMILIES)}")
             coef = _law_families.coefficients(_law_families.FAMILIES[family], dict(coef))
             needs = ("name", "coefficients")
@@ -399,7 +399,7 @@ class PeelForce:
             with np.errstate(all="ignore"):
                 return np.asarray(impl(v, V, order), dtype=float)
 
-        return find_folds(fn, V, window, (lo, hi), repr(self), FOLD_GRID_DENSITY)
+        return find_folds(fn, V, window, (lo, hi), shown_law(self), FOLD_GRID_DENSITY)
 
 
 def _restore(kind: str, name: str | None, coefficients: tuple, source: str | None, tables: tuple,
@@ -415,6 +415,12 @@ def _restore(kind: str, name: str | None, coefficients: tuple, source: str | Non
 
 
 _PAPER_LAW = PeelForce("paper")
+
+
+def shown_law(force: Any, limit: int = 300) -> str:
+    """``repr(force)`` for a message, cut after ``limit`` characters (an expression law's text may be long)."""
+    r = repr(force)
+    return r if len(r) <= limit else f"{r[:limit]}... ({len(r)} characters)"
 
 
 def law_label(force: Any) -> str:
@@ -436,4 +442,4 @@ def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = A
     if where is None:
         where = sys._getframe(2).f_code.co_name
     raise ValueError(f"params.force: {where} runs the laws {', '.join(repr(x) for x in laws)} only, not "
-                     f"{force!r}")
+                     f"{shown_law(force)}")

@@ -46,10 +46,10 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import shown
 from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
 from ._jit import kernel
 from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
-from ._law_grammar import shorten
 from .errors import KernelCacheWarning
 
 __all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "expression_source",
@@ -494,7 +494,7 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     except Expired as exc:
         if exc.caller:  # the caller's max_wall: its own budget exception (exact.simulate turns it into one)
             raise
-        raise ValueError(f"expression law {shorten(source)}: rendering and compiling it took more than "
+        raise ValueError(f"expression law {shown(source)}: rendering and compiling it took more than "
                          f"{LAW_BUILD_SECONDS:g} s; write it in a simpler form (expanded, fewer factors)") from None
     _EXPRESSION_KERNELS[source] = (law, pack)
     return _EXPRESSION_KERNELS[source]

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from . import _law_grammar
+from ._checks import shown
 from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
 
 __all__ = ["PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical", "from_stored", "from_text"]
@@ -66,7 +67,7 @@ def _grammar_round_trip(e: Any, label: str) -> str:
         if back == e:
             return text
         e = back
-    raise ValueError(f"expression {label}: its canonical text {_law_grammar.shorten(text)} does not read back as "
+    raise ValueError(f"expression {label}: its canonical text {shown(text)} does not read back as "
                      "the same expression; write it differently (e.g. expanded)")
 
 
@@ -99,7 +100,7 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
             raise ValueError(f"constant {name!r} clashes with the law's variable {name} (v: peel velocity, "
                              "V: pull speed, m/s)")
         if not (isinstance(name, str) and name.isidentifier()) or name in _law_grammar.FUNCTIONS:
-            raise ValueError(f"constant name {_law_grammar.shorten(str(name), 40)} must be an identifier other than "
+            raise ValueError(f"constant name {shown(str(name), 40)} must be an identifier other than "
                              "a function's name")
         x = real(name, value)
         if not math.isfinite(x) or abs(x) > _law_grammar.MAX_LITERAL:
@@ -107,10 +108,10 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
                              f"magnitude, got {value!r}")
         values[name] = _number(x)
     if isinstance(expr, str):
-        label = _law_grammar.shorten(expr)
+        label = shown(expr)
         text = expr
     elif isinstance(expr, sp.Basic):
-        label = _law_grammar.shorten(str(expr))
+        label = shown(str(expr))
         text = _law_grammar.canonical_text(expr)
     else:
         raise TypeError(f"expression must be a string or a sympy expression, got {type(expr).__name__}")
@@ -136,7 +137,7 @@ def _checked_text(text: str, values: dict[str, Any], label: str) -> str:
         raise ValueError(f"expression {label} is not a scalar expression (got {type(e).__name__})")
     e = _integral_floats(e)
     if v not in e.free_symbols:
-        raise ValueError(f"expression {label} does not depend on v (it is {_law_grammar.shorten(str(e), 60)}): a peel "
+        raise ValueError(f"expression {label} does not depend on v (it is {shown(str(e), 60)}): a peel "
                          "force must vary with the peel velocity")
     ExpressionLaw(e).probe(label)  # before printing: a complex law is named by the point where it is complex
     return _grammar_round_trip(e, label)
@@ -161,7 +162,7 @@ def from_stored(text: Any) -> str:
     v, V = _symbols()
     e, _used = _law_grammar.parse(text, {"v": v, "V": V}, legacy=True)
     if not isinstance(e, sp.Expr):
-        raise ValueError(f"stored expression {_law_grammar.shorten(text)} is not a scalar expression")
+        raise ValueError(f"stored expression {shown(text)} is not a scalar expression")
     return canonical(e, {})
 
 

@@ -35,8 +35,10 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from ._checks import shown
+
 __all__ = ["FUNCTIONS", "MAX_CALL_DEPTH", "MAX_CHARS", "MAX_EXPONENT", "MAX_LITERAL", "MAX_NODES", "NON_SMOOTH",
-           "canonical_text", "parse", "shorten"]
+           "canonical_text", "parse"]
 
 #: The longest expression text accepted [characters].
 MAX_CHARS = 2000
@@ -68,12 +70,6 @@ _LEGACY_CALLS = frozenset({"Add", "Mul", "Pow", "Integer", "Float", "Rational", 
                            "NegativeOne", "Exp1", "Pi"})
 
 
-def shorten(text: str, limit: int = 200) -> str:
-    """``repr(text)``, cut to ``limit`` characters with the full length said (for messages echoing input)."""
-    r = repr(text)
-    return r if len(r) <= limit else f"{r[:limit]}... ({len(text)} characters)"
-
-
 def _supported() -> str:
     return ", ".join(sorted(set(FUNCTIONS)))
 
@@ -92,7 +88,7 @@ class _Builder:
         self.nodes = 0
 
     def fail(self, why: str) -> ValueError:
-        return ValueError(f"expression {shorten(self.text)}: {why}")
+        return ValueError(f"expression {shown(self.text)}: {why}")
 
     def number(self, x: Any) -> Any:
         """A numeric result, checked against :data:`MAX_LITERAL` (and finite)."""
@@ -113,7 +109,7 @@ class _Builder:
         if isinstance(node, ast.Constant):
             value = node.value
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise self.fail(f"{type(value).__name__} literal {shorten(repr(value), 40)} is not a number")
+                raise self.fail(f"{type(value).__name__} literal {shown(value, 40)} is not a number")
             if isinstance(value, int):
                 if abs(value) > MAX_LITERAL:
                     raise self.fail(f"the integer literal has {len(str(abs(value)))} digits: numbers are bounded "
@@ -155,7 +151,7 @@ class _Builder:
         if name.lower() in ("nan", "inf", "infinity", "oo", "zoo"):
             raise self.fail(f"{name} is not a number a law can hold: a peel force is finite")
         known = ", ".join(["v", "V", *sorted(n for n in self.names if n not in ("v", "V")), *_CONSTANTS])
-        raise self.fail(f"unknown symbol {shorten(name, 40)}: a law may use {known}; give other constants as "
+        raise self.fail(f"unknown symbol {shown(name, 40)}: a law may use {known}; give other constants as "
                         f"keywords, e.g. {name if name.isidentifier() and len(name) < 20 else 'a'}=1.0")
 
     def power(self, a: Any, b: Any) -> Any:
@@ -182,7 +178,7 @@ class _Builder:
                             f"(its Newton steps, the fold conditions f' = 0 and the Jacobians); the smooth "
                             f"functions are {_supported()} (write a smooth law, e.g. sqrt(x**2 + d**2) for |x|)")
         if fname not in FUNCTIONS:
-            raise self.fail(f"unknown function {shorten(fname, 40)}: the functions a law may call are {_supported()}")
+            raise self.fail(f"unknown function {shown(fname, 40)}: the functions a law may call are {_supported()}")
         if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
             raise self.fail(f"{fname} takes one positional argument, e.g. {fname}(v)")
         if depth + 1 > MAX_CALL_DEPTH:
@@ -278,7 +274,7 @@ def parse(text: str, names: Mapping[str, Any] | None = None, *, legacy: bool = F
     if not isinstance(text, str):
         raise TypeError(f"expression must be a string, got {type(text).__name__}")
     if len(text) > MAX_CHARS:
-        raise ValueError(f"expression {shorten(text)} is longer than {MAX_CHARS} characters (a law's text is "
+        raise ValueError(f"expression {shown(text)} is longer than {MAX_CHARS} characters (a law's text is "
                          "bounded so that parsing, differentiating and compiling it stay bounded)")
     if not text.strip():
         raise ValueError("expression is empty: write a law in v, e.g. '300 - 100*v + 20*v**2'")
@@ -287,10 +283,10 @@ def parse(text: str, names: Mapping[str, Any] | None = None, *, legacy: bool = F
         # applies (``a + b*v^2`` is a + b v², not (a + b v) xor 2); ``^`` inside a string changes a string, refused
         tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
     except SyntaxError as exc:
-        raise ValueError(f"expression {shorten(text)} does not parse: {exc.msg}"
+        raise ValueError(f"expression {shown(text)} does not parse: {exc.msg}"
                          + (f" at column {exc.offset}" if exc.offset else "")) from None
     except (RecursionError, MemoryError, ValueError):
-        raise ValueError(f"expression {shorten(text)} does not parse: nested too deeply") from None
+        raise ValueError(f"expression {shown(text)} does not parse: nested too deeply") from None
     b = _Builder(text, names or {}, legacy)
     try:
         return b.build(tree), b.used

@@ -280,12 +280,16 @@ def test_cli_refuses_a_grid_too_large_at_once(tmp_path, capsys, argv, match):
      "stopped: the --max-wall budget"),
     (["sweep", "--I", "1e-5:1e-3:10:log", "--V", "1:2:2", "--measure", "period", "--workers", "0", "--quiet"],
      "error: sweep: the wall-clock budget max_wall=0.5 s was spent"),
+    (["compare"], "error: more than 0.5 s of wall time (--max-wall)"),
+    (["figures", "--out", "FIGS"], "error: more than 0.5 s of wall time (--max-wall)"),
 ])
 def test_cli_max_wall_bounds_each_command(tmp_path, capsys, argv, after):
     """Each of orbit, bifurcation, basins and sweep, given work for minutes and ``--max-wall 0.5``, ends within
     :data:`BOUND` with exit status 3 (a solver stop) and says why on stderr; the sweep leaves its manifest in its
-    directory for the same command to resume (categorical)."""
+    directory for the same command to resume; compare and figures, whose library calls have no budget of their
+    own, are stopped by the command's timer (categorical)."""
     out = tmp_path / "s"
+    argv = [str(tmp_path / "figs") if a == "FIGS" else a for a in argv]
     rc, took = _cli(argv + ["--max-wall", str(BUDGET)] + (["--out", str(out)] if argv[0] == "sweep" else []))
     assert rc == 3 and took < BOUND
     assert after in capsys.readouterr().err
@@ -293,10 +297,10 @@ def test_cli_max_wall_bounds_each_command(tmp_path, capsys, argv, after):
         assert (out / "sweep.json").exists()
 
 
-@pytest.mark.parametrize("command", ["orbit", "bifurcation", "basins", "sweep", "simulate", "dynamics"])
+@pytest.mark.parametrize("command", ["orbit", "bifurcation", "basins", "sweep", "simulate", "dynamics", "folds",
+                                     "estimate", "segment", "compare", "benchmark", "figures"])
 def test_every_cli_max_wall_defaults_to_600_seconds(command):
-    """``--max-wall`` of every subcommand that runs the exact model defaults to 600 s and says so in its help
-    (exact value and text)."""
+    """``--max-wall`` of every subcommand defaults to 600 s and says so in its help (exact value and text)."""
     from peelapprox.cli import build_parser
 
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices[command]

@@ -35,10 +35,11 @@ import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from .._deadline import WallSpent, time_limit
 from .._version import __version__
 from . import basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
 from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, clip, exit_status, one_line
-from ._common import ArgumentParser, HelpFormatter
+from ._common import ArgumentParser, HelpFormatter, add_max_wall_option
 
 __all__ = ["build_parser", "main"]
 
@@ -77,18 +78,28 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=f"peelapprox {__version__}")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     simulate.add_parser(sub).set_defaults(func=_simulate)
-    estimate.add_folds_parser(sub).set_defaults(func=_folds)
-    estimate.add_estimate_parser(sub).set_defaults(func=_estimate)
-    estimate.add_segment_parser(sub).set_defaults(func=_segment)
-    compare.add_parser(sub).set_defaults(func=_compare)
-    benchmark.add_parser(sub).set_defaults(func=_benchmark)
+    _hard_wall(estimate.add_folds_parser(sub)).set_defaults(func=_folds)
+    _hard_wall(estimate.add_estimate_parser(sub)).set_defaults(func=_estimate)
+    _hard_wall(estimate.add_segment_parser(sub)).set_defaults(func=_segment)
+    _hard_wall(compare.add_parser(sub)).set_defaults(func=_compare)
+    _hard_wall(benchmark.add_parser(sub)).set_defaults(func=_benchmark)
     sweep.add_parser(sub).set_defaults(func=_sweep)
-    figures.add_parser(sub).set_defaults(func=_figures)
+    _hard_wall(figures.add_parser(sub)).set_defaults(func=_figures)
     dynamics.add_parser(sub).set_defaults(func=_dynamics)
     orbit.add_orbit_parser(sub).set_defaults(func=_orbit)
     orbit.add_bifurcation_parser(sub).set_defaults(func=_bifurcation)
     basins.add_parser(sub).set_defaults(func=_basins)
     return ap
+
+
+def _hard_wall(sp: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """``--max-wall S`` (default 600 s) on a subcommand whose library calls have no wall budget of their own: the
+    whole command is stopped when it is spent (exit status 3; :func:`main` arms the timer).  The subcommands that
+    run budgeted library calls (simulate, dynamics, orbit, bifurcation, basins, sweep) pass theirs on instead and
+    write what they computed."""
+    add_max_wall_option(sp, spent="when it is spent the command stops (exit status 3)")
+    sp.set_defaults(hard_wall=True)
+    return sp
 
 
 def _warning_line(command: str) -> Callable[..., None]:
@@ -125,7 +136,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         command = args.command
         with warnings.catch_warnings():  # restores Python's printer when the command returns
             warnings.showwarning = _warning_line(command)
-            return args.func(args)
+            if not getattr(args, "hard_wall", False):
+                return args.func(args)
+            try:
+                with time_limit(args.max_wall, WallSpent):
+                    return args.func(args)
+            except WallSpent:
+                ap.exit(3, f"peelapprox {command}: error: more than {args.max_wall:g} s of wall time (--max-wall); "
+                           "pass a larger --max-wall\n")
     except KeyboardInterrupt:
         ap.exit(EXIT_INTERRUPTED, f"peelapprox {command}: interrupted\n")
     except Exception as exc:
