@@ -49,7 +49,9 @@ SHOWN_LIMIT = 200
 
 
 def shown(value: Any, limit: int = SHOWN_LIMIT) -> str:
-    """``repr(value)`` for a message, cut after ``limit`` characters with ``... (N characters)`` appended.
+    """``repr(value)`` for a message, cut after ``limit`` characters, its full length said.
+
+    The cut text ends in ``"... (N characters)"``.
 
     N is the length of the value itself for ``str``/``bytes`` (what the user typed) and of its ``repr``
     otherwise, so the reader knows how much was left out.  ``repr`` is the value as Python writes it
