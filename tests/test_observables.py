@@ -1,6 +1,10 @@
-"""The observables of a stick-slip attractor: :class:`peelapprox.StickSlipObservables`.
+"""The observables of a stick-slip attractor: :class:`peelapprox.StickSlipObservables` and
+:func:`exact.attractor_observables`.
 
-Oracles: hand-computed jump sequences (exact arithmetic, spreads by :func:`statistics.stdev`).
+Oracles: hand-computed jump sequences (exact arithmetic, spreads by :func:`statistics.stdev`), the jump times
+and force drops read directly from ``exact.simulate(..., save="jumps")``, the Newton-closed periodic orbit of
+:func:`exact.periodic_orbit` (its period over its n returns), the periods docs/dynamics.md states, the
+tape-mass table of docs/tape-mass-dynamics.md and the solver's own reproducibility between tolerances.
 """
 
 from __future__ import annotations
@@ -12,7 +16,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from peelapprox import PeelParams, StickSlipObservables
+import exact
+import peelapprox
+from peelapprox import ModelBreakdown, PeelForce, PeelParams, StickSlipObservables, force_drops
 
 AB, CD = 0, 1  # from_branch codes (peelapprox.BRANCHES)
 MEANS = ("slip_interval", "force_drop", "slip_time", "stick_time")
@@ -109,6 +115,99 @@ def test_bad_input_is_named():
         StickSlipObservables.from_trajectory(object())
     with pytest.raises(ValueError, match="max_period"):
         StickSlipObservables.from_trajectory(HAND, max_period=0)
+    with pytest.raises(ValueError, match="t_window"):
+        exact.attractor_observables(PeelParams(V=1.0, I=1e-5), t_window=0.0)
+
+
+def test_low_inertia_against_the_jumps_and_the_periodic_orbit(p_low):
+    """V = 1, I = 1e-5 (the paper's law), window [30, 50] s at rtol 1e-10.  Period 3 (docs/dynamics.md: from
+    α0 = 0 the orbit is period 3).  Oracles:
+
+    * the mean of ``np.diff`` of the AB→CD jump times of ``exact.simulate(..., save="jumps")``, over the last
+      whole 3-cycles, computed here, and the force drops of :func:`peelapprox.force_drops`: the same run, read
+      independently (1e-12 relative: summation order only);
+    * the Newton-closed orbit of :func:`exact.periodic_orbit` (rtol 1e-12, closing residual ~1e-12): its
+      period over its 3 returns is the mean slip interval, its largest return F_max (measured 3e-12 and
+      9e-12 relative; asserted 1e-8);
+    * over whole cycles each slip interval is a CD stay plus an AB stay, so the two means add up to it
+      (1e-12 relative: rounding).
+    """
+    o = exact.attractor_observables(p_low)
+    tr = exact.simulate(p_low, 50.0, save="jumps", t_transient=30.0, rtol=1e-10)
+    t_slip = tr.jumps.t[tr.jumps.from_branch == AB]
+    intervals = np.diff(t_slip)
+    whole = intervals[intervals.size % 3:]
+    drops = force_drops(tr)
+    assert (o.status, o.period, o.n_slips) == ("stick-slip", 3, t_slip.size)
+    assert o.slip_interval == pytest.approx(np.mean(whole), rel=1e-12)
+    assert o.slip_interval_spread == pytest.approx(np.std(whole, ddof=1), rel=1e-12)
+    assert o.force_drop == pytest.approx(np.mean(drops[drops.size % 3:]), rel=1e-12)
+    assert (o.F_max, o.F_min) == (tr.jumps.F.max(), tr.jumps.F.min())
+    assert o.slip_time + o.stick_time == pytest.approx(o.slip_interval, rel=1e-12)
+    orbit = exact.periodic_orbit(p_low)
+    assert orbit.n == 3
+    assert o.slip_interval == pytest.approx(orbit.period / orbit.n, rel=1e-8)
+    assert o.F_max == pytest.approx(orbit.return_map_values.max(), rel=1e-8)
+    assert o.method == "exact: hybrid (DOP853), rtol 1e-10, alpha0 0, window [30, 50] s, period_rtol 1e-06"
+    assert (o.V, o.I) == (1.0, 1e-5)
+
+
+def test_high_inertia_period_8_and_reproducibility(p_low, p_high):
+    """V = 1, I = 1e-2: period 8 (docs/dynamics.md, Fig. 4 confirmed); the slip interval is the Newton-closed
+    orbit's period over its 8 returns (measured 4.5e-10 relative: the window's orbit is still converging, to
+    ~1e-7 in F; asserted 1e-8).  Reproducibility, the issue's target: every mean, spread and F extreme at
+    rtol 1e-10 and 1e-12 agree to 1e-6 relative on both periodic attractors (measured 1.3e-10 at most)."""
+    o = exact.attractor_observables(p_high)
+    orbit = exact.periodic_orbit(p_high)
+    assert (o.status, o.period, orbit.n) == ("stick-slip", 8, 8)
+    assert o.slip_interval == pytest.approx(orbit.period / 8, rel=1e-8)
+    for p in (p_low, p_high):
+        a, b = exact.attractor_observables(p), exact.attractor_observables(p, rtol=1e-12)
+        assert (a.period, a.n_slips) == (b.period, b.n_slips)
+        for name in (*MEANS, *(f"{m}_spread" for m in MEANS), "F_max", "F_min"):
+            assert getattr(a, name) == pytest.approx(getattr(b, name), rel=1e-6), (p.I, name)
+
+
+def test_steady_peeling_is_a_status_not_an_error():
+    """Categorical, two ways to have no stick-slip: the paper's law at V = 0.2 m/s, where the fixed point is
+    stable (docs/theory.md: "V = 0.2 ... no stick-slip"), and a law without folds (f = 200 + 50 v).  Both are
+    "steady" with None means, and say why."""
+    o = exact.attractor_observables(PeelParams(V=0.2, I=1e-5))
+    assert o.status == "steady" and o.slip_interval is None and o.force_drop is None and o.F_max is None
+    assert "the fixed point is stable" in o.reason
+    law = PeelForce.expression("200 + 50*v")
+    o = exact.attractor_observables(PeelParams(V=1.0, I=1e-5, force=law), t_transient=5.0, t_window=5.0)
+    assert o.status == "steady" and o.period is None and o.n_slips == 0
+    assert "the law has no folds at V = 1 m/s" in o.reason
+
+
+def test_tape_mass_variant_matches_its_documented_window():
+    """The tape-mass model (m = 1e-4 kg, V = 1, I = 1e-5; its jumps are the crossings of the inflection
+    velocity), over docs/tape-mass-dynamics.md's window (2 s transient, 4 s, rtol 1e-8, period_rtol 1e-5).
+    That page's table gives period-5, 13.2 slips/s and F at slips 268.9–276.8 N (all slips of the window),
+    which the observables must reproduce to their printed digits (half a unit of the last: 0.05 N, 0.05 /s,
+    the half included, since 13.25 prints as 13.2); the mean drop over the
+    window's whole cycles agrees with the mean of :func:`peelapprox.force_drops` over the same cycles
+    (1e-12)."""
+    p = PeelParams(V=1.0, I=1e-5, tape_mass=1e-4)
+    o = exact.attractor_observables(p, t_transient=2.0, t_window=4.0, rtol=1e-8, period_rtol=1e-5)
+    assert (o.status, o.period) == ("stick-slip", 5)
+    assert o.n_slips / 4.0 == pytest.approx(13.2, abs=0.051)  # 53 slips: 13.25 prints as 13.2
+    assert o.F_max == pytest.approx(276.8, abs=0.05) and o.F_min == pytest.approx(189.1, abs=0.05)
+    assert o.method.startswith("exact: smooth (LSODA), rtol 1e-08")
+    tr = exact.window_run(p, t_transient=2.0, window=4.0, rtol=1e-8)
+    drops = force_drops(tr)
+    assert o.force_drop == pytest.approx(np.mean(drops[drops.size % 5:]), rel=1e-12)
+    for name in MEANS:
+        assert np.isfinite(getattr(o, name)) and getattr(o, name) > 0
+
+
+def test_breakdown_propagates_and_names_are_shared():
+    """A breakdown is an exception, not a status (docs/dynamics.md: V = 0.5, I = 1e-4 breaks down at
+    t = 0.018 s); the lazily offered ``peelapprox.attractor_observables`` is exact's own object."""
+    with pytest.raises(ModelBreakdown):
+        exact.attractor_observables(PeelParams(V=0.5, I=1e-4), t_transient=0.0, t_window=1.0)
+    assert peelapprox.attractor_observables is exact.attractor_observables
 
 
 def test_dataframe_row():
