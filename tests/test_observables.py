@@ -202,6 +202,19 @@ def test_tape_mass_variant_matches_its_documented_window():
         assert np.isfinite(getattr(o, name)) and getattr(o, name) > 0
 
 
+def test_constant_load_transient_then_steady():
+    """Categorical, under a constant load above f_max (F_L = 300 N, M = 0.1 kg; tests/test_load.py: only the CD
+    fixed point exists and is stable, the jumps stop within 0.1 s): the window [0, 0.5] s sees the last jumps
+    and then a quiet CD stay over 10 times the longest complete stay, "transient"; the window [0.2, 0.5] s has
+    no jump, "steady" on CD."""
+    p = PeelParams(V=1.0, I=1e-5, loading="load", load_mass=0.1, load=300.0)
+    kw = dict(rtol=1e-6, solver="LSODA")
+    o = exact.attractor_observables(p, t_transient=0.0, t_window=0.5, **kw)
+    assert o.status == "transient" and o.n_slips >= 2 and "open CD stay" in o.reason
+    o = exact.attractor_observables(p, t_transient=0.2, t_window=0.3, **kw)
+    assert o.status == "steady" and o.slip_interval is None and "steady peeling on CD" in o.reason
+
+
 def test_breakdown_propagates_and_names_are_shared():
     """A breakdown is an exception, not a status (docs/dynamics.md: V = 0.5, I = 1e-4 breaks down at
     t = 0.018 s); the lazily offered ``peelapprox.attractor_observables`` is exact's own object."""
