@@ -9,7 +9,9 @@ error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the
 limits) are the validated forms of ``simulate``'s keywords.
 
 The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
-(sampled starts grouped by the attractor they reach) and the largest Lyapunov exponent, ``lyapunov(params,
+(sampled starts grouped by the attractor they reach), ``attractor_observables`` (the slip interval, force
+drop, slip and stick times and period of the attractor one window reaches: a
+``peelapprox.StickSlipObservables``) and the largest Lyapunov exponent, ``lyapunov(params,
 method=...)`` with the methods "two-trajectory", "tangent", "return-map" and "variational" (also
 ``lyapunov_tangent``, ``lyapunov_return_map``; ``benettin`` is the generic two-trajectory method for any
 flow). Each runs the peel-force law ``params.force`` (any law with a compiled kernel; the variational method,
@@ -19,7 +21,7 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._attractors import DEFAULT_MAX_WALL, Attractor, attractors, window_run
+from ._attractors import DEFAULT_MAX_WALL, Attractor, attractor_observables, attractors, window_run
 from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._continuation import (
@@ -99,6 +101,7 @@ __all__ = [
     "window_run",
     "attractors",
     "Attractor",
+    "attractor_observables",
     "DEFAULT_MAX_WALL",
     "lyapunov",
     "check_lyapunov_options",

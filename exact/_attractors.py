@@ -4,6 +4,8 @@
   run behind :func:`attractors`, the sweep measures ``period`` and ``jumps`` and ``peelapprox dynamics``.
 * :func:`attractors` — sample initial peel angles and group the attractors they reach, by the return-map
   analysis of :mod:`peelapprox` (:func:`peelapprox.classify`, :func:`peelapprox.settle_time`).
+* :func:`attractor_observables` — the observables of the attractor one window reaches
+  (:class:`peelapprox.StickSlipObservables`, read off :func:`window_run`'s jumps).
 """
 
 from __future__ import annotations
@@ -16,16 +18,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from peelapprox import (
+    TIME_MAX,
     WINDOW_DEFAULTS,
     ModelBreakdown,
     PeelParams,
     SolverBudgetExceeded,
+    StickSlipObservables,
     classify,
     return_map,
     settle_time,
 )
 from peelapprox.errors import WallBudget
-from peelapprox.validate import duration, function, optional, positive, state, states
+from peelapprox.io import fmt_number
+from peelapprox.validate import duration, function, integer, optional, positive, state, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
@@ -33,7 +38,8 @@ from ._options import method_option
 from ._simulate import initial_state, simulate
 from ._trajectory import Trajectory
 
-__all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors", "paper_model_only"]
+__all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors", "attractor_observables",
+           "paper_model_only"]
 
 #: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
 #: attractors): their work grows with counts (n, n_returns, starts) that no step budget bounds.
@@ -114,6 +120,80 @@ def window_run(
     return _window_run(_params("params", params), duration("t_transient", t_transient, zero=True),
                        duration("window", window), _rtol("rtol", rtol), state("alpha0", alpha0, "alpha"),
                        optional(positive, "max_wall", max_wall), method, solver)
+
+
+def attractor_observables(
+    params: PeelParams,
+    *,
+    t_transient: float = WINDOW_DEFAULTS["t_transient"],
+    t_window: float = WINDOW_DEFAULTS["window"],
+    rtol: float = WINDOW_DEFAULTS["rtol"],
+    alpha0: float = WINDOW_DEFAULTS["alpha0"],
+    period_rtol: float = 1e-6,
+    max_period: int = 32,
+    max_wall: float | None = None,
+    method: str | None = None,
+    solver: str | None = None,
+) -> StickSlipObservables:
+    """The observables of the exact attractor reached from ``alpha0``: slip interval, force drop, slip and
+    stick times, the F range at the jumps and the return map's period (docs/dynamics.md, "Attractor
+    observables").
+
+    One :func:`window_run` (cached: a sweep point's other window measures share it) read by
+    :meth:`peelapprox.StickSlipObservables.from_trajectory`.  Steady peeling (no folds at V, a stable fixed
+    point: no jump in the window) is ``status="steady"`` with every mean None, not an error.
+
+    Parameters
+    ----------
+    params : PeelParams
+        Any law ``params.force``; a model variant (a tape mass, a constant load) runs its own method, whose
+        jumps are the crossings of the inflection velocity of f (docs/tape-mass-dynamics.md).
+    t_transient : float
+        Seconds integrated and discarded before the window, in [0, 1e6] (30).
+    t_window : float
+        Seconds whose jumps are read, in (0, 1e6] (20); ``t_transient + t_window`` at most 1e6.
+    rtol : float
+        Relative tolerance of the run, in :data:`peelapprox.RTOL_RANGE` (1e-10).
+    alpha0 : float
+        Initial peel angle [rad]; the rest of the initial state is :func:`exact.initial_state`'s (0).
+    period_rtol, max_period
+        Of the period detection (:func:`peelapprox.periodicity`): 1e-6 and 32.
+    max_wall : float, optional
+        Wall-clock budget [s] of the run; None: unbounded.
+    method, solver : str, optional
+        :func:`exact.simulate`'s (None: the model's method and the method's solver).
+
+    Returns
+    -------
+    peelapprox.StickSlipObservables
+        With ``method`` e.g. ``"exact: hybrid (DOP853), rtol 1e-10, alpha0 0, window [30, 50] s,
+        period_rtol 1e-06"``.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named, with its range), before the run.
+    peelapprox.ModelBreakdown
+        When the model breaks down in the run (its time and state; the sweeps record it as a status).
+    peelapprox.SolverBudgetExceeded
+        When a step budget or ``max_wall`` is spent.
+    """
+    params = _params("params", params)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    t_window = duration("t_window", t_window)
+    if t_transient + t_window > TIME_MAX:
+        raise ValueError(f"t_transient + t_window must be at most {TIME_MAX:g} s (simulate's t_end), got "
+                         f"{t_transient:g} + {t_window:g}")
+    rtol, alpha0 = _rtol("rtol", rtol), state("alpha0", alpha0, "alpha")
+    period_rtol, max_period = positive("period_rtol", period_rtol), integer("max_period", max_period)
+    method_option(method, solver=solver, eps=None, rtol=rtol, atol=None, v_floor=None, params=params)
+    tr = window_run(params, t_transient=t_transient, window=t_window, rtol=rtol, alpha0=alpha0, max_wall=max_wall,
+                    method=method, solver=solver)
+    how = (f"exact: {tr.method} ({tr.solver}), rtol {fmt_number(rtol, 3)}, alpha0 {fmt_number(alpha0, 6)}, window "
+           f"[{fmt_number(t_transient, 6)}, {fmt_number(t_transient + t_window, 6)}] s, period_rtol "
+           f"{fmt_number(period_rtol, 3)}")
+    return StickSlipObservables.from_trajectory(tr, t_transient, period_rtol=period_rtol, max_period=max_period,
+                                                method=how)
 
 
 @functools.lru_cache(maxsize=2)

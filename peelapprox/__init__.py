@@ -11,8 +11,11 @@ The (I, V) sweep (``sweep``, ``load_sweep``, ``SweepResult``, ``register_measure
 imported from there on first use (``import peelapprox`` imports no sibling package).  So are the
 dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lyapunov(params, method=...)``),
 ``lyapunov_tangent``, ``lyapunov_return_map``, ``LyapunovResult``, ``benettin``, ``attractors``,
-``Attractor``, ``periodic_orbit``, ``continue_orbit``, ``switch_branch``, ``basins``.  The return-map analysis
-of a trajectory (``return_map``, ``periodicity``, ``classify``, ``force_drops``, ``settle_time``) is the core's own.
+``Attractor``, ``attractor_observables``, ``periodic_orbit``, ``continue_orbit``, ``switch_branch``,
+``basins``.  The return-map analysis of a trajectory (``return_map``, ``periodicity``, ``classify``,
+``force_drops``, ``settle_time``) is the core's own, and so is the one definition of a stick-slip attractor's
+observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObservables.from_trajectory``;
+``attractor_observables`` runs the exact solver for them).
 """
 
 from . import _law_paper  # noqa: F401  (hands the built-in law to PeelForce; see its docstring)
@@ -46,6 +49,7 @@ from ._estimate import (
 from ._law import PeelForce
 from ._law_compiled import branch_structure, fixed_point
 from ._law_folds import Folds
+from ._observables import StickSlipObservables
 from ._params import (
     EPS_DEFAULT,
     EPS_RANGE,
@@ -147,9 +151,12 @@ __all__ = [
     "classify",
     "force_drops",
     "settle_time",
+    # the observables of a stick-slip attractor (exact: attractor_observables)
+    "StickSlipObservables",
     # dynamics of the exact solution: they live in exact, imported from it on first access
     "attractors",
     "Attractor",
+    "attractor_observables",
     "lyapunov",
     "lyapunov_tangent",
     "lyapunov_return_map",
@@ -177,10 +184,10 @@ __all__ = [
 _LAZY = {name: "comparisons.sweep" for name in
          ("sweep", "load_sweep", "SweepResult", "register_measure", "MEASURES", "parse_grid")}
 # the dynamics that run the exact solver (the Lyapunov family, attractors) live in exact
-_LAZY.update({name: "exact" for name in ("attractors", "Attractor", "lyapunov", "lyapunov_tangent",
-                                         "lyapunov_return_map", "LyapunovResult", "benettin", "periodic_orbit",
-                                         "PeriodicOrbit", "continue_orbit", "OrbitBranch", "switch_branch", "basins",
-                                         "BasinResult")})
+_LAZY.update({name: "exact" for name in ("attractors", "Attractor", "attractor_observables", "lyapunov",
+                                         "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult", "benettin",
+                                         "periodic_orbit", "PeriodicOrbit", "continue_orbit", "OrbitBranch",
+                                         "switch_branch", "basins", "BasinResult")})
 
 
 def __getattr__(name: str):

@@ -32,7 +32,7 @@ API = {
         "lyapunov_return_map", "lyapunov_tangent", "parse_grid", "peel_force", "peel_force_derivative",
         "periodicity", "quasi_static_branch_time", "reduced_segment", "register_measure", "return_map",
         "settle_time", "sinusoid_alpha", "slope_criterion", "sweep", "wkb_alpha", "wkb_amplitude_phase",
-        "wkb_error_bound",
+        "wkb_error_bound", "StickSlipObservables", "attractor_observables",
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "Smooth", "STEP_BUDGET",
@@ -46,6 +46,7 @@ API = {
         "continue_orbit", "OrbitBranch", "BranchPoint", "Bifurcation", "switch_branch", "crest_margin", "Crest",
         "orbit_diagram", "OrbitDiagram", "explain", "MAX_DIAGRAM_VALUES",
         "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor", "MAX_BASIN_STARTS",
+        "attractor_observables",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
