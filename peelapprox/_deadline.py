@@ -29,13 +29,21 @@ __all__ = ["LAW_BUILD_SECONDS", "Expired", "WallSpent", "caller_budget", "time_l
 #: to write differently (expanded, fewer factors).
 LAW_BUILD_SECONDS = 60.0
 
+#: The longest limit armed as a timer [s] (about 3 years; ``setitimer`` overflows ``time_t`` near 1e10 s).
+MAX_TIMER = 1e8
+#: Seconds between the timer's repeated firings after the limit (module docstring of :func:`time_limit`).
+REPEAT = 0.05
+
 #: The caller's deadline (``time.perf_counter()`` value), if a public call set one (:func:`caller_budget`).
 _CALLER: contextvars.ContextVar[float | None] = contextvars.ContextVar("peelapprox_caller_deadline", default=None)
 
 
-class Expired(Exception):  # noqa: N818 - an event, not an error the user sees (callers turn it into theirs)
+class Expired(BaseException):  # noqa: N818 - an event, not an error the user sees (callers turn it into theirs)
     """The time limit of :func:`time_limit` ran out; ``seconds`` is the limit that applied, ``caller`` is True
-    when it was the caller's budget (:func:`caller_budget`) rather than the limit of the call itself."""
+    when it was the caller's budget (:func:`caller_budget`) rather than the limit of the call itself.
+
+    A ``BaseException``, as ``KeyboardInterrupt`` is: the code it interrupts (sympy's assumptions, numba's
+    passes) has ``except Exception`` clauses that would otherwise swallow it and carry on."""
 
     def __init__(self, seconds: float, caller: bool) -> None:
         super().__init__(f"more than {seconds:g} s")
@@ -86,7 +94,7 @@ def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator
     limit = (outer - now) if caller and outer is not None else seconds
     if limit <= 0.0:
         raise error(0.0, caller)
-    if not _can_interrupt():
+    if limit > MAX_TIMER or not _can_interrupt():  # beyond the timer's range (time_t): a check on return
         yield
         if time.perf_counter() - now > limit:
             raise error(limit, caller)
@@ -96,7 +104,9 @@ def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator
         raise error(limit, caller)
 
     previous = signal.signal(signal.SIGALRM, _expire)
-    signal.setitimer(signal.ITIMER_REAL, limit)
+    # repeating: an exception raised where Python cannot propagate it (a weakref callback, a ctypes callback of
+    # llvmlite) is printed and dropped, so the timer fires again every REPEAT seconds until one lands
+    signal.setitimer(signal.ITIMER_REAL, limit, REPEAT)
     try:
         yield
     finally:

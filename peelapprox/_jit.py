@@ -30,8 +30,11 @@ from __future__ import annotations
 
 import hashlib
 import inspect
+import os
 import pickle  # only its exception, for numba's cache files (numba unpickles them itself)
+import stat
 import struct
+import tempfile
 import types
 import warnings
 from collections.abc import Callable
@@ -39,13 +42,14 @@ from pathlib import Path
 from typing import Any, Literal
 
 from numba import njit
+from numba.core import config as numba_config
 from numba.core import types as _nbtypes
 from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
 
 __all__ = ["kernel", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
-           "caching_enabled"]
+           "caching_enabled", "unsafe_dir"]
 
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -103,6 +107,51 @@ _njit: Any = njit
 def caching_enabled() -> bool:
     """False once a kernel had to be compiled without a writable cache location."""
     return bool(_state["cache"])
+
+
+def unsafe_dir(d: Path) -> str | None:
+    """Why ``d`` may not hold code this process runs (None: it may): it must be a real directory (not a
+    symbolic link), owned by this user and writable by no one else, in a parent that others cannot rename it in
+    (not writable by others, or sticky as ``/tmp``), so that nobody else can plant or replace a law module or
+    numba's cache files (pickles numba loads) in it.  Created (mode 0700) if missing."""
+    try:
+        if not os.path.lexists(d):
+            d.mkdir(parents=True, exist_ok=True, mode=0o700)
+        st = os.lstat(d)
+        parent = os.stat(d.parent)
+    except OSError as exc:
+        return f"cannot be created or read ({exc.strerror or exc})"
+    if stat.S_ISLNK(st.st_mode):
+        return "is a symbolic link"
+    if not stat.S_ISDIR(st.st_mode):
+        return "is not a directory"
+    if hasattr(os, "geteuid") and st.st_uid != os.geteuid():
+        return f"is owned by another user (uid {st.st_uid})"
+    if st.st_mode & 0o022:
+        return f"is writable by {'others' if st.st_mode & 0o002 else 'its group'} (mode {stat.S_IMODE(st.st_mode):o})"
+    if parent.st_mode & 0o002 and not parent.st_mode & stat.S_ISVTX:
+        return f"is in a directory others can write to without the sticky bit (mode {stat.S_IMODE(parent.st_mode):o})"
+    try:
+        with tempfile.NamedTemporaryFile(dir=d, prefix=".probe-"):
+            pass
+    except OSError as exc:
+        return f"is not writable ({exc.strerror or exc})"
+    return None
+
+
+def _check_numba_cache_dir() -> None:
+    """Once per process: a ``NUMBA_CACHE_DIR`` that others could write to (numba loads the pickles it finds there)
+    turns caching off, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why."""
+    if _state.get("dir_checked"):
+        return
+    _state["dir_checked"] = True
+    env = getattr(numba_config, "CACHE_DIR", "") or ""
+    why = unsafe_dir(Path(env)) if env else None
+    if why is not None:
+        _state["cache"] = False
+        warnings.warn(f"peelapprox: NUMBA_CACHE_DIR={env!r} {why}; numba loads the pickled files it finds there, so "
+                      "kernels are compiled without caching in this process (point NUMBA_CACHE_DIR to a directory "
+                      "of yours that only you can write)", KernelCacheWarning, stacklevel=4)
 
 
 def _stamp_with_tag(dispatcher: Any) -> bool:
@@ -302,6 +351,7 @@ def _dispatcher(fn: Callable, inline: Literal["never", "always"], fastmath: bool
     """The numba dispatcher of :func:`_compile`."""
     if not outside:
         _check_source(fn)
+    _check_numba_cache_dir()
     if name is not None:  # distinct cache files for the pieces of each vector field (make_dop853)
         fn = _renamed(fn, name.replace("<locals>.", "").replace(".", "_"))
     if _state["cache"]:

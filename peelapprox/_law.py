@@ -229,6 +229,13 @@ class PeelForce:
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
         """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated."""
+        if not isinstance(d, Mapping):
+            raise TypeError(f"d must be a mapping of the law's fields (dataclasses.asdict(law) or its JSON), got "
+                            f"{type(d).__name__}")
+        unknown = sorted(set(d) - {"kind", "name", "coefficients", "source", "tables", "display"})
+        if unknown:
+            raise ValueError(f"d has unknown field(s) {shown(', '.join(map(str, unknown)))}: a law's fields are kind, "
+                             "name, coefficients, source, tables, display")
         return cls(**dict(d))  # lists for tuples: __post_init__ makes them canonical
 
     # ------------------------------------------------------------------ value semantics

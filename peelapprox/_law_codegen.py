@@ -32,9 +32,11 @@ import it.
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import os
 import re
+import shutil
 import stat
 import sys
 import tempfile
@@ -48,7 +50,7 @@ import numpy as np
 
 from ._checks import shown
 from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
-from ._jit import kernel
+from ._jit import kernel, unsafe_dir
 from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
 from .errors import KernelCacheWarning
 
@@ -359,29 +361,14 @@ def cache_dir() -> Path:
 MAX_MODULE_BYTES = 1 << 20
 
 
-def _unsafe_dir(d: Path) -> str | None:
-    """Why ``d`` may not hold code this process runs (None: it may): it must be a real directory (not a
-    symbolic link), owned by this user and writable by no one else, so that nobody else can plant or replace a
-    law module or numba's cache files (pickles) in it.  Created (mode 0700) if missing."""
-    try:
-        d.mkdir(parents=True, exist_ok=True, mode=0o700)
-        st = os.lstat(d)
-    except OSError as exc:
-        return f"cannot be created or read ({exc.strerror or exc})"
-    if stat.S_ISLNK(st.st_mode):
-        return "is a symbolic link"
-    if not stat.S_ISDIR(st.st_mode):
-        return "is not a directory"
-    if hasattr(os, "geteuid") and st.st_uid != os.geteuid():
-        return f"is owned by another user (uid {st.st_uid})"
-    if st.st_mode & 0o022:
-        return f"is writable by {'group' if st.st_mode & 0o020 else 'others'} (mode {stat.S_IMODE(st.st_mode):o})"
-    try:
-        with tempfile.NamedTemporaryFile(dir=d, prefix=".probe-"):
-            pass
-    except OSError as exc:
-        return f"is not writable ({exc.strerror or exc})"
-    return None
+def numba_cache_dir() -> Path:
+    """The directory numba's caches of this process go to when ``NUMBA_CACHE_DIR`` is set (its pickled index
+    and data files are loaded by numba: it must be as private as the law cache), else the law cache's
+    ``__pycache__``."""
+    import numba
+
+    env = getattr(numba.config, "CACHE_DIR", "") or ""
+    return Path(env) if env else cache_dir() / "__pycache__"
 
 
 _FALLBACK: dict[str, Path] = {}
@@ -391,15 +378,18 @@ def _law_dir() -> Path:
     """The verified cache directory (:func:`cache_dir` and its ``__pycache__``, where numba writes), else a
     private temporary one for this process, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why."""
     d = cache_dir()
-    why = _unsafe_dir(d)
-    if why is None:  # numba's cache files (pickles it loads) go to __pycache__ beside the module
-        why = _unsafe_dir(d / "__pycache__")
+    why = unsafe_dir(d)
+    if why is None:  # numba's cache files (pickles it loads) go to __pycache__ beside the module, or NUMBA_CACHE_DIR
+        nb = numba_cache_dir()
+        why = unsafe_dir(nb)
         if why is not None:
-            why = f"has a __pycache__ that {why}"
+            why = (f"has a __pycache__ that {why}" if nb == d / "__pycache__" else
+                   f"is fine, but NUMBA_CACHE_DIR={str(nb)!r}, where numba keeps the compiled laws, {why}")
     if why is None:
         return d
     if "dir" not in _FALLBACK:
         _FALLBACK["dir"] = Path(tempfile.mkdtemp(prefix="peelapprox-laws-"))  # mode 0700, new
+        atexit.register(shutil.rmtree, _FALLBACK["dir"], ignore_errors=True)
         warnings.warn(f"peelapprox: the law cache directory {str(d)!r} {why}; expression laws are written to "
                       f"{str(_FALLBACK['dir'])!r} for this process only (set PEELAPPROX_CACHE_DIR to a directory of "
                       "yours that only you can write to keep them compiled across processes)",

@@ -205,15 +205,19 @@ class ExpressionLaw:
         """ValueError naming the first point of the probe where f, f' or f'' is complex or not finite."""
         for Vp in (PROBE_PULL if self.depends_on_V else (1.0,)):
             for order, what in enumerate(("f", "f'", "f''")):
-                y = self.raw(PROBE_V, Vp, order)
+                try:
+                    y = self.raw(PROBE_V, Vp, order)
+                except (ArithmeticError, TypeError, ValueError) as exc:  # an overflow in numpy's scalar code, ...
+                    raise ValueError(f"expression {label}: {what} cannot be evaluated on v in [{V_DOMAIN[0]:g}, "
+                                     f"{V_DOMAIN[1]:g}] m/s, V={Vp:g} m/s ({type(exc).__name__}: {exc})") from None
                 if np.iscomplexobj(y) and np.any(y.imag != 0):
                     i = int(np.flatnonzero(y.imag != 0)[0])
-                    raise ValueError(f"expression {label!r}: {what} is complex at v={PROBE_V[i]:.6g} m/s, "
+                    raise ValueError(f"expression {label}: {what} is complex at v={PROBE_V[i]:.6g} m/s, "
                                      f"V={Vp:g} m/s ({what} = {complex(y[i])}); a law must be real on v in "
                                      f"[{V_DOMAIN[0]:g}, {V_DOMAIN[1]:g}] m/s")
                 y = np.real(y)
                 bad = np.flatnonzero(~np.isfinite(y))
                 if bad.size:
                     i = int(bad[0])
-                    raise ValueError(f"expression {label!r}: {what} is {y[i]} at v={PROBE_V[i]:.6g} m/s, V={Vp:g} "
+                    raise ValueError(f"expression {label}: {what} is {y[i]} at v={PROBE_V[i]:.6g} m/s, V={Vp:g} "
                                      f"m/s; a law must be finite on v in [{V_DOMAIN[0]:g}, {V_DOMAIN[1]:g}] m/s")

@@ -93,9 +93,10 @@ class _Builder:
     def number(self, x: Any) -> Any:
         """A numeric result, checked against :data:`MAX_LITERAL` (and finite)."""
         sp = self.sp
-        if x.is_Number:
-            if x in (sp.nan, sp.oo, -sp.oo, sp.zoo) or abs(float(x)) > MAX_LITERAL:
-                raise self.fail(f"the number {_num_text(x)} is not finite or exceeds {MAX_LITERAL:g} in magnitude")
+        if x.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+            raise self.fail(f"{_num_text(x)} is not finite (a division by zero, a log of 0, ...)")
+        if x.is_Number and abs(float(x)) > MAX_LITERAL:
+            raise self.fail(f"the number {_num_text(x)} exceeds {MAX_LITERAL:g} in magnitude")
         return x
 
     def build(self, node: ast.AST, depth: int = 0) -> Any:
@@ -164,7 +165,13 @@ class _Builder:
             if fa != 0.0 and fb * math.log10(abs(fa)) > math.log10(MAX_LITERAL):
                 raise self.fail(f"the power {_num_text(a)}**{_num_text(b)} exceeds {MAX_LITERAL:g} (numbers are "
                                 "bounded; exponent towers are refused)")
-        return self.number(a ** b)
+        r = self.number(a ** b)
+        if r.is_Pow and r.exp.is_Number and abs(float(r.exp)) > MAX_EXPONENT:  # (v**1000)**1000 = v**1000000
+            raise self.fail(f"the exponent {_num_text(r.exp)} of {_num_text(r.base)} exceeds {MAX_EXPONENT} in "
+                            "magnitude")
+        if not r.free_symbols and not r.is_Number:  # pi**1000, 2**0.5: one float, bounded
+            return self.constant(r, f"{_num_text(a)}**{_num_text(b)}")
+        return r
 
     def call(self, node: ast.Call, depth: int) -> Any:
         sp = self.sp
@@ -184,7 +191,21 @@ class _Builder:
         if depth + 1 > MAX_CALL_DEPTH:
             raise self.fail(f"function calls nested more than {MAX_CALL_DEPTH} deep (f'' grows with each level and "
                             "is compiled: the depth is bounded to keep that bounded)")
-        return self.number(getattr(sp, FUNCTIONS[fname])(self.build(node.args[0], depth + 1)))
+        arg = self.build(node.args[0], depth + 1)
+        value = self.number(getattr(sp, FUNCTIONS[fname])(arg))
+        if not value.free_symbols and not value.is_Number:  # sin(2**70), exp(3): one float, bounded and real
+            return self.constant(value, f"{fname}({_num_text(arg)})")
+        return value
+
+    def constant(self, value: Any, text: str) -> Any:
+        """A number-valued subexpression as one float, checked finite, real and at most :data:`MAX_LITERAL`."""
+        sp = self.sp
+        z = complex(sp.N(value, 20))
+        if z.imag != 0.0:
+            raise self.fail(f"{text} is not real (it is {z}): a peel force is real")
+        if not math.isfinite(z.real) or abs(z.real) > MAX_LITERAL:
+            raise self.fail(f"{text} is not finite or exceeds {MAX_LITERAL:g} in magnitude")
+        return sp.Integer(int(z.real)) if z.real.is_integer() else sp.Float(z.real)
 
     def legacy_call(self, fname: str, node: ast.Call, depth: int) -> Any:
         """A constructor of sympy's ``srepr`` (a stored law of peelapprox 0.2), built from checked arguments."""
@@ -192,6 +213,9 @@ class _Builder:
         if depth + 1 > 4 * MAX_CALL_DEPTH + 8:
             raise self.fail("stored expression nested too deep")
         kw = {k.arg: k.value for k in node.keywords}
+        for key, val in kw.items():
+            if not (isinstance(val, ast.Constant) and isinstance(val.value, (bool, int))):
+                raise self.fail(f"stored {fname}: keyword {shown(key, 40)} must be a literal")
         if fname == "Symbol":
             if (len(node.args) != 1 or not isinstance(node.args[0], ast.Constant)
                     or node.args[0].value not in ("v", "V") or set(kw) - {"positive", "real"}):
@@ -285,13 +309,19 @@ def parse(text: str, names: Mapping[str, Any] | None = None, *, legacy: bool = F
     except SyntaxError as exc:
         raise ValueError(f"expression {shown(text)} does not parse: {exc.msg}"
                          + (f" at column {exc.offset}" if exc.offset else "")) from None
-    except (RecursionError, MemoryError, ValueError):
+    except (RecursionError, MemoryError):
         raise ValueError(f"expression {shown(text)} does not parse: nested too deeply") from None
+    except ValueError as exc:  # a null byte, a lone surrogate, ...
+        raise ValueError(f"expression {shown(text)} does not parse: {exc}") from None
     b = _Builder(text, names or {}, legacy)
     try:
-        return b.build(tree), b.used
+        e = b.build(tree)
     except RecursionError:
         raise b.fail("nested too deeply") from None
+    for p in e.atoms(b.sp.Pow):  # products combine powers: v**600*v**600 = v**1200
+        if p.exp.is_Number and abs(float(p.exp)) > MAX_EXPONENT:
+            raise b.fail(f"the exponent {_num_text(p.exp)} exceeds {MAX_EXPONENT} in magnitude")
+    return e, b.used
 
 
 def canonical_text(expr: Any) -> str:

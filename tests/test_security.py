@@ -199,6 +199,12 @@ def _V():
     ("log(1+" * 12 + "v" + ")" * 12, "nested more than 6 deep"),
     ("v + " * 300 + "1", "more than 400 syntax nodes"),
     ("1/(v - v)", "division by zero"),
+    ("300 - v + (v**1000)**1000", "exponent 1000000 of v exceeds 1000"),
+    ("v**600*v**600 + 1", "exponent 1200 exceeds 1000"),
+    ("pi**1000*v*1e-300 + 300", "pi\\*\\*1000 is not finite or exceeds"),
+    ("300 - v + log(0)", "zoo is not finite"),
+    ("300 - v + sqrt(-1)", "sqrt\\(-1\\) is not real"),
+    ("300 - v\ud800", "does not parse: 'utf-8' codec"),
     ("", "empty"),
     ("300 - v +", "does not parse"),
 ])
@@ -211,6 +217,18 @@ def test_the_probe_tracebacks_are_named_errors(text, says):
     with pytest.raises(ValueError, match=says):
         PeelForce.expression(text)
     assert time.perf_counter() - t0 < 2.0
+
+
+def test_numbers_of_functions_are_one_float():
+    """Hypothesis: a function of a number (``sin(2**70)``, ``exp(3)``) is stored as its float value (numpy could not
+    evaluate ``sin`` of a 71-bit integer: a TypeError naming neither law nor argument); the value is sympy's to 20
+    digits, rounded: equal to math.sin(2.0**70) to 1 ulp-level relative 1e-15."""
+    import math
+
+    law = PeelForce.expression("300 - v + sin(2**70)")
+    c = float(law(1e-6, 1.0)) + 1e-6 - 300
+    assert abs(c - math.sin(2.0**70)) <= 1e-12
+    assert PeelForce.expression("300 - v + exp(3)") == PeelForce.expression(f"300 - v + {math.exp(3)!r}")
 
 
 def test_long_input_is_not_echoed_whole():
@@ -343,6 +361,42 @@ def test_a_directory_others_can_write_is_not_used(tmp_path, monkeypatch, mode):
     with pytest.warns(KernelCacheWarning, match="writable by"):
         _check_law(PeelForce.expression(_LAW))
     assert list(d.iterdir()) == []
+
+
+def test_a_parent_others_can_write_is_refused(tmp_path, monkeypatch):
+    """Hypothesis: a private cache directory inside a directory others can write to without the sticky bit (so
+    they could rename it away and put their own in its place) is refused with a warning naming why."""
+    parent = tmp_path / "open"
+    parent.mkdir()
+    os.chmod(parent, 0o777)
+    monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(parent / "laws"))
+    monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
+    monkeypatch.setattr(C, "_FALLBACK", {})
+    with pytest.warns(KernelCacheWarning, match="without the sticky bit"):
+        _check_law(PeelForce.expression(_LAW))
+
+
+def test_a_numba_cache_dir_others_can_write_is_not_used(tmp_path, monkeypatch):
+    """Hypothesis: a ``NUMBA_CACHE_DIR`` others can write to (a sticky 1777 directory: anyone may plant a pickled
+    index there, which numba loads) turns caching off with a warning; the kernel still computes (x + 2 = 3
+    exactly) and nothing is read from or written to that directory."""
+    import numba
+
+    from peelapprox import _jit as J
+
+    d = tmp_path / "nbc"
+    d.mkdir()
+    os.chmod(d, 0o1777)
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(d))
+    monkeypatch.setitem(J._state, "dir_checked", False)
+    monkeypatch.setitem(J._state, "cache", True)
+
+    def add_two(x):
+        return x + 2.0
+
+    with pytest.warns(KernelCacheWarning, match="NUMBA_CACHE_DIR"):
+        k = J.kernel(outside=True)(add_two)
+    assert k(1.0) == 3.0 and list(d.iterdir()) == []
 
 
 def test_a_good_cache_is_used_without_a_warning(law_dir, recwarn):
