@@ -240,6 +240,8 @@ def test_long_input_is_not_echoed_whole():
 
 
 # ------------------------------------------------------------------------------------- bounded law builds
+# the timer's first firing may land in a gc callback of pytest's, which prints it and drops it; the repeat lands
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 def test_a_law_costly_to_differentiate_is_stopped(monkeypatch):
     """Hypothesis: within the grammar's size limits sympy can still take minutes (f'' of a product of 39
     binomials: over 5 min measured); the build is interrupted at LAW_BUILD_SECONDS (here 1 s) with a ValueError

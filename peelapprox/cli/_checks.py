@@ -291,7 +291,8 @@ def clip(text: str, limit: int = SHOWN_LIMIT) -> str:
     """``text`` with every run of more than ``limit`` non-blank characters cut as :func:`peelapprox.validate.shown`
     cuts a value (its first ``limit`` characters, then ``... (N characters)``): what a message echoes of a
     user's input (an option's value, a path, a name) stays short even where the message did not use ``shown``."""
-    return re.sub(rf"\S{{{limit + 1},}}", lambda m: f"{m.group()[:limit]}... ({len(m.group())} characters)", text)
+    # runs up to limit + 3 pass: shown()'s own cut (limit characters and "...") is not cut a second time
+    return re.sub(rf"\S{{{limit + 4},}}", lambda m: f"{m.group()[:limit]}... ({len(m.group())} characters)", text)
 
 
 def one_line(exc: BaseException) -> str:
