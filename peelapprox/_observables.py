@@ -42,7 +42,7 @@ __all__ = ["StickSlipObservables", "STATUSES", "QUIET_FACTOR", "jump_statistics"
 _AB, _CD = BRANCHES.index("AB"), BRANCHES.index("CD")
 
 #: The values of :attr:`StickSlipObservables.status`.
-STATUSES = ("stick-slip", "steady", "too few slips", "transient")
+STATUSES = ("stick-slip", "steady", "too few slips", "transient", "no attractor", "breakdown")
 
 #: The jumps have stopped ("transient") when the open stay after the window's last jump is longer than this
 #: many times the longest complete stay of the window.  A periodic orbit's open stay is at most its longest
@@ -169,7 +169,9 @@ class StickSlipObservables:
         0); ``"too few slips"`` (jumps in the window but fewer than two AB→CD jumps: no slip interval;
         lengthen the window); ``"transient"`` (the jumps stop inside the window: the open stay after the last
         jump is longer than ``QUIET_FACTOR`` = 10 times the longest complete stay; the means are those of the
-        jumps seen, not of an attractor).
+        jumps seen, not of an attractor).  :func:`peelapprox.approximate_attractor` adds ``"no attractor"`` (its
+        reduced return map spent a budget first) and ``"breakdown"`` (a reduced segment broke down), both with
+        every mean None, and its ``"steady"`` includes a segment settling at the stable fixed point.
     reason : str
         A sentence saying why the status.
     method : str
