@@ -165,3 +165,21 @@ def test_bad_params_are_named():
         approximate_attractor({"V": 1.0})
     with pytest.raises(ValueError, match="params"):
         approximate_attractor(PeelParams(V=1.0, I=1e-5, tape_mass=1e-3))
+
+
+def test_benchmark_runs_and_writes(tmp_path):
+    """The benchmark's one-point run (V = 1, I = 1e-5: stick-slip in both): its summary rows count the point,
+    the JSON holds the exact and the chain's rows, the CSV the summary (0.5 s)."""
+    from comparisons.benchmark import approx_attractor as bench
+
+    out_json, out_csv = tmp_path / "a.json", tmp_path / "a.csv"
+    assert bench.main(["--V", "1", "--I", "1e-5", "--chains", "default,check", "--repeats", "1", "--json",
+                       str(out_json), "--csv", str(out_csv)]) == 0
+    import json
+
+    data = json.loads(out_json.read_text())
+    (pt,) = data["points"]
+    assert pt["exact"]["status"] == pt["default"]["status"] == "stick-slip"
+    rows = {(s["chain"], s["regime"]): s for s in data["summary"]}
+    assert rows[("check", "all")]["n"] == 1 and rows[("check", "all")]["both_within_10"] == 1.0
+    assert out_csv.read_text().startswith("chain,regime,n,")
