@@ -35,6 +35,7 @@ from ._alpha import (
     wkb_amplitude_phase,
     wkb_error_bound,
 )
+from ._approximate import approximate_attractor
 from ._estimate import (
     INERTIA_RULE,
     VELOCITY_RULE,
@@ -151,8 +152,9 @@ __all__ = [
     "classify",
     "force_drops",
     "settle_time",
-    # the observables of a stick-slip attractor (exact: attractor_observables)
+    # the observables of a stick-slip attractor (exact: attractor_observables; the reduced equations' prediction)
     "StickSlipObservables",
+    "approximate_attractor",
     # dynamics of the exact solution: they live in exact, imported from it on first access
     "attractors",
     "Attractor",

@@ -334,9 +334,13 @@ def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alp
     """
     F_in, s = _force_ramp(_params("params", params, variants=False), np.zeros(1), F_in, F_rate)
     a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
-    Om = _omega(F_in, params.R, params.I)
-    c = (ad_in + s * a_in / (4.0 * F_in)) / Om
-    return math.hypot(a_in, c), math.atan2(a_in, c)
+    return _wkb_match(F_in, s, a_in, ad_in, params.R, params.I)
+
+
+def _wkb_match(F_in, s, alpha_in, alphadot_in, R, I) -> tuple[float, float]:
+    """``(A, φ)`` of the sinusoid through ``(α_in, α̇_in)`` at t = 0 (:func:`wkb_amplitude_phase`, unchecked)."""
+    c = (alphadot_in + s * alpha_in / (4.0 * F_in)) / _omega(F_in, R, I)
+    return math.hypot(alpha_in, c), math.atan2(alpha_in, c)
 
 
 def wkb_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_in: float,

@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import integrate
 
-from ._alpha import cd_damping_time, inertial_frequency, inertial_periods, law_fprime
+from ._alpha import InertialPeriods, cd_damping_time, inertial_frequency, inertial_periods, law_fprime
 from ._law_compiled import branch_structure, fixed_point
 from ._params import PeelParams
 from ._peelforce import BranchStructure, FixedPoint
@@ -37,6 +37,7 @@ __all__ = [
     "estimate",
     "INERTIA_RULE",
     "VELOCITY_RULE",
+    "regime",
 ]
 
 #: How :func:`estimate` labels inertia (stated once, printed by the CLI).
@@ -267,6 +268,41 @@ class RegimeEstimate:
         return d
 
 
+def _labels(params: PeelParams, bs: BranchStructure, fp: FixedPoint
+            ) -> tuple[InertialPeriods, float, float, str, float, str]:
+    """The regime labels of :data:`INERTIA_RULE` and :data:`VELOCITY_RULE` at a point with folds, and the numbers
+    they are read from: ``(periods, tau_cd, ratio, inertia, gap, velocity)``."""
+    assert bs.f_max is not None and bs.f_min is not None  # the caller's: has_folds
+    per = inertial_periods(params)
+    if bs.v_land_cd is None:  # a table that stops below f_max on CD: no AB->CD landing, no CD damping time
+        raise ValueError(f"params.force: {params.force!r} at V={params.V} never reaches f_max={bs.f_max} N on its "
+                         "fast branch within its domain: an AB->CD jump could not land (extend the table)")
+    tau_cd = cd_damping_time(params, per.F_mean, bs.v_land_cd)
+    ratio = per.at_mean / tau_cd
+    inertia = "low" if ratio < 1.0 else ("intermediate" if ratio < 5.0 else "high")
+    gap = (bs.f_max - bs.f_min) / bs.f_max
+    velocity = "stable" if fp.stable else ("low" if gap >= 0.1 else "high")
+    return per, tau_cd, ratio, inertia, gap, velocity
+
+
+def regime(params: PeelParams) -> tuple[str, str]:
+    """``(inertia, velocity)``: the labels of :func:`estimate` (:data:`INERTIA_RULE`, :data:`VELOCITY_RULE`)
+    without its branch times and bounds; ``("n/a", "stable")`` where the law has no folds at V.
+
+    Raises
+    ------
+    ValueError
+        As :func:`estimate`, for a law whose folds or CD landing cannot be found.
+    """
+    params = _checked(params)
+    bs = _law_structure(params)
+    fp = fixed_point(params.V, params.R, force=params.force)
+    if not bs.has_folds:
+        return "n/a", "stable"
+    _, _, _, inertia, _, velocity = _labels(params, bs, fp)
+    return inertia, velocity
+
+
 def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: float | None = None
              ) -> RegimeEstimate:
     """Regime estimate for one parameter point, without running the DAE.
@@ -302,23 +338,13 @@ def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: f
     alpha_max = optional(in_range, "alpha_max", alpha_max, **angle)
     bs = _law_structure(params)
     fp: FixedPoint = fixed_point(params.V, params.R, force=params.force)
-    velocity = "stable" if fp.stable else None
     if not bs.has_folds:
         return RegimeEstimate(
             params.V, params.I, params.k, params.R, False, None, None, None, None, None, None, fp.v, fp.F,
             fp.fprime, fp.stable, None, None, None, None, None, None, None, None, None, None, None, None, None,
             "n/a", "stable")
     assert bs.v_max is not None and bs.f_max is not None and bs.v_min is not None and bs.f_min is not None
-    per = inertial_periods(params)
-    if bs.v_land_cd is None:  # a table that stops below f_max on CD: no AB->CD landing, no CD damping time
-        raise ValueError(f"params.force: {params.force!r} at V={params.V} never reaches f_max={bs.f_max} N on its "
-                         "fast branch within its domain: an AB->CD jump could not land (extend the table)")
-    tau_cd = cd_damping_time(params, per.F_mean, bs.v_land_cd)
-    ratio = per.at_mean / tau_cd
-    inertia = "low" if ratio < 1.0 else ("intermediate" if ratio < 5.0 else "high")
-    gap = (bs.f_max - bs.f_min) / bs.f_max
-    if velocity is None:
-        velocity = "low" if gap >= 0.1 else "high"
+    per, tau_cd, ratio, inertia, gap, velocity = _labels(params, bs, fp)
     # quasi-static passages exist only if F keeps moving towards the fold: on AB
     # F rises while v < V, so the fold must lie below V (else the orbit settles
     # at the stable fixed point v = V); on CD F falls while v > V.

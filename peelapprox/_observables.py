@@ -37,12 +37,12 @@ from ._returnmap import HasJumps, _trajectory, periodicity
 from .io import fmt_number, html_table, jsonable, optional_import
 from .validate import duration, integer, positive
 
-__all__ = ["StickSlipObservables", "STATUSES", "QUIET_FACTOR"]
+__all__ = ["StickSlipObservables", "STATUSES", "QUIET_FACTOR", "jump_statistics"]
 
 _AB, _CD = BRANCHES.index("AB"), BRANCHES.index("CD")
 
 #: The values of :attr:`StickSlipObservables.status`.
-STATUSES = ("stick-slip", "steady", "too few slips", "transient")
+STATUSES = ("stick-slip", "steady", "too few slips", "transient", "no attractor", "breakdown")
 
 #: The jumps have stopped ("transient") when the open stay after the window's last jump is longer than this
 #: many times the longest complete stay of the window.  A periodic orbit's open stay is at most its longest
@@ -71,6 +71,46 @@ def _whole_cycles(x: np.ndarray, n: int | None) -> np.ndarray:
     if n is None or x.size < n:
         return x
     return x[x.size - (x.size // n) * n:]
+
+
+def jump_statistics(t: np.ndarray, F: np.ndarray, fb: np.ndarray, *, period_rtol: float, max_period: int
+                    ) -> tuple[dict[str, Any], int | None]:
+    """The statistics of a jump sequence: the fields of :class:`StickSlipObservables` that its jumps define.
+
+    The one place of the definitions in the module docstring, shared by the exact side
+    (:meth:`StickSlipObservables.from_trajectory`) and the reduced return map
+    (:func:`peelapprox.approximate_attractor`).
+
+    Parameters
+    ----------
+    t, F, fb : ndarray
+        Jump times [s], pull forces [N] and branches left (codes of :data:`peelapprox.BRANCHES`): 1-D, one
+        length, at least one jump, in time order, alternating (checked by the caller).
+    period_rtol, max_period
+        Of :func:`peelapprox.periodicity`.
+
+    Returns
+    -------
+    (dict, int or None)
+        ``n_slips``, ``period``, ``period_label``, each mean and ``<mean>_spread``, ``F_max``, ``F_min``; and the
+        number of whole cycles the means were taken over (None without a period).
+    """
+    slips = np.flatnonzero(fb == _AB)
+    to_cd = slips[slips + 1 < t.size]  # AB→CD jumps followed by a CD→AB jump: complete CD stays
+    to_ab = np.flatnonzero(fb[:-1] == _CD)  # CD→AB jumps followed by an AB→CD jump: complete AB stays
+    samples = {"slip_interval": np.diff(t[slips]), "force_drop": F[to_cd] - F[to_cd + 1],
+               "slip_time": t[to_cd + 1] - t[to_cd], "stick_time": t[to_ab + 1] - t[to_ab]}
+    if slips.size >= 2:
+        per = periodicity(F[slips], rtol=period_rtol, max_period=max_period)
+        period, label = per.period, per.label
+    else:
+        period, label = None, "too short" if slips.size else "no stick-slip"
+    values: dict[str, Any] = {"n_slips": int(slips.size), "period": period, "period_label": label,
+                              "F_max": float(F.max()), "F_min": float(F.min())}
+    for name, x in samples.items():
+        values[name], values[f"{name}_spread"] = _mean_spread(_whole_cycles(x, period))
+    cycles = None if period is None else len(_whole_cycles(samples["slip_interval"], period)) // period
+    return values, cycles
 
 
 def _window_text(start: float, end: float | None) -> str:
@@ -129,7 +169,9 @@ class StickSlipObservables:
         0); ``"too few slips"`` (jumps in the window but fewer than two AB→CD jumps: no slip interval;
         lengthen the window); ``"transient"`` (the jumps stop inside the window: the open stay after the last
         jump is longer than ``QUIET_FACTOR`` = 10 times the longest complete stay; the means are those of the
-        jumps seen, not of an attractor).
+        jumps seen, not of an attractor).  :func:`peelapprox.approximate_attractor` adds ``"no attractor"`` (its
+        reduced return map spent a budget first) and ``"breakdown"`` (a reduced segment broke down), both with
+        every mean None, and its ``"steady"`` includes a segment settling at the stable fixed point.
     reason : str
         A sentence saying why the status.
     method : str
@@ -266,21 +308,9 @@ class StickSlipObservables:
     def _from_jumps(cls, t: np.ndarray, F: np.ndarray, fb: np.ndarray, end: float | None, period_rtol: float,
                     max_period: int, common: dict[str, Any]) -> StickSlipObservables:
         """The observables of a window's jumps ``t, F, fb`` (checked, alternating, at least one)."""
-        slips = np.flatnonzero(fb == _AB)
-        to_cd = slips[slips + 1 < t.size]  # AB→CD jumps followed by a CD→AB jump: complete CD stays
-        to_ab = np.flatnonzero(fb[:-1] == _CD)  # CD→AB jumps followed by an AB→CD jump: complete AB stays
-        samples = {"slip_interval": np.diff(t[slips]), "force_drop": F[to_cd] - F[to_cd + 1],
-                   "slip_time": t[to_cd + 1] - t[to_cd], "stick_time": t[to_ab + 1] - t[to_ab]}
-        if slips.size >= 2:
-            per = periodicity(F[slips], rtol=period_rtol, max_period=max_period)
-            period, label = per.period, per.label
-        else:
-            period, label = None, "too short" if slips.size else "no stick-slip"
-        values: dict[str, Any] = {}
-        for name, x in samples.items():
-            values[name], values[f"{name}_spread"] = _mean_spread(_whole_cycles(x, period))
+        stats, cycles = jump_statistics(t, F, fb, period_rtol=period_rtol, max_period=max_period)
         stays = np.diff(t)
-        n = slips.size
+        n, label = stats["n_slips"], stats["period_label"]
         if n < 2:
             status = "too few slips"
             reason = (f"{n} AB→CD jump{'' if n == 1 else 's'} among the {t.size} jumps of the window "
@@ -293,10 +323,8 @@ class StickSlipObservables:
         else:
             status = "stick-slip"
             reason = (f"{n} slips in the window {_window_text(common['t_start'], end)}, return map {label}"
-                      + (f"; means over the last {len(_whole_cycles(samples['slip_interval'], period)) // period}"
-                         f" whole cycles" if period is not None else ""))
-        return cls(status=status, reason=reason, n_slips=int(n), period=period, period_label=label,
-                   F_max=float(F.max()), F_min=float(F.min()), **values, **common)
+                      + (f"; means over the last {cycles} whole cycles" if cycles is not None else ""))
+        return cls(status=status, reason=reason, **stats, **common)
 
     # ------------------------------------------------------------------------------------------ output
     def as_dict(self) -> dict[str, Any]:

@@ -1,0 +1,185 @@
+"""The stick-slip attractor of the reduced return map: :func:`peelapprox.approximate_attractor`.
+
+Oracles: the quasi-static limit in closed form (α held at 0: the AB and CD stays are the quadratures of
+:func:`peelapprox.quasi_static_branch_time`, the force drop is ``f_max - f_min``); the exact attractor
+(:func:`exact.attractor_observables`) for the chain's own check, genalpha + fullvdot, the full branch dynamics
+linearised in α; the exact solver's statuses where nothing slips; the law's folds for the crest jump.  Its speed
+is measured in ``python -m comparisons.benchmark.approx_attractor``, not here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import exact
+from peelapprox import (
+    ALPHA_MODELS,
+    V_EQUATIONS,
+    PeelParams,
+    StickSlipObservables,
+    approximate_attractor,
+    branch_structure,
+    estimate,
+    reduced_segment,
+)
+
+MEANS = ("slip_interval", "force_drop", "slip_time", "stick_time")
+FULL = dict(alpha_model="genalpha", v_equation="fullvdot", cd_alpha_model="genalpha", cd_v_equation="fullvdot")
+
+
+def test_quasi_static_limit_is_the_quadrature(p_low):
+    """Closed-form oracle.  With α held at 0 on both branches (``"static"``: α = α_in = 0 from the start, the jump
+    kicks of α̇ ignored), approxvdot reads ``f'(v) v̇ = Ḟ = k(V - v)``: the AB stay is ``∫ f'/(k(V - v)) dv`` from
+    ``v_land_ab`` to ``v_max`` (``estimate(p).t_ab_quasi_static``, scipy quad at 1e-11), the CD stay likewise,
+    F rises by ``f(v_max) - f(v_land_ab) = f_max - f_min`` on AB and falls by as much on CD, so the map is period-1
+    after one cycle and stops at :data:`EARLY_RETURNS` = 12 returns.  At rtol 1e-8 every observable agrees to
+    6.8e-9 relative (measured; 4.5e-7 at rtol 1e-6): 5e-8 is the integration's error with a margin."""
+    e = estimate(p_low)
+    o = approximate_attractor(p_low, alpha_model="static", cd_alpha_model="static", rtol=1e-8)
+    assert (o.status, o.period, o.period_label) == ("stick-slip", 1, "period-1")
+    assert o.method == ("approximate: AB static/approxvdot, CD static/approxvdot, period-1 reached after 12 returns, "
+                        "rtol 1e-08")
+    assert o.stick_time == pytest.approx(e.t_ab_quasi_static, rel=5e-8)
+    assert o.slip_time == pytest.approx(e.t_cd_quasi_static, rel=5e-8)
+    assert o.slip_interval == pytest.approx(e.t_ab_quasi_static + e.t_cd_quasi_static, rel=5e-8)
+    assert o.force_drop == pytest.approx(e.f_max - e.f_min, rel=5e-8)
+    assert (o.F_max, o.F_min) == (pytest.approx(e.f_max, rel=5e-8), pytest.approx(e.f_min, rel=5e-8))
+    for name in MEANS:  # one orbit repeated: every spread is the integration's noise
+        assert getattr(o, f"{name}_spread") <= 5e-8 * getattr(o, name)
+
+
+@pytest.mark.parametrize("V, I", [(1.5714285714285714, 5.179474679231212e-06),
+                                  (2.942857142857143, 5.179474679231212e-06),
+                                  (4.314285714285714, 2.6826957952797274e-05), (1.0, 1e-5)])
+def test_genalpha_fullvdot_chain_reproduces_the_exact_attractor(V, I):
+    """The chain's own check.  genalpha + fullvdot on both branches is the full branch dynamics (FLOW1, FLOW2,
+    FLOW3, CONSTR differentiated) with ``sin α → α``, ``cos α → 1``, and the jumps keep (F, α, ω) as the hybrid
+    solver does, so its attractor is the exact one up to O(α²): measured at these four low-inertia points
+    (periods 1, 1, 3, 3), |relative error| of slip_interval and force_drop at most 2.4e-4 (V = 1, I = 1e-5),
+    the same at rtol 1e-6 and 1e-8 (the linearisation, not the integration).  1e-3 allows 4x that.  At
+    intermediate and high inertia (α ~ 0.1 to 0.6) the linear chain can settle on another attractor than the exact
+    one (docs/theory.md, "The approximate attractor")."""
+    p = PeelParams(V=V, I=I)
+    ex = exact.attractor_observables(p)
+    ap = approximate_attractor(p, **FULL)
+    assert ex.status == ap.status == "stick-slip"
+    assert ap.method.startswith("approximate: AB genalpha/fullvdot, CD genalpha/fullvdot, ")
+    for name in ("slip_interval", "force_drop", "stick_time", "slip_time"):
+        assert getattr(ap, name) == pytest.approx(getattr(ex, name), rel=1e-3), name
+
+
+def test_the_front_jumps_at_an_oscillation_crest(p_low):
+    """The AB exit is the crossing of ``v = v_max`` by the v equation, whatever drives v there.  At V = 1,
+    I = 1e-5 the α oscillation kicked by the CD→AB jump (α̇ += (v_min - v_land_ab)/R = 86 rad/s) makes v
+    oscillate: a crest that stays below the fold turns v back and the segment goes on (v falls at least once
+    by more than 1 % before the exit, and never exceeds v_max before it), and the exit comes at a crest before F
+    reaches f_max.  On the map the largest F at a jump is 9.5 N below f_max (exact: 7.2 N, F up to 278.4 N):
+    4 N is a margin no quasi-static passage (F_max = f_max to 1e-8, above) could meet."""
+    bs = branch_structure(p_low.V)
+    kick = (bs.v_min - bs.v_land_ab) / p_low.R
+    seg = reduced_segment(p_low, "AB", F_in=bs.f_min, alpha_in=0.0, alphadot_in=kick, rtol=1e-8)
+    falls = np.maximum.accumulate(seg.v) / seg.v
+    assert falls.max() > 1.01
+    assert np.all(seg.v[:-1] < bs.v_max) and seg.v[-1] == pytest.approx(bs.v_max, rel=1e-12)
+    assert seg.F_exit < bs.f_max - 4.0
+    o = approximate_attractor(p_low)
+    assert o.status == "stick-slip" and o.F_max < bs.f_max - 4.0
+
+
+def test_steady_without_folds_and_at_a_stable_fixed_point():
+    """The exact solver's statuses as oracle.  V = 5.5: fvV has no folds (the cusp is at V ≈ 5.2): steady, nothing
+    chained.  V = 5: folds, but V > v_min = 4.46 m/s, so the fixed point v = V on CD is stable; the exact
+    attractor is steady peeling (``attractor_observables``), and the map's first CD segment settles towards
+    v = V without reaching v_min: steady, with the fixed point's f'(V, V) in the reason.  Every mean None."""
+    none = approximate_attractor(PeelParams(V=5.5, I=1e-4))
+    assert none.status == "steady" and "no folds" in none.reason
+    p = PeelParams(V=5.0, I=1e-4)
+    assert exact.attractor_observables(p).status == "steady"
+    o = approximate_attractor(p)
+    assert o.status == "steady" and "fixed point v = V is stable" in o.reason
+    for x in (none, o):
+        assert x.n_slips == 0 and x.period is None
+        assert all(getattr(x, name) is None for name in MEANS)
+        assert all(v is None or not (isinstance(v, float) and math.isnan(v)) for v in x.as_dict().values())
+
+
+def test_breakdown_and_budget_are_statuses():
+    """V = 0.2, I = 1e-4: the exact solver breaks down there (F(1 + sin α) falls to f(0+) on AB), and so does the
+    map: its first AB segment drives v to 0 (the e^60 fall).  A wall budget spent before the first return is
+    "no attractor".  Neither raises, and neither carries a NaN."""
+    o = approximate_attractor(PeelParams(V=0.2, I=1e-4))
+    assert o.status == "breakdown" and "v -> 0" in o.reason
+    b = approximate_attractor(PeelParams(V=1.0, I=1e-5), max_wall=1e-9)
+    assert b.status == "no attractor" and "max_wall" in b.reason
+    for x in (o, b):
+        assert all(getattr(x, name) is None for name in MEANS)
+
+
+def test_defaults_follow_the_regime(p_low, p_high):
+    """The defaults of the docstring's table, read off ``method``: low inertia (estimate's r < 1) approxalpha on
+    AB and airy2 on CD; high inertia airy1 on both; each slot given replaces that slot only."""
+    assert estimate(p_low).inertia == "low" and estimate(p_high).inertia == "high"
+    assert approximate_attractor(p_low).method.startswith(
+        "approximate: AB approxalpha/approxvdot, CD airy2/approxvdot, ")
+    assert approximate_attractor(p_high).method.startswith("approximate: AB airy1/approxvdot, CD airy1/approxvdot, ")
+    o = approximate_attractor(p_high, cd_alpha_model="exponential", n_transient=5, n_returns=10)
+    assert o.method.startswith("approximate: AB airy1/approxvdot, CD exponential/approxvdot")
+    assert isinstance(o, StickSlipObservables)
+
+
+@pytest.mark.parametrize("am", ALPHA_MODELS)
+@pytest.mark.parametrize("ve", V_EQUATIONS)
+def test_every_combination_runs(am, ve):
+    """Every α model and v equation on each branch (the other branch at its default) returns observables or a
+    status, never an exception or a NaN (V = 2, I = 1e-4: intermediate inertia)."""
+    p = PeelParams(V=2.0, I=1e-4)
+    for kw in (dict(alpha_model=am, v_equation=ve), dict(cd_alpha_model=am, cd_v_equation=ve)):
+        o = approximate_attractor(p, n_transient=5, n_returns=10, **kw)
+        assert o.status in ("stick-slip", "steady", "no attractor", "breakdown")
+        assert all(not (isinstance(v, float) and math.isnan(v)) for v in o.as_dict().values())
+
+
+@pytest.mark.parametrize("kwargs, error, name", [
+    (dict(alpha_model="airy"), ValueError, "alpha_model"),
+    (dict(cd_v_equation="vdot"), ValueError, "cd_v_equation"),
+    (dict(v_equation=3), TypeError, "v_equation"),
+    (dict(n_returns=2), ValueError, "n_returns"),
+    (dict(n_transient=-1), ValueError, "n_transient"),
+    (dict(n_transient=4.0), TypeError, "n_transient"),
+    (dict(rtol=0.5), ValueError, "rtol"),
+    (dict(max_wall=0.0), ValueError, "max_wall"),
+])
+def test_bad_input_is_named(p_low, kwargs, error, name):
+    """A bad option is a ValueError or TypeError naming it, before anything runs."""
+    with pytest.raises(error, match=name):
+        approximate_attractor(p_low, **kwargs)
+
+
+def test_bad_params_are_named():
+    """Not a PeelParams: a TypeError naming params; a model variant (the reduced equations are the massless
+    DAE's): a ValueError naming params."""
+    with pytest.raises(TypeError, match="params"):
+        approximate_attractor({"V": 1.0})
+    with pytest.raises(ValueError, match="params"):
+        approximate_attractor(PeelParams(V=1.0, I=1e-5, tape_mass=1e-3))
+
+
+def test_benchmark_runs_and_writes(tmp_path):
+    """The benchmark's one-point run (V = 1, I = 1e-5: stick-slip in both): its summary rows count the point,
+    the JSON holds the exact and the chain's rows, the CSV the summary (0.5 s)."""
+    from comparisons.benchmark import approx_attractor as bench
+
+    out_json, out_csv = tmp_path / "a.json", tmp_path / "a.csv"
+    assert bench.main(["--V", "1", "--I", "1e-5", "--chains", "default,check", "--repeats", "1", "--json",
+                       str(out_json), "--csv", str(out_csv)]) == 0
+    import json
+
+    data = json.loads(out_json.read_text())
+    (pt,) = data["points"]
+    assert pt["exact"]["status"] == pt["default"]["status"] == "stick-slip"
+    rows = {(s["chain"], s["regime"]): s for s in data["summary"]}
+    assert rows[("check", "all")]["n"] == 1 and rows[("check", "all")]["both_within_10"] == 1.0
+    assert out_csv.read_text().startswith("chain,regime,n,")
