@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ._estimate import regime
+from ._regime import regime
 from ._law_compiled import compiled_law, fixed_point
 from ._observables import StickSlipObservables, jump_statistics
 from ._params import PeelParams
