@@ -27,10 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from ._regime import regime
 from ._law_compiled import compiled_law, fixed_point
 from ._observables import StickSlipObservables, jump_statistics
 from ._params import PeelParams
+from ._regime import regime
 from ._segment import SegmentPlan, run_segment, segment_plan, segment_status
 from ._segment_kernel import ALPHA_MODELS, AM_EXP, AM_HARM, AM_SIN, AM_STATIC, V_EQUATIONS, alpha_at
 from ._status import DONE, F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR

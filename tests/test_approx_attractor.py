@@ -183,3 +183,56 @@ def test_benchmark_runs_and_writes(tmp_path):
     rows = {(s["chain"], s["regime"]): s for s in data["summary"]}
     assert rows[("check", "all")]["n"] == 1 and rows[("check", "all")]["both_within_10"] == 1.0
     assert out_csv.read_text().startswith("chain,regime,n,")
+
+
+# ------------------------------------------------------------------- estimate() offers the attractor and its validity
+def _csv_default_rows() -> dict:
+    import csv
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "benchmark" / "approx_attractor.csv"
+    with open(path, newline="") as fh:
+        return {r["regime"]: r for r in csv.DictReader(fh) if r["chain"] == "default"}
+
+
+def test_validity_table_is_the_measurement():
+    """Hypothesis: the validity estimate() reports is the benchmark's measurement, not a second copy that
+    drifted: every default row of docs/benchmark/approx_attractor.csv is in peelapprox._validity.VALIDITY with
+    the same point count and fractions (exact: the same decimal text parsed to the same floats)."""
+    from peelapprox._validity import VALIDITY
+
+    rows = _csv_default_rows()
+    assert set(rows) == set(VALIDITY)
+    for label, r in rows.items():
+        v = VALIDITY[label]
+        assert (v.points, v.slip_interval, v.force_drop, v.both) == (
+            int(r["n"]), float(r["slip_interval_within_10"]), float(r["force_drop_within_10"]),
+            float(r["both_within_10"]))
+
+
+def test_estimate_offers_the_attractor_and_says_how_often_it_holds():
+    """Hypothesis: ``estimate(p).attractor()`` is ``approximate_attractor(p)`` (deterministic: equal fields), and
+    ``estimate(p).validity`` quotes the measured percentage of p's regime (the CSV's fraction, rounded to a whole
+    percent, computed here from the file)."""
+    import dataclasses
+
+    from peelapprox import PeelParams, approximate_attractor, estimate
+
+    p = PeelParams(V=1.0, I=1e-5)
+    e = estimate(p)
+    assert dataclasses.asdict(e.attractor()) == dataclasses.asdict(approximate_attractor(p))
+    row = _csv_default_rows()[e.label]
+    pct = f"{100 * float(row['slip_interval_within_10']):.0f} %"
+    assert f"within 10 % of the exact attractor on {pct} of the {row['n']} '{e.label}' points" in \
+        e.validity["slip_interval"]
+    assert "params" not in e.as_dict()
+
+
+def test_an_estimate_without_params_cannot_run_the_attractor():
+    """Hypothesis: a RegimeEstimate rebuilt from its dict (no params) says what to call instead."""
+    from peelapprox import PeelParams, RegimeEstimate, estimate
+
+    d = estimate(PeelParams(V=1.0, I=1e-5)).as_dict()
+    d.pop("label")
+    with pytest.raises(ValueError, match="approximate_attractor"):
+        RegimeEstimate(**d).attractor()

@@ -1,0 +1,58 @@
+"""How often the approximate attractor is right, as measured: the validity :func:`peelapprox.estimate` reports.
+
+The numbers are the ``default`` rows of ``docs/benchmark/approx_attractor.csv``, the measurement of
+``python -m comparisons.benchmark.approx_attractor --V 0.2:5:40 --I 1e-6:1e-1:40:log --chains default,paper,check``
+(:func:`peelapprox.approximate_attractor` with its defaults against :func:`exact.attractor_observables` on the
+40 x 40 grid over V in [0.2, 5] m/s and I in [1e-6, 1e-1] kg m^2, the paper's law, k = 1000 N/m, R = 0.1 m):
+per regime label of :func:`peelapprox.estimate`, the stick-slip points of the exact solution and the fraction
+of them where the predicted slip interval, force drop, and both, are within 10 % of the exact ones.  A test
+checks that this table equals the file; a new measurement is copied here by hand, with the file.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+__all__ = ["SOURCE", "VALIDITY", "Validity", "validity_text"]
+
+#: Where the numbers come from (the module docstring's command), as a reader of :attr:`RegimeEstimate.validity`
+#: is told.
+SOURCE = ("40 x 40 grid over V in [0.2, 5] m/s, I in [1e-6, 1e-1] kg m^2 (log), paper's law, k = 1000 N/m, "
+          "R = 0.1 m: python -m comparisons.benchmark.approx_attractor")
+
+
+class Validity(NamedTuple):
+    """The measured accuracy of the default approximate attractor in one regime."""
+
+    points: int
+    """Stick-slip points of the exact solution with this label."""
+    slip_interval: float
+    """Fraction of them with the predicted slip interval within 10 % of the exact one."""
+    force_drop: float
+    """The same for the force drop."""
+    both: float
+    """The same for both at once."""
+
+
+#: Per regime label (:attr:`peelapprox.RegimeEstimate.label`), and ``"all"``.
+VALIDITY: dict[str, Validity] = {
+    'high inertia, high V': Validity(315, 0.4, 0.3904761904761905, 0.3873015873015873),
+    'high inertia, low V': Validity(345, 0.7275362318840579, 0.5681159420289855, 0.5652173913043478),
+    'intermediate inertia, high V': Validity(153, 0.7320261437908496, 0.7320261437908496, 0.7320261437908496),
+    'intermediate inertia, low V': Validity(231, 0.8051948051948052, 0.8051948051948052, 0.7965367965367965),
+    'low inertia, high V': Validity(92, 0.7391304347826086, 0.7391304347826086, 0.7391304347826086),
+    'low inertia, low V': Validity(283, 0.7667844522968198, 0.7667844522968198, 0.7667844522968198),
+    'no stick-slip (stable fixed point)': Validity(23, 0.8695652173913043, 0.8695652173913043, 0.782608695652174),
+    'all': Validity(1442, 0.6796116504854369, 0.6393897364771152, 0.6352288488210819),
+}
+
+
+def validity_text(label: str) -> dict[str, str]:
+    """``{observable: sentence}`` for a regime label: "within 10 % of the exact attractor on 77 % of the 283
+    'low inertia, low V' points measured (...)"; a label not measured says so."""
+    v = VALIDITY.get(label)
+    if v is None or v.points == 0:
+        return {name: f"not measured for {label!r} points" for name in ("slip_interval", "force_drop")}
+    return {name: (f"within 10 % of the exact attractor on {100 * frac:.0f} % of the {v.points} {label!r} points "
+                   f"measured ({SOURCE})") for name, frac in (("slip_interval", v.slip_interval),
+                                                             ("force_drop", v.force_drop))}
