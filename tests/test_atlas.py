@@ -1,5 +1,5 @@
-"""The atlas (comparisons.atlas): end to end on a small grid, resume after a kill, bad input refused before any
-point.
+"""The atlas (comparisons.atlas, ``peelapprox atlas``): end to end on a small grid, resume after a kill, bad input
+refused before any point, the command line.
 
 The solvers are deterministic and the records hold no timings, so what the atlas records is compared with
 direct calls of the same functions for *exact* equality (JSON round-trips floats exactly); a relative error
@@ -33,6 +33,7 @@ from comparisons.atlas import (
 )
 from exact import attractor_observables
 from peelapprox import ModelBreakdown, PeelParams, estimate
+from peelapprox.cli import main
 
 TESTS = str(Path(__file__).resolve().parent)
 #: Short windows for the tests (module docstring).
@@ -243,12 +244,42 @@ def test_kill_and_resume(tmp_path, monkeypatch):
     assert load_atlas(out).sweep.records == fresh.sweep.records
 
 
-def test_cost_projection():
+def test_cli_atlas(tmp_path, capsys):
+    """Hypothesis: ``peelapprox atlas`` on a 1 x 2 grid exits 0, writes the records, the four tables as CSV and
+    JSON and (``--plot``) the maps as PNG, and prints the summary, equal to ``load_atlas(DIR).summary()``
+    (exact equality through JSON); the same command again resumes (computes nothing: the records unchanged); a
+    bad ``--V`` is exit status 2 naming it.  Categorical and exact."""
+    out = tmp_path / "at"
+    argv = ["atlas", "--V", "0.5,1", "--I", "1e-5", "--out", str(out), "--workers", "0", "--t-transient", "10",
+            "--window", "5", "--segments", "2", "--format", "json", "--quiet"]
+    assert main(argv + ["--plot"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary == json.loads(json.dumps(load_atlas(out).summary()))
+    for table in ("points", "errors", "segments", "summary"):
+        assert (out / f"atlas_{table}.csv").is_file() and (out / f"atlas_{table}.json").is_file()
+    maps = sorted(p.name for p in (out / "maps").iterdir())
+    assert "dynamics.png" in maps and "error_estimate_slip_interval.png" in maps
+    assert len(maps) == 1 + 6 * len(load_atlas(out).approximations) + 2
+    assert all((out / "maps" / m).stat().st_size > 10_000 for m in maps)
+    before = (out / "results.jsonl").read_text()
+    assert main(argv) == 0
+    assert (out / "results.jsonl").read_text() == before
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exc:
+        main(["atlas", "--V", "0.5:x:3", "--I", "1e-5", "--out", str(tmp_path / "bad")])
+    assert exc.value.code == 2 and "--V" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()
+
+
+def test_cost_projection(capsys):
     """Hypothesis: ``atlas_cost`` times every part at the sample points and projects mean-per-point x points /
-    workers (the arithmetic exact to rounding, 1e-12 relative).  The timings themselves are not asserted (they
-    depend on the machine)."""
+    workers (the arithmetic exact to rounding, 1e-12 relative); ``peelapprox atlas --cost`` prints it.  The
+    timings themselves are not asserted (they depend on the machine)."""
     cost = atlas_cost([1e-5, 1e-3], [1.0, 2.0, 3.0], sample=1, workers=2, options={**OPTS, "t_window": 1.0})
     assert cost.points == [(1e-3, 2.0)] and set(cost.times) >= {"exact", "segments", "regime", "approx:estimate"}
     assert all(len(t) == 1 and t[0] > 0 for t in cost.times.values())
     total = cost.rows()[-1]
     assert math.isclose(total["grid_wall_s"], sum(t[0] for t in cost.times.values()) * 6 / 2, rel_tol=1e-12)
+    assert main(["atlas", "--V", "1,2", "--I", "1e-5", "--cost", "1", "--t-transient", "1", "--window", "1",
+                 "--quiet"]) == 0
+    assert "projected" in capsys.readouterr().out
