@@ -7,7 +7,7 @@ engine (:mod:`comparisons.sweep`: resumable after a kill, a local process pool o
 stderr, a manifest):
 
 * ``atlas_exact`` — the exact attractor's :class:`peelapprox.StickSlipObservables`
-  (:func:`exact.attractor_observables`, 30 s of transient then 20 s measured, rtol 1e-10) and its class:
+  (:func:`exact.attractor_observables`, 100 s of transient then 20 s measured, rtol 1e-10) and its class:
   ``period-n``, ``aperiodic``, ``too short`` where it stick-slips; ``steady``, ``transient``, ``too few slips``,
   ``breakdown`` (with the reason) where it does not;
 * ``atlas_segments`` — each reduction of the harness (:data:`comparisons.DEFAULT_MODELS`, an α model and a v

@@ -119,7 +119,7 @@ def atlas(
     k, R, l, geometry : optional
         :class:`peelapprox.PeelParams` fields of every point (None: its defaults, k = 1000 N/m, R = 0.1 m).
     options : mapping, optional
-        Changes to :data:`~comparisons.atlas.measures.DEFAULTS`: ``t_transient`` (30 s), ``t_window`` (20 s),
+        Changes to :data:`~comparisons.atlas.measures.DEFAULTS`: ``t_transient`` (100 s), ``t_window`` (20 s),
         ``rtol`` (1e-10), ``alpha0`` (0), ``segments_per_branch`` (8), ``segment_rtol`` (1e-10),
         ``reductions`` (``{"AB": [[alpha_model, v_equation], ...], "CD": [...]}``, the harness's
         :data:`comparisons.DEFAULT_MODELS`).

@@ -21,7 +21,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         sub, "atlas", help="where the approximations hold: exact attractor vs every approximation over a (V, I) grid; "
                            "resumable maps and tables",
         description="At every (V, I) grid point: the exact attractor's observables (slip interval, force drop, slip "
-                    "and stick times, the force range at the jumps; 30 s of transient, 20 s measured) and its class "
+                    "and stick times, the force range at the jumps; 100 s of transient, 20 s measured) and its class "
                     "(period n, aperiodic, steady, breakdown); every approximation's prediction of the same "
                     "observables (estimate: the quasi-static cycle of peelapprox.estimate; approx:default: "
                     "peelapprox.approximate_attractor once it exists, skipped until then); and each reduction of the "
@@ -34,7 +34,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     "reductions' median per-segment errors.  Prints the summary: per approximation and observable "
                     "the share of the exact stick-slip points predicted within 10 %.  --cost N instead times each "
                     "part at N sample points of the grid and prints the projected time, computing nothing else.",
-        examples=["peelapprox atlas --V 0.2:5:8 --I 1e-6:1e-1:8:log --out atlas/ --plot   # ~10 s on 2 cores",
+        examples=["peelapprox atlas --V 0.2:5:8 --I 1e-6:1e-1:8:log --out atlas/ --plot   # 64 points, < 1 min",
                   "peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --out atlas40/ --workers 2 --max-wall 900",
                   "peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --cost 16   # the projected time first",
                   "peelapprox atlas --V 0.5:4:6 --I 1e-5:1e-2:6:log --force-family cubic --out cubic/ --plot"])
@@ -57,7 +57,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
                        help="connect to a running dask scheduler, e.g. tcp://host:8786")
     w = at.add_argument_group("the exact window and the segments (left out: the default given)")
-    w.add_argument("--t-transient", type=float, default=None, help="transient skipped [s] (default: 30)")
+    w.add_argument("--t-transient", type=float, default=None,
+                   help="transient skipped [s] (default: 100: the slowest orbits of the (0.2-5 m/s, 1e-6-0.1 kg m^2) "
+                        "plane drift for ~100 s)")
     w.add_argument("--window", type=float, default=None, help="measured window [s] (default: 20)")
     w.add_argument("--rtol", type=float, default=None, help="tolerance of the exact runs (default: 1e-10)")
     w.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (default: 0)")
