@@ -167,6 +167,33 @@ def test_predictions_checked_and_both_return_types(tmp_path, monkeypatch):
         PeelParams(V=1.0, I=1e-5))["stick_time"]
 
 
+def test_approximate_attractor_plugs_in_by_its_registry_entry(tmp_path, monkeypatch):
+    """Hypothesis: the built-in entry ``"approx:default"`` (an import reference) is measured as soon as
+    ``peelapprox.approximate_attractor`` resolves, with no other change, and an entry whose reference does not
+    resolve is skipped, with why; a lambda added as one registry line runs in this process, and a process pool
+    refuses it before any point (ValueError naming ``approximations``: its workers could not find it).  Here a
+    stand-in for ``approximate_attractor`` returns estimate's prediction, so the two rows are equal (exact
+    equality)."""
+    def stand_in(params):
+        return estimate_observables(params)
+
+    monkeypatch.setattr(peelapprox, "approximate_attractor", stand_in, raising=False)
+    monkeypatch.setitem(APPROXIMATIONS, "approx:lambda", lambda p: estimate_observables(p))
+    opts = {**OPTS, "segments_per_branch": 0}
+    res = atlas([1e-5], [1.0], out=tmp_path / "a", options=opts, max_workers=0, progress=False)
+    assert {"estimate", "approx:default", "approx:lambda"} <= set(res.approximations) and not res.skipped
+    for obs in OBSERVABLES:
+        assert res.prediction("approx:default", obs)[0, 0] == res.prediction("estimate", obs)[0, 0]
+        assert res.prediction("approx:lambda", obs)[0, 0] == res.prediction("estimate", obs)[0, 0]
+    monkeypatch.setitem(APPROXIMATIONS, "approx:default", "peelapprox:no_such_function_yet")  # not written yet
+    res = atlas([1e-5], [1.0], out=tmp_path / "b", approximations=["estimate", "approx:default"], options=opts,
+                max_workers=0, progress=False)
+    assert res.approximations == ("estimate",) and "not importable" in res.skipped["approx:default"]
+    with pytest.raises(ValueError, match="approximations: 'approx:lambda'"):
+        atlas([1e-5], [1.0], out=tmp_path / "c", approximations=["approx:lambda"], max_workers=2, progress=False)
+    assert not (tmp_path / "c").exists()
+
+
 @pytest.mark.parametrize("kwargs, match", [
     ({"I_values": []}, "I_values"),
     ({"V_values": [1.0, -2.0]}, "V_values"),
