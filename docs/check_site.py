@@ -35,8 +35,8 @@ from urllib.parse import urlparse
 #: The public modules with an API page (docs/api/<module>.rst); tests/test_docs_api.py keeps it complete.
 API_MODULES = (
     "peelapprox", "exact", "comparisons", "peelapprox.plotting", "peelapprox.io", "peelapprox.validate",
-    "peelapprox.errors", "peelapprox.kernels", "peelapprox.cli", "comparisons.sweep", "comparisons.stress",
-    "comparisons.benchmark", "comparisons.benchmark.peers",
+    "peelapprox.errors", "peelapprox.kernels", "peelapprox.cli", "comparisons.atlas", "comparisons.sweep",
+    "comparisons.stress", "comparisons.benchmark", "comparisons.benchmark.peers",
 )
 #: Pages that must hold typeset formulas (the landing page states the model's equations; the theory page maps
 #: the paper's equations to the code).

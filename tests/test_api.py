@@ -58,6 +58,11 @@ API = {
                       "param_attrs", "write_csv", "write_rows"},
     "peelapprox.plotting": {"TRAJECTORY_CYCLES", "new_figure", "plot_bifurcation", "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot"},
+    "comparisons.atlas": {
+        "atlas", "AtlasResult", "load_atlas", "APPROXIMATIONS", "register_approximation", "OBSERVABLES", "DEFAULTS",
+        "TOLERANCE", "estimate_observables", "plot_error_map", "plot_dynamics_map", "plot_segment_maps",
+        "write_maps", "atlas_cost", "AtlasCost",
+    },
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
         "MANIFEST", "RESERVED", "RESULTS", "record_key", "MAX_SWEEP_POINTS", "check_grid_size",

@@ -37,7 +37,7 @@ from typing import Any
 
 from .._deadline import WallSpent, time_limit
 from .._version import __version__
-from . import basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
+from . import atlas, basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
 from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, clip, exit_status, one_line
 from ._common import ArgumentParser, HelpFormatter, add_max_wall_option
 
@@ -56,6 +56,7 @@ _dynamics = dynamics.run
 _orbit = orbit.run_orbit
 _bifurcation = orbit.run_bifurcation
 _basins = basins.run
+_atlas = atlas.run
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -89,13 +90,14 @@ def build_parser() -> argparse.ArgumentParser:
     orbit.add_orbit_parser(sub).set_defaults(func=_orbit)
     orbit.add_bifurcation_parser(sub).set_defaults(func=_bifurcation)
     basins.add_parser(sub).set_defaults(func=_basins)
+    atlas.add_parser(sub).set_defaults(func=_atlas)
     return ap
 
 
 def _hard_wall(sp: argparse.ArgumentParser) -> argparse.ArgumentParser:
     """``--max-wall S`` (default 600 s) on a subcommand whose library calls have no wall budget of their own: the
     whole command is stopped when it is spent (exit status 3; :func:`main` arms the timer).  The subcommands that
-    run budgeted library calls (simulate, dynamics, orbit, bifurcation, basins, sweep) pass theirs on instead and
+    run budgeted library calls (simulate, dynamics, orbit, bifurcation, basins, sweep, atlas) pass theirs on instead and
     write what they computed."""
     add_max_wall_option(sp, spent="when it is spent the command stops (exit status 3)")
     sp.set_defaults(hard_wall=True)

@@ -1,0 +1,401 @@
+"""The records of an atlas read as maps and tables: :class:`AtlasResult` and :func:`load_atlas` (read-only).
+
+The relative error of an approximation's observable is computed here, from the records, and nowhere else:
+``(predicted - exact) / |exact|`` where the exact attractor stick-slips (``atlas_exact_status == "ok"``), the
+approximation predicts stick-slip and both values exist; elsewhere it is undefined and
+:meth:`AtlasResult.undefined` says why.  Maps are :class:`numpy.ma.MaskedArray` (masked where undefined, the
+data under the mask 0): no NaN anywhere.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any
+
+import numpy as np
+
+from peelapprox.io import fmt_number, html_table, jsonable, optional_import, write_rows
+
+from ..sweep import SweepResult, load_sweep, record_key
+from ..sweep.store import failed
+from .approximations import OBSERVABLES, TOLERANCE, UNITS, key_of
+from .measures import MEASURE_NAMES, SEGMENT_STATS, SPREADS, reduction_key
+
+__all__ = ["AtlasResult", "load_atlas", "TABLES"]
+
+#: The tables of an atlas (:meth:`AtlasResult.tables`), each written as ``atlas_<name>.csv`` / ``.json``.
+TABLES = ("points", "errors", "segments", "summary")
+
+_NOT_COMPUTED = "not computed"
+
+
+def _exact_key(field: str) -> str:
+    return record_key("atlas_exact", field)
+
+
+def _approx_key(name: str, field: str) -> str:
+    return record_key("atlas_approx", f"{key_of(name)}_{field}")
+
+
+def _segment_key(reduction: str, stat: str) -> str:
+    return record_key("atlas_segments", f"{reduction}_{stat}")
+
+
+def _number(v: Any) -> float | None:
+    return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+
+
+class AtlasResult:
+    """An atlas's records on its (I, V) grid: the exact dynamics, the predictions, their relative errors and
+    the reductions' per-segment errors, as maps (arrays ``[i, j]`` for ``I_values[i], V_values[j]``), tables,
+    an xarray Dataset and figures.
+
+    Attributes
+    ----------
+    sweep : comparisons.sweep.SweepResult
+        The records themselves (the atlas's directory is a sweep directory).
+    I_values, V_values : ndarray
+        The grid.
+    approximations : tuple of str
+        The approximations measured (names of :data:`~comparisons.atlas.approximations.APPROXIMATIONS`).
+    skipped : dict
+        Registered approximations that were not importable when the atlas started -> why.
+    observables : tuple of str
+        :data:`~comparisons.atlas.approximations.OBSERVABLES`.
+    reductions : tuple of str
+        The reductions compared per segment, ``"<branch>_<alpha_model>_<v_equation>"``.
+    options : dict
+        The atlas's options (window, segments, reductions, approximations, model fields).
+    out : str or None
+        Its directory.
+    """
+
+    def __init__(self, sweep: SweepResult):
+        missing = [m for m in MEASURE_NAMES if m not in sweep.measures]
+        if missing:
+            raise ValueError(f"not an atlas: the sweep in {sweep.out!r} lacks the measures {missing} "
+                             f"(it has {list(sweep.measures)})")
+        self.sweep = sweep
+        self.I_values, self.V_values = sweep.I_values, sweep.V_values
+        self.options = dict(sweep.options)
+        self.approximations = tuple(self.options.get("approximations", {}))
+        self.skipped = dict(self.options.get("skipped_approximations", {}))
+        self.observables = OBSERVABLES
+        self.reductions = tuple(reduction_key(b, am, ve) for b, pairs in self.options.get("reductions", {}).items()
+                                for am, ve in pairs)
+        self.out = sweep.out
+        self.force = sweep.force
+
+    # ------------------------------------------------------------------------------------------ the grid
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(len(I_values), len(V_values))``."""
+        return (self.I_values.size, self.V_values.size)
+
+    @property
+    def complete(self) -> bool:
+        """Every grid point has a record."""
+        return self.sweep.complete
+
+    def missing(self) -> list[tuple[float, ...]]:
+        """(I, V) of the points not computed yet."""
+        return self.sweep.missing()
+
+    def failed(self) -> list[tuple[float, ...]]:
+        """(I, V) of the points where a measure raised (``status`` ``"error: ..."``)."""
+        return self.sweep.failed()
+
+    def _grid(self, fn) -> np.ndarray:
+        """An object array of ``fn(record or None)`` over the grid."""
+        arr = np.empty(self.shape, dtype=object)
+        for i, I in enumerate(self.I_values):
+            for j, V in enumerate(self.V_values):
+                arr[i, j] = fn(self.sweep.record(I, V))
+        return arr
+
+    def _masked(self, fn) -> np.ma.MaskedArray:
+        """A masked float array of ``fn(record or None)`` (masked where it is None; 0 under the mask)."""
+        vals = self._grid(fn)
+        mask = np.array([v is None for v in vals.ravel()], dtype=bool).reshape(self.shape)
+        data = np.array([0.0 if v is None else float(v) for v in vals.ravel()], dtype=float).reshape(self.shape)
+        return np.ma.MaskedArray(data, mask=mask)
+
+    # ------------------------------------------------------------------------------------------ the exact side
+    def exact_class(self) -> np.ndarray:
+        """The exact dynamics at each point (str): ``period-n``, ``aperiodic``, ``too short`` where it
+        stick-slips; else ``steady``, ``transient``, ``too few slips``, ``breakdown``, ``budget``; ``failed``
+        where a measure raised, ``not computed`` where the point is still to run."""
+        def cls(rec):
+            if rec is None:
+                return _NOT_COMPUTED
+            return rec.get(_exact_key("class")) or ("failed" if failed(rec) else rec["status"])
+        return self._grid(cls)
+
+    def status(self) -> np.ndarray:
+        """Each point's status (``ok`` where the exact attractor stick-slips; ``not computed`` if not run)."""
+        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else rec["status"])
+
+    def stick_slip(self) -> np.ndarray:
+        """Boolean map: the exact attractor stick-slips (``status == "ok"``)."""
+        return self.status() == "ok"
+
+    def regime(self) -> np.ndarray:
+        """:func:`peelapprox.estimate`'s regime label at each point (``not computed`` where the point is still
+        to run, ``failed`` where its record has none)."""
+        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else
+                          rec.get(record_key("atlas_approx", "regime"), "failed"))
+
+    def exact(self, observable: str) -> np.ma.MaskedArray:
+        """An exact observable (or its spread, ``<observable>_spread``, or ``period``), masked where the
+        record has none."""
+        self._check_observable(observable, (*OBSERVABLES, *SPREADS, "period", "n_slips"))
+        return self._masked(lambda rec: None if rec is None else _number(rec.get(_exact_key(observable))))
+
+    # ------------------------------------------------------------------------------------------ predictions
+    def _check_name(self, name: str) -> None:
+        if name not in self.approximations:
+            raise ValueError(f"approximation {name!r} is not in this atlas; it has {list(self.approximations)}"
+                             + (f" (skipped: {self.skipped})" if self.skipped else ""))
+
+    @staticmethod
+    def _check_observable(observable: str, known=OBSERVABLES) -> None:
+        if observable not in known:
+            raise ValueError(f"observable must be one of {list(known)}, got {observable!r}")
+
+    def prediction(self, name: str, observable: str) -> np.ma.MaskedArray:
+        """Approximation ``name``'s prediction of ``observable`` (or ``period``), masked where it has none."""
+        self._check_name(name)
+        self._check_observable(observable, (*OBSERVABLES, "period"))
+        return self._masked(lambda rec: None if rec is None else _number(rec.get(_approx_key(name, observable))))
+
+    def prediction_status(self, name: str) -> np.ndarray:
+        """Approximation ``name``'s status at each point (``stick-slip``, ``steady``, ``breakdown:...``,
+        ``error: ...``; ``not computed``)."""
+        self._check_name(name)
+        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else
+                          rec.get(_approx_key(name, "status"), "failed"))
+
+    def _why(self, rec: dict | None, name: str, observable: str) -> str:
+        """Why the relative error is undefined at ``rec`` ("" where it is defined)."""
+        if rec is None:
+            return _NOT_COMPUTED
+        if failed(rec):
+            return f"failed: {rec['status']}"
+        if rec.get(_exact_key("status")) != "ok":
+            return f"exact: {rec.get(_exact_key('class'), rec['status'])}"
+        status = rec.get(_approx_key(name, "status"))
+        if status != "stick-slip":
+            return f"predicted: {status}"
+        e, a = _number(rec.get(_exact_key(observable))), _number(rec.get(_approx_key(name, observable)))
+        if e is None:
+            return "no exact value"
+        if a is None:
+            return "not predicted"
+        return "exact value 0" if e == 0 else ""
+
+    def undefined(self, name: str, observable: str) -> np.ndarray:
+        """Why the relative error of ``name``'s ``observable`` is undefined at each point ("" where defined):
+        ``not computed``, ``failed: ...``, ``exact: <class>`` (no stick-slip there), ``predicted: <status>``
+        (the approximation predicts none, or failed), ``no exact value``, ``not predicted``."""
+        self._check_name(name)
+        self._check_observable(observable)
+        return self._grid(lambda rec: self._why(rec, name, observable))
+
+    def relative_error(self, name: str, observable: str, *, signed: bool = False) -> np.ma.MaskedArray:
+        """``|predicted - exact| / |exact|`` of ``name``'s ``observable`` (``signed``: without the outer
+        absolute value), masked where undefined (:meth:`undefined` says why)."""
+        self._check_name(name)
+        self._check_observable(observable)
+
+        def err(rec):
+            if self._why(rec, name, observable):
+                return None
+            e, a = float(rec[_exact_key(observable)]), float(rec[_approx_key(name, observable)])
+            d = (a - e) / abs(e)
+            return d if signed else abs(d)
+        return self._masked(err)
+
+    def segment_error(self, reduction: str, stat: str = "dt_median") -> np.ma.MaskedArray:
+        """A reduction's per-point summary of its per-segment relative errors: ``stat`` one of ``dt_median``,
+        ``dt_worst``, ``dF_median``, ``dF_worst`` (or the counts ``n``, ``failed``), masked where the point has
+        none (no stick-slip, no stay solved)."""
+        if reduction not in self.reductions:
+            raise ValueError(f"reduction must be one of {list(self.reductions)}, got {reduction!r}")
+        self._check_observable(stat, SEGMENT_STATS)
+        return self._masked(lambda rec: None if rec is None else _number(rec.get(_segment_key(reduction, stat))))
+
+    # ------------------------------------------------------------------------------------------ summaries
+    def within(self, name: str, observable: str, tol: float = TOLERANCE) -> dict:
+        """How often ``name`` predicts ``observable`` within ``tol``: over the exact stick-slip points, the
+        number ``stick_slip``, ``compared`` (error defined), ``within`` (error <= tol), ``fraction`` (within /
+        stick_slip; None without stick-slip points), ``median_error`` and ``worst_error`` (None if none)."""
+        err = self.relative_error(name, observable)
+        n_ss = int(self.stick_slip().sum())
+        vals = err.compressed()
+        n_in = int((vals <= tol).sum())
+        return {"approximation": name, "observable": observable, "stick_slip": n_ss, "compared": int(vals.size),
+                "within": n_in, "fraction": n_in / n_ss if n_ss else None,
+                "median_error": float(np.median(vals)) if vals.size else None,
+                "worst_error": float(vals.max()) if vals.size else None}
+
+    def summary(self, tol: float = TOLERANCE) -> list[dict]:
+        """:meth:`within` for every approximation and observable, then for every reduction the same of its
+        per-point median ``|Δt|`` and ``|ΔF|`` errors (``approximation`` = ``segments:<reduction>``,
+        ``observable`` = ``dt_median`` / ``dF_median``)."""
+        rows = [self.within(n, o, tol) for n in self.approximations for o in OBSERVABLES]
+        n_ss = int(self.stick_slip().sum())
+        ss = self.stick_slip()
+        for red in self.reductions:
+            for stat in ("dt_median", "dF_median"):
+                m = self.segment_error(red, stat)
+                v = np.ma.MaskedArray(m.data, mask=m.mask | ~ss).compressed()
+                n_in = int((v <= tol).sum())
+                rows.append({"approximation": f"segments:{red}", "observable": stat, "stick_slip": n_ss,
+                             "compared": int(v.size), "within": n_in, "fraction": n_in / n_ss if n_ss else None,
+                             "median_error": float(np.median(v)) if v.size else None,
+                             "worst_error": float(v.max()) if v.size else None})
+        return rows
+
+    # ------------------------------------------------------------------------------------------ tables
+    def point_rows(self) -> list[dict]:
+        """One row per computed point: I, V, status, the exact class, reason, period and observables, the
+        regime label, each approximation's status."""
+        rows = []
+        for rec in self.sweep.records:
+            row: dict[str, Any] = {"I": rec["I"], "V": rec["V"], "status": rec["status"],
+                                   "exact_class": rec.get(_exact_key("class"), "failed" if failed(rec) else ""),
+                                   "exact_reason": rec.get(_exact_key("reason")),
+                                   "regime": rec.get(record_key("atlas_approx", "regime"))}
+            row.update({f"exact_{f}": rec.get(_exact_key(f)) for f in ("period", "n_slips", *OBSERVABLES)})
+            row.update({f"{name}_status": rec.get(_approx_key(name, "status")) for name in self.approximations})
+            rows.append(row)
+        return rows
+
+    def error_rows(self) -> list[dict]:
+        """One row per computed point, approximation and observable: exact and predicted values, the signed
+        relative error (None where undefined) and why it is undefined ("" where defined)."""
+        rows = []
+        for rec in self.sweep.records:
+            for name in self.approximations:
+                for obs in OBSERVABLES:
+                    why = self._why(rec, name, obs)
+                    e, a = _number(rec.get(_exact_key(obs))), _number(rec.get(_approx_key(name, obs)))
+                    rows.append({"I": rec["I"], "V": rec["V"], "approximation": name, "observable": obs,
+                                 "unit": UNITS[obs], "exact": e, "predicted": a,
+                                 "rel_error": None if why or e is None or a is None else (a - e) / abs(e),
+                                 "undefined": why})
+        return rows
+
+    def segment_rows(self) -> list[dict]:
+        """One row per computed point and reduction: the stays solved and failed, median and worst |Δt| and
+        |ΔF| relative errors (None where the point has none)."""
+        return [{"I": rec["I"], "V": rec["V"], "reduction": red, "exact_class": rec.get(_exact_key("class")),
+                 **{stat: rec.get(_segment_key(red, stat)) for stat in SEGMENT_STATS}}
+                for rec in self.sweep.records for red in self.reductions]
+
+    def tables(self) -> dict[str, list[dict]]:
+        """Every table of the atlas by name (:data:`TABLES`): ``points``, ``errors``, ``segments``,
+        ``summary``."""
+        return {"points": self.point_rows(), "errors": self.error_rows(), "segments": self.segment_rows(),
+                "summary": self.summary()}
+
+    def write_tables(self, directory, formats: tuple[str, ...] = ("csv", "json")) -> list[str]:
+        """Write each table as ``atlas_<name>.<format>`` into ``directory`` (created); returns the paths."""
+        bad = [f for f in formats if f not in ("csv", "json")]
+        if bad or not formats:
+            raise ValueError(f"formats must be a non-empty tuple of 'csv' and/or 'json', got {formats!r}")
+        os.makedirs(directory, exist_ok=True)
+        return [write_rows(os.path.join(directory, f"atlas_{name}.{fmt}"), rows)
+                for name, rows in self.tables().items() for fmt in formats]
+
+    def to_xarray(self) -> Any:
+        """The atlas as an :class:`xarray.Dataset` on dimensions ``I``, ``V`` (and ``approximation``,
+        ``observable``, ``reduction``, ``stat``): ``exact`` [I, V, observable], ``predicted`` and
+        ``rel_error`` (signed) [approximation, I, V, observable], ``segment_error`` [reduction, I, V, stat],
+        ``exact_class``, ``regime``, ``status`` [I, V] (str).  NaN is xarray's mark of an undefined value
+        here; ``undefined`` [approximation, I, V, observable] says why.
+
+        Raises
+        ------
+        ImportError
+            If xarray is not installed (``pip install 'peelapprox[data]'``).
+        """
+        xr = optional_import("xarray", "AtlasResult.to_xarray")
+
+        def filled(m: np.ma.MaskedArray) -> np.ndarray:
+            return m.filled(np.nan)
+
+        names = list(self.approximations)
+        stats = ("dt_median", "dt_worst", "dF_median", "dF_worst")
+        data: dict[str, Any] = {
+            "exact": (("I", "V", "observable"), np.stack([filled(self.exact(o)) for o in OBSERVABLES], -1)),
+            "exact_class": (("I", "V"), self.exact_class().astype(str)),
+            "regime": (("I", "V"), self.regime().astype(str)),
+            "status": (("I", "V"), self.status().astype(str)),
+        }
+        if names:
+            data["predicted"] = (("approximation", "I", "V", "observable"), np.stack(
+                [np.stack([filled(self.prediction(n, o)) for o in OBSERVABLES], -1) for n in names]))
+            data["rel_error"] = (("approximation", "I", "V", "observable"), np.stack(
+                [np.stack([filled(self.relative_error(n, o, signed=True)) for o in OBSERVABLES], -1) for n in names]))
+            data["undefined"] = (("approximation", "I", "V", "observable"), np.stack(
+                [np.stack([self.undefined(n, o).astype(str) for o in OBSERVABLES], -1) for n in names]))
+        if self.reductions:
+            data["segment_error"] = (("reduction", "I", "V", "stat"), np.stack(
+                [np.stack([filled(self.segment_error(r, s)) for s in stats], -1) for r in self.reductions]))
+        coords = {"I": ("I", self.I_values, {"units": "kg m²"}), "V": ("V", self.V_values, {"units": "m/s"}),
+                  "observable": list(OBSERVABLES), "approximation": names, "reduction": list(self.reductions),
+                  "stat": list(stats)}
+        attrs = {"options": json.dumps(jsonable(self.options)), "force": repr(self.force), "out": self.out or "",
+                 "units": json.dumps(UNITS), "skipped": json.dumps(self.skipped),
+                 "points": len(self.sweep.records), "total": int(np.prod(self.shape))}
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    # ------------------------------------------------------------------------------------------ figures
+    def plot_error(self, name: str, observable: str, path=None, **kwargs: Any) -> Any:
+        """:func:`comparisons.atlas.plots.plot_error_map` of this atlas."""
+        from .plots import plot_error_map
+
+        return plot_error_map(self, name, observable, path, **kwargs)
+
+    def plot_dynamics(self, path=None, **kwargs: Any) -> Any:
+        """:func:`comparisons.atlas.plots.plot_dynamics_map` of this atlas."""
+        from .plots import plot_dynamics_map
+
+        return plot_dynamics_map(self, path, **kwargs)
+
+    def write_maps(self, directory) -> list[str]:
+        """:func:`comparisons.atlas.plots.write_maps` of this atlas: every map as a PNG in ``directory``."""
+        from .plots import write_maps
+
+        return write_maps(self, directory)
+
+    # ------------------------------------------------------------------------------------------ display
+    def _summary(self) -> dict:
+        n = int(np.prod(self.shape))
+        return {"grid": f"{self.shape[0]} I x {self.shape[1]} V", "points": f"{len(self.sweep.records)}/{n}",
+                "stick-slip": int(self.stick_slip().sum()), "failed": len(self.failed()),
+                "approximations": ", ".join(self.approximations) or "–",
+                "skipped": ", ".join(self.skipped) or "–", "reductions": len(self.reductions),
+                "window": f"{fmt_number(self.options.get('t_transient'), 4)} + "
+                          f"{fmt_number(self.options.get('t_window'), 4)} s", "out": self.out}
+
+    def _repr_html_(self) -> str:
+        return html_table("AtlasResult", self._summary())
+
+    def __repr__(self) -> str:
+        s = self._summary()
+        return (f"AtlasResult({s['grid']}, {s['points']} points, {s['stick-slip']} stick-slip, approximations="
+                f"{list(self.approximations)}, out={self.out!r})")
+
+
+def load_atlas(out) -> AtlasResult:
+    """Read an atlas directory (finished or not) without changing it.
+
+    Raises
+    ------
+    ValueError
+        No manifest, a malformed file (:func:`comparisons.sweep.load_sweep`), or a sweep that is not an atlas.
+    """
+    return AtlasResult(load_sweep(out))

@@ -1,0 +1,186 @@
+"""``peelapprox atlas``: where the approximations hold over a (V, I) grid (:func:`comparisons.atlas.atlas`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+from .. import GEOMETRIES
+from ._checks import check_output_path, connect_dask_scheduler, nonnegative_int, positive_int
+from ._common import FORMATS, add_max_wall_option, subcommand
+from ._force import add_force_options, force_from_args
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    at = subcommand(
+        sub, "atlas", help="where the approximations hold: exact attractor vs every approximation over a (V, I) grid; "
+                           "resumable maps and tables",
+        description="At every (V, I) grid point: the exact attractor's observables (slip interval, force drop, slip "
+                    "and stick times, the force range at the jumps; 100 s of transient, 20 s measured) and its class "
+                    "(period n, aperiodic, steady, breakdown); every approximation's prediction of the same "
+                    "observables (estimate: the quasi-static cycle of peelapprox.estimate; approx:default: "
+                    "peelapprox.approximate_attractor once it exists, skipped until then); and each reduction of the "
+                    "harness (an alpha model and a v equation per branch) seeded from the exact branch entries of the "
+                    "window's last stays, with its median and worst |dt| and |dF| relative errors.  Each finished "
+                    "point is appended to DIR/results.jsonl, so a killed atlas resumes where it stopped.\n\n"
+                    "Writes DIR/atlas_points, atlas_errors, atlas_segments and atlas_summary (.csv and .json), and "
+                    "with --plot the maps under DIR/maps/: one per approximation and observable of the relative "
+                    "error with the cells within 10 % outlined, the exact dynamics with the regimes of estimate, the "
+                    "reductions' median per-segment errors.  Prints the summary: per approximation and observable "
+                    "the share of the exact stick-slip points predicted within 10 %.  --cost N instead times each "
+                    "part at N sample points of the grid and prints the projected time, computing nothing else.",
+        examples=["peelapprox atlas --V 0.2:5:8 --I 1e-6:1e-1:8:log --out atlas/ --plot   # 64 points, < 1 min",
+                  "peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --out atlas40/ --workers 2 --max-wall 900",
+                  "peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --cost 16   # the projected time first",
+                  "peelapprox atlas --V 0.5:4:6 --I 1e-5:1e-2:6:log --force-family cubic --out cubic/ --plot"])
+    at.add_argument("--V", required=True, metavar="SPEC",
+                    help="pull speeds [m/s]: start:stop:num[:log] or a comma list, e.g. 0.2:5:40")
+    at.add_argument("--I", required=True, metavar="SPEC",
+                    help="roller inertias [kg m^2], same syntax, e.g. 1e-6:1e-1:40:log; the grid holds at most "
+                         "1000000 points")
+    at.add_argument("--out", metavar="DIR",
+                    help="output directory (required unless --cost): sweep.json, results.jsonl, the atlas tables, "
+                         "maps/; an existing DIR with the same grid and options is resumed")
+    at.add_argument("--approximations", metavar="NAMES",
+                    help="comma-separated names of comparisons.atlas.APPROXIMATIONS (default: every registered one "
+                         "whose function is importable)")
+    where = at.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
+                       help="local worker processes (default: all CPUs; 0: in this process)")
+    where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
+                       help="start a dask LocalCluster with N single-threaded worker processes")
+    where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
+                       help="connect to a running dask scheduler, e.g. tcp://host:8786")
+    w = at.add_argument_group("the exact window and the segments (left out: the default given)")
+    w.add_argument("--t-transient", type=float, default=None,
+                   help="transient skipped [s] (default: 100: the slowest orbits of the (0.2-5 m/s, 1e-6-0.1 kg m^2) "
+                        "plane drift for ~100 s)")
+    w.add_argument("--window", type=float, default=None, help="measured window [s] (default: 20)")
+    w.add_argument("--rtol", type=float, default=None, help="tolerance of the exact runs (default: 1e-10)")
+    w.add_argument("--alpha0", type=float, default=None, help="initial peel angle [rad] (default: 0)")
+    w.add_argument("--segments", type=nonnegative_int, default=None, metavar="N",
+                   help="complete stays of each branch compared per point, the last ones of the window (default: "
+                        "8; 0: no segment errors)")
+    w.add_argument("--segment-rtol", type=float, default=None,
+                   help="tolerance of the reduced solves (default: 1e-10)")
+    p = at.add_argument_group("model parameters (PeelParams; V and I are the grid)")
+    p.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (default: 1000)")
+    p.add_argument("--R", type=float, default=None, help="roller radius [m] (default: 0.1)")
+    p.add_argument("--l", type=float, default=None, help="roller-motor distance [m] (read by --geometry exact; "
+                                                        "default: 1)")
+    p.add_argument("--geometry", choices=GEOMETRIES, default=None,
+                   help="the closure cos(theta): paper or exact (default: paper)")
+    add_force_options(at)
+    at.add_argument("--retry-failed", action="store_true",
+                    help="compute again the points of DIR whose status is an error (else they count as done)")
+    at.add_argument("--plot", action="store_true", help="write every map as a PNG under DIR/maps/")
+    at.add_argument("--cost", type=positive_int, default=None, metavar="N",
+                    help="time each part (exact run, segments, each approximation) at about N sample points of the "
+                         "grid in this process and print the projected time of the grid on --workers (default 2) "
+                         "processes; nothing is written")
+    at.add_argument("--format", choices=FORMATS, default="table",
+                    help="how the summary is printed: table (markdown), csv or json")
+    at.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
+    add_max_wall_option(at, what="this run",
+                        spent="when it is spent no point is started, the points done stay in DIR, the exit status "
+                              "is 3, and the same command again resumes the rest")
+    return at
+
+
+#: Option -> the atlas option it sets (each only when given: a resumed atlas's options must match).
+_WINDOW = {"t_transient": "t_transient", "window": "t_window", "rtol": "rtol", "alpha0": "alpha0",
+           "segments": "segments_per_branch", "segment_rtol": "segment_rtol"}
+
+
+def run(args: argparse.Namespace) -> int:
+    from comparisons.atlas import atlas, atlas_cost
+    from comparisons.sweep import check_grid_size, parse_grid
+
+    V_values = parse_grid(args.V, name="--V")
+    I_values = parse_grid(args.I, name="--I")
+    check_grid_size({"--I": I_values.size, "--V": V_values.size})
+    options = {key: getattr(args, opt) for opt, key in _WINDOW.items() if getattr(args, opt) is not None}
+    model = {key: getattr(args, key) for key in ("k", "R", "l", "geometry")}
+    approximations = None if args.approximations is None else \
+        [a.strip() for a in args.approximations.split(",") if a.strip()]
+    force = force_from_args(args)
+    if args.cost is not None:
+        if force.kind != "paper" or args.out or args.plot:
+            raise ValueError("--cost times the paper's law and writes nothing: leave out --out, --plot and the law "
+                             "options")
+        cost = atlas_cost(I_values, V_values, sample=args.cost, workers=args.workers or 2,
+                          approximations=approximations, k=args.k, R=args.R, options=options,
+                          progress=not args.quiet)
+        if args.format == "table":
+            print(cost)
+        else:
+            _print_rows(cost.rows(), args.format)
+        return 0
+    if not args.out:
+        raise ValueError("--out DIR is required (the atlas's records, tables and maps go there), unless --cost")
+    check_output_path(args.out, "dir", "--out", read_only_ok=True)
+    client = cluster = None
+    executor, max_workers = None, None
+    if args.dask_local or args.dask_scheduler:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            print("error: --dask-local/--dask-scheduler need dask.distributed: pip install 'peelapprox[distributed]'",
+                  file=sys.stderr)
+            return 2
+        if args.dask_local:
+            cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
+            client = Client(cluster)
+        else:
+            client = connect_dask_scheduler(args.dask_scheduler)
+        executor = client.get_executor()
+    else:
+        max_workers = args.workers
+    t0 = time.perf_counter()
+    try:
+        result = atlas(I_values, V_values, out=args.out, approximations=approximations, force=force, options=options,
+                       executor=executor, max_workers=max_workers, progress=not args.quiet,
+                       retry_failed=args.retry_failed, max_wall=args.max_wall, **model)
+    except RuntimeError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    print(f"atlas: {len(result.sweep.records)} points in {args.out} ({time.perf_counter() - t0:.1f} s)"
+          + (f"; skipped (not importable yet): {', '.join(result.skipped)}" if result.skipped else ""),
+          file=sys.stderr)
+    try:
+        for path in result.write_tables(args.out):
+            print(f"wrote {path}", file=sys.stderr)
+        if args.plot:
+            paths = result.write_maps(os.path.join(args.out, "maps"))
+            print(f"wrote {len(paths)} maps in {os.path.join(args.out, 'maps')}", file=sys.stderr)
+    except OSError as exc:  # e.g. a complete atlas in a read-only directory: still report it
+        print(f"note: cannot write into {args.out} ({exc}); the summary is printed only", file=sys.stderr)
+    _print_rows(result.summary(), args.format)
+    return 1 if result.failed() else 0
+
+
+def _print_rows(rows: list[dict], fmt: str) -> None:
+    """``rows`` as JSON, CSV or a markdown table (floats to 4 significant digits)."""
+    from ..io import fmt_number, write_csv
+
+    if fmt == "json":
+        print(json.dumps(rows, indent=2))
+        return
+    if fmt == "csv":
+        write_csv(sys.stdout, rows)
+        return
+    cols = list(dict.fromkeys(k for r in rows for k in r))
+    print("| " + " | ".join(cols) + " |")
+    print("|" + "|".join("---" for _ in cols) + "|")
+    for r in rows:
+        print("| " + " | ".join(fmt_number(r.get(c), 4, missing="") for c in cols) + " |")
