@@ -186,34 +186,39 @@ def test_benchmark_runs_and_writes(tmp_path):
 
 
 # ------------------------------------------------------------------- estimate() offers the attractor and its validity
-def _csv_default_rows() -> dict:
+def _atlas_rows() -> dict:
+    """``{regime: {observable: row}}`` of the approx:default rows of docs/atlas/atlas_regimes.csv."""
     import csv
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "docs" / "benchmark" / "approx_attractor.csv"
+    path = Path(__file__).resolve().parents[1] / "docs" / "atlas" / "atlas_regimes.csv"
+    out: dict = {}
     with open(path, newline="") as fh:
-        return {r["regime"]: r for r in csv.DictReader(fh) if r["chain"] == "default"}
+        for r in csv.DictReader(fh):
+            if r["approximation"] == "approx:default":
+                out.setdefault(r["regime"], {})[r["observable"]] = r
+    return out
 
 
 def test_validity_table_is_the_measurement():
-    """Hypothesis: the validity estimate() reports is the benchmark's measurement, not a second copy that
-    drifted: every default row of docs/benchmark/approx_attractor.csv is in peelapprox._validity.VALIDITY with
-    the same point count and fractions (exact: the same decimal text parsed to the same floats)."""
+    """Hypothesis: the validity estimate() reports is the atlas's measurement, not a second copy that drifted:
+    every regime of the approx:default rows of docs/atlas/atlas_regimes.csv is in peelapprox._validity.VALIDITY
+    with the same point count and fractions (exact: the same decimal text parsed to the same floats)."""
     from peelapprox._validity import VALIDITY
 
-    rows = _csv_default_rows()
+    rows = _atlas_rows()
     assert set(rows) == set(VALIDITY)
     for label, r in rows.items():
         v = VALIDITY[label]
         assert (v.points, v.slip_interval, v.force_drop, v.both) == (
-            int(r["n"]), float(r["slip_interval_within_10"]), float(r["force_drop_within_10"]),
-            float(r["both_within_10"]))
+            int(r["slip_interval"]["stick_slip"]), float(r["slip_interval"]["fraction"]),
+            float(r["force_drop"]["fraction"]), float(r["slip_interval+force_drop"]["fraction"]))
 
 
 def test_estimate_offers_the_attractor_and_says_how_often_it_holds():
     """Hypothesis: ``estimate(p).attractor()`` is ``approximate_attractor(p)`` (deterministic: equal fields), and
-    ``estimate(p).validity`` quotes the measured percentage of p's regime (the CSV's fraction, rounded to a whole
-    percent, computed here from the file)."""
+    ``estimate(p).validity`` quotes the atlas's measured percentage of p's regime (the CSV's fraction, rounded to a
+    whole percent, computed here from the file)."""
     import dataclasses
 
     from peelapprox import PeelParams, approximate_attractor, estimate
@@ -221,9 +226,9 @@ def test_estimate_offers_the_attractor_and_says_how_often_it_holds():
     p = PeelParams(V=1.0, I=1e-5)
     e = estimate(p)
     assert dataclasses.asdict(e.attractor()) == dataclasses.asdict(approximate_attractor(p))
-    row = _csv_default_rows()[e.label]
-    pct = f"{100 * float(row['slip_interval_within_10']):.0f} %"
-    assert f"within 10 % of the exact attractor on {pct} of the {row['n']} '{e.label}' points" in \
+    row = _atlas_rows()[e.label]["slip_interval"]
+    pct = f"{100 * float(row['fraction']):.0f} %"
+    assert f"within 10 % of the exact attractor on {pct} of the {row['stick_slip']} '{e.label}' points" in \
         e.validity["slip_interval"]
     assert "params" not in e.as_dict()
 

@@ -129,7 +129,19 @@ def test_small_atlas_segments_and_tables(small, tmp_path):
             assert 0 <= med[0, 0] <= worst[0, 0]
         assert med[1, 0] is np.ma.masked and med[0, 2] is np.ma.masked
     paths = small.write_tables(tmp_path)
-    assert len(paths) == 8
+    assert len(paths) == 10
+    # the per-regime table agrees with the maps, counted here from them: for each approximation and observable,
+    # the points within 10 % summed over the labels are those of within(), and each label's count is its cells'
+    regimes, ss = small.regime(), small.stick_slip()
+    by = json.loads((tmp_path / "atlas_regimes.json").read_text())
+    for name in small.approximations:
+        for obs in OBSERVABLES:
+            mine = [r for r in by if r["approximation"] == name and r["observable"] == obs]
+            assert sum(r["within"] for r in mine) == small.within(name, obs)["within"]
+            err = small.relative_error(name, obs).filled(np.inf)
+            for r in mine:
+                sel = ss & (regimes == r["regime"])
+                assert r["stick_slip"] == int(sel.sum()) and r["within"] == int(((err <= 0.1) & sel).sum())
     rows = json.loads((tmp_path / "atlas_errors.json").read_text())
     assert len(rows) == 6 * len(small.approximations) * len(OBSERVABLES)
     assert (tmp_path / "atlas_errors.csv").read_text().count("\n") == len(rows) + 1

@@ -25,7 +25,7 @@ from .measures import MEASURE_NAMES, SEGMENT_STATS, SPREADS, reduction_key
 __all__ = ["AtlasResult", "load_atlas", "TABLES"]
 
 #: The tables of an atlas (:meth:`AtlasResult.tables`), each written as ``atlas_<name>.csv`` / ``.json``.
-TABLES = ("points", "errors", "segments", "summary")
+TABLES = ("points", "errors", "segments", "summary", "regimes")
 
 _NOT_COMPUTED = "not computed"
 
@@ -257,6 +257,29 @@ class AtlasResult:
                              "worst_error": float(v.max()) if v.size else None})
         return rows
 
+    def by_regime(self, tol: float = TOLERANCE) -> list[dict]:
+        """:meth:`within` per regime label of :func:`peelapprox.estimate`: for every approximation, label and
+        observable (and ``"slip_interval+force_drop"``, both within at once), the exact stick-slip points with
+        that label (``stick_slip``), how many of them have a defined error (``compared``), how many are within
+        ``tol`` (``within``) and the ``fraction`` within (of ``stick_slip``): what ``estimate(p).validity``
+        quotes."""
+        regimes, ss = self.regime(), self.stick_slip()
+        rows = []
+        for name in self.approximations:
+            ok = {o: self.relative_error(name, o).filled(np.inf) <= tol for o in OBSERVABLES}
+            defined = {o: ~np.ma.getmaskarray(self.relative_error(name, o)) for o in OBSERVABLES}
+            ok["slip_interval+force_drop"] = ok["slip_interval"] & ok["force_drop"]
+            defined["slip_interval+force_drop"] = defined["slip_interval"] & defined["force_drop"]
+            for label in sorted({str(x) for x in regimes[ss]}):
+                sel = ss & (regimes == label)
+                n = int(sel.sum())
+                for obs in (*OBSERVABLES, "slip_interval+force_drop"):
+                    n_in = int((ok[obs] & sel).sum())
+                    rows.append({"approximation": name, "regime": label, "observable": obs, "stick_slip": n,
+                                 "compared": int((defined[obs] & sel).sum()), "within": n_in,
+                                 "fraction": n_in / n if n else None})
+        return rows
+
     # ------------------------------------------------------------------------------------------ tables
     def point_rows(self) -> list[dict]:
         """One row per computed point: I, V, status, the exact class, reason, period and observables, the
@@ -296,9 +319,9 @@ class AtlasResult:
 
     def tables(self) -> dict[str, list[dict]]:
         """Every table of the atlas by name (:data:`TABLES`): ``points``, ``errors``, ``segments``,
-        ``summary``."""
+        ``summary``, ``regimes`` (:meth:`by_regime`)."""
         return {"points": self.point_rows(), "errors": self.error_rows(), "segments": self.segment_rows(),
-                "summary": self.summary()}
+                "summary": self.summary(), "regimes": self.by_regime()}
 
     def write_tables(self, directory, formats: tuple[str, ...] = ("csv", "json")) -> list[str]:
         """Write each table as ``atlas_<name>.<format>`` into ``directory`` (created); returns the paths."""
