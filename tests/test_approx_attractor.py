@@ -241,3 +241,18 @@ def test_an_estimate_without_params_cannot_run_the_attractor():
     d.pop("label")
     with pytest.raises(ValueError, match="approximate_attractor"):
         RegimeEstimate(**d).attractor()
+
+
+def test_cli_estimate_attractor(capsys):
+    """Hypothesis: ``peelapprox estimate --attractor --format json`` adds the approximate attractor's observables
+    (equal to ``approximate_attractor(p)``'s: the same deterministic computation, exact) and the validity texts."""
+    import json
+
+    from peelapprox import PeelParams, approximate_attractor
+    from peelapprox.cli import main
+
+    assert main(["estimate", "--V", "1", "--I", "1e-5", "--attractor", "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)
+    a = approximate_attractor(PeelParams(V=1.0, I=1e-5))
+    assert row["attractor_slip_interval"] == a.slip_interval and row["attractor_force_drop"] == a.force_drop
+    assert row["attractor_status"] == "stick-slip" and "low inertia, low V" in row["validity_slip_interval"]

@@ -53,12 +53,17 @@ def add_estimate_parser(sub) -> argparse.ArgumentParser:
                     "folds, the fixed point, the periods and stick/slip times, and the labels inertia (low, "
                     "intermediate, high) and velocity (stable, low, high) with the rules that set them.",
         examples=["peelapprox estimate --V 1 --I 1e-2 --format json",
+                  "peelapprox estimate --V 1 --I 1e-5 --attractor",
                   "peelapprox estimate --V 4 --I 1e-5 --alpha-min -0.3 --alpha-max 0.3 --out estimate.csv"])
     add_params(es, geometry=False, variants=REDUCED_ONLY)
     es.add_argument("--alpha-min", type=float, default=None,
                     help="peel angle [rad] of the force bound f_max/(1+sin alpha_min) (default: no bound)")
     es.add_argument("--alpha-max", type=float, default=None,
                     help="peel angle [rad] of the force bound f_min/(1+sin alpha_max) (default: no bound)")
+    es.add_argument("--attractor", action="store_true",
+                    help="also predict the stick-slip attractor from the reduced equations (approximate_attractor: "
+                         "slip interval, force drop, slip and stick times, force extremes, period; milliseconds) "
+                         "and say how often such a prediction held in this regime, as the atlas measured it")
     add_format(es, "the estimate")
     es.add_argument("--out", help="also write the estimate to this .csv or .json")
     return es
@@ -70,7 +75,12 @@ def run_estimate(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "table", "--out") if args.out else None
     params = params_from_args(args)
     law = params.force
-    row = estimate(params, alpha_min=args.alpha_min, alpha_max=args.alpha_max).as_dict()
+    est = estimate(params, alpha_min=args.alpha_min, alpha_max=args.alpha_max)
+    row = est.as_dict()
+    if args.attractor:
+        att = est.attractor().as_dict()
+        row.update({f"attractor_{k}": v for k, v in att.items() if k not in ("V", "I")})
+        row.update({f"validity_{k}": v for k, v in est.validity.items()})
     print_mapping({**row, **law_fields(law, spec=args.format == "json")}, args.format)
     if out:
         write_table(out, [row], law)
