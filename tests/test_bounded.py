@@ -274,7 +274,8 @@ def test_cli_refuses_a_grid_too_large_at_once(tmp_path, capsys, argv, match):
 
 
 @pytest.mark.parametrize("argv, after", [
-    (["orbit", "--V", "1", "--I", "1e-5", "--t-transient", "100000"], "error: more than 0.5 s of wall time"),
+    (["orbit", "--V", "1", "--I", "1e-5", "--t-transient", "100000"],
+     "error: more than 0.5 s of wall time (--max-wall)"),
     (["bifurcation", "--V", "1", "--I", "1e-5", "--range", "0.9:1.1:100"], "stopped: the --max-wall budget"),
     (["basins", "--V", "1", "--I", "1e-5", "--alpha0", "0:0.3:10", "--F0", "200:280:10", "--workers", "0"],
      "stopped: the --max-wall budget"),

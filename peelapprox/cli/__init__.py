@@ -151,7 +151,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:
         status = exit_status(exc)
         if status is not None:
-            ap.exit(status, f"peelapprox {command}: error: {one_line(exc)}\n")
+            # the library's advice names its keyword; on the command line it is the option
+            text = (one_line(exc).replace("pass a larger max_wall, or None", "pass a larger --max-wall")
+                    .replace("wall time (max_wall)", "wall time (--max-wall)"))
+            ap.exit(status, f"peelapprox {command}: error: {text}\n")
         if os.environ.get(TRACEBACK_ENV, "").strip() == "1":
             raise
         ap.exit(EXIT_INTERNAL, _internal_error(command, exc))
