@@ -155,7 +155,7 @@ def test_low_inertia_against_the_jumps_and_the_periodic_orbit(p_low):
 def test_high_inertia_period_8_and_reproducibility(p_low, p_high):
     """V = 1, I = 1e-2: period 8 (docs/dynamics.md, Fig. 4 confirmed); the slip interval is the Newton-closed
     orbit's period over its 8 returns (measured 4.5e-10 relative: the window's orbit is still converging, to
-    ~1e-7 in F; asserted 1e-8).  Reproducibility, the issue's target: every mean, spread and F extreme at
+    ~1e-7 in F; asserted 1e-8).  Reproducibility, the stated target: every mean, spread and F extreme at
     rtol 1e-10 and 1e-12 agree to 1e-6 relative on both periodic attractors (measured 1.3e-10 at most)."""
     o = exact.attractor_observables(p_high)
     orbit = exact.periodic_orbit(p_high)

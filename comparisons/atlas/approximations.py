@@ -18,7 +18,6 @@ reduced return map iterated to its attractor; skipped until that function exists
 
 from __future__ import annotations
 
-import importlib
 import numbers
 import re
 from collections.abc import Callable, Mapping
@@ -26,6 +25,8 @@ from typing import Any
 
 from peelapprox import PeelParams, StickSlipObservables, estimate
 from peelapprox.io import fmt_number
+
+from ..sweep.task import import_ref
 
 __all__ = ["APPROXIMATIONS", "OBSERVABLES", "UNITS", "TOLERANCE", "Entry", "register_approximation",
            "estimate_observables", "resolve", "available", "key_of", "predict"]
@@ -147,21 +148,13 @@ def register_approximation(name: str, entry: Entry, *, replace: bool = False) ->
     APPROXIMATIONS[name] = entry
 
 
-def _import(ref: str) -> Any:
-    module, _, attr = ref.partition(":")
-    obj: Any = importlib.import_module(module)
-    for part in attr.split("."):
-        obj = getattr(obj, part)
-    return obj
-
-
 def _ref_of(fn: Callable) -> str | None:
     """``module:qualname`` of a module-level function a worker can import, else None."""
     module, qual = getattr(fn, "__module__", None), getattr(fn, "__qualname__", "")
     if not module or module in ("__main__", "__mp_main__") or "<" in qual:
         return None
     try:
-        return f"{module}:{qual}" if _import(f"{module}:{qual}") is fn else None
+        return f"{module}:{qual}" if import_ref(f"{module}:{qual}") is fn else None
     except Exception:
         return None
 
@@ -187,7 +180,7 @@ def resolve(name: str, ref: str | None = None) -> Callable[[PeelParams], Any]:
     if callable(entry):
         return entry
     ref_, kwargs = (entry, {}) if isinstance(entry, str) else entry
-    fn = _import(ref_)
+    fn = import_ref(ref_)
     if not callable(fn):
         raise TypeError(f"approximation {name!r}: {ref_} is not callable")
     if not kwargs:

@@ -3,7 +3,7 @@
     python -m comparisons.benchmark.approx_attractor [--V 0.2:5:8] [--I 1e-6:1e-1:8:log] [--repeats 3]
         [--chains default,paper,check] [--exact-json FILE] [--json FILE] [--csv FILE]
 
-Target (issue "the approximate side, made whole"): the default chain within 10 % of the exact ``slip_interval``
+Target (the library's accuracy goal for its namesake): the default chain within 10 % of the exact ``slip_interval``
 and ``force_drop`` on at least 90 % of the stick-slip points of a 40 x 40 grid over V in [0.2, 5] m/s and I in
 [1e-6, 1e-1] kg m^2 (log), the paper's law at the default k and R; at most 10 ms median per call.
 

@@ -25,7 +25,7 @@ from .law import LAW_KEYS, law_fields, point_law
 from .measures import MEASURES, Measure, _ref, record_key
 from .store import RESERVED
 
-__all__ = ["NOT_RUN", "PARAM_OPTIONS", "run_point", "make_params", "worker_refs"]
+__all__ = ["NOT_RUN", "PARAM_OPTIONS", "import_ref", "run_point", "make_params", "worker_refs"]
 
 #: The status of a point the sweep's wall-clock budget left out or cut (module docstring): never recorded.
 NOT_RUN = "not run: max_wall"
@@ -36,7 +36,9 @@ NOT_RUN = "not run: max_wall"
 PARAM_OPTIONS = ("k", "R", "l", "geometry", "tape_mass", "loading", "load_mass", "load")
 
 
-def _import_ref(ref: str) -> Callable:
+def import_ref(ref: str) -> Any:
+    """The object an import reference ``"module:qualname"`` names (a module-level function the workers import;
+    the reference comes from this process's registries, never from a file)."""
     mod, _, qual = ref.partition(":")
     obj: Any = importlib.import_module(mod)
     for part in qual.split("."):
@@ -61,7 +63,7 @@ def _resolve(name: str, ref: None | str | bytes) -> Measure:
         if fn is not None and _ref(fn) == ref:
             return fn
         try:
-            return _import_ref(ref)
+            return import_ref(ref)
         except Exception:
             pass
     if name in MEASURES:
@@ -160,7 +162,7 @@ def _importable(fn: Callable) -> bool:
     if mod in ("__main__", "__mp_main__", "?") or "<" in qual:
         return False
     try:
-        return _import_ref(_ref(fn)) is fn
+        return import_ref(_ref(fn)) is fn
     except Exception:
         return False
 

@@ -11,11 +11,13 @@ the run, not after it, when that name cannot be written, and
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import re
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
 
 from .. import validate as _validate
 from .._checks import SHOWN_LIMIT
@@ -286,6 +288,40 @@ def connect_dask_scheduler(address: str):
 #: Longest message :func:`one_line` prints [characters]: ten lines of a wide terminal.
 MESSAGE_LIMIT = 2000
 
+
+
+@contextlib.contextmanager
+def worker_pool(args: argparse.Namespace) -> Iterator[tuple[Any, int | None]]:
+    """``(executor, max_workers)`` of a grid command's ``--workers``, ``--dask-local`` and ``--dask-scheduler``
+    (sweep, atlas): a dask client's executor, or None and ``--workers`` (0: in this process); the dask client
+    and local cluster are closed on exit.
+
+    Raises
+    ------
+    ValueError
+        A dask option without dask.distributed installed.
+    """
+    if not (args.dask_local or args.dask_scheduler):
+        yield None, args.workers
+        return
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise ValueError("--dask-local/--dask-scheduler need dask.distributed: pip install "
+                         "'peelapprox[distributed]'") from None
+    cluster = None
+    if args.dask_local:
+        cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
+        client = Client(cluster)
+    else:
+        client = connect_dask_scheduler(args.dask_scheduler)
+    print(f"dask: {client}", file=sys.stderr)
+    try:
+        yield client.get_executor(), None
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 def clip(text: str, limit: int = SHOWN_LIMIT) -> str:
     """``text`` with every run of more than ``limit`` non-blank characters cut as :func:`peelapprox.validate.shown`

@@ -9,7 +9,7 @@ import sys
 import time
 
 from .. import GEOMETRIES
-from ._checks import check_output_path, connect_dask_scheduler, nonnegative_int, positive_int
+from ._checks import check_output_path, nonnegative_int, positive_int, worker_pool
 from ._common import FORMATS, add_max_wall_option, subcommand
 from ._force import add_force_options, force_from_args
 
@@ -124,36 +124,15 @@ def run(args: argparse.Namespace) -> int:
     if not args.out:
         raise ValueError("--out DIR is required (the atlas's records, tables and maps go there), unless --cost")
     check_output_path(args.out, "dir", "--out", read_only_ok=True)
-    client = cluster = None
-    executor, max_workers = None, None
-    if args.dask_local or args.dask_scheduler:
-        try:
-            from distributed import Client, LocalCluster
-        except ImportError:
-            print("error: --dask-local/--dask-scheduler need dask.distributed: pip install 'peelapprox[distributed]'",
-                  file=sys.stderr)
-            return 2
-        if args.dask_local:
-            cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
-            client = Client(cluster)
-        else:
-            client = connect_dask_scheduler(args.dask_scheduler)
-        executor = client.get_executor()
-    else:
-        max_workers = args.workers
     t0 = time.perf_counter()
     try:
-        result = atlas(I_values, V_values, out=args.out, approximations=approximations, force=force, options=options,
-                       executor=executor, max_workers=max_workers, progress=not args.quiet,
-                       retry_failed=args.retry_failed, max_wall=args.max_wall, **model)
+        with worker_pool(args) as (executor, max_workers):
+            result = atlas(I_values, V_values, out=args.out, approximations=approximations, force=force,
+                           options=options, executor=executor, max_workers=max_workers, progress=not args.quiet,
+                           retry_failed=args.retry_failed, max_wall=args.max_wall, **model)
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3
-    finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
     print(f"atlas: {len(result.sweep.records)} points in {args.out} ({time.perf_counter() - t0:.1f} s)"
           + (f"; skipped (not importable yet): {', '.join(result.skipped)}" if result.skipped else ""),
           file=sys.stderr)

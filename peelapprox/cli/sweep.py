@@ -9,7 +9,7 @@ import sys
 import time
 
 from .. import GEOMETRIES
-from ._checks import check_output_path, check_sweep_plot_key, connect_dask_scheduler, nonnegative_int, positive_int
+from ._checks import check_output_path, check_sweep_plot_key, nonnegative_int, positive_int, worker_pool
 from ._common import add_max_wall_option, add_variant_options, subcommand
 from ._force import add_force_options, force_from_args
 
@@ -147,37 +147,15 @@ def run(args: argparse.Namespace) -> int:
         prev = load_sweep(args.out)
         print(f"{args.out} holds a sweep with {len(prev.records)}/{prev.I_values.size * prev.V_values.size} points "
               "done: resuming it if grid, measures and options match", file=sys.stderr)
-    client = cluster = None
-    executor, max_workers = None, None
-    if args.dask_local or args.dask_scheduler:
-        try:
-            from distributed import Client, LocalCluster
-        except ImportError:
-            print("error: --dask-local/--dask-scheduler need dask.distributed: pip install 'peelapprox[distributed]'",
-                  file=sys.stderr)
-            return 2
-        if args.dask_local:
-            cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, dashboard_address=None)
-            client = Client(cluster)
-        else:
-            client = connect_dask_scheduler(args.dask_scheduler)
-        print(f"dask: {client}", file=sys.stderr)
-        executor = client.get_executor()
-    else:
-        max_workers = args.workers  # 0: in this process
     t0 = time.perf_counter()
     try:
-        result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor, max_workers=max_workers,
-                       options=options, progress=not args.quiet, retry_failed=args.retry_failed, force=force,
-                       coef=coef, max_wall=args.max_wall)
+        with worker_pool(args) as (executor, max_workers):
+            result = sweep(I_values, V_values, args.measure, out=args.out, executor=executor,
+                           max_workers=max_workers, options=options, progress=not args.quiet,
+                           retry_failed=args.retry_failed, force=force, coef=coef, max_wall=args.max_wall)
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3
-    finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
     print(f"sweep: {len(result.records)} points in {args.out}/{RESULTS} ({time.perf_counter() - t0:.1f} s)",
           file=sys.stderr)
     csv_path = os.path.join(args.out, "results.csv")
