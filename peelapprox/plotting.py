@@ -16,8 +16,8 @@ from typing import Any, cast
 
 import numpy as np
 
-__all__ = ["new_figure", "plot_bifurcation", "plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot",
-           "TRAJECTORY_CYCLES"]
+__all__ = ["cell_edges", "new_figure", "plot_bifurcation", "plot_phase_diagram", "plot_segment", "plot_trajectory",
+           "pyplot", "TRAJECTORY_CYCLES"]
 
 #: The stick-slip cycles (AB→CD jump to AB→CD jump) :func:`plot_trajectory` shows by default: the last ones.
 TRAJECTORY_CYCLES = 5
@@ -234,6 +234,19 @@ def plot_segment(seg: Any, path: str | None = None, *, exact: Any = None, title:
     return fig
 
 
+def cell_edges(x: np.ndarray, log: bool = False) -> np.ndarray:
+    """Cell edges around increasing grid values ``x`` for ``pcolormesh``: the midpoints (of log10 x if ``log``),
+    the outer edges mirrored; one value gets a cell of half a decade (``log``) or 10 % of it either side."""
+    y = np.log10(x) if log else np.asarray(x, float)
+    if y.size == 1:
+        h = 0.5 if log else max(0.1 * abs(y[0]), 1e-12)
+        e = np.array([y[0] - h, y[0] + h])
+    else:
+        mid = 0.5 * (y[1:] + y[:-1])
+        e = np.concatenate([[2 * y[0] - mid[0]], mid, [2 * y[-1] - mid[-1]]])
+    return 10.0 ** e if log else e
+
+
 def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I: bool = True,
                        log_V: bool = False, title: str | None = None, ax: Any = None, fig: Any = None):
     """A sweep quantity over the (V, I) plane, one cell per grid point (pcolormesh).
@@ -273,17 +286,7 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
     oi, ov = np.argsort(I), np.argsort(V)
     I, V, vals = I[oi], V[ov], vals[np.ix_(oi, ov)]
 
-    def edges(x: np.ndarray, log: bool) -> np.ndarray:
-        y = np.log10(x) if log else x
-        if y.size == 1:
-            h = 0.5 if log else max(0.1 * abs(y[0]), 1e-12)
-            e = np.array([y[0] - h, y[0] + h])
-        else:
-            mid = 0.5 * (y[1:] + y[:-1])
-            e = np.concatenate([[2 * y[0] - mid[0]], mid, [2 * y[-1] - mid[-1]]])
-        return 10.0 ** e if log else e
-
-    VE, IE = edges(V, log_V), edges(I, log_I)
+    VE, IE = cell_edges(V, log_V), cell_edges(I, log_I)
     fig, axs = _canvas(ax, fig, (1, 1), (8, 5.5))
     ax = axs[0, 0]
     if vals.dtype == object:

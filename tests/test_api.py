@@ -56,7 +56,7 @@ API = {
     },
     "peelapprox.io": {"TABLE_EXTENSIONS", "ProgressLine", "fmt_number", "html_table", "jsonable", "optional_import",
                       "param_attrs", "write_csv", "write_rows"},
-    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "new_figure", "plot_bifurcation", "plot_phase_diagram",
+    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot"},
     "comparisons.atlas": {
         "atlas", "AtlasResult", "load_atlas", "APPROXIMATIONS", "register_approximation", "OBSERVABLES", "DEFAULTS",

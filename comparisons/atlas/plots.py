@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox.plotting import new_figure
+from peelapprox.plotting import cell_edges, new_figure
 
 from .approximations import OBSERVABLES, TOLERANCE, key_of
 
@@ -44,18 +44,6 @@ def class_group(cls: str) -> str:
         n = int(cls.split("-", 1)[1])
         return f"period-{n}" if n <= 3 else ("period 4-8" if n <= 8 else "period 9-32")
     return cls if cls in CLASS_GROUPS else "failed"
-
-
-def _edges(x: np.ndarray, log: bool) -> np.ndarray:
-    """Cell edges around grid values: midpoints (on a log scale if ``log``), the outer ones mirrored."""
-    y = np.log10(x) if log else x
-    if y.size == 1:
-        h = 0.5 if log else max(0.1 * abs(y[0]), 1e-12)
-        e = np.array([y[0] - h, y[0] + h])
-    else:
-        mid = 0.5 * (y[1:] + y[:-1])
-        e = np.concatenate([[2 * y[0] - mid[0]], mid, [2 * y[-1] - mid[-1]]])
-    return 10.0 ** e if log else e
 
 
 def _sorted(result: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -142,7 +130,7 @@ def plot_error_map(result: Any, name: str, observable: str, path: str | None = N
     V, I, oi, ov = _sorted(result)
     err, why = err[np.ix_(oi, ov)], why[np.ix_(oi, ov)]
     fig, ax = _axes(ax, fig, (7.5, 5.0))
-    VE, IE = _edges(V, False), _edges(I, True)
+    VE, IE = cell_edges(V, False), cell_edges(I, True)
     codes = np.ma.masked_all(why.shape)
     legend: list[Any] = []
     for n, (prefix, text, colour) in enumerate(_UNDEFINED):
@@ -190,7 +178,7 @@ def plot_dynamics_map(result: Any, path: str | None = None, *, regimes: bool = T
     classes = result.exact_class()[np.ix_(oi, ov)]
     groups = np.array([CLASS_GROUPS.index(class_group(str(c))) for c in classes.ravel()]).reshape(classes.shape)
     fig, ax = _axes(ax, fig, (8.5, 5.5))
-    VE, IE = _edges(V, False), _edges(I, True)
+    VE, IE = cell_edges(V, False), cell_edges(I, True)
     ax.pcolormesh(VE, IE, groups, cmap=ListedColormap(_GROUP_COLOURS), vmin=-0.5, vmax=len(CLASS_GROUPS) - 0.5,
                   edgecolors="face")
     present = sorted(set(groups.ravel().tolist()))
@@ -240,7 +228,7 @@ def plot_segment_maps(result: Any, stat: str = "dt_median", path: str | None = N
     ncol = max((len(r) for r in rows), default=1)
     fig = fig if fig is not None else new_figure(figsize=(3.3 * ncol + 1.2, 3.0 * max(len(rows), 1) + 0.6))
     V, I, oi, ov = _sorted(result)
-    VE, IE = _edges(V, False), _edges(I, True)
+    VE, IE = cell_edges(V, False), cell_edges(I, True)
     mesh = None
     axes = []
     for r, reds in enumerate(rows):
