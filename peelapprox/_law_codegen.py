@@ -32,14 +32,10 @@ import it.
 
 from __future__ import annotations
 
-import atexit
 import hashlib
 import os
 import re
-import shutil
-import stat
 import sys
-import tempfile
 import types
 import warnings
 from collections.abc import Callable, Sequence
@@ -50,8 +46,9 @@ import numpy as np
 
 from ._checks import shown
 from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
-from ._jit import kernel, unsafe_dir
+from ._jit import kernel
 from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
+from ._law_cache import cache_dir, law_dir, read_verified, write_atomic
 from .errors import KernelCacheWarning
 
 __all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "expression_source",
@@ -351,81 +348,6 @@ def codegen_version() -> str:
     return f"{CODEGEN_VERSION}-{h.hexdigest()[:12]}"
 
 
-def cache_dir() -> Path:
-    """Where expression laws are written: ``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``."""
-    env = os.environ.get("PEELAPPROX_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "peelapprox" / "laws"
-
-
-#: The largest law module read back from the cache [bytes] (a rendered law is a few kB).
-MAX_MODULE_BYTES = 1 << 20
-
-
-def numba_cache_dir() -> Path:
-    """The directory numba's caches of this process go to when ``NUMBA_CACHE_DIR`` is set (its pickled index
-    and data files are loaded by numba: it must be as private as the law cache), else the law cache's
-    ``__pycache__``."""
-    import numba
-
-    env = getattr(numba.config, "CACHE_DIR", "") or ""
-    return Path(env) if env else cache_dir() / "__pycache__"
-
-
-_FALLBACK: dict[str, Path] = {}
-
-
-def _law_dir() -> Path:
-    """The verified cache directory (:func:`cache_dir` and its ``__pycache__``, where numba writes), else a
-    private temporary one for this process, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why."""
-    d = cache_dir()
-    why = unsafe_dir(d)
-    if why is None:  # numba's cache files (pickles it loads) go to __pycache__ beside the module, or NUMBA_CACHE_DIR
-        nb = numba_cache_dir()
-        why = unsafe_dir(nb)
-        if why is not None:
-            why = (f"has a __pycache__ that {why}" if nb == d / "__pycache__" else
-                   f"is fine, but NUMBA_CACHE_DIR={str(nb)!r}, where numba keeps the compiled laws, {why}")
-    if why is None:
-        return d
-    if "dir" not in _FALLBACK:
-        _FALLBACK["dir"] = Path(tempfile.mkdtemp(prefix="peelapprox-laws-"))  # mode 0700, new
-        atexit.register(shutil.rmtree, _FALLBACK["dir"], ignore_errors=True)
-        warnings.warn(f"peelapprox: the law cache directory {str(d)!r} {why}; expression laws are written to "
-                      f"{str(_FALLBACK['dir'])!r} for this process only (set PEELAPPROX_CACHE_DIR to a directory of "
-                      "yours that only you can write to keep them compiled across processes)",
-                      KernelCacheWarning, stacklevel=3)
-    return _FALLBACK["dir"]
-
-
-def _read_verified(path: Path) -> bytes | None:
-    """The bytes of the law module at ``path`` if it is a regular file of this user's that no one else can write
-    (never through a symbolic link: ``O_NOFOLLOW``), else None."""
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
-    except OSError:
-        return None
-    with os.fdopen(fd, "rb") as fh:
-        st = os.fstat(fh.fileno())
-        if (not stat.S_ISREG(st.st_mode) or st.st_mode & 0o022 or st.st_size > MAX_MODULE_BYTES
-                or (hasattr(os, "geteuid") and st.st_uid != os.geteuid())):
-            return None
-        return fh.read(MAX_MODULE_BYTES + 1)
-
-
-def _write_atomic(d: Path, path: Path, text: bytes) -> None:
-    """Write ``text`` to ``path`` by a new file renamed over it (a link or a planted file is replaced, not
-    followed)."""
-    fd, tmp = tempfile.mkstemp(dir=d, prefix=f".{path.stem}-", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def expression_source(source: str) -> str:
     """The module text of the expression law with canonical text ``source`` (see _law_expr; parsed, never
     evaluated)."""
@@ -493,17 +415,17 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
 def _build_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     """:func:`expression_kernel`'s work: render, verify or write the module, compile."""
     digest = hashlib.sha256(f"{source}\0{codegen_version()}".encode()).hexdigest()
-    d = _law_dir()
+    d = law_dir()
     path = d / f"law_{digest[:32]}.py"
     text = expression_source(source).encode()
-    on_disk = _read_verified(path)
+    on_disk = read_verified(path)
     if on_disk != text:  # missing, or planted/replaced/truncated: written anew (a changed time stamp is a numba miss)
         if on_disk is not None or os.path.lexists(path):
             warnings.warn(f"peelapprox: the cached law module {str(path)!r} did not match the law it is named after "
                           "(replaced, truncated or not a regular file of yours); it is written anew",
                           KernelCacheWarning, stacklevel=2)
             Path(path).unlink(missing_ok=True)
-        _write_atomic(d, path, text)
+        write_atomic(d, path, text)
     # the module is built from the text rendered here, not read back from the file (which only names it for numba's
     # on-disk cache, in the verified directory): what runs is what this process generated from the law
     modname = f"peelapprox_law_{digest[:32]}"

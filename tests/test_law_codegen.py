@@ -28,6 +28,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+import peelapprox._law_cache as LC
 import peelapprox._law_codegen as C
 from peelapprox import PeelForce
 from peelapprox._law_abi import LAW_FP, LAW_FPP, LAW_LNV, paper_coefficients, paper_law
@@ -249,7 +250,7 @@ def law_cache(tmp_path, monkeypatch):
     """A fresh expression-law cache directory and an empty per-process memo."""
     monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(tmp_path / "laws"))
     monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
-    monkeypatch.setattr(C, "_FALLBACK", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
     return tmp_path / "laws"
 
 

@@ -25,6 +25,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from peelapprox import PeelForce, PeelParams
+from peelapprox import _law_cache as LC
 from peelapprox import _law_codegen as C
 from peelapprox import _law_grammar as G
 from peelapprox.cli import main as cli_main
@@ -280,7 +281,7 @@ def law_dir(tmp_path, monkeypatch):
     d = tmp_path / "laws"
     monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(d))
     monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
-    monkeypatch.setattr(C, "_FALLBACK", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
     return d
 
 
@@ -343,11 +344,11 @@ def test_a_symlinked_cache_directory_is_not_used(tmp_path, monkeypatch):
     link.symlink_to(real)
     monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(link))
     monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
-    monkeypatch.setattr(C, "_FALLBACK", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
     with pytest.warns(KernelCacheWarning, match="symbolic link"):
         _check_law(PeelForce.expression(_LAW))
     assert list(real.iterdir()) == []
-    assert stat.S_IMODE(os.stat(C._FALLBACK["dir"]).st_mode) == 0o700
+    assert stat.S_IMODE(os.stat(LC._FALLBACK["dir"]).st_mode) == 0o700
 
 
 @pytest.mark.parametrize("mode", [0o777, 0o775])
@@ -359,7 +360,7 @@ def test_a_directory_others_can_write_is_not_used(tmp_path, monkeypatch, mode):
     os.chmod(d, mode)
     monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(d))
     monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
-    monkeypatch.setattr(C, "_FALLBACK", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
     with pytest.warns(KernelCacheWarning, match="writable by"):
         _check_law(PeelForce.expression(_LAW))
     assert list(d.iterdir()) == []
@@ -373,7 +374,7 @@ def test_a_parent_others_can_write_is_refused(tmp_path, monkeypatch):
     os.chmod(parent, 0o777)
     monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(parent / "laws"))
     monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
-    monkeypatch.setattr(C, "_FALLBACK", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
     with pytest.warns(KernelCacheWarning, match="without the sticky bit"):
         _check_law(PeelForce.expression(_LAW))
 
