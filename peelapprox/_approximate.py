@@ -15,8 +15,10 @@ attractor:
 3. **CD**: the CD α model and v equation from ``v_land_cd`` until v falls to ``v_min``.
 4. **CD→AB jump**: likewise, ``α̇ → α̇ + (v_min - v_land_ab)/R``.
 
-The force at each jump and the jump times make the same jump record an exact trajectory has, and the observables
-are read off it by :func:`peelapprox._observables.jump_statistics`, the one definition both sides use.
+The map starts where the exact solver does, and again at rest on the relaxation cycle's foot where that start
+finds no periodic attractor (:func:`approximate_attractor`, "Start").  The force at each jump and the jump times
+make the same jump record an exact trajectory has, and the observables are read off it by
+:func:`peelapprox._observables.jump_statistics`, the one definition both sides use.
 """
 
 from __future__ import annotations
@@ -39,17 +41,22 @@ from .validate import choice, integer, optional, positive
 from .validate import params as _params
 from .validate import rtol as _rtol
 
-__all__ = ["APPROX_DEFAULTS", "EARLY_RETURNS", "PERIOD_RTOL", "SEGMENT_MAX_STEPS", "approximate_attractor",
+__all__ = ["APPROX_DEFAULTS", "EARLY_RETURNS", "PERIOD_RTOL", "SEGMENT_MAX_STEPS", "STARTS", "approximate_attractor",
            "default_models"]
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
 #: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``; the table and its reasons are in
 #: the docstring of :func:`approximate_attractor`.
 APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
-    "low": (("approxalpha", "approxvdot"), ("airy2", "approxvdot")),
+    "low": (("airy1", "approxvdot"), ("airy1", "approxvdot")),
     "intermediate": (("airy1", "approxvdot"), ("airy1", "approxvdot")),
     "high": (("airy1", "approxvdot"), ("airy1", "approxvdot")),
 }
+
+#: Where the map starts (``start=``): ``"solver"``, the exact solver's default start; ``"rest"``, the foot of the
+#: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, the solver's start and, where that
+#: reaches no periodic attractor, the rest start (:func:`approximate_attractor`).
+STARTS = ("auto", "solver", "rest")
 
 #: The map stops early once its last ``max(EARLY_RETURNS, 3 n)`` returns repeat with a period n <= 12 to the
 #: period tolerance (:data:`PERIOD_RTOL`) and their mismatch is not growing: a periodic attractor has then been
@@ -82,6 +89,7 @@ def approximate_attractor(
     v_equation: str | None = None,
     cd_alpha_model: str | None = None,
     cd_v_equation: str | None = None,
+    start: str = "auto",
     n_transient: int = 40,
     n_returns: int = 60,
     rtol: float = 1e-6,
@@ -90,32 +98,29 @@ def approximate_attractor(
     """The stick-slip attractor predicted by the paper's reduced branch-wise equations, without the DAE.
 
     Iterates the reduced return map (module docstring: AB segment to the fold, jump, CD segment to the fold,
-    jump) from the exact solver's default start (:func:`exact.initial_state`: ``α = 0``, ``ω = V/R``,
-    ``F = 1.01 f(V, V)``, v on the branch whose root is lowest) and reads the observables off its jumps with the
-    definitions of :class:`StickSlipObservables` (slip interval, force drop, slip and stick times, F at the jumps,
-    the return map's period).
+    jump) and reads the observables off its jumps with the definitions of :class:`StickSlipObservables` (slip
+    interval, force drop, slip and stick times, F at the jumps, the return map's period).
 
-    Defaults follow :func:`peelapprox.estimate`'s inertia label (:data:`peelapprox.INERTIA_RULE`,
-    ``r = T_mean/τ_CD``); the velocity label does not change them:
+    **Start** (``start="auto"``).  The map starts where :func:`exact.simulate` does (:func:`exact.initial_state`:
+    ``α = 0``, ``ω = V/R``, ``F = 1.01 f(V, V)``, v on the branch whose root is lowest).  That start gives α a
+    kick ``α̇ = (V - v)/R`` which, over much of the intermediate- and high-inertia plane, puts the map on a small
+    jumping mode around the unstable fixed point; the exact run leaves it after thousands of slips (tens of
+    seconds), the map within its budget often does not.  Where the map from the solver's start reaches no
+    periodic attractor, it is run again from the foot of the relaxation cycle at rest (AB landing, ``F = f_min``,
+    ``α = α̇ = 0``), which lands on the large orbit directly; that run is the prediction if it stick-slips.
+    ``"solver"`` and ``"rest"`` select one start; docs/theory.md, "The approximate attractor", has the measurements.
 
-    ============================  ============================  ============================  =================
-    estimate's label              AB                            CD                            paper, Sec. V
-    ============================  ============================  ============================  =================
-    low inertia (r < 1), any V    approxalpha + approxvdot      airy2 + approxvdot            Case I
-    intermediate (1 <= r < 5)     airy1 + approxvdot            airy1 + approxvdot            Airy1, Case III
-    high inertia (r >= 5)         airy1 + approxvdot            airy1 + approxvdot            Airy1, Case III
-    ============================  ============================  ============================  =================
-
-    Case I drops ``v̇/R`` from genalpha on AB (approxalpha); on CD Airy2 keeps its damping ``F α̇/(R f')``.  At
-    intermediate and high inertia the peel kinematics ``α̇ = ω - v/R`` (FLOW1) drives α on both branches and
-    approxalpha fails (docs/theory.md, "The approximate attractor": with approxalpha on AB and airy2 on CD, 7.5 %
-    of the high-inertia, low-V points of a 40 x 40 grid are within 10 % of the exact attractor, 56.5 % with Airy1):
-    the default there is Airy1 (genalpha1 with ``1 + α ≈ 1``, ``Ḟ ≈ k(V - v)``), the paper's general α equation;
-    with approxvdot it is the same field as genalpha + approxvdot, the paper's Case III.  It drops the O(α) terms
-    (the factor ``1 + α`` of fullvdot, ``R α α̇`` of FLOW3) but is not of lower order than the branch dynamics.
-    The paper's literal Case II (approxalpha on AB, airy2 on CD) is selectable and measured in
-    ``python -m comparisons.benchmark.approx_attractor``.  ``genalpha + fullvdot`` on both branches is the full
-    branch dynamics linearised in α: the chain's check against the exact attractor, never a default.
+    **Reductions.**  Airy1 + approxvdot on both branches (:data:`APPROX_DEFAULTS`, the same for every label of
+    :func:`peelapprox.estimate`'s inertia rule, chosen by measurement): Airy1 (genalpha with ``1 + α ≈ 1`` and
+    ``Ḟ ≈ k(V - v)``) is the paper's general α equation and, with approxvdot, the field of its Case III.  It keeps
+    FLOW1's kinematic term ``-v̇/R`` (``α̇ = ω - v/R``), large near the folds where ``f' → 0``, which approxalpha
+    drops and Airy2 keeps only in part; on a 40 x 40 grid of the paper's law it is within 10 % of the exact slip
+    interval and force drop at 94 % of the low-inertia, low-V points against 77 % for the paper's Case I
+    (approxalpha on AB, airy2 on CD).  It drops the O(α) terms (the factor ``1 + α`` of fullvdot, ``R α α̇`` of
+    FLOW3) but is not of lower order than the branch dynamics.  Every combination of :data:`ALPHA_MODELS` and
+    :data:`V_EQUATIONS` is selectable, the paper's literal Cases I-III among them (measured in ``python -m
+    comparisons.benchmark.approx_attractor``).  ``genalpha + fullvdot`` on both branches is the full branch
+    dynamics linearised in α: the chain's check against the exact attractor, never a default.
 
     Parameters
     ----------
@@ -127,6 +132,9 @@ def approximate_attractor(
         None: the regime's (table).
     cd_alpha_model, cd_v_equation : str, optional
         CD's; None: the regime's.  Each None is filled independently.
+    start : {"auto", "solver", "rest"}
+        Where the map starts (:data:`STARTS`; above): ``"auto"`` the solver's start, then the rest start where
+        that reaches no periodic attractor.
     n_transient : int
         Returns (AB→CD jumps) discarded before the sample, an integer in [0, 10**6] (40).
     n_returns : int
@@ -144,9 +152,10 @@ def approximate_attractor(
     Returns
     -------
     StickSlipObservables
-        ``method`` names the chain, e.g. ``"approximate: AB approxalpha/approxvdot, CD airy2/approxvdot, 60
-        returns after 40, rtol 1e-06"`` (or ``"..., period-3 reached after 17 returns, ..."`` when it stopped
-        early); ``t_start``/``t_end`` are the sample's first and last jump times on the map's own clock
+        ``method`` names the chain and the start, e.g. ``"approximate: AB airy1/approxvdot, CD airy1/approxvdot,
+        solver's start, 60 returns after 40, rtol 1e-06"`` (``"..., period-3 reached after 17 returns, ..."`` when
+        it stopped early; ``"rest start (the solver's: no periodic attractor in 100 returns), ..."`` when ``auto``
+        took the second start); ``t_start``/``t_end`` are the sample's first and last jump times on the map's own clock
         (0 at the start).  ``status`` is
 
         * ``"stick-slip"``: the sample's observables;
@@ -175,6 +184,7 @@ def approximate_attractor(
               optional(choice, "cd_v_equation", cd_v_equation, V_EQUATIONS))
     n_transient = integer("n_transient", n_transient, lo=0, hi=10**6)
     n_returns = integer("n_returns", n_returns, lo=3, hi=10**6)
+    start = choice("start", start, STARTS)
     rtol = _rtol("rtol", rtol)
     max_wall = optional(positive, "max_wall", max_wall)
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
@@ -194,8 +204,18 @@ def approximate_attractor(
         return StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
                                              reason=f"a jump has no landing on {which}: no return map")
     assert bs.v_max is not None and bs.v_min is not None  # has_folds
-    return _iterate(params, law, (ab_am, ab_ve), (cd_am, cd_ve), n_transient, n_returns, rtol, max_wall, t_wall,
-                    chain, common)
+    models = ((ab_am, ab_ve), (cd_am, cd_ve))
+    if start == "rest":
+        return _iterate(params, law, models, _rest(law), n_transient, n_returns, rtol, max_wall, t_wall,
+                        f"{chain}, rest start", common)[0]
+    first, periodic = _iterate(params, law, models, _solver_start(params, law), n_transient, n_returns, rtol,
+                               max_wall, t_wall, f"{chain}, solver's start", common)
+    if start == "solver" or first.status != "stick-slip" or periodic:
+        return first
+    second, _ = _iterate(params, law, models, _rest(law), n_transient, n_returns, rtol, max_wall, t_wall,
+                         f"{chain}, rest start (the solver's: no periodic attractor in {n_transient + n_returns} "
+                         "returns)", common)
+    return second if second.status == "stick-slip" else first
 
 
 def _plan(params: PeelParams, law: Any, branch: str, v_in: float, models: tuple[str, str], rtol: float
@@ -206,12 +226,23 @@ def _plan(params: PeelParams, law: Any, branch: str, v_in: float, models: tuple[
                         max_steps=SEGMENT_MAX_STEPS)
 
 
-def _start(params: PeelParams, law: Any) -> tuple[int, float, float]:
-    """``(branch code, F, v)`` of the exact solver's default start (:func:`exact.initial_state`, α = 0): F = 1.01
+#: A start of the map: ``(branch code (0 AB, 1 CD), F, v, α, α̇)``.
+Start = tuple[int, float, float, float, float]
+
+
+def _rest(law: Any) -> Start:
+    """The foot of the relaxation cycle at rest: the AB landing ``v_land_ab`` with ``F = f_min``, ``α = α̇ = 0``."""
+    bs = law.structure
+    return 0, float(bs.f_min), float(bs.v_land_ab), 0.0, 0.0
+
+
+def _solver_start(params: PeelParams, law: Any) -> Start:
+    """The exact solver's default start (:func:`exact.initial_state`, α = 0, ω = V/R so α̇ = (V - v)/R): F = 1.01
     f(V, V) on the branch with the lowest root; the AB landing with F = f_min where f(V) is outside the law's
     domain or the level has no root."""
     bs = law.structure
     lo, hi = law.domain
+    kick = lambda v: (params.V - v) / params.R  # noqa: E731
     if lo <= params.V <= hi:
         F = 1.01 * law.f(params.V)
         for code, branch in enumerate(("AB", "CD")):
@@ -222,26 +253,28 @@ def _start(params: PeelParams, law: Any) -> tuple[int, float, float]:
                     break
                 lo_b, hi_b = bs.branch_range(branch)
                 if lo_b < v < hi_b:
-                    return code, F, v
+                    return code, F, v, 0.0, kick(v)
                 break
-    return 0, float(bs.f_min), float(bs.v_land_ab)
+    return 0, float(bs.f_min), float(bs.v_land_ab), 0.0, kick(float(bs.v_land_ab))
 
 
-def _iterate(params: PeelParams, law: Any, ab: tuple[str, str], cd: tuple[str, str], n_transient: int,
-             n_returns: int, rtol: float, max_wall: float | None, t_wall: float, chain: str,
-             common: dict[str, Any]) -> StickSlipObservables:
-    """Iterate the map (module docstring) and read its sample's observables."""
+def _iterate(params: PeelParams, law: Any, models: tuple[tuple[str, str], tuple[str, str]], start: Start,
+             n_transient: int, n_returns: int, rtol: float, max_wall: float | None, t_wall: float, chain: str,
+             common: dict[str, Any]) -> tuple[StickSlipObservables, bool]:
+    """Iterate the map (module docstring) from ``start``: its sample's observables, and whether it stopped early
+    on a periodic attractor."""
+    ab, cd = models
     bs = law.structure
     R = params.R
     plans = (_plan(params, law, "AB", bs.v_land_ab, ab, rtol), _plan(params, law, "CD", bs.v_land_cd, cd, rtol))
     # the jump of ω-continuity: α̇ after = α̇ before + (v before - v after)/R
     kick = ((bs.v_max - bs.v_land_cd) / R, (bs.v_min - bs.v_land_ab) / R)
     closed = {AM_SIN, AM_HARM, AM_EXP, AM_STATIC}
-    branch, F, v0 = _start(params, law)
+    branch, F, v0, a, ad = start
+    t = 0.0
     first: SegmentPlan | None = None
     if v0 != plans[branch].v_in:
         first = _plan(params, law, ("AB", "CD")[branch], v0, (ab, cd)[branch], rtol)
-    a, ad, t = 0.0, params.V / R - v0 / R, 0.0
     jt: list[float] = []
     jF: list[float] = []
     jb: list[int] = []
@@ -256,7 +289,7 @@ def _iterate(params: PeelParams, law: Any, ab: tuple[str, str], cd: tuple[str, s
         first = None
         run = run_segment(plan, F, a, ad)
         if run.code != DONE:
-            return _failed(params, plan, run, len(returns), t, chain, common)
+            return _failed(params, plan, run, len(returns), t, chain, common), False
         y = run.y
         t += float(y[0])
         F = float(y[2])
@@ -277,7 +310,7 @@ def _iterate(params: PeelParams, law: Any, ab: tuple[str, str], cd: tuple[str, s
             return StickSlipObservables._no_slip(
                 status="no attractor", method=chain, **common,
                 reason=f"max_wall = {fmt_number(max_wall, 3)} s spent after {len(returns)} of the {total} returns "
-                       f"(n_transient + n_returns)")
+                       f"(n_transient + n_returns)"), False
     if sample_from is None:
         sample_from = ret_at[n_transient]
         how = f"{n_returns} returns after {n_transient}"
@@ -290,7 +323,7 @@ def _iterate(params: PeelParams, law: Any, ab: tuple[str, str], cd: tuple[str, s
     common = {**common, "t_start": float(T[0]), "t_end": float(T[-1])}
     reason = (f"{stats['n_slips']} slips of the reduced return map ({how}), return map {stats['period_label']}"
               + (f"; means over the last {cycles} whole cycles" if cycles is not None else ""))
-    return StickSlipObservables(status="stick-slip", reason=reason, method=method, **stats, **common)
+    return StickSlipObservables(status="stick-slip", reason=reason, method=method, **stats, **common), early[0] > 0
 
 
 def _repeats(x: list[float], tol: float) -> int | None:

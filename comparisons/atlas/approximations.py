@@ -92,6 +92,13 @@ def estimate_observables(params: PeelParams) -> dict:
 APPROXIMATIONS: dict[str, Entry] = {
     "estimate": estimate_observables,
     "approx:default": "peelapprox:approximate_attractor",
+    # the same reductions from the exact solver's start only: what the default's second start buys
+    "approx:solver": ("peelapprox:approximate_attractor", {"start": "solver"}),
+    # the paper's Case I (approxalpha on AB, airy2 on CD) everywhere
+    "approx:caseI": ("peelapprox:approximate_attractor", {"alpha_model": "approxalpha", "cd_alpha_model": "airy2"}),
+    # the full branch dynamics linearised in alpha: the chain's check, not a prediction
+    "approx:check": ("peelapprox:approximate_attractor", {"alpha_model": "genalpha", "v_equation": "fullvdot",
+                                                          "cd_alpha_model": "genalpha", "cd_v_equation": "fullvdot"}),
 }
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_:.+-]*$")

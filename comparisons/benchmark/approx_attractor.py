@@ -11,11 +11,14 @@ At every grid point, in one process: :func:`exact.attractor_observables` (its de
 window, rtol 1e-10; a breakdown of the exact run is recorded as its status), :func:`peelapprox.estimate`'s
 regime label, and each chain of ``--chains``:
 
-* ``default``: ``approximate_attractor(p)``, the regime's reductions;
+* ``default``: ``approximate_attractor(p)``, its default reductions and start;
+* ``solver``: the default reductions from the solver's start only (``start="solver"``);
 * ``paper``: the paper's Sec. V prescriptions taken literally: Case I and II (low V) approxalpha + approxvdot on
   AB, airy2 + approxvdot on CD; Case III (high V at intermediate or high inertia) genalpha + approxvdot on both;
-* ``check``: genalpha + fullvdot on both branches, the full branch dynamics linearised in α (not a prediction);
-* ``airy1``: airy1 + approxvdot on both branches at every point.
+* ``caseI``: approxalpha + approxvdot on AB, airy2 + approxvdot on CD at every point (the paper's Case I);
+* ``check``: genalpha + fullvdot on both branches, the full branch dynamics linearised in α (not a prediction).
+
+Every chain but ``solver`` uses the default start (``"auto"``).
 
 Timing: each chain's call is repeated ``--repeats`` times after one untimed call, the median per point; the
 table gives the median and 90th percentile of those over the exact stick-slip points.  A point counts as within
@@ -61,16 +64,16 @@ CHAINS = {
     "paper": _paper,
     "check": lambda p, label: dict(alpha_model="genalpha", v_equation="fullvdot", cd_alpha_model="genalpha",
                                    cd_v_equation="fullvdot"),
-    "airy1": lambda p, label: dict(alpha_model="airy1", v_equation="approxvdot", cd_alpha_model="airy1",
-                                   cd_v_equation="approxvdot"),
+    "solver": lambda p, label: dict(start="solver"),
+    "caseI": lambda p, label: _PAPER_LOW_V,
 }
 _OBS = ("slip_interval", "force_drop", "slip_time", "stick_time", "F_max", "F_min")
 
 
-def _exact_row(p: PeelParams) -> dict[str, Any]:
+def _exact_row(p: PeelParams, t_transient: float) -> dict[str, Any]:
     t0 = time.perf_counter()
     try:
-        o = exact.attractor_observables(p, max_wall=300.0)
+        o = exact.attractor_observables(p, t_transient=t_transient, max_wall=300.0)
         row = {"status": o.status, "period": o.period_label, **{k: getattr(o, k) for k in _OBS}}
     except (ModelBreakdown, SolverBudgetExceeded) as exc:
         row = {"status": f"exact {type(exc).__name__}", "period": None, **dict.fromkeys(_OBS)}
@@ -143,6 +146,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--I", default="1e-6:1e-1:8:log", help="moments of inertia [kg m^2], start:stop:num:log")
     ap.add_argument("--chains", default="default,paper,check", help=f"comma list of {', '.join(CHAINS)}")
     ap.add_argument("--repeats", type=int, default=3, help="timed calls per chain and point (after one untimed)")
+    ap.add_argument("--t-transient", type=float, default=30.0,
+                    help="the exact run's transient [s] before its 20 s window (default 30, attractor_observables')")
     ap.add_argument("--exact-json", help="reuse the exact rows of an earlier --json of the same grid")
     ap.add_argument("--json", help="write every point's rows and the summary as JSON")
     ap.add_argument("--csv", help="write the summary table as CSV")
@@ -154,6 +159,8 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"--chains: unknown chain {c!r}, choose from {', '.join(CHAINS)}")
     if args.repeats < 1:
         ap.error("--repeats must be >= 1")
+    if not 0.0 <= args.t_transient <= 1e4:
+        ap.error("--t-transient must be in [0, 1e4] s")
     cached: dict[str, dict] = {}
     if args.exact_json:
         with open(args.exact_json) as fh:
@@ -165,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
         p = PeelParams(V=V, I=I)
         e = estimate(p)
         row: dict[str, Any] = {"V": V, "I": I, "regime": e.label,
-                               "exact": cached.get(f"{V!r},{I!r}") or _exact_row(p)}
+                               "exact": cached.get(f"{V!r},{I!r}") or _exact_row(p, args.t_transient)}
         for c in chains:
             row[c] = _chain_row(p, CHAINS[c](p, (e.inertia, e.velocity)), args.repeats)
         rows.append(row)
