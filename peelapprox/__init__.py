@@ -47,7 +47,8 @@ from ._estimate import (
     slope_criterion,
 )
 from ._observables import StickSlipObservables
-from ._params import (
+from ._params import PeelParams
+from ._ranges import (
     EPS_DEFAULT,
     EPS_RANGE,
     GEOMETRIES,
@@ -63,7 +64,6 @@ from ._params import (
     TAPE_MASS_RANGE,
     TIME_MAX,
     WINDOW_DEFAULTS,
-    PeelParams,
 )
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment

@@ -49,7 +49,8 @@ import numpy as np
 from scipy import integrate, special
 
 from ._jit import jitable
-from ._params import TIME_MAX, PeelParams
+from ._params import PeelParams
+from ._ranges import TIME_MAX
 from .errors import SolverFailure
 from .law import branch_structure
 from .validate import choice, in_range, optional, state, states, times

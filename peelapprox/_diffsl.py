@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._params import GEOMETRIES
+from ._ranges import GEOMETRIES
 from .io import optional_import
 from .law import PeelForce, branch_structure
 

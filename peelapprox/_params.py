@@ -6,30 +6,20 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ._checks import ArgumentTypeError, _got, choice, in_range, interval
-from ._ranges import (  # offered here too, with PeelParams
-    EPS_DEFAULT,
-    EPS_RANGE,
+from ._ranges import (
     GEOMETRIES,
     GRAVITY,
     L_OVER_R_MIN,
     LOAD_MASS_RANGE,
     LOAD_RANGE,
     LOADINGS,
-    LYAPUNOV_TAU,
     PARAM_RANGES,
-    RTOL_RANGE,
-    STATE_RANGES,
-    T_TRANSIENT,
     TAPE_MASS_RANGE,
-    TIME_MAX,
-    WINDOW_DEFAULTS,
     default_load_masses,
 )
 from .law import PeelForce
 
-__all__ = ["EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE", "LOAD_MASS_RANGE",
-           "LOAD_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
-           "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
+__all__ = ["PeelParams"]
 
 _VARIANT_DEFAULTS = {"tape_mass": None, "loading": "velocity", "load_mass": None, "load": None}
 

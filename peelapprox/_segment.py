@@ -69,7 +69,8 @@ from numba.experimental.function_type import _get_wrapper_address as _wrapper_ad
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, _wkb_match
 from ._packing import model_block
-from ._params import TIME_MAX, PeelParams
+from ._params import PeelParams
+from ._ranges import TIME_MAX
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
 from ._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V_FLOOR, status_error
 from .law import ALL_LAWS, BRANCHES, peel_force_derivative
@@ -219,7 +220,7 @@ def reduced_segment(
     max_steps : int
         Step budget, an integer in [1, 1e15] (a float such as ``1e6`` is refused: write ``10**6``).
 
-    Entry states must lie in :data:`peelapprox._params.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
+    Entry states must lie in :data:`peelapprox.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
     ``alpha_in`` and ``amplitude`` in [-π, π], ``alphadot_in`` in [-1e9, 1e9] rad/s, ``v_in``, ``v_f`` in
     (1e-150, 1e3] m/s, ``F_rate`` in [-1e12, 1e12] N/s).
 

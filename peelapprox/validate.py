@@ -59,7 +59,8 @@ from ._checks import (
     shown,
     times,
 )
-from ._params import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX, PeelParams
+from ._params import PeelParams
+from ._ranges import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX
 from .law import ALL_LAWS, require_law
 
 __all__ = [
@@ -129,7 +130,7 @@ def paper_model(name: str, x: PeelParams, *, where: str) -> PeelParams:
 
 
 def state(name: str, x: Any, quantity: str) -> float:
-    """A scalar state variable in its range :data:`peelapprox._params.STATE_RANGES` [quantity].
+    """A scalar state variable in its range :data:`peelapprox.STATE_RANGES` [quantity].
 
     ``quantity`` is ``"alpha"`` (rad), ``"omega"`` (rad/s, also for α̇), ``"F"`` (N), ``"v"`` (m/s, open at
     0) or ``"F_rate"`` (N/s); e.g. ``state("F0", F0, "F")``.

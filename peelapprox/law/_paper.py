@@ -102,26 +102,11 @@ def _fpp(v, b, A):
 
 
 def paper_structure(V: float) -> BranchStructure:
-    """The :class:`BranchStructure` of fvV at V (every field); cached per V.
+    """The :class:`BranchStructure` of fvV at V (every field; V checked); cached per V.
 
-    The folds are the two roots of ``f'(v, V) = 0`` on either side of the
-    unique minimiser of ``f'`` (root of ``f''``), each located by Brent's
-    method to ``xtol = 4 ulp``.  Robust near the cusp where the folds merge
-    (``V ≈ 5.2``): no grid is used for the folds themselves.
-
-    Parameters
-    ----------
-    V : float
-        Pull speed [m/s] (> 0).
-
-    Returns
-    -------
-    BranchStructure
-
-    Raises
-    ------
-    ValueError
-        If V is outside ``PARAM_RANGES["V"]`` (TypeError if not a number).
+    The folds are the two roots of ``f'(v, V) = 0`` either side of the unique minimiser of ``f'`` (root of
+    ``f''``), each by Brent's method to ``xtol = 4 ulp``: robust near the cusp (``V ≈ 5.2``), no grid for the
+    folds themselves.  :func:`peelapprox.branch_structure` is the public face.
     """
     return _branch_structure(check_V(V))
 
