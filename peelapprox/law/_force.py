@@ -117,7 +117,7 @@ class PeelForce:
 
         The smooth normal form of the N-shaped (rising-falling-rising) law of Hong & Yue, Phys. Rev. Lett.
         74, 254 (1995) — the generic smooth N, not Hong & Yue's own numbers (which could not be verified).
-        Folds at the roots of ``b - 2 c v + 3 d v^2``; defaults (the issue's example) put them at 0.691 and
+        Folds at the roots of ``b - 2 c v + 3 d v^2``; the defaults put them at 0.691 and
         1.809 m/s.
         """
         return cls.family("cubic", a=a, b=b, c=c, d=d)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 from scipy.optimize import brentq
@@ -52,7 +52,7 @@ _V_LO = 1e-12
 _V_HI = 300.0  # exp(300/11) ~ 7e11: f is astronomically large there
 
 
-def check_V(V) -> float:
+def check_V(V: Any) -> float:
     """The pull speed V in :data:`peelapprox.PARAM_RANGES` (the law's valid range, one bound for all)."""
     return in_range("V", V, *PARAM_RANGES["V"])
 
@@ -62,7 +62,7 @@ def _check_v(v) -> np.ndarray:
     return reals("v", v, *STATE_RANGES["v"], lo_open=True)
 
 
-def peel_force(v, V):
+def peel_force(v: Any, V: float) -> Any:
     """Peel force f(v, V) of Eq. (fvV) [N].
 
     ``f = 400 v^0.35 + 110 v^0.15 + 130 e^(v/11) - 2 V^1.5
@@ -85,7 +85,7 @@ def peel_force(v, V):
     return f[()] if np.ndim(f) == 0 else f
 
 
-def peel_force_derivative(v, V, order: int = 1):
+def peel_force_derivative(v: Any, V: float, order: int = 1) -> Any:
     """``∂ᵏf/∂vᵏ (v, V)`` for ``order`` k in {0, 1, 2} [N s^k/m^k]."""
     order = choice("order", order, (0, 1, 2))
     b, A = peel_force_coefficients(check_V(V))
@@ -204,7 +204,7 @@ def _invert(G: float, bs: BranchStructure, branch: str, b: float, A: float) -> f
     return brentq(g, bs.v_min, hi_v, xtol=1e-300, rtol=4 * np.finfo(float).eps)
 
 
-def branch_inverse(G, V: float, branch: str):
+def branch_inverse(G: Any, V: float, branch: str) -> Any:
     """Velocity v on a stable branch with ``f(v, V) = G``.
 
     Parameters
