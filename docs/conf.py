@@ -66,7 +66,7 @@ def _constant_docs() -> dict[str, str]:
 
     autodoc looks for a constant's ``#:`` comment in the module it documents the constant under
     (``peelapprox`` for ``peelapprox.PARAM_RANGES``), but the comment is where the constant is written
-    (``peelapprox._params``; ``peelapprox.MEASURES`` in ``comparisons.sweep.measures``).  Find that module: a
+    (``peelapprox._ranges``; ``peelapprox.MEASURES`` in ``comparisons.sweep.measures``).  Find that module: a
     module of the three packages whose attribute of that name is this very object and carries a ``#:``
     comment.  The API pages' template adds the text (``_templates/autosummary/base.rst``).
     """

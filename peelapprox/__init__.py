@@ -18,7 +18,6 @@ observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObs
 ``attractor_observables`` runs the exact solver for them).
 """
 
-from . import _law_paper  # noqa: F401  (hands the built-in law to PeelForce; see its docstring)
 from ._alpha import (
     ALPHA_FORMS,
     InertialPeriods,
@@ -47,11 +46,9 @@ from ._estimate import (
     quasi_static_branch_time,
     slope_criterion,
 )
-from ._law import PeelForce
-from ._law_compiled import branch_structure, fixed_point
-from ._law_folds import Folds
 from ._observables import StickSlipObservables
-from ._params import (
+from ._params import PeelParams
+from ._ranges import (
     EPS_DEFAULT,
     EPS_RANGE,
     GEOMETRIES,
@@ -67,21 +64,24 @@ from ._params import (
     TAPE_MASS_RANGE,
     TIME_MAX,
     WINDOW_DEFAULTS,
-    PeelParams,
-)
-from ._peelforce import (
-    BRANCHES,
-    BREAKDOWN_LEVEL,
-    BranchStructure,
-    FixedPoint,
-    branch_inverse,
-    peel_force,
-    peel_force_derivative,
 )
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._version import __version__ as __version__
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from .law import (
+    BRANCHES,
+    BREAKDOWN_LEVEL,
+    BranchStructure,
+    FixedPoint,
+    Folds,
+    PeelForce,
+    branch_inverse,
+    branch_structure,
+    fixed_point,
+    peel_force,
+    peel_force_derivative,
+)
 
 __all__ = [
     "PeelParams",

@@ -49,10 +49,10 @@ import numpy as np
 from scipy import integrate, special
 
 from ._jit import jitable
-from ._law_compiled import branch_structure
-from ._params import TIME_MAX, PeelParams
-from ._peelforce import peel_force_derivative
+from ._params import PeelParams
+from ._ranges import TIME_MAX
 from .errors import SolverFailure
+from .law import branch_structure
 from .validate import choice, in_range, optional, state, states, times
 from .validate import finite as _finite
 from .validate import params as _params
@@ -189,9 +189,7 @@ def inertial_period(params: PeelParams, F):
 
 
 def law_fprime(params: PeelParams, v):
-    """∂f/∂v of the run's law ``params.force`` at v (fvV through :func:`peel_force_derivative`, bitwise)."""
-    if params.force.kind == "paper":
-        return peel_force_derivative(v, params.V)
+    """∂f/∂v of the run's law ``params.force`` at v (fvV through :func:`peelapprox.peel_force_derivative`, bitwise)."""
     return params.force.df(v, params.V)
 
 

@@ -29,7 +29,6 @@ from typing import Any
 
 import numpy as np
 
-from ._law_compiled import compiled_law, fixed_point
 from ._observables import StickSlipObservables, jump_statistics
 from ._params import PeelParams
 from ._regime import regime
@@ -37,6 +36,8 @@ from ._segment import SegmentPlan, run_segment, segment_plan, segment_status
 from ._segment_kernel import ALPHA_MODELS, AM_EXP, AM_HARM, AM_SIN, AM_STATIC, V_EQUATIONS, alpha_at
 from ._status import DONE, F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
 from .io import fmt_number
+from .law import fixed_point
+from .law._compiled import compiled_law
 from .validate import choice, integer, optional, positive
 from .validate import params as _params
 from .validate import rtol as _rtol

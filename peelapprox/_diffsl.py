@@ -20,9 +20,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._law_compiled import branch_structure
-from ._params import GEOMETRIES
+from ._ranges import GEOMETRIES
 from .io import optional_import
+from .law import PeelForce, branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._params import PeelParams
@@ -70,13 +70,10 @@ def _law_expression(force):
         For a tabulated law (no closed form to write in DiffSL), naming ``params.force``.
     """
     from . import _symbolic as S
-
-    if force is None or force.kind == "paper":
-        return S.peel_force_expr(S.v, S.V)
-    from . import _law_sympy as L
+    from .law import _symbolic as L
 
     try:
-        e = L.law_expression(force)
+        e = L.law_expression(force or PeelForce.paper())
     except ValueError:
         raise ValueError(f"params.force: {force!r} is tabulated and cannot be written in DiffSL: the diffsol peer and "
                          "the eps-variational Lyapunov method need a closed-form law (an expression or a family); "
@@ -87,7 +84,7 @@ def _law_expression(force):
 def _diffsl_expressions(geometry: str, force=None) -> dict:
     """DiffSL (C-syntax) expressions of c(α), φ_α, φ_ω, φ_F and φ_v, printed from the one symbolic source
     :mod:`peelapprox._symbolic` (``cos_theta_expr``, ``equations_of_motion``; fvV inside CONSTR, or the law
-    ``force`` in its place, :mod:`peelapprox._law_sympy`), so the peer integrates the same model as every other
+    ``force`` in its place, :mod:`peelapprox.law._symbolic`), so the peer integrates the same model as every other
     solver without a second copy of the formulas.  The pull force is named ``Fp`` in DiffSL (``F_i`` is
     DiffSL's right-hand side)."""
     import sympy as sp
@@ -96,9 +93,9 @@ def _diffsl_expressions(geometry: str, force=None) -> dict:
 
     Fp = sp.Symbol("Fp", real=True)
     alpha_dot, omega_dot, F_dot, constraint = S.equations_of_motion(S.c_)
-    f_law = _law_expression(force)
-    if force is not None and force.kind != "paper":  # CONSTR with the law instead of fvV
-        constraint = constraint + S.peel_force_expr(S.v, S.V) - f_law
+    f_law, fvv = _law_expression(force), S.peel_force_expr(S.v, S.V)
+    if f_law != fvv:  # CONSTR with the law instead of fvV
+        constraint = constraint + fvv - f_law
     sub = {S.F: Fp}
     code = {name: sp.ccode(e.xreplace(sub)) for name, e in
             (("phi_a", alpha_dot), ("phi_w", omega_dot), ("phi_F", F_dot), ("phi_v", constraint))}
@@ -200,8 +197,6 @@ def diffsl_model(geometry: str = "paper", *, tangent: bool = False, force=None):
     """
     ds = import_optional("pydiffsol", "pydiffsol", "peer 'diffsol'")
     code = diffsl_code(geometry, tangent=tangent, force=force)
-    if force is None or force.kind == "paper":
-        return ds.Ode(code, matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
     try:
         return ds.Ode(code, matrix_type=ds.nalgebra_dense, ode_solver=ds.bdf)
     except Exception as exc:  # pydiffsol reports a DiffSL compile error as its own exception type

@@ -21,12 +21,11 @@ import numpy as np
 from scipy import integrate
 
 from ._alpha import inertial_frequency, law_fprime
-from ._law_compiled import fixed_point
 from ._observables import StickSlipObservables
 from ._params import PeelParams
-from ._peelforce import BranchStructure, FixedPoint
 from ._regime import INERTIA_RULE, VELOCITY_RULE, _checked, _labels, _law_structure, regime
 from ._validity import validity_text
+from .law import BranchStructure, FixedPoint, fixed_point
 from .validate import choice, flag, function, in_range, nonnegative, optional, state
 
 __all__ = [

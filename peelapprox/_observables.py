@@ -31,10 +31,9 @@ from typing import Any
 
 import numpy as np
 
-from ._law_compiled import fixed_point
-from ._peelforce import BRANCHES
 from ._returnmap import HasJumps, _trajectory, periodicity
 from .io import fmt_number, html_table, jsonable, optional_import
+from .law import BRANCHES, fixed_point
 from .validate import duration, integer, positive
 
 __all__ = ["StickSlipObservables", "STATUSES", "QUIET_FACTOR", "jump_statistics"]

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._law import require_law
 from ._params import PeelParams
-from ._peelforce import peel_force_coefficients
+from .law import require_law
+from .law._paper import peel_force_coefficients
 
 __all__ = ["MODEL_FIELDS", "M_V", "M_I", "M_K", "M_R", "M_L", "M_B", "M_A", "M_GEOM", "N_M", "model_block"]
 
@@ -46,7 +46,7 @@ def model_block(params: PeelParams, size: int = N_M, laws: tuple[str, ...] = ("p
     size : int, default N_M
         Length of the driver's vector, ``N_M`` plus its own fields (which the driver fills).
     laws : tuple of str, default ("paper",)
-        The laws ``params.force`` may be (``peelapprox._law.law_label`` names): those the calling driver
+        The laws ``params.force`` may be (``peelapprox.law.law_label`` names): those the calling driver
         honours.  A driver that takes the law as an argument (the hybrid law driver: ``"cubic"``) passes it
         its own coefficients; for such a law the slots ``b, A`` of fvV are unused and hold 0.0 (not NaN, which
         the vector's checks would trip on).
@@ -59,7 +59,7 @@ def model_block(params: PeelParams, size: int = N_M, laws: tuple[str, ...] = ("p
     require_law(params, "the compiled drivers (model_block)", laws)
     if size < N_M:
         raise ValueError(f"size must be at least the model block's length {N_M}, got {size}")
-    b, A = peel_force_coefficients(params.V) if params.force.kind == "paper" else (0.0, 0.0)
+    b, A = peel_force_coefficients(params.V) if params.force.inlined else (0.0, 0.0)
     p = np.zeros(size)
     p[:N_M] = params.V, params.I, params.k, params.R, params.l, b, A, 0.0 if params.geometry == "paper" else 1.0
     return p

@@ -2,107 +2,24 @@
 
 from __future__ import annotations
 
-import math
-import types
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ._checks import ArgumentTypeError, _got, choice, in_range, interval
-from ._law import PeelForce
+from ._ranges import (
+    GEOMETRIES,
+    GRAVITY,
+    L_OVER_R_MIN,
+    LOAD_MASS_RANGE,
+    LOAD_RANGE,
+    LOADINGS,
+    PARAM_RANGES,
+    TAPE_MASS_RANGE,
+    default_load_masses,
+)
+from .law import PeelForce
 
-__all__ = ["EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE", "LOAD_MASS_RANGE",
-           "LOAD_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
-           "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "PeelParams"]
-
-#: Closures of ``cos θ`` available to the model.  ``"paper"`` is the paper's
-#: numerics, ``cos θ = -sin α`` (used in FLOW2, flow3 and CONSTR);  ``"exact"``
-#: is the full geometry ``cos θ = -l sin α / L``, ``L² = l² + R² - 2 l R cos α``.
-GEOMETRIES = ("paper", "exact")
-
-#: Smallest ``l/R``: closer, the exact closure's ``L(α) = l - R + O(α²)`` cancels (see :class:`PeelParams`).
-L_OVER_R_MIN = 1.001
-
-#: Valid range ``(lo, hi)`` of each numeric field, closed at both ends (``l`` also needs
-#: ``l >= L_OVER_R_MIN * R``).  Chosen so that every function of the package returns or raises a
-#: documented exception (no overflow, no division by zero, no bracket failure) with room to spare;
-#: the reasons and the measurements behind each bound are in :class:`PeelParams`.
-PARAM_RANGES = {
-    "V": (1e-6, 100.0),
-    "I": (1e-12, 1e6),
-    "k": (1e-3, 1e7),
-    "R": (1e-4, 10.0),
-    "l": (L_OVER_R_MIN * 1e-4, 1e3),
-}
-#: Valid range ``(lo, hi)`` of the state variables wherever they are given as arguments (initial and
-#: entry states; forces, velocities and angles of the closed forms), closed unless noted:
-#:
-#: * ``"alpha"`` [rad], ``[-π, π]``: one turn (the closures are 2π-periodic; the reduced equations,
-#:   linear in α, are meant for ``|α|`` of order 0.1).
-#: * ``"omega"`` [rad/s], for ω and α̇: ``|ω| <= 1e9``, above every natural rate of the model within
-#:   :data:`PARAM_RANGES` (``V/R <= 1e6``; the inertial frequency ``sqrt(F R/I)`` on the branches,
-#:   F <= 1e3 N, is <= 1e8).  Measured: α̇_in = 1e9 still returns (or fails with a documented
-#:   SolverFailure) in :func:`reduced_segment`; 1e300 divided by zero.
-#: * ``"F"`` [N]: ``[1e-3, 1e7]``: the pull force; the peel force is 100-400 N in the stick-slip window and
-#:   ``f(V, V) <= 1.3e6 N`` at the fastest V.  ``F_in = 1e-300`` divided by zero, ``1e300`` did not finish.
-#: * ``"v"`` [m/s]: ``(1e-150, 1e3]``: every branch velocity the model reaches is below 30 m/s; f(1e3, V) ~ 4e41 N
-#:   is still finite (its e^(v/11) overflows at v ~ 7800).  Below 1e-150, v² underflows in f'' (the reduced
-#:   equations' fullvdot); the model's own breakdown velocity (``BranchStructure.v_breakdown``) is ~1e-67.
-#: * ``"F_rate"`` [N/s], ``|dF/dt| <= 1e12``: ``k V <= 1e9``.
-STATE_RANGES = {
-    "alpha": (-math.pi, math.pi),
-    "omega": (-1e9, 1e9),
-    "F": (1e-3, 1e7),
-    "v": (1e-150, 1e3),
-    "F_rate": (-1e12, 1e12),
-}
-#: Largest time [s] accepted as a horizon or a time since a branch entry by the closed forms and the reduced
-#: segment: 1e6 s (12 days of peeling) keeps ``F_in + F_rate t`` and the phases finite.
-TIME_MAX = 1e6
-
-#: Valid relative tolerance of every DOP853 run of the package (exact.simulate, the reduced segments, the
-#: dynamics functions) and of the regularised scheme: below 1e-14 the error test asks for less than rounding,
-#: above 1e-2 it controls nothing a user could mean.
-RTOL_RANGE = (1e-14, 1e-2)
-
-#: Default transient [s] discarded by the dynamics functions (windowed runs, attractors, the Lyapunov family,
-#: the sweep measures): the paper's orbits settle within it (docs/dynamics.md, "Transients").
-T_TRANSIENT = 30.0
-#: Default renormalisation interval [s] of the two-trajectory Lyapunov exponent (docs/dynamics.md).
-LYAPUNOV_TAU = 0.005
-#: Defaults of the windowed run (``exact.window_run``) shared by the attractors, the sweep measures ``period``
-#: and ``jumps`` and ``peelapprox dynamics``: 20 s of jumps after the transient, at rtol 1e-10, from α0 = 0.
-#: Read-only (a ``types.MappingProxyType``): the one place these defaults are written.
-WINDOW_DEFAULTS = types.MappingProxyType(dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0))
-
-#: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons.benchmark.eps) goes
-#: down to 1e-15, where double precision is exhausted (the fast transit time ~ ε/f' falls below the rounding
-#: of t); at 1e-300 the rates (F(1 + c) - f)/ε overflow.  Above 1e-2 the "fast" transits last as long as
-#: the slow dynamics (the paper uses 1e-7): no longer a regularisation of the jumps.
-EPS_RANGE = (1e-15, 1e-2)
-#: Default regularisation ε of the ε-regularised scheme and of the variational Lyapunov exponent: the paper's.
-EPS_DEFAULT = 1e-7
-
-#: Loading modes: ``"velocity"`` (the paper's: the end O' pulled at the constant speed V) or ``"load"`` (a
-#: constant force F_L on a body of mass M at O': ``M V̇_p = F_L - F``, the pull speed ``V_p`` a state).
-LOADINGS = ("velocity", "load")
-#: Standard gravity [m/s²]: a hanging mass M is the load ``F_L = M g`` (the default of ``load``).
-GRAVITY = 9.80665
-#: Valid tape (ribbon) mass m [kg] of the tape-mass model (0 or None: the massless model).  Its fast time scale
-#: is ~ m (1 + sin α)² / f' (the ε of XDAE, docs/tape-mass.md): from 1e-15 kg (EPS_RANGE's floor: the time
-#: scale reaches the rounding of t) to 10 kg (a 10 m ribbon of heavy tape; far above the paper's I/R²).
-TAPE_MASS_RANGE = (1e-15, 10.0)
-#: Valid loading mass M [kg] under ``loading="load"``: 1 mg (the loading is then force control) to 1000 t
-#: (then the pull speed hardly changes within a run: velocity control).
-LOAD_MASS_RANGE = (1e-6, 1e6)
-#: Valid load F_L [N]: the range of the pull force F (:data:`STATE_RANGES`).
-LOAD_RANGE = (1e-3, 1e7)
-
-
-def default_load_masses() -> tuple[float, float]:
-    """The loading masses M [kg] (within :data:`LOAD_MASS_RANGE`) whose default load ``M g`` lies in
-    :data:`LOAD_RANGE`: what a user who gives no load may pass."""
-    return max(LOAD_MASS_RANGE[0], LOAD_RANGE[0] / GRAVITY), min(LOAD_MASS_RANGE[1], LOAD_RANGE[1] / GRAVITY)
-
+__all__ = ["PeelParams"]
 
 _VARIANT_DEFAULTS = {"tape_mass": None, "loading": "velocity", "load_mass": None, "load": None}
 
@@ -276,7 +193,7 @@ class PeelParams:
         """The fields as before ``force`` existed, then ``force`` if it is not the paper's law, then the variant
         fields that are not at their defaults (so the default's ``repr`` and ``hash`` are as before)."""
         base = (self.V, self.I, self.k, self.R, self.l, self.geometry)
-        return base if self.force.kind == "paper" else base + (self.force,)
+        return base if self.force == PeelForce.paper() else base + (self.force,)
 
     def _variant_items(self) -> tuple:
         return tuple((n, getattr(self, n)) for n in ("tape_mass", "loading", "load_mass", "load")

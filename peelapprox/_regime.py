@@ -10,9 +10,8 @@ from __future__ import annotations
 import sys
 
 from ._alpha import InertialPeriods, cd_damping_time, inertial_periods
-from ._law_compiled import branch_structure, fixed_point
 from ._params import PeelParams
-from ._peelforce import BranchStructure, FixedPoint
+from .law import BranchStructure, FixedPoint, branch_structure, fixed_point
 from .validate import params as _params
 
 __all__ = ["INERTIA_RULE", "VELOCITY_RULE", "regime"]

@@ -27,7 +27,7 @@ from typing import Literal, Protocol, cast, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._peelforce import BRANCHES
+from .law import BRANCHES
 from .validate import ArgumentTypeError, integer, positive, reals
 
 __all__ = ["return_map", "Periodicity", "periodicity", "classify", "force_drops", "settle_time", "HasJumps",

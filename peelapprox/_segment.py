@@ -68,14 +68,14 @@ from numba.experimental.function_type import _get_wrapper_address as _wrapper_ad
 
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, _wkb_match
-from ._law import ALL_LAWS
-from ._law_abi import LAW_SIG, LAW_TYPE
-from ._law_compiled import CompiledLaw, compiled_law
 from ._packing import model_block
-from ._params import TIME_MAX, PeelParams
-from ._peelforce import BRANCHES, peel_force_derivative
+from ._params import PeelParams
+from ._ranges import TIME_MAX
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
 from ._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V_FLOOR, status_error
+from .law import ALL_LAWS, BRANCHES, peel_force_derivative
+from .law._abi import LAW_SIG, LAW_TYPE
+from .law._compiled import CompiledLaw, compiled_law
 from .validate import choice, duration, integer, optional, optional_finite, reals, times
 from .validate import params as _params
 from .validate import rtol as _rtol
@@ -220,7 +220,7 @@ def reduced_segment(
     max_steps : int
         Step budget, an integer in [1, 1e15] (a float such as ``1e6`` is refused: write ``10**6``).
 
-    Entry states must lie in :data:`peelapprox._params.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
+    Entry states must lie in :data:`peelapprox.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
     ``alpha_in`` and ``amplitude`` in [-π, π], ``alphadot_in`` in [-1e9, 1e9] rad/s, ``v_in``, ``v_f`` in
     (1e-150, 1e3] m/s, ``F_rate`` in [-1e12, 1e12] N/s).
 
@@ -354,7 +354,7 @@ class _LawAddress:
 
     Passing the law's dispatcher itself makes numba type it and look up its compiled wrapper on every call of
     the driver, ~35 µs: more than a short segment's integration.  This object carries the type
-    (``_numba_type_``, :data:`peelapprox._law_abi.LAW_TYPE`) and the address, looked up once; the driver calls
+    (``_numba_type_``, :data:`peelapprox.law._abi.LAW_TYPE`) and the address, looked up once; the driver calls
     the same compiled law (measured: the same numbers bitwise, a 100-cycle reduced map at V = 2.26, I = 1e-2
     in 3.0 ms instead of 6.8 ms).
     """

@@ -18,9 +18,9 @@ as the hybrid solver's (``exact._hybrid_law``):
 
 * ``run(False)`` -- the paper's law fvV **inlined** (:func:`field`, ``q`` carrying ``b, A``): the default path,
   bitwise the numbers of 0.2.0;
-* ``run(True)`` -- the law as an **argument** ``law`` of type :data:`peelapprox._law_abi.LAW_TYPE` with its
+* ``run(True)`` -- the law as an **argument** ``law`` of type :data:`peelapprox.law._abi.LAW_TYPE` with its
   coefficients ``coef`` (:func:`field_law`: ``law(ln v, coef, LAW_LNV)``), for any compiled law
-  (:func:`peelapprox._law_compiled.compiled_law`) without compiling again.
+  (:func:`peelapprox.law._compiled.compiled_law`) without compiling again.
 
 Both are compiled for the one signature :data:`RUN_SIG` on first use and cached across processes; the law's
 field is compiled without numba's reference-counting runtime (``kernel(nrt=False)``), which would wrap every
@@ -39,10 +39,10 @@ from ._alpha import _decay, _harmonic, _restoring, _sinusoid
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
 from ._jit import kernel, rebind
-from ._law_abi import LAW_LNV, LAW_TYPE, pack_inlined, pack_law
 from ._packing import M_A, M_B, M_I, M_K, M_R, M_V, N_M
-from ._peelforce import peel_force_fp_jit
 from ._status import DONE, F_NONPOSITIVE, MAX_STEPS, NONFINITE, OUT_FULL, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
+from .law._abi import LAW_LNV, LAW_TYPE, pack_inlined, pack_law
+from .law._paper import peel_force_fp_jit
 
 __all__ = ["ALPHA_MODELS", "RUN_SIG", "V_EQUATIONS", "alpha_of", "field", "field_law", "run", "segment_parameters"]
 
@@ -286,7 +286,7 @@ def run(law_argument: bool) -> Any:
     ----------
     law_argument : bool
         False: the paper's law fvV inlined, ``law`` and ``coef`` unused (the default path, the numbers of 0.2.0).
-        True: the law ``law`` (:data:`peelapprox._law_abi.LAW_TYPE`) with the coefficients ``coef``; a new law or
+        True: the law ``law`` (:data:`peelapprox.law._abi.LAW_TYPE`) with the coefficients ``coef``; a new law or
         new coefficients compile nothing.
 
     Returns

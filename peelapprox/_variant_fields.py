@@ -11,7 +11,7 @@ model          states  equations
 ``"eps_load"`` 5       the massless tape under a load: XDAE (``ε v̇ = F(1 - cos θ) - f``) with ``V → V_p``
 =============  ======  ===================================================================================
 
-The peel-force law is an argument (``law(v, coef, LAW_FP)``, :mod:`peelapprox._law_abi`), so every law runs
+The peel-force law is an argument (``law(v, coef, LAW_FP)``, :mod:`peelapprox.law._abi`), so every law runs
 through the one compiled field per model; the law is evaluated at the **fixed** pull speed its coefficients
 were packed for (``params.V``), also under a load where the pull speed ``V_p`` varies (docs/constant-load.md).
 The parameter vector is the model block followed by ``(m or ε, M, F_L)`` (:func:`variant_parameters`).
@@ -28,10 +28,10 @@ from numba import types as _nb
 
 from . import _generated as _g
 from ._jit import kernel, rebind
-from ._law import ALL_LAWS
-from ._law_abi import LAW_FP, LAW_TYPE, paper_law
 from ._model_jit import closure_d2, regularized_rhs
 from ._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
+from .law import ALL_LAWS
+from .law._abi import LAW_FP, LAW_TYPE, paper_law
 
 __all__ = ["VARIANT_MODELS", "Q_MASS", "Q_LOAD_MASS", "Q_LOAD", "variant_parameters", "variant_field",
            "bound_variant_field"]
@@ -173,7 +173,7 @@ def bound_variant_field(model: str, law: Any) -> tuple[Any, Any]:
 
     Passing the law as an argument from Python (:func:`variant_field`) costs ~65 µs per call (numba types the
     function argument at every call); with the law bound in, ~1 µs (docs/tape-mass.md, "Which integrator").  The
-    paper's law (:func:`peelapprox._law_abi.paper_law`) is bound in cached kernels (compiled once per machine);
+    paper's law (:func:`peelapprox.law._abi.paper_law`) is bound in cached kernels (compiled once per machine);
     another law in a closure compiled once per process (~2 s) and kept.
     """
     fun, jac = variant_field(model)

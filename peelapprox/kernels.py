@@ -3,10 +3,10 @@
 Everything here is compiled by :func:`peelapprox._jit.kernel` from the one generated source
 (:mod:`peelapprox._generated`, written by :mod:`peelapprox._symbolic`), compiled once, and shared by every
 driver: the peel force (fvV) in the velocity and in the ln v form, the law ABI by which a driver takes the
-peel-force law as a function argument with its coefficients as data (:mod:`peelapprox._law_abi`: ``LAW_SIG``,
+peel-force law as a function argument with its coefficients as data (:mod:`peelapprox.law._abi`: ``LAW_SIG``,
 ``LAW_TYPE``, the forms ``LAW_*``, the compiled laws ``LAWS``; the tabulated law ``table_law`` and its packing
-``table_coefficients``, :mod:`peelapprox._law_table_jit`; the laws generated from their symbolic form,
-:func:`family_kernel` and :func:`expression_kernel` of :mod:`peelapprox._law_codegen`), the ``cos θ`` closures with the
+``table_coefficients``, :mod:`peelapprox.law._table_jit`; the laws generated from their symbolic form,
+:func:`family_kernel` and :func:`expression_kernel` of :mod:`peelapprox.law.codegen`), the ``cos θ`` closures with the
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
 system XDAE and its Jacobian (also as whole fields of the state and a packed parameter vector, the form the
 stiff solvers call), and the model variants' fields (the tape mass, the constant load:
@@ -54,22 +54,6 @@ from ._dop853 import (
     workspace,
 )
 from ._jit import kernel, rebind
-from ._law import ALL_LAWS
-from ._law_abi import (
-    LAW_FP,
-    LAW_FPP,
-    LAW_LNV,
-    LAW_SIG,
-    LAW_TYPE,
-    LAWS,
-    pack_inlined,
-    pack_law,
-    paper_coefficients,
-    paper_law,
-)
-from ._law_codegen import expression_kernel, family_kernel
-from ._law_compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
-from ._law_table_jit import table_coefficients, table_law
 from ._model_jit import (
     closure,
     closure_d2,
@@ -83,9 +67,25 @@ from ._model_jit import (
     slow_rates,
 )
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
-from ._peelforce import _invert as branch_inverse_at
-from ._peelforce import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
 from ._variant_fields import VARIANT_MODELS, bound_variant_field, variant_field, variant_parameters
+from .law import ALL_LAWS
+from .law._abi import (
+    LAW_FP,
+    LAW_FPP,
+    LAW_LNV,
+    LAW_SIG,
+    LAW_TYPE,
+    LAWS,
+    pack_inlined,
+    pack_law,
+    paper_coefficients,
+    paper_law,
+)
+from .law._compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
+from .law._kernels import expression_kernel, family_kernel
+from .law._paper import _invert as branch_inverse_at
+from .law._paper import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
+from .law._table_jit import table_coefficients, table_law
 
 #: Index of ε in the regularised system's parameter vector, after the model block.
 Q_EPS = N_M

@@ -59,8 +59,9 @@ from ._checks import (
     shown,
     times,
 )
-from ._law import ALL_LAWS, require_law
-from ._params import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX, PeelParams
+from ._params import PeelParams
+from ._ranges import EPS_RANGE, RTOL_RANGE, STATE_RANGES, TIME_MAX
+from .law import ALL_LAWS, require_law
 
 __all__ = [
     "ArgumentTypeError",
@@ -96,7 +97,7 @@ def params(name: str, x: Any, *, laws: tuple[str, ...] = ALL_LAWS, where: str | 
     """x if it is a :class:`peelapprox.PeelParams` (validated when it was built), else ArgumentTypeError.
 
     A ValueError if ``x.force`` is not one of ``laws``, the laws the calling function runs (by their names:
-    ``"paper"``, ``"cubic"``, ``"tabulated"``, ... as in ``peelapprox._law.law_label``; default every law);
+    ``"paper"``, ``"cubic"``, ``"tabulated"``, ... as in ``peelapprox.law.law_label``; default every law);
     the message names ``where`` (default: that function).  With ``variants=False`` (the paper's reduced
     equations), also a ValueError for a model variant (:func:`paper_model`).
     """
@@ -129,7 +130,7 @@ def paper_model(name: str, x: PeelParams, *, where: str) -> PeelParams:
 
 
 def state(name: str, x: Any, quantity: str) -> float:
-    """A scalar state variable in its range :data:`peelapprox._params.STATE_RANGES` [quantity].
+    """A scalar state variable in its range :data:`peelapprox.STATE_RANGES` [quantity].
 
     ``quantity`` is ``"alpha"`` (rad), ``"omega"`` (rad/s, also for α̇), ``"F"`` (N), ``"v"`` (m/s, open at
     0) or ``"F_rate"`` (N/s); e.g. ``state("F0", F0, "F")``.

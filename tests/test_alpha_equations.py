@@ -114,7 +114,7 @@ def test_segment_frozen_airy2_is_alpha_numerical_airy2(V, I):
 def test_model_block_layout(geometry):
     """Hypothesis: the model block is ``(V, I, k, R, l, b, A, geometry flag)`` at the named indices, exactly
     (values copied; b and A those of the generated peel-force law at this V)."""
-    from peelapprox._peelforce import peel_force_coefficients
+    from peelapprox.law._paper import peel_force_coefficients
 
     p = PeelParams(V=2.0, I=1e-3, k=900.0, R=0.12, l=0.8, geometry=geometry)
     m = model_block(p)

@@ -49,8 +49,7 @@ from hypothesis import strategies as st
 
 import exact
 import peelapprox as pa
-from peelapprox import PARAM_RANGES, PeelParams
-from peelapprox._params import EPS_RANGE, STATE_RANGES, TIME_MAX
+from peelapprox import EPS_RANGE, PARAM_RANGES, STATE_RANGES, TIME_MAX, PeelParams
 from peelapprox.cli import main as cli_main
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 

@@ -27,7 +27,7 @@ warnings.simplefilter("always")
 with warnings.catch_warnings(record=True) as w:
     import peelapprox, exact
     from peelapprox import PeelParams
-    from peelapprox._peelforce import peel_force
+    from peelapprox.law._paper import peel_force
     from peelapprox.kernels import paper_coefficients, paper_law
     from exact._hybrid import pull_force
     from exact._hybrid_law import driver, pull_force_law

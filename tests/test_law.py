@@ -187,7 +187,7 @@ def convergence_rows(Ns=(20, 40, 80, 160)):
 
 
 def test_tabulated_convergence():
-    """Hypothesis (measured, stated in peelapprox/_law_table.py): PCHIP in ln v of the cubic converges at
+    """Hypothesis (measured, stated in peelapprox/law/_table.py): PCHIP in ln v of the cubic converges at
     third order away from the folds (observed order ≥ 2.5 between consecutive N; measured 2.8-2.95); at the
     folds PCHIP puts f' = 0 at the extreme datum, so the fold *positions* are data points, within one
     spacing h (in ln v) of the true ones, and f_max (f_min) is the largest (smallest) datum: below (above)

@@ -1,4 +1,4 @@
-"""Compiled peel-force laws generated from one symbolic source (issue 15): peelapprox._law_sympy, _law_codegen.
+"""Compiled peel-force laws generated from one symbolic source: peelapprox.law._render, _kernels and codegen.
 
 Oracles: the families' formulas written a second time here by hand (f, f', f'' in closed form, as the numpy
 evaluators of ``_law_families`` were before they were generated) and evaluated at 30 digits (mpmath); the
@@ -28,13 +28,15 @@ import numpy as np
 import pytest
 import sympy as sp
 
-import peelapprox._law_cache as LC
-import peelapprox._law_codegen as C
+import peelapprox.law._cache as LC
+import peelapprox.law._kernels as C
+import peelapprox.law._render as R
+import peelapprox.law.codegen as CG
 from peelapprox import PeelForce
-from peelapprox._law_abi import LAW_FP, LAW_FPP, LAW_LNV, paper_coefficients, paper_law
-from peelapprox._law_families import FAMILIES
-from peelapprox._law_sympy import V, family_expression, law_expression, v
 from peelapprox.errors import KernelCacheWarning
+from peelapprox.law._abi import LAW_FP, LAW_FPP, LAW_LNV, paper_coefficients, paper_law
+from peelapprox.law._families import FAMILIES
+from peelapprox.law._symbolic import V, family_expression, law_expression, v
 
 ROOT = Path(__file__).resolve().parent.parent
 VGRID = np.logspace(-6, 3, 37)  # 9 decades: the domain of an expression law, beyond the families' physical range
@@ -101,19 +103,19 @@ def _pulls(name):
 
 # ------------------------------------------------------------------ the generated module
 def test_generated_laws_module_is_fresh():
-    """Hypothesis: peelapprox/_generated_laws.py is exactly what render_module() produces now (exact string
-    equality, as tests/test_symbolic.py for _generated.py): regenerate with ``python -m peelapprox._law_codegen``."""
-    assert C.render_module() == (ROOT / "peelapprox" / "_generated_laws.py").read_text()
+    """Hypothesis: peelapprox/law/_generated.py is exactly what render_module() produces now (exact string
+    equality, as tests/test_symbolic.py for _generated.py): regenerate with ``python -m peelapprox.law.codegen``."""
+    assert CG.render_module() == (ROOT / "peelapprox" / "law" / "_generated.py").read_text()
 
 
 def test_rendering_does_not_depend_on_the_hash_seed():
     """Hypothesis: the rendering is deterministic (the coef entries are numbered in sympy's canonical order, not
     in set order), so the committed file does not flap between runs: exact equality under another PYTHONHASHSEED."""
-    code = "import sys; from peelapprox._law_codegen import render_module; sys.stdout.write(render_module())"
+    code = "import sys; from peelapprox.law.codegen import render_module; sys.stdout.write(render_module())"
     env = dict(os.environ, PYTHONHASHSEED="12345", PYTHONPATH=str(ROOT))
     r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
-    assert r.stdout == C.render_module()
+    assert r.stdout == CG.render_module()
 
 
 # ------------------------------------------------------------------ the symbolic form and the numpy evaluators
@@ -205,7 +207,7 @@ def test_kernel_does_no_V_arithmetic():
     import inspect
     import re
 
-    from peelapprox import _generated_laws as G
+    from peelapprox.law import _generated as G
 
     for name in FAMILIES:
         tree = ast.parse(inspect.getsource(G.LAWS[name][0]))
@@ -320,7 +322,7 @@ def test_unwritable_cache_dir_falls_back_with_a_warning(law_cache, monkeypatch):
 PROBE = """
 import json, sys
 from peelapprox import PeelForce
-from peelapprox._law_codegen import expression_kernel
+from peelapprox.law._kernels import expression_kernel
 force = PeelForce.expression("a*v**0.35 + b*exp(-v/V) - c*V**0.4*sqrt(v)", a=400.0, b=130.0, c=45.0)
 law, pack = expression_kernel(force.source)
 print(json.dumps(dict(hits=sum(law.stats.cache_hits.values()), misses=sum(law.stats.cache_misses.values()),
@@ -355,9 +357,9 @@ def test_bad_input():
     source a TypeError (exact messages matched)."""
     a = sp.Symbol("coef", real=True)
     with pytest.raises(ValueError, match="coefficient name 'coef'"):
-        C.render_law("law", a * v, (a,))
+        R.render_law("law", a * v, (a,))
     with pytest.raises(ValueError, match="symbols q other than"):
-        C.render_law("law", sp.Symbol("q") * v, ())
+        R.render_law("law", sp.Symbol("q") * v, ())
     with pytest.raises(ValueError, match="unknown peel-force family 'nope'"):
         C.family_kernel("nope")
     with pytest.raises(ValueError, match="unknown peel-force family 'nope'"):

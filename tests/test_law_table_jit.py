@@ -15,9 +15,9 @@ from numba import njit, types
 from numba.core import event
 
 from peelapprox import PeelForce, peel_force
-from peelapprox._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_TYPE, paper_coefficients, paper_law
-from peelapprox._law_table import TableLaw
-from peelapprox._law_table_jit import (
+from peelapprox.law._abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_TYPE, paper_coefficients, paper_law
+from peelapprox.law._table import TableLaw
+from peelapprox.law._table_jit import (
     T_COUNT,
     T_HEAD,
     T_UHI,

@@ -188,7 +188,7 @@ def test_any_coefficient_magnitude_gives_a_named_outcome(family, data, logV):
     drawn or left at its default), constructing the law, its folds, ``estimate`` and a 1 ms ``exact.simulate``
     either succeed or raise a named exception of the package (ValueError/TypeError for bad input; the model's
     stops); never ZeroDivisionError, OverflowError or scipy's RuntimeError.  No tolerance: classes of outcome."""
-    from peelapprox._law_families import FAMILIES
+    from peelapprox.law._families import FAMILIES
 
     names = FAMILIES[family].names
     coefs = {n: data.draw(_MAG, label=n) for n in names if data.draw(st.booleans(), label=f"set {n}")}

@@ -212,7 +212,7 @@ def test_lyapunov_variational_at_a_stable_fixed_point_is_the_leading_eigenvalue(
     """
     pytest.importorskip("pydiffsol")
     from exact._regularized import _jac, param_vector
-    from peelapprox._peelforce import peel_force
+    from peelapprox.law._paper import peel_force
 
     p = PeelParams(V=V, I=I)
     x = np.array([0.0, V / p.R, float(peel_force(V, V)), V])

@@ -143,7 +143,7 @@ def test_fold_location_is_invariant_to_the_bracket(V, lo, hi):
     from scipy.optimize import brentq
 
     from peelapprox._generated import peel_force_coefficients
-    from peelapprox._peelforce import _V_HI, _V_LO, _fp
+    from peelapprox.law._paper import _V_HI, _V_LO, _fp
 
     bs = branch_structure(V)
     b, A = peel_force_coefficients(V)

@@ -25,11 +25,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from peelapprox import PeelForce, PeelParams
-from peelapprox import _law_cache as LC
-from peelapprox import _law_codegen as C
-from peelapprox import _law_grammar as G
 from peelapprox.cli import main as cli_main
 from peelapprox.errors import KernelCacheWarning
+from peelapprox.law import _cache as LC
+from peelapprox.law import _grammar as G
+from peelapprox.law import _kernels as C
 
 ROOT = Path(__file__).resolve().parents[1]
 #: An N-shaped law (folds at v = 0.691 and 1.809 m/s): stick-slip, so every consumer runs it.
@@ -164,7 +164,7 @@ def test_canonical_text_round_trips_and_floats_are_exact():
         law = PeelForce.expression(text)
         again = PeelForce.from_dict({"kind": "expression", "source": law.source})
         assert again == law and again.source == law.source
-        assert G.parse(law.source, {"v": _v(), "V": _V()})[0] == law._impl().exprs[0]
+        assert G.parse(law.source, {"v": _v(), "V": _V()})[0] == law._evaluator().exprs[0]
     assert "0.1*v" in PeelForce.expression("0.1*v + 300").source
 
 
@@ -248,7 +248,7 @@ def test_a_law_costly_to_differentiate_is_stopped(monkeypatch):
     binomials: over 5 min measured); the build is interrupted at LAW_BUILD_SECONDS (here 1 s) with a ValueError
     saying so, returning within 10 s (the interval timer lands within milliseconds; 10 s allows a noisy
     machine)."""
-    import peelapprox._law_expr as E
+    import peelapprox.law._expression as E
 
     monkeypatch.setattr(E, "LAW_BUILD_SECONDS", 1.0)
     text = "150 + 300*v - 300*v**2 + 80*v**3 + 1e-9*" + "*".join(f"(v+{i})" for i in range(1, 40))
@@ -448,7 +448,7 @@ _FORBIDDEN = {"eval", "exec", "compile", "__import__", "sympify", "sp.sympify", 
 #: The places they may, each with its reason.
 _ALLOWED = {
     # the module text this process rendered from a parsed, whitelisted law (never text read from a file)
-    ("peelapprox/_law_codegen.py", "compile"), ("peelapprox/_law_codegen.py", "exec"),
+    ("peelapprox/law/_kernels.py", "compile"), ("peelapprox/law/_kernels.py", "exec"),
     # a sweep's measure shipped by value (cloudpickle bytes made by the parent process) to its own workers
     ("comparisons/sweep/task.py", "pickle.loads"),
 }

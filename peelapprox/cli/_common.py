@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 
 from .. import GEOMETRIES, GRAVITY, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
 from .._checks import interval
-from .._params import default_load_masses
+from .._ranges import default_load_masses
 from ..errors import WallBudget
 from ..io import fmt_number, write_csv, write_rows
 from ._checks import clip, positive_float
@@ -203,7 +203,7 @@ def params_from_args(args: argparse.Namespace) -> PeelParams:
 def _check_default_load(args: argparse.Namespace) -> None:
     """With ``--loading load``, ``--load-mass M`` in its range and no ``--load``: a ValueError unless the default
     load M g lies in LOAD_RANGE, saying that the default was used (the user gave no --load) and which --load-mass
-    gives a valid one (:func:`peelapprox._params.default_load_masses`)."""
+    gives a valid one (:func:`peelapprox._ranges.default_load_masses`)."""
     M = getattr(args, "load_mass", None)
     if getattr(args, "loading", None) != "load" or getattr(args, "load", None) is not None or M is None:
         return

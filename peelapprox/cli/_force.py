@@ -43,7 +43,7 @@ TABLE_COLUMNS = (("v", "f"), ("V", "v", "f"))
 def _family_names() -> tuple[str, ...]:
     """The families' names.  peelapprox has no public list of them (``PeelForce.family`` only names them in the
     error for an unknown one), so they are read from the private registry, inside the package."""
-    from .._law_families import FAMILIES
+    from ..law._families import FAMILIES
 
     return tuple(FAMILIES)
 

@@ -8,7 +8,7 @@ import os
 import sys
 import time
 
-from .. import GEOMETRIES
+from .. import GEOMETRIES, PeelForce
 from ._checks import check_output_path, nonnegative_int, positive_int, worker_pool
 from ._common import FORMATS, add_max_wall_option, subcommand
 from ._force import add_force_options, force_from_args
@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         [a.strip() for a in args.approximations.split(",") if a.strip()]
     force = force_from_args(args)
     if args.cost is not None:
-        if force.kind != "paper" or args.out or args.plot:
+        if force != PeelForce.paper() or args.out or args.plot:
             raise ValueError("--cost times the paper's law and writes nothing: leave out --out, --plot and the law "
                              "options")
         cost = atlas_cost(I_values, V_values, sample=args.cost, workers=args.workers or 2,

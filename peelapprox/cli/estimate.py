@@ -32,15 +32,8 @@ def run_folds(args: argparse.Namespace) -> int:
     from .. import branch_structure, fixed_point
 
     law = force_from_args(args)
-    if law.kind == "paper":
-        bs = branch_structure(args.V)
-        fp = fixed_point(args.V)
-        row = {**bs.__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
-    else:  # the law's own folds (PeelForce.folds) and the steady sliding v = V, stable iff f'(V, V) > 0
-        import dataclasses
-
-        fprime = float(law.df(args.V, args.V))
-        row = {**dataclasses.asdict(law.folds(args.V)), "fixed_point_stable": fprime > 0, "fprime_at_V": fprime}
+    fp = fixed_point(args.V, force=law)  # the steady sliding v = V, stable iff f'(V, V) > 0
+    row = {**branch_structure(args.V, force=law).__dict__, "fixed_point_stable": fp.stable, "fprime_at_V": fp.fprime}
     row.update(law_fields(law, spec=args.format == "json"))
     print_mapping(row, args.format)
     return 0

@@ -4,7 +4,7 @@
 ``__pycache__`` and ``NUMBA_CACHE_DIR`` must pass :func:`peelapprox._jit.unsafe_dir`), else a private temporary
 one with a :class:`~peelapprox.errors.KernelCacheWarning`; :func:`read_verified` reads a law module without
 following links and only from a regular file of this user's; :func:`write_atomic` replaces it.  What runs is
-decided by :func:`peelapprox._law_codegen.expression_kernel`, which compares the file with the module it renders.
+decided by :func:`peelapprox.law._kernels.expression_kernel`, which compares the file with the module it renders.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from ._jit import unsafe_dir
-from .errors import KernelCacheWarning
+from .._jit import unsafe_dir
+from ..errors import KernelCacheWarning
 
 __all__ = ["MAX_MODULE_BYTES", "cache_dir", "law_dir", "numba_cache_dir", "read_verified", "write_atomic"]
 

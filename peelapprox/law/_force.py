@@ -1,69 +1,32 @@
-"""The peel-force law as data: :class:`PeelForce`, its folds (:class:`Folds`), the not-yet-supported check.
+"""The peel-force law as data: :class:`PeelForce`, one law ``f(v, V)`` [N] of the peel velocity and the pull speed.
 
-A :class:`PeelForce` is one law ``f(v, V)`` [N] of the peel velocity v and the pull speed V [m/s]
-(Eq. fvV is the paper's).  Four kinds, each plain data (strings and tuples of floats), so a law is
-immutable, hashable, equal by value, picklable and JSON-able (``dataclasses.asdict``):
-
-* ``"paper"`` — the built-in fvV (:meth:`PeelForce.paper`), evaluated by :func:`peelapprox.peel_force`
-  itself, bitwise;
-* ``"family"`` — a fixed form with its coefficients as data (:mod:`peelapprox._law_families`: the paper's
-  family, the N-shaped cubic, the power-law branches);
-* ``"expression"`` — a sympy expression in ``v`` and ``V`` kept as canonical text
-  (:mod:`peelapprox._law_expr`);
-* ``"tabulated"`` — measured curves, PCHIP in ln v (:mod:`peelapprox._law_table`).
-
-The evaluation of the paper kind and the parameter ranges live in modules that import
-:mod:`peelapprox._params`, which imports this one (for ``PeelParams.force``); so they are handed in once,
-at ``import peelapprox``, by :mod:`peelapprox._law_paper` (:func:`register_paper`) instead of imported here.
+Four kinds, each plain data (strings and tuples of floats), so a law is immutable, hashable, equal by value,
+picklable and JSON-able (``dataclasses.asdict``): ``"paper"`` (the built-in fvV, evaluated bitwise by
+:func:`peelapprox.peel_force`), ``"family"`` (a formula of :mod:`peelapprox.law._families` with its coefficients
+as data), ``"expression"`` (a sympy expression kept as canonical text) and ``"tabulated"`` (measured curves).
+What a kind does is its implementation object (:mod:`peelapprox.law._kinds`, :attr:`PeelForce.impl`).
 """
 
 from __future__ import annotations
 
 import hashlib
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
+from .._checks import in_range, shown
+from .._ranges import PARAM_RANGES
+from . import _expression, _families
+from ._folds import BranchStructure
+from ._kinds import FOLD_GRID_DENSITY, KIND_IMPLS, LawKind, shown_law
 
-from . import _law_expr, _law_families, _law_table
-from ._checks import in_range, reals, shown
-from ._law_folds import Folds, find_folds
+__all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "PeelForce", "law_label", "require_law", "shown_law"]
 
-__all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "Folds", "PeelForce", "law_label", "register_paper",
-           "require_law"]
-
-#: The kinds of law, in the order of the module docstring.
-KINDS = ("paper", "family", "expression", "tabulated")
+#: The kinds of law.
+KINDS = tuple(KIND_IMPLS)
 #: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
-ALL_LAWS = ("paper", *(f.constructor for f in _law_families.FAMILIES.values()), "expression", "tabulated")
-#: Points per unit of ln v of the grid on which :meth:`PeelForce.folds` brackets the sign changes of f'
-#: (neighbours 0.5 % apart in v; at least 2001 points).
-FOLD_GRID_DENSITY = 200
-#: Lower end [m/s] of the fold search of the families (the built-in law searches from the same 1e-12).
-_FAMILY_FOLD_LO = 1e-12
-
-#: Filled by :func:`register_paper` at ``import peelapprox``.
-_PAPER: dict[str, Any] = {}
-
-
-def register_paper(*, evaluate: Callable, branch_structure: Callable, V_range: tuple[float, float],
-                   v_range: tuple[float, float]) -> None:
-    """Hand in the built-in law's evaluation, its branch structure and the ranges of V and v (see module)."""
-    _PAPER.update(evaluate=evaluate, branch_structure=branch_structure, V_range=V_range, v_range=v_range)
-
-
-def _hooks() -> dict[str, Any]:
-    if not _PAPER:  # pragma: no cover - peelapprox/__init__ imports _law_paper
-        raise RuntimeError("peelapprox._law_paper has not registered the paper's law: import peelapprox first")
-    return _PAPER
-
-
-def _num(x: float) -> str:
-    """A coefficient as a physicist writes it, exact (shortest repr, ``150`` for ``150.0``)."""
-    r = repr(float(x))
-    return r[:-2] if r.endswith(".0") else r
+ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -108,30 +71,19 @@ class PeelForce:
 
     # ------------------------------------------------------------------ construction
     def __post_init__(self) -> None:
-        kind, family, coef, source, tables = self.kind, self.name, self.coefficients, self.source, self.tables
-        if kind not in KINDS:
-            raise ValueError(f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
-        empty = {"name": family is None, "coefficients": not coef, "source": source is None, "tables": not tables}
-        needs = {"paper": (), "family": ("name",), "expression": ("source",), "tabulated": ("tables",)}[kind]
-        if kind == "family":
-            if family not in _law_families.FAMILIES:
-                raise ValueError(f"unknown peel-force family {shown(family)}: the families are "
-                                 f"{', '.join(_law_families.FAMILIES)}")
-            coef = _law_families.coefficients(_law_families.FAMILIES[family], dict(coef))
-            needs = ("name", "coefficients")
-        elif kind == "expression":
-            if not isinstance(source, str):
-                raise TypeError(f"source of an expression law must be a string, got {type(source).__name__}")
-            source = _law_expr.from_stored(source)
-        elif kind == "tabulated":
-            tables = _law_table.check_tables(tables, _hooks()["V_range"])
-        extra = [name for name, e in empty.items() if not e and name not in needs]
+        if self.kind not in KINDS:
+            raise ValueError(f"kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        impl = KIND_IMPLS[self.kind]
+        given = {"name": self.name is not None, "coefficients": bool(self.coefficients),
+                 "source": self.source is not None, "tables": bool(self.tables)}
+        extra = [name for name, g in given.items() if g and name not in impl.needs]
+        fields = impl.canonical(self)
         if extra:
-            raise ValueError(f"a {kind!r} law takes no {', '.join(extra)}")
-        for name, value in (("coefficients", coef or ()), ("source", source), ("tables", tables or ())):
-            object.__setattr__(self, name, value)
+            raise ValueError(f"a {self.kind!r} law takes no {', '.join(extra)}")
+        for name, empty in (("coefficients", ()), ("source", None), ("tables", ())):
+            object.__setattr__(self, name, fields.get(name, getattr(self, name) or empty))
         # what repr shows is derived from the canonical content, never taken from stored data
-        object.__setattr__(self, "display", self._default_display())
+        object.__setattr__(self, "display", impl.display(self))
 
     @classmethod
     def paper(cls) -> PeelForce:
@@ -140,7 +92,7 @@ class PeelForce:
 
     @classmethod
     def family(cls, name: str, **coefficients: float) -> PeelForce:
-        """A law of the named family (:mod:`peelapprox._law_families`), missing coefficients at their defaults.
+        """A law of the named family (:mod:`peelapprox.law._families`), missing coefficients at their defaults.
 
         ValueError for an unknown family or coefficient name (the message lists the valid ones), a
         non-finite coefficient, or a non-positive scale (``v3``, ``A1``, ``v1``, ``m``).
@@ -165,7 +117,7 @@ class PeelForce:
 
         The smooth normal form of the N-shaped (rising-falling-rising) law of Hong & Yue, Phys. Rev. Lett.
         74, 254 (1995) — the generic smooth N, not Hong & Yue's own numbers (which could not be verified).
-        Folds at the roots of ``b - 2 c v + 3 d v^2``; defaults (the issue's example) put them at 0.691 and
+        Folds at the roots of ``b - 2 c v + 3 d v^2``; the defaults put them at 0.691 and
         1.809 m/s.
         """
         return cls.family("cubic", a=a, b=b, c=c, d=d)
@@ -199,7 +151,7 @@ class PeelForce:
             on v, or f, f', f'' complex or non-finite at a point of the probe (v log-spaced over
             [1e-6, 1e3] m/s; V in 0.01, 0.1, 1, 10 m/s if the law depends on V), the point named.
         """
-        text = _law_expr.canonical(expr, constants)
+        text = _expression.canonical(expr, constants)
         return _restore("expression", None, (), text, ())  # checked: no second parse and probe
 
     @classmethod
@@ -255,111 +207,60 @@ class PeelForce:
     def __reduce__(self):
         return (_restore, (self.kind, self.name, self.coefficients, self.source, self.tables, self.display))
 
-    def _default_display(self) -> str:
-        if self.kind == "expression":
-            return repr(self.source)
-        if self.kind == "tabulated":
-            parts = []
-            for V, v, f in self.tables:
-                parts.append(f"V={V!r}: {len(v)} points, v in [{v[0]:.6g}, {v[-1]:.6g}] m/s, "
-                             f"f in [{min(f):.6g}, {max(f):.6g}] N")
-            return "; ".join(parts)
-        return ""
-
     def __repr__(self) -> str:
-        if self.kind == "paper":
-            return "PeelForce.paper()"
-        if self.kind == "family":
-            ctor = _law_families.FAMILIES[str(self.name)].constructor
-            return f"PeelForce.{ctor}({', '.join(f'{n}={_num(x)}' for n, x in self.coefficients)})"
-        if self.kind == "expression":
-            return f"PeelForce.expression({self.display})"
-        return f"PeelForce.tabulated(<{self.display}>)"
+        return self.impl.show(self)
+
+    @property
+    def impl(self) -> LawKind:
+        """What this kind of law does (:mod:`peelapprox.law._kinds`)."""
+        return KIND_IMPLS[self.kind]
 
     @property
     def key(self) -> str:
         """SHA-256 (hex) of the law's canonical content: of an expression's canonical text, else of its
         kind, family, coefficients (exact hex floats) and tables; the same in every process."""
-        if self.kind == "expression":
-            text = str(self.source)
-        else:
-            parts = [self.kind, str(self.name)] + [f"{n}={float(x).hex()}" for n, x in self.coefficients]
-            for V, v, f in self.tables:
-                parts.append(f"V={'None' if V is None else float(V).hex()}")
-                parts.append(":".join(np.asarray(x, dtype="<f8").tobytes().hex() for x in (v, f)))
-            text = "|".join(parts)
-        return hashlib.sha256(text.encode()).hexdigest()
+        return hashlib.sha256(self.impl.key_text(self).encode()).hexdigest()
 
     @property
     def depends_on_V(self) -> bool:
         """True if f changes with the pull speed V."""
-        if self.kind == "paper":
-            return True
-        if self.kind == "family":
-            return _law_families.FAMILIES[str(self.name)].depends_on_V
-        if self.kind == "expression":
-            return bool(self._impl().depends_on_V)
-        return len(self.tables) > 1
+        return self.impl.depends_on_V(self)
+
+    @property
+    def inlined(self) -> bool:
+        """True for the built-in fvV, which the compiled drivers inline (its coefficients in the model block)."""
+        return self.impl.inlined
 
     @property
     def v_range(self) -> tuple[float, float]:
         """``(lo, hi)`` [m/s]: the peel velocities at which the law may be evaluated (the built-in law and the
         families: ``STATE_RANGES["v"]``, open at lo; an expression: [1e-6, 1e3]; a table: its range)."""
-        if self.kind in ("paper", "family"):
-            return _hooks()["v_range"]
-        if self.kind == "expression":
-            return _law_expr.V_DOMAIN
-        return self._impl().v_range()
+        return self.impl.v_range(self)
 
     # ------------------------------------------------------------------ evaluation
-    def _impl(self) -> Any:
-        impl = self.__dict__.get("_evaluator")
+    def _evaluator(self) -> Any:
+        """The kind's numpy evaluator of this law, built once (an expression's derivatives, a table's PCHIP)."""
+        impl = self.__dict__.get("_evaluate_with")
         if impl is None:
-            if self.kind == "expression":
-                impl = _law_expr.ExpressionLaw(str(self.source))
-            elif self.kind == "tabulated":
-                impl = _law_table.TableLaw(self.tables)
-            else:
-                fam = _law_families.FAMILIES[str(self.name)]
-                c = tuple(x for _, x in self.coefficients)
-                impl = lambda v, V, order: fam.evaluate(v, V, c, order)  # noqa: E731
-            object.__setattr__(self, "_evaluator", impl)
+            impl = self.impl.evaluator(self)
+            object.__setattr__(self, "_evaluate_with", impl)
         return impl
-
-    def _evaluate(self, v: Any, V: Any, order: int) -> Any:
-        hooks = _hooks()
-        if self.kind == "paper":
-            return hooks["evaluate"](v, V, order)
-        V = in_range("V", V, *hooks["V_range"])
-        if self.kind == "family":
-            lo, hi = hooks["v_range"]
-            va = reals("v", v, lo, hi, lo_open=True)
-        else:
-            va = reals("v", v)
-        with np.errstate(all="ignore"):
-            out = np.asarray(self._impl()(va, V, order), dtype=float)
-        if not np.all(np.isfinite(out)):
-            i = int(np.flatnonzero(~np.isfinite(out).ravel())[0])
-            what = ("f", "f'", "f''")[order]
-            raise ValueError(f"the peel-force law {self!r} gives {what} = "
-                             f"{out.ravel()[i]} at v={float(va.ravel()[i])!r} m/s, V={V!r} m/s")
-        return out[()] if out.ndim == 0 else out
 
     def f(self, v: Any, V: float) -> Any:
         """f(v, V) [N], vectorised over v (a float for a scalar v)."""
-        return self._evaluate(v, V, 0)
+        return self.impl.evaluate(self, v, V, 0)
 
     __call__ = f
 
     def df(self, v: Any, V: float) -> Any:
         """∂f/∂v (v, V) [N s/m]."""
-        return self._evaluate(v, V, 1)
+        return self.impl.evaluate(self, v, V, 1)
 
     def d2f(self, v: Any, V: float) -> Any:
         """∂²f/∂v² (v, V) [N s²/m²]."""
-        return self._evaluate(v, V, 2)
+        return self.impl.evaluate(self, v, V, 2)
 
-    def folds(self, V: float) -> Folds:
+    def folds(self, V: float) -> BranchStructure:
         """The folds of ``f(·, V)`` (local maximum, then local minimum in v) and where jumps from them land.
 
         The built-in law's are :func:`peelapprox.branch_structure`'s.  Any other law's are found on its
@@ -370,8 +271,10 @@ class PeelForce:
 
         Returns
         -------
-        Folds
-            ``has_folds=False`` (every fold field None) when f' > 0 throughout: no stick-slip at this V.
+        BranchStructure
+            The folds and landings (``v_inflection``, ``f_zero``, ``v_breakdown`` NaN:
+            ``branch_structure(V, force=law)`` has every field); ``has_folds=False`` (every fold field None)
+            when f' > 0 throughout: no stick-slip at this V.
 
         Raises
         ------
@@ -383,30 +286,12 @@ class PeelForce:
         if cache is None:
             cache = {}
             object.__setattr__(self, "_folds", cache)
-        V = in_range("V", V, *_hooks()["V_range"])
+        V = in_range("V", V, *PARAM_RANGES["V"])
         if V not in cache:
             if len(cache) >= 256:
                 cache.clear()
-            cache[V] = self._find_folds(V)
+            cache[V] = self.impl.folds(self, V)
         return cache[V]
-
-    def _find_folds(self, V: float) -> Folds:
-        if self.kind == "paper":
-            bs = _hooks()["branch_structure"](V)
-            return Folds(V, bs.has_folds, bs.v_max, bs.f_max, bs.v_min, bs.f_min, bs.v_land_cd, bs.v_land_ab)
-        lo, hi = self.v_range
-        if self.kind == "family":
-            lo = lo * 10.0  # the families' domain is open at lo
-            window = (_FAMILY_FOLD_LO, hi)
-        else:
-            window = (lo, hi)
-        impl = self._impl()
-
-        def fn(v: np.ndarray, order: int) -> np.ndarray:
-            with np.errstate(all="ignore"):
-                return np.asarray(impl(v, V, order), dtype=float)
-
-        return find_folds(fn, V, window, (lo, hi), shown_law(self), FOLD_GRID_DENSITY)
 
 
 def _restore(kind: str, name: str | None, coefficients: tuple, source: str | None, tables: tuple,
@@ -417,25 +302,17 @@ def _restore(kind: str, name: str | None, coefficients: tuple, source: str | Non
     for field_name, value in (("kind", kind), ("name", name), ("coefficients", coefficients), ("source", source),
                               ("tables", tables)):
         object.__setattr__(law, field_name, value)
-    object.__setattr__(law, "display", law._default_display())
+    object.__setattr__(law, "display", law.impl.display(law))
     return law
 
 
 _PAPER_LAW = PeelForce("paper")
 
 
-def shown_law(force: Any, limit: int = 300) -> str:
-    """``repr(force)`` for a message, cut after ``limit`` characters (an expression law's text may be long)."""
-    r = repr(force)
-    return r if len(r) <= limit else f"{r[:limit]}... ({len(r)} characters)"
-
-
 def law_label(force: Any) -> str:
     """The name by which a consumer lists the laws it honours: ``"paper"`` (the built-in fvV), a family's
     constructor (``"paper_family"``, ``"cubic"``, ``"power_branches"``), ``"expression"`` or ``"tabulated"``."""
-    if force.kind == "family":
-        return str(_law_families.FAMILIES[str(force.name)].constructor)
-    return str(force.kind)
+    return force.impl.label(force)
 
 
 def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = ALL_LAWS) -> None:
@@ -444,7 +321,7 @@ def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = A
     diffsol peer need a closed form; a driver with fvV inlined needs the paper's law).  ``where`` names the
     consumer (default: the caller's caller, i.e. the public function that validated its ``params``)."""
     force = getattr(params, "force", None)
-    if force is None or force.kind == "paper" or law_label(force) in laws:
+    if force is None or force.inlined or law_label(force) in laws:
         return
     if where is None:
         where = sys._getframe(2).f_code.co_name

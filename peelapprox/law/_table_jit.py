@@ -1,13 +1,13 @@
-"""The compiled tabulated peel-force law: a measured curve f(v) as data for the compiled solvers (issue 15).
+"""The compiled tabulated peel-force law: a measured curve f(v) as data for the compiled solvers.
 
-:func:`table_law` is a law of the ABI of :mod:`peelapprox._law_abi` (signature ``LAW_SIG``, compiled once,
+:func:`table_law` is a law of the ABI of :mod:`peelapprox.law._abi` (signature ``LAW_SIG``, compiled once,
 cached on disk): its coefficients ``coef`` are the packed tables of a ``PeelForce.tabulated`` law at the run's
 pull speed V, built by :func:`table_coefficients`.  A new table, of any length, is new data and recompiles
 nothing.  It plays the part of Eq. (fvV) for a measured curve.
 
 What it evaluates
 -----------------
-Exactly the piecewise cubic that :class:`~peelapprox._law_table.TableLaw` evaluates with scipy: for each table
+Exactly the piecewise cubic that :class:`~peelapprox.law._table.TableLaw` evaluates with scipy: for each table
 the :class:`~scipy.interpolate.PchipInterpolator` of f in ``u = ln v`` (its breakpoints ``.x`` and its
 coefficients ``.c`` are packed as they are), evaluated on the interval ``x[i] <= u < x[i+1]`` (the last one
 closed at the right, as scipy's ``find_interval``), found by binary search between the bounds of a guide
@@ -69,9 +69,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jit import kernel
-from ._law_abi import LAW_FP, LAW_LNV, LAW_SIG
-from ._law_table import TableLaw, check_tables
+from .._jit import kernel
+from ._abi import LAW_FP, LAW_LNV, LAW_SIG
+from ._table import TableLaw, check_tables
 
 __all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "table_law", "table_coefficients"]
 
@@ -139,9 +139,9 @@ def _pchip_sums(coef, u):
     return F, D, D2
 
 
-@kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a tabulated law (issue 17)
+@kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a tabulated law: the default path needs none
 def table_law(x, coef, form):
-    """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox._law_abi`), ``coef`` from
+    """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox.law._abi`), ``coef`` from
     :func:`table_coefficients`: PCHIP in ``u = ln v`` as scipy evaluates it, continued C¹-linearly in u outside
     the tables' common range (for Runge-Kutta stages only: module docstring)."""
     if form == LAW_LNV:
@@ -181,10 +181,10 @@ def table_coefficients(tables, V: float) -> np.ndarray:
     ----------
     tables : sequence of (V or None, v, f)
         The law's tables, as ``PeelForce.tables`` (checked again by
-        :func:`peelapprox._law_table.check_tables`: sorted, positive, finite, one maximum then one minimum).
+        :func:`peelapprox.law._table.check_tables`: sorted, positive, finite, one maximum then one minimum).
     V : float
         The run's pull speed [m/s] (constant during a run): selects the table, or the two around V and their
-        weights (linear in V), as :class:`~peelapprox._law_table.TableLaw` does.
+        weights (linear in V), as :class:`~peelapprox.law._table.TableLaw` does.
 
     Returns
     -------
@@ -199,7 +199,7 @@ def table_coefficients(tables, V: float) -> np.ndarray:
     TypeError
         V not a real number, tables not a sequence of triples.
     """
-    from ._checks import finite
+    from .._checks import finite
 
     V = finite("V", V)
     tables = check_tables(tables, (0.0, np.inf))

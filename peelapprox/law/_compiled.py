@@ -1,12 +1,12 @@
 """Any :class:`peelapprox.PeelForce` as the compiled solvers take it: kernel, coefficients, branch structure, domain.
 
 :func:`compiled_law` is the one place where a law becomes what a compiled driver calls (the ABI of
-:mod:`peelapprox._law_abi`: ``law(x, coef, form)``) at one pull speed V:
+:mod:`peelapprox.law._abi`: ``law(x, coef, form)``) at one pull speed V:
 
 =================  ==========================================================================================
-kind               kernel and ``coef``
+kind               kernel and ``coef`` (the law's :meth:`~peelapprox.law._kinds.LawKind.kernel`)
 =================  ==========================================================================================
-``paper``          :func:`peelapprox._law_abi.paper_law`, ``(b, A)`` of fvV; the drivers inline it instead
+``paper``          :func:`peelapprox.law._abi.paper_law`, ``(b, A)`` of fvV; the drivers inline it instead
                    (``inlined=True``: the default path, bitwise the numbers of 0.2.0)
 ``family``         the family's kernel compiled once with the package; ``coef`` packed from V and the
                    coefficients (changing a coefficient recompiles nothing)
@@ -26,6 +26,7 @@ the breakdown velocity is ``lo`` itself and ``f_zero = f(lo)``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -34,18 +35,10 @@ from typing import Any, cast
 import numpy as np
 from scipy.optimize import brentq
 
-from ._checks import shown
-from ._law import PeelForce
-from ._law_abi import LAW_FP, LAW_FPP, LAWS, paper_coefficients, unused_law
-from ._law_codegen import expression_kernel, family_kernel
-from ._law_families import packed
-from ._law_table_jit import table_coefficients, table_law
-from ._params import STATE_RANGES
-from ._peelforce import BREAKDOWN_LEVEL, BranchStructure, FixedPoint, _check_V
-from ._peelforce import branch_structure as _paper_structure
-from ._peelforce import fixed_point as _paper_fixed_point
+from ._abi import LAW_FP, LAW_FPP, unused_law
+from ._folds import BREAKDOWN_LEVEL, BranchStructure
 
-__all__ = ["CompiledLaw", "U_ZERO", "branch_structure", "compiled_law", "fixed_point", "law_domain", "law_structure"]
+__all__ = ["CompiledLaw", "U_ZERO", "compiled_law", "law_domain", "law_structure"]
 
 #: ``ln v`` standing for ``v = 0+`` where a law's domain reaches 0 (e^-690 ≈ 1e-300 m/s: f(0+) to rounding).
 U_ZERO = -690.0
@@ -74,7 +67,7 @@ class CompiledLaw:
         True for the paper's law, which the drivers inline (they ignore ``fn`` and ``coef``).
     """
 
-    force: PeelForce
+    force: Any
     V: float
     fn: Any
     coef: np.ndarray
@@ -86,7 +79,7 @@ class CompiledLaw:
     def arg(self) -> Any:
         """The law argument a compiled driver is passed: :attr:`fn`, or for the paper's law, which the drivers
         inline and never call through the argument, a trivial kernel of the law type (so that the default path
-        compiles no second copy of fvV: issue 17)."""
+        compiles no second copy of fvV)."""
         return unused_law if self.inlined else self.fn
 
     def f(self, v: float) -> float:
@@ -130,39 +123,19 @@ class CompiledLaw:
         return math.exp(brentq(g, lo, hi, xtol=1e-15, rtol=_RTOL))
 
 
-def law_domain(force: PeelForce) -> tuple[float, float]:
+def law_domain(force: Any) -> tuple[float, float]:
     """``(lo, hi)`` [m/s] where the compiled law may be evaluated (module docstring)."""
-    if force.kind in ("paper", "family"):
-        return (0.0, math.inf)
-    return force.v_range
+    return force.impl.domain(force)
 
 
-def _kernel(force: PeelForce, V: float) -> tuple[Callable, np.ndarray, bool]:
-    """``(kernel, coef, inlined)`` of ``force`` at V (module docstring's table)."""
-    if force.kind == "paper":
-        return LAWS["paper"], paper_coefficients(V), True
-    if force.kind == "family":
-        fn, pack = family_kernel(str(force.name))
-        return fn, packed(f"params.force={shown(force)}", pack, V, tuple(x for _, x in force.coefficients)), False
-    if force.kind == "expression":
-        fn, pack = expression_kernel(str(force.source))
-        return fn, packed(f"params.force={shown(force)}", pack, V), False
-    return table_law, table_coefficients(force.tables, V), False
-
-
-def law_structure(force: PeelForce, V: float, fn: Callable, coef: np.ndarray,
+def law_structure(fo: BranchStructure, V: float, fn: Callable, coef: np.ndarray,
                   domain: tuple[float, float]) -> BranchStructure:
-    """The :class:`BranchStructure` of ``force`` at V with the compiled kernel ``fn``/``coef``.
-
-    The paper's law: :func:`peelapprox.branch_structure` (bitwise).  Any other: the folds and landings of
-    :meth:`PeelForce.folds`; ``f_zero = f(lo)`` (``lo`` the domain's start, or ``v = e^-690`` for a domain
+    """The whole :class:`BranchStructure` at V of a law with the folds ``fo`` (:meth:`PeelForce.folds`) and the
+    compiled kernel ``fn``/``coef``: ``f_zero = f(lo)`` (``lo`` the domain's start, or ``v = e^-690`` for a domain
     reaching 0); the breakdown velocity is ``lo`` for a domain starting above 0, else where
     ``f - f_zero = BREAKDOWN_LEVEL max(|f_zero|, 1)`` (Brent in ln v, as for fvV); ``v_inflection`` the root
     of f'' between the folds (Brent), or without folds the minimiser of f' on a grid.
     """
-    if force.kind == "paper":
-        return _paper_structure(V)
-    fo = force.folds(V)
     lo_d, hi_d = domain
 
     def f(u: float) -> float:
@@ -190,15 +163,13 @@ def law_structure(force: PeelForce, V: float, fn: Callable, coef: np.ndarray,
         w = np.linspace(max(u_lo, math.log(1e-6)), math.log(min(hi_d, 1e3)), 2001)
         d = np.array([float(fn(math.exp(x), coef, LAW_FP)[1]) for x in w])
         v_infl = math.exp(float(w[int(np.argmin(d))]))
-    return BranchStructure(V=float(V), has_folds=fo.has_folds, v_max=fo.v_max, f_max=fo.f_max, v_min=fo.v_min,
-                           f_min=fo.f_min, v_inflection=v_infl, f_zero=f_zero, v_land_cd=fo.v_land_cd,
-                           v_land_ab=fo.v_land_ab, v_breakdown=v_br)
+    return dataclasses.replace(fo, V=float(V), v_inflection=v_infl, f_zero=f_zero, v_breakdown=v_br)
 
 
-_CACHE: dict[tuple[PeelForce, float], CompiledLaw] = {}
+_CACHE: dict[tuple[Any, float], CompiledLaw] = {}
 
 
-def compiled_law(force: PeelForce, V: float) -> CompiledLaw:
+def compiled_law(force: Any, V: float) -> CompiledLaw:
     """The law ``force`` at pull speed V as the compiled drivers take it (module docstring); cached per (law, V).
 
     Raises
@@ -211,65 +182,15 @@ def compiled_law(force: PeelForce, V: float) -> CompiledLaw:
     key = (force, float(V))
     out = _CACHE.get(key)
     if out is None:
-        domain = law_domain(force)
-        v_lo = STATE_RANGES["v"][0]
-        if force.kind == "tabulated" and domain[0] < v_lo:
-            raise ValueError(f"params.force: the table starts at v={domain[0]!r} m/s, below the model's velocities "
-                             f"STATE_RANGES['v'] = ({v_lo:g}, {STATE_RANGES['v'][1]:g}] m/s (v^2 underflows in f'' "
-                             "there): give the table's v in m/s, within that range")
-        fn, coef, inlined = _kernel(force, V)
+        impl = force.impl
+        domain = impl.domain(force)
+        fn, coef = impl.kernel(force, V)
         try:
-            bs = law_structure(force, V, fn, coef, domain)
+            bs = impl.structure(force, V, fn, coef, domain)
         except ValueError as e:
             raise ValueError(f"params.force: {e}") from None
-        out = CompiledLaw(force, float(V), fn, np.ascontiguousarray(coef, dtype=float), bs, domain, inlined)
+        out = CompiledLaw(force, float(V), fn, np.ascontiguousarray(coef, dtype=float), bs, domain, impl.inlined)
         if len(_CACHE) >= 512:
             _CACHE.clear()
         _CACHE[key] = out
     return out
-
-
-def branch_structure(V: float, *, force: PeelForce | None = None) -> BranchStructure:
-    """Folds, inflection and landing velocities of ``f(·, V)``; cached per V (per law and V).
-
-    The structure every solver uses for the law ``force`` (a :class:`peelapprox.PeelForce`; None or
-    ``PeelForce.paper()``: fvV).  For fvV, the folds are the two roots of ``f'(v, V) = 0`` on either side of the
-    unique minimiser of ``f'`` (root of ``f''``), each located by Brent's method to ``xtol = 4 ulp``, robust
-    near the cusp where the folds merge (``V ≈ 5.2``).  For another law, :func:`law_structure` (the folds of
-    :meth:`PeelForce.folds`, ``f(0+)`` or f at the start of the law's domain, the breakdown velocity, the
-    minimiser of f').
-
-    Parameters
-    ----------
-    V : float
-        Pull speed [m/s], in ``PARAM_RANGES["V"]``.
-    force : PeelForce, optional
-        The law (default: the paper's fvV).
-
-    Returns
-    -------
-    BranchStructure
-
-    Raises
-    ------
-    ValueError
-        If V is outside ``PARAM_RANGES["V"]`` (TypeError if not a number), or the law's folds cannot be found
-        (the message names ``params.force``).
-    """
-    if force is None or force.kind == "paper":
-        return _paper_structure(V)
-    return compiled_law(force, _check_V(V)).structure
-
-
-def fixed_point(V: float, R: float = 0.1, *, force: PeelForce | None = None) -> FixedPoint:
-    """Fixed point ``α = 0, ω = V/R, v = V, F = f(V, V)`` of FLOW1–flow3 with CONSTR and its stability
-    (``f'(V, V) > 0``: the paper's Hopf criterion).
-
-    ``V`` and ``R`` must lie in :data:`peelapprox.PARAM_RANGES`; ``force`` (a :class:`peelapprox.PeelForce`;
-    None: fvV) is the law, evaluated at ``v = V`` (ValueError if V is outside its domain).
-    """
-    base = _paper_fixed_point(V, R)  # validates V and R
-    if force is None or force.kind == "paper":
-        return base
-    f, fp = float(force.f(base.v, base.v)), float(force.df(base.v, base.v))
-    return FixedPoint(0.0, base.omega, f, base.v, fp, bool(fp > 0))

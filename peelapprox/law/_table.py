@@ -1,4 +1,4 @@
-"""Tabulated peel-force laws: a measured curve f(v), PCHIP in ln v, checked point by point (issue 15).
+"""Tabulated peel-force laws: a measured curve f(v), PCHIP in ln v, checked point by point.
 
 A table is ``(V, v, f)``: the pull speed it was measured at (None: used at every V), peel velocities
 [m/s] and forces [N].  :func:`check_table` validates one; :class:`TableLaw` evaluates a set of them.
@@ -43,7 +43,7 @@ def check_table(v, f, label: str = "") -> tuple[tuple[float, ...], tuple[float, 
 
 def _floats(name: str, x) -> np.ndarray:
     """x as a float array (NaN kept: :func:`_check_arrays` names it), or ArgumentTypeError."""
-    from ._checks import ArgumentTypeError
+    from .._checks import ArgumentTypeError
 
     bad = x is None or isinstance(x, (str, bytes, bool, np.bool_))
     try:
@@ -155,7 +155,7 @@ def check_tables(tables, V_range: tuple[float, float]) -> tuple[Table, ...]:
     """``(V, v, f)`` triples as canonical tuples, each table checked by :func:`check_table`: one table (V a
     pull speed in ``V_range`` or None: used at every V), or several at strictly increasing V in ``V_range``
     whose v ranges overlap."""
-    from ._checks import in_range
+    from .._checks import in_range
 
     try:
         items = list(tables)

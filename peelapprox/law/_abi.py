@@ -3,7 +3,7 @@
 A driver compiled for the law type :data:`LAW_TYPE` takes the law as a first-class function argument
 ``law`` and its coefficients as a float vector ``coef``, and evaluates the peel force (fvV for the paper's law)
 as ``law(x, coef, form)``; it is compiled once for that type, so a new law or new coefficients recompile
-nothing (docs/design-peel-force-laws.md, issue 15).  The V-dependence of a law is evaluated in Python when a
+nothing (docs/design-peel-force-laws.md).  The V-dependence of a law is evaluated in Python when a
 run is packed (V is constant during a run): ``coef`` of the paper's law is ``(b, A) = peel_force_coefficients(V)``.
 
 The three forms (``form``, an int64):
@@ -21,8 +21,8 @@ compiled law costs one compilation per machine).  :func:`paper_law` (:data:`LAWS
 Ananthakrishna (2004) through exactly the generated code the drivers inline (:mod:`peelapprox._generated`:
 ``peel_force_lnv``, ``peel_force_fp``, ``peel_force_fpp``), so a driver taking it as an argument gives bitwise
 the numbers of the inlined law.  The other laws are generated from their sympy form
-(:mod:`peelapprox._law_codegen`: the families in :mod:`peelapprox._generated_laws`, an expression in the user
-cache) or are the table kernel (:mod:`peelapprox._law_table_jit`); :func:`peelapprox._law_compiled.compiled_law`
+(:mod:`peelapprox.law._kernels`: the families from :mod:`peelapprox.law._generated`, an expression in the user
+cache) or are the table kernel (:mod:`peelapprox.law._table_jit`); :func:`peelapprox.law._compiled.compiled_law`
 picks the kernel of a :class:`peelapprox.PeelForce`.
 """
 
@@ -31,8 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numba import types
 
-from ._jit import kernel
-from ._peelforce import (
+from .._jit import kernel
+from ._paper import (
     peel_force_coefficients,
     peel_force_fp_jit,
     peel_force_fpp_jit,
@@ -50,7 +50,7 @@ LAW_TYPE = types.FunctionType(LAW_SIG)
 LAW_LNV, LAW_FP, LAW_FPP = 0, 1, 2
 
 
-@kernel(signature=LAW_SIG, lazy=True)  # compiled on first use: the default drivers inline fvV instead (issue 17)
+@kernel(signature=LAW_SIG, lazy=True)  # compiled on first use: the default drivers inline fvV instead
 def paper_law(x, coef, form):
     """fvV at ``x`` in the form ``form`` with ``coef = (b, A) = peel_force_coefficients(V)``: the generated
     ``peel_force_lnv`` / ``peel_force_fp`` / ``peel_force_fpp`` unchanged (the inlined law's arithmetic)."""
@@ -65,8 +65,8 @@ def paper_law(x, coef, form):
 @kernel(signature=LAW_SIG, lazy=True)
 def unused_law(x, coef, form):
     """The law argument of a driver with the paper's law inlined, which never calls it
-    (:attr:`peelapprox._law_compiled.CompiledLaw.arg`): a trivial kernel of the law type, so that the default
-    path does not compile :func:`paper_law` (issue 17)."""
+    (:attr:`peelapprox.law._compiled.CompiledLaw.arg`): a trivial kernel of the law type, so that the default
+    path does not compile :func:`paper_law` (a cold start compiles less)."""
     return np.nan, np.nan, np.nan
 
 

@@ -35,7 +35,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from ._checks import shown
+from .._checks import shown
 
 __all__ = ["FUNCTIONS", "MAX_CALL_DEPTH", "MAX_CHARS", "MAX_EXPONENT", "MAX_LITERAL", "MAX_NODES", "NON_SMOOTH",
            "canonical_text", "parse"]

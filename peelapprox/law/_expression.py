@@ -2,7 +2,7 @@
 
 :func:`canonical` turns what the user typed (a string or a sympy expression, with named constants) into
 the canonical text of the law -- the expression with the constants substituted, printed in the grammar of
-:mod:`peelapprox._law_grammar` (floats exact), in the symbols ``v`` and ``V`` (both positive) -- and checks
+:mod:`peelapprox.law._grammar` (floats exact), in the symbols ``v`` and ``V`` (both positive) -- and checks
 it; :class:`ExpressionLaw` rebuilds the expression from that text by the same grammar (parsed, never
 evaluated) and evaluates f, f' and f'' (derivatives by sympy) through ``sympy.lambdify`` to numpy (lambdify
 prints the checked sympy tree as numpy code: only whitelisted nodes reach it).  The canonical text is plain
@@ -24,9 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from . import _law_grammar
-from ._checks import shown
-from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
+from .._checks import shown
+from .._deadline import LAW_BUILD_SECONDS, Expired, time_limit
+from . import _grammar
 
 __all__ = ["PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical", "from_stored", "from_text"]
 
@@ -61,8 +61,8 @@ def _grammar_round_trip(e: Any, label: str) -> str:
     """The canonical text of ``e``, checked to parse back to ``e`` itself (at most two printings)."""
     v, V = _symbols()
     for _ in range(3):
-        text = _law_grammar.canonical_text(e)
-        back, _used = _law_grammar.parse(text, {"v": v, "V": V})
+        text = _grammar.canonical_text(e)
+        back, _used = _grammar.parse(text, {"v": v, "V": V})
         back = _integral_floats(back)
         if back == e:
             return text
@@ -74,7 +74,7 @@ def _grammar_round_trip(e: Any, label: str) -> str:
 def canonical(expr: Any, constants: dict[str, Any]) -> str:
     """The canonical text of ``expr`` with ``constants`` substituted; checked.
 
-    The text is ``expr`` printed in the grammar of :mod:`peelapprox._law_grammar` (sympy's string form, floats
+    The text is ``expr`` printed in the grammar of :mod:`peelapprox.law._grammar` (sympy's string form, floats
     exact), which :func:`from_text` parses back to the same expression: what a law stores and hashes.  A string
     is parsed by that grammar, never evaluated; a sympy expression is printed and parsed the same way, so
     both meet the same whitelist.
@@ -91,7 +91,7 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
     """
     import sympy as sp
 
-    from ._checks import real
+    from .._checks import real
 
     v, V = _symbols()
     values: dict[str, Any] = {}
@@ -99,12 +99,12 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
         if name in ("v", "V"):
             raise ValueError(f"constant {name!r} clashes with the law's variable {name} (v: peel velocity, "
                              "V: pull speed, m/s)")
-        if not (isinstance(name, str) and name.isidentifier()) or name in _law_grammar.FUNCTIONS:
+        if not (isinstance(name, str) and name.isidentifier()) or name in _grammar.FUNCTIONS:
             raise ValueError(f"constant name {shown(str(name), 40)} must be an identifier other than "
                              "a function's name")
         x = real(name, value)
-        if not math.isfinite(x) or abs(x) > _law_grammar.MAX_LITERAL:
-            raise ValueError(f"constant {name} must be finite and at most {_law_grammar.MAX_LITERAL:g} in "
+        if not math.isfinite(x) or abs(x) > _grammar.MAX_LITERAL:
+            raise ValueError(f"constant {name} must be finite and at most {_grammar.MAX_LITERAL:g} in "
                              f"magnitude, got {value!r}")
         values[name] = _number(x)
     if isinstance(expr, str):
@@ -112,7 +112,7 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
         text = expr
     elif isinstance(expr, sp.Basic):
         label = shown(str(expr))
-        text = _law_grammar.canonical_text(expr)
+        text = _grammar.canonical_text(expr)
     else:
         raise TypeError(f"expression must be a string or a sympy expression, got {type(expr).__name__}")
     try:
@@ -129,7 +129,7 @@ def _checked_text(text: str, values: dict[str, Any], label: str) -> str:
     import sympy as sp
 
     v, V = _symbols()
-    e, used = _law_grammar.parse(text, {"v": v, "V": V, **values})
+    e, used = _grammar.parse(text, {"v": v, "V": V, **values})
     unused = sorted(set(values) - used)
     if unused:
         raise ValueError(f"constant(s) {', '.join(unused)} do not occur in the expression {label}")
@@ -160,7 +160,7 @@ def from_stored(text: Any) -> str:
     if not isinstance(text, str):
         raise TypeError(f"source of an expression law must be a string, got {type(text).__name__}")
     v, V = _symbols()
-    e, _used = _law_grammar.parse(text, {"v": v, "V": V}, legacy=True)
+    e, _used = _grammar.parse(text, {"v": v, "V": V}, legacy=True)
     if not isinstance(e, sp.Expr):
         raise ValueError(f"stored expression {shown(text)} is not a scalar expression")
     return canonical(e, {})
@@ -169,7 +169,7 @@ def from_stored(text: Any) -> str:
 def from_text(text: str) -> Any:
     """The sympy expression of a canonical text (:func:`canonical`), by the grammar: never evaluated."""
     v, V = _symbols()
-    return _law_grammar.parse(text, {"v": v, "V": V})[0]
+    return _grammar.parse(text, {"v": v, "V": V})[0]
 
 
 class ExpressionLaw:

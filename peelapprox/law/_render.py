@@ -1,7 +1,7 @@
-"""Compiled peel-force laws generated from their symbolic form: the families and user expressions (issue 15).
+"""The rendering of a peel-force law from its symbolic form into Python source of the compiled laws' ABI.
 
-:func:`render_law` turns a law ``f(v, V; c)`` (sympy, :mod:`peelapprox._law_sympy`) into the Python source of
-a law of the ABI of :mod:`peelapprox._law_abi` — ``law(x, coef, form) -> (f8, f8, f8)`` — and of its packing
+:func:`render_law` turns a law ``f(v, V; c)`` (sympy, :mod:`peelapprox.law._symbolic`) into the Python source of
+a law of the ABI of :mod:`peelapprox.law._abi` — ``law(x, coef, form) -> (f8, f8, f8)`` — and of its packing
 ``pack(V, c) -> coef``.  The rendering:
 
 * **u = ln v.**  Every power of v with a non-integer exponent becomes ``exp(p u)`` (a half-integer one
@@ -18,43 +18,21 @@ a law of the ABI of :mod:`peelapprox._law_abi` — ``law(x, coef, form) -> (f8, 
 * **One code path, CSE** over f, v f', f', f'' (as :mod:`peelapprox._symbolic` does): f, then the return of
   ``LAW_LNV`` with v f', then f' and the return of ``LAW_FP``, then f''; floats are printed exactly (``repr``).
 
-The families are rendered into the committed module :mod:`peelapprox._generated_laws` (regenerate with
-``python -m peelapprox._law_codegen``; a test checks that it is current) and compiled lazily by
-:func:`family_kernel`.  An expression law is rendered by :func:`expression_kernel` into a module of the user's
-cache directory (``PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``), named by the SHA-256 of its
-canonical text and :func:`codegen_version` (so a changed expression or code generator is a new file, never a
-stale kernel), written atomically (temp file + ``os.replace``) and compiled with numba's on-disk cache: a
-second process loads the law and compiles nothing.
-
-sympy is imported by this module (rendering) only when a law is rendered; :func:`family_kernel` does not
-import it.
+sympy is imported when a law is rendered, not with this module.
 """
 
 from __future__ import annotations
 
-import hashlib
-import os
 import re
-import sys
-import types
-import warnings
-from collections.abc import Callable, Sequence
-from pathlib import Path
+from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
+from ._abi import LAW_FP, LAW_FPP, LAW_LNV
 
-from ._checks import shown
-from ._deadline import LAW_BUILD_SECONDS, Expired, time_limit
-from ._jit import kernel
-from ._law_abi import LAW_FP, LAW_FPP, LAW_LNV, LAW_SIG
-from ._law_cache import cache_dir, law_dir, read_verified, write_atomic
-from .errors import KernelCacheWarning
+__all__ = ["CODEGEN_VERSION", "render_law"]
 
-__all__ = ["CODEGEN_VERSION", "cache_dir", "codegen_version", "expression_kernel", "expression_source",
-           "family_kernel", "render_law", "render_module", "write_module"]
-
-#: Bump when the rendering changes what a law computes (the file's own hash is in :func:`codegen_version` too).
+#: Bump when the rendering changes what a law computes (the file's own hash is in
+#: :func:`peelapprox.law._kernels.codegen_version` too).
 CODEGEN_VERSION = "law-codegen-1"
 #: The forms hard-coded in the rendered source (0, 1, 2), checked against the ABI's.
 _FORMS = (LAW_LNV, LAW_FP, LAW_FPP)
@@ -62,6 +40,7 @@ assert _FORMS == (0, 1, 2), _FORMS
 #: Names a coefficient may not take (the kernel's and pack's own).
 _RESERVED = {"x", "coef", "form", "v", "u", "s", "V", "numpy", "cs"}
 _GENERATED_NAME = re.compile(r"^[wt]\d+$")
+
 
 
 # ---------------------------------------------------------------------------------------------- rendering
@@ -166,7 +145,7 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     name : str
         The law function's name; ``pack_name`` (default ``name + "_pack"``) is its packing.
     expr : sympy expression
-        ``f`` in the symbols ``v`` and ``V`` of :mod:`peelapprox._law_sympy` and ``coef_symbols``.
+        ``f`` in the symbols ``v`` and ``V`` of :mod:`peelapprox.law._symbolic` and ``coef_symbols``.
     coef_symbols : sequence of sympy symbols
         The coefficients, in the order ``pack``'s ``c`` gives them.
     doc : str
@@ -186,7 +165,7 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     """
     import sympy as sp
 
-    from ._law_sympy import V, v
+    from ._symbolic import V, v
 
     _check_names(coef_symbols)
     unknown = sorted(s.name for s in expr.free_symbols - {v, V, *coef_symbols})
@@ -232,7 +211,7 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     pack_name = pack_name or f"{name}_pack"
     layout = ", ".join(p.doprint(d) for d in derived)
     lines = [f"def {name}(x, coef, form):",
-             f'    """{doc or "A peel-force law"} in the ABI of peelapprox._law_abi.',
+             f'    """{doc or "A peel-force law"} in the ABI of peelapprox.law._abi.',
              "",
              f"    coef = {pack_name}(V, c) = [{layout}]",
              '    """',
@@ -263,179 +242,3 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     else:
         plines.append("    return numpy.zeros(0, dtype=numpy.float64)")
     return law + "\n\n" + "\n".join(plines) + "\n"
-
-
-# ---------------------------------------------------------------------------------------------- the families
-_HEADER = '''"""GENERATED by ``python -m peelapprox._law_codegen`` -- do not edit by hand.
-
-The peel-force families of :mod:`peelapprox._law_families`, rendered by :func:`peelapprox._law_codegen.render_law`
-from their symbolic form in :mod:`peelapprox._law_sympy`: for each family ``law_<name>(x, coef, form)`` in the
-ABI of :mod:`peelapprox._law_abi` and ``law_<name>_pack(V, c)`` giving its ``coef`` from the pull speed V and the
-family's coefficients (in the family's order).  Plain Python on numpy functions: numba compiles the laws
-(:func:`peelapprox._law_codegen.family_kernel`) and numpy evaluates them on arrays (the families' evaluators).
-"""
-
-import numpy
-'''
-
-
-def render_module() -> str:
-    """The source text of :mod:`peelapprox._generated_laws`."""
-    from ._law_families import FAMILIES
-    from ._law_sympy import family_expression
-
-    parts = [_HEADER]
-    for name, fam in FAMILIES.items():
-        expr, syms = family_expression(name)
-        parts.append(render_law(f"law_{name}", expr, syms, doc=f"The {name!r} family ({fam.reference})"))
-    parts.append("#: family name -> (law, pack)\nLAWS = {\n"
-                 + "".join(f"    {name!r}: (law_{name}, law_{name}_pack),\n" for name in FAMILIES) + "}\n")
-    return "\n\n".join(parts)
-
-
-def write_module(path: str | os.PathLike | None = None) -> str:
-    """Render and write :mod:`peelapprox._generated_laws`; return the path."""
-    target = Path(path) if path else Path(__file__).with_name("_generated_laws.py")
-    target.write_text(render_module())
-    return str(target)
-
-
-_FAMILY_KERNELS: dict[str, tuple[Callable, Callable]] = {}
-
-
-def family_kernel(name: str) -> tuple[Any, Callable[..., np.ndarray]]:
-    """The compiled law of the family ``name`` and its packing: ``(law, pack)``.
-
-    ``law`` is compiled for :data:`peelapprox._law_abi.LAW_SIG` by :func:`peelapprox._jit.kernel` (cached on
-    disk); ``pack(V, c)`` gives its ``coef`` (float64 array) from the pull speed V and the coefficients ``c``
-    in the family's order (``tuple(x for _, x in force.coefficients)``).  Memoised per process.
-
-    Raises
-    ------
-    ValueError
-        ``name`` is not a family (the message lists them).
-    """
-    from . import _generated_laws as G
-
-    if name not in G.LAWS:
-        raise ValueError(f"unknown peel-force family {name!r}: the families are {', '.join(G.LAWS)}")
-    if name not in _FAMILY_KERNELS:
-        law, pack = G.LAWS[name]
-        _FAMILY_KERNELS[name] = (kernel(signature=LAW_SIG)(law), pack)
-    return _FAMILY_KERNELS[name]
-
-
-# ---------------------------------------------------------------------------------------------- expressions
-_EXPR_HEADER = '''"""GENERATED by peelapprox._law_codegen ({version}) -- the expression peel-force law
-
-    {text}
-
-as ``law(x, coef, form)`` in the ABI of peelapprox._law_abi and ``pack(V)`` giving its coef.
-"""
-
-import numpy
-'''
-
-_EXPRESSION_KERNELS: dict[str, tuple[Any, Callable]] = {}
-
-
-def codegen_version() -> str:
-    """:data:`CODEGEN_VERSION` and the first 12 hex digits of the SHA-256 of this file and
-    :mod:`peelapprox._law_sympy` (a changed renderer gives new file names: no stale kernel)."""
-    h = hashlib.sha256()
-    for f in ("_law_codegen.py", "_law_sympy.py"):
-        h.update(Path(__file__).with_name(f).read_bytes())
-    return f"{CODEGEN_VERSION}-{h.hexdigest()[:12]}"
-
-
-def expression_source(source: str) -> str:
-    """The module text of the expression law with canonical text ``source`` (see _law_expr; parsed, never
-    evaluated)."""
-    import sympy as sp
-
-    from ._law_expr import from_text
-
-    e = from_text(source)
-    text = sp.sstr(e)
-    return (_EXPR_HEADER.format(version=codegen_version(), text=text) + "\n\n"
-            + render_law("law", e, (), pack_name="pack", doc=f"f = {text}"))
-
-
-def _run_module(code: Any, namespace: dict[str, Any]) -> None:
-    """Run the module code this process rendered from a law (:func:`expression_source`), never text read from a
-    file or given by a user: the one place the package executes generated Python (numba compiles its ``law``)."""
-    exec(code, namespace)  # noqa: S102 - generated here from a parsed, whitelisted sympy tree
-
-
-def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
-    """The compiled law of an expression and its packing: ``(law, pack)``, ``pack(V) -> coef``.
-
-    ``source`` is the canonical text of an expression law (``PeelForce.source``, in the grammar of
-    :mod:`peelapprox._law_grammar`: parsed, never evaluated).  The law is rendered (sympy) into module text in
-    this process; ``<cache_dir()>/law_<sha256>.py`` (hash of ``source`` and :func:`codegen_version`) must hold
-    exactly that text, else it is written anew, atomically (a planted, replaced or truncated file, or a link,
-    is replaced with a :class:`~peelapprox.errors.KernelCacheWarning`).  The module is built from the rendered
-    text, not from the file, which names it for numba's on-disk cache (``__pycache__`` next to it, or
-    ``NUMBA_CACHE_DIR``): a second process renders again (tens of ms), loads the compiled law and compiles
-    nothing.  The cache directory and its ``__pycache__`` must be real directories of this user's that no one
-    else can write; otherwise (a link, another owner, group- or world-writable, unwritable) a private temporary
-    directory is used for this process, with a :class:`~peelapprox.errors.KernelCacheWarning` naming why.
-    Memoised per process.
-
-    Bounded in wall time: :data:`peelapprox._deadline.LAW_BUILD_SECONDS`, or the caller's budget
-    (:func:`peelapprox._deadline.caller_budget`, e.g. ``simulate``'s ``max_wall``) if that is nearer.
-
-    Raises
-    ------
-    TypeError
-        ``source`` is not a string.
-    ValueError
-        ``source`` is not a law of the grammar, or rendering and compiling it took longer than
-        ``LAW_BUILD_SECONDS``.
-    peelapprox._deadline.Expired
-        The caller's budget ran out (the caller turns it into its budget exception).
-    """
-    if not isinstance(source, str):
-        raise TypeError(f"source must be the canonical text (str) of an expression law, got {type(source).__name__}")
-    hit = _EXPRESSION_KERNELS.get(source)
-    if hit is not None:
-        return hit
-    try:
-        with time_limit(LAW_BUILD_SECONDS):
-            law, pack = _build_kernel(source)
-    except Expired as exc:
-        if exc.caller:  # the caller's max_wall: its own budget exception (exact.simulate turns it into one)
-            raise
-        raise ValueError(f"expression law {shown(source)}: rendering and compiling it took more than "
-                         f"{LAW_BUILD_SECONDS:g} s; write it in a simpler form (expanded, fewer factors)") from None
-    _EXPRESSION_KERNELS[source] = (law, pack)
-    return _EXPRESSION_KERNELS[source]
-
-
-def _build_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
-    """:func:`expression_kernel`'s work: render, verify or write the module, compile."""
-    digest = hashlib.sha256(f"{source}\0{codegen_version()}".encode()).hexdigest()
-    d = law_dir()
-    path = d / f"law_{digest[:32]}.py"
-    text = expression_source(source).encode()
-    on_disk = read_verified(path)
-    if on_disk != text:  # missing, or planted/replaced/truncated: written anew (a changed time stamp is a numba miss)
-        if on_disk is not None or os.path.lexists(path):
-            warnings.warn(f"peelapprox: the cached law module {str(path)!r} did not match the law it is named after "
-                          "(replaced, truncated or not a regular file of yours); it is written anew",
-                          KernelCacheWarning, stacklevel=2)
-            Path(path).unlink(missing_ok=True)
-        write_atomic(d, path, text)
-    # the module is built from the text rendered here, not read back from the file (which only names it for numba's
-    # on-disk cache, in the verified directory): what runs is what this process generated from the law
-    modname = f"peelapprox_law_{digest[:32]}"
-    mod = types.ModuleType(modname)
-    mod.__file__ = str(path)
-    code = compile(text, str(path), "exec")
-    sys.modules[modname] = mod
-    _run_module(code, mod.__dict__)
-    return kernel(signature=LAW_SIG, outside=True)(mod.law), mod.pack
-
-
-if __name__ == "__main__":  # pragma: no cover
-    print("wrote", write_module())

@@ -1,4 +1,4 @@
-"""The folds of any peel-force law: the local maximum and minimum of ``f(·, V)`` and the jumps' landings.
+"""The one fold record (:class:`BranchStructure`) and the search for the folds of any law but fvV.
 
 :func:`find_folds` works on a vectorised evaluator ``fn(v, order)`` of f (order 0) and f' (order 1) at one
 pull speed, so it serves every kind of :class:`peelapprox.PeelForce` but the built-in one (whose folds are
@@ -21,36 +21,60 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from scipy.optimize import brentq
 
-__all__ = ["Folds", "find_folds"]
+__all__ = ["BRANCHES", "BREAKDOWN_LEVEL", "BranchStructure", "Folds", "find_folds"]
 
 _RTOL = 4 * np.finfo(float).eps
 
 
+#: Names of the stable branches, indexed by the integer codes used in arrays.
+BRANCHES = ("AB", "CD")
+#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times ``max(|f(0+)|, 1 N)``) at which the
+#: model breaks down (:attr:`BranchStructure.v_breakdown`).
+BREAKDOWN_LEVEL = 1e-10
+
+
 @dataclass(frozen=True)
-class Folds:
-    """The folds of ``f(·, V)`` and where jumps from them land (:meth:`peelapprox.PeelForce.folds`).
+class BranchStructure:
+    """The stable branches of ``f(·, V)`` at one pull speed: its folds, where jumps land, and what the solvers read.
+
+    One record for every law: :meth:`peelapprox.PeelForce.folds` fills the folds and landings (the law's own
+    search), :func:`peelapprox.branch_structure` every field.  ``Folds`` is another name of this class.
 
     Attributes
     ----------
     V : float
         Pull speed [m/s].
     has_folds : bool
-        True if f has a local maximum followed by a local minimum in v (stick-slip at this V); False if f
-        increases in v throughout (no stick-slip: one stable branch, every other field None).
+        True inside the stick-slip window (f has a local maximum followed by a local minimum in v).  When
+        False, f increases in v, there is one stable branch (AB, ``v in (0, inf)``), no jumps, and every fold
+        field is None.
     v_max, f_max : float or None
         The fold ending the slow branch AB (local maximum of f) [m/s, N].
     v_min, f_min : float or None
         The fold starting the fast branch CD (local minimum of f) [m/s, N].
+    v_inflection : float
+        The minimiser of f' (``f'' = 0``), between the folds when they exist.
+    f_zero : float
+        ``f(0+, V)`` (fvV: ``130 - 2 V^1.5``; a law whose domain starts above 0: f there): below this level AB
+        has no root.
     v_land_cd : float or None
-        Where an AB→CD jump lands: the CD velocity with ``f = f_max``; None if f stays below ``f_max`` up
-        to the end of the law's domain (e.g. a table that stops too early).
+        Where an AB→CD jump lands: the CD velocity with ``f = f_max``; None if f stays below ``f_max`` up to
+        the end of the law's domain.
     v_land_ab : float or None
-        Where a CD→AB jump lands: the AB velocity with ``f = f_min``; None if f stays above ``f_min`` down
-        to the start of the law's domain.
+        Where a CD→AB jump lands: the AB velocity with ``f = f_min``; None if f stays above ``f_min`` down to
+        the start of the law's domain.
+    v_breakdown : float
+        The AB velocity where ``f - f(0+) = BREAKDOWN_LEVEL max(|f(0+)|, 1 N)``: a level this close to
+        ``f(0+)`` is f(0+) to within the solvers' rounding, so CONSTR has no resolvable root above it (the
+        model's breakdown criterion, used by ``exact.simulate``); ~1e-67 m/s for fvV at every V.
+
+    ``v_inflection``, ``f_zero`` and ``v_breakdown`` are NaN (not computed) in the record of
+    :meth:`PeelForce.folds`, which finds the folds by numpy alone.
     """
 
     V: float
@@ -59,13 +83,45 @@ class Folds:
     f_max: float | None = None
     v_min: float | None = None
     f_min: float | None = None
+    v_inflection: float = math.nan
+    f_zero: float = math.nan
     v_land_cd: float | None = None
     v_land_ab: float | None = None
+    v_breakdown: float = math.nan
+
+    def branch_range(self, branch: str) -> tuple[float, float]:
+        """Range ``(v_lo, v_hi)`` of v on a stable branch."""
+        if branch == "AB":
+            return (0.0, cast(float, self.v_max) if self.has_folds else math.inf)
+        if branch == "CD":
+            if not self.has_folds:
+                raise ValueError(f"branch 'CD' does not exist for V={self.V}: f(v, V) has no fold "
+                                 "(no stick-slip window)")
+            assert self.v_min is not None  # has_folds
+            return (self.v_min, math.inf)
+        raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
+
+    def has_root(self, G: float, branch: str) -> bool:
+        """True if ``f(v, V) = G`` has a root on the branch: AB ``(f(0+), f_max]``, CD ``[f_min, inf)``."""
+        lo, hi = self.level_range(branch)
+        return (lo < G <= hi) if branch == "AB" else (lo <= G < hi)
+
+    def level_range(self, branch: str) -> tuple[float, float]:
+        """Range of levels ``G = F(1 - cos θ)`` for which the branch has a root."""
+        if branch == "AB":
+            return (self.f_zero, cast(float, self.f_max) if self.has_folds else math.inf)
+        self.branch_range(branch)  # raises unless branch is CD and the folds exist
+        assert self.f_min is not None
+        return (self.f_min, math.inf)
+
+
+#: The folds of a law (:meth:`peelapprox.PeelForce.folds`): the same record.
+Folds = BranchStructure
 
 
 def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tuple[float, float],
-               domain: tuple[float, float], label: str, density: int) -> Folds:
-    """The :class:`Folds` of the law ``fn`` at pull speed V (module docstring).
+               domain: tuple[float, float], label: str, density: int) -> BranchStructure:
+    """The folds and landings (:class:`BranchStructure`) of the law ``fn`` at pull speed V (module docstring).
 
     Parameters
     ----------
@@ -114,7 +170,7 @@ def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tu
     kinds = [k for k, _, _ in extrema]
     if not kinds:
         if s[0] > 0:
-            return Folds(V, False)
+            return BranchStructure(V, False)
         raise ValueError(f"the peel-force law {label} decreases in v throughout [{window[0]:g}, {window[1]:g}] m/s "
                          f"at V={V!r}: no stable branch")
     if kinds != ["max", "min"]:
@@ -130,7 +186,7 @@ def find_folds(fn: Callable[[np.ndarray, int], np.ndarray], V: float, window: tu
     v_land_ab = None
     if at(lo, 0) < f_min:
         v_land_ab = math.exp(_root(lambda x: (at(x, 0) - f_min) / f_scale, lo, math.log(v_max), label, V))
-    return Folds(V, True, v_max, f_max, v_min, f_min, v_land_cd, v_land_ab)
+    return BranchStructure(V, True, v_max, f_max, v_min, f_min, v_land_cd=v_land_cd, v_land_ab=v_land_ab)
 
 
 def _power_of_two(x: float) -> float:

@@ -1,19 +1,11 @@
-"""The peel force f(v, V) (Eq. fvV), its derivatives, folds and branch inverses.
+"""The paper's law fvV (Eq. fvV): its evaluation, branch structure and branch inverses, bitwise the 0.2 numbers.
 
-This is the one module that evaluates the peel force.  The formulas themselves
-are generated from the sympy source (:mod:`peelapprox._symbolic`) into
-:mod:`peelapprox._generated`; here they are wrapped as
-
-* vectorised numpy functions with argument checking (:func:`peel_force`,
-  :func:`peel_force_derivative`),
-* numba-compiled scalar kernels (:data:`peel_force_fp_jit`,
-  :data:`peel_force_fpp_jit`) for the solvers,
-* the branch structure of ``f(·, V)``: the folds ``(v_max, f_max)`` (local
-  maximum, end of the slow stable branch AB) and ``(v_min, f_min)`` (local
-  minimum, start of the fast stable branch CD), found once per V and cached
-  (:func:`branch_structure`),
-* the inverse of f on each stable branch (:func:`branch_inverse`), accurate
-  for ``v << 1`` because it solves in ``ln v``.
+The formulas are generated from the sympy source (:mod:`peelapprox._symbolic`) into
+:mod:`peelapprox._generated`; here they are wrapped as vectorised numpy functions with argument checks
+(:func:`peel_force`, :func:`peel_force_derivative`), numba kernels for the solvers (``peel_force_*_jit``),
+the branch structure of ``f(·, V)`` (:func:`paper_structure`: folds by Brent's method either side of the
+minimiser of f', cached per V) and the inverse of f on each stable branch (:func:`branch_inverse`, in
+``ln v`` so that ``v << 1`` keeps its relative precision).
 """
 
 from __future__ import annotations
@@ -21,16 +13,16 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 from scipy.optimize import brentq
 
-from . import _generated as _g
-from ._jit import kernel
-from ._params import PARAM_RANGES, STATE_RANGES
-from .validate import choice, in_range, reals
+from .. import _generated as _g
+from .._checks import choice, in_range, reals
+from .._jit import kernel
+from .._ranges import PARAM_RANGES, STATE_RANGES
+from ._folds import BRANCHES, BREAKDOWN_LEVEL, BranchStructure
 
 __all__ = [
     "peel_force",
@@ -39,16 +31,11 @@ __all__ = [
     "peel_force_fp_jit",
     "peel_force_fpp_jit",
     "peel_force_lnv_jit",
-    "BranchStructure",
-    "branch_structure",
+    "paper_structure",
+    "paper_value_slope",
     "branch_inverse",
-    "FixedPoint",
-    "fixed_point",
-    "BRANCHES",
+    "check_V",
 ]
-
-#: Names of the stable branches, indexed by the integer codes used in arrays.
-BRANCHES = ("AB", "CD")
 
 peel_force_coefficients = _g.peel_force_coefficients
 
@@ -65,7 +52,7 @@ _V_LO = 1e-12
 _V_HI = 300.0  # exp(300/11) ~ 7e11: f is astronomically large there
 
 
-def _check_V(V) -> float:
+def check_V(V: Any) -> float:
     """The pull speed V in :data:`peelapprox.PARAM_RANGES` (the law's valid range, one bound for all)."""
     return in_range("V", V, *PARAM_RANGES["V"])
 
@@ -75,7 +62,7 @@ def _check_v(v) -> np.ndarray:
     return reals("v", v, *STATE_RANGES["v"], lo_open=True)
 
 
-def peel_force(v, V):
+def peel_force(v: Any, V: float) -> Any:
     """Peel force f(v, V) of Eq. (fvV) [N].
 
     ``f = 400 v^0.35 + 110 v^0.15 + 130 e^(v/11) - 2 V^1.5
@@ -93,15 +80,15 @@ def peel_force(v, V):
     ndarray or float
         Same shape as ``v``.
     """
-    b, A = peel_force_coefficients(_check_V(V))
+    b, A = peel_force_coefficients(check_V(V))
     f, _ = _g.peel_force_fp(_check_v(v), b, A)
     return f[()] if np.ndim(f) == 0 else f
 
 
-def peel_force_derivative(v, V, order: int = 1):
+def peel_force_derivative(v: Any, V: float, order: int = 1) -> Any:
     """``∂ᵏf/∂vᵏ (v, V)`` for ``order`` k in {0, 1, 2} [N s^k/m^k]."""
     order = choice("order", order, (0, 1, 2))
-    b, A = peel_force_coefficients(_check_V(V))
+    b, A = peel_force_coefficients(check_V(V))
     out = _g.peel_force_fpp(_check_v(v), b, A)[order]
     return out[()] if np.ndim(out) == 0 else out
 
@@ -114,110 +101,14 @@ def _fpp(v, b, A):
     return _g.peel_force_fpp(v, b, A)[2]
 
 
-@dataclass(frozen=True)
-class BranchStructure:
-    """Stable branches and folds of ``f(·, V)`` for one pull speed.
+def paper_structure(V: float) -> BranchStructure:
+    """The :class:`BranchStructure` of fvV at V (every field; V checked); cached per V.
 
-    Attributes
-    ----------
-    V : float
-        Pull speed [m/s].
-    has_folds : bool
-        True inside the stick-slip window (f has a local max and min).  When
-        False, f is increasing in v, there is one stable branch (called AB,
-        spanning ``v in (0, inf)``) and no jumps are possible.
-    v_max, f_max : float or None
-        Fold at the end of AB (local maximum of f).
-    v_min, f_min : float or None
-        Fold at the start of CD (local minimum of f).
-    v_inflection : float
-        The minimiser of f' (``f'' = 0``), between the folds when they exist.
-    f_zero : float
-        ``f(0+, V) = 130 - 2 V^1.5``: below this pull level AB has no root.
-    v_land_cd : float or None
-        Where an AB→CD jump lands: the CD root of ``f = f_max``.
-    v_land_ab : float or None
-        Where a CD→AB jump lands: the AB root of ``f = f_min``; None if
-        ``f_min <= f_zero`` (the orbit would have nowhere to land).
-    v_breakdown : float
-        The AB velocity where ``f(v, V) - f(0+, V) = BREAKDOWN_LEVEL``
-        (``1e-10 max(|f(0+)|, 1 N)``): a level this close to ``f(0+)`` is
-        f(0+) to within the rounding of the solvers' arithmetic, so CONSTR
-        has no resolvable root above it (the model's breakdown criterion,
-        used by ``exact.simulate``).  Since ``f - f(0+) ≈ 110 v^0.15`` at
-        small v, it is ~1e-67 m/s for every V: far below any physical
-        speed, reached only where the level really falls to f(0+).
+    The folds are the two roots of ``f'(v, V) = 0`` either side of the unique minimiser of ``f'`` (root of
+    ``f''``), each by Brent's method to ``xtol = 4 ulp``: robust near the cusp (``V ≈ 5.2``), no grid for the
+    folds themselves.  :func:`peelapprox.branch_structure` is the public face.
     """
-
-    V: float
-    has_folds: bool
-    v_max: float | None
-    f_max: float | None
-    v_min: float | None
-    f_min: float | None
-    v_inflection: float
-    f_zero: float
-    v_land_cd: float | None
-    v_land_ab: float | None
-    v_breakdown: float = 0.0
-    # The fold fields (v_max, f_max, v_min, f_min, v_land_cd) are floats exactly when has_folds
-    # (_folds_and_landings sets them together; v_land_ab may stay None): below, the casts in
-    # ``... if has_folds else ...`` and the asserts after a has_folds guard state that for the type checker.
-
-    def branch_range(self, branch: str) -> tuple[float, float]:
-        """Range ``(v_lo, v_hi)`` of v on a stable branch."""
-        if branch == "AB":
-            return (0.0, cast(float, self.v_max) if self.has_folds else math.inf)
-        if branch == "CD":
-            if not self.has_folds:
-                raise ValueError(f"branch 'CD' does not exist for V={self.V}: f(v, V) has no fold "
-                                 "(no stick-slip window)")
-            assert self.v_min is not None  # has_folds
-            return (self.v_min, math.inf)
-        raise ValueError(f"branch must be 'AB' or 'CD', got {branch!r}")
-
-    def has_root(self, G: float, branch: str) -> bool:
-        """True if ``f(v, V) = G`` has a root on the branch: AB ``(f(0+), f_max]``, CD ``[f_min, inf)``."""
-        lo, hi = self.level_range(branch)
-        return (lo < G <= hi) if branch == "AB" else (lo <= G < hi)
-
-    def level_range(self, branch: str) -> tuple[float, float]:
-        """Range of levels ``G = F(1 - cos θ)`` for which the branch has a root."""
-        if branch == "AB":
-            return (self.f_zero, cast(float, self.f_max) if self.has_folds else math.inf)
-        self.branch_range(branch)  # raises unless branch is CD and the folds exist
-        assert self.f_min is not None
-        return (self.f_min, math.inf)
-
-
-def branch_structure(V: float) -> BranchStructure:
-    """Folds, inflection and landing velocities of ``f(·, V)``; cached per V.
-
-    The folds are the two roots of ``f'(v, V) = 0`` on either side of the
-    unique minimiser of ``f'`` (root of ``f''``), each located by Brent's
-    method to ``xtol = 4 ulp``.  Robust near the cusp where the folds merge
-    (``V ≈ 5.2``): no grid is used for the folds themselves.
-
-    Parameters
-    ----------
-    V : float
-        Pull speed [m/s] (> 0).
-
-    Returns
-    -------
-    BranchStructure
-
-    Raises
-    ------
-    ValueError
-        If V is outside ``PARAM_RANGES["V"]`` (TypeError if not a number).
-    """
-    return _branch_structure(_check_V(V))
-
-
-#: Relative distance of the level ``F(1 - cos θ)`` above ``f(0+, V)`` (times ``max(|f(0+)|, 1 N)``) at which the
-#: model breaks down (BranchStructure.v_breakdown).
-BREAKDOWN_LEVEL = 1e-10
+    return _branch_structure(check_V(V))
 
 
 @functools.lru_cache(maxsize=512)
@@ -244,13 +135,13 @@ def _folds_and_landings(V: float) -> BranchStructure:
     v_inf = brentq(_fpp, grid[i], grid[i + 1], args=(b, A), xtol=1e-300, rtol=4 * np.finfo(float).eps)
     f_zero = float(130.0 + b)
     if _fp(v_inf, b, A) >= 0:
-        return BranchStructure(V, False, None, None, None, None, v_inf, f_zero, None, None)
+        return BranchStructure(V, False, v_inflection=v_inf, f_zero=f_zero)
     kw = dict(args=(b, A), xtol=1e-300, rtol=4 * np.finfo(float).eps)
     v_max = brentq(_fp, _V_LO, v_inf, **kw)
     v_min = brentq(_fp, v_inf, _V_HI, **kw)
     f_max = float(_g.peel_force_fp(v_max, b, A)[0])
     f_min = float(_g.peel_force_fp(v_min, b, A)[0])
-    tmp = BranchStructure(V, True, v_max, f_max, v_min, f_min, v_inf, f_zero, None, None)
+    tmp = BranchStructure(V, True, v_max, f_max, v_min, f_min, v_inflection=v_inf, f_zero=f_zero)
     v_land_cd = _invert(f_max, tmp, "CD", b, A)
     v_land_ab = _invert(f_min, tmp, "AB", b, A) if f_min > f_zero else None
     return BranchStructure(V, True, v_max, f_max, v_min, f_min, v_inf, f_zero, v_land_cd, v_land_ab)
@@ -268,7 +159,7 @@ def _invert(G: float, bs: BranchStructure, branch: str, b: float, A: float) -> f
     G : float
         Level of the pull side of CONSTR, ``G = F(1 - cos θ)`` [N].
     bs : BranchStructure
-        ``branch_structure(V)`` of the pull speed V.
+        ``paper_structure(V)`` of the pull speed V.
     branch : {"AB", "CD"}
         The slow branch ``(0, v_max]`` or the fast branch ``[v_min, inf)``; must be one of the two.
     b, A : float
@@ -313,7 +204,7 @@ def _invert(G: float, bs: BranchStructure, branch: str, b: float, A: float) -> f
     return brentq(g, bs.v_min, hi_v, xtol=1e-300, rtol=4 * np.finfo(float).eps)
 
 
-def branch_inverse(G, V: float, branch: str):
+def branch_inverse(G: Any, V: float, branch: str) -> Any:
     """Velocity v on a stable branch with ``f(v, V) = G``.
 
     Parameters
@@ -337,7 +228,7 @@ def branch_inverse(G, V: float, branch: str):
         If ``G`` is outside the branch's level range
         (AB: ``(f(0+), f_max]``, CD: ``[f_min, inf)``), naming the range.
     """
-    bs = branch_structure(V)
+    bs = paper_structure(V)
     bs.branch_range(choice("branch", branch, BRANCHES))
     b, A = peel_force_coefficients(bs.V)
     Ga = reals("G", G)
@@ -345,27 +236,7 @@ def branch_inverse(G, V: float, branch: str):
     return float(out) if out.ndim == 0 else out
 
 
-@dataclass(frozen=True)
-class FixedPoint:
-    """The steady state ``α = 0, ω = V/R, v = V, F = f(V, V)`` (Sec. II).
-
-    ``stable`` is ``f'(V, V) > 0``: the paper's Hopf criterion.
-    """
-
-    alpha: float
-    omega: float
-    F: float
-    v: float
-    fprime: float
-    stable: bool
-
-
-def fixed_point(V: float, R: float = 0.1) -> FixedPoint:
-    """Fixed point of FLOW1–flow3 with CONSTR and its stability (``f'(V,V) > 0``).
-
-    ``V`` and ``R`` must lie in :data:`peelapprox.PARAM_RANGES`.
-    """
-    V = _check_V(V)
-    R = in_range("R", R, *PARAM_RANGES["R"])
+def paper_value_slope(V: float) -> tuple[float, float]:
+    """``(f, f')`` of fvV at the steady sliding ``v = V`` (the fixed point of :func:`peelapprox.fixed_point`)."""
     f, fp = _g.peel_force_fp(V, *peel_force_coefficients(V))
-    return FixedPoint(0.0, V / R, float(f), V, float(fp), bool(fp > 0))
+    return float(f), float(fp)
