@@ -34,18 +34,22 @@ from ._continuation import (
 )
 from ._crest import Crest, crest_margin
 from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
+from ._hybrid_driver import compile_kernels, hybrid_field
+from ._initial import initial_state
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
-from ._options import Budget, Hybrid, Regularized, SaveAt, Smooth, default_atol
-from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
-from ._simulate import (
+from ._options import (
     ATOL_SCALE,
     STEP_BUDGET,
-    compile_kernels,
+    Budget,
+    Hybrid,
+    Regularized,
+    SaveAt,
+    Smooth,
+    default_atol,
     default_max_steps,
-    hybrid_field,
-    initial_state,
-    simulate,
 )
+from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
+from ._simulate import simulate
 from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import VARIATIONAL_LAWS, lyapunov_variational

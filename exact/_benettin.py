@@ -216,9 +216,9 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
     """
     from peelapprox.errors import SolverBudgetExceeded, WallBudget
 
+    from ._initial import initial_state
     from ._options import method_option, output_options
     from ._regularized import run_regularized
-    from ._simulate import initial_state
     from ._trajectory import State
 
     # a variant's method: smooth, or regularized under a load (never the hybrid one)

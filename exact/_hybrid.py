@@ -76,7 +76,7 @@ its event driver: folds, jumps, t_end, output and breakdown checks.
 
 Everything per step runs inside one numba function; Python is entered only
 when an output buffer fills or the run ends.  That function, :func:`_run`, is
-compiled twice by :mod:`exact._hybrid_law`: with the paper's law fvV inlined
+compiled twice by :mod:`exact._hybrid_driver`: with the paper's law fvV inlined
 (the default) and with the peel-force law as a typed function argument.
 """
 
@@ -224,7 +224,7 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-#: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_law` (the paper's law inlined, or the
+#: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_driver` (the paper's law inlined, or the
 #: law as an argument): the field ``_FIELD(y, P, out)``, the pull force ``_PULL(alpha, v, P)``,
 #: ``P = _PACK(p, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
 _FIELD: Any = None
@@ -255,7 +255,7 @@ def _run(
     Returns a status code (module constants).  All state needed to continue is
     in ``st`` and ``cnt``; the caller empties full buffers and calls again.
     In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force is ``law`` with ``coef``,
-    or the paper's law inlined: :func:`exact._hybrid_law.driver`.
+    or the paper's law inlined: :func:`exact._hybrid_driver.driver`.
     """
     P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)

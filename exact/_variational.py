@@ -34,7 +34,8 @@ from peelapprox.validate import duration, function, in_range, optional, state
 from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
 
-from ._simulate import _atol_vector, initial_state
+from ._initial import initial_state
+from ._options import _atol_vector
 
 if TYPE_CHECKING:  # pragma: no cover
     from peelapprox import PeelParams
