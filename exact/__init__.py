@@ -37,17 +37,9 @@ from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
 from ._hybrid_driver import compile_kernels, hybrid_field
 from ._initial import initial_state
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
-from ._options import (
-    ATOL_SCALE,
-    STEP_BUDGET,
-    Budget,
-    Hybrid,
-    Regularized,
-    SaveAt,
-    Smooth,
-    default_atol,
-    default_max_steps,
-)
+from ._method_contract import default_atol
+from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
+from ._options import Budget, SaveAt, default_max_steps
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
 from ._simulate import simulate
 from ._switch import switch_branch

@@ -35,7 +35,7 @@ from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
 from ._initial import initial_state
-from ._options import method_option
+from ._method_contract import method_option
 from ._simulate import simulate
 from ._trajectory import Trajectory
 

@@ -48,7 +48,8 @@ from . import _hybrid as H
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 if TYPE_CHECKING:
-    from ._options import Budget, Hybrid, SaveAt
+    from ._method_contract import Method
+    from ._options import Budget, SaveAt
 
 __all__ = ["RUN_SIG", "V_RUNAWAY", "compile_kernels", "domain_status", "driver", "field_law", "hybrid_field",
            "law_for", "param_vector", "pull_force_law", "run_hybrid"]
@@ -283,7 +284,7 @@ class _Buffers:
         return data, brs, jd
 
 
-def run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, saveat: SaveAt, budget: Budget,
+def run_hybrid(params: PeelParams, t_end: float, s0: State, method: Method, saveat: SaveAt, budget: Budget,
                progress: Callable[[float, float], None] | None) -> Trajectory:
     """``simulate(method="hybrid")`` from the consistent state ``s0``, the options validated and the budget
     resolved: the compiled loop called until t_end, emptying its buffers and checking the wall budget between
@@ -296,7 +297,7 @@ def run_hybrid(params: PeelParams, t_end: float, s0: State, method: Hybrid, save
     return traj
 
 
-def _drive(params: PeelParams, t_end: float, s0: State, method: Hybrid, saveat: SaveAt, budget: Budget,
+def _drive(params: PeelParams, t_end: float, s0: State, method: Method, saveat: SaveAt, budget: Budget,
            progress: Callable[[float, float], None] | None) -> Trajectory:
     rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
     t_store, max_wall, max_steps = saveat.t_transient, budget.max_wall, int(cast(int, budget.max_steps))

@@ -12,9 +12,9 @@ from peelapprox.kernels import BuildExpired, caller_budget
 from peelapprox.validate import duration, in_range
 from peelapprox.validate import params as _params
 
-from ._hybrid_driver import run_hybrid
 from ._initial import initial_state
-from ._options import Budget, Hybrid, Regularized, SaveAt, Smooth, method_option, output_options
+from ._method_contract import Method, method_option
+from ._options import Budget, SaveAt, output_options
 from ._trajectory import Trajectory
 
 __all__ = ["simulate", "VP0_MAX"]
@@ -45,7 +45,7 @@ def simulate(
     F0: float | None = None,
     branch0: str | None = None,
     Vp0: float | None = None,
-    method: str | Hybrid | Regularized | Smooth | None = None,
+    method: str | Method | None = None,
     solver: str | None = None,
     rtol: float = 1e-8,
     atol: None | float | Sequence[float] = None,
@@ -172,7 +172,7 @@ def simulate(
     _params("params", params)
     opts = method_option(method, solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor, params=params)
     t_end = duration("t_end", t_end)
-    out, lim = output_options(opts.name, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
+    out, lim = output_options(opts, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
                               max_points=max_points, max_steps=max_steps, max_jumps=max_jumps, max_wall=max_wall)
     if progress is True:
         progress = _progress_printer(f"simulate V={params.V} I={params.I}")
@@ -190,11 +190,7 @@ def simulate(
                     raise ValueError(f"Vp0 (the initial pull speed) applies only under loading='load'; got Vp0={Vp0!r} "
                                      "with loading='velocity' (the pull speed is params.V)")
                 st0 = dataclasses.replace(st0, Vp=in_range("Vp0", Vp0, 0.0, VP0_MAX))
-            if isinstance(opts, Hybrid):
-                return run_hybrid(params, t_end, st0, opts, out, lim, progress)
-            from ._regularized import run_regularized
-
-            return run_regularized(params, t_end, st0, opts, out, lim, progress)  # the ε-scheme, the variants' ODEs
+            return opts.run(params, t_end, st0, out, lim, progress)
     except BuildExpired:
         raise SolverBudgetExceeded(f"more than {lim.max_wall:g} s of wall time (max_wall) compiling the peel-force "
                                    f"law {params.force!r} before the run started; pass a larger max_wall, or None "

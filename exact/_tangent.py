@@ -287,7 +287,7 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     """
     from ._benettin import natural_scales
     from ._initial import initial_state
-    from ._options import ATOL_SCALE
+    from ._methods import ATOL_SCALE
     from ._simulate import simulate
 
     T = duration("T", T)
