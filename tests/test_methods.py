@@ -113,3 +113,22 @@ def test_the_hybrid_jump_columns_are_those_of_jumps():
     assert (j.t, j.alpha, j.omega, j.F, j.v_before, j.v_after) == (
         row[H.J_T], row[H.J_ALPHA], row[H.J_OMEGA], row[H.J_F], row[H.J_V_BEFORE], row[H.J_V_AFTER])
     assert (j.from_branch, j.to_branch) == ("AB", "CD")
+
+
+def test_the_cli_reads_its_method_and_solver_choices_from_the_table(euler):
+    """Hypothesis: ``simulate --method`` and ``--solver`` take what the table holds when the parser checks them
+    (a method entered after the parser was built included), and the help states each method's own default
+    solver (LSODA for smooth, Radau for regularized) from the classes (exact strings)."""
+    import argparse
+
+    from peelapprox.cli import build_parser
+
+    ap = build_parser()
+    sim = next(a for a in ap._actions if isinstance(a, argparse._SubParsersAction)).choices["simulate"]
+    opts = {a.dest: a for a in sim._actions}
+    assert tuple(opts["method"].choices) == ("hybrid", "regularized", "smooth", "euler")
+    assert tuple(opts["solver"].choices) == ("Radau", "BDF", "LSODA", "DOP853", "RK45")
+    text = " ".join(sim.format_help().split())
+    assert "--method smooth: Radau, BDF, LSODA, DOP853, RK45 (default: LSODA)" in text
+    assert "--method regularized: Radau, BDF, LSODA (default: Radau)" in text
+    assert f"euler: {Euler.about}" in text
