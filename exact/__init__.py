@@ -1,12 +1,12 @@
 """The full peeling model and its solvers.
 
-``simulate(params, t_end, ...)`` integrates the differential-algebraic system
-FLOW1, FLOW2, flow3 with the constraint CONSTR of De, Maybhate and
-Ananthakrishna, either in the ε → 0 limit (``method="hybrid"``, default) or
-with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
-The option objects :class:`Hybrid`, :class:`Regularized` (the method and its
-error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the
-limits) are the validated forms of ``simulate``'s keywords.
+``simulate(params, t_end, ...)`` integrates the differential-algebraic system FLOW1, FLOW2, flow3 with the
+constraint CONSTR of De, Maybhate and Ananthakrishna by one of its methods: the ε → 0 limit
+(``method="hybrid"``, the default for the paper's model), the paper's ε-regularised mass-matrix scheme
+(``method="regularized"``, the default for a massless tape under a load) or the tape-mass model's smooth ODE
+(``method="smooth"``).  The option objects :class:`Hybrid`, :class:`Regularized`, :class:`Smooth` (the method
+and its error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the limits) are the validated
+forms of ``simulate``'s keywords.
 
 The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
 (sampled starts grouped by the attractor they reach), ``attractor_observables`` (the slip interval, force

@@ -103,13 +103,21 @@ class Method:
     solver: str | None = None
     eps: float | None = None
 
-    def _check_shared(self) -> None:
-        """Validate and normalise ``rtol`` (a float), ``atol`` (None or 4 floats) and ``v_floor``."""
+    def __post_init__(self) -> None:
+        """Validate the fields, in ``simulate``'s order: ``solver`` (among ``solvers``, for a method with one), the
+        method's own (:meth:`_check_own`), then ``rtol``, ``atol`` (normalised to None or 4 floats) and
+        ``v_floor``."""
+        if self.solvers:
+            object.__setattr__(self, "solver", choice("solver", self.solver, self.solvers))
+        self._check_own()
         rtol = _rtol("rtol", self.rtol)
         atol = None if self.atol is None else tuple(float(a) for a in _atol_vector(self.atol_scale, rtol, self.atol))
         object.__setattr__(self, "rtol", rtol)
         object.__setattr__(self, "atol", atol)
         object.__setattr__(self, "v_floor", optional(positive, "v_floor", self.v_floor))
+
+    def _check_own(self) -> None:
+        """Validate the fields a method adds (set each with ``object.__setattr__``: the dataclass is frozen)."""
 
     def atol_vector(self) -> np.ndarray:
         """The 4 absolute tolerances the integrator uses (a new array)."""

@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
 from peelapprox import EPS_DEFAULT
-from peelapprox.validate import choice
 from peelapprox.validate import eps as _eps
 
 from ._hybrid_driver import run_hybrid
@@ -60,16 +59,21 @@ class Hybrid(Method):
     atol: float | Sequence[float] | None = None
     v_floor: float | None = None
 
-    def __post_init__(self) -> None:
-        self._check_shared()
-
     def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
         return run_hybrid(params, t_end, s0, self, saveat, budget, progress)
 
 
+class _OnScipy(Method):
+    """A method run on a scipy solver by :func:`exact._regularized.run_regularized`."""
+
+    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
+            progress: Callable[[float, float], None] | None) -> Trajectory:
+        return run_regularized(params, t_end, s0, self, saveat, budget, progress)
+
+
 @dataclass(frozen=True, kw_only=True)
-class Regularized(Method):
+class Regularized(_OnScipy):
     """The paper's ε-regularised scheme (``method="regularized"``): mass matrix ``diag(1, 1, 1, ε)`` on a
     scipy stiff solver with the analytic Jacobian.
 
@@ -98,18 +102,12 @@ class Regularized(Method):
     atol: float | Sequence[float] | None = None
     v_floor: float | None = None
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "solver", choice("solver", self.solver, self.solvers))
+    def _check_own(self) -> None:
         object.__setattr__(self, "eps", _eps("eps", self.eps))
-        self._check_shared()
-
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
-            progress: Callable[[float, float], None] | None) -> Trajectory:
-        return run_regularized(params, t_end, s0, self, saveat, budget, progress)
 
 
 @dataclass(frozen=True, kw_only=True)
-class Smooth(Method):
+class Smooth(_OnScipy):
     """The model variants' smooth ODE (``method="smooth"``): the tape-mass model (``PeelParams(tape_mass=m)``,
     with or without a load) on a scipy solver, the stiff ones with the analytic Jacobian.
 
@@ -138,13 +136,6 @@ class Smooth(Method):
     atol: float | Sequence[float] | None = None
     v_floor: float | None = None
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "solver", choice("solver", self.solver, self.solvers))
-        self._check_shared()
-
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
-            progress: Callable[[float, float], None] | None) -> Trajectory:
-        return run_regularized(params, t_end, s0, self, saveat, budget, progress)
 
 
 METHODS.update({m.name: m for m in (Hybrid, Regularized, Smooth)})

@@ -35,7 +35,6 @@ def _progress_printer(label: str) -> Callable[[float, float], None]:
     return report
 
 
-
 def simulate(
     params: PeelParams,
     t_end: float,
@@ -89,7 +88,8 @@ def simulate(
         method, for the tape-mass model ``params.tape_mass``): its ODE on a
         scipy ``solver`` (docs/tape-mass.md).  None: the model's default.
         A method the model cannot use is a ValueError saying which it can.
-        A method object (:class:`Hybrid`, :class:`Regularized`, :class:`Smooth`) holds
+        A method object (:class:`Hybrid`, :class:`Regularized`, :class:`Smooth`: a class of the table of
+        methods, ``exact._options.METHODS``, whose names ``method`` takes) holds
         ``solver``, ``eps``, ``rtol``, ``atol`` and ``v_floor`` itself: those
         keywords must then stay at their defaults (ValueError naming both).
     solver : {"Radau", "BDF", "LSODA"}, optional

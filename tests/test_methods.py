@@ -34,8 +34,9 @@ class Euler(Method):
     atol: float | None = None
     v_floor: float | None = None
 
-    def __post_init__(self) -> None:
-        self._check_shared()
+    def _check_own(self) -> None:
+        if not self.dt > 0:
+            raise ValueError(f"dt must be positive, got {self.dt!r}")
 
     def run(self, params, t_end, s0, saveat, budget, progress):
         cl = compiled_law(params.force, params.V)
