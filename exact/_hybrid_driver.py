@@ -299,6 +299,7 @@ def run_hybrid(params: PeelParams, t_end: float, s0: State, method: Method, save
 
 def _drive(params: PeelParams, t_end: float, s0: State, method: Method, saveat: SaveAt, budget: Budget,
            progress: Callable[[float, float], None] | None) -> Trajectory:
+    """:func:`run_hybrid` without the compile bookkeeping: the law bound, the buffers set, the loop called."""
     rtol, atol, v_floor = method.rtol, method.atol_vector(), method.v_floor
     t_store, max_wall, max_steps = saveat.t_transient, budget.max_wall, int(cast(int, budget.max_steps))
     cl = law_for(params)  # the paper's law (default): the driver with fvV inlined

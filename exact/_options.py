@@ -1,14 +1,15 @@
-"""The option objects of :func:`exact.simulate` besides the method: what to save, the budgets.
+"""The option objects of :func:`exact.simulate` besides the method (what to save, the budgets), and the table
+:data:`METHODS` of its methods, which the budget reads a method's step budget from.
 
 In the style of diffrax (``diffeqsolve(solver=Dopri5(), saveat=SaveAt(ts=...), ...)``), each group of
-``simulate``'s keywords has a frozen, keyword-only, self-validating dataclass: the method (:mod:`exact._methods`),
-:class:`SaveAt` (every step, the states at given times, or the jumps only, after ``t_transient``) and
-:class:`Budget` (stored points, accepted steps, stored jumps, wall time).  ``simulate`` builds them from its
-keywords (:func:`method_option`, :func:`output_options`) or takes them as given, and hands them to the method,
-which reads their fields and validates nothing again.  Each object checks its fields with the named validators
-of :mod:`peelapprox.validate`, so a bad field raises the same error as the ``simulate`` keyword of that name;
-what depends on the horizon ``t_end`` is checked or resolved by ``simulate`` (:meth:`SaveAt.within`,
-:meth:`Budget.resolved`).
+``simulate``'s keywords has a frozen, keyword-only, self-validating dataclass: the method
+(:mod:`exact._method_contract`), :class:`SaveAt` (every step, the states at given times, or the jumps only, after
+``t_transient``) and :class:`Budget` (stored points, accepted steps, stored jumps, wall time).  ``simulate``
+builds them from its keywords (``method_option``, :func:`output_options`) or takes them as given, and hands
+them to the method, which reads their fields and validates nothing again.  Each object checks its fields with
+the named validators of :mod:`peelapprox.validate`, so a bad field raises the same error as the ``simulate``
+keyword of that name; what depends on the horizon ``t_end`` is checked or resolved by ``simulate``
+(:meth:`SaveAt.within`, :meth:`Budget.resolved`).
 """
 
 from __future__ import annotations
