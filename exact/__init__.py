@@ -1,12 +1,12 @@
 """The full peeling model and its solvers.
 
-``simulate(params, t_end, ...)`` integrates the differential-algebraic system
-FLOW1, FLOW2, flow3 with the constraint CONSTR of De, Maybhate and
-Ananthakrishna, either in the ε → 0 limit (``method="hybrid"``, default) or
-with the paper's ε-regularised mass-matrix scheme (``method="regularized"``).
-The option objects :class:`Hybrid`, :class:`Regularized` (the method and its
-error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the
-limits) are the validated forms of ``simulate``'s keywords.
+``simulate(params, t_end, ...)`` integrates the differential-algebraic system FLOW1, FLOW2, flow3 with the
+constraint CONSTR of De, Maybhate and Ananthakrishna by one of its methods: the ε → 0 limit
+(``method="hybrid"``, the default for the paper's model), the paper's ε-regularised mass-matrix scheme
+(``method="regularized"``, the default for a massless tape under a load) or the tape-mass model's smooth ODE
+(``method="smooth"``).  The option objects :class:`Hybrid`, :class:`Regularized`, :class:`Smooth` (the method
+and its error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the limits) are the validated
+forms of ``simulate``'s keywords.
 
 The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
 (sampled starts grouped by the attractor they reach), ``attractor_observables`` (the slip interval, force
@@ -34,18 +34,14 @@ from ._continuation import (
 )
 from ._crest import Crest, crest_margin
 from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
+from ._hybrid_driver import compile_kernels, hybrid_field
+from ._initial import initial_state
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
-from ._options import Budget, Hybrid, Regularized, SaveAt, Smooth, default_atol
+from ._method_contract import default_atol
+from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
+from ._options import METHODS, Budget, SaveAt, default_max_steps
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
-from ._simulate import (
-    ATOL_SCALE,
-    STEP_BUDGET,
-    compile_kernels,
-    default_max_steps,
-    hybrid_field,
-    initial_state,
-    simulate,
-)
+from ._simulate import simulate
 from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._variational import VARIATIONAL_LAWS, lyapunov_variational
@@ -61,6 +57,7 @@ __all__ = [
     "compile_kernels",
     "ATOL_SCALE",
     "STEP_BUDGET",
+    "METHODS",
     "default_max_steps",
     "default_atol",
     "hybrid_field",

@@ -34,8 +34,9 @@ from peelapprox.validate import duration, function, integer, optional, positive,
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._options import method_option
-from ._simulate import initial_state, simulate
+from ._initial import initial_state
+from ._method_contract import method_option
+from ._simulate import simulate
 from ._trajectory import Trajectory
 
 __all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors", "attractor_observables",

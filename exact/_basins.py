@@ -33,7 +33,7 @@ from peelapprox.validate import rtol as _rtol
 
 from ._attractors import DEFAULT_MAX_WALL, paper_model_only
 from ._basins_run import APERIODIC, BREAKDOWN, FAILURE, INVALID, UNDETERMINED, msg, reporter, run_all
-from ._options import method_option
+from ._method_contract import method_option
 from ._orbits import PeriodicOrbit, periodic_orbit
 from ._simulate import simulate
 

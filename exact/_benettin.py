@@ -25,7 +25,7 @@ from peelapprox.io import fmt_number, html_table
 from peelapprox.validate import function, integer
 
 if TYPE_CHECKING:
-    from ._options import Regularized, Smooth
+    from ._methods import Regularized, Smooth
 
 __all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult", "STDERR_BATCHES", "batch_means"]
 
@@ -216,9 +216,9 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
     """
     from peelapprox.errors import SolverBudgetExceeded, WallBudget
 
-    from ._options import method_option, output_options
-    from ._regularized import run_regularized
-    from ._simulate import initial_state
+    from ._initial import initial_state
+    from ._method_contract import method_option
+    from ._options import output_options
     from ._trajectory import State
 
     # a variant's method: smooth, or regularized under a load (never the hybrid one)
@@ -233,11 +233,11 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
     def run(x: np.ndarray, dt: float) -> tuple[np.ndarray, int]:
         s0 = State(0.0, float(x[0]), float(x[1]), float(x[2]), float(x[3]), "AB",
                    float(x[4]) if under_load else None)
-        out, lim = output_options(opts.name, dt, None, None, save="jumps", t_eval=None, t_transient=0.0,
+        out, lim = output_options(opts, dt, None, None, save="jumps", t_eval=None, t_transient=0.0,
                                   max_points=5_000_000, max_steps=int(max(1e5, 2e6 * dt)), max_jumps=20_000_000,
                                   max_wall=wall.left(0.0, s0.__dict__, t_total))
         try:
-            tr = run_regularized(params, dt, s0, opts, out, lim, None)
+            tr = opts.run(params, dt, s0, out, lim, None)
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         s = tr.final_state

@@ -39,7 +39,7 @@ AB the level ``G = f(v)`` approaches ``f(0+, V)`` as ``110 v^0.15``, so v must
 be followed over some 60 decades before G is within rounding of f(0+): with v
 as the state (absolute tolerance ~1e-14 m/s) the run had to stop at a floor
 ``v = 1e-9`` m/s where G was still ~5 N above f(0+) — a numerical stop
-reported as a breakdown (issue 13).  In u, ``du/ds = Ġ`` is smooth and
+reported as a breakdown.  In u, ``du/ds = Ġ`` is smooth and
 bounded there, and the breakdown is declared by the model's criterion:
 ``G - f(0+) <= BREAKDOWN_LEVEL`` (1e-10 relative), i.e. ``v <= v_breakdown``
 (~1e-67 m/s, :class:`peelapprox.BranchStructure`).
@@ -76,7 +76,7 @@ its event driver: folds, jumps, t_end, output and breakdown checks.
 
 Everything per step runs inside one numba function; Python is entered only
 when an output buffer fills or the run ends.  That function, :func:`_run`, is
-compiled twice by :mod:`exact._hybrid_law`: with the paper's law fvV inlined
+compiled twice by :mod:`exact._hybrid_driver`: with the paper's law fvV inlined
 (the default) and with the peel-force law as a typed function argument.
 """
 
@@ -131,7 +131,8 @@ N_C = 7
 # output columns
 O_T, O_AL, O_OM, O_F, O_V = range(5)
 N_O = 5
-# jump columns: t, from, to, alpha, omega, F, v_before, v_after
+# jump columns, the order of exact.Jumps.from_buffer
+J_T, J_FROM, J_TO, J_ALPHA, J_OMEGA, J_F, J_V_BEFORE, J_V_AFTER = range(8)
 N_J = 8
 #: the fold event fires at v = v_max (1 - FOLD_REL) on AB, v_min (1 + FOLD_REL)
 #: on CD (module docstring, "Folded singularities")
@@ -224,8 +225,91 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-#: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_law` (the paper's law inlined, or the
-#: law as an argument): the field ``_FIELD(y, P, out)``, the pull force ``_PULL(alpha, v, P)``,
+@kernel
+def _resume(st, y):
+    """Read the resumable solver state into y; returns ``(t0, branch, h)``."""
+    y[0] = st[S_TAU]
+    y[1] = st[S_AL]
+    y[2] = st[S_OM]
+    y[3] = st[S_U]
+    return st[S_T0], int(st[S_BR]), st[S_H]
+
+
+@kernel
+def _end(st, y, ye, h, status):
+    """Stop the call at ``ye`` (copied into y; the next call continues with step h) and return ``status``."""
+    for i in range(4):
+        y[i] = ye[i]
+    _save(st, y, h)
+    return status
+
+
+_GO = -1  # _room_left: nothing stops the call before the next step
+
+
+@kernel
+def _room_left(calls, max_call_steps, save_mode, cnt, nout_cap, njump_cap):
+    """The status that ends the call before the next step (its step quota used, or a buffer without room for what
+    a step may store), else ``_GO``: budgets and buffers are checked between steps only."""
+    if calls >= max_call_steps:
+        return PAUSE
+    if save_mode == SAVE_STEPS and cnt[C_NOUT] + 2 > nout_cap:
+        return OUT_FULL
+    if cnt[C_NJOUT] + 1 > njump_cap:
+        return JUMPS_FULL
+    return _GO
+
+
+@kernel
+def _fold_crossing(y, y_new, p, br):
+    """``(crossed, u_event, g_start, g_end)``: whether the step ``[y, y_new]`` reaches the fold event of branch br
+    (AB: u rises to ``P_UEV_AB``; CD: falls to ``P_UEV_CD``), the event level and ``u - u_event`` at both ends."""
+    uf = p[P_UEV_AB] if br == 0 else p[P_UEV_CD]
+    gA = y[3] - uf
+    gB = y_new[3] - uf
+    return (gB >= 0.0 if br == 0 else gB <= 0.0), uf, gA, gB
+
+
+@kernel
+def _record_jump(jbuf, cnt, tj, br, ye, F, v_before, v_after):
+    """Store the jump at ``tj`` from branch br at state ``ye`` (α, ω; F the pull force) in the next row of jbuf."""
+    k = cnt[C_NJOUT]
+    jbuf[k, J_T] = tj
+    jbuf[k, J_FROM] = br
+    jbuf[k, J_TO] = 1 - br
+    jbuf[k, J_ALPHA] = ye[1]
+    jbuf[k, J_OMEGA] = ye[2]
+    jbuf[k, J_F] = F
+    jbuf[k, J_V_BEFORE] = v_before
+    jbuf[k, J_V_AFTER] = v_after
+    cnt[C_NJOUT] += 1
+
+
+@kernel
+def _land(st, y, ye, tj, br, v_after):
+    """The state after the jump at ``tj`` onto branch br: τ from 0, (α, ω) those of ``ye``, v the landing root."""
+    y[0] = 0.0
+    y[1] = ye[1]
+    y[2] = ye[2]
+    y[3] = np.log(v_after)
+    st[S_T0] = tj
+    st[S_BR] = br
+
+
+@kernel
+def _advance(y, y_new, f0, K):
+    """Accept the plain step to ``y_new``: it becomes y, with its last stage as the field f0 there.  t(s)
+    increases on a stable branch, but near a folded singularity its increments fall below the step's error
+    tolerance (module docstring): τ is kept non-decreasing (τ does not enter the field)."""
+    if y_new[0] < y[0]:
+        y_new[0] = y[0]
+    for i in range(4):
+        y[i] = y_new[i]
+        f0[i] = K[_NS, i]
+
+
+#: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_driver` (the paper's law inlined, or
+#: the law as an argument): the field ``_FIELD(y, P, out)``, the pull force ``_PULL(alpha, v, P)``,
 #: ``P = _PACK(p, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
 _FIELD: Any = None
 _PULL: Any = None
@@ -233,45 +317,18 @@ _PACK: Any = None
 _dop: Any = None
 
 
-def _run(
-    st,
-    p,
-    law,
-    coef,
-    rtol,
-    atol,
-    t_end,
-    t_store,
-    save_mode,
-    t_eval,
-    out,
-    out_br,
-    jbuf,
-    cnt,
-    max_call_steps,
-):
+def _run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, out_br, jbuf, cnt, max_call_steps):
     """Advance the hybrid solver from ``st`` until t_end or a buffer/quota limit.
 
-    Returns a status code (module constants).  All state needed to continue is
-    in ``st`` and ``cnt``; the caller empties full buffers and calls again.
-    In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.  The peel force is ``law`` with ``coef``,
-    or the paper's law inlined: :func:`exact._hybrid_law.driver`.
+    Returns a status code (module constants).  All state needed to continue is in ``st`` and ``cnt``; the caller
+    empties full buffers and calls again.  In ``SAVE_TEVAL`` mode ``out`` must have a row per ``t_eval`` point.
+    The peel force is ``law`` with ``coef``, or the paper's law inlined: :func:`exact._hybrid_driver.driver`.
     """
     P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
-
-    nout_cap = out.shape[0]
-    njump_cap = jbuf.shape[0]
     n_teval = t_eval.shape[0]
-
-    y[0] = st[S_TAU]
-    y[1] = st[S_AL]
-    y[2] = st[S_OM]
-    y[3] = st[S_U]
-    t0 = st[S_T0]
-    br = int(st[S_BR])
-    h = st[S_H]
+    t0, br, h = _resume(st, y)
     has_folds = p[P_FOLDS] != 0.0
     calls = 0
     n_bad = 0  # successive steps rejected for their dense output
@@ -283,16 +340,10 @@ def _run(
         cnt[C_RHS] += 1
 
     while True:
-        # ---- budget / buffer checks happen between steps only
-        if calls >= max_call_steps:
+        stop = _room_left(calls, max_call_steps, save_mode, cnt, out.shape[0], jbuf.shape[0])
+        if stop != _GO:
             _save(st, y, h)
-            return PAUSE
-        if save_mode == SAVE_STEPS and cnt[C_NOUT] + 2 > nout_cap:
-            _save(st, y, h)
-            return OUT_FULL
-        if cnt[C_NJOUT] + 1 > njump_cap:
-            _save(st, y, h)
-            return JUMPS_FULL
+            return stop
 
         # ---- one accepted step
         status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, P, rtol, atol, K, y_new, tmp, sc)
@@ -310,15 +361,11 @@ def _run(
         nte0 = cnt[C_TEVAL]
         ok = True
 
-        # ---- events inside [y, y_new]
+        # ---- events inside [y, y_new]: the fold (x_fold), then t_end (x_end), as fractions of the step
         dense = False
-        # fold (AB: v reaches v_max from below; CD: v reaches v_min from above)
         x_fold = 2.0
         if has_folds:
-            uf = p[P_UEV_AB] if br == 0 else p[P_UEV_CD]
-            gA = y[3] - uf
-            gB = y_new[3] - uf
-            crossed = gB >= 0.0 if br == 0 else gB <= 0.0
+            crossed, uf, gA, gB = _fold_crossing(y, y_new, p, br)
             if crossed:
                 dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
                 ok = _finite_rows(Fc)
@@ -328,12 +375,9 @@ def _run(
         # (or a user's v_floor), checked at step end
         if ok and br == 0 and y_new[3] <= p[P_UFLOOR] and x_fold > 1.0:
             cnt[C_STEPS] += 1
-            for i in range(4):
-                y[i] = y_new[i]
-            _save(st, y, h_next)
-            return NO_ROOT
-        # end time: τ increases up to the fold (f' > 0 on the branch) and falls
-        # again beyond it, so t_end is looked for in [0, min(x_fold, 1)]
+            return _end(st, y, y_new, h_next, NO_ROOT)
+        # τ increases up to the fold (f' > 0 on the branch) and falls again beyond it, so t_end is looked for in
+        # [0, min(x_fold, 1)]
         x_end = 2.0
         x_stop = 1.0
         if ok:
@@ -369,6 +413,7 @@ def _run(
                 cnt[C_NOUT] += 1
                 cnt[C_TEVAL] += 1
 
+        # ---- the state where the step stops (ye)
         if ok:
             if x_fold <= 1.0 or x_end <= 1.0:
                 interp(y, Fc, x_stop, ye)
@@ -396,15 +441,9 @@ def _run(
 
         c_e, _ = _closure(ye[1], p)
         if not (1.0 + c_e > 1e-12):
-            for i in range(4):
-                y[i] = ye[i]
-            _save(st, y, h)
-            return GEOMETRY
+            return _end(st, y, ye, h, GEOMETRY)
         if br == 1 and ye[3] > p[P_UCEIL]:
-            for i in range(4):
-                y[i] = ye[i]
-            _save(st, y, h)
-            return V_CEILING
+            return _end(st, y, ye, h, V_CEILING)
 
         if x_end <= 1.0 and x_end <= x_fold:
             # reached t_end (a fold exactly at t_end is left for a later call)
@@ -413,50 +452,27 @@ def _run(
                 ve = np.exp(ye[3])
                 _store(out, cnt[C_NOUT], t_end, ye, ve, _PULL(ye[1], ve, P), out_br, br)
                 cnt[C_NOUT] += 1
-            for i in range(4):
-                y[i] = ye[i]
-            _save(st, y, h_next)
-            return DONE
+            return _end(st, y, ye, h_next, DONE)
 
         if x_fold <= 1.0:
             # ---- jump at the fold: v exactly at the fold value, (α, ω, F) continuous
             v_fold = p[P_VMAX] if br == 0 else p[P_VMIN]
             ye[3] = np.log(v_fold)
-            ye[0] = max(ye[0], y[0])  # as for a plain step (below)
+            ye[0] = max(ye[0], y[0])  # as for a plain step (_advance)
             tj = t0 + ye[0]
             Fj = _PULL(ye[1], v_fold, P)
-            if br == 0:
-                v_after = p[P_VLCD]
-            else:
-                v_after = p[P_VLAB]
-                if not (v_after > 0.0):
-                    for i in range(4):
-                        y[i] = ye[i]
-                    _save(st, y, h)
-                    return NO_LANDING
+            v_after = p[P_VLCD] if br == 0 else p[P_VLAB]
+            if br == 1 and not (v_after > 0.0):  # a CD->AB jump without a landing root
+                return _end(st, y, ye, h, NO_LANDING)
             if tj >= t_store:
                 if save_mode == SAVE_STEPS:
                     _store(out, cnt[C_NOUT], tj, ye, v_fold, Fj, out_br, br)
                     cnt[C_NOUT] += 1
-                k = cnt[C_NJOUT]
-                jbuf[k, 0] = tj
-                jbuf[k, 1] = br
-                jbuf[k, 2] = 1 - br
-                jbuf[k, 3] = ye[1]
-                jbuf[k, 4] = ye[2]
-                jbuf[k, 5] = Fj
-                jbuf[k, 6] = v_fold
-                jbuf[k, 7] = v_after
-                cnt[C_NJOUT] += 1
+                _record_jump(jbuf, cnt, tj, br, ye, Fj, v_fold, v_after)
             cnt[C_JUMPS] += 1
             br = 1 - br
             t0 = tj
-            y[0] = 0.0
-            y[1] = ye[1]
-            y[2] = ye[2]
-            y[3] = np.log(v_after)
-            st[S_T0] = t0
-            st[S_BR] = br
+            _land(st, y, ye, tj, br, v_after)
             if tj >= t_store and save_mode == SAVE_STEPS:
                 _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
                 cnt[C_NOUT] += 1
@@ -466,14 +482,7 @@ def _run(
             continue
 
         # ---- plain accepted step
-        if y_new[0] < y[0]:
-            # t(s) increases on a stable branch; near a folded singularity its
-            # increments fall below the step's error tolerance (module
-            # docstring): keep the invariant.  τ does not enter the field.
-            y_new[0] = y[0]
-        for i in range(4):
-            y[i] = y_new[i]
-            f0[i] = K[_NS, i]
+        _advance(y, y_new, f0, K)
         h = h_next
         if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
             v = np.exp(y[3])

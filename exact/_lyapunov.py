@@ -55,8 +55,9 @@ from ._benettin import (
     natural_scales,
     variant_two_trajectory,
 )
+from ._initial import initial_state
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
-from ._simulate import initial_state, simulate
+from ._simulate import simulate
 
 __all__ = ["METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]
 

@@ -160,7 +160,7 @@ def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: 
     ModelBreakdown, SolverBudgetExceeded, SolverFailure
         The orbit breaks down or does not return.
     """
-    from ._simulate import ATOL_SCALE
+    from ._methods import ATOL_SCALE
 
     ts = system or system_of(params)
     x0 = np.asarray(x, dtype=float).reshape(2)

@@ -34,13 +34,13 @@ from peelapprox.kernels import regularized_field as _fun  # the compiled field, 
 from peelapprox.kernels import regularized_field_jacobian as _jac
 from peelapprox.kernels import regularized_parameters as param_vector
 
-from ._options import Regularized
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 if TYPE_CHECKING:
     from peelapprox import PeelParams
 
-    from ._options import Budget, SaveAt, Smooth
+    from ._method_contract import Method
+    from ._options import Budget, SaveAt
 
 _SOLVERS = {"Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 #: Explicit solvers (no Jacobian), offered for the tape-mass model at large masses (not stiff there).
@@ -55,12 +55,12 @@ _EXPLICIT = {"DOP853": integrate.DOP853, "RK45": integrate.RK45}
 V_ARREST = 1e-12
 
 
-def run_regularized(params: PeelParams, t_end: float, s0: State, method: Regularized | Smooth, saveat: SaveAt,
+def run_regularized(params: PeelParams, t_end: float, s0: State, method: Method, saveat: SaveAt,
                     budget: Budget, progress: Callable[[float, float], None] | None) -> Trajectory:
     """Driver for ``simulate(method="regularized")`` and, for the model variants (``params.variant``: the tape
     mass, the constant load), ``method="smooth"``: the options validated, the budget resolved."""
-    solver, rtol, atol, v_floor = method.solver, method.rtol, method.atol_vector(), method.v_floor
-    eps = method.eps if isinstance(method, Regularized) else None
+    solver, rtol, atol, v_floor = cast(str, method.solver), method.rtol, method.atol_vector(), method.v_floor
+    eps = method.eps  # the regularised scheme's; None for the variants' smooth ODE
     t_store, te, max_wall = saveat.t_transient, saveat.ts, budget.max_wall
     max_points, max_jumps, max_steps = budget.max_points, budget.max_jumps, int(cast(int, budget.max_steps))
     cl = compiled_law(params.force, params.V)  # the paper's law: fvV inlined in the field (the default)

@@ -53,7 +53,7 @@ from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, integer, optional, positive
 
 from . import _hybrid as H
-from . import _hybrid_law as HL
+from . import _hybrid_driver as HD
 from ._jacobian import jacobian_law, jacobian_paper
 
 DONE, FOLD, MAX_STEPS, NO_LANDING, NO_ROOT, STEP_FAIL, V_CEILING = (
@@ -150,7 +150,7 @@ def _make_to_fold(field, jac, pack, tag: str):
 
 
 _TO_FOLD = {False: _make_to_fold(H._rhs, jacobian_paper, pack_inlined, "inlined"),
-            True: _make_to_fold(HL._rhs_law, jacobian_law, pack_law, "law")}
+            True: _make_to_fold(HD._rhs_law, jacobian_law, pack_law, "law")}
 
 
 def to_fold(law_argument: bool) -> Any:
@@ -210,14 +210,13 @@ class TangentSystem:
 def tangent_system(params) -> TangentSystem:
     """The :class:`TangentSystem` of ``params`` (its law's compiled driver, field and pull force)."""
     from ._attractors import paper_model_only
-    from ._simulate import _param_vector
 
     paper_model_only(params, "the hybrid tangent dynamics (section returns, periodic_orbit, solve_orbit, "
                      "continue_orbit, lyapunov methods 'tangent' and 'return-map')",
                      "use exact.orbit_diagram, exact.attractors or lyapunov(method='two-trajectory')")
-    cl = HL.law_for(params)  # the paper's law (default): the driver with fvV inlined
+    cl = HD.law_for(params)  # the paper's law (default): the driver with fvV inlined
     law, coef, bs = cl.arg, cl.coef, cl.structure
-    p = _param_vector(params) if cl.inlined else _param_vector(params, None, bs, cl.domain)
+    p = HD.param_vector(params) if cl.inlined else HD.param_vector(params, None, bs, cl.domain)
     if cl.inlined:
         def field(y, out):
             H._rhs(y, p, out)
@@ -225,13 +224,13 @@ def tangent_system(params) -> TangentSystem:
         def pull(a, v):
             return H.pull_force(a, v, p)
     else:
-        rhs_law = HL.field_law()
+        rhs_law = HD.field_law()
 
         def field(y, out):
             rhs_law(y, p, law, coef, out)
 
         def pull(a, v):
-            return HL.pull_force_law(a, v, p, law, coef)
+            return HD.pull_force_law(a, v, p, law, coef)
     return TangentSystem(cl, p, to_fold(not cl.inlined), field, pull)
 
 
@@ -287,7 +286,9 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     raises :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
     from ._benettin import natural_scales
-    from ._simulate import ATOL_SCALE, initial_state, simulate
+    from ._initial import initial_state
+    from ._methods import ATOL_SCALE
+    from ._simulate import simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
@@ -341,14 +342,14 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
             break
         if status != FOLD:
             lo, hi = cl.domain
-            status, what = HL.domain_status(status, cl, math.exp(y[3]), math.inf)
+            status, what = HD.domain_status(status, cl, math.exp(y[3]), math.inf)
             raise status_error(status, t=t_transient + t + y[0], state=where(t + y[0]), prefix="tangent integration: ",
                                where=f"at t = {t_transient + t + y[0]:.6g} s", limit=int(max_steps),
                                f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]), lo=lo, hi=hi,
                                law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)
         t += y[0]
         if ts.jump(y, br) is None:
-            code, what = HL.domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
+            code, what = HD.domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
             raise status_error(code, t=t_transient + t, state=where(t), prefix="tangent integration: ",
                                where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero, what=what,
                                lo=cl.domain[0], hi=cl.domain[1], law=repr(params.force))

@@ -34,7 +34,8 @@ from peelapprox.validate import duration, function, in_range, optional, state
 from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
 
-from ._simulate import _atol_vector, initial_state
+from ._initial import initial_state
+from ._method_contract import default_atol
 
 if TYPE_CHECKING:  # pragma: no cover
     from peelapprox import PeelParams
@@ -173,7 +174,7 @@ def lyapunov_variational(
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
     eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
-    a = _atol_vector("regularized", rtol, None)
+    a = default_atol("regularized", rtol)
     alpha0 = state("alpha0", alpha0, "alpha")
     progress = optional(function, "progress", progress)
     ode = diffsl_model(params.geometry, tangent=True, force=params.force)

@@ -73,7 +73,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "peelapprox/kernels.py",
     "exact/_hybrid.py",
-    "exact/_hybrid_law.py",
+    "exact/_hybrid_driver.py",
     "exact/_jacobian.py",
     "exact/_regularized.py",
     "exact/_tangent.py",

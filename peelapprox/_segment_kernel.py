@@ -14,7 +14,7 @@ Parameter vector ``q``: the model block of :mod:`peelapprox._packing` (``M_V``, 
 driver's fields ``Q_*`` from index ``N_M``.
 
 The peel-force law (issue 15): the driver body :func:`_run` is compiled twice (:func:`peelapprox._jit.rebind`),
-as the hybrid solver's (``exact._hybrid_law``):
+as the hybrid solver's (``exact._hybrid_driver``):
 
 * ``run(False)`` -- the paper's law fvV **inlined** (:func:`field`, ``q`` carrying ``b, A``): the default path,
   bitwise the numbers of 0.2.0;
@@ -146,7 +146,7 @@ def field(y, q, out):
     _field_at(y, q, v, v * fp, out)
 
 
-@kernel(nrt=False)  # no reference counting around the law call (exact._hybrid_law: 62 vs 29 ns per field)
+@kernel(nrt=False)  # no reference counting around the law call (exact._hybrid_driver: 62 vs 29 ns per field)
 def field_law(y, P, out):
     """:func:`field` for the law of ``P = (q, law, coef)``: ``law(ln v, coef, LAW_LNV)`` gives ``(v, f, v f')``."""
     q, law, coef = P

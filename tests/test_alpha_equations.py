@@ -134,7 +134,7 @@ def test_every_driver_vector_starts_with_the_model_block():
     block followed by their own fields, numbered from ``N_M`` without gaps or overlaps (exact comparisons of
     indices and values)."""
     from exact import _hybrid as H
-    from exact._simulate import _param_vector
+    from exact._hybrid_driver import param_vector as _param_vector
     from peelapprox import _segment_kernel as K
 
     p = PeelParams(V=1.0, I=1e-5, geometry="exact")

@@ -35,7 +35,8 @@ API = {
         "wkb_error_bound", "StickSlipObservables", "attractor_observables", "approximate_attractor",
     },
     "exact": {
-        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "ModelBreakdown", "Regularized", "Smooth", "STEP_BUDGET",
+        "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
+        "STEP_BUDGET",
         "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",

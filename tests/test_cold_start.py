@@ -27,7 +27,7 @@ import peelapprox, exact
 at_import = sum(1 for _, e in rec.buffer if e.is_start)
 import peelapprox.law._abi as A, peelapprox.law._table_jit as T, peelapprox._segment_kernel as SK
 import peelapprox.kernels as K
-import exact._hybrid_law as HL, exact._tangent as TG
+import exact._hybrid_driver as HL, exact._tangent as TG
 {job}
 others = dict(paper_law=A.paper_law, table_law=T.table_law, pull_force_law=HL.pull_force_law,
               hybrid_law_driver=HL._DRIVERS[True], field_law=HL._field_law,

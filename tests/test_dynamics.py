@@ -220,7 +220,7 @@ def test_saltation_maps_the_flow_direction_onto_the_flow_direction():
     fold state of V = 1, I = 1e-5."""
     from exact import _hybrid as H
     from exact import simulate
-    from exact._simulate import _param_vector
+    from exact._hybrid_driver import param_vector as _param_vector
     from exact._tangent import saltation
 
     p = PeelParams(V=1.0, I=1e-5)

@@ -30,9 +30,9 @@ with warnings.catch_warnings(record=True) as w:
     from peelapprox.law._paper import peel_force
     from peelapprox.kernels import paper_coefficients, paper_law
     from exact._hybrid import pull_force
-    from exact._hybrid_law import driver, pull_force_law
+    from exact._hybrid_driver import driver, pull_force_law
     run = driver(True)  # the driver taking the law as an argument: compiled or loaded from the cache here
-    from exact._simulate import _param_vector
+    from exact._hybrid_driver import param_vector as _param_vector
     p = PeelParams(V=1.0, I=1e-5)
     kern = float(pull_force(0.2, 0.1, _param_vector(p, 1e-9)))
     kern_law = float(pull_force_law(0.2, 0.1, _param_vector(p, 1e-9), paper_law, paper_coefficients(1.0)))
@@ -101,7 +101,7 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     the kernel follows the changed source.  The kernel and numpy evaluate the same expression, so they agree
     to rounding (1e-12 relative); the change of 400 v^0.35 -> 401 v^0.35 at v = 0.1 moves f by 0.447 N (F by 0.373 N),
     10^9 times that tolerance.  The same for the law passed as a function argument (issue 15: ``paper_law``
-    and the driver taking it, ``exact._hybrid_law.driver(True)``, compiled for an explicit signature): the driver is
+    and the driver taking it, ``exact._hybrid_driver.driver(True)``, compiled for an explicit signature): the driver is
     loaded from the cache by a second process (a cache hit, no miss, one signature) and compiled anew after the
     change (a miss)."""
     _copy_packages(tmp_path)

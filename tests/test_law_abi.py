@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 import exact._hybrid as H
-import exact._hybrid_law as HL
-import exact._simulate as ES
+import exact._hybrid_driver as HL
 from exact import Budget, Hybrid, SaveAt, State
 from peelapprox import PeelForce, PeelParams, branch_structure
 from peelapprox.kernels import (
@@ -40,7 +39,7 @@ def _poly(coef):
 
 def _give_paper_as_law(monkeypatch) -> None:
     """Route runs of the paper's law through the law driver (``inlined=False``: the law as an argument) by
-    substituting ``exact._hybrid_law.law_for``."""
+    substituting ``exact._hybrid_driver.law_for``."""
     from peelapprox.kernels import CompiledLaw, compiled_law
 
     def law_for(params):
@@ -64,7 +63,7 @@ def test_paper_law_is_the_inlined_law_bitwise():
             f, fp, nan = paper_law(v, c, LAW_FP)
             assert (f, fp) == peel_force_fp_jit(v, b, A) and np.isnan(nan)
             assert paper_law(v, c, LAW_FPP) == peel_force_fpp_jit(v, b, A)
-        p = ES._param_vector(PeelParams(V=V, I=1e-5))
+        p = HL.param_vector(PeelParams(V=V, I=1e-5))
         for a, v in ((0.0, 0.1), (0.3, 1e-20), (-0.5, 3.0)):
             assert HL.pull_force_law(a, v, p, paper_law, c) == H.pull_force(a, v, p)
             y = np.array([0.0, a, 10.0, np.log(v)])
@@ -154,8 +153,8 @@ def test_second_law_runs_in_the_compiled_driver_with_its_own_folds():
     s0 = State(0.0, 0.0, 1.2 / 0.1, float(np.polyval(_poly(COEF), v0)), v0, "AB")
     run = HL.driver(True)
     assert len(run.signatures) == 1
-    tr = ES._run_hybrid(params, 2.0, s0, Hybrid(rtol=1e-10), SaveAt(jumps_only=True),
-                        Budget(max_points=10, max_steps=10**7, max_jumps=10**5), None)
+    tr = HL.run_hybrid(params, 2.0, s0, Hybrid(rtol=1e-10), SaveAt(jumps_only=True),
+                       Budget(max_points=10, max_steps=10**7, max_jumps=10**5), None)
     assert len(run.signatures) == 1
     assert len(tr.jumps.t) >= 20  # stick-slip: ~17 cycles per second at these parameters
     assert_jumps_at_cubic_folds(tr.jumps, COEF)

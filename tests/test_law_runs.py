@@ -12,7 +12,7 @@ import pytest
 from test_law_abi import _numpy_folds, _poly, assert_jumps_at_cubic_folds  # numpy's folds of a cubic
 
 import exact
-import exact._hybrid_law as HL
+import exact._hybrid_driver as HL
 from peelapprox import PeelForce, PeelParams
 from peelapprox.kernels import M_A, M_B, N_M, model_block
 from peelapprox.validate import params as validate_params

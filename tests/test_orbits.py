@@ -14,8 +14,7 @@ import pytest
 from numba import njit
 
 import exact
-import exact._hybrid_law as HL
-import exact._simulate as ES
+import exact._hybrid_driver as HL
 from exact._jacobian import field_jacobian
 from peelapprox import PeelForce, PeelParams, return_map
 from peelapprox.kernels import LAW_FPP, compiled_law
@@ -37,7 +36,7 @@ def test_field_jacobian_is_the_derivative_of_the_field(params):
     size) at states on both branches, to 1e-6 relative to the largest entry (the difference quotient's own
     error is ~1e-8; a wrong term is off by O(1))."""
     cl = compiled_law(params.force, params.V)
-    p = ES._param_vector(params, None, cl.structure, cl.domain)
+    p = HL.param_vector(params, None, cl.structure, cl.domain)
     rng = np.random.default_rng(3)
     for v in (0.02, 0.3, 3.0, 12.0):
         y = np.array([0.0, rng.uniform(-0.2, 0.2), rng.uniform(0, 30), math.log(v)])

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import fields
 from typing import Any
 
 from ._checks import check_output_path, positive_float, positive_int
@@ -13,16 +15,71 @@ from ._force import law_fields
 __all__ = ["add_parser", "run"]
 
 
+def _methods() -> Mapping[str, Any]:
+    """exact's table of solver methods (name -> class), imported when first needed."""
+    from exact import METHODS
+
+    return METHODS
+
+
+class _FromMethods(Sequence[str]):
+    """A list read from the table of solver methods when argparse first needs it (to check a value or to print
+    the help): building the parser loads no ``exact``."""
+
+    def __init__(self, read: Callable[[Mapping[str, Any]], Iterable[str]]):
+        self._read: Callable[[Mapping[str, Any]], Iterable[str]] = read
+        self._items: tuple[str, ...] | None = None
+
+    def _all(self) -> tuple[str, ...]:
+        if self._items is None:
+            self._items = tuple(self._read(_methods()))
+        return self._items
+
+    def __getitem__(self, i):  # type: ignore[override]
+        return self._all()[i]
+
+    def __len__(self) -> int:
+        return len(self._all())
+
+    def __repr__(self) -> str:
+        return repr(self._all())
+
+
+class _HelpFromMethods(str):
+    """An option's help written from the table of solver methods when printed (argparse formats a help as
+    ``help % params``); ``short`` stands for it until then."""
+
+    def __new__(cls, short: str, write: Callable[[Mapping[str, Any]], str]) -> _HelpFromMethods:
+        obj = super().__new__(cls, short)
+        obj._write = write  # type: ignore[attr-defined]
+        return obj
+
+    def __mod__(self, params: Any) -> str:
+        return self._write(_methods()) % params  # type: ignore[attr-defined]
+
+
+def _default_solver(method: Any) -> str:
+    return str(next(f.default for f in fields(method) if f.name == "solver"))
+
+
+def _method_help(methods: Mapping[str, Any]) -> str:
+    return "; ".join(f"{name}: {m.about}" for name, m in methods.items()) + (
+        " (default: the model's, the first of these that solves it)")
+
+
+def _solver_help(methods: Mapping[str, Any]) -> str:
+    return "scipy solver of " + "; ".join(
+        f"--method {name}: {', '.join(m.solvers)} (default: {_default_solver(m)})"
+        for name, m in methods.items() if m.solvers)
+
+
 def add_parser(sub) -> argparse.ArgumentParser:
     sp = subcommand(
         sub, "simulate", help="integrate the full model (exact solution)",
         description="Integrate the full model (the DAE of the paper, its jumps between the branches of f(v, V) "
                     "included) from an initial state and print a summary of the run: steps, jumps, the force at "
-                    "the jumps, the final state.  Methods: hybrid (the jumps as events, exact as eps -> 0; the "
-                    "default for the paper's model), regularized (the paper's eps-regularised scheme, by scipy's "
-                    "Radau, BDF or LSODA; the default for a massless tape under --loading load) or smooth (the "
-                    "tape-mass model's ODE, --tape-mass, by scipy's Radau, BDF, LSODA, DOP853 or RK45; its only "
-                    "method).  The model variants: --tape-mass (the peeled ribbon's mass, docs/tape-mass.md) and "
+                    "the jumps, the final state, by one of exact.simulate's solver methods (--method, --solver).  "
+                    "The model variants: --tape-mass (the peeled ribbon's mass, docs/tape-mass.md) and "
                     "--loading load --load-mass [--load] (a constant load instead of a constant pull speed; the "
                     "pull speed Vp is then a state, in the summary and the plot; docs/constant-load.md).",
         examples=["peelapprox simulate --V 1 --I 1e-2 --t-end 20 --t-transient 10 --plot fig4.png --out run.npz",
@@ -39,13 +96,10 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g.add_argument("--F0", type=float, default=None, help="initial pull force [N] (default: 1.01 f(V, V))")
     g.add_argument("--branch0", choices=("AB", "CD"), default=None,
                    help="initial branch of f (default: the lowest-velocity stable root)")
-    g.add_argument("--method", choices=("hybrid", "regularized", "smooth"), default=None,
-                   help="hybrid: jumps as events; regularized: the paper's eps-scheme; smooth: the tape-mass "
-                        "model's ODE (default: the model's: hybrid, smooth with --tape-mass, regularized with "
-                        "--loading load and no tape mass)")
-    g.add_argument("--solver", choices=("Radau", "BDF", "LSODA", "DOP853", "RK45"), default=None,
-                   help="scipy solver of --method regularized (Radau, BDF, LSODA) or smooth (all five) "
-                        "(default: Radau)")
+    g.add_argument("--method", choices=_FromMethods(lambda methods: methods), default=None,
+                   help=_HelpFromMethods("the solver method", _method_help))
+    g.add_argument("--solver", default=None, help=_HelpFromMethods("the scipy solver", _solver_help),
+                   choices=_FromMethods(lambda methods: dict.fromkeys(s for m in methods.values() for s in m.solvers)))
     g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the integration")
     g.add_argument("--eps", type=float, default=None,
                    help="the paper's regularisation parameter epsilon of --method regularized (default: 1e-7)")
