@@ -8,8 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peelapprox import BRANCHES, PeelParams
+from peelapprox import BRANCHES, ForceSeries, PeelParams
 from peelapprox.io import fmt_number, html_table, optional_import, param_attrs
+from peelapprox.validate import finite, integer, nonnegative, optional, positive
 
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 
@@ -372,6 +373,61 @@ class Trajectory:
             "wall time [s]": st.wall_time, "final state": (f"α={fmt_number(self.final_state.alpha, 6)} rad, "
                                                            f"F={fmt_number(self.final_state.F, 6)} N, "
                                                            f"branch {self.final_state.branch}")})
+
+    def as_series(self, rate: float, *, noise: float = 0.0, drift: float = 0.0, seed: int | None = None,
+                  t_start: float | None = None) -> ForceSeries:
+        """The pull force as a tensile machine would record it: a :class:`peelapprox.ForceSeries` sampled at
+        ``rate`` [Hz] from ``t_start`` (default: the first stored time at or after ``t_transient``) to ``t_end``.
+
+        Where the stored times are the sampling grid (a run with ``t_eval=np.arange(t0, t_end, 1/rate)``) the
+        samples are the solver's own values; otherwise F is interpolated linearly between the stored points,
+        and ``source`` says so with the largest gap between them (F is smooth between jumps and continuous at
+        them; a gap longer than ``1/rate`` loses detail: run with ``t_eval`` on the grid instead).
+
+        Parameters
+        ----------
+        rate : float
+            Sampling rate [Hz], in (0, 1e9].
+        noise : float
+            Standard deviation [N] of Gaussian white noise added to every sample (0).
+        drift : float
+            A linear drift of the force [N] over the series, from 0 at its start to ``drift`` at its end (0).
+        seed : int, optional
+            Of the noise's generator (:func:`numpy.random.default_rng`); None: fresh entropy.
+        t_start : float, optional
+            First sample time [s].
+
+        Returns
+        -------
+        ForceSeries
+            With ``V`` the run's pull speed and ``source`` saying how it was sampled.
+        """
+        rate = positive("rate", rate)
+        if rate > 1e9:
+            raise ValueError(f"rate must be at most 1e9 Hz, got {rate!r}")
+        noise = nonnegative("noise", noise)
+        drift = finite("drift", drift)
+        seed = optional(integer, "seed", seed, lo=0, hi=2**63 - 1)
+        keep = self.t >= (self.t_transient if t_start is None else float(t_start))
+        t, F = self.t[keep], self.F[keep]
+        if t.size < 2:
+            raise ValueError("the trajectory stores fewer than 2 points after t_start: nothing to sample")
+        grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
+        if grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=1e-9 / rate):
+            Fs, how = F.copy(), "the solver's values on the grid"
+        else:
+            uniq = np.concatenate(([True], np.diff(t) > 0))  # a jump's two rows share F: keep one
+            Fs = np.interp(grid, t[uniq], F[uniq])
+            how = (f"interpolated linearly between {int(uniq.sum())} stored points (largest gap "
+                   f"{fmt_number(float(np.max(np.diff(t[uniq]))), 3)} s)")
+        if drift:
+            Fs = Fs + drift * (grid - grid[0]) / max(float(grid[-1] - grid[0]), 1e-300)
+        if noise:
+            Fs = Fs + np.random.default_rng(seed).normal(0.0, noise, grid.size)
+        p = self.params
+        source = (f"exact.simulate(V = {fmt_number(p.V, 6)} m/s, I = {fmt_number(p.I, 4)} kg m^2) sampled at "
+                  f"{fmt_number(rate, 6)} Hz ({how}), noise {fmt_number(noise, 3)} N, drift {fmt_number(drift, 3)} N")
+        return ForceSeries(grid, Fs, V=float(p.V), source=source)
 
     def to_dataframe(self):
         """The stored points as a :class:`pandas.DataFrame`: columns ``t, alpha, omega, F, v`` (the arrays

@@ -67,6 +67,7 @@ from ._ranges import (
 )
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
+from ._series import ForceSeries, Slips, Spectrum
 from ._version import __version__ as __version__
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from .law import (
@@ -85,6 +86,9 @@ from .law import (
 
 __all__ = [
     "PeelParams",
+    "ForceSeries",
+    "Slips",
+    "Spectrum",
     "PeelForce",
     "Folds",
     "GEOMETRIES",
