@@ -70,6 +70,8 @@ class Slips:
         Times of the force maximum before the slip and of the minimum after it [s].
     F_before, F_after : ndarray
         The force there [N], from straight-line fits of the sticks on either side (module docstring).
+    rise : ndarray
+        The slope of the line fitted to the stick before each slip [N/s] (``k(V - v)`` in the model).
     drop : ndarray
         ``F_before - F_after`` [N].
     slip_time : ndarray
@@ -86,6 +88,7 @@ class Slips:
     t_end: np.ndarray
     F_before: np.ndarray
     F_after: np.ndarray
+    rise: np.ndarray
     threshold: float
     noise: float
     method: str
@@ -111,7 +114,7 @@ class Slips:
         first slip's stick)."""
         return [{"t_start": float(self.t_start[k]), "t_end": float(self.t_end[k]),
                  "F_before": float(self.F_before[k]), "F_after": float(self.F_after[k]),
-                 "drop": float(self.drop[k]), "slip_time": float(self.slip_time[k]),
+                 "drop": float(self.drop[k]), "slip_time": float(self.slip_time[k]), "rise": float(self.rise[k]),
                  "stick_before": None if k == 0 else float(self.stick_time[k - 1])} for k in range(len(self))]
 
     def write(self, path: str) -> None:
@@ -187,20 +190,21 @@ def _line(t: np.ndarray, F: np.ndarray, lo: int, hi: int, min_n: int) -> tuple[f
 
 
 def _corner(t: np.ndarray, F: np.ndarray, stick: tuple[int, int], fall: tuple[int, int], near: int,
-            window: tuple[int, int]) -> tuple[float, float]:
+            window: tuple[int, int]) -> tuple[float, float, float]:
     """Where the line fitted to the stick meets the line fitted to the slip's fall: ``(time, F of the stick
-    line there)``, the time kept within ``t[window]``; at ``t[near]`` where a line has too few samples."""
+    line there, the stick line's slope)``, the time kept within ``t[window]``; at ``t[near]`` (slope 0) where
+    the stick has too few samples for a line."""
     s = _line(t, F, *stick, min_n=3)
     f = _line(t, F, *fall, min_n=2)
     lo_t, hi_t = float(t[window[0]]), float(t[window[1]])
     if s is None:
-        return float(t[near]), float(F[near])
+        return float(t[near]), float(F[near]), 0.0
     tc = float(t[near])
     if f is not None and f[0] != s[0]:
         # s0 (t - ts) + s1 = f0 (t - tf) + f1
         tc = (f[1] - s[1] - f[0] * f[2] + s[0] * s[2]) / (s[0] - f[0])
         tc = min(max(tc, lo_t), hi_t)
-    return tc, s[1] + s[0] * (tc - s[2])
+    return tc, s[1] + s[0] * (tc - s[2]), s[0]
 
 
 def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None, smooth: int = 5,
@@ -233,7 +237,7 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
     if peaks and peaks[0] == 0:
         peaks, valleys = peaks[1:], valleys[1:]
     n = len(peaks)
-    ts, te, fb, fa = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    ts, te, fb, fa, rise = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     last = len(F) - 1
     for k in range(n):
         p, v = peaks[k], valleys[k]
@@ -248,16 +252,17 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
         knee = p + (int(flat[-1]) + 1 if flat.size else 0)
         L = max(2, min(fit, (v - knee) // 3))
         lo = max(before + (knee - before) // 2, knee - half - fit)
-        ts[k], fb[k] = _corner(t, F, (lo, knee - half), (knee + half, min(knee + half + L, v - half)), knee,
+        ts[k], fb[k], rise[k] = _corner(t, F, (lo, knee - half), (knee + half, min(knee + half + L, v - half)), knee,
                                (max(p - half - 1, 0), min(knee + half + 1, last)))
         hi = min(v + (after - v) // 2, v + half + 1 + fit)
-        te[k], fa[k] = _corner(t, F, (v + half + 1, hi), (max(knee + half, v - half - L), v - half), v,
+        te[k], fa[k], _ = _corner(t, F, (v + half + 1, hi), (max(knee + half, v - half - L), v - half), v,
                                (max(v - half - 1, 0), min(v + half + 1, last)))
     method = (f"slips: falls of the {smooth}-sample moving average by more than {fmt_number(h, 3)} N "
               + (f"(8 sigma, sigma = {fmt_number(sigma, 3)} N from the second differences)" if threshold is None
                  else "(given)")
               + f", F before and after from line fits of up to {fit} stick samples")
-    return Slips(t_start=ts, t_end=te, F_before=fb, F_after=fa, threshold=float(h), noise=sigma, method=method)
+    return Slips(t_start=ts, t_end=te, F_before=fb, F_after=fa, rise=rise, threshold=float(h), noise=sigma,
+                 method=method)
 
 
 class ForceSeries:
