@@ -21,7 +21,7 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._attractors import DEFAULT_MAX_WALL, Attractor, attractor_observables, attractors, window_run
+from ._attractors import Attractor, attractor_observables, attractors, window_run
 from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._continuation import (
@@ -41,6 +41,7 @@ from ._method_contract import default_atol
 from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
 from ._options import METHODS, Budget, SaveAt, default_max_steps
 from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
+from ._shared import DEFAULT_MAX_WALL
 from ._simulate import simulate
 from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory

@@ -31,10 +31,10 @@ from peelapprox.validate import ArgumentTypeError, duration, flag, integer, opti
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._attractors import DEFAULT_MAX_WALL, paper_model_only
 from ._basins_run import APERIODIC, BREAKDOWN, FAILURE, INVALID, UNDETERMINED, msg, reporter, run_all
 from ._method_contract import method_option
 from ._orbits import PeriodicOrbit, periodic_orbit
+from ._shared import DEFAULT_MAX_WALL, paper_model_only
 from ._simulate import simulate
 
 __all__ = ["MATCH_RTOL", "CYCLE_DIGITS", "INVALID", "APERIODIC", "BREAKDOWN", "UNDETERMINED", "FAILURE",

@@ -59,7 +59,6 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure, WallBudget
 from peelapprox.validate import finite, function, in_range, integer, optional, positive
 
-from ._attractors import DEFAULT_MAX_WALL
 from ._branch_end import NO_CREST, event_message, events_ahead, failure_end, near
 from ._corrector import (
     PARAMETERS,
@@ -72,6 +71,7 @@ from ._corrector import (
 )
 from ._crest import crest_margin
 from ._orbits import PeriodicOrbit, minimal_period
+from ._shared import DEFAULT_MAX_WALL
 
 __all__ = ["FAILURES", "PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "Stepper", "continue_orbit",
            "parameter_value", "with_parameter"]

@@ -25,9 +25,9 @@ from peelapprox.io import ProgressLine
 from peelapprox.validate import duration, function, optional, positive, reals
 from peelapprox.validate import params as _params
 
-from ._attractors import DEFAULT_MAX_WALL
 from ._corrector import with_parameter
 from ._orbits import solve_orbit
+from ._shared import DEFAULT_MAX_WALL
 
 __all__ = ["MAX_DIAGRAM_VALUES", "OrbitDiagram", "explain", "orbit_diagram"]
 

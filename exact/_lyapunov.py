@@ -45,18 +45,18 @@ from peelapprox.validate import (
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._attractors import DEFAULT_MAX_WALL, paper_model_only, window_run
+from ._attractors import window_run
 from ._benettin import (
     STDERR_BATCHES,
     BenettinResult,
     LyapunovResult,
     batch_means,
     benettin,
-    natural_scales,
     variant_two_trajectory,
 )
 from ._initial import initial_state
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
+from ._shared import DEFAULT_MAX_WALL, natural_scales, paper_model_only
 from ._simulate import simulate
 
 __all__ = ["METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]

@@ -40,8 +40,8 @@ from peelapprox.kernels import status as _st
 from peelapprox.validate import duration, in_range, integer, optional, positive
 from peelapprox.validate import params as _params
 
-from ._attractors import DEFAULT_MAX_WALL, paper_model_only
 from ._orbit_start import check_start, seed
+from ._shared import DEFAULT_MAX_WALL, paper_model_only
 from ._tangent import TangentSystem, tangent_system
 
 __all__ = ["PeriodicOrbit", "SectionReturn", "check_wall", "monodromy_fd", "periodic_orbit", "section_return",

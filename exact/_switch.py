@@ -10,9 +10,9 @@ import numpy as np
 from peelapprox.errors import SolverBudgetExceeded, WallBudget
 from peelapprox.validate import in_range, optional, positive
 
-from ._attractors import DEFAULT_MAX_WALL
 from ._continuation import FAILURES, Bifurcation, Stepper
 from ._orbits import PeriodicOrbit, minimal_period
+from ._shared import DEFAULT_MAX_WALL
 
 __all__ = ["SWITCH_DLAM", "switch_branch"]
 
