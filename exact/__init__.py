@@ -21,31 +21,54 @@ whose DiffSL model is printed from fvV, the paper's only). The return-map analys
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._attractors import Attractor, attractor_observables, attractors, window_run
-from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
-from ._benettin import BenettinResult, LyapunovResult, benettin
-from ._continuation import (
-    Bifurcation,
-    BranchPoint,
-    OrbitBranch,
-    continue_orbit,
-    parameter_value,
-    with_parameter,
-)
-from ._crest import Crest, crest_margin
-from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
 from ._hybrid_driver import compile_kernels, hybrid_field
 from ._initial import initial_state
-from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._method_contract import default_atol
 from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
 from ._options import METHODS, Budget, SaveAt, default_max_steps
-from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
 from ._shared import DEFAULT_MAX_WALL
 from ._simulate import simulate
-from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
-from ._variational import VARIATIONAL_LAWS, lyapunov_variational
+from .dynamics import (
+    MAX_BASIN_STARTS,
+    MAX_DIAGRAM_VALUES,
+    VARIATIONAL_LAWS,
+    Attractor,
+    BasinAttractor,
+    BasinResult,
+    BenettinResult,
+    LyapunovResult,
+    OrbitDiagram,
+    attractor_observables,
+    attractors,
+    basins,
+    benettin,
+    check_lyapunov_options,
+    explain,
+    lyapunov,
+    lyapunov_return_map,
+    lyapunov_tangent,
+    lyapunov_variational,
+    orbit_diagram,
+    window_run,
+)
+from .orbits import (
+    Bifurcation,
+    BranchPoint,
+    Crest,
+    OrbitBranch,
+    PeriodicOrbit,
+    SectionReturn,
+    continue_orbit,
+    crest_margin,
+    monodromy_fd,
+    parameter_value,
+    periodic_orbit,
+    section_return,
+    solve_orbit,
+    switch_branch,
+    with_parameter,
+)
 
 __all__ = [
     "simulate",

@@ -23,10 +23,10 @@ from peelapprox import PeelParams
 from peelapprox.io import fmt_number, html_table
 from peelapprox.validate import function, integer
 
-from ._shared import natural_scales
+from .._shared import natural_scales
 
 if TYPE_CHECKING:
-    from ._methods import Regularized, Smooth
+    from .._methods import Regularized, Smooth
 
 __all__ = ["BenettinResult", "benettin", "LyapunovResult", "STDERR_BATCHES", "batch_means"]
 
@@ -209,10 +209,10 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
     """
     from peelapprox.errors import SolverBudgetExceeded, WallBudget
 
-    from ._initial import initial_state
-    from ._method_contract import method_option
-    from ._options import output_options
-    from ._trajectory import State
+    from .._initial import initial_state
+    from .._method_contract import method_option
+    from .._options import output_options
+    from .._trajectory import State
 
     # a variant's method: smooth, or regularized under a load (never the hybrid one)
     opts = cast("Regularized | Smooth", method_option(None, solver=solver, eps=None, rtol=rtol, atol=None,

@@ -9,7 +9,7 @@ for ``(x, λ)``: the period-n closing condition and one linear condition, which 
 of a continuation step (``τ`` the branch's secant, ``w_ref`` the predicted point), a natural step
 (``τ = (0, 0, 1)``: λ fixed) or the amplitude condition of a branch switch (``τ`` along a multiplier's
 eigenvector).  The Jacobian is ``[[DP^n - 1, ∂P^n/∂λ], [τ]]`` with ``DP^n`` from the saltation tangent
-(:func:`exact._orbits.compose`) and ``∂P^n/∂λ`` by a forward difference (step ``1e-7 max(|λ|, Λ)``: its error,
+(:func:`exact.orbits._section.compose`) and ``∂P^n/∂λ`` by a forward difference (step ``1e-7 max(|λ|, Λ)``: its error,
 ~1e-6 relative, slows Newton's convergence to linear with that rate, no more; not computed for a natural step,
 where it does not enter).  A step that does not reduce the
 closing residual is halved (at most 8 times).
@@ -27,7 +27,8 @@ from peelapprox import PeelForce, PeelParams
 from peelapprox.errors import WallBudget
 from peelapprox.validate import ArgumentTypeError
 
-from ._orbits import PeriodicOrbit, check_wall, compose, make_orbit, section_return_n, system_of
+from ._periodic import PeriodicOrbit, check_wall, make_orbit
+from ._section import compose, section_return_n, system_of
 
 __all__ = ["PARAMETERS", "VARIANT_PARAMETERS", "bordered_newton", "branch_tangent", "check_parameter",
            "parameter_value", "with_parameter"]
@@ -113,7 +114,7 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
     Converged when the closing residual ``|P^n(x) - x| / max(1, |x|)`` (in ``x / scale``) is at most ``tol`` and
     the linear condition holds to ``1e-9 max(1, |w_ref|)``.  A Newton step that would move λ by more than
     ``max_dlam`` is shortened to it.  ``wall``, the caller's wall-clock budget, is checked before each iteration
-    and each halved step (:func:`exact._orbits.check_wall`).
+    and each halved step (:func:`exact.orbits._periodic.check_wall`).
 
     Raises
     ------

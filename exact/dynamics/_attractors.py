@@ -34,11 +34,11 @@ from peelapprox.validate import duration, function, integer, optional, positive,
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._initial import initial_state
-from ._method_contract import method_option
-from ._shared import DEFAULT_MAX_WALL
-from ._simulate import simulate
-from ._trajectory import Trajectory
+from .._initial import initial_state
+from .._method_contract import method_option
+from .._shared import DEFAULT_MAX_WALL
+from .._simulate import simulate
+from .._trajectory import Trajectory
 
 __all__ = ["window_run", "states_alpha", "Attractor", "attractors", "attractor_observables"]
 

@@ -4,7 +4,7 @@
 (``"force.c"``) by **pseudo-arclength continuation** in ``w = (α, ω R/V, λ/Λ)`` (the first section state,
 scaled, and the parameter λ over the span ``Λ = |stop - start|``): the predictor steps ``h`` along the secant
 through the last two points (from the start, along the branch's tangent, the null vector of ``[DP^n - 1,
-∂P^n/∂λ]``, oriented towards ``stop``), and the corrector (:func:`exact._corrector.bordered_newton`, n fixed)
+∂P^n/∂λ]``, oriented towards ``stop``), and the corrector (:func:`exact.orbits._corrector.bordered_newton`, n fixed)
 solves the closing condition ``P^n(x; λ) = x`` together with ``τ · (w - w_pred) = 0`` (the step orthogonal to
 the secant).  Steps from an orbit with a real multiplier within ``FOLD_NEAR`` (0.25) of +1 are
 pseudo-arclength steps, so the branch passes **folds**, where λ turns back; the others (and the last one onto
@@ -23,7 +23,7 @@ in λ and ``GAUGE_TOL`` in the gauge, or 40 halvings) on the quantity that chang
   both neighbouring points; where it lies between them, λ does not turn and the crossing is reported as a
   ``"branch_point"``);
 * **period doubling** (a real multiplier through -1: ``μ + 1``); :func:`switch_branch` starts the doubled
-  (period-2n) branch there (:mod:`exact._switch`);
+  (period-2n) branch there (:mod:`exact.orbits._switch`);
 * **Neimark-Sacker** (a complex pair through the unit circle: ``|μ| - 1``).
 
 The non-smooth ends of a branch are reported as the reason it stopped (``OrbitBranch.stopped``, with the
@@ -34,7 +34,7 @@ when it lies within two steps (or 1e-3 of the span) of the last point, else the 
   falls below ``graze_tol k V``; the multipliers diverge on the way in;
 * ``"crest"``: an interior crest of ``F (1 + c(α))`` on AB reaches f_max (or a trough on CD reaches f_min):
   beyond it the solution jumps one oscillation earlier, the itinerary changes and this orbit no longer exists
-  (:mod:`exact._crest`).  Detected when the crest margin of an accepted point falls below ``crest_tol``, or,
+  (:mod:`exact.orbits._crest`).  Detected when the crest margin of an accepted point falls below ``crest_tol``, or,
   when Newton fails at ``min_step``, when the last two points' margins extrapolate linearly to 0 within two
   steps or 1e-3 of the span; ``end_value`` is that extrapolation (likewise for a grazing, from ``Ġ²``, and a
   breakdown, from the lowest level on AB above f(0+));
@@ -59,6 +59,7 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure, WallBudget
 from peelapprox.validate import finite, function, in_range, integer, optional, positive
 
+from .._shared import DEFAULT_MAX_WALL
 from ._branch_end import NO_CREST, event_message, events_ahead, failure_end, near
 from ._corrector import (
     PARAMETERS,
@@ -70,8 +71,7 @@ from ._corrector import (
     with_parameter,
 )
 from ._crest import crest_margin
-from ._orbits import PeriodicOrbit, minimal_period
-from ._shared import DEFAULT_MAX_WALL
+from ._periodic import PeriodicOrbit, minimal_period
 
 __all__ = ["FAILURES", "PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "Stepper", "continue_orbit",
            "parameter_value", "with_parameter"]
@@ -143,17 +143,17 @@ class OrbitBranch:
         """:meth:`rows` as a :class:`pandas.DataFrame`, one row per point in the order continued; ``df.attrs``:
         ``units`` (per column), ``parameter``, ``stopped``, ``end_value``, ``message``, ``bifurcations``
         (``[{"kind", "value"}]``) and ``params`` (the start's).  ImportError without pandas."""
-        from ._dataout import branch_dataframe
+        from ._branch_out import branch_dataframe
 
         return branch_dataframe(self)
 
     def __repr__(self) -> str:
-        from ._dataout import branch_summary
+        from ._branch_out import branch_summary
 
         return branch_summary(self, short=True)
 
     def _repr_html_(self) -> str:
-        from ._dataout import branch_summary
+        from ._branch_out import branch_summary
 
         return branch_summary(self, short=False)
 
@@ -253,7 +253,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         (``PeriodicOrbit.fold_rates``) falls below ``graze_tol * k V``.
     crest_tol : float
         The branch stops with "crest" when an interior crest of the orbit comes within ``crest_tol (f_max -
-        f_min)`` of its fold (:func:`exact._crest.crest_margin`, one run of a period per point); 0 checks only
+        f_min)`` of its fold (:func:`exact.orbits._crest.crest_margin`, one run of a period per point); 0 checks only
         when Newton fails.
     progress : callable, optional
         ``progress(points, value)`` after every accepted point.

@@ -1,6 +1,6 @@
 """Where a continued branch ends (:func:`exact.continue_orbit`): the crest, breakdown and grazing events its last
 points extrapolate to, and the stop reason and message of a branch whose corrector fails at the smallest step
-(the module docstring of :mod:`exact._continuation` describes the events).
+(the module docstring of :mod:`exact.orbits._continuation` describes the events).
 
 ``points`` are the branch's :class:`exact.BranchPoint` objects (``value``, ``orbit``), in the order continued,
 and ``crests`` their :class:`exact.Crest` margins.
@@ -17,7 +17,7 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown
 
 from ._crest import Crest, crest_margin
-from ._orbits import PeriodicOrbit
+from ._periodic import PeriodicOrbit
 
 __all__ = ["NO_CREST", "event_message", "events_ahead", "failure_end", "near"]
 
@@ -34,7 +34,7 @@ def near(event: float, value: float, previous: float, span: float) -> float:
 def events_ahead(points: Sequence[Any], crests: list[Crest]) -> dict[str, float]:
     """The parameter values where the last two points' crest margin ("crest"), floor ("breakdown") and squared
     slowest fold rate ("grazing": Ġ vanishes like the square root of the distance), falling, extrapolate
-    linearly to 0 (:mod:`exact._continuation`); only the falling ones."""
+    linearly to 0 (:mod:`exact.orbits._continuation`); only the falling ones."""
     if len(points) < 2:
         return {}
     a, b = points[-2].value, points[-1].value
@@ -67,7 +67,7 @@ def failure_end(exc: Exception, points: Sequence[Any], crests: list[Crest], para
                 ) -> tuple[str, str, float]:
     """Why a branch whose corrector fails at the smallest step ends: a crest, breakdown or grazing event
     extrapolated ahead (within two steps or 1e-3 of the span; past a grazing the corrector's orbits break down),
-    else a breakdown of the corrector's orbit, else no convergence (:mod:`exact._continuation`)."""
+    else a breakdown of the corrector's orbit, else no convergence (:mod:`exact.orbits._continuation`)."""
     if len(points) >= 2:
         if not math.isfinite(crests[-1].margin + crests[-1].floor):  # crest_tol = 0: measure now
             crests[-2:] = [crest_margin(p.orbit) for p in points[-2:]]
