@@ -71,6 +71,7 @@ from ._corrector import (
     with_parameter,
 )
 from ._crest import crest_margin
+from ._kinds import ENDS, KINDS, crossing, gauge, marker
 from ._periodic import PeriodicOrbit, minimal_period
 
 __all__ = ["FAILURES", "PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "Stepper", "continue_orbit",
@@ -106,6 +107,16 @@ class Bifurcation:
     orbit: PeriodicOrbit
     parameter: str = "V"
 
+    @property
+    def marker(self) -> tuple[str, str]:
+        """The matplotlib marker and colour of its kind (:data:`exact.orbits._kinds.BIFURCATIONS`)."""
+        return marker(self.kind)
+
+    @property
+    def doubles(self) -> bool:
+        """A period doubling: :func:`exact.switch_branch` starts the doubled branch here."""
+        return self.kind == "period_doubling"
+
 
 @dataclass(frozen=True)
 class OrbitBranch:
@@ -135,6 +146,11 @@ class OrbitBranch:
     wall_time: float
     end_value: float = math.nan
 
+    @property
+    def end_marker(self) -> str | None:
+        """The matplotlib marker of its non-smooth end (:data:`exact.orbits._kinds.ENDS`), None for another stop."""
+        return KINDS[self.stopped].marker if self.stopped in {k.name for k in ENDS} else None
+
     def rows(self) -> list[dict]:
         """Every point as a row (:meth:`BranchPoint.row`), for ``peelapprox.io.write_rows`` (CSV/JSON)."""
         return [p.row(self.parameter) for p in self.points]
@@ -156,29 +172,6 @@ class OrbitBranch:
         from ._branch_out import branch_summary
 
         return branch_summary(self, short=False)
-
-
-def _crossing(a: PeriodicOrbit, b: PeriodicOrbit) -> str | None:
-    """The bifurcation between two orbits of a branch, by their multipliers (module docstring), or None."""
-    ma, mb = a.multipliers, b.multipliers
-    real_a, real_b = np.all(np.abs(ma.imag) < 1e-12), np.all(np.abs(mb.imag) < 1e-12)
-    if not real_a and not real_b:
-        return "neimark_sacker" if (abs(ma[0]) - 1.0) * (abs(mb[0]) - 1.0) < 0 else None
-    if real_a and real_b:
-        for kind, level in (("fold", 1.0), ("period_doubling", -1.0)):
-            sa, sb = np.sort(ma.real - level), np.sort(mb.real - level)
-            if np.any(np.sign(sa) != np.sign(sb)):
-                return kind
-    return None
-
-
-def _gauge(kind: str, o: PeriodicOrbit) -> float:
-    """The quantity whose sign change marks ``kind`` (module docstring)."""
-    mu = o.multipliers
-    if kind == "neimark_sacker":
-        return float(abs(mu[0]) - 1.0)
-    level = 1.0 if kind == "fold" else -1.0
-    return float(min(mu.real - level, key=abs))
 
 
 class Stepper:
@@ -356,7 +349,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
                        f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
                        "its multipliers diverge")
             break
-        kind = _crossing(last.orbit, o)
+        kind = crossing(last.orbit.multipliers, o.multipliers)
         if kind is not None:
             try:
                 bifs.append(_locate(kind, last, pt, st, locate_tol))
@@ -420,15 +413,16 @@ def _check_correction(st: Stepper, pt: BranchPoint, w_pred: np.ndarray, max_corr
 
 
 def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: Stepper, locate_tol: float) -> Bifurcation:
-    """Bisection along the arclength from ``a`` to ``b`` on :func:`_gauge` (module docstring)."""
+    """Bisection along the arclength from ``a`` to ``b`` on the kind's test value
+    (:func:`exact.orbits._kinds.gauge`)."""
     wa, wb = st.w(a), st.w(b)
     tau = (wb - wa) / np.linalg.norm(wb - wa)
-    ga = _gauge(kind, a.orbit)
+    ga = gauge(kind, a.orbit.multipliers)
     lo, hi, best = 0.0, 1.0, b
     pa, pb = a, b
     for _ in range(40):
         if (abs(pb.value - pa.value) <= locate_tol * max(abs(pa.value), abs(pb.value), 1e-300)
-                and abs(_gauge(kind, best.orbit)) <= GAUGE_TOL):
+                and abs(gauge(kind, best.orbit.multipliers)) <= GAUGE_TOL):
             break
         mid = 0.5 * (lo + hi)
         try:
@@ -437,7 +431,7 @@ def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: Stepper, locate_tol: 
             if _out_of_wall(exc):
                 raise
             break
-        gm = _gauge(kind, pm.orbit)
+        gm = gauge(kind, pm.orbit.multipliers)
         if gm == 0 or math.copysign(1.0, gm) != math.copysign(1.0, ga):
             hi, pb, best = mid, pm, pm
         else:

@@ -56,7 +56,7 @@ def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: flo
         ``max_wall`` spent (``budget="max_wall"``): the call returns one orbit or nothing, so a spent budget is
         an exception, as in :func:`exact.periodic_orbit`.
     """
-    if not isinstance(bifurcation, Bifurcation) or bifurcation.kind != "period_doubling":
+    if not isinstance(bifurcation, Bifurcation) or not bifurcation.doubles:
         raise ValueError(f"bifurcation must be a period_doubling Bifurcation, got {bifurcation!r:.80}")
     amplitude = in_range("amplitude", amplitude, 0.0, 0.1, lo_open=True)
     tol = in_range("tol", tol, 1e-14, 1e-3)
