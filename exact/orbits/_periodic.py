@@ -25,7 +25,7 @@ from peelapprox.validate import params as _params
 
 from .._shared import DEFAULT_MAX_WALL, paper_model_only
 from .._tangent import TangentSystem
-from ._section import compose, section_F, section_return_n, system_of
+from ._section import Composed, compose, section_F, section_return_n, system_of
 from ._start import check_start, seed
 
 __all__ = ["SAME_STATE", "PeriodicOrbit", "check_wall", "make_orbit", "minimal_period", "periodic_orbit",
@@ -227,21 +227,21 @@ def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol
     steps = 0
     for _ in range(max_iter):
         check_wall(wall, "periodic_orbit", x)
-        xn, J, T, states, k, rates = compose(params, ts, x, n, rtol)
-        steps += k
-        z, g = x / s, (xn - x) / s
+        c = compose(params, ts, x, n, rtol)
+        steps += c.steps
+        z, g = x / s, (c.x - x) / s
         res = float(np.linalg.norm(g) / max(1.0, np.linalg.norm(z)))
         history.append(res)
         if res <= tol:
             break
-        Js = J * s[None, :] / s[:, None]  # DP^n in z
+        Js = c.jacobian * s[None, :] / s[:, None]  # DP^n in z
         dz = np.linalg.solve(Js - np.eye(2), -g)
         lam = 1.0
         for _ in range(9):  # halve a step that does not reduce the residual
             x_try = (z + lam * dz) * s
             xt = section_return_n(params, ts, x_try, n, rtol)
-            steps += xt[1]
-            r_try = float(np.linalg.norm((xt[0] - x_try) / s) / max(1.0, np.linalg.norm(x_try / s)))
+            steps += xt.steps
+            r_try = float(np.linalg.norm((xt.x - x_try) / s) / max(1.0, np.linalg.norm(x_try / s)))
             if r_try < res:
                 break
             lam *= 0.5
@@ -249,19 +249,19 @@ def solve_orbit(params: PeelParams, x0: Any, n: int, *, tol: float = 1e-10, rtol
     else:
         raise ValueError(f"periodic_orbit: Newton did not close the period-{n} orbit to tol={tol} in "
                          f"max_iter={max_iter} iterations; residuals {', '.join(f'{r:.3g}' for r in history)}")
-    return make_orbit(params, ts, J, T, states, rates, history, steps, wall0)
+    return make_orbit(params, ts, c, history, steps, wall0)
 
 
-def make_orbit(params: PeelParams, ts: TangentSystem, J: np.ndarray, T: float, states: np.ndarray,
-               rates: np.ndarray, history: list[float], steps: int, wall0: float) -> PeriodicOrbit:
-    """The :class:`PeriodicOrbit` of a closed Newton iteration (``compose``'s output at the orbit)."""
-    n = len(states)
-    mu = np.linalg.eigvals(J)
+def make_orbit(params: PeelParams, ts: TangentSystem, c: Composed, history: list[float], steps: int,
+               wall0: float) -> PeriodicOrbit:
+    """The :class:`PeriodicOrbit` of a closed Newton iteration (``c``: :func:`compose` at the orbit)."""
+    n = len(c.states)
+    mu = np.linalg.eigvals(c.jacobian)
     mu = mu[np.argsort(-np.abs(mu))]
-    return PeriodicOrbit(params=params, n=n, period=T, section_states=states,
-                         return_map_values=section_F(params, ts, states[:, 0]), itinerary=("CD", "AB") * n,
+    return PeriodicOrbit(params=params, n=n, period=c.period, section_states=c.states,
+                         return_map_values=section_F(params, ts, c.states[:, 0]), itinerary=("CD", "AB") * n,
                          multipliers=mu, stable=bool(np.all(np.abs(mu) < 1.0)), residual=history[-1],
-                         newton=tuple(history), monodromy=J, fold_rates=rates, steps=steps,
+                         newton=tuple(history), monodromy=c.jacobian, fold_rates=c.fold_rates, steps=steps,
                          wall_time=time.perf_counter() - wall0)
 
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -31,8 +31,8 @@ from peelapprox.kernels import status as _st
 
 from .._tangent import TangentSystem, tangent_system
 
-__all__ = ["SectionReturn", "compose", "monodromy_fd", "section_return", "section_return_n", "section_F",
-           "system_of"]
+__all__ = ["Composed", "Iterated", "SectionReturn", "TangentReturn", "compose", "monodromy_fd", "section_return",
+           "section_return_n", "section_F", "system_of"]
 
 #: Relative tolerance of the tangent runs, whatever the state's ``rtol``: the tangent's directional difference
 #: quotient carries ~1e-9 relative noise, which a tighter error control would chase with ever smaller steps.
@@ -75,6 +75,45 @@ class SectionReturn:
     fold_rates: tuple[float, float] = (math.nan, math.nan)
 
 
+class TangentReturn(NamedTuple):
+    """One return ``P(x)`` with one tangent ``(δα, δω)`` carried along (:func:`_one_return`)."""
+
+    x: np.ndarray
+    """``(α, ω)`` at the next AB→CD jump."""
+    dx: np.ndarray
+    """The tangent's ``(δα, δω)`` there."""
+    dtime: float
+    """The tangent's change of the return time."""
+    time: float
+    """The return time [s]."""
+    steps: int
+    fold_rates: tuple[float, float]
+    """``Ġ`` on arrival at the CD fold and at the AB fold [N/s]."""
+
+
+class Composed(NamedTuple):
+    """``P^n`` at a section state with its Jacobian (:func:`compose`)."""
+
+    x: np.ndarray
+    """``P^n(x)``."""
+    jacobian: np.ndarray
+    """``DP^n`` in ``(α, ω)``."""
+    period: float
+    """The time of the n returns [s]."""
+    states: np.ndarray
+    """The n section states visited, the start first, shape (n, 2)."""
+    steps: int
+    fold_rates: np.ndarray
+    """The 2n fold rates ``Ġ`` [N/s] (CD, AB, CD, ...)."""
+
+
+class Iterated(NamedTuple):
+    """``P^n`` at a section state without the tangent (:func:`section_return_n`)."""
+
+    x: np.ndarray
+    steps: int
+
+
 def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarray, t0: float) -> int:
     """Integrate ``y`` (state and tangent) on branch ``br`` to its fold; raise the status's exception else."""
     law = ts.law
@@ -101,10 +140,8 @@ def _leg(ts: TangentSystem, y: np.ndarray, br: int, rtol: float, atol: np.ndarra
     return int(n)
 
 
-def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, atol: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray, float, float, int, tuple[float, float]]:
-    """``P(x)`` with the tangent ``d = (δα, δω)`` carried along: ``(x', (δα', δω'), δT, T, steps, (Ġ at the CD
-    fold, Ġ at the AB fold))``."""
+def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, atol: np.ndarray) -> TangentReturn:
+    """``P(x)`` with the tangent ``d = (δα, δω)`` carried along."""
     y = np.array([0.0, x[0], x[1], math.log(ts.landing(0)), 0.0, d[0], d[1], 0.0])
     steps = _leg(ts, y, 1, rtol, atol, 0.0)
     t_cd = float(y[0])
@@ -117,7 +154,8 @@ def _one_return(ts: TangentSystem, x: np.ndarray, d: np.ndarray, rtol: float, at
     steps += _leg(ts, y, 0, rtol, atol, t_cd)
     gm = np.empty(4)
     ts.field(y[:4], gm)
-    return y[1:3].copy(), y[5:7].copy(), float(y[4]), t_cd + float(y[0]), steps, (rate_cd, float(gm[3]))
+    return TangentReturn(y[1:3].copy(), y[5:7].copy(), float(y[4]), t_cd + float(y[0]), steps,
+                         (rate_cd, float(gm[3])))
 
 
 def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: bool = True,
@@ -153,21 +191,21 @@ def section_return(params: PeelParams, x: Any, *, rtol: float = 1e-12, tangent: 
     x0 = np.asarray(x, dtype=float).reshape(2)
     scale = np.asarray(ATOL_SCALE["hybrid"])
     atol = np.concatenate([rtol * scale, np.ones(4)])  # the tangent stays 0: its weights do not matter
-    xn, _, _, T, steps, rates = _one_return(ts, x0, np.zeros(2), rtol, atol)  # the state alone, at rtol
+    r = _one_return(ts, x0, np.zeros(2), rtol, atol)  # the state alone, at rtol
     if not tangent:
-        return SectionReturn(xn, None, T, None, steps, rates)
+        return SectionReturn(r.x, None, r.time, None, r.steps, r.fold_rates)
     jrt = max(rtol, TANGENT_RTOL)
     atol_t = np.concatenate([jrt * scale, np.full(4, TANGENT_ATOL)])
-    cols, dts = [], []
+    cols, dts, steps = [], [], r.steps
     s = np.array([1.0, ts.law.V / float(ts.p[M_R])])  # unit vectors of z = (α, ω R/V): balanced columns
     for i in range(2):
         d = np.zeros(2)
         d[i] = s[i]
-        _, dx, dT, _, n, _ = _one_return(ts, x0, d, jrt, atol_t)
-        cols.append(dx / s[i])
-        dts.append(dT / s[i])
-        steps += n
-    return SectionReturn(xn, np.column_stack(cols), T, np.array(dts), steps, rates)
+        t = _one_return(ts, x0, d, jrt, atol_t)
+        cols.append(t.dx / s[i])
+        dts.append(t.dtime / s[i])
+        steps += t.steps
+    return SectionReturn(r.x, np.column_stack(cols), r.time, np.array(dts), steps, r.fold_rates)
 
 
 def system_of(params: PeelParams) -> TangentSystem:
@@ -182,9 +220,8 @@ def section_F(params: PeelParams, ts: TangentSystem, alpha: np.ndarray) -> np.nd
     return float(ts.law.structure.f_max) / (1.0 + np.asarray(params.closure(np.asarray(alpha))[0]))
 
 
-def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
-             ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, int, np.ndarray]:
-    """``(P^n(x), DP^n, period, the n section states, steps, the 2n fold rates)``."""
+def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float) -> Composed:
+    """``P^n(x)`` with ``DP^n``, the period, the n section states, the steps and the 2n fold rates."""
     J = np.eye(2)
     T, steps, states = 0.0, 0, [x.copy()]
     rates: list[float] = []
@@ -197,17 +234,16 @@ def compose(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: 
         x = r.x
         states.append(x.copy())
         rates.extend(r.fold_rates)
-    return x, J, T, np.array(states[:-1]), steps, np.array(rates)
+    return Composed(x, J, T, np.array(states[:-1]), steps, np.array(rates))
 
 
-def section_return_n(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float
-                     ) -> tuple[np.ndarray, int]:
-    """``(P^n(x), steps)`` without the tangent."""
+def section_return_n(params: PeelParams, ts: TangentSystem, x: np.ndarray, n: int, rtol: float) -> Iterated:
+    """``P^n(x)`` and the steps taken, without the tangent."""
     steps = 0
     for _ in range(n):
         r = section_return(params, x, rtol=rtol, tangent=False, system=ts)
         x, steps = r.x, steps + r.steps
-    return x, steps
+    return Iterated(x, steps)
 
 
 def monodromy_fd(params: PeelParams, x: Any, n: int, *, h: float = 1e-5, rtol: float = 1e-12) -> np.ndarray:
@@ -220,6 +256,6 @@ def monodromy_fd(params: PeelParams, x: Any, n: int, *, h: float = 1e-5, rtol: f
     for i in range(2):
         e = np.zeros(2)
         e[i] = h * s[i]
-        Pn = [section_return_n(params, ts, x + k * e, n, rtol)[0] for k in (2, 1, -1, -2)]
+        Pn = [section_return_n(params, ts, x + k * e, n, rtol).x for k in (2, 1, -1, -2)]
         cols.append((-Pn[0] + 8 * Pn[1] - 8 * Pn[2] + Pn[3]) / (12 * e[i]))
     return np.column_stack(cols)
