@@ -1,22 +1,20 @@
-"""The full peeling model and its solvers.
+"""The full peeling model: its solvers, its periodic orbits and its dynamics, in three rooms behind one face.
 
-``simulate(params, t_end, ...)`` integrates the differential-algebraic system FLOW1, FLOW2, flow3 with the
-constraint CONSTR of De, Maybhate and Ananthakrishna by one of its methods: the ε → 0 limit
-(``method="hybrid"``, the default for the paper's model), the paper's ε-regularised mass-matrix scheme
-(``method="regularized"``, the default for a massless tape under a load) or the tape-mass model's smooth ODE
-(``method="smooth"``).  The option objects :class:`Hybrid`, :class:`Regularized`, :class:`Smooth` (the method
-and its error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the limits) are the validated
-forms of ``simulate``'s keywords.
+* **Solving** (this package's own modules): ``simulate(params, t_end, ...)`` integrates the DAE FLOW1, FLOW2,
+  flow3 with the constraint CONSTR of De, Maybhate and Ananthakrishna by one of the methods in ``METHODS``:
+  the ε → 0 limit ``Hybrid`` (the paper's model's default), the ε-regularised mass-matrix scheme
+  ``Regularized`` (a massless tape under a load) or the tape-mass model's smooth ODE ``Smooth``; ``SaveAt`` and
+  ``Budget`` say what is stored and the limits.  The saltation-tangent driver the other two rooms share is
+  here too.
+* **Orbits** (:mod:`exact.orbits`): the AB→CD section map and its Jacobian, periodic orbits by Newton and their
+  Floquet multipliers, continuation in a parameter with its bifurcations, crest and grazing ends, and the
+  switch to a doubled branch (``periodic_orbit``, ``continue_orbit``, ``switch_branch``).
+* **Dynamics** (:mod:`exact.dynamics`, built on the orbits, never the other way): windowed runs, attractors
+  and their observables, basins, brute-force orbit diagrams and the largest Lyapunov exponent by four methods
+  (``attractors``, ``basins``, ``orbit_diagram``, ``lyapunov(params, method=...)``).
 
-The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
-(sampled starts grouped by the attractor they reach), ``attractor_observables`` (the slip interval, force
-drop, slip and stick times and period of the attractor one window reaches: a
-``peelapprox.StickSlipObservables``) and the largest Lyapunov exponent, ``lyapunov(params,
-method=...)`` with the methods "two-trajectory", "tangent", "return-map" and "variational" (also
-``lyapunov_tangent``, ``lyapunov_return_map``; ``benettin`` is the generic two-trajectory method for any
-flow). Each runs the peel-force law ``params.force`` (any law with a compiled kernel; the variational method,
-whose DiffSL model is printed from fvV, the paper's only). The return-map analysis of a trajectory
-(``return_map``, ``periodicity``, ``force_drops``, ``settle_time``) is the core package's: :mod:`peelapprox`.
+Every public name is importable from ``exact`` itself; the return-map analysis of a trajectory
+(``return_map``, ``periodicity``) is the core package's, :mod:`peelapprox`.
 """
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
