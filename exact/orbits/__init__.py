@@ -1,6 +1,6 @@
 """Periodic orbits of the hybrid DAE and their branches: the AB→CD section map and its saltation Jacobian
 (``section_return``, ``monodromy_fd``), orbits by Newton (``periodic_orbit``, ``solve_orbit``), continuation in a
-parameter with the bifurcations located (``continue_orbit``; the kinds in ``BIFURCATION_KINDS``), the crest and
+parameter with the bifurcations located (``continue_orbit``; their kinds in one table, ``_kinds``), the crest and
 grazing ends of a branch (``crest_margin``) and the switch to the doubled branch (``switch_branch``).
 
 Built on the solvers and the tangent driver of :mod:`exact`; never on :mod:`exact.dynamics`, which builds on it.
