@@ -118,7 +118,7 @@ def setup(app):
     """Let a class re-exported by several public modules be documented on each module's page.
 
     autodoc marks each page's entry with the class's canonical (defining) name, e.g.
-    ``exact._attractors.Attractor`` for ``peelapprox.Attractor`` and ``exact.Attractor``; the Python domain
+    ``exact.dynamics._attractors.Attractor`` for ``peelapprox.Attractor`` and ``exact.Attractor``; the Python domain
     would report the second alias of one canonical name as a duplicate description.  Two aliases of one
     object are not a duplicate: keep the first.  Real duplicates (two entries of one documented name) still
     warn.

@@ -1,50 +1,72 @@
-"""The full peeling model and its solvers.
+"""The full peeling model: its solvers, its periodic orbits and its dynamics, in three rooms behind one face.
 
-``simulate(params, t_end, ...)`` integrates the differential-algebraic system FLOW1, FLOW2, flow3 with the
-constraint CONSTR of De, Maybhate and Ananthakrishna by one of its methods: the ε → 0 limit
-(``method="hybrid"``, the default for the paper's model), the paper's ε-regularised mass-matrix scheme
-(``method="regularized"``, the default for a massless tape under a load) or the tape-mass model's smooth ODE
-(``method="smooth"``).  The option objects :class:`Hybrid`, :class:`Regularized`, :class:`Smooth` (the method
-and its error control), :class:`SaveAt` (what is stored) and :class:`Budget` (the limits) are the validated
-forms of ``simulate``'s keywords.
+* **Solving** (this package's own modules): ``simulate(params, t_end, ...)`` integrates the DAE FLOW1, FLOW2,
+  flow3 with the constraint CONSTR of De, Maybhate and Ananthakrishna by one of the methods in ``METHODS``:
+  the ε → 0 limit ``Hybrid`` (the paper's model's default), the ε-regularised mass-matrix scheme
+  ``Regularized`` (a massless tape under a load) or the tape-mass model's smooth ODE ``Smooth``; ``SaveAt`` and
+  ``Budget`` say what is stored and the limits.  The saltation-tangent driver the other two rooms share is
+  here too.
+* **Orbits** (:mod:`exact.orbits`): the AB→CD section map and its Jacobian, periodic orbits by Newton and their
+  Floquet multipliers, continuation in a parameter with its bifurcations, crest and grazing ends, and the
+  switch to a doubled branch (``periodic_orbit``, ``continue_orbit``, ``switch_branch``).
+* **Dynamics** (:mod:`exact.dynamics`, built on the orbits, never the other way): windowed runs, attractors
+  and their observables, basins, brute-force orbit diagrams and the largest Lyapunov exponent by four methods
+  (``attractors``, ``basins``, ``orbit_diagram``, ``lyapunov(params, method=...)``).
 
-The dynamics of its solutions: ``window_run`` (the jumps over a window after a transient), ``attractors``
-(sampled starts grouped by the attractor they reach), ``attractor_observables`` (the slip interval, force
-drop, slip and stick times and period of the attractor one window reaches: a
-``peelapprox.StickSlipObservables``) and the largest Lyapunov exponent, ``lyapunov(params,
-method=...)`` with the methods "two-trajectory", "tangent", "return-map" and "variational" (also
-``lyapunov_tangent``, ``lyapunov_return_map``; ``benettin`` is the generic two-trajectory method for any
-flow). Each runs the peel-force law ``params.force`` (any law with a compiled kernel; the variational method,
-whose DiffSL model is printed from fvV, the paper's only). The return-map analysis of a trajectory
-(``return_map``, ``periodicity``, ``force_drops``, ``settle_time``) is the core package's: :mod:`peelapprox`.
+Every public name is importable from ``exact`` itself; the return-map analysis of a trajectory
+(``return_map``, ``periodicity``) is the core package's, :mod:`peelapprox`.
 """
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._attractors import DEFAULT_MAX_WALL, Attractor, attractor_observables, attractors, window_run
-from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
-from ._benettin import BenettinResult, LyapunovResult, benettin
-from ._continuation import (
-    Bifurcation,
-    BranchPoint,
-    OrbitBranch,
-    continue_orbit,
-    parameter_value,
-    with_parameter,
-)
-from ._crest import Crest, crest_margin
-from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
 from ._hybrid_driver import compile_kernels, hybrid_field
 from ._initial import initial_state
-from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._method_contract import default_atol
 from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
 from ._options import METHODS, Budget, SaveAt, default_max_steps
-from ._orbits import PeriodicOrbit, SectionReturn, monodromy_fd, periodic_orbit, section_return, solve_orbit
+from ._shared import DEFAULT_MAX_WALL
 from ._simulate import simulate
-from ._switch import switch_branch
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
-from ._variational import VARIATIONAL_LAWS, lyapunov_variational
+from .dynamics import (
+    MAX_BASIN_STARTS,
+    MAX_DIAGRAM_VALUES,
+    VARIATIONAL_LAWS,
+    Attractor,
+    BasinAttractor,
+    BasinResult,
+    BenettinResult,
+    LyapunovResult,
+    OrbitDiagram,
+    attractor_observables,
+    attractors,
+    basins,
+    benettin,
+    check_lyapunov_options,
+    explain,
+    lyapunov,
+    lyapunov_return_map,
+    lyapunov_tangent,
+    lyapunov_variational,
+    orbit_diagram,
+    window_run,
+)
+from .orbits import (
+    Bifurcation,
+    BranchPoint,
+    Crest,
+    OrbitBranch,
+    PeriodicOrbit,
+    SectionReturn,
+    continue_orbit,
+    crest_margin,
+    monodromy_fd,
+    parameter_value,
+    periodic_orbit,
+    section_return,
+    solve_orbit,
+    switch_branch,
+    with_parameter,
+)
 
 __all__ = [
     "simulate",

@@ -209,7 +209,7 @@ class TangentSystem:
 
 def tangent_system(params) -> TangentSystem:
     """The :class:`TangentSystem` of ``params`` (its law's compiled driver, field and pull force)."""
-    from ._attractors import paper_model_only
+    from ._shared import paper_model_only
 
     paper_model_only(params, "the hybrid tangent dynamics (section returns, periodic_orbit, solve_orbit, "
                      "continue_orbit, lyapunov methods 'tangent' and 'return-map')",
@@ -285,9 +285,9 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     run and after every jump (the compiled loop between two jumps is bounded by ``max_steps``); exceeding it
     raises :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
-    from ._benettin import natural_scales
     from ._initial import initial_state
     from ._methods import ATOL_SCALE
+    from ._shared import natural_scales
     from ._simulate import simulate
 
     T = duration("T", T)

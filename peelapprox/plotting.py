@@ -317,10 +317,6 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
     return fig
 
 
-_BIFURCATION_MARKERS = {"fold": ("s", "C3"), "period_doubling": ("D", "C1"), "neimark_sacker": ("*", "C4")}
-_END_MARKERS = {"grazing": "x", "crest": "+", "breakdown": "1"}
-
-
 def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None = None, *,
                      title: str | None = None, ax: Any = None, fig: Any = None):
     """The brute-force orbit diagram with continued branches of periodic orbits drawn over it.
@@ -373,11 +369,11 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
                 ax.plot(xs[i:i + 2], Fs[i:i + 2, j], style, color=color, lw=1.4,
                         label=f"period-{n} branch {k + 1}" if i == 0 and j == 0 and label_branches else None)
         for b in br.bifurcations:
-            marker, c = _BIFURCATION_MARKERS.get(b.kind, ("o", "k"))
+            marker, c = b.marker  # from the kinds' table of exact.orbits
             ax.plot(np.full(n, b.value), b.orbit.return_map_values, marker, color=c, ms=8, mec="k",
                     label=b.kind.replace("_", " "))
-        if br.stopped in _END_MARKERS:  # the non-smooth end, at its (extrapolated) parameter value
-            ax.plot(np.full(n, br.end_value), Fs[-1], _END_MARKERS[br.stopped], color="k", ms=7,
+        if br.end_marker is not None:  # the non-smooth end, at its (extrapolated) parameter value
+            ax.plot(np.full(n, br.end_value), Fs[-1], br.end_marker, color="k", ms=7,
                     label=br.stopped)
     handles, labels = ax.get_legend_handles_labels()
     uniq = dict(zip(labels, handles))

@@ -82,7 +82,7 @@ def test_invalid_start_and_breakdown_are_labels_not_exceptions():
     r = exact.basins(CUBIC, alpha0=[-0.3, 0.3], F0=[200.0, 230.0], t_transient=10.0, window=5.0, max_workers=0,
                      progress=False)
     assert r.axis == "F0"
-    assert r.labels.tolist() == [[exact._basins.INVALID, 0], [exact._basins.BREAKDOWN, 0]]
+    assert r.labels.tolist() == [[exact.dynamics._basins.INVALID, 0], [exact.dynamics._basins.BREAKDOWN, 0]]
     assert r.texts[0, 0] == "invalid start" and r.texts[1, 0] == "breakdown:no_root"
     assert "no stable root of CONSTR" in r.messages[0]
     assert r.attractors[0].cycle[0] == pytest.approx(240.0602, abs=1e-3)
@@ -95,7 +95,8 @@ def test_undetermined_windows():
     transient, not periodic, and too few (< 3 max_period = 96) to call aperiodic ("too short")."""
     r = exact.basins(CUBIC, alpha0=[0.0], omega0=[12.0], t_transient=0.0, window=0.1, max_workers=0,
                      progress=False)
-    assert r.labels.tolist() == [[exact._basins.UNDETERMINED]] and r.texts[0, 0] == "undetermined:no stick-slip"
+    assert r.labels.tolist() == [[exact.dynamics._basins.UNDETERMINED]]
+    assert r.texts[0, 0] == "undetermined:no stick-slip"
     assert r.n_returns[0, 0] == 1 and r.attractors == ()
     r = exact.basins(PeelParams(V=1.0, I=1e-5), alpha0=[-0.2], F0=[283.5], t_transient=0.0, window=1.0,
                      max_workers=0, progress=False)
@@ -210,7 +211,7 @@ def test_fvV_larger_grid_on_a_pool():
                 feasible = True
             except ValueError:
                 feasible = False
-            assert (r.labels[i, j] == exact._basins.INVALID) == (not feasible)
+            assert (r.labels[i, j] == exact.dynamics._basins.INVALID) == (not feasible)
     assert sorted(a.n for a in r.attractors) == [1, 3, 15]
     for att in r.attractors:
         assert att.orbit is not None and att.orbit.stable

@@ -188,7 +188,7 @@ def test_basins_returns_every_start_when_max_wall_is_spent(workers):
     assert took < BOUND
     assert r.labels.shape == (10, 10)
     cut = r.texts == "failure:max_wall"
-    assert cut.sum() >= 50 and np.all(r.labels[cut] == exact._basins.FAILURE)
+    assert cut.sum() >= 50 and np.all(r.labels[cut] == exact.dynamics._basins.FAILURE)
     assert all(a.orbit is not None or "max_wall" in (a.orbit_error or "") for a in r.attractors)
 
 

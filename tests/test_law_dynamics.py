@@ -119,7 +119,7 @@ def test_natural_scales_and_hybrid_field_follow_the_law():
     paper's for the paper's law (exactly as before); ``hybrid_field`` returns by default the field
     ``simulate`` runs: the law as an argument for the cubic, fvV inlined for the paper's law (the same objects
     as ``law_argument=True``/``False``)."""
-    from exact._benettin import natural_scales
+    from exact._shared import natural_scales
 
     a, b, c, d = 150.0, 300.0, 300.0, 80.0
     v_max = (c - math.sqrt(c * c - 3 * b * d)) / (3 * d)

@@ -53,3 +53,25 @@ def test_the_rooms_are_layered_in_the_documented_order():
     c = _contracts()["rooms"]
     assert c["type"] == "layers" and c["layers"] == ["comparisons", "exact", "peelapprox"]
     assert all(rule.startswith("peelapprox.cli") for rule in c.get("ignore_imports", []))
+
+
+def test_orbits_stand_below_dynamics_and_both_rooms_are_acyclic():
+    """Hypothesis: ``exact.orbits`` may not import ``exact.dynamics`` (directly or through another module), and
+    the no-circle contract covers the modules inside each of exact's two sub-packages, not only exact's top
+    level (exact list membership)."""
+    c = _contracts()
+    f = c["orbits-below-dynamics"]
+    assert f["type"] == "forbidden" and f["source_modules"] == ["exact.orbits"]
+    assert f["forbidden_modules"] == ["exact.dynamics"] and not f.get("allow_indirect_imports", False)
+    assert {"exact", "exact.orbits", "exact.dynamics"} <= set(c["acyclic"]["ancestors"])
+
+
+def test_every_package_is_installed():
+    """Hypothesis: ``[tool.setuptools] packages`` lists every package on disk (each directory of the three rooms
+    with an ``__init__.py``), so a wheel carries the sub-packages too (set equality)."""
+    with open(ROOT / "pyproject.toml", "rb") as fh:
+        listed = set(tomllib.load(fh)["tool"]["setuptools"]["packages"])
+    on_disk = set(PACKAGES)
+    for package in PACKAGES:
+        on_disk |= {info.name for info in pkgutil.walk_packages([str(ROOT / package)], package + ".") if info.ispkg}
+    assert listed == on_disk

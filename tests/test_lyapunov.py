@@ -129,7 +129,7 @@ def test_variational_wall_watch_raises_between_intervals():
     """The variational method gets its wall budget through its ``progress`` callback (called after every
     renormalisation interval).  Hypothesis: the watcher calls the user's progress while the budget lasts and
     raises SolverBudgetExceeded(budget="max_wall") with the interval's time once it is spent (categorical)."""
-    from exact._lyapunov import _watch_wall
+    from exact.dynamics._lyapunov import _watch_wall
     from peelapprox.errors import WallBudget
 
     seen = []

@@ -229,3 +229,26 @@ def test_branches_explain_the_brute_force_periods_at_I_1e_2(tmp_path):
     assert len(periodic) >= 5
     for V, n in periodic.items():
         assert any(m == n and lo - 1e-9 <= V <= hi + 1e-9 for m, lo, hi in ranges), (V, n, ranges)
+
+
+def test_bifurcation_kinds_table():
+    """Hypothesis: the one table of kinds detects each bifurcation by its test function on synthetic multipliers
+    (a real one through +1: fold, through -1: period doubling, a complex pair through the unit circle:
+    Neimark-Sacker, a real pair turning complex: none) and drives the bisection gauge to the signed distance of
+    the nearest multiplier; every kind has its own plot marker, and a record reads its marker from the table."""
+    from exact.orbits._kinds import BIFURCATIONS, ENDS, crossing, gauge
+
+    def mu(*x):
+        return np.array(x, dtype=complex)
+
+    assert crossing(mu(0.5, 0.9), mu(0.5, 1.1)) == "fold"
+    assert crossing(mu(-0.9, 0.2), mu(-1.1, 0.2)) == "period_doubling"
+    assert crossing(mu(0.9j, -0.9j), mu(1.1j, -1.1j)) == "neimark_sacker"
+    assert crossing(mu(0.5, 0.6), mu(0.5 + 0.1j, 0.5 - 0.1j)) is None
+    assert crossing(mu(0.5, 0.6), mu(0.4, 0.7)) is None
+    assert gauge("fold", mu(0.2, 0.999)) == pytest.approx(-0.001)
+    assert gauge("neimark_sacker", mu(1.01j, -1.01j)) == pytest.approx(0.01)
+    kinds = BIFURCATIONS + ENDS
+    assert len({k.name for k in kinds}) == len({k.marker for k in kinds}) == len(kinds)
+    b = exact.Bifurcation("period_doubling", 1.0, None, "V")  # type: ignore[arg-type]
+    assert b.marker == ("D", "C1") and b.doubles and not exact.Bifurcation("fold", 1.0, None).doubles  # type: ignore[arg-type]

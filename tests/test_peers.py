@@ -318,7 +318,7 @@ def test_lyapunov_variational_without_pydiffsol_names_the_bench_extra(monkeypatc
 def test_the_old_module_names_still_resolve_to_the_moved_objects():
     """``comparisons._peers`` and ``comparisons._benchmark`` stay compatibility aliases: every name they export
     resolves, to the very object of its new home (identity checks).  ``tangent_solve`` and ``TANGENT_OPTIONS``,
-    internals of the variational exponent, moved to ``exact._variational`` without an alias (a sibling may not
+    internals of the variational exponent, moved to ``exact.dynamics._variational`` without an alias (a sibling may not
     import a private module of exact)."""
     from comparisons import _benchmark, _peers, benchmark
 

@@ -144,7 +144,7 @@ def _continue(o, param: str, stop: float, lo: float, hi: float, max_points: int,
                                   or "no bifurcation"))
     out = [b]
     for x in b.bifurcations:
-        if x.kind != "period_doubling" or depth < 1:
+        if not x.doubles or depth < 1:
             continue
         if wall_spent(wall):
             say(f"{indent}    no doubled branch: --max-wall spent")

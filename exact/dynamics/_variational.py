@@ -34,8 +34,8 @@ from peelapprox.validate import duration, function, in_range, optional, state
 from peelapprox.validate import eps as _eps
 from peelapprox.validate import params as _params
 
-from ._initial import initial_state
-from ._method_contract import default_atol
+from .._initial import initial_state
+from .._method_contract import default_atol
 
 if TYPE_CHECKING:  # pragma: no cover
     from peelapprox import PeelParams
@@ -161,13 +161,14 @@ def lyapunov_variational(
     peelapprox.SolverFailure
         diffsol gave up (its message, and the state at the start of the failing interval, are attached).
     """
-    from ._benettin import BenettinResult, LyapunovResult, natural_scales
+    from .._shared import natural_scales
+    from ._benettin import BenettinResult, LyapunovResult
 
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)
     _params("params", params, laws=VARIATIONAL_LAWS, where=VARIATIONAL_LAWS_NOTE)
     if params.variant is not None:
-        from ._attractors import paper_model_only
+        from .._shared import paper_model_only
 
         paper_model_only(params, "lyapunov method 'variational' (the paper's eps-scheme)",
                          "use method='two-trajectory'")

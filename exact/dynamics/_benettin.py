@@ -7,7 +7,6 @@
   :meth:`BenettinResult.from_logs` for every method of :func:`exact.lyapunov`.
 * :class:`LyapunovResult` — the peeling model's largest exponent in bits/s, the one result type of
   :func:`exact.lyapunov` whatever the method (its ``method`` field says which).
-* :func:`natural_scales` — the sizes ``(1 rad, V/R, f_max)`` by which every method scales ``(δα, δω, δF)``.
 """
 
 from __future__ import annotations
@@ -20,14 +19,16 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from peelapprox import PeelParams, branch_structure
+from peelapprox import PeelParams
 from peelapprox.io import fmt_number, html_table
 from peelapprox.validate import function, integer
 
-if TYPE_CHECKING:
-    from ._methods import Regularized, Smooth
+from .._shared import natural_scales
 
-__all__ = ["natural_scales", "BenettinResult", "benettin", "LyapunovResult", "STDERR_BATCHES", "batch_means"]
+if TYPE_CHECKING:
+    from .._methods import Regularized, Smooth
+
+__all__ = ["BenettinResult", "benettin", "LyapunovResult", "STDERR_BATCHES", "batch_means"]
 
 #: Batches of every Lyapunov record's standard error (:meth:`BenettinResult.from_logs`, :func:`batch_means`).
 STDERR_BATCHES = 10
@@ -46,14 +47,6 @@ def batch_means(logs: np.ndarray, dts: np.ndarray, m: int = STDERR_BATCHES) -> t
     edges = np.searchsorted(np.cumsum(dts), np.linspace(0.0, dts.sum(), m + 1)[1:-1], side="right")
     edges = np.unique(edges[(edges > 0) & (edges < logs.size)])  # no empty batch (a long interval spans several)
     return (np.array([x.sum() for x in np.split(logs, edges)]), np.array([x.sum() for x in np.split(dts, edges)]))
-
-
-def natural_scales(params: PeelParams) -> np.ndarray:
-    """The natural sizes ``(1 rad, V/R, f_max)`` of ``(α, ω, F)``: every Lyapunov estimate measures
-    perturbations in ``(δα, δω, δF)`` divided by these (``f_max`` of the law ``params.force`` at V, its
-    :func:`peelapprox.branch_structure`; 1 N when f has no folds)."""
-    bs = branch_structure(params.V, force=params.force)
-    return np.array([1.0, params.V / params.R, bs.f_max if bs.has_folds else 1.0])
 
 
 @dataclass
@@ -216,10 +209,10 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
     """
     from peelapprox.errors import SolverBudgetExceeded, WallBudget
 
-    from ._initial import initial_state
-    from ._method_contract import method_option
-    from ._options import output_options
-    from ._trajectory import State
+    from .._initial import initial_state
+    from .._method_contract import method_option
+    from .._options import output_options
+    from .._trajectory import State
 
     # a variant's method: smooth, or regularized under a load (never the hybrid one)
     opts = cast("Regularized | Smooth", method_option(None, solver=solver, eps=None, rtol=rtol, atol=None,

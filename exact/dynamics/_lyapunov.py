@@ -3,16 +3,16 @@
 :func:`lyapunov` measures the largest exponent, in bits/s, of the full model FLOW1, FLOW2, flow3 with CONSTR
 after a transient, by one of :data:`METHODS`:
 
-* ``"two-trajectory"`` (default) — :func:`~exact._benettin.benettin`'s renormalisation of two neighbouring
+* ``"two-trajectory"`` (default) — :func:`~exact.dynamics._benettin.benettin`'s renormalisation of two neighbouring
   hybrid orbits every ``tau`` seconds;
 * ``"tangent"`` — the variational equation of the hybrid solver's field with saltation matrices at the
   jumps (:mod:`exact._tangent`; also :func:`lyapunov_tangent`);
 * ``"return-map"`` — the tangent map of the AB→CD jump-to-jump map by central differences (also
   :func:`lyapunov_return_map`);
 * ``"variational"`` — the variational equations of the ε-regularised system XDAE through diffsol
-  (``exact._variational``, needs the ``bench`` extra).
+  (``exact.dynamics._variational``, needs the ``bench`` extra).
 
-Every method returns one :class:`~exact._benettin.LyapunovResult`; :func:`check_lyapunov_options` checks a
+Every method returns one :class:`~exact.dynamics._benettin.LyapunovResult`; :func:`check_lyapunov_options` checks a
 method's options without running it.  docs/dynamics.md compares the methods.
 """
 
@@ -45,19 +45,19 @@ from peelapprox.validate import (
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._attractors import DEFAULT_MAX_WALL, paper_model_only, window_run
+from .._initial import initial_state
+from .._shared import DEFAULT_MAX_WALL, natural_scales, paper_model_only
+from .._simulate import simulate
+from ._attractors import window_run
 from ._benettin import (
     STDERR_BATCHES,
     BenettinResult,
     LyapunovResult,
     batch_means,
     benettin,
-    natural_scales,
     variant_two_trajectory,
 )
-from ._initial import initial_state
 from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
-from ._simulate import simulate
 
 __all__ = ["METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]
 
@@ -189,7 +189,8 @@ def _two_trajectory(
     solver: str | None = None,
 ) -> LyapunovResult:
     """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver, or for
-    a model variant (``params.variant``) on its method with ``solver`` (:func:`exact._benettin.variant_two_trajectory`).
+    a model variant (``params.variant``) on its method with ``solver``
+    (:func:`exact.dynamics._benettin.variant_two_trajectory`).
 
     ``n`` renormalisation intervals are measured (10000 by default), or ``max(2, round(T/tau))`` of them when
     ``T`` is given (:func:`lyapunov` refuses both).  The two orbits' state is ``(α, ω, F, branch)``; ``run``
@@ -333,7 +334,7 @@ TANGENT_BATCHES = STDERR_BATCHES
 def _tangent(params: PeelParams, *, t_transient: float = T_TRANSIENT, T: float = 50.0, rtol: float = 1e-10,
              alpha0: float = 0.0, max_steps: int | None = None, max_wall: float | None = None) -> LyapunovResult:
     """Method ``"tangent"`` of :func:`lyapunov` (:func:`lyapunov_tangent`, and a wall budget ``max_wall``)."""
-    from ._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
+    from .._tangent import lyapunov_saltation  # its kernels compile on first use: not at ``import exact``
 
     params = _params("params", params)
     paper_model_only(params, "lyapunov method 'tangent' (saltation matrices at the hybrid jumps)",

@@ -9,7 +9,7 @@ for ``(x, λ)``: the period-n closing condition and one linear condition, which 
 of a continuation step (``τ`` the branch's secant, ``w_ref`` the predicted point), a natural step
 (``τ = (0, 0, 1)``: λ fixed) or the amplitude condition of a branch switch (``τ`` along a multiplier's
 eigenvector).  The Jacobian is ``[[DP^n - 1, ∂P^n/∂λ], [τ]]`` with ``DP^n`` from the saltation tangent
-(:func:`exact._orbits.compose`) and ``∂P^n/∂λ`` by a forward difference (step ``1e-7 max(|λ|, Λ)``: its error,
+(:func:`exact.orbits._section.compose`) and ``∂P^n/∂λ`` by a forward difference (step ``1e-7 max(|λ|, Λ)``: its error,
 ~1e-6 relative, slows Newton's convergence to linear with that rate, no more; not computed for a natural step,
 where it does not enter).  A step that does not reduce the
 closing residual is halved (at most 8 times).
@@ -27,7 +27,8 @@ from peelapprox import PeelForce, PeelParams
 from peelapprox.errors import WallBudget
 from peelapprox.validate import ArgumentTypeError
 
-from ._orbits import PeriodicOrbit, check_wall, compose, make_orbit, section_return_n, system_of
+from ._periodic import PeriodicOrbit, check_wall, make_orbit
+from ._section import compose, section_return_n, system_of
 
 __all__ = ["PARAMETERS", "VARIANT_PARAMETERS", "bordered_newton", "branch_tangent", "check_parameter",
            "parameter_value", "with_parameter"]
@@ -113,7 +114,7 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
     Converged when the closing residual ``|P^n(x) - x| / max(1, |x|)`` (in ``x / scale``) is at most ``tol`` and
     the linear condition holds to ``1e-9 max(1, |w_ref|)``.  A Newton step that would move λ by more than
     ``max_dlam`` is shortened to it.  ``wall``, the caller's wall-clock budget, is checked before each iteration
-    and each halved step (:func:`exact._orbits.check_wall`).
+    and each halved step (:func:`exact.orbits._periodic.check_wall`).
 
     Raises
     ------
@@ -131,22 +132,23 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
         check_wall(wall, "continuation", x)
         p = params_at(lam)
         ts = system_of(p)
-        xn, J, T, states, k, rates = compose(p, ts, x, n, rtol)
-        steps += k
+        cp = compose(p, ts, x, n, rtol)
+        steps += cp.steps
+        xn = cp.x
         w = np.concatenate([x / scale, [lam / lam_scale]])
         res, c = _residual(x, xn, scale), float(tau @ (w - w_ref))
         history.append(res)
         if res <= tol and abs(c) <= 1e-9 * max(1.0, float(np.linalg.norm(w_ref))):
-            return make_orbit(p, ts, J, T, states, rates, history, steps, wall0), lam
+            return make_orbit(p, ts, cp, history, steps, wall0), lam
         A = np.zeros((3, 3))
-        A[:2, :2] = J * scale[None, :] / scale[:, None] - eye
+        A[:2, :2] = cp.jacobian * scale[None, :] / scale[:, None] - eye
         A[2] = tau
         if tau[0] != 0 or tau[1] != 0 or c != 0:  # else λ stays: the column does not enter the step
             d = FD_STEP * max(abs(lam), lam_scale)
             p2 = params_at(lam + d)
-            xn2, k = section_return_n(p2, system_of(p2), x, n, rtol)
-            steps += k
-            A[:2, 2] = (xn2 - xn) / scale / (d / lam_scale)
+            it = section_return_n(p2, system_of(p2), x, n, rtol)
+            steps += it.steps
+            A[:2, 2] = (it.x - xn) / scale / (d / lam_scale)
         try:
             dw = np.linalg.solve(A, -np.concatenate([(xn - x) / scale, [c]]))
         except np.linalg.LinAlgError:
@@ -157,9 +159,9 @@ def bordered_newton(params_at: Callable[[float], PeelParams], n: int, x0: np.nda
             wt = w + s * dw
             xt, lt = wt[:2] * scale, float(wt[2] * lam_scale)
             pt = params_at(lt)
-            xtn, k = section_return_n(pt, system_of(pt), xt, n, rtol)
-            steps += k
-            if _residual(xt, xtn, scale) < res:
+            it = section_return_n(pt, system_of(pt), xt, n, rtol)
+            steps += it.steps
+            if _residual(xt, it.x, scale) < res:
                 break
             s *= 0.5
         x, lam = xt, lt
@@ -175,8 +177,8 @@ def branch_tangent(params_at: Callable[[float], PeelParams], orbit: PeriodicOrbi
     x = orbit.section_states[0]
     d = FD_STEP * max(abs(lam), lam_scale)
     p0, p1 = params_at(lam), params_at(lam + d)
-    xn0, _ = section_return_n(p0, system_of(p0), x, orbit.n, rtol)
-    xn1, _ = section_return_n(p1, system_of(p1), x, orbit.n, rtol)
+    xn0 = section_return_n(p0, system_of(p0), x, orbit.n, rtol).x
+    xn1 = section_return_n(p1, system_of(p1), x, orbit.n, rtol).x
     A = np.empty((2, 3))
     A[:, :2] = orbit.monodromy * scale[None, :] / scale[:, None] - np.eye(2)
     A[:, 2] = (xn1 - xn0) / scale / (d / lam_scale)

@@ -18,8 +18,8 @@ import numpy as np
 from peelapprox import BRANCHES, PeelParams, periodicity
 from peelapprox.validate import choice, duration, state
 
-from ._simulate import simulate
-from ._trajectory import State, Trajectory
+from .._simulate import simulate
+from .._trajectory import State, Trajectory
 
 __all__ = ["check_start", "seed"]
 

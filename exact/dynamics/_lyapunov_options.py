@@ -30,7 +30,7 @@ METHODS: dict[str, tuple[str, ...]] = {
 SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
 
 #: The check of each option of :data:`METHODS`, ``check(name, value) -> value``: the one the methods apply
-#: (the variational method's, in ``exact._variational``, are the same validators).
+#: (the variational method's, in ``exact.dynamics._variational``, are the same validators).
 _OPTION_CHECKS: dict[str, Callable[[str, Any], Any]] = {
     "tau": duration,
     "n": lambda name, x: integer(name, x, lo=2),

@@ -25,9 +25,8 @@ from peelapprox.io import ProgressLine
 from peelapprox.validate import duration, function, optional, positive, reals
 from peelapprox.validate import params as _params
 
-from ._attractors import DEFAULT_MAX_WALL
-from ._corrector import with_parameter
-from ._orbits import solve_orbit
+from .._shared import DEFAULT_MAX_WALL
+from ..orbits import solve_orbit, with_parameter
 
 __all__ = ["MAX_DIAGRAM_VALUES", "OrbitDiagram", "explain", "orbit_diagram"]
 
@@ -160,7 +159,7 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     ValueError, TypeError
         A bad argument (named): more than :data:`MAX_DIAGRAM_VALUES` values, a value ``parameter`` cannot take.
     """
-    from ._simulate import simulate
+    from .._simulate import simulate
 
     wall0 = time.perf_counter()
     params = _params("params", params)
@@ -245,8 +244,8 @@ def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-
         Per diagram value, the index into ``branches`` of the first branch that explains it; None where none
         does, the run is not periodic, or ``max_wall`` was spent before the value was examined.
     """
-    from ._continuation import OrbitBranch
-    from ._corrector import VARIANT_PARAMETERS
+    from ..orbits import OrbitBranch
+    from ..orbits._corrector import VARIANT_PARAMETERS
 
     if diagram.parameter in VARIANT_PARAMETERS:
         raise ValueError(f"diagram: explain reads a diagram against continued branches of the paper's massless, "

@@ -1,6 +1,6 @@
 """Branch switching at a period doubling: :func:`switch_branch` finds the period-2n orbit born where a period-n
 branch of :func:`exact.continue_orbit` has a Floquet multiplier through -1 (the bordered corrector of
-:mod:`exact._corrector` with an amplitude condition along the multiplier's eigenvector).
+:mod:`exact.orbits._corrector` with an amplitude condition along the multiplier's eigenvector).
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ import numpy as np
 from peelapprox.errors import SolverBudgetExceeded, WallBudget
 from peelapprox.validate import in_range, optional, positive
 
-from ._attractors import DEFAULT_MAX_WALL
+from .._shared import DEFAULT_MAX_WALL
 from ._continuation import FAILURES, Bifurcation, Stepper
-from ._orbits import PeriodicOrbit, minimal_period
+from ._periodic import PeriodicOrbit, minimal_period
 
 __all__ = ["SWITCH_DLAM", "switch_branch"]
 
@@ -25,7 +25,7 @@ def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: flo
                   rtol: float = 1e-12, max_wall: float | None = DEFAULT_MAX_WALL) -> PeriodicOrbit:
     """The period-2n orbit born at a period doubling of a period-n branch.
 
-    Solves ``P^{2n}(x; λ) = x`` with ``e · (z - z*) = a`` (:func:`exact._corrector.bordered_newton`): ``z*`` the
+    Solves ``P^{2n}(x; λ) = x`` with ``e · (z - z*) = a`` (:func:`exact.orbits._corrector.bordered_newton`): ``z*`` the
     scaled section state of the orbit at the bifurcation, ``e`` the eigenvector of its multiplier -1, ``a`` the
     ``amplitude`` (then a/4 and 4a if Newton fails or returns the period-n orbit itself), λ free.  Continue the
     result with :func:`exact.continue_orbit` (its parameter is ``bifurcation.parameter``; the doubled branch lies on
@@ -56,7 +56,7 @@ def switch_branch(bifurcation: Bifurcation, *, amplitude: float = 1e-3, tol: flo
         ``max_wall`` spent (``budget="max_wall"``): the call returns one orbit or nothing, so a spent budget is
         an exception, as in :func:`exact.periodic_orbit`.
     """
-    if not isinstance(bifurcation, Bifurcation) or bifurcation.kind != "period_doubling":
+    if not isinstance(bifurcation, Bifurcation) or not bifurcation.doubles:
         raise ValueError(f"bifurcation must be a period_doubling Bifurcation, got {bifurcation!r:.80}")
     amplitude = in_range("amplitude", amplitude, 0.0, 0.1, lo_open=True)
     tol = in_range("tol", tol, 1e-14, 1e-3)

@@ -34,17 +34,13 @@ from peelapprox.validate import duration, function, integer, optional, positive,
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._initial import initial_state
-from ._method_contract import method_option
-from ._simulate import simulate
-from ._trajectory import Trajectory
+from .._initial import initial_state
+from .._method_contract import method_option
+from .._shared import DEFAULT_MAX_WALL
+from .._simulate import simulate
+from .._trajectory import Trajectory
 
-__all__ = ["DEFAULT_MAX_WALL", "window_run", "states_alpha", "Attractor", "attractors", "attractor_observables",
-           "paper_model_only"]
-
-#: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
-#: attractors): their work grows with counts (n, n_returns, starts) that no step budget bounds.
-DEFAULT_MAX_WALL = 3600.0
+__all__ = ["window_run", "states_alpha", "Attractor", "attractors", "attractor_observables"]
 
 
 def states_alpha(name: str, x) -> np.ndarray:
@@ -53,18 +49,6 @@ def states_alpha(name: str, x) -> np.ndarray:
     if a.ndim != 1:
         raise ValueError(f"{name} must be a 1-D sequence of initial peel angles, got shape {a.shape}")
     return a
-
-
-def paper_model_only(params: PeelParams, what: str, instead: str = "") -> None:
-    """Refuse a model variant (``params.variant``: a tape mass or a constant load) for ``what``, a tool built on
-    the hybrid solver's jumps (its section returns, tangent dynamics and saltation matrices), with a ValueError
-    naming ``params`` and the model it supports (``instead``: what to use for the variant)."""
-    if params.variant is not None:
-        raise ValueError(
-            f"{what} supports the paper's massless, velocity-controlled model only (params.tape_mass=None, "
-            f"params.loading='velocity': the hybrid method's jumps and saltation matrices), got params with "
-            f"tape_mass={params.tape_mass!r}, loading={params.loading!r} (variant {params.variant!r})"
-            + (f"; {instead}" if instead else ""))
 
 
 # ---------------------------------------------------------------------------------------------- windows

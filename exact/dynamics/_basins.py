@@ -9,7 +9,7 @@ a process pool / any :class:`concurrent.futures.Executor` (as the (I, V) sweep o
 the result does not depend on which, nor on the order in which the starts finish.
 
 Every call is bounded: a grid of at most :data:`MAX_BASIN_STARTS` starts (refused before any run) and a
-wall-clock budget ``max_wall`` for all of it (:mod:`exact._basins_run`: the starts it leaves out or cuts are
+wall-clock budget ``max_wall`` for all of it (:mod:`exact.dynamics._basins_run`: the starts it leaves out or cuts are
 failures, ``"failure:max_wall"``).
 """
 
@@ -31,11 +31,11 @@ from peelapprox.validate import ArgumentTypeError, duration, flag, integer, opti
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
-from ._attractors import DEFAULT_MAX_WALL, paper_model_only
+from .._method_contract import method_option
+from .._shared import DEFAULT_MAX_WALL, paper_model_only
+from .._simulate import simulate
+from ..orbits import PeriodicOrbit, periodic_orbit
 from ._basins_run import APERIODIC, BREAKDOWN, FAILURE, INVALID, UNDETERMINED, msg, reporter, run_all
-from ._method_contract import method_option
-from ._orbits import PeriodicOrbit, periodic_orbit
-from ._simulate import simulate
 
 __all__ = ["MATCH_RTOL", "CYCLE_DIGITS", "INVALID", "APERIODIC", "BREAKDOWN", "UNDETERMINED", "FAILURE",
            "MAX_BASIN_STARTS", "BasinAttractor", "BasinResult", "basins"]
@@ -232,17 +232,17 @@ class BasinResult:
         ``label`` (:attr:`labels`, with CF ``flag_values``/``flag_meanings``), ``outcome`` (:attr:`texts`), ``n``
         (the period reached, 0 for none), ``n_returns``; attrs: the parameters (``params_V``, ...), the settings
         and the attractors (JSON).  ImportError without xarray (``pip install 'peelapprox[data]'``)."""
-        from ._dataout import basins_xarray
+        from ._basins_out import basins_xarray
 
         return basins_xarray(self, _CODE_TEXT)
 
     def __repr__(self) -> str:
-        from ._dataout import basins_summary
+        from ._basins_out import basins_summary
 
         return basins_summary(self, short=True)
 
     def _repr_html_(self) -> str:
-        from ._dataout import basins_summary
+        from ._basins_out import basins_summary
 
         return basins_summary(self, short=False)
 
@@ -335,7 +335,8 @@ def basins(
         by its first start's run, in this process): Floquet multipliers, stability.
     executor : concurrent.futures.Executor, optional
         Runs the starts (e.g. a dask ``Client.get_executor()``), used as is and left running; the function
-        shipped is :func:`exact._basins_run.run_start`, its arguments plain data (PeelParams pickles with its law).
+        shipped is :func:`exact.dynamics._basins_run.run_start`, its arguments plain data (PeelParams pickles
+        with its law).
     max_workers : int, optional
         Without ``executor``: 0 runs in this process; n > 0 a local spawned process pool of n workers; None
         (default) one worker per CPU available, at most one per start.

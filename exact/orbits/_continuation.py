@@ -4,7 +4,7 @@
 (``"force.c"``) by **pseudo-arclength continuation** in ``w = (α, ω R/V, λ/Λ)`` (the first section state,
 scaled, and the parameter λ over the span ``Λ = |stop - start|``): the predictor steps ``h`` along the secant
 through the last two points (from the start, along the branch's tangent, the null vector of ``[DP^n - 1,
-∂P^n/∂λ]``, oriented towards ``stop``), and the corrector (:func:`exact._corrector.bordered_newton`, n fixed)
+∂P^n/∂λ]``, oriented towards ``stop``), and the corrector (:func:`exact.orbits._corrector.bordered_newton`, n fixed)
 solves the closing condition ``P^n(x; λ) = x`` together with ``τ · (w - w_pred) = 0`` (the step orthogonal to
 the secant).  Steps from an orbit with a real multiplier within ``FOLD_NEAR`` (0.25) of +1 are
 pseudo-arclength steps, so the branch passes **folds**, where λ turns back; the others (and the last one onto
@@ -23,7 +23,7 @@ in λ and ``GAUGE_TOL`` in the gauge, or 40 halvings) on the quantity that chang
   both neighbouring points; where it lies between them, λ does not turn and the crossing is reported as a
   ``"branch_point"``);
 * **period doubling** (a real multiplier through -1: ``μ + 1``); :func:`switch_branch` starts the doubled
-  (period-2n) branch there (:mod:`exact._switch`);
+  (period-2n) branch there (:mod:`exact.orbits._switch`);
 * **Neimark-Sacker** (a complex pair through the unit circle: ``|μ| - 1``).
 
 The non-smooth ends of a branch are reported as the reason it stopped (``OrbitBranch.stopped``, with the
@@ -34,7 +34,7 @@ when it lies within two steps (or 1e-3 of the span) of the last point, else the 
   falls below ``graze_tol k V``; the multipliers diverge on the way in;
 * ``"crest"``: an interior crest of ``F (1 + c(α))`` on AB reaches f_max (or a trough on CD reaches f_min):
   beyond it the solution jumps one oscillation earlier, the itinerary changes and this orbit no longer exists
-  (:mod:`exact._crest`).  Detected when the crest margin of an accepted point falls below ``crest_tol``, or,
+  (:mod:`exact.orbits._crest`).  Detected when the crest margin of an accepted point falls below ``crest_tol``, or,
   when Newton fails at ``min_step``, when the last two points' margins extrapolate linearly to 0 within two
   steps or 1e-3 of the span; ``end_value`` is that extrapolation (likewise for a grazing, from ``Ġ²``, and a
   breakdown, from the lowest level on AB above f(0+));
@@ -59,7 +59,7 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure, WallBudget
 from peelapprox.validate import finite, function, in_range, integer, optional, positive
 
-from ._attractors import DEFAULT_MAX_WALL
+from .._shared import DEFAULT_MAX_WALL
 from ._branch_end import NO_CREST, event_message, events_ahead, failure_end, near
 from ._corrector import (
     PARAMETERS,
@@ -71,7 +71,8 @@ from ._corrector import (
     with_parameter,
 )
 from ._crest import crest_margin
-from ._orbits import PeriodicOrbit, minimal_period
+from ._kinds import ENDS, KINDS, crossing, gauge, marker
+from ._periodic import PeriodicOrbit, minimal_period
 
 __all__ = ["FAILURES", "PARAMETERS", "Bifurcation", "BranchPoint", "OrbitBranch", "Stepper", "continue_orbit",
            "parameter_value", "with_parameter"]
@@ -106,6 +107,16 @@ class Bifurcation:
     orbit: PeriodicOrbit
     parameter: str = "V"
 
+    @property
+    def marker(self) -> tuple[str, str]:
+        """The matplotlib marker and colour of its kind (:data:`exact.orbits._kinds.BIFURCATIONS`)."""
+        return marker(self.kind)
+
+    @property
+    def doubles(self) -> bool:
+        """A period doubling: :func:`exact.switch_branch` starts the doubled branch here."""
+        return self.kind == "period_doubling"
+
 
 @dataclass(frozen=True)
 class OrbitBranch:
@@ -135,6 +146,11 @@ class OrbitBranch:
     wall_time: float
     end_value: float = math.nan
 
+    @property
+    def end_marker(self) -> str | None:
+        """The matplotlib marker of its non-smooth end (:data:`exact.orbits._kinds.ENDS`), None for another stop."""
+        return KINDS[self.stopped].marker if self.stopped in {k.name for k in ENDS} else None
+
     def rows(self) -> list[dict]:
         """Every point as a row (:meth:`BranchPoint.row`), for ``peelapprox.io.write_rows`` (CSV/JSON)."""
         return [p.row(self.parameter) for p in self.points]
@@ -143,42 +159,19 @@ class OrbitBranch:
         """:meth:`rows` as a :class:`pandas.DataFrame`, one row per point in the order continued; ``df.attrs``:
         ``units`` (per column), ``parameter``, ``stopped``, ``end_value``, ``message``, ``bifurcations``
         (``[{"kind", "value"}]``) and ``params`` (the start's).  ImportError without pandas."""
-        from ._dataout import branch_dataframe
+        from ._branch_out import branch_dataframe
 
         return branch_dataframe(self)
 
     def __repr__(self) -> str:
-        from ._dataout import branch_summary
+        from ._branch_out import branch_summary
 
         return branch_summary(self, short=True)
 
     def _repr_html_(self) -> str:
-        from ._dataout import branch_summary
+        from ._branch_out import branch_summary
 
         return branch_summary(self, short=False)
-
-
-def _crossing(a: PeriodicOrbit, b: PeriodicOrbit) -> str | None:
-    """The bifurcation between two orbits of a branch, by their multipliers (module docstring), or None."""
-    ma, mb = a.multipliers, b.multipliers
-    real_a, real_b = np.all(np.abs(ma.imag) < 1e-12), np.all(np.abs(mb.imag) < 1e-12)
-    if not real_a and not real_b:
-        return "neimark_sacker" if (abs(ma[0]) - 1.0) * (abs(mb[0]) - 1.0) < 0 else None
-    if real_a and real_b:
-        for kind, level in (("fold", 1.0), ("period_doubling", -1.0)):
-            sa, sb = np.sort(ma.real - level), np.sort(mb.real - level)
-            if np.any(np.sign(sa) != np.sign(sb)):
-                return kind
-    return None
-
-
-def _gauge(kind: str, o: PeriodicOrbit) -> float:
-    """The quantity whose sign change marks ``kind`` (module docstring)."""
-    mu = o.multipliers
-    if kind == "neimark_sacker":
-        return float(abs(mu[0]) - 1.0)
-    level = 1.0 if kind == "fold" else -1.0
-    return float(min(mu.real - level, key=abs))
 
 
 class Stepper:
@@ -253,7 +246,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         (``PeriodicOrbit.fold_rates``) falls below ``graze_tol * k V``.
     crest_tol : float
         The branch stops with "crest" when an interior crest of the orbit comes within ``crest_tol (f_max -
-        f_min)`` of its fold (:func:`exact._crest.crest_margin`, one run of a period per point); 0 checks only
+        f_min)`` of its fold (:func:`exact.orbits._crest.crest_margin`, one run of a period per point); 0 checks only
         when Newton fails.
     progress : callable, optional
         ``progress(points, value)`` after every accepted point.
@@ -356,7 +349,7 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
                        f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
                        "its multipliers diverge")
             break
-        kind = _crossing(last.orbit, o)
+        kind = crossing(last.orbit.multipliers, o.multipliers)
         if kind is not None:
             try:
                 bifs.append(_locate(kind, last, pt, st, locate_tol))
@@ -420,15 +413,16 @@ def _check_correction(st: Stepper, pt: BranchPoint, w_pred: np.ndarray, max_corr
 
 
 def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: Stepper, locate_tol: float) -> Bifurcation:
-    """Bisection along the arclength from ``a`` to ``b`` on :func:`_gauge` (module docstring)."""
+    """Bisection along the arclength from ``a`` to ``b`` on the kind's test value
+    (:func:`exact.orbits._kinds.gauge`)."""
     wa, wb = st.w(a), st.w(b)
     tau = (wb - wa) / np.linalg.norm(wb - wa)
-    ga = _gauge(kind, a.orbit)
+    ga = gauge(kind, a.orbit.multipliers)
     lo, hi, best = 0.0, 1.0, b
     pa, pb = a, b
     for _ in range(40):
         if (abs(pb.value - pa.value) <= locate_tol * max(abs(pa.value), abs(pb.value), 1e-300)
-                and abs(_gauge(kind, best.orbit)) <= GAUGE_TOL):
+                and abs(gauge(kind, best.orbit.multipliers)) <= GAUGE_TOL):
             break
         mid = 0.5 * (lo + hi)
         try:
@@ -437,7 +431,7 @@ def _locate(kind: str, a: BranchPoint, b: BranchPoint, st: Stepper, locate_tol: 
             if _out_of_wall(exc):
                 raise
             break
-        gm = _gauge(kind, pm.orbit)
+        gm = gauge(kind, pm.orbit.multipliers)
         if gm == 0 or math.copysign(1.0, gm) != math.copysign(1.0, ga):
             hi, pb, best = mid, pm, pm
         else:

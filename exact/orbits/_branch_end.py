@@ -1,6 +1,6 @@
 """Where a continued branch ends (:func:`exact.continue_orbit`): the crest, breakdown and grazing events its last
 points extrapolate to, and the stop reason and message of a branch whose corrector fails at the smallest step
-(the module docstring of :mod:`exact._continuation` describes the events).
+(the module docstring of :mod:`exact.orbits._continuation` describes the events).
 
 ``points`` are the branch's :class:`exact.BranchPoint` objects (``value``, ``orbit``), in the order continued,
 and ``crests`` their :class:`exact.Crest` margins.
@@ -17,7 +17,8 @@ import numpy as np
 from peelapprox.errors import ModelBreakdown
 
 from ._crest import Crest, crest_margin
-from ._orbits import PeriodicOrbit
+from ._kinds import ENDS
+from ._periodic import PeriodicOrbit
 
 __all__ = ["NO_CREST", "event_message", "events_ahead", "failure_end", "near"]
 
@@ -32,18 +33,17 @@ def near(event: float, value: float, previous: float, span: float) -> float:
 
 
 def events_ahead(points: Sequence[Any], crests: list[Crest]) -> dict[str, float]:
-    """The parameter values where the last two points' crest margin ("crest"), floor ("breakdown") and squared
-    slowest fold rate ("grazing": Ġ vanishes like the square root of the distance), falling, extrapolate
-    linearly to 0 (:mod:`exact._continuation`); only the falling ones."""
+    """The parameter values where the last two points' test values of the non-smooth ends (:data:`ENDS`: crest
+    margin, floor, squared slowest fold rate), falling, extrapolate linearly to 0 (:mod:`exact.orbits._continuation`);
+    only the falling ones."""
     if len(points) < 2:
         return {}
     a, b = points[-2].value, points[-1].value
     out = {}
-    ra, rb = (float(np.min(np.abs(p.orbit.fold_rates))) ** 2 for p in points[-2:])  # Ġ² ∝ distance to grazing
-    for event, (ma, mb) in (("crest", (crests[-2].margin, crests[-1].margin)),
-                            ("breakdown", (crests[-2].floor, crests[-1].floor)), ("grazing", (ra, rb))):
+    for kind in ENDS:
+        ma, mb = (kind.test(p.orbit, c) for p, c in zip(points[-2:], crests[-2:]))
         if math.isfinite(ma) and math.isfinite(mb) and mb < ma and b != a:
-            out[event] = b + mb * (b - a) / (ma - mb)
+            out[kind.name] = b + mb * (b - a) / (ma - mb)
     return out
 
 
@@ -67,7 +67,7 @@ def failure_end(exc: Exception, points: Sequence[Any], crests: list[Crest], para
                 ) -> tuple[str, str, float]:
     """Why a branch whose corrector fails at the smallest step ends: a crest, breakdown or grazing event
     extrapolated ahead (within two steps or 1e-3 of the span; past a grazing the corrector's orbits break down),
-    else a breakdown of the corrector's orbit, else no convergence (:mod:`exact._continuation`)."""
+    else a breakdown of the corrector's orbit, else no convergence (:mod:`exact.orbits._continuation`)."""
     if len(points) >= 2:
         if not math.isfinite(crests[-1].margin + crests[-1].floor):  # crest_tol = 0: measure now
             crests[-2:] = [crest_margin(p.orbit) for p in points[-2:]]

@@ -23,8 +23,8 @@ import numpy as np
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, SolverFailure, periodicity, return_map
 from peelapprox.io import ProgressLine
 
-from ._initial import initial_state
-from ._simulate import simulate
+from .._initial import initial_state
+from .._simulate import simulate
 
 __all__ = ["APERIODIC", "BREAKDOWN", "FAILURE", "INVALID", "UNDETERMINED", "WALL_TEXT", "msg", "reporter", "run_all",
            "run_start"]
