@@ -35,6 +35,7 @@ from .dynamics import (
     BasinAttractor,
     BasinResult,
     BenettinResult,
+    Inference,
     LyapunovResult,
     OrbitDiagram,
     attractor_observables,
@@ -43,6 +44,7 @@ from .dynamics import (
     benettin,
     check_lyapunov_options,
     explain,
+    infer,
     lyapunov,
     lyapunov_return_map,
     lyapunov_tangent,
@@ -129,4 +131,6 @@ __all__ = [
     "LyapunovResult",
     "benettin",
     "BenettinResult",
+    "infer",
+    "Inference",
 ]

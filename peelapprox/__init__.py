@@ -12,7 +12,8 @@ imported from there on first use (``import peelapprox`` imports no sibling packa
 dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lyapunov(params, method=...)``),
 ``lyapunov_tangent``, ``lyapunov_return_map``, ``LyapunovResult``, ``benettin``, ``attractors``,
 ``Attractor``, ``attractor_observables``, ``periodic_orbit``, ``continue_orbit``, ``switch_branch``,
-``basins``.  The return-map analysis of a trajectory (``return_map``, ``periodicity``, ``classify``,
+``basins``, ``infer`` (parameters from measured force traces).  The return-map analysis of a trajectory
+(``return_map``, ``periodicity``, ``classify``,
 ``force_drops``, ``settle_time``) is the core's own, and so is the one definition of a stick-slip attractor's
 observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObservables.from_trajectory``;
 ``attractor_observables`` runs the exact solver for them).
@@ -175,6 +176,8 @@ __all__ = [
     "switch_branch",
     "basins",
     "BasinResult",
+    "infer",
+    "Inference",
     # (I, V) sweeps
     "sweep",
     "load_sweep",
@@ -193,7 +196,7 @@ _LAZY = {name: "comparisons.sweep" for name in
 _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "attractor_observables", "lyapunov",
                                          "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult", "benettin",
                                          "periodic_orbit", "PeriodicOrbit", "continue_orbit", "OrbitBranch",
-                                         "switch_branch", "basins", "BasinResult")})
+                                         "switch_branch", "basins", "BasinResult", "infer", "Inference")})
 
 
 def __getattr__(name: str):

@@ -1,7 +1,7 @@
 """The dynamics of the exact solution: windowed runs and the attractors they reach (``window_run``,
 ``attractors``, ``attractor_observables``), basins of attraction (``basins``), brute-force orbit diagrams
-(``orbit_diagram``, ``explain``) and the largest Lyapunov exponent by four methods (``lyapunov``; ``benettin``
-for any flow).
+(``orbit_diagram``, ``explain``), the largest Lyapunov exponent by four methods (``lyapunov``; ``benettin``
+for any flow) and the parameters that reproduce measured force traces (``infer``).
 
 Built on the solvers of :mod:`exact` and on :mod:`exact.orbits` (basins name their periodic orbits, diagrams are
 explained by continued branches).  Every name here is also :mod:`exact`'s.
@@ -11,6 +11,7 @@ from ._attractors import Attractor, attractor_observables, attractors, window_ru
 from ._basins import MAX_BASIN_STARTS, BasinAttractor, BasinResult, basins
 from ._benettin import BenettinResult, LyapunovResult, benettin
 from ._diagram import MAX_DIAGRAM_VALUES, OrbitDiagram, explain, orbit_diagram
+from ._infer import Inference, infer
 from ._lyapunov import check_lyapunov_options, lyapunov, lyapunov_return_map, lyapunov_tangent
 from ._variational import VARIATIONAL_LAWS, lyapunov_variational
 
@@ -18,5 +19,5 @@ __all__ = [
     "window_run", "attractors", "Attractor", "attractor_observables", "basins", "MAX_BASIN_STARTS", "BasinResult",
     "BasinAttractor", "orbit_diagram", "MAX_DIAGRAM_VALUES", "explain", "OrbitDiagram", "lyapunov",
     "check_lyapunov_options", "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult", "benettin",
-    "BenettinResult", "lyapunov_variational", "VARIATIONAL_LAWS",
+    "BenettinResult", "lyapunov_variational", "VARIATIONAL_LAWS", "infer", "Inference",
 ]

@@ -1,0 +1,438 @@
+"""Parameters from data: the model's parameters whose force trace reads like the measured one.
+
+:func:`infer` adjusts the free parameters of a :class:`peelapprox.PeelParams` (I, k, R, a family law's
+coefficients) until the exact model's force trace, sampled like the measured :class:`peelapprox.ForceSeries`
+and read by the same slip detector with the same threshold, gives the same statistics, at one pull speed or
+several (one series per V).
+
+* **Statistics** (:data:`OBSERVABLES`): the slip interval, force drop, stick and slip times of
+  :meth:`ForceSeries.observables`, the mean slope of the sticks (``k (V - v)``: mostly k) and the mean force at
+  a slip's start (set by the law and the α oscillation: mostly I).  The model's are read off an exact run
+  (``t_transient`` seconds, then the series' duration at its sampling times) with white noise of the series'
+  level added (σ of :meth:`ForceSeries.noise`, a fixed seed), by the same detector with the same threshold, so
+  the detector's biases under noise (a 10 % smaller drop where sticks are 40 samples long) cancel.
+* **Residuals.**  ``(model - data) / σ``, σ the detector's repeatability under noise
+  (:data:`REPEATABILITY`, relative, measured) and, for an aperiodic trace, the standard error of the mean in
+  quadrature; a periodic trace's means are over whole cycles.
+* **Search, then fit.**  An attractor's statistics are not smooth in the parameters (periodic windows,
+  coexisting attractors), so a local fit alone finds a nearby minimum with an overconfident interval.  First
+  a grid over ``params0 / search`` to ``params0 · search`` (ln θ for I, k, R; ±30 % for coefficients; at most
+  :data:`GRID_RUNS` points per series), then :func:`scipy.optimize.least_squares` from the grid's best point.
+* **Intervals.**  95 %, the union of two: the profile of every evaluated point (the parameter's range among the
+  points with χ² ≤ χ²_min + 3.84 · s, s = max(1, χ²_min/dof)) and the Jacobian's at the optimum (±1.96
+  standard errors of ``s (JᵀJ)⁻¹``).  A parameter is *not identified* when that interval spans more than a
+  factor 2 (log-fitted) or its value (coefficients), or reaches the edge of the search: the data do not
+  determine it, and the report says so instead of quoting a number.  None is identified when the best fit is
+  poor (χ² improbable at :data:`POOR_FIT`): the model describes the data nowhere in the search.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from peelapprox import PARAM_RANGES, ForceSeries, PeelParams
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded
+from peelapprox.io import fmt_number, jsonable
+from peelapprox.validate import choice, positive
+
+from .._simulate import simulate
+
+__all__ = ["DIFF_STEP", "GRID_RUNS", "Inference", "OBSERVABLES", "POOR_FIT", "REPEATABILITY", "infer"]
+
+#: The statistics fitted, in this order (module docstring).
+OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
+#: The σ of each statistic, relative: not the detector's repeatability under noise (a 20 s, 10 kHz model trace
+#: read with 0.5 N of white noise and without differs by 2e-6 in the slip interval, 0.2 % in the drop, 4.5 % in
+#: the slip time) but the model's own roughness: from one periodic window to the next (I varied by 5 % steps
+#: at V = 1 m/s, I = 1e-2) the means jump by 0.3 to 4 %, so a σ below that makes χ² a comb whose teeth no search
+#: can resolve.  The cycle frequency (the strongest spectral line below half the slip frequency: the return
+#: map's cycle, 1/(n · slip interval), which follows the α oscillation, ∝ I^-1/2 at high inertia) gets 3 %.
+REPEATABILITY = {"slip_interval": 0.02, "force_drop": 0.02, "stick_time": 0.02, "slip_time": 0.05, "rise": 0.02,
+                 "F_start": 0.005, "f_cycle": 0.03}
+#: The seed of the noise added to every model trace (the same at every parameter point: the statistics move with
+#: the parameters, not with a new draw).
+NOISE_SEED = 20041
+#: The most grid points of the search per series (an odd number per axis, params0 at the centre: 9 x 9 for two
+#: parameters).
+GRID_RUNS = 81
+#: Below this probability of χ² (given its degrees of freedom) the model does not describe the data at any
+#: point evaluated, and no parameter is called identified.
+POOR_FIT = 1e-3
+#: Relative step of the forward-difference Jacobian.
+DIFF_STEP = 1e-3
+#: The parameters fitted in ln θ (positive, spanning decades); the others, a law's coefficients, in θ.
+_LOG = ("I", "k", "R")
+#: A residual for a model run that does not stick-slip or breaks down: far outside any σ.
+_PENALTY = 1e3
+
+
+@dataclass(frozen=True)
+class Inference:
+    """What :func:`infer` found.
+
+    Attributes
+    ----------
+    params : PeelParams
+        ``params0`` with the fitted values (its V that of the first series).
+    values, stderr : dict
+        Fitted value and standard error of each free parameter (the error of ln θ for I, k, R).
+    intervals : dict
+        95 % interval ``(low, high)`` of each free parameter.
+    identified : dict
+        Whether the data determine each free parameter (module docstring), and ``verdicts`` the sentence why.
+    residuals : list of dict
+        Per series and observable: V, observable, data, sigma, model, normalised residual.
+    chi2, dof : float, int
+        Σ residual² at the optimum and observables minus free parameters.
+    status, message : str
+        ``"converged"``, ``"budget"`` (``max_wall`` spent: the best point so far) or ``"failed"``; why.
+    n_evaluations : int
+        Exact attractor runs.
+    wall_time : float
+        Seconds.
+    """
+
+    params: PeelParams
+    values: dict[str, float]
+    stderr: dict[str, float | None]
+    intervals: dict[str, tuple[float, float] | None]
+    identified: dict[str, bool]
+    verdicts: dict[str, str]
+    residuals: list[dict[str, Any]]
+    chi2: float
+    dof: int
+    status: str
+    message: str
+    n_evaluations: int
+    wall_time: float
+
+    def report(self) -> str:
+        """A plain-text report: each parameter with its interval or why it is not identified, the fit's χ²
+        and the residual table."""
+        lines = [f"infer: {self.status} ({self.message}); {self.n_evaluations} exact runs, "
+                 f"{fmt_number(self.wall_time, 3)} s; chi2 = {fmt_number(self.chi2, 4)} on {self.dof} dof"]
+        for name, value in self.values.items():
+            iv = self.intervals[name]
+            span = "" if iv is None else f", 95 % in [{fmt_number(iv[0], 4)}, {fmt_number(iv[1], 4)}]"
+            lines.append(f"  {name} = {fmt_number(value, 5)}{span}: {self.verdicts[name]}")
+        for r in self.residuals:
+            lines.append(f"  V = {fmt_number(r['V'], 4)} m/s {r['observable']}: data {fmt_number(r['data'], 5)} "
+                         f"± {fmt_number(r['sigma'], 2)}, model {fmt_number(r['model'], 5)}, "
+                         f"residual {fmt_number(r['residual'], 3)}")
+        return "\n".join(lines)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The result as plain JSON data (``params`` as its fields)."""
+        import dataclasses
+
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "params"}
+        return jsonable({**d, "params": dataclasses.asdict(self.params)})
+
+    def plot(self, ax: Any = None) -> Any:
+        """Model against data: each observable's data (with its σ) and the fitted model, per series, as
+        model/data - 1 [%]; returns the axes."""
+        from peelapprox.plotting import pyplot
+
+        plt = pyplot()
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 3.5))
+        xs = np.arange(len(self.residuals))
+        rel = [100 * (r["model"] / r["data"] - 1) if r["data"] else 0.0 for r in self.residuals]
+        err = [100 * r["sigma"] / abs(r["data"]) if r["data"] else 0.0 for r in self.residuals]
+        ax.axhline(0.0, color="0.6", lw=0.8)
+        ax.errorbar(xs, np.zeros_like(xs, dtype=float), yerr=err, fmt="none", ecolor="0.4", capsize=3,
+                    label="data ± σ")
+        ax.plot(xs, rel, "o", color="C3", label="fitted model")
+        ax.set_xticks(xs, [f"{r['observable']}\nV={fmt_number(r['V'], 3)}" for r in self.residuals], fontsize=7)
+        ax.set_ylabel("model / data − 1 [%]")
+        fitted = ", ".join(f"{k} = {fmt_number(v, 4)}" for k, v in self.values.items())
+        ax.set_title(f"infer: {fitted} (χ² = {fmt_number(self.chi2, 3)}, {self.dof} dof)", fontsize=9)
+        ax.legend(fontsize=8)
+        return ax
+
+
+def _free_names(params0: PeelParams, free: Sequence[str]) -> list[str]:
+    """The free parameters, checked: I, k, R, or ``force.<coefficient>`` of a family law."""
+    if isinstance(free, str) or not isinstance(free, Sequence) or not free:
+        raise TypeError(f"free must be a non-empty sequence of parameter names, got {free!r}")
+    coefs = dict(params0.force.coefficients) if params0.force.kind == "family" else {}
+    out = []
+    for name in free:
+        if not isinstance(name, str):
+            raise TypeError(f"free: each name must be a string, got {name!r}")
+        if name.startswith("force."):
+            if name[6:] not in coefs:
+                have = ", ".join(f"force.{c}" for c in coefs) or "none (params0.force is not a family law)"
+                raise ValueError(f"free: {name!r} is not a coefficient of params0.force; its coefficients: {have}")
+        elif name not in _LOG:
+            raise ValueError(f"free: {name!r} is not a fitted parameter; choose from I, k, R, force.<coefficient>")
+        if name in out:
+            raise ValueError(f"free: {name!r} is given twice")
+        out.append(name)
+    return out
+
+
+def _apply(params0: PeelParams, names: list[str], x: np.ndarray, V: float) -> PeelParams:
+    """``params0`` at pull speed V with the free parameters at ``x`` (ln θ for I, k, R)."""
+    changes: dict[str, Any] = {"V": V}
+    coefs = dict(params0.force.coefficients) if params0.force.kind == "family" else {}
+    for name, xi in zip(names, x):
+        if name in _LOG:
+            changes[name] = math.exp(float(xi))
+        else:
+            coefs[name[6:]] = float(xi)
+    if any(n.startswith("force.") for n in names):
+        changes["force"] = type(params0.force).family(str(params0.force.name), **coefs)
+    return params0.replace(**changes)
+
+
+def _stats(series: ForceSeries, threshold: float | None) -> tuple[np.ndarray | None, Any, float]:
+    """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables and
+    the detector's threshold."""
+    slips = series.slips(threshold)
+    o = series.observables(slips.threshold)
+    if o.status != "stick-slip" or len(slips) < 2:
+        return None, o, slips.threshold
+    assert o.slip_interval is not None  # stick-slip with two slips or more
+    vals = [getattr(o, n) for n in OBSERVABLES[:4]] + [float(np.mean(slips.rise)), float(np.mean(slips.F_before)),
+                                                       _cycle_frequency(series, 1.0 / o.slip_interval)]
+    return np.asarray(vals, dtype=float), o, slips.threshold
+
+
+def _cycle_frequency(series: ForceSeries, f_slip: float) -> float:
+    """The strongest line of the trace's periodogram (Hann window, linear trend removed) between 3 / duration
+    and half the slip frequency, refined by a parabola through its log power and its neighbours [Hz]."""
+    from scipy.signal import periodogram
+
+    f, p = periodogram(series.F, fs=(len(series) - 1) / series.duration, window="hann", detrend="linear")
+    band = np.flatnonzero((f >= 3.0 / series.duration) & (f <= 0.5 * f_slip))
+    if band.size < 3:
+        return 0.5 * f_slip
+    i = int(band[np.argmax(p[band])])
+    if 0 < i < f.size - 1 and min(p[i - 1], p[i], p[i + 1]) > 0:
+        a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
+        shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
+        return float(f[i] + max(-0.5, min(0.5, shift)) * (f[1] - f[0]))
+    return float(f[i])
+
+
+def _data(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The series' statistics, their σ (module docstring: residuals), the detector's threshold and the noise
+    level."""
+    if series.V is None:
+        raise ValueError(f"{series!r} has no pull speed: give ForceSeries(..., V=...) (the model needs V)")
+    vals, o, threshold = _stats(series, None)
+    if vals is None:
+        raise ValueError(f"the series at V = {fmt_number(series.V, 4)} m/s does not stick-slip ({o.status}: "
+                         f"{o.reason}): there is nothing to fit")
+    sig = np.array([REPEATABILITY[n] * abs(v) for n, v in zip(OBSERVABLES, vals)])
+    sig[-1] = max(sig[-1], 0.5 / series.duration)  # at least half a periodogram bin
+    if o.period is None:  # an aperiodic trace: its means scatter
+        for j, n in enumerate(OBSERVABLES[:4]):
+            spread = getattr(o, f"{n}_spread") or 0.0
+            sig[j] = math.hypot(sig[j], spread / math.sqrt(max(o.n_slips - 1, 1)))
+    return vals, sig, threshold, series.noise
+
+
+def _model(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float, rtol: float,
+           max_wall: float) -> np.ndarray | None:
+    """The statistics of the model's trace at ``p``, sampled at the series' times after ``t_transient`` with
+    white noise of the series' level added (a fixed seed), read with the series' threshold; None where it does
+    not stick-slip or breaks down."""
+    t_eval = t_transient + (series.t - series.t[0])
+    try:
+        tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall)
+    except (ModelBreakdown, SolverBudgetExceeded):
+        return None
+    F = tr.F + np.random.default_rng(NOISE_SEED).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
+    return _stats(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)[0]
+
+
+def _grid(names: list[str], x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, search: float, n_series: int
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The search grid (module docstring) and its box ``(low, high)`` per parameter, in fitted coordinates."""
+    half = np.array([math.log(search) if n in _LOG else 0.3 * max(abs(x), 1e-12) for n, x in zip(names, x0)])
+    box_lo, box_hi = np.maximum(x0 - half, lo), np.minimum(x0 + half, hi)
+    per = max(3, int(math.floor((GRID_RUNS / max(n_series, 1)) ** (1.0 / len(names)) + 1e-9)))
+    per = min(per - (per % 2 == 0), 9)  # odd: params0 is a node
+    axes = [np.linspace(a, b, per) for a, b in zip(box_lo, box_hi)]
+    pts = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(names), -1).T
+    return pts, box_lo, box_hi
+
+
+def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
+          more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
+          t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0,
+          progress: Callable[[str], None] | None = None) -> Inference:
+    """The model's parameters whose force traces read like the measured ones (module docstring).
+
+    Parameters
+    ----------
+    series : ForceSeries
+        A trace with its pull speed ``V`` set.
+    params0 : PeelParams
+        The model and the centre of the search; parameters not in ``free`` keep their values.
+    free : sequence of str
+        The fitted parameters: ``"I"``, ``"k"``, ``"R"``, ``"force.<coefficient>"`` of a family law (("I", "k")).
+    more : sequence of ForceSeries
+        Traces at other pull speeds, fitted together with ``series``.
+    statistics : sequence of str
+        The statistics fitted, a subset of :data:`OBSERVABLES` (all).  Where coexisting attractors make the
+        period, and with it the cycle frequency and the means over a cycle, jump between neighbouring parameter
+        values (low inertia), the per-stick statistics ``("rise", "F_start", "force_drop")`` vary smoothly.
+    search : float
+        The grid spans ``params0 / search`` to ``params0 · search`` for I, k and R (±30 % for coefficients),
+        within :data:`peelapprox.PARAM_RANGES`; in (1, 100] (3).
+    t_transient : float
+        Seconds of each model run before its sampled window, in (0, 1e4] (30).
+    rtol : float
+        Of every model run (1e-10).
+    max_wall : float
+        Wall-clock budget [s] (600): at its end the best point so far is returned with status ``"budget"``.
+    progress : callable, optional
+        Called with a line of text after each model run.
+
+    Returns
+    -------
+    Inference
+
+    Raises
+    ------
+    ValueError, TypeError
+        A series without V or without stick-slip, an unknown or repeated free parameter, an option out of
+        range; each names the argument.
+    """
+    from scipy.optimize import least_squares
+
+    t_wall = time.perf_counter()
+    if not isinstance(params0, PeelParams):
+        raise TypeError(f"params0 must be a PeelParams, got {type(params0).__name__}")
+    all_series = [series, *more]
+    for s in all_series:
+        if not isinstance(s, ForceSeries):
+            raise TypeError(f"series and more must be ForceSeries, got {type(s).__name__}")
+    names = _free_names(params0, free)
+    if isinstance(statistics, str) or not isinstance(statistics, Sequence) or not statistics:
+        raise TypeError(f"statistics must be a non-empty sequence of names from {OBSERVABLES}, got {statistics!r}")
+    sel = np.array([OBSERVABLES.index(choice("statistics", n, OBSERVABLES)) for n in statistics])
+    if len(set(sel.tolist())) != sel.size:
+        raise ValueError(f"statistics: a name is given twice in {tuple(statistics)!r}")
+    max_wall = positive("max_wall", max_wall)
+    search = positive("search", search, hi=100.0)
+    if search <= 1.0:
+        raise ValueError(f"search must be in (1, 100], got {search!r}")
+    t_transient = positive("t_transient", t_transient, hi=1e4)
+    data = [_data(s) for s in all_series]
+    Vs = [float(s.V) for s in all_series if s.V is not None]  # _data refused a series without V
+    coefs = dict(params0.force.coefficients) if params0.force.kind == "family" else {}
+    x0 = np.array([math.log(getattr(params0, n)) if n in _LOG else coefs[n[6:]] for n in names])
+    lo = np.array([math.log(PARAM_RANGES[n][0]) if n in _LOG else -np.inf for n in names])
+    hi = np.array([math.log(PARAM_RANGES[n][1]) if n in _LOG else np.inf for n in names])
+    x0 = np.clip(x0, lo, hi)
+    evaluated: list[tuple[np.ndarray, float, list]] = []
+
+    class _Spent(Exception):
+        pass
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        left = max_wall - (time.perf_counter() - t_wall)
+        if left <= 0:
+            raise _Spent
+        out: list[np.ndarray] = []
+        models: list[np.ndarray | None] = []
+        for s, V, (vals, sig, threshold, noise) in zip(all_series, Vs, data):
+            m = _model(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol, max(1.0, left))
+            out.append(np.full(sel.size, _PENALTY) if m is None else ((m - vals) / sig)[sel])
+            models.append(m)
+        res = np.concatenate(out)
+        evaluated.append((np.array(x), float(res @ res), models))
+        if progress is not None:
+            progress(f"infer: run {len(evaluated)}, chi2 = {fmt_number(evaluated[-1][1], 4)} at "
+                     + ", ".join(f"{n} = {fmt_number(v, 5)}" for n, v in zip(names, _values(names, x))))
+        return res
+
+    grid, box_lo, box_hi = _grid(names, x0, lo, hi, search, len(all_series))
+    status, message, jac = "converged", "", None
+    try:
+        for x in grid:
+            residuals(x)
+        start = min(evaluated, key=lambda e: e[1])[0]
+        sol = least_squares(residuals, start, bounds=(box_lo, box_hi), diff_step=DIFF_STEP, max_nfev=100)
+        jac = sol.jac
+        status = "converged" if sol.success else "failed"
+        message = str(sol.message)
+    except _Spent:
+        status, message = "budget", f"max_wall = {fmt_number(max_wall, 3)} s spent; the best point so far"
+    return _result(params0, names, sel, jac, evaluated, (box_lo, box_hi), data, Vs, status, message,
+                   time.perf_counter() - t_wall)
+
+
+def _values(names: list[str], x: np.ndarray) -> list[float]:
+    return [math.exp(float(xi)) if n in _LOG else float(xi) for n, xi in zip(names, x)]
+
+
+def _result(params0: PeelParams, names: list[str], sel: np.ndarray, jac: np.ndarray | None, evaluated: list,
+            box: tuple,
+            data: list, Vs: list[float], status: str, message: str, wall: float) -> Inference:
+    """The :class:`Inference` at the best evaluated point: intervals and verdicts (module docstring)."""
+    from scipy.stats import chi2 as chi2_dist
+
+    n_obs = sel.size * len(data)
+    dof = n_obs - len(names)
+    x, chi2, model = min(evaluated, key=lambda e: e[1]) if evaluated else (None, math.inf, None)
+    if x is None:
+        raise ValueError("max_wall was spent before the first model run: give a larger max_wall")
+    s = max(1.0, chi2 / dof) if dof > 0 else 1.0
+    p_fit = float(chi2_dist.sf(chi2, dof)) if dof > 0 else 1.0
+    poor = p_fit < POOR_FIT
+    accept = [e[0] for e in evaluated if e[1] <= chi2 + 3.84 * s]
+    values = dict(zip(names, _values(names, x)))
+    stderr: dict[str, float | None] = dict.fromkeys(names)
+    intervals: dict[str, tuple[float, float] | None] = {}
+    identified = dict.fromkeys(names, False)
+    verdicts: dict[str, str] = {}
+    cov = None
+    if jac is not None:
+        cov = np.linalg.pinv(jac.T @ jac) * s
+    for i, name in enumerate(names):
+        lo_i, hi_i = min(a[i] for a in accept), max(a[i] for a in accept)
+        if cov is not None and math.isfinite(float(cov[i, i])) and cov[i, i] > 0:
+            se = math.sqrt(float(cov[i, i]))
+            stderr[name] = se
+            lo_i, hi_i = min(lo_i, x[i] - 1.96 * se), max(hi_i, x[i] + 1.96 * se)
+        edge = lo_i <= box[0][i] + 1e-12 or hi_i >= box[1][i] - 1e-12
+        log = name in _LOG
+        intervals[name] = (math.exp(lo_i), math.exp(hi_i)) if log else (float(lo_i), float(hi_i))
+        narrow = (hi_i - lo_i <= math.log(2.0)) if log else (hi_i - lo_i <= abs(float(x[i])))
+        identified[name] = narrow and not edge and not poor
+        if poor:
+            verdicts[name] = (f"not identified: the best point evaluated fits poorly (chi2 = {fmt_number(chi2, 4)} on "
+                              f"{dof} dof, probability {fmt_number(p_fit, 2)}): the model at no point searched "
+                              "describes the data")
+        elif identified[name]:
+            reach = max(x[i] - lo_i, hi_i - x[i])
+            verdicts[name] = (f"identified: 95 % within a factor {fmt_number(math.exp(reach), 3)}" if log
+                              else f"identified: 95 % within ± {fmt_number(reach, 3)}")
+        elif edge:
+            verdicts[name] = ("not identified: points as good as the best reach the edge of the search "
+                              f"[{fmt_number(_values([name], np.array([box[0][i]]))[0], 4)}, "
+                              f"{fmt_number(_values([name], np.array([box[1][i]]))[0], 4)}]")
+        else:
+            verdicts[name] = (f"not identified: its 95 % interval spans more than "
+                              f"{'a factor 2' if log else 'its value'}")
+    residuals = []
+    for V, (vals, sig, _, _), m in zip(Vs, data, model or [None] * len(data)):
+        for j in sel.tolist():
+            obs = OBSERVABLES[j]
+            mv = None if m is None else float(m[j])
+            residuals.append({"V": V, "observable": obs, "data": float(vals[j]), "sigma": float(sig[j]),
+                              "model": mv, "residual": None if mv is None else (mv - float(vals[j])) / float(sig[j])})
+    return Inference(params=_apply(params0, names, x, Vs[0]), values=values, stderr=stderr, intervals=intervals,
+                     identified=identified, verdicts=verdicts, residuals=residuals, chi2=chi2, dof=dof,
+                     status=status, message=message, n_evaluations=len(evaluated) * len(data), wall_time=wall)

@@ -1,0 +1,80 @@
+"""Parameters from data: :func:`peelapprox.infer` recovers the parameters of a synthetic experiment.
+
+The oracle is the truth the synthetic trace was made with: the exact model at known parameters, sampled at
+10 kHz with 0.5 N of white noise and a 5 N drift (``Trajectory.as_series``), the way a tensile machine records.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import exact
+from peelapprox import ForceSeries, PeelParams, infer
+
+
+def _trace(V: float, I: float, k: float = 1000.0, seconds: float = 20.0) -> ForceSeries:
+    tr = exact.simulate(PeelParams(V=V, I=I, k=k), 30.0 + seconds, t_eval=30.0 + np.arange(int(seconds * 1e4)) / 1e4)
+    return tr.as_series(1e4, noise=0.5, drift=5.0, seed=1)
+
+
+@pytest.fixture(scope="module")
+def high_inertia() -> ForceSeries:
+    return _trace(1.0, 1e-2)
+
+
+def test_k_alone_is_recovered():
+    """Hypothesis: with I known, the stiffness k of a periodic high-inertia trace (V = 1, I = 1e-2, k = 1000 N/m;
+    5 s of it, 20 cycles of the period-8 orbit, to keep the test short) is recovered from a start at 900 N/m
+    within 5 % (the goal; measured 1.3 % from 20 s with I free too), identified, its 95 % interval covering the
+    truth."""
+    res = infer(_trace(1.0, 1e-2, seconds=5.0), PeelParams(V=1.0, I=1e-2, k=900.0), ("k",), search=1.5,
+                max_wall=300)
+    assert res.status == "converged" and res.identified["k"]
+    assert abs(res.values["k"] / 1000.0 - 1) < 0.05
+    lo, hi = res.intervals["k"]
+    assert lo <= 1000.0 <= hi
+    assert res.params.k == res.values["k"] and res.params.V == 1.0
+    assert "identified" in res.report() and len(res.residuals) == 7
+
+
+@pytest.mark.slow
+def test_I_and_k_at_high_inertia(high_inertia):
+    """Hypothesis (the stated goal): at V = 1, I = 1e-2 (period 8) I is recovered within 10 % and k within 5 %
+    from a start at I = 1.3e-2, k = 900, both identified with 95 % intervals covering the truth (measured: I
+    0.6 % off, k 1.3 %; ~100 exact runs, 1-3 min)."""
+    res = infer(high_inertia, PeelParams(V=1.0, I=1.3e-2, k=900.0), ("I", "k"), max_wall=900)
+    assert res.identified == {"I": True, "k": True}
+    assert abs(res.values["I"] / 1e-2 - 1) < 0.10 and abs(res.values["k"] / 1000.0 - 1) < 0.05
+    assert res.intervals["I"][0] <= 1e-2 <= res.intervals["I"][1]
+    assert res.intervals["k"][0] <= 1000.0 <= res.intervals["k"][1]
+
+
+@pytest.mark.slow
+def test_a_multistable_point_is_not_called_identified():
+    """Hypothesis: at V = 1, I = 1e-5 periods 1, 3 and 15 coexist (docs/dynamics.md), so neighbouring parameter
+    points land on other attractors and no point of the search fits the period-3 trace (chi2 probability
+    below 1e-3): the verdict is "not identified" for both parameters, not a number with a narrow interval."""
+    res = infer(_trace(1.0, 1e-5), PeelParams(V=1.0, I=1.3e-5, k=900.0), ("I", "k"), max_wall=900)
+    assert res.identified == {"I": False, "k": False}
+    assert all("fits poorly" in v for v in res.verdicts.values())
+
+
+def test_bad_input_is_named(high_inertia):
+    p0 = PeelParams(V=1.0, I=1e-2)
+    t = np.arange(1000) / 1000.0
+    cases = [
+        (dict(series=high_inertia, params0=p0, free=("m",)), ValueError, "free"),
+        (dict(series=high_inertia, params0=p0, free=("force.a1",)), ValueError, "not a coefficient"),
+        (dict(series=high_inertia, params0=p0, free=("k", "k")), ValueError, "twice"),
+        (dict(series=high_inertia, params0=p0, free="k"), TypeError, "free"),
+        (dict(series=high_inertia, params0={"V": 1}, free=("k",)), TypeError, "params0"),
+        (dict(series=ForceSeries(t, t), params0=p0, free=("k",)), ValueError, "no pull speed"),
+        (dict(series=ForceSeries(t, t, V=1.0), params0=p0, free=("k",)), ValueError, "does not stick-slip"),
+        (dict(series=high_inertia, params0=p0, free=("k",), search=1.0), ValueError, "search"),
+        (dict(series=high_inertia, params0=p0, free=("k",), statistics=("period",)), ValueError, "statistics"),
+        (dict(series=high_inertia, params0=p0, free=("k",), max_wall=0.0), ValueError, "max_wall"),
+    ]
+    for kwargs, error, match in cases:
+        with pytest.raises(error, match=match):
+            infer(**kwargs)
