@@ -30,8 +30,10 @@ range; the test is one-sided (chaos makes neighbours diverge faster than the nul
 ``p = (1 + #{λ_surrogate ≥ λ}) / (n + 1)``, rejected at ``p ≤ alpha`` (19 surrogates: p ≥ 0.05).
 
 A periodic trace gives λ ≈ 0 *and the test does not reject*.  That does not say the trace is noise: the
-surrogates of a periodic series are periodic too (its spectrum is lines; new phases of the lines make another
-periodic series) and also give λ ≈ 0, so λ is no larger than the null's.  The test asks for evidence of
+surrogates of a periodic series are nearly periodic too (its spectrum is lines; new phases of the lines make
+another periodic series, blurred only by the lines' leakage into their neighbours) and give λ ≥ 0 (0.01-0.5
+bits/s on the model's period-3 orbit, about 0.05 on its period-1 orbit), so the data's λ ≈ 0 is no larger than
+the null's.  The test asks for evidence of
 sensitive dependence beyond a linear process, and a periodic trace has none.  The verdict "periodic" is read
 off λ ≈ 0 and the return map's period (:meth:`ForceSeries.observables`), not off the test.
 """
@@ -39,6 +41,7 @@ off λ ≈ 0 and the return map's period (:meth:`ForceSeries.observables`), not 
 from __future__ import annotations
 
 import math
+import textwrap
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -211,8 +214,8 @@ class SeriesLyapunov:
         ax.set(xlabel=f"time followed, k × {fmt_number(self.step * 1e3, 3)} ms ({unit}) [s]",
                ylabel="mean ln distance [ln N]")
         V = "" if self.V is None else f"V = {fmt_number(self.V, 4)} m/s, "
-        ax.set_title(f"{V}{self.embedded} embedded (m = {self.dimension}, delay {self.delay})\n{self.source}",
-                     fontsize=8)
+        ax.set_title(textwrap.fill(f"{V}{self.embedded} embedded (m = {self.dimension}, delay {self.delay}); "
+                                   f"{self.source}", 70), fontsize=8)
         ax.legend(loc="lower right", fontsize=8)
         return ax
 
