@@ -387,6 +387,9 @@ def series_lyapunov(series: Any, *, embed: str = "returns", dimension: int | Non
     else:
         a = int(np.searchsorted(ks, int(fit_range[0])))
         b = int(np.searchsorted(ks, int(fit_range[1]), side="right")) - 1
+        if b - a + 1 < 3:
+            raise ValueError(f"fit_range = {fit_range!r} holds {max(b - a + 1, 0)} of the curve's steps (they are "
+                             f"{int(ks[1] - ks[0])} apart here): it needs at least 3")
     sl = slice(a, b + 1)
     slope, se, icept = _slope(ks[sl].astype(float), y[sl])
     to_bits = 1.0 / (step * math.log(2.0))

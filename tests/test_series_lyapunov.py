@@ -112,6 +112,7 @@ def test_plots_return_axes_with_units(chaos_short):
     ({"horizon": 10**6}, "horizon"), ({"neighbours": 0}, "neighbours"), ({"fit": (0.6, 0.1)}, "fit"),
     ({"fit_range": (5, 2)}, "fit_range"), ({"alpha": 1.5}, "alpha"), ({"max_wall": 0.0}, "max_wall"),
     ({"references": 1}, "references"), ({"theiler": -1}, "theiler"),
+    ({"embed": "trace", "fit_range": (100, 110)}, "fit_range"),
 ])
 def test_bad_options_are_named(chaos_short, kwargs, match):
     with pytest.raises(ValueError, match=match):
