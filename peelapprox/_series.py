@@ -34,8 +34,9 @@ extrema are the trace's ends, not the stick-slip's).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -43,6 +44,9 @@ from numpy.typing import ArrayLike
 from ._observables import StickSlipObservables, jump_statistics
 from .io import fmt_number, jsonable, write_rows
 from .validate import integer, optional, positive, reals
+
+if TYPE_CHECKING:
+    from ._series_lyapunov import SeriesLyapunov
 
 __all__ = ["ForceSeries", "Slips", "Spectrum", "detect_slips", "noise_level", "MIN_SAMPLES"]
 
@@ -400,6 +404,147 @@ class ForceSeries:
         f, p = welch(Fu, fs=(n - 1) / self.duration, nperseg=nper, detrend=detrend)
         peak = float(f[1 + int(np.argmax(p[1:]))]) if f.size > 1 else 0.0
         return Spectrum(frequency=f, power=p, peak=peak)
+
+    def lyapunov(self, *, embed: str = "returns", dimension: int | None = None, delay: int | None = None,
+                 theiler: int | None = None, horizon: int | None = None, neighbours: int = 1,
+                 references: int = 4000, fit: tuple[float, float] = (0.1, 0.6),
+                 fit_range: tuple[int, int] | None = None, surrogates: int = 19, alpha: float = 0.05,
+                 threshold: float | None = None, seed: int | None = 0, max_wall: float = 300.0,
+                 progress: Callable[[int, int], Any] | None = None) -> SeriesLyapunov:
+        """The largest Lyapunov exponent from the trace, by delay embedding and the divergence of nearest
+        neighbours (Rosenstein et al. 1993, Kantz 1994), with a surrogate-data test
+        (:mod:`peelapprox._series_lyapunov`).
+
+        Parameters
+        ----------
+        embed : {"returns", "trace"}
+            What is embedded: the force before each slip, one step per return (default; the measured choice),
+            or the uniformly resampled trace F(t), one step per sample.
+        dimension, delay : int, optional
+            Embedding dimension (1 to 20) and delay [steps].  None: 4 and 1 for returns; 5 and an eighth of
+            the mean slip interval for the trace.
+        theiler : int, optional
+            Neighbours closer in time than this many steps are not paired.  None: ``dimension * delay``
+            (returns), one mean slip interval (trace).
+        horizon : int, optional
+            Steps each pair is followed.  None: a quarter of the slips, at most 400 slip intervals.
+        neighbours : int
+            Nearest neighbours whose mean distance is followed per reference point (1: Rosenstein; more:
+            Kantz's average; 1 to 50).
+        references : int
+            Reference points, evenly spread over the series (20 to 10**6; 4000).
+        fit : (float, float)
+            The fit range, as fractions of the curve's rise from its start to the attractor's size (the mean
+            ln distance of random pairs); ``(0.1, 0.6)``.
+        fit_range : (int, int), optional
+            The fit range in steps, instead of ``fit``.
+        surrogates : int
+            IAAFT surrogates for the test (0: no test; 19 for a one-sided test at 5 %).
+        alpha : float
+            The test's level (0.05).
+        threshold : float, optional
+            Of :meth:`slips`.
+        seed : int or None
+            Of the surrogates' and the saturation level's random numbers (0).
+        max_wall : float
+            Wall-time budget [s] (300).  Surrogates not made by then are left out and ``status`` says so; a
+            budget spent before the data's own curve raises ``TimeoutError``.
+        progress : callable, optional
+            Called as ``progress(done, total)`` after each surrogate.
+
+        Returns
+        -------
+        SeriesLyapunov
+            λ [bits/s] with its standard error, the divergence curve, the fit range, the embedding and the
+            surrogate test.  A periodic trace gives λ ≈ 0 and a test that does not reject: its surrogates
+            are nearly periodic too (a line spectrum with new phases), so the test finds nothing beyond a
+            linear process; "periodic" is read off λ ≈ 0 and the return map's period, not off the test.
+            Noise: the default detector threshold (8 σ) can miss slips whose stick rises less than it (at
+            V = 2.5, I = 1e-4 with 0.5 N of noise, 531 of 6271), which scrambles the returns; give
+            ``threshold`` below the smallest drop (docs/dynamics.md).  A λ the surrogates do not reject is
+            no evidence of chaos.
+
+        Raises
+        ------
+        ValueError
+            Naming the argument: fewer than 3 slips, a series too short for the horizon, embedding and
+            Theiler window, parameters out of range.
+        """
+        from ._series_lyapunov import series_lyapunov
+
+        return series_lyapunov(self, embed=embed, dimension=dimension, delay=delay, theiler=theiler,
+                               horizon=horizon, neighbours=neighbours, references=references, fit=fit,
+                               fit_range=fit_range, surrogates=surrogates, alpha=alpha, threshold=threshold,
+                               seed=seed, max_wall=max_wall, progress=progress)
+
+    def plot(self, ax: Any = None, *, window: tuple[float, float] | None = None, threshold: float | None = None):
+        """The trace F(t) with its detected slips marked (start ▼, end ▲, at the fitted corners).
+
+        Parameters
+        ----------
+        ax : matplotlib axes, optional
+            Draw there; None: new axes from :func:`peelapprox.plotting.pyplot`.
+        window : (float, float), optional
+            The time span shown [s]; None: the whole trace.
+        threshold : float, optional
+            Of :meth:`slips`.
+
+        Returns
+        -------
+        matplotlib axes
+        """
+        lo, hi = (self.t[0], self.t[-1]) if window is None else (float(window[0]), float(window[1]))
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ValueError(f"window must be (t_start, t_end) with t_start < t_end, got {window!r}")
+        if ax is None:
+            from .plotting import pyplot
+
+            _, ax = pyplot().subplots(figsize=(9, 4))
+        s = self.slips(threshold)
+        m = (self.t >= lo) & (self.t <= hi)
+        ax.plot(self.t[m], self.F[m], lw=0.7, color="C0", label="F(t)")
+        a = (s.t_start >= lo) & (s.t_start <= hi)
+        b = (s.t_end >= lo) & (s.t_end <= hi)
+        ax.plot(s.t_start[a], s.F_before[a], "v", ms=4, color="C3", label=f"slip start ({len(s)} slips)")
+        ax.plot(s.t_end[b], s.F_after[b], "^", ms=4, color="C2", label="slip end")
+        ax.set(xlabel="t [s]", ylabel="F [N]", xlim=(lo, hi))
+        ax.set_title(f"{self._label()}; threshold {fmt_number(s.threshold, 3)} N", fontsize=8)
+        ax.legend(loc="best", fontsize=8)
+        return ax
+
+    def plot_return_map(self, ax: Any = None, *, threshold: float | None = None):
+        """The return map of the force before the slips, F_n+1 against F_n, with the diagonal.
+
+        Parameters
+        ----------
+        ax : matplotlib axes, optional
+            Draw there; None: new axes from :func:`peelapprox.plotting.pyplot`.
+        threshold : float, optional
+            Of :meth:`slips`.
+
+        Returns
+        -------
+        matplotlib axes
+        """
+        if ax is None:
+            from .plotting import pyplot
+
+            _, ax = pyplot().subplots(figsize=(5, 5))
+        x, y = self.return_map(threshold)
+        ax.plot(x, y, ".", ms=3, color="C0", label=f"{x.size} returns")
+        if x.size:
+            lo, hi = float(min(x.min(), y.min())), float(max(x.max(), y.max()))
+            ax.plot([lo, hi], [lo, hi], lw=0.8, color="0.5", label="F_n+1 = F_n")
+        ax.set(xlabel="$F_n$ before slip n [N]", ylabel="$F_{n+1}$ [N]")
+        ax.set_title(f"return map: {self._label()}", fontsize=8)
+        ax.legend(loc="best", fontsize=8)
+        return ax
+
+    def _label(self) -> str:
+        """The pull speed and the source, for a title (wrapped at 70 characters)."""
+        import textwrap
+
+        return textwrap.fill(("" if self.V is None else f"V = {fmt_number(self.V, 4)} m/s, ") + self.source, 70)
 
     def as_rows(self) -> list[dict[str, float]]:
         """One row per sample: ``t, F``."""

@@ -34,7 +34,7 @@ API = {
         "periodicity", "quasi_static_branch_time", "reduced_segment", "register_measure", "return_map",
         "settle_time", "sinusoid_alpha", "slope_criterion", "sweep", "wkb_alpha", "wkb_amplitude_phase",
         "wkb_error_bound", "StickSlipObservables", "attractor_observables", "approximate_attractor", "ForceSeries",
-        "Slips", "Spectrum",
+        "Slips", "Spectrum", "SeriesLyapunov", "SurrogateTest",
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
