@@ -16,9 +16,12 @@ happens in the jumps).
    too few samples to move a median.
 2. *Extrema with hysteresis.*  On the force averaged over ``smooth`` samples, a maximum is confirmed when the
    force falls more than ``threshold`` below it, and the following minimum when the force rises more than
-   ``threshold`` above it (a zigzag filter).  The default threshold is ``8 σ`` (and at least 1e-9 of the force
-   range): a noise excursion of 8 σ of the averaged force has a probability below 1e-12 per sample.  A trend
-   slower than the threshold per stick (a drift) moves no extremum past it.
+   ``threshold`` above it (a zigzag filter).  The default threshold is 12 times the averaged force's noise,
+   ``12 σ / √smooth`` (5.4 σ for 5 samples; and at least 1e-9 of the force range): on a flat trace of a million
+   samples the averaged noise's running maximum and a later minimum lie ~10 of its σ apart at the extremes, so
+   12 confirms no false slip, while a stick that rises by 5.4 σ is seen (at 8 σ of the raw force, sticks rising
+   less than 4 N at 0.5 N of noise were missed: 531 of 6271 at V = 2.5, I = 1e-4).  A trend slower than the
+   threshold per stick (a drift) moves no extremum past it.
 3. *Corners.*  A slip starts at the knee where the stick's slow rise turns into the fast fall, and ends at
    the corner where the fall turns into the next rise: each is the crossing of a straight line fitted to the
    stick (at most ``fit`` samples, from the middle of the stick to ``smooth // 2`` samples before the corner)
@@ -52,8 +55,8 @@ __all__ = ["ForceSeries", "Slips", "Spectrum", "detect_slips", "noise_level", "M
 
 #: The fewest samples a trace may have.
 MIN_SAMPLES = 16
-#: The default threshold in units of the noise level σ (module docstring, step 2).
-THRESHOLD_SIGMAS = 8.0
+#: The default threshold in units of the averaged force's noise, σ/√smooth (module docstring, step 2).
+THRESHOLD_SIGMAS = 12.0
 
 
 def noise_level(F: np.ndarray) -> float:
@@ -220,7 +223,8 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
     t, F : ndarray
         Times [s] (increasing) and forces [N], checked by :class:`ForceSeries`.
     threshold : float, optional
-        The fall [N] that confirms a slip (and the rise that ends it); None: ``8 σ`` (:data:`THRESHOLD_SIGMAS`).
+        The fall [N] that confirms a slip (and the rise that ends it); None: ``12 σ / √smooth``
+        (:data:`THRESHOLD_SIGMAS`).
     smooth : int
         Samples of the moving average the extrema are searched on (odd, 1 to 101; 5).
     fit : int
@@ -232,7 +236,7 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
     """
     sigma = noise_level(F)
     span = float(F.max() - F.min())
-    h = max(THRESHOLD_SIGMAS * sigma, 1e-9 * span) if threshold is None else threshold
+    h = max(THRESHOLD_SIGMAS * sigma / math.sqrt(smooth), 1e-9 * span) if threshold is None else threshold
     Fs = F if smooth == 1 else np.convolve(F, np.ones(smooth) / smooth, mode="same")
     half = smooth // 2
     if half:  # the ends of a 'same' convolution are averages over fewer samples: keep the raw force there
@@ -262,7 +266,8 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
         te[k], fa[k], _ = _corner(t, F, (v + half + 1, hi), (max(knee + half, v - half - L), v - half), v,
                                (max(v - half - 1, 0), min(v + half + 1, last)))
     method = (f"slips: falls of the {smooth}-sample moving average by more than {fmt_number(h, 3)} N "
-              + (f"(8 sigma, sigma = {fmt_number(sigma, 3)} N from the second differences)" if threshold is None
+              + (f"(12 sigma/sqrt({smooth}), sigma = {fmt_number(sigma, 3)} N from the second differences)"
+                 if threshold is None
                  else "(given)")
               + f", F before and after from line fits of up to {fit} stick samples")
     return Slips(t_start=ts, t_end=te, F_before=fb, F_after=fa, rise=rise, threshold=float(h), noise=sigma,
@@ -459,10 +464,9 @@ class ForceSeries:
             surrogate test.  A periodic trace gives λ ≈ 0 and a test that does not reject: its surrogates
             are nearly periodic too (a line spectrum with new phases), so the test finds nothing beyond a
             linear process; "periodic" is read off λ ≈ 0 and the return map's period, not off the test.
-            Noise: the default detector threshold (8 σ) can miss slips whose stick rises less than it (at
-            V = 2.5, I = 1e-4 with 0.5 N of noise, 531 of 6271), which scrambles the returns; give
-            ``threshold`` below the smallest drop (docs/dynamics.md).  A λ the surrogates do not reject is
-            no evidence of chaos.
+            Noise: the detector misses slips whose stick rises less than its threshold (5.4 σ by default),
+            which scrambles the returns; give ``threshold`` below the smallest drop where sticks are that
+            short (docs/dynamics.md).  A λ the surrogates do not reject is no evidence of chaos.
 
         Raises
         ------

@@ -51,8 +51,7 @@ def test_chaotic_trace_fast(chaos_short):
 def test_chaotic_trace_50s_within_25_percent():
     """Hypothesis (the target): 50 s at 20 kHz at V = 2.5, I = 1e-4 give λ within 25 % of the exact 5.28
     bits/s (measured 5.46, +3.5 %) and the surrogate test rejects; with 0.5 N noise and the detector's
-    threshold set to 2 N (the default 8 σ = 4 N misses slips whose stick rises less than that) within 25 % too
-    (measured 4.87, -8 %)."""
+    threshold set to 2 N within 25 % too (measured 4.87, -8 %; 5.01 at the default threshold, 2.7 N)."""
     s = _series(2.5, 1e-4, 50.0)
     r = s.lyapunov()
     assert abs(r.lambda_bits_per_s / EXACT_BITS - 1) < 0.25, r
