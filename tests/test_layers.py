@@ -53,3 +53,17 @@ def test_the_rooms_are_layered_in_the_documented_order():
     c = _contracts()["rooms"]
     assert c["type"] == "layers" and c["layers"] == ["comparisons", "exact", "peelapprox"]
     assert all(rule.startswith("peelapprox.cli") for rule in c.get("ignore_imports", []))
+
+
+def test_no_private_module_is_an_alias_of_another():
+    """Hypothesis: no private module lives on as a compatibility alias of a moved one (the shims
+    ``comparisons._benchmark``, ``_stress`` and ``_peers`` were removed in 0.3.0): no module of the three
+    packages star-imports another, the form those aliases took, and the removed names stay gone (exact)."""
+    aliases = []
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            if "import *" in path.read_text(encoding="utf-8"):
+                aliases.append(str(path.relative_to(ROOT)))
+    assert aliases == []
+    gone = {"comparisons._benchmark", "comparisons._stress", "comparisons._peers"}
+    assert gone.isdisjoint(_private_modules("comparisons"))
