@@ -17,13 +17,13 @@ import numpy as np
 from exact import DEFAULT_MAX_WALL
 from peelapprox import PARAM_RANGES, PeelForce, SolverBudgetExceeded
 from peelapprox.io import ProgressLine, jsonable
-from peelapprox.validate import ArgumentTypeError, integer, optional, positive
+from peelapprox.validate import ArgumentTypeError, flag, integer, optional, positive
 from peelapprox.validate import path as _path
 
 from .._worker import SERIAL, run_tasks
 from .grid import check_grid_size, grid_length
 from .law import check_coef, check_force, manifest_fields
-from .measures import _OPTION_CHECKS, MEASURES, _ref
+from .measures import MEASURES, OPTION_CHECKS, measure_ref
 from .result import SweepResult
 from .store import (
     FORMAT,
@@ -210,12 +210,11 @@ def sweep(
         raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
     if not (isinstance(progress, bool) or progress is None or callable(progress)):
         raise ValueError("progress must be a bool, None or a callable (done, total, record)")
-    for name, flag in (("resume", resume), ("retry_failed", retry_failed)):
-        if not isinstance(flag, bool):
-            raise ValueError(f"{name} must be True or False, got {flag!r}")
+    resume = flag("resume", resume)
+    retry_failed = flag("retry_failed", retry_failed)
     if max_workers == 0:
         executor = SERIAL
-    refs = {name: _ref(MEASURES[name]) for name in measures}
+    refs = {name: measure_ref(MEASURES[name]) for name in measures}
     task_refs = refs if executor == SERIAL else worker_refs(measures)
 
     out = _path("out", out)
@@ -249,7 +248,7 @@ def _check_options(measures: Sequence[str], options: Mapping, force: PeelForce |
             from None
     frozen = MappingProxyType(options)
     for name in measures:
-        check = _OPTION_CHECKS.get(name)
+        check = OPTION_CHECKS.get(name)
         if check is not None:
             try:
                 check(frozen)
