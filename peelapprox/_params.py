@@ -48,8 +48,8 @@ class PeelParams:
     force : PeelForce, default ``PeelForce.paper()``
         The peel-force law f(v, V) (fvV by default).  A mapping (as
         ``dataclasses.asdict`` writes it) is turned back into a law.  Other
-        laws than the paper's are refused, for now, by the functions that
-        use the parameters (issue 15); the default leaves ``repr``,
+        laws than the paper's are refused, naming the law, by the functions
+        that cannot run them (``validate.params``); the default leaves ``repr``,
         equality and ``hash`` as they were before the field existed.
     tape_mass : float or None, default None
         Mass m of the peeled ribbon [kg] (docs/tape-mass.md): the
@@ -151,7 +151,7 @@ class PeelParams:
         self._check_variant()
 
     def _check_variant(self) -> None:
-        """Validate and normalise the variant fields (issue 18): ``tape_mass`` 0 -> None, the default load."""
+        """Validate and normalise the variant fields (tape mass, load): ``tape_mass`` 0 -> None, the default load."""
         if self.tape_mass is not None:
             m = self.tape_mass
             if not isinstance(m, bool) and isinstance(m, (int, float)) and m == 0:

@@ -96,7 +96,7 @@ def test_eps_study_needs_three_reference_jumps():
 
 @pytest.mark.slow
 def test_benchmark_quick_cli_writes_its_outputs(tmp_path):
-    """``peelapprox benchmark --quick --no-peers --out DIR`` (the issue's acceptance run, ~1 min) writes the
+    """``peelapprox benchmark --quick --no-peers --out DIR`` (the benchmark's acceptance run, ~1 min) writes the
     table, CSV/JSON and both plots; its JSON parses; on every scene the hybrid error falls monotonically by at
     least 1e4 from rtol 1e-4 to 1e-12 (DOP853 is 8th order; measured >= 1e6), and the regularised runs'
     errors sit above 1e-4 (their ε-bias at ε = 1e-7: measured 4.5e-4 … 0.14)."""

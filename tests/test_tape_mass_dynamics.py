@@ -1,4 +1,4 @@
-"""The dynamics tools with the model variants (issue 18, docs/tape-mass-dynamics.md): what runs a tape mass or
+"""The dynamics tools with the model variants (docs/tape-mass-dynamics.md): what runs a tape mass or
 a constant load through ``exact.simulate``'s variant method, and what refuses it with a ValueError naming
 ``params`` and the model it supports."""
 

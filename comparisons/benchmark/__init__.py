@@ -42,7 +42,7 @@ costs), :mod:`.run` (:func:`run_benchmark`), :mod:`.report` (the report and its 
 :mod:`.timing` and :mod:`.peers` (one module per external peer).  Two scripts time the other jobs:
 ``python -m comparisons.benchmark.reduced_cost`` (the reduced equations, :mod:`.reduced_cost`) and
 ``python -m comparisons.benchmark.compare_cost`` (``peelapprox compare``, cold and warm, :mod:`.compare_cost`).
-The tape-mass model (issue 18): ``python -m comparisons.benchmark.tape_mass`` (its solvers' work precision
+The tape-mass model (docs/tape-mass.md): ``python -m comparisons.benchmark.tape_mass`` (its solvers' work precision
 across the mass range, :mod:`.tape_mass`) and ``python -m comparisons.benchmark.tape_mass_limit`` (the low-mass
 limit and the ε of a tape mass, :mod:`.tape_mass_limit`).
 """

@@ -27,9 +27,9 @@ class BenchScene:
         return PeelParams(V=self.V, I=self.I)
 
 
-#: The three scenes of issue 5 (the paper's Cases I-III).  Horizons hold 8, 35 and 47 jumps: every part of
-#: a solver is exercised (folds, both branches, landings, the rapid-jump cascades of Cases II-III), while
-#: scipy's Radau at ε = 1e-10 and rtol 1e-9 still finishes each in ~10 s.
+#: The three scenes of the work-precision benchmark (the paper's Cases I-III).  Horizons hold 8, 35 and 47
+#: jumps: every part of a solver is exercised (folds, both branches, landings, the rapid-jump cascades of
+#: Cases II-III), while scipy's Radau at ε = 1e-10 and rtol 1e-9 still finishes each in ~10 s.
 BENCH_SCENES = (
     BenchScene("V1-I1e-5", 1.0, 1e-5, 0.3),
     BenchScene("V1-I1e-2", 1.0, 1e-2, 0.5),

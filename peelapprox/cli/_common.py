@@ -161,8 +161,8 @@ def wall_left(wall: WallBudget) -> float | None:
 
 
 def add_variant_options(v: Any, *, loading_default: str | None = "velocity") -> None:
-    """The model variant's options ``--tape-mass --loading --load-mass --load`` (issue 18) in the argument group
-    ``v``; ``loading_default=None`` for a command that records only the options given (``sweep``)."""
+    """The model variant's options ``--tape-mass --loading --load-mass --load`` (docs/tape-mass.md) in the
+    argument group ``v``; ``loading_default=None`` for a command that records only the options given (``sweep``)."""
     v.add_argument("--tape-mass", type=float, default=None, metavar="KG",
                    help=f"mass m of the peeled ribbon [kg], in [{TAPE_MASS_RANGE[0]:g}, {TAPE_MASS_RANGE[1]:g}]: "
                         "the tape-mass model, a smooth ODE (method smooth) (default: none, the paper's massless "
@@ -182,8 +182,8 @@ def add_variant_options(v: Any, *, loading_default: str | None = "velocity") -> 
 def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True, variants: str | None = None) -> None:
     """The options ``--V --I --k --R`` of :class:`peelapprox.PeelParams` and, with ``geometry`` (for the exact
     model; the reduced equations are the paper's linear closure), ``--l --geometry``, its law ``force``
-    (:func:`peelapprox.cli._force.add_force_options`) and the model variant (issue 18): ``--tape-mass
-    --loading --load-mass --load``; :func:`params_from_args` builds them.
+    (:func:`peelapprox.cli._force.add_force_options`) and the model variant (a tape mass, a load):
+    ``--tape-mass --loading --load-mass --load``; :func:`params_from_args` builds them.
 
     ``variants``: None if the subcommand runs the variants; else why it does not (e.g. "runs the paper's reduced
     equations, derived for the massless tape under velocity control"): the variant options are still there,
