@@ -11,7 +11,13 @@ calls it before the first point:
 
 The built-ins: ``regime`` (:func:`peelapprox.estimate`, closed form), ``jumps`` (jump statistics of one
 windowed exact run), ``period`` (the return map's period over the same run), ``lyapunov`` (the largest
-Lyapunov exponent of :func:`peelapprox.lyapunov`, bits/s).
+Lyapunov exponent of :func:`peelapprox.lyapunov`, bits/s).  Their options: ``jumps`` and ``period`` share
+the one run of :func:`exact.window_run` and read ``t_transient`` (30 s), ``t_end`` (t_transient + 20 s),
+``rtol`` (1e-10) and ``alpha0`` (0), ``period`` also ``period_rtol``; ``lyapunov`` reads ``t_transient`` and
+``lyapunov_time`` (50 s); ``solver`` (default: the method's) is the scipy solver of a model variant's runs,
+one of :func:`solvers`.  The engine reads the other :class:`~peelapprox.PeelParams` fields (``k, R, l,
+geometry`` and the variant's ``tape_mass, loading, load_mass, load``) and adds ``max_wall``, what is left of
+the sweep's wall-clock budget, which the built-ins pass on to their runs.
 """
 
 from __future__ import annotations
