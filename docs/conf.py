@@ -3,7 +3,7 @@
 Build (warnings are errors): ``pip install -e ".[docs]" && python -m sphinx -W --keep-going -b html docs
 docs/_build/html``; check it in a headless browser: ``python docs/check_site.py docs/_build/html``.
 
-Why Sphinx (issue 17): the docstrings are numpydoc, native to Sphinx through the numpydoc extension;
+Why Sphinx: the docstrings are numpydoc, native to Sphinx through the numpydoc extension;
 autosummary writes one page per public name from each public module's ``__all__`` (``docs/api/``, checked
 complete by ``tests/test_docs_api.py``); myst-parser reads the existing markdown chapters as they are.
 mkdocstrings' numpy style renders fewer numpydoc sections.  MathJax is served from the site itself

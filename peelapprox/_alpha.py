@@ -1,7 +1,5 @@
-"""Reduced equations for the peel angle α on one branch (paper Sec. V).
-
-All of them come from genalpha, ``α̈ = -F R α/I - v̇/R`` (FLOW1 and FLOW2
-with ``sin α ≈ α``), by dropping or freezing terms:
+"""Reduced equations for the peel angle α on one branch (paper Sec. V): all from genalpha, ``α̈ = -F R α/I - v̇/R``
+(FLOW1 and FLOW2 with ``sin α ≈ α``), by dropping or freezing terms:
 
 =====================  =============================================  =========================
 label                  equation                                        here
@@ -17,27 +15,16 @@ Airy2                  ``α̈ = -FRα/I - F α̇/(R f'(v))``                 :fu
 CD limit of Airy2      ``α̇ = -F α/(R f'(v))``, frozen f', F            :func:`cd_decay_alpha`
 =====================  =============================================  =========================
 
-Here the force on the branch is the paper's ``F = F_in + k(V - v) t`` with v
-frozen (``s = F_rate``, default ``k V``: the paper drops v on AB).  Coupling
-to the peel velocity (approxvdot, fullvdot, genalpha with v̇) is in
-:mod:`peelapprox._segment`.
-
+The force on the branch is the paper's ``F = F_in + k(V - v) t`` with v frozen (``s = F_rate``, default ``k V``:
+the paper drops v on AB); the coupling to the peel velocity (approxvdot, fullvdot) is in :mod:`peelapprox._segment`.
 Units: t [s], α [rad], α̇ [rad/s], F [N], R [m], I [kg m²], k [N/m], v, V [m/s].
 
-Each formula of these equations is written once, below, as a function of
-scalars that works on numpy arrays and inside numba (:func:`peelapprox._jit.jitable`):
-the approxalpha frequency and restoring term (``_omega``, ``_restoring``), the
-closed forms (``_sinusoid``, ``_harmonic``, ``_decay``), the CD damping time
-(``_damping_time``) and the frozen force rate (``_frozen_rate``).  The public
-functions here and the compiled segment solver (:mod:`peelapprox._segment_kernel`)
-call the same functions.  Two caveats, both measured: numpy's vectorised ``exp``
-(SIMD) and the libm ``exp`` of the compiled code differ in the last bit for ~5 %
-of arguments, so ``_decay`` on an array and inside the kernel agree to 1 ulp,
-not bitwise (``sin``/``cos`` agreed bitwise on 10^5 arguments); and the damping
-terms of Airy1/Airy2 appear in two arithmetic forms — ``(Ḟ + F α̇)/(R f')`` in
-:func:`alpha_numerical`, and multiplied by ``dt/ds = v f'`` with the ``f'``
-cancelled in the segment solver (which integrates through the fold, where
-``f' = 0``) — the same equation, not the same floating-point operations.
+Each formula is written once, below, as a function of scalars that works on numpy arrays and inside numba
+(:func:`peelapprox._jit.jitable`), called by the public functions here and by the compiled segment solver alike.
+Two caveats, measured: numpy's vectorised ``exp`` and the compiled libm ``exp`` differ in the last bit for ~5 %
+of arguments (``_decay`` agrees to 1 ulp, not bitwise); and the segment solver multiplies Airy1/Airy2's damping
+``(Ḟ + F α̇)/(R f')`` by ``dt/ds = v f'`` with ``f'`` cancelled (it integrates through the fold, ``f' = 0``): the
+same equation, not the same floating-point operations.
 """
 
 from __future__ import annotations

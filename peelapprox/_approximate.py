@@ -16,7 +16,7 @@ attractor:
 4. **CD→AB jump**: likewise, ``α̇ → α̇ + (v_min - v_land_ab)/R``.
 
 The map starts where the exact solver does, and again at rest on the relaxation cycle's foot where that start
-finds no periodic attractor (:func:`approximate_attractor`, "Start").  The force at each jump and the jump times
+finds no periodic attractor (:func:`approximate_attractor`).  The force at each jump and the jump times
 make the same jump record an exact trajectory has, and the observables are read off it by
 :func:`peelapprox._observables.jump_statistics`, the one definition both sides use.
 """
@@ -102,80 +102,50 @@ def approximate_attractor(
     jump) and reads the observables off its jumps with the definitions of :class:`StickSlipObservables` (slip
     interval, force drop, slip and stick times, F at the jumps, the return map's period).
 
-    **Start** (``start="auto"``).  The map starts where :func:`exact.simulate` does (:func:`exact.initial_state`:
-    ``α = 0``, ``ω = V/R``, ``F = 1.01 f(V, V)``, v on the branch whose root is lowest).  That start gives α a
-    kick ``α̇ = (V - v)/R`` which, over much of the intermediate- and high-inertia plane, puts the map on a small
-    jumping mode around the unstable fixed point; the exact run leaves it after thousands of slips (tens of
-    seconds), the map within its budget often does not.  Where the map from the solver's start reaches no
-    periodic attractor, it is run again from the foot of the relaxation cycle at rest (AB landing, ``F = f_min``,
-    ``α = α̇ = 0``), which lands on the large orbit directly; that run is the prediction if it stick-slips.
-    ``"solver"`` and ``"rest"`` select one start; docs/theory.md, "The approximate attractor", has the measurements.
-
-    **Reductions.**  Airy1 + approxvdot on both branches (:data:`APPROX_DEFAULTS`, the same for every label of
-    :func:`peelapprox.estimate`'s inertia rule, chosen by measurement): Airy1 (genalpha with ``1 + α ≈ 1`` and
-    ``Ḟ ≈ k(V - v)``) is the paper's general α equation and, with approxvdot, the field of its Case III.  It keeps
-    FLOW1's kinematic term ``-v̇/R`` (``α̇ = ω - v/R``), large near the folds where ``f' → 0``, which approxalpha
-    drops and Airy2 keeps only in part; on a 40 x 40 grid of the paper's law it is within 10 % of the exact slip
-    interval and force drop at 94 % of the low-inertia, low-V points against 77 % for the paper's Case I
-    (approxalpha on AB, airy2 on CD).  It drops the O(α) terms (the factor ``1 + α`` of fullvdot, ``R α α̇`` of
-    FLOW3) but is not of lower order than the branch dynamics.  Every combination of :data:`ALPHA_MODELS` and
-    :data:`V_EQUATIONS` is selectable, the paper's literal Cases I-III among them (measured in ``python -m
-    comparisons.benchmark.approx_attractor``).  ``genalpha + fullvdot`` on both branches is the full branch
-    dynamics linearised in α: the chain's check against the exact attractor, never a default.
+    The map starts where :func:`exact.simulate` does (:func:`exact.initial_state`); that start's kick
+    ``α̇ = (V - v)/R`` can hold the map on a small mode around the unstable fixed point which the exact run
+    leaves only after thousands of slips, so where it reaches no periodic attractor the map starts again at rest
+    on the relaxation cycle's foot.  The default reductions, Airy1 + approxvdot on both branches,
+    keep FLOW1's kinematic term ``-v̇/R``, large near the folds, and measured best on a
+    40 x 40 grid of the paper's law (94 % of the low-inertia, low-V points within 10 % of the exact slip
+    interval and force drop, against 77 % for the paper's Case I).  docs/theory.md, "The approximate
+    attractor", has the measurements of both choices.
 
     Parameters
     ----------
     params : PeelParams
         The paper's model (no tape mass or load: the reduced equations are the massless DAE's), any law with a
         compiled kernel.  The reduced equations are linear in α whatever ``params.geometry``.
-    alpha_model, v_equation : str, optional
-        AB's α model (one of :data:`peelapprox.ALPHA_MODELS`) and v equation (:data:`peelapprox.V_EQUATIONS`);
-        None: the regime's (table).
-    cd_alpha_model, cd_v_equation : str, optional
-        CD's; None: the regime's.  Each None is filled independently.
+    alpha_model, v_equation, cd_alpha_model, cd_v_equation : str, optional
+        AB's and CD's α model (:data:`peelapprox.ALPHA_MODELS`) and v equation (:data:`peelapprox.V_EQUATIONS`),
+        any combination; each None is the default (:data:`APPROX_DEFAULTS`).
     start : {"auto", "solver", "rest"}
-        Where the map starts (:data:`STARTS`; above): ``"auto"`` the solver's start, then the rest start where
-        that reaches no periodic attractor.
+        Where the map starts (:data:`STARTS`): ``"auto"`` the solver's, then at rest if need be (above).
     n_transient : int
         Returns (AB→CD jumps) discarded before the sample, an integer in [0, 10**6] (40).
     n_returns : int
-        Returns in the sample, an integer in [3, 10**6] (60).  The map stops earlier once its returns repeat
-        with a period n <= 12 over the last ``max(12, 3n)`` returns (:data:`EARLY_RETURNS`), which are then the
-        sample: an attractor reached, not cut short.
+        Returns in the sample, in [3, 10**6] (60); fewer once they repeat with a period n <= 12 over the last
+        ``max(12, 3n)`` (:data:`EARLY_RETURNS`): an attractor reached.
     rtol : float
-        Relative tolerance of each segment, in :data:`peelapprox.RTOL_RANGE` (1e-6: the observables agree with
-        rtol 1e-10 to 1e-4 relative or better at the points measured, far inside the reductions' own errors).
-        The returns' period tolerance is ``max(1e-4, 100 rtol)`` (:data:`PERIOD_RTOL`).
+        Relative tolerance of each segment (1e-6: the observables agree with rtol 1e-10 to 1e-4, far inside the
+        reductions' own errors); the returns' period tolerance is :data:`PERIOD_RTOL`.
     max_wall : float or None
-        Wall-clock budget [s] of the call, checked between segments (10; None: unbounded).  Each segment also
-        has a step budget (:data:`SEGMENT_MAX_STEPS`) and the horizon of :func:`peelapprox.reduced_segment`.
+        Wall-clock budget [s] (10; None: unbounded), checked between segments, each with a step budget.
 
     Returns
     -------
     StickSlipObservables
-        ``method`` names the chain and the start, e.g. ``"approximate: AB airy1/approxvdot, CD airy1/approxvdot,
-        solver's start, 60 returns after 40, rtol 1e-06"`` (``"..., period-3 reached after 17 returns, ..."`` when
-        it stopped early; ``"rest start (the solver's: no periodic attractor in 100 returns), ..."`` when ``auto``
-        took the second start); ``t_start``/``t_end`` are the sample's first and last jump times on the map's own clock
-        (0 at the start).  ``status`` is
-
-        * ``"stick-slip"``: the sample's observables;
-        * ``"steady"``: the law has no folds at V, or a segment approaches the stable fixed point ``v = V``
-          without reaching its fold (within the segment's horizon): steady peeling;
-        * ``"no attractor"``: a budget was spent first (``max_wall``, a segment's steps or horizon with an
-          unstable fixed point); the reason says which and after how many returns;
-        * ``"breakdown"``: a reduced segment broke down (v → 0 on AB, v running away on CD, F → 0, v leaving
-          the law's domain, a collapsed step, no landing on AB); the reason is the segment's.
-
-        Every mean is None for the last three, never NaN.
+        ``method`` names the chain, the start and the sample, ``t_start``/``t_end`` are on the map's own clock.
+        ``status``: ``"stick-slip"``; ``"steady"`` (no folds at V, or a segment settles on the stable fixed
+        point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment), with the
+        reason.  Every mean is None for the last three, never NaN.
 
     Raises
     ------
     ValueError
-        For an unknown model, a count or tolerance out of range, a model variant or a law without a compiled
-        kernel; the message names the argument.
+        An unknown model, a value out of range, a model variant or a law without a compiled kernel (named).
     peelapprox.validate.ArgumentTypeError
-        (also a TypeError) For an argument of the wrong kind (a float count, a non-PeelParams ``params``).
+        (also a TypeError) An argument of the wrong kind.
     """
     t_wall = time.perf_counter()
     params = _params("params", params, variants=False)

@@ -2,10 +2,11 @@
 
 Provenance: copied verbatim (the same literals and the same numpy expressions, so the same float64 values bit for
 bit) from scipy 1.17.1, ``scipy/integrate/_ivp/dop853_coefficients.py``, a private module of scipy that the
-package imported until issue 17; scipy in turn took the coefficients from Hairer's Fortran DOP853 (Hairer,
-Nørsett & Wanner, *Solving Ordinary Differential Equations I*, 2nd ed., Springer 1993, II.10).  Only the module
-docstring, this provenance note and ``__all__`` were added; the literals are unchanged.  tests/test_dop853_tableau.py
-asserts that every array equals scipy's bitwise wherever the installed scipy still has that module.
+package imported until 0.3.0 (a private module may change in any scipy release); scipy in turn took the
+coefficients from Hairer's Fortran DOP853 (Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations
+I*, 2nd ed., Springer 1993, II.10).  Only the module docstring, this provenance note and ``__all__`` were added;
+the literals are unchanged.  tests/test_dop853_tableau.py asserts that every array equals scipy's bitwise
+wherever the installed scipy still has that module.
 
 scipy's licence (BSD-3-Clause), whose notice is kept as its conditions require:
 

@@ -161,21 +161,14 @@ class StickSlipObservables:
 
     Attributes
     ----------
-    status : str
-        One of ``STATUSES``: ``"stick-slip"`` (at least two AB→CD jumps in the window, still slipping at
-        its end); ``"steady"`` (no jump in the window: steady peeling, the law has no folds at V or the
-        orbit rests at a stable fixed point; every mean, spread, F extreme and the period None, ``n_slips``
-        0); ``"too few slips"`` (jumps in the window but fewer than two AB→CD jumps: no slip interval;
-        lengthen the window); ``"transient"`` (the jumps stop inside the window: the open stay after the last
-        jump is longer than ``QUIET_FACTOR`` = 10 times the longest complete stay; the means are those of the
-        jumps seen, not of an attractor).  :func:`peelapprox.approximate_attractor` adds ``"no attractor"`` (its
-        reduced return map spent a budget first) and ``"breakdown"`` (a reduced segment broke down), both with
-        every mean None, and its ``"steady"`` includes a segment settling at the stable fixed point.
-    reason : str
-        A sentence saying why the status.
+    status, reason : str
+        One of ``STATUSES``: ``"stick-slip"`` (two AB→CD jumps or more, still slipping at the window's end),
+        ``"steady"`` (no jump: every mean None), ``"too few slips"`` (lengthen the window), ``"transient"`` (the
+        jumps stop inside the window: the means are of the jumps seen, not of an attractor);
+        :func:`peelapprox.approximate_attractor` adds ``"no attractor"`` and ``"breakdown"``.  ``reason`` is a
+        sentence saying why.
     method : str
-        How the observables were obtained, e.g. ``"exact: hybrid (DOP853), rtol 1e-10, alpha0 0, window
-        [30, 50] s, period_rtol 1e-06"``.
+        How the observables were obtained, e.g. ``"exact: hybrid (DOP853), rtol 1e-10, ..."``.
     V, I : float or None
         Pull speed [m/s] and moment of inertia [kg m²], from the trajectory's ``params`` when it has them.
     n_slips : int
@@ -185,14 +178,9 @@ class StickSlipObservables:
     period_label : str
         ``"period-n"``, ``"aperiodic"``, ``"too short"`` (:class:`peelapprox.Periodicity`'s labels) or
         ``"no stick-slip"`` (no AB→CD jump).
-    slip_interval, slip_interval_spread : float or None
-        Mean time between consecutive AB→CD jumps [s] and its spread.
-    force_drop, force_drop_spread : float or None
-        Mean of F at an AB→CD jump minus F at the next CD→AB jump [N] and its spread.
-    slip_time, slip_time_spread : float or None
-        Mean CD stay [s] and its spread.
-    stick_time, stick_time_spread : float or None
-        Mean AB stay [s] and its spread.
+    slip_interval, force_drop, slip_time, stick_time : float or None
+        Means of the time between consecutive AB→CD jumps [s], of F at an AB→CD jump minus F at the next CD→AB
+        jump [N], of the CD stays [s] and of the AB stays [s]; each ``*_spread`` is its spread.
     F_max, F_min : float or None
         The largest and smallest pull force at the window's jumps [N].
     t_start, t_end : float or None

@@ -31,90 +31,34 @@ class PeelParams:
     Parameters
     ----------
     V : float
-        Pull speed of the motor at O' [m/s]; enters the peel force ``f(v, V)``
-        (fvV) and the tape elongation rate (flow3).
+        Pull speed of the motor at O' [m/s]: the peel force ``f(v, V)`` (fvV) and the tape's elongation (flow3).
     I : float
         Moment of inertia of the roller tape [kg m²] (FLOW2).
-    k : float, default 1000
-        Elastic constant of the tape [N/m] (flow3).
-    R : float, default 0.1
-        Roller radius [m] (FLOW1, FLOW2).
+    k, R : float, default 1000, 0.1
+        Elastic constant of the tape [N/m] (flow3); roller radius [m] (FLOW1, FLOW2).
     l : float, default 1
-        Distance O–O' between the roller axis and the motor [m]; must exceed
-        ``R``.  Used only by ``geometry="exact"``.
+        Distance O–O' from the roller axis to the motor [m], at least ``1.001 R``; read by ``geometry="exact"``.
     geometry : {"paper", "exact"}, default "paper"
-        Closure of ``cos θ``: the paper's ``-sin α`` or the exact
-        ``-l sin α / L(α)``.
+        Closure of ``cos θ``: the paper's ``-sin α`` or the exact ``-l sin α / L(α)``.
     force : PeelForce, default ``PeelForce.paper()``
-        The peel-force law f(v, V) (fvV by default).  A mapping (as
-        ``dataclasses.asdict`` writes it) is turned back into a law.  Other
-        laws than the paper's are refused, for now, by the functions that
-        use the parameters (issue 15); the default leaves ``repr``,
-        equality and ``hash`` as they were before the field existed.
+        The peel-force law f(v, V); a mapping (``dataclasses.asdict``'s) is turned back into a law.
     tape_mass : float or None, default None
-        Mass m of the peeled ribbon [kg] (docs/tape-mass.md): the
-        tape-mass model, LAGRAN plus the ribbon's kinetic energy, a smooth
-        ODE whose jumps arise from the dynamics.  None or 0: the paper's
-        massless model (the DAE).  Else in ``TAPE_MASS_RANGE`` = [1e-15, 10].
+        Mass m of the peeled ribbon [kg], in ``TAPE_MASS_RANGE``: the tape-mass model, a smooth ODE whose jumps
+        arise from the dynamics (docs/tape-mass.md).  None or 0: the paper's massless DAE.
     loading : {"velocity", "load"}, default "velocity"
-        ``"velocity"``: the end O' pulled at the constant speed V (the
-        paper).  ``"load"``: a constant force ``load`` on a body of mass
-        ``load_mass`` at O' (docs/constant-load.md): ``M V̇_p = F_L - F``,
-        the pull speed ``V_p`` a state starting at V; the peel-force law is
-        still evaluated at the fixed speed V.
-    load_mass : float or None
-        M [kg], required with ``loading="load"`` (in ``LOAD_MASS_RANGE`` =
-        [1e-6, 1e6]), refused otherwise.
-    load : float or None
-        F_L [N] (``LOAD_RANGE`` = [1e-3, 1e7]); default ``load_mass *
-        GRAVITY``: a hanging mass.  Only with ``loading="load"``.
+        The end O' pulled at the constant speed V (the paper), or by a constant force ``load`` on a body of mass
+        ``load_mass``: ``M V̇_p = F_L - F``, the pull speed a state starting at V (docs/constant-load.md).
+    load_mass, load : float or None
+        M [kg] (``LOAD_MASS_RANGE``), required with ``loading="load"`` and refused otherwise; F_L [N]
+        (``LOAD_RANGE``), default ``load_mass * GRAVITY``, a hanging mass.
 
     Raises
     ------
     TypeError
-        (:class:`peelapprox.validate.ArgumentTypeError`, also a
-        ValueError) If a field is not a real number (None, a string, a
-        bool) or ``geometry`` is not a string.
+        (:class:`~peelapprox.validate.ArgumentTypeError`, also a ValueError) A field of the wrong kind.
     ValueError
-        If a field is not finite, lies outside its range
-        (:data:`PARAM_RANGES`), if ``l < 1.001 R``, or if ``geometry`` is
-        unknown.  The message names the field and its valid range.
-
-    Notes
-    -----
-    Valid ranges (:data:`PARAM_RANGES`; the paper's values are V = 0.05-8
-    m/s, I = 1e-6-1e-1 kg m², k = 1000 N/m, R = 0.1 m).  Each bound keeps the
-    numerics of every function in the package valid, with margin; beyond
-    them the runs fail with ZeroDivisionError, OverflowError or bracket
-    errors, or take unbounded time.  Measured with ``estimate``,
-    ``reduced_segment`` and a 0.2 s ``exact.simulate(..., save="jumps")``
-    in both geometries, around V = 2, I = 1e-4:
-
-    * ``V`` in [1e-6, 100] m/s.  The law fvV is fitted to the paper's
-      V <= 10; its ``f(0+, V) = 130 - 2 V^1.5`` is negative above 16 m/s.
-      Numerically, the fixed point ``f(V, V) ~ 130 e^(V/11)`` overflows at
-      V ~ 7800, and the solvers' root bracket (v <= 300 m/s) fails already
-      at V = 300 (exact.simulate: "f(a) and f(b) must have different
-      signs"); V = 100 and 200 work.  Below 1e-6 m/s nothing fails (V =
-      1e-300 ends in a documented breakdown) but the stick phase lasts
-      ``(f_max - f_min)/(k V)`` > 1e5 s: not a pull speed.
-    * ``I`` in [1e-12, 1e6] kg m².  The inertial period ``2π sqrt(I/(F R))``
-      is 1.2e-6 s at I = 1e-12 (a 0.2 s run: 2 s of wall time); at 1e-15 it
-      does not finish in 20 s.  1e6 kg m² (a 10 t flywheel) is used by the
-      tests as the inertia-free limit; 1e9 also works.
-    * ``k`` in [1e-3, 1e7] N/m.  The stiff time ``sqrt(I/(k R²))`` sets the
-      step: 0.2 s take 1.1 s at k = 1e7, 16 s at 1e8, over 20 s at 1e9;
-      ``k = 1e300`` divides by zero (the default absolute tolerances).  Down to
-      k = 1e-6 every run returns (the reduced segment then exhausts its step
-      budget, a documented SolverBudgetExceeded).
-    * ``R`` in [1e-4, 10] m.  ``V/R`` and ``F R/I`` set the fast scales:
-      R = 1e-4 takes 0.3 s, 1e-5 5 s, 1e-6 over 20 s; ``R = 1e-300`` divides
-      by zero.  R = 100 (with l = 1000) still works; 10 m is a generous roller.
-    * ``l`` in [1.001 R, 1e3] m (``l`` is read only by ``geometry="exact"``).
-      At ``l = R (1 + 1e-12)`` the closure is NaN at α = 0 and at
-      ``R (1 + 1e-6)`` a 0.2 s run does not finish in 20 s; from 1.001 R
-      (closure slope ``l/(l - R)`` <= 1001) runs are ordinary.  l = 1e6 works;
-      beyond 1 km the exact geometry is the paper's to 1e-4.
+        A field not finite or outside its range (:data:`PARAM_RANGES`, where the bounds are explained), or
+        ``l < 1.001 R``; the message names the field and its range.
 
     Examples
     --------
@@ -151,7 +95,7 @@ class PeelParams:
         self._check_variant()
 
     def _check_variant(self) -> None:
-        """Validate and normalise the variant fields (issue 18): ``tape_mass`` 0 -> None, the default load."""
+        """Validate and normalise the variant fields (tape mass, load): ``tape_mass`` 0 -> None, the default load."""
         if self.tape_mass is not None:
             m = self.tape_mass
             if not isinstance(m, bool) and isinstance(m, (int, float)) and m == 0:

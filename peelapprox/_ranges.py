@@ -18,13 +18,44 @@ __all__ = ["EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE",
 #: is the full geometry ``cos θ = -l sin α / L``, ``L² = l² + R² - 2 l R cos α``.
 GEOMETRIES = ("paper", "exact")
 
-#: Smallest ``l/R``: closer, the exact closure's ``L(α) = l - R + O(α²)`` cancels (see :class:`PeelParams`).
+#: Smallest ``l/R``: closer, the exact closure's ``L(α) = l - R + O(α²)`` cancels (see ``l`` below).
 L_OVER_R_MIN = 1.001
 
-#: Valid range ``(lo, hi)`` of each numeric field, closed at both ends (``l`` also needs
+#: Valid range ``(lo, hi)`` of each numeric field of :class:`PeelParams`, closed at both ends (``l`` also needs
 #: ``l >= L_OVER_R_MIN * R``).  Chosen so that every function of the package returns or raises a
-#: documented exception (no overflow, no division by zero, no bracket failure) with room to spare;
-#: the reasons and the measurements behind each bound are in :class:`PeelParams`.
+#: documented exception (no overflow, no division by zero, no bracket failure) with room to spare.
+#:
+#: The paper's values are V = 0.05-8 m/s, I = 1e-6-1e-1 kg m², k = 1000 N/m, R = 0.1 m.  Beyond the bounds
+#: the runs fail with ZeroDivisionError, OverflowError or bracket
+#: errors, or take unbounded time.  Measured with ``estimate``,
+#: ``reduced_segment`` and a 0.2 s ``exact.simulate(..., save="jumps")``
+#: in both geometries, around V = 2, I = 1e-4:
+#:
+#: * ``V`` in [1e-6, 100] m/s.  The law fvV is fitted to the paper's
+#:   V <= 10; its ``f(0+, V) = 130 - 2 V^1.5`` is negative above 16 m/s.
+#:   Numerically, the fixed point ``f(V, V) ~ 130 e^(V/11)`` overflows at
+#:   V ~ 7800, and the solvers' root bracket (v <= 300 m/s) fails already
+#:   at V = 300 (exact.simulate: "f(a) and f(b) must have different
+#:   signs"); V = 100 and 200 work.  Below 1e-6 m/s nothing fails (V =
+#:   1e-300 ends in a documented breakdown) but the stick phase lasts
+#:   ``(f_max - f_min)/(k V)`` > 1e5 s: not a pull speed.
+#: * ``I`` in [1e-12, 1e6] kg m².  The inertial period ``2π sqrt(I/(F R))``
+#:   is 1.2e-6 s at I = 1e-12 (a 0.2 s run: 2 s of wall time); at 1e-15 it
+#:   does not finish in 20 s.  1e6 kg m² (a 10 t flywheel) is used by the
+#:   tests as the inertia-free limit; 1e9 also works.
+#: * ``k`` in [1e-3, 1e7] N/m.  The stiff time ``sqrt(I/(k R²))`` sets the
+#:   step: 0.2 s take 1.1 s at k = 1e7, 16 s at 1e8, over 20 s at 1e9;
+#:   ``k = 1e300`` divides by zero (the default absolute tolerances).  Down to
+#:   k = 1e-6 every run returns (the reduced segment then exhausts its step
+#:   budget, a documented SolverBudgetExceeded).
+#: * ``R`` in [1e-4, 10] m.  ``V/R`` and ``F R/I`` set the fast scales:
+#:   R = 1e-4 takes 0.3 s, 1e-5 5 s, 1e-6 over 20 s; ``R = 1e-300`` divides
+#:   by zero.  R = 100 (with l = 1000) still works; 10 m is a generous roller.
+#: * ``l`` in [1.001 R, 1e3] m (``l`` is read only by ``geometry="exact"``).
+#:   At ``l = R (1 + 1e-12)`` the closure is NaN at α = 0 and at
+#:   ``R (1 + 1e-6)`` a 0.2 s run does not finish in 20 s; from 1.001 R
+#:   (closure slope ``l/(l - R)`` <= 1001) runs are ordinary.  l = 1e6 works;
+#:   beyond 1 km the exact geometry is the paper's to 1e-4.
 PARAM_RANGES = {
     "V": (1e-6, 100.0),
     "I": (1e-12, 1e6),

@@ -134,7 +134,7 @@ def periodicity(
         hybrid solver at rtol 1e-10 reproduces a periodic orbit's jump forces to ~1e-12, so 1e-6 separates
         periodic orbits from chaotic ones, whose returns do not come within 1e-6 for n <= 32.
     max_period : int
-        Largest n tried (the issue asks n <= 32).
+        Largest n tried.
     min_repeats : int
         A period n needs at least ``min_repeats · n`` pairs ``(x_k, x_{k+n})``.
 

@@ -143,7 +143,7 @@ def lagrange_equations():
 
 
 # --------------------------------------------------------------------------
-# model variants (issue 18): the tape's mass, the constant load
+# model variants (docs/tape-mass.md, docs/constant-load.md): the tape's mass, the constant load
 # --------------------------------------------------------------------------
 #: Tape (ribbon) mass m [kg], loading-device mass M [kg], load F_L [N], the pull speed as a state V_p [m/s].
 m_tape, M_load, F_load = sp.symbols("m M F_L", positive=True)
@@ -453,7 +453,7 @@ def render_module() -> str:
 
 
 def _render_variants() -> list[str]:
-    """The model variants' kernels (issue 18): the tape-mass rates, the load's rate, the three Jacobians."""
+    """The model variants' kernels: the tape-mass rates, the load's rate, the three Jacobians."""
     ddc, fs, fp = sp.symbols("ddc f fp")
     rhs, _ = variant_system("tape_load")
     state = ["alpha", "omega", "F", "v"]

@@ -1,4 +1,4 @@
-"""The model variants' compiled fields (issue 18): the tape-mass model and the constant load.
+"""The model variants' compiled fields (the follow-ups of the paper's model): the tape-mass model and the constant load.
 
 Three smooth ODE systems in the state ``y = (α, ω, F, v)`` or ``(α, ω, F, v, V_p)``, each with its analytic
 Jacobian, rendered from :func:`peelapprox._symbolic.variant_system` into :mod:`peelapprox._generated`:

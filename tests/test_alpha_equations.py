@@ -1,4 +1,4 @@
-"""Each fact in one place (issue 14, item 2): the reduced α equations and the parameter packings.
+"""Each fact in one place: the reduced α equations and the parameter packings.
 
 The reduced α equations used to be written in ``peelapprox/_alpha.py`` (the public closed forms and
 ``alpha_numerical``) and again inside the reduced-segment kernel; the kernels' parameter vectors each had their

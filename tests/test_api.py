@@ -1,4 +1,4 @@
-"""The public API of each package (issue 14: names that move between rooms must keep working).
+"""The public API of each package (names that move between modules must keep working).
 
 Each set below is the package's public API as of 0.3.0.dev0.  A name may be added to a package (then add it
 here), but one listed here may not disappear: the test fails if it is missing from ``__all__`` or does not

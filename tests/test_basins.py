@@ -1,4 +1,4 @@
-"""Basins of attraction (issue 16 item 3): exact.basins labels a grid of starts by the attractor each reaches.
+"""Basins of attraction: exact.basins labels a grid of starts by the attractor each reaches.
 
 The scene: the cubic law at V = 1.2 m/s, I = 2.2e-5 kg m², where two stable period-1 orbits coexist
 (docs/orbits.md: F at the jump 240.06 N, |μ| = 0.29, and 238.47 N, |μ| = 0.66).  From α0 = 0, ω0 = 18 rad/s
@@ -61,7 +61,7 @@ def test_two_coexisting_attractors_from_different_starts(cubic_basins):
 
 def test_orbits_close_on_the_attractors_cycles(cubic_basins):
     """orbits=True: Newton's periodic orbit (an independent method: a fixed point of the section map, closed to
-    1e-10) has the attractor's return-map value to 1e-8 relative (the issue's criterion) and is stable, with
+    1e-10) has the attractor's return-map value to 1e-8 relative (the agreement asked of basins) and is stable, with
     the multiplier moduli of docs/orbits.md's two branches at this I (0.29 and 0.66, to 0.01)."""
     mods = []
     for a in cubic_basins.attractors:
@@ -199,7 +199,7 @@ def test_fvV_larger_grid_on_a_pool():
     """A 9 x 7 (α0, F0) grid at fvV, V = 1, I = 1e-5 on a 2-worker pool (about 30 s): a start is labelled
     "invalid start" exactly where exact.initial_state raises ValueError (the oracle: no root of CONSTR); the
     attractors are periods 15, 3 and 1 (docs/orbits.md, Basins), each with a stable periodic orbit found by Newton
-    whose return-map values equal the attractor's cycle to 1e-8 relative (the issue's criterion)."""
+    whose return-map values equal the attractor's cycle to 1e-8 relative (the agreement asked of basins)."""
     p = PeelParams(V=1.0, I=1e-5)
     a0, F0 = np.linspace(-0.4, 0.4, 9), np.linspace(150.0, 330.0, 7)
     r = exact.basins(p, alpha0=a0, F0=F0, t_transient=40.0, window=20.0, max_workers=2, progress=False,

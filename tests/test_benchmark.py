@@ -71,11 +71,15 @@ def test_matched_ratio_picks_the_fastest_hybrid_run_that_is_as_accurate():
     assert r["ratio"] == pytest.approx(1000.0) and r["hybrid_error"] == 5e-4
 
 
+@pytest.mark.slow
 def test_fold_passage_delay_scales_as_eps_to_two_thirds():
     """Hypothesis (singular perturbation theory of a fold, the known ε^(2/3) law): the regularised scheme's
     jump at the AB fold lags the ε → 0 jump by C ε^p with p = 2/3.  Two ε two decades apart give p from their
     ratio; tolerance ±0.05 on p (measured 0.668 over ε = 1e-11…1e-5: the transit after the fold adds an O(ε)
-    term, a 1 % effect at ε = 1e-4)."""
+    term, a 1 % effect at ε = 1e-4).  Slow tier (~8 s): the default tier checks the same law at a fraction of
+    the cost, tests/test_exact.py::test_regularized_converges_to_hybrid at the AB fold and
+    tests/test_law_runs.py::test_regularized_cubic_converges_to_the_hybrid_like_eps_two_thirds over jumps
+    at both folds."""
     rows = eps_study(BENCH_SCENES[0], (1e-4, 1e-6))
     assert all(r.status == "ok" for r in rows)
     p_ab = math.log(rows[0].delay_ab / rows[1].delay_ab) / math.log(100.0)
@@ -92,7 +96,7 @@ def test_eps_study_needs_three_reference_jumps():
 
 @pytest.mark.slow
 def test_benchmark_quick_cli_writes_its_outputs(tmp_path):
-    """``peelapprox benchmark --quick --no-peers --out DIR`` (the issue's acceptance run, ~1 min) writes the
+    """``peelapprox benchmark --quick --no-peers --out DIR`` (the benchmark's acceptance run, ~1 min) writes the
     table, CSV/JSON and both plots; its JSON parses; on every scene the hybrid error falls monotonically by at
     least 1e4 from rtol 1e-4 to 1e-12 (DOP853 is 8th order; measured >= 1e6), and the regularised runs'
     errors sit above 1e-4 (their ε-bias at ε = 1e-7: measured 4.5e-4 … 0.14)."""

@@ -1,5 +1,5 @@
 """Where branches of periodic orbits end or turn: folds passed by pseudo-arclength steps, period doublings with
-the switch to the doubled branch, the crest event and the grazing (issue 16; docs/orbits.md)."""
+the switch to the doubled branch, the crest event and the grazing (docs/orbits.md)."""
 
 import numpy as np
 import pytest

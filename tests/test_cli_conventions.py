@@ -1,4 +1,4 @@
-"""The command line's conventions (issue 17, part 5): ``python -m peelapprox`` and ``--version``; every
+"""The command line's conventions: ``python -m peelapprox`` and ``--version``; every
 subcommand's help has a description, examples, every default and unit, no raw markup, and lists what the
 subcommand can do; the same parameter flags and ``--format`` choices; units in table output; ``figures`` writes
 into a directory of its own; ``compare`` ends with a within/outside/failed summary."""

@@ -1,5 +1,4 @@
-"""User errors on the command line: one line on stderr, a nonzero exit status, never a traceback (issue 13, items
-6 and 8).
+"""User errors on the command line: one line on stderr, a nonzero exit status, never a traceback.
 
 Each row of :data:`CASES` is a reproducer that gave a traceback (or silently accepted nonsense) before: an output
 path into a missing directory, through a file or onto a directory (found only *after* the run, so the work was
@@ -72,7 +71,7 @@ CASES = [
     ("dynamics-max-period-zero", DYN + ["--max-period", "0"], 2, ["argument --max-period", "integer >= 1"]),
     ("dynamics-attractors-nan", DYN + ["--attractors=nan"], 2, ["argument --attractors", "finite", "got nan"]),
     ("dynamics-attractors-empty-item", DYN + ["--attractors=0.1,,0.2"], 2, ["argument --attractors", "comma list"]),
-    # (issue 14: "dynamics-return-map-alpha0", the refusal of --alpha0 with --lyapunov-method return-map, is
+    # ("dynamics-return-map-alpha0", the refusal of --alpha0 with --lyapunov-method return-map, is
     # gone: exact.lyapunov's return-map method starts from any alpha0; tests/test_cli.py runs it)
     ("dynamics-lyapunov-eps", DYN + ["--lyapunov-method", "regularized", "--eps", "1e-30"], 2,
      ["eps", "1e-15", "got 1e-30"]),

@@ -1,4 +1,4 @@
-"""The peel-force law on the command line (issue 15): ``--force``, ``--force-table``, ``--force-family`` and the
+"""The peel-force law on the command line: ``--force``, ``--force-table``, ``--force-family`` and the
 record of the law in what the CLI prints and writes (peelapprox/cli/_force.py)."""
 
 from __future__ import annotations
@@ -204,7 +204,7 @@ def test_simulate_with_a_cubic_records_the_law(tmp_path, capsys):
     (``law``, ``law_key``, ``law_spec`` which ``PeelForce.from_dict`` rebuilds into an equal law with the same
     key), the jumps CSV (``law``, ``law_key`` on every row) and the .npz (its params' force).  The run is the
     cubic's: every AB->CD jump leaves at its fold v_max = (c - sqrt(c² - 3bd))/(3d) and every CD->AB one at
-    v_min = (c + sqrt(c² - 3bd))/(3d) (closed form; ≤ 1e-9, the fold accuracy issue 15 asks)."""
+    v_min = (c + sqrt(c² - 3bd))/(3d) (closed form; ≤ 1e-9, the fold accuracy promised for every law)."""
     from exact import Trajectory
 
     a, b, c, d = 150.0, 300.0, 280.0, 80.0
@@ -260,7 +260,7 @@ def test_const_keeps_integer_and_float_apart():
 
 def test_folds_of_a_given_law(tmp_path, capsys):
     """Hypothesis: ``folds --force-family cubic`` prints the cubic's folds, at the roots of f' = b - 2cv + 3dv²
-    (closed form; ≤ 1e-9 as issue 15 asks of folds) with f there, and the fixed point's f'(V, V) (the
+    (closed form; ≤ 1e-9 as promised of every law's folds) with f there, and the fixed point's f'(V, V) (the
     polynomial, to rounding: 1e-12 relative); the record rebuilds the law.  ``--force-table`` of the same
     cubic sampled every 0.5 % in v finds v_max within one table spacing (the folds of a table are data
     points, docs/usage.md)."""

@@ -1,4 +1,4 @@
-"""A job compiles only the kernels it runs (issue 17, fast first call).
+"""A job compiles only the kernels it runs (a fast first call).
 
 Each test runs a fresh interpreter with an empty numba cache (``NUMBA_CACHE_DIR`` and ``PEELAPPROX_CACHE_DIR`` in
 a temporary directory), so the repository's own cache is neither used nor touched, and reads numba's own record

@@ -167,7 +167,7 @@ def test_statistics_low_inertia():
 
 
 def test_cli_compare_json_rows(capsys):
-    """`peelapprox compare --format json` prints rows carrying the issue's keys, with numbers or null
+    """`peelapprox compare --format json` prints rows carrying the documented keys, with numbers or null
     (never NaN: json.loads would accept NaN, so it is checked explicitly)."""
     assert main(["compare", "--scene", "case-II-point-a", "--scene", "case-III-bounds", "--format", "json",
                  "--no-stats"]) == 0

@@ -1,4 +1,4 @@
-"""Data out in the ecosystem's shapes (issue 17, part 4): pandas DataFrames and xarray Datasets of the result
+"""Data out in the ecosystem's shapes : pandas DataFrames and xarray Datasets of the result
 objects, the ImportError without the ``data`` extra, and the short ``__repr__``/``_repr_html_`` of notebooks.
 
 The round-trips are checked against the result objects' own arrays and records, compared **exactly**

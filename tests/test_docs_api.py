@@ -1,5 +1,4 @@
-"""The documentation site's API reference lists every public name (issue 17: "every public name has a
-rendered reference entry").
+"""The documentation site's API reference lists every public name (each has a rendered entry).
 
 ``docs/api/<module>.rst`` holds one page per public module, whose ``autosummary`` lists are what Sphinx
 turns into one page per name.  These tests read those sources (no Sphinx needed): a new public name, or a new

@@ -146,7 +146,7 @@ SD_TANGENT = (19.0, 0.374)
 
 @pytest.mark.slow
 def test_saltation_tangent_dynamics_agrees_with_the_two_trajectory_estimate():
-    """The issue's primary method (variational equations with saltation matrices at the jumps) against the
+    """The primary method (variational equations with saltation matrices at the jumps) against the
     two-trajectory estimate at V = 2.5, I = 1e-4, both after the default 30 s transient: the tangent over
     61 s without its first second, the two-trajectory over 200 s (n = 40000); measured 5.493 and 5.196 bits/s.
 
@@ -164,7 +164,7 @@ def test_saltation_tangent_dynamics_agrees_with_the_two_trajectory_estimate():
     5.169 ± 0.116 (two-trajectory, 600 s), differ by 0.16 ± 0.14 (1.2 σ): no systematic difference is left.
     The old check (tangent 20 s with the transient vs two-trajectory 50 s, within 10 %) had a combined sd
     of 0.54 bits/s (10.5 %) plus the 0.26 bias, so it failed by chance (5.832 vs 5.280).  The spread is
-    measured here rather than taken from the reported ``stderr_bits`` (batch means since issue 17; before,
+    measured here rather than taken from the reported ``stderr_bits`` (batch means since 0.3.0; before,
     the two-trajectory error treated its correlated 5 ms intervals as independent and was ~9× this spread).
     """
     import math

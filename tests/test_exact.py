@@ -163,7 +163,7 @@ def test_bad_arguments(p_low, kw, match):
 def test_breakdown_when_constraint_loses_root(p_low):
     """Starting on AB with F just above f(0+) and a large negative alpha-rate drives
     F(1+sin a) below f(0+): ModelBreakdown with time and state, never NaN.  The reason is the model's own
-    criterion (issue 13 item 9): at the reported state the level G = F(1 + sin a) is within
+    criterion (not a solver's velocity floor): at the reported state the level G = F(1 + sin a) is within
     BREAKDOWN_LEVEL = 1e-10 relative of f(0+) (checked to 2e-10 relative: the reported state is the end of
     the step that crossed the threshold, where G has moved on by at most that step's decrease)."""
     from peelapprox import branch_structure

@@ -1,4 +1,4 @@
-"""Compiled kernels are never stale and never need a writable cache (issue 13, items 3-4).
+"""Compiled kernels are never stale and never need a writable cache (a stale kernel once gave wrong numbers silently).
 
 Both tests run the package from a temporary copy in a subprocess, so the
 repository's own numba cache is neither used nor touched.
@@ -100,7 +100,7 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     loaded unchanged (the pull force of the kernel then disagreed with the numpy law by ~37 N).  Hypothesis:
     the kernel follows the changed source.  The kernel and numpy evaluate the same expression, so they agree
     to rounding (1e-12 relative); the change of 400 v^0.35 -> 401 v^0.35 at v = 0.1 moves f by 0.447 N (F by 0.373 N),
-    10^9 times that tolerance.  The same for the law passed as a function argument (issue 15: ``paper_law``
+    10^9 times that tolerance.  The same for the law passed as a function argument (``paper_law``
     and the driver taking it, ``exact._hybrid_driver.driver(True)``, compiled for an explicit signature): the driver is
     loaded from the cache by a second process (a cache hit, no miss, one signature) and compiled anew after the
     change (a miss)."""

@@ -1,4 +1,4 @@
-"""PeelForce, the peel-force law as data (issue 15): the four kinds, their folds, value semantics, bad laws.
+"""PeelForce, the peel-force law as data: the four kinds, their folds, value semantics, bad laws.
 
 Oracles: the built-in law's own functions (bitwise, or to rounding for re-written forms), the cubic's folds
 and landings in closed form, sympy's derivatives of the same formula, and the data of a table.
@@ -116,7 +116,7 @@ CUBICS = [dict(a=150, b=300, c=300, d=80), dict(a=50, b=2.5, c=3.0, d=1.0), dict
 def test_cubic_folds_closed_form(coef):
     """Hypothesis: the cubic's folds are the roots of f' = b - 2 c v + 3 d v² (v = (c ∓ sqrt(c² - 3bd))/(3d))
     and its landings the third roots of f - f_fold = d (v - v_fold)² (v - v_land), v_land = c/d - 2 v_fold
-    (Vieta); all to 1e-9 relative (the issue's acceptance bound; Brent's roots are ~4 ulp)."""
+    (Vieta); all to 1e-9 relative (the fold accuracy promised for every law; Brent's roots are ~4 ulp)."""
     a, b, c, d = (float(coef[k]) for k in "abcd")
     law = PeelForce.cubic(**coef)
     disc = math.sqrt(c * c - 3 * b * d)
@@ -348,7 +348,7 @@ CONSUMERS = {
 @pytest.mark.parametrize("kind", sorted(LAW_KINDS))
 @pytest.mark.parametrize("name", sorted(CONSUMERS))
 def test_consumers_honour_every_kind_of_law(name, kind):
-    """Hypothesis: every consumer of params takes every kind of law (issue 15 item 2; the refusals of the
+    """Hypothesis: every consumer of params takes every kind of law (any tape's law runs everywhere; the refusals of the
     transition are gone): with fvV written as each kind (the power branches calibrated to it), each returns a
     value, never a ValueError refusing the law."""
     p = PeelParams(V=1.0, I=1e-5, force=LAW_KINDS[kind])

@@ -1,4 +1,4 @@
-"""The peel-force law as a function argument of the hybrid driver (issue 15, the compiled side).
+"""The peel-force law as a function argument of the hybrid driver (any law compiled once, passed to the loop).
 
 The paper's law through the ABI must be *the same arithmetic* as the inlined law (bitwise), and a second law
 must run through the one compiled law driver without compiling it again, with the physics of that law: its jumps

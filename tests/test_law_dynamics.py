@@ -1,4 +1,4 @@
-"""The dynamics measures and the sweeps with a peel-force law other than the paper's (issue 15).
+"""The dynamics measures and the sweeps with a peel-force law other than the paper's.
 
 The cubic ``PeelForce.cubic()`` (a=150, b=300, c=300, d=80) at V = 1.2 m/s has a stable period-5 stick-slip
 orbit at I = 1e-5 and a period-1 orbit at I = 3e-5 (tests/test_law_runs.py checks its physics); its coefficient

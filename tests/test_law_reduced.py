@@ -1,5 +1,5 @@
 """The paper's reduced branch-wise equations, the regime estimates and the comparison harness on peel-force laws
-other than fvV (issue 15): ``reduced_segment``, ``estimate`` and ``comparisons.compare`` honour ``params.force``.
+other than fvV: ``reduced_segment``, ``estimate`` and ``comparisons.compare`` honour ``params.force``.
 
 Oracles: the cubic ``f = a + b v - c v^2 + d v^3`` has its folds, landings and quasi-static branch time in closed
 form; the exact hybrid solver of the same law (its segments seed the reductions); the branch-wise reference

@@ -1,4 +1,4 @@
-"""Runs with a peel-force law other than the paper's through ``PeelParams.force`` (issue 15): the cubic
+"""Runs with a peel-force law other than the paper's through ``PeelParams.force``: the cubic
 ``PeelForce.cubic(a, b, c, d)`` in ``exact.simulate(method="hybrid")``, end to end.
 
 The independent oracle is numpy's polynomial algebra (``np.polyval``, ``np.roots`` of f' and of ``f - level``):
@@ -17,7 +17,7 @@ from peelapprox import PeelForce, PeelParams
 from peelapprox.kernels import M_A, M_B, N_M, model_block
 from peelapprox.validate import params as validate_params
 
-#: Two cubics with two folds whose CD->AB jumps land: the issue's example (folds 0.691, 1.809 m/s) and another.
+#: Two cubics with two folds whose CD->AB jumps land: the documented example (folds 0.691, 1.809 m/s) and another.
 CUBICS = [(150.0, 300.0, 300.0, 80.0), (100.0, 250.0, 280.0, 90.0)]
 
 

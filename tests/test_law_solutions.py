@@ -1,4 +1,4 @@
-"""Solutions of the full DAE with a peel-force law given as data (issue 15, "How we will know").
+"""Solutions of the full DAE with a peel-force law given as data: the evidence that a tape's own law is solved right.
 
 Hypotheses: a tabulated curve sampled from an analytic law reproduces that law's jump times within the
 interpolation error and converges as the table is refined; a run that leaves a table stops with a

@@ -1,4 +1,4 @@
-"""The compiled tabulated law (peelapprox._law_table_jit, issue 15) against scipy's PCHIP (TableLaw).
+"""The compiled tabulated law (peelapprox.law._table_jit) against scipy's PCHIP (TableLaw).
 
 The oracle is scipy: :class:`~peelapprox._law_table.TableLaw` (``PchipInterpolator`` in ln v, linear in V)
 and the interpolants themselves, evaluated by scipy's own code.  The tables are samples of the paper's law

@@ -75,3 +75,17 @@ def test_every_package_is_installed():
     for package in PACKAGES:
         on_disk |= {info.name for info in pkgutil.walk_packages([str(ROOT / package)], package + ".") if info.ispkg}
     assert listed == on_disk
+
+
+def test_no_private_module_is_an_alias_of_another():
+    """Hypothesis: no private module lives on as a compatibility alias of a moved one (the shims
+    ``comparisons._benchmark``, ``_stress`` and ``_peers`` were removed in 0.3.0): no module of the three
+    packages star-imports another, the form those aliases took, and the removed names stay gone (exact)."""
+    aliases = []
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            if "import *" in path.read_text(encoding="utf-8"):
+                aliases.append(str(path.relative_to(ROOT)))
+    assert aliases == []
+    gone = {"comparisons._benchmark", "comparisons._stress", "comparisons._peers"}
+    assert gone.isdisjoint(_private_modules("comparisons"))

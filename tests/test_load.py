@@ -1,5 +1,5 @@
-"""Force-controlled (constant-load) peeling, ``PeelParams(loading="load", load_mass=M, load=F_L)`` (issue 18,
-part 3; docs/constant-load.md).
+"""Force-controlled (constant-load) peeling, ``PeelParams(loading="load", load_mass=M, load=F_L)``
+(docs/constant-load.md).
 
 The oracles are independent of the load mode's solver: the velocity-controlled run (the M → ∞ limit) and its
 first-order perturbation in 1/M, the fixed points of the law (``f(V*, V) = F_L`` by the branch inverse) and the

@@ -1,4 +1,4 @@
-"""``exact.lyapunov(params, method, ...)``: the one entry point of the Lyapunov family (issue 14 item 1).
+"""``exact.lyapunov(params, method, ...)``: the one entry point of the Lyapunov family.
 
 The methods' numbers are tested in tests/test_dynamics.py (known exponents, agreement between methods) and
 bitwise against the named entry points here: the dispatcher must add nothing to the computation.

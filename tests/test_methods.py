@@ -133,3 +133,28 @@ def test_the_cli_reads_its_method_and_solver_choices_from_the_table(euler):
     assert "--method smooth: Radau, BDF, LSODA, DOP853, RK45 (default: LSODA)" in text
     assert "--method regularized: Radau, BDF, LSODA (default: Radau)" in text
     assert f"euler: {Euler.about}" in text
+
+
+def test_the_sweep_reads_its_solver_choices_from_the_table(monkeypatch):
+    """Hypothesis: the sweep's option ``solver`` (comparisons.sweep) and ``peelapprox sweep --solver`` accept
+    every scipy solver of the table, in its order, a solver of a method entered after the parser was built
+    included; an unknown one is refused naming the option (exact tuples, categorical outcome)."""
+    import argparse
+
+    from comparisons.sweep import measures
+    from peelapprox.cli import build_parser
+
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class Heun(Euler):
+        name: ClassVar[str] = "heun"
+        solvers: ClassVar[tuple[str, ...]] = ("Heun",)
+
+    ap = build_parser()
+    monkeypatch.setitem(METHODS, Heun.name, Heun)
+    every = ("Radau", "BDF", "LSODA", "DOP853", "RK45", "Heun")
+    assert measures.solvers() == every
+    assert measures._check_solver({"solver": "Heun"}) == "Heun"
+    with pytest.raises(ValueError, match="solver"):
+        measures._check_solver({"solver": "heun"})
+    sw = next(a for a in ap._actions if isinstance(a, argparse._SubParsersAction)).choices["sweep"]
+    assert tuple(next(a for a in sw._actions if a.dest == "solver").choices) == every

@@ -1,4 +1,4 @@
-"""The option objects of ``exact.simulate`` (issue 14 item 3): Hybrid, Regularized, SaveAt, Budget.
+"""The option objects of ``exact.simulate``: Hybrid, Regularized, SaveAt, Budget.
 
 Each is a frozen, keyword-only dataclass validated in ``__post_init__`` by the same named validators as the
 ``simulate`` keyword of the same name, so a bad field raises the same exception with the same message; a run

@@ -1,4 +1,4 @@
-"""Periodic orbits as objects (issue 16): the section map's Jacobian, Newton's orbits, Floquet multipliers.
+"""Periodic orbits as objects: the section map's Jacobian, Newton's orbits, Floquet multipliers.
 
 Oracles: central differences of the field (for its analytic Jacobian), fourth-order differences of the
 return map (for the tangent's monodromy), the long-run simulation's return map (for the orbit's values),
@@ -59,7 +59,7 @@ def test_field_jacobian_is_the_derivative_of_the_field(params):
 @pytest.mark.parametrize("params, kw, n", [(CUBIC, {}, 1), (PAPER, dict(t_transient=40.0), 3)], ids=["cubic", "fvV"])
 def test_stable_orbit_closes_matches_the_long_run_and_fd_multipliers(params, kw, n):
     """Hypothesis: from the default start, Newton finds the attractor the long run settles on: period ``n``,
-    closing residual <= 1e-10 (the issue's bound), stable; its return-map values equal those of a 20 s
+    closing residual <= 1e-10 (the corrector's bound), stable; its return-map values equal those of a 20 s
     simulation after the transient at rtol 1e-12 to 1e-8 relative (measured 4e-14); its multipliers equal the
     eigenvalues of a fourth-order finite-difference monodromy to 1e-6 (measured 1e-8 and 7e-8); and one
     period of its trajectory ends where it began, (α, ω) to 1e-9 relative (v is not compared: at the fold it
@@ -206,7 +206,7 @@ def test_orbit_diagram_values_and_labels():
 
 @pytest.mark.slow
 def test_branches_explain_the_brute_force_periods_at_I_1e_2(tmp_path):
-    """Hypothesis (the issue's acceptance in a window): at I = 1e-2 every periodic value of the brute-force
+    """Hypothesis (orbits explain the diagram, in a window): at I = 1e-2 every periodic value of the brute-force
     orbit diagram over V in [0.9, 1.2] (from α0 = 0 after 30 s) lies in the stable range of a continued branch
     of the same period (seeded automatically where the diagram's period changes): the periods 7, 8, 9, 10 of
     the period-adding windows, whose ends are Neimark–Sacker bifurcations and crest events (measured on

@@ -1,4 +1,4 @@
-"""Packaging (issue 17, part 5): the licence file matches the declared SPDX licence, the citation file names the
+"""Packaging: the licence file matches the declared SPDX licence, the citation file names the
 paper and the library, and the DOP853 coefficients are the package's own (no import of scipy's private module),
 equal bitwise to scipy's where scipy still has them."""
 

@@ -12,7 +12,7 @@ import exact
 from comparisons.benchmark import peers as P
 from comparisons.benchmark.peers import common as PC
 from comparisons.benchmark.peers import diffsol as PD
-from exact import _variational as LV
+from exact.dynamics import _variational as LV
 from exact._regularized import _fun
 from peelapprox import PeelParams, branch_structure
 from peelapprox import kernels as K
@@ -313,18 +313,3 @@ def test_lyapunov_variational_without_pydiffsol_names_the_bench_extra(monkeypatc
     with pytest.raises(PeerUnavailableError, match=r"pydiffsol.*peelapprox\[bench\]"):
         exact.lyapunov_variational(PeelParams(V=2.0, I=1e-4), T=1.0)
     assert issubclass(PeerUnavailableError, ImportError) and P.PeerUnavailableError is PeerUnavailableError
-
-
-def test_the_old_module_names_still_resolve_to_the_moved_objects():
-    """``comparisons._peers`` and ``comparisons._benchmark`` stay compatibility aliases: every name they export
-    resolves, to the very object of its new home (identity checks).  ``tangent_solve`` and ``TANGENT_OPTIONS``,
-    internals of the variational exponent, moved to ``exact.dynamics._variational`` without an alias (a sibling may not
-    import a private module of exact)."""
-    from comparisons import _benchmark, _peers, benchmark
-
-    for mod in (_peers, _benchmark):
-        for name in mod.__all__:
-            assert getattr(mod, name) is not None, (mod.__name__, name)
-    assert _peers.lyapunov_regularized is exact.lyapunov_variational
-    assert _peers.run_peer is P.run_peer and _peers.diffsl_code is K.diffsl_code
-    assert _benchmark.run_benchmark is benchmark.run_benchmark and _benchmark.BENCH_SCENES is benchmark.BENCH_SCENES

@@ -1,4 +1,4 @@
-"""The plot functions' conventions (issue 17, part 5): they leave the session's matplotlib backend alone, draw into
+"""The plot functions' conventions: they leave the session's matplotlib backend alone, draw into
 ``ax=``/``fig=`` when given and return the figure, and show a readable window of a long stick-slip run."""
 
 from __future__ import annotations

@@ -28,7 +28,7 @@ P2 = PeelParams(V=1.0, I=1e-2)
 @pytest.mark.parametrize("I", [1e-5, 1e-3, 1e-2])
 @pytest.mark.parametrize("F_rate", [None, -2000.0])
 def test_airy_closed_form_matches_numerical_integration(I, F_rate):
-    """Ai/Bi solution of Airy vs DOP853 at rtol 1e-12 agree to <= 1e-9 of max|α| (issue's criterion).
+    """Ai/Bi solution of Airy vs DOP853 at rtol 1e-12 agree to <= 1e-9 of max|α| (the closed forms' accuracy).
 
     The integration error at rtol 1e-12 over tens of oscillations is ~1e-11;
     the Airy evaluation is accurate to ~1e-14 at |x| <= 100.
@@ -395,4 +395,4 @@ def test_cli_estimate_and_segment(tmp_path):
                "--alphadot-in", "9.7", "--v-in", "0.00188", "--v-f", "0.4", "--curves", str(csv), "--format", "json"])
     assert rc == 0
     lines = csv.read_text().splitlines()
-    assert lines[0] == "t,v,F,alpha,alphadot,law,law_key" and len(lines) == 801  # the law recorded (issue 15)
+    assert lines[0] == "t,v,F,alpha,alphadot,law,law_key" and len(lines) == 801  # the law recorded

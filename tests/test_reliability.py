@@ -1,6 +1,6 @@
-"""Regression tests of issue 13: no silent wrong answer from the exact solver.
+"""Regression tests: no silent wrong answer from the exact solver.
 
-Each reproducer of the issue is a test that failed on the code before the fix.
+Each reproducer is a test that failed on the code before the fix.
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ def test_return_map_lyapunov_max_wall():
 
 @pytest.mark.parametrize("save", ["jumps", "steps"])
 def test_max_wall_at_a_high_jump_rate(save):
-    """Review of issue 13: the wall budget was checked only when the kernel paused after 250k steps in one
+    """Found in review: the wall budget was checked only when the kernel paused after 250k steps in one
     call, but at V=4, I=1e-2 (~480 jumps/s) the jump or point buffer fills first, every call: a 600 s run
     with max_wall=0.3 completed (3.4 s).  Hypothesis: the budget is checked after every kernel return, so the
     run raises SolverBudgetExceeded("max_wall") long before t_end (it reaches t < 300 s; categorical)."""
@@ -187,7 +187,7 @@ def test_regularized_failure_reports_last_state_in_domain():
 
 
 def test_saltation_tangent_reports_no_root_breakdown():
-    """Review of issue 13: the saltation tangent's driver ignored the breakdown criterion and integrated ln v
+    """Found in review: the saltation tangent's driver ignored the breakdown criterion and integrated ln v
     to underflow, ending in a step-size SolverFailure.  Hypothesis: at V=0.5, I=1e-4 (the hybrid solver's
     no_root breakdown at t = 0.0183 s) it raises ModelBreakdown('no_root') near that time (within 1e-3 s:
     both integrate the same field; the tangent's tolerances differ) with a finite state."""

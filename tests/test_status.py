@@ -1,4 +1,4 @@
-"""The one status table of the compiled drivers (issue 14, item 2)."""
+"""The one status table of the compiled drivers (each status code defined once)."""
 
 from __future__ import annotations
 

@@ -426,7 +426,7 @@ def test_plot_phase_diagram_numeric(pool_result, tmp_path):
     assert (tmp_path / "p.png").stat().st_size > 5_000
 
 
-# --------------------------------------------------------------------------------------------- issue 13, item 7
+# ------------------------------------------------------------------------- poisoned sweeps (bugs once, now refused)
 
 @pytest.mark.parametrize("measures, options, match", [
     ("jumps", {"t_end": 1.0, "t_transient": 5.0}, r"t_end must be greater than t_transient = 5"),
@@ -448,7 +448,7 @@ def test_invalid_options_rejected_before_any_point(tmp_path, measures, options, 
     one raises ValueError naming it and its valid range, and nothing is written (no manifest to pin the
     bad options, no error records that a resume would keep).
 
-    Reproducer of issue 13 item 7: ``t_end=1, t_transient=5`` or ``rtol=1`` used to compute every point
+    Reproducer: ``t_end=1, t_transient=5`` or ``rtol=1`` used to compute every point
     as an error record.  No tolerance: categorical outcome.
     """
     out = tmp_path / "sw"
@@ -474,7 +474,7 @@ def test_point_status_reflects_its_measures(tmp_path):
     measure (V=0.5, I=1e-4, the level reaches f(0+)) is ``status = "breakdown:no_root"``, not ``"ok"``; a raising
     measure outranks a breakdown; a point whose measures all succeed is ``"ok"``.
 
-    Reproducer of issue 13 item 7.  No tolerance: categorical outcome.
+    Reproducer of a poisoned sweep.  No tolerance: categorical outcome.
     """
     res = sweep([1e-5, 1e-4], [0.5], ("regime", "jumps", "flaky"), out=tmp_path / "sw", executor="serial",
                 progress=False, options={"fail_at_V": 2.0})
@@ -491,7 +491,7 @@ def test_retry_failed(tmp_path, monkeypatch):
     unchanged), and ``retry_failed=True`` recomputes exactly those points, leaving one record per point
     and the ok records byte for byte as they were.
 
-    Reproducer of issue 13 item 7 (failed points could never be retried).  Exact equality: deterministic.
+    Reproducer (failed points could never be retried).  Exact equality: deterministic.
     """
     out = tmp_path / "sw"
     monkeypatch.setenv("PEELAPPROX_TEST_FAIL", "1")
@@ -537,7 +537,7 @@ def test_notebook_measure_on_process_pool(tmp_path):
     """Hypothesis: a measure defined in ``__main__`` without a file (a notebook, ``python -c``) works on the
     default process pool: the engine ships it by value (cloudpickle), since no worker can import it.
 
-    Reproducer of issue 13 item 7: it used to fail at every point with LookupError.  Exact equality of
+    Reproducer: it used to fail at every point with LookupError.  Exact equality of
     I*V: the same float product in the worker.
     """
     pytest.importorskip("cloudpickle")
@@ -588,7 +588,7 @@ def test_symlinks_are_not_followed(tmp_path, name):
     """Hypothesis: a sweep file that is a symbolic link (here to a file outside ``out``) is refused with a
     ValueError naming it, and the file it points to is not changed; load_sweep refuses it too.
 
-    Reproducer of issue 13 item 7: a resume appended to whatever ``results.jsonl`` pointed to.
+    Reproducer: a resume appended to whatever ``results.jsonl`` pointed to.
     """
     out = tmp_path / "sw"
     _partial_sweep(out)
@@ -622,7 +622,7 @@ def test_malformed_manifest_gives_the_clear_error(tmp_path, damage):
     """Hypothesis: a crafted or corrupted manifest (wrong types, missing keys, non-finite grid values) makes
     load_sweep and a resume raise ValueError saying the manifest is malformed, never another exception.
 
-    Reproducer of issue 13 item 7 (these gave TypeError/KeyError/AttributeError tracebacks).
+    Reproducer (these gave TypeError/KeyError/AttributeError tracebacks).
     """
     out = tmp_path / "sw"
     _partial_sweep(out)
@@ -652,7 +652,7 @@ def test_malformed_record_gives_the_clear_error(tmp_path, line):
     missing status, non-scalar values, an int no float can hold, deep nesting) makes load_sweep and a resume
     raise ValueError naming the line as malformed, never another exception.
 
-    Reproducer of issue 13 item 7 (``I=1e400`` and wrong types gave tracebacks).
+    Reproducer (``I=1e400`` and wrong types gave tracebacks).
     """
     out = tmp_path / "sw"
     lines = _partial_sweep(out)
@@ -705,7 +705,7 @@ def test_read_only_complete_sweep_loads_and_reports(tmp_path, capsys, read_only)
     with a note); an incomplete one is a ValueError saying how many points remain and that out is not
     writable.  Exact equality of the records: they are read back unchanged.
 
-    Reproducer of issue 13 item 7 (it failed even to report a complete sweep).
+    Reproducer (it failed even to report a complete sweep).
     """
     out = tmp_path / "sw"
     full = sweep(I2, V2, "slowprod", out=out, executor="serial", progress=False)

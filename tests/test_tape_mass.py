@@ -1,4 +1,4 @@
-"""The tape-mass model's solver and its low-mass limit (issue 18, docs/tape-mass.md).
+"""The tape-mass model's solver and its low-mass limit (docs/tape-mass.md).
 
 The oracles are independent of the code under test: the massless model's hybrid solution (its own event-driven
 DOP853 on the branch dynamics), the paper's ε-scheme (``method="regularized"``), the fold-passage law ε^(2/3)

@@ -1,4 +1,4 @@
-"""The dynamics tools with the model variants (issue 18, docs/tape-mass-dynamics.md): what runs a tape mass or
+"""The dynamics tools with the model variants (docs/tape-mass-dynamics.md): what runs a tape mass or
 a constant load through ``exact.simulate``'s variant method, and what refuses it with a ValueError naming
 ``params`` and the model it supports."""
 
@@ -88,7 +88,7 @@ def test_orbit_diagram_over_the_tape_mass_has_the_massless_limit():
     F0, F1 = d.returns
     assert F0.size == F1.size >= 5
     np.testing.assert_allclose(F1, F0, rtol=2e-3)
-    if importlib.util.find_spec("pandas") is not None:  # the data extra (the CI's test install has no pandas)
+    if importlib.util.find_spec("pandas") is not None:  # the data extra (in the test install since 0.3.0)
         assert d.to_dataframe().attrs["units"]["tape_mass"] == "kg"
 
 

@@ -1,4 +1,4 @@
-"""The named argument validators (peelapprox.validate) and the item-6 reproducers of issue 13.
+"""The named argument validators (peelapprox.validate) and reproducers of bad arguments once accepted.
 
 Every bad argument must end in a ``ValueError`` or ``TypeError`` whose message names the argument, never in
 ZeroDivisionError, OverflowError, AttributeError, a numba error or a NaN result.

@@ -1,4 +1,4 @@
-"""The variants' stress grid (issue 18: "no NaN or hang over a stress grid in (m, V, I) and (M, I)"),
+"""The variants' stress grid (no NaN or hang over a stress grid in (m, V, I) and (M, I)),
 comparisons.stress.variants: a fast subset in the default tier, the whole grid (144 points) under ``-m slow``.
 
 Hypothesis: every run ends in a result, a documented ModelBreakdown or a SolverBudgetExceeded (``max_wall``
@@ -55,7 +55,7 @@ def _check(rec: dict) -> None:
 
 
 def test_grid_is_the_issues_grid():
-    """54 tape-mass points (m × V × I as the issue lists them) and 90 load points (M × I × 3 loads × 2 masses)."""
+    """54 tape-mass points (m × V × I, docs/robustness.md) and 90 load points (M × I × 3 loads × 2 masses)."""
     pts = variant_grid()
     tape = [p for p in pts if p.group == "tape"]
     load = [p for p in pts if p.group == "load"]

@@ -1,4 +1,4 @@
-"""The model variants' equations (issue 18) from their symbolic source: the tape-mass model and the load.
+"""The model variants' equations from their symbolic source: the tape-mass model and the load.
 
 Hypotheses: (1) the compact rates of :func:`tape_mass_rates` are exactly what the Lagrange equations give for
 LAGRAN plus the ribbon's kinetic energy (sympy simplifies the difference to 0: no tolerance); (2) with m = 0

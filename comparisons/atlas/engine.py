@@ -97,13 +97,8 @@ def atlas(
     """Where the approximations hold: the exact attractor, every approximation's prediction and each
     reduction's exact-seeded errors at every (I, V) grid point, on the sweep engine.
 
-    At each point the measures of :mod:`comparisons.atlas.measures` run: the exact observables
-    (:func:`exact.attractor_observables` over the window ``t_transient`` .. ``t_transient + t_window``) and
-    the dynamics' class, the reductions' per-segment errors on the same window's last stays, and every
-    approximation of :data:`~comparisons.atlas.approximations.APPROXIMATIONS` with
-    :func:`peelapprox.estimate`'s regime label.  Each finished point is on disk at once (``out`` is a sweep
-    directory: :mod:`comparisons.sweep`), so a killed atlas loses only its running points and the same call
-    finishes the rest.
+    The measures of :mod:`comparisons.atlas.measures` run at each point; ``out`` is a sweep directory
+    (:mod:`comparisons.sweep`), so a killed atlas loses only its running points and the same call finishes them.
 
     Parameters
     ----------
@@ -119,14 +114,10 @@ def atlas(
     k, R, l, geometry : optional
         :class:`peelapprox.PeelParams` fields of every point (None: its defaults, k = 1000 N/m, R = 0.1 m).
     options : mapping, optional
-        Changes to :data:`~comparisons.atlas.measures.DEFAULTS`: ``t_transient`` (100 s), ``t_window`` (20 s),
-        ``rtol`` (1e-10), ``alpha0`` (0), ``segments_per_branch`` (8), ``segment_rtol`` (1e-10),
-        ``reductions`` (``{"AB": [[alpha_model, v_equation], ...], "CD": [...]}``, the harness's
-        :data:`comparisons.DEFAULT_MODELS`).
+        Changes to :data:`~comparisons.atlas.measures.DEFAULTS` (the window ``t_transient`` 100 s and
+        ``t_window`` 20 s, tolerances, ``segments_per_branch``, ``reductions``).
     executor, max_workers, progress, resume, retry_failed, max_wall
-        As :func:`comparisons.sweep.sweep`: a local process pool by default (``max_workers=0``: in this
-        process), any Executor (a dask cluster's); progress on stderr; the wall-clock budget of this call
-        [s] (default 3600, None: unbounded).
+        As :func:`comparisons.sweep.sweep`.
 
     Returns
     -------
@@ -136,11 +127,9 @@ def atlas(
     Raises
     ------
     ValueError
-        A bad grid, option or approximation name (naming it), before any point runs; an ``out`` that holds
-        another sweep.
+        A bad grid, option or approximation name (named) before any point runs, or ``out`` holds another sweep.
     peelapprox.SolverBudgetExceeded
-        ``max_wall`` was spent: the points done stay in ``out`` (``partial`` is their :class:`AtlasResult`);
-        the same call again computes the rest.
+        ``max_wall`` was spent (``partial``: the :class:`AtlasResult` so far; the same call computes the rest).
     RuntimeError
         ``out`` is locked by another run, or a worker died (the records written stay).
     """

@@ -1,4 +1,4 @@
-"""Cold and warm start of each entry point, each in fresh processes with a fresh numba cache (issue 17).
+"""Cold and warm start of each entry point, each in fresh processes with a fresh numba cache (a new user's first call).
 
 ``python -m comparisons.benchmark.cold_start [--json F] [--only NAME ...]`` runs every entry point of
 :data:`ENTRY_POINTS` twice, each time in a new Python process: **cold**, with ``NUMBA_CACHE_DIR`` and

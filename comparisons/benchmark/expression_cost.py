@@ -1,4 +1,4 @@
-"""Cost of the generated peel-force laws (issue 15, peelapprox._law_codegen): compile, load and per call.
+"""Cost of the generated peel-force laws (a tape's own law, peelapprox.law.codegen): compile, load and per call.
 
     python -m comparisons.benchmark.expression_cost [--n N] [--json FILE]
 

@@ -1,4 +1,4 @@
-"""Cost of the peel-force law as a function argument of the hybrid driver (issue 15, the compiled side).
+"""Cost of the peel-force law as a function argument of the hybrid driver (a law other than the inlined fvV).
 
     python -m comparisons.benchmark.law_cost [--before PATH] [--rounds N] [--json FILE]
 

@@ -1,4 +1,4 @@
-"""The paper's reduced equations on laws other than fvV: approximate vs exact (issue 15, the reductions' side).
+"""The paper's reduced equations on laws other than fvV: approximate vs exact (do they hold for your tape?).
 
     python -m comparisons.benchmark.law_reduced [--json FILE]
 

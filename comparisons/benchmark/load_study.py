@@ -1,4 +1,4 @@
-"""The constant-load study (issue 18, part 3; docs/constant-load.md): force-controlled peeling measured.
+"""The constant-load study (docs/constant-load.md): force-controlled peeling measured.
 
 ``python -m comparisons.benchmark.load_study {limit,stability,phase,duration,figures,all} [--out DIR]``
 writes CSV and JSON tables (and, for ``figures``, PNGs) and reports progress on stderr:

@@ -1,11 +1,11 @@
-"""Cost of a periodic orbit with its Floquet multipliers (issue 16): Newton on the AB→CD section map.
+"""Cost of a periodic orbit with its Floquet multipliers (docs/orbits.md): Newton on the AB→CD section map.
 
     python -m comparisons.benchmark.orbit_cost [--json FILE]
 
 For each scene: a run past its transient seeds ``exact.periodic_orbit`` (its jumps give the period n and the
 start); the orbit is then found again from that run, timed (the best of 3, the seed run excluded), with the
 Newton iterations, the closing residual, the multipliers' moduli and the integration steps; then a
-200-point continuation (:data:`CONTINUATIONS`), timed.  The issue's targets: one orbit with multipliers for
+200-point continuation (:data:`CONTINUATIONS`), timed.  The targets: one orbit with multipliers for
 n <= 10 in <= 50 ms; a 200-point continuation in <= 10 s.
 """
 

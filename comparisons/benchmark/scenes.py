@@ -27,9 +27,9 @@ class BenchScene:
         return PeelParams(V=self.V, I=self.I)
 
 
-#: The three scenes of issue 5 (the paper's Cases I-III).  Horizons hold 8, 35 and 47 jumps: every part of
-#: a solver is exercised (folds, both branches, landings, the rapid-jump cascades of Cases II-III), while
-#: scipy's Radau at ε = 1e-10 and rtol 1e-9 still finishes each in ~10 s.
+#: The three scenes of the work-precision benchmark (the paper's Cases I-III).  Horizons hold 8, 35 and 47
+#: jumps: every part of a solver is exercised (folds, both branches, landings, the rapid-jump cascades of
+#: Cases II-III), while scipy's Radau at ε = 1e-10 and rtol 1e-9 still finishes each in ~10 s.
 BENCH_SCENES = (
     BenchScene("V1-I1e-5", 1.0, 1e-5, 0.3),
     BenchScene("V1-I1e-2", 1.0, 1e-2, 0.5),
@@ -38,8 +38,10 @@ BENCH_SCENES = (
 
 
 def jump_errors(t: np.ndarray, F: np.ndarray, t_ref: np.ndarray, F_ref: np.ndarray) -> tuple[float, float]:
-    """The benchmark's error metric (module docstring): ``(max |Δt_j| / T̄_ref, max |ΔF_j| / F_j^ref)``
-    over the reference's jumps; ``(inf, inf)`` if the run has a different number of jumps."""
+    """The benchmark's error metric: ``(max |Δt_j| / T̄_ref, max |ΔF_j| / F_j^ref)`` over the reference's jumps
+    (all of them in the horizon; T̄_ref the reference's mean interval between jumps); the reported error is the
+    larger of the two.  ``(inf, inf)`` if the run has a different number of jumps: it is on another orbit.  The
+    regularised runs record a jump where v crosses the inflection velocity of f, the hybrid one at the fold."""
     if len(t_ref) < 2:
         raise ValueError(f"the reference needs at least 2 jumps in the horizon, got {len(t_ref)}")
     if len(t) != len(t_ref):

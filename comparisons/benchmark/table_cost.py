@@ -1,4 +1,4 @@
-"""Cost per call of the compiled tabulated law against the paper's law, through the law argument (issue 15).
+"""Cost per call of the compiled tabulated law against the paper's law, through the law argument.
 
     python -m comparisons.benchmark.table_cost [--n N] [--rounds R] [--json FILE]
 
@@ -18,7 +18,7 @@ away), over the same points of ln v in the common range:
 
 in the form ``LAW_LNV`` (the hybrid field's) and, on the sweep, ``LAW_FP`` and ``LAW_FPP``.  Each figure is
 the best of ``--rounds`` alternating rounds of ``--n`` calls, minus nothing (the loop's own cost is the same
-for every law and is included).  The ratio to the paper's law is per call; the issue's target is per step
+for every law and is included).  The ratio to the paper's law is per call; the target is per step
 (≤ 1.5× the paper's), which the lead measures on runs: a DOP853 step makes ~12 field evaluations of ~25 ns, so
 a per-call difference Δ changes a step of ~800 ns by about 12 Δ (docs/design-peel-force-laws.md).
 """

@@ -1,4 +1,4 @@
-"""Which integrator solves the tape-mass model (issue 18) fastest, across the mass range: work precision.
+"""Which integrator solves the tape-mass model (docs/tape-mass.md) fastest, across the mass range: work precision.
 
     python -m comparisons.benchmark.tape_mass [--json FILE] [--figure PNG] [--cap SECONDS] [--quick]
 

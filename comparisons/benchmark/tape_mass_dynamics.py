@@ -1,4 +1,4 @@
-"""How the tape mass changes the stick-slip dynamics at realistic masses (issue 18, docs/tape-mass-dynamics.md).
+"""How the tape mass changes the stick-slip dynamics at realistic masses (docs/tape-mass-dynamics.md).
 
 ``python -m comparisons.benchmark.tape_mass_dynamics [--out DIR] [--quick] [--no-lyapunov] [--no-diagram]``
 measures, for the paper's three regimes (:data:`REGIMES`) and the tape masses :data:`MASSES` (0: the massless

@@ -1,4 +1,4 @@
-"""The tape-mass model's low-mass limit, measured (issue 18): convergence to the massless (hybrid) solution, and
+"""The tape-mass model's low-mass limit, measured: convergence to the massless (hybrid) solution, and
 which ε of the paper's scheme a tape mass corresponds to.
 
     python -m comparisons.benchmark.tape_mass_limit [--json FILE] [--figure PNG]

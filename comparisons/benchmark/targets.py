@@ -47,7 +47,7 @@ def _rhs_cost_ns(n: int = 200_000) -> float:
 
 def speed_targets(*, repeats: int = 5, long_run: float = 200.0,
                   progress: Callable[[str], None] | None = None) -> list[dict]:
-    """The exact-model issue's speed targets, measured: per-step cost on each scene (rtol 1e-8, 1 s, or the
+    """The exact model's speed targets, measured: per-step cost on each scene (rtol 1e-8, 1 s, or the
     long run), the long V=4 run, and the share of the time spent in field evaluations."""
     say = progress or (lambda msg: None)
     rhs_ns = _rhs_cost_ns()

@@ -1,4 +1,9 @@
-"""How the benchmark times a run, and keeps its stdout clean of the C solvers' messages."""
+"""How the benchmark times a run, and keeps its stdout clean of the C solvers' messages.
+
+As the SciML work-precision benchmarks: one untimed warm-up per configuration, then the minimum over repeats.
+The multi-second scipy Radau/BDF runs are warmed up on the horizon up to the reference's second jump (which
+exercises every code path) and timed once.
+"""
 
 from __future__ import annotations
 

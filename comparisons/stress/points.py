@@ -64,7 +64,8 @@ TOL_POINTS: tuple[tuple[str, float, float, float, float], ...] = (
     ("irregular V=4", 4.0, 1e-2, 1000.0, 0.3),
     ("stiff near cusp", 5.0, 1e-3, 1e4, 0.5),
 )
-#: The loose-tolerance grid (issue 13): 6 V × 4 I × 3 α0 × 6 (rtol, atol) = 432 runs of 5 s, ``save="jumps"``.
+#: The loose-tolerance grid (a new user's tolerance scan): 6 V × 4 I × 3 α0 × 6 (rtol, atol) = 432 runs of 5 s,
+#: ``save="jumps"``.
 #: Before the kernel rejected steps whose dense output left the domain, 66 of 432 such runs ended with a NaN
 #: state (a false "geometry" breakdown) or a "successful" trajectory with v < 0.
 LOOSE_V: tuple[float, ...] = (0.5, 1.0, 2.0, 4.0, 6.0, 8.0)

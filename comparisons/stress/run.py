@@ -1,43 +1,19 @@
 """One stress point in this process: run it and classify how it ended.
 
-:func:`run_point` runs a :class:`~comparisons.stress.points.StressPoint`,
-inspects the trajectory (complete or partial) and returns a record;
-:func:`is_allowed` and :func:`is_bug` classify records.
+:func:`run_point` runs a :class:`~comparisons.stress.points.StressPoint`, inspects the trajectory (complete or
+partial) and returns a record; :func:`is_allowed` and :func:`is_bug` classify records.  Every run must end in a
+:class:`~exact.Trajectory` or a documented exception, never in a non-finite value or a hang; the record's
+``outcome`` says which:
 
-Every run of the model must end in a :class:`~exact.Trajectory` or in one of
-the documented exceptions (:class:`~exact.ModelBreakdown`,
-:class:`~exact.SolverBudgetExceeded`, :class:`~exact.SolverFailure`, or a
-``ValueError`` for an infeasible initial state) -- never in a non-finite
-value, never in a hang.  A record's class says which.
+* allowed: ``ok`` (reached ``t_end``); ``breakdown:<reason>`` (:class:`~exact.ModelBreakdown`: ``no_root``,
+  ``no_landing``, ``geometry``, ``v_ceiling``, ...); ``budget:<which>`` (:class:`~exact.SolverBudgetExceeded`
+  for ``max_steps``, ``max_jumps`` or ``max_points``); ``solver_failure`` (:class:`~exact.SolverFailure`);
+  ``invalid_initial_state`` (:func:`exact.initial_state`'s ValueError: no root of CONSTR at that α0 and F0);
+* bugs: ``nan`` (a non-finite value in the returned or partial arrays); ``timeout`` (no answer within the
+  wall-clock timeout: a hang); ``crash`` (the worker died); ``unexpected:<ExceptionType>`` (any other
+  exception, also a ValueError from ``simulate`` after the initial state was accepted).
 
-Outcome classes (``record["outcome"]``)
----------------------------------------
-``ok``
-    Reached ``t_end``.
-``breakdown:<reason>``
-    :class:`~exact.ModelBreakdown` with ``reason`` (``no_root``,
-    ``no_landing``, ``geometry``, ``v_ceiling``, ...).
-``budget:<which>``
-    :class:`~exact.SolverBudgetExceeded` for ``max_steps``, ``max_jumps`` or
-    ``max_points``.
-``solver_failure``
-    :class:`~exact.SolverFailure`.
-``invalid_initial_state``
-    :func:`exact.initial_state` raised ``ValueError`` (no root of CONSTR at
-    the requested α0 and default F0).
-``nan``
-    A non-finite value in the returned arrays (or in the partial trajectory
-    attached to an exception): a bug.
-``timeout``
-    No answer within the wall-clock timeout: a hang, a bug.
-``crash``
-    The worker process died (segfault, abort): a bug.
-``unexpected:<ExceptionType>``
-    Any other exception (also a ``ValueError`` raised by ``simulate`` after
-    the initial state was accepted): a bug.
-
-Independently of the class, ``t_monotone`` is False if stored times or jump
-times ever decrease or leave ``[0, t_end]``: a bug.
+Independently, ``t_monotone`` is False, a bug, if stored or jump times ever decrease or leave ``[0, t_end]``.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""The stress grid of the model variants (issue 18): the tape mass over (m, V, I) and the constant load over
-(M, I, F_L), each run by :func:`exact.simulate` with the model's own method, bounded in wall time.
+"""The stress grid of the model variants (docs/tape-mass.md, docs/constant-load.md): the tape mass over
+(m, V, I) and the constant load over (M, I, F_L), each run by :func:`exact.simulate` with the model's own method,
+bounded in wall time.
 
     python -m comparisons.stress.variants [--quick] [--out DIR] [--t-end S] [--max-wall S] [--timeout S]
 
@@ -52,7 +53,7 @@ LOAD_MASSES: tuple[float, ...] = (1e-6, 1e-3, 1.0, 1e3, 1e6)
 LOAD_V = 1.0
 #: The tape mass [kg] of the load grid's massive half.
 LOAD_TAPE_MASS = 1e-4
-#: The endings a variant run may have (the issue's rule): a result, a ModelBreakdown, a SolverBudgetExceeded.
+#: The endings a variant run may have (anything else is a bug): a result, a ModelBreakdown, a SolverBudgetExceeded.
 #: A ``solver_failure`` (scipy gave up: the step size underflowed) is simulate's documented last resort, but
 #: recorded here as a finding (reported to the solver's owner: it should be a breakdown or a budget).
 VARIANT_ALLOWED: tuple[str, ...] = ("ok", "breakdown:", "budget:")

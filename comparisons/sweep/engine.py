@@ -17,13 +17,13 @@ import numpy as np
 from exact import DEFAULT_MAX_WALL
 from peelapprox import PARAM_RANGES, PeelForce, SolverBudgetExceeded
 from peelapprox.io import ProgressLine, jsonable
-from peelapprox.validate import ArgumentTypeError, integer, optional, positive
+from peelapprox.validate import ArgumentTypeError, flag, integer, optional, positive
 from peelapprox.validate import path as _path
 
 from .._worker import SERIAL, run_tasks
 from .grid import check_grid_size, grid_length
 from .law import check_coef, check_force, manifest_fields
-from .measures import _OPTION_CHECKS, MEASURES, _ref
+from .measures import MEASURES, OPTION_CHECKS, measure_ref
 from .result import SweepResult
 from .store import (
     FORMAT,
@@ -80,89 +80,40 @@ def sweep(
     Parameters
     ----------
     I_values, V_values : sequence of float
-        Grid axes (finite, > 0, no repeats); every pair is one task.  The grid (with ``coef``, times its
-        values) holds at most :data:`~comparisons.sweep.grid.MAX_SWEEP_POINTS` (1e6) points.
+        Grid axes (finite, > 0, no repeats); every pair (with ``coef``, every triple) is one task.
     measures : str or sequence of str
         Names in :data:`MEASURES` (``"regime,jumps"`` is split at commas).
     out : path
-        Output directory (created); see :mod:`comparisons.sweep` for its files.
+        Output directory, created; its files: :mod:`comparisons.sweep.store`.
     executor : None, "serial" or concurrent.futures.Executor
-        ``None``: a local :class:`ProcessPoolExecutor` (``spawn`` start
-        method, ``max_workers`` processes, shut down at the end).
-        ``"serial"``: in this process, one point after another (debugging).
-        Any Executor: used as is and left running, e.g.
-        ``distributed.Client(...).get_executor()`` for a dask cluster.
-    max_workers : int, optional
-        Processes of the local pool (default: CPUs available, at most the
-        number of points to compute); 0 runs in this process, as
-        ``executor="serial"`` (the CLI's ``--workers 0``).  Only with
-        ``executor=None``.
+        None: a local spawn :class:`ProcessPoolExecutor` of ``max_workers`` processes (default: the CPUs; 0 runs
+        in this process, as ``"serial"``).  Any Executor is used as is, e.g. a dask client's.
     options : mapping, optional
-        JSON-serialisable settings passed to every measure (see
-        :mod:`comparisons.sweep`), checked before the first point.
+        JSON-serialisable settings passed to every measure (:mod:`comparisons.sweep.measures`).
     progress : bool or callable
-        ``True``: progress on stderr with an ETA, rate-limited (a line for
-        the first point, the last, every ~5 % and every failed point, with
-        its status; one updating line in Jupyter).  A callable receives
-        ``(done, total, record)`` (``done`` counts resumed points too).
-    resume : bool
-        With an existing sweep in ``out`` (same grid, measures and options,
-        else ValueError naming what differs): skip its finished points.
-        ``resume=False`` refuses a non-empty ``out`` (ValueError) rather than
-        overwrite it.
-    retry_failed : bool
-        Also compute again the points of ``out`` whose status is an error
-        (their records are dropped first); by default they count as finished.
-    force : peelapprox.PeelForce, optional
-        The peel-force law at every point (default: the paper's fvV).  It
-        travels to the workers pickled (plain data); the manifest and every
-        record say which law ran (:mod:`comparisons.sweep.law`).
-    coef : (str, sequence of float), optional
-        ``(name, values)``: a coefficient of the family law ``force`` swept as a
-        third grid axis (I x V x values; one I or one V to sweep the
-        coefficient instead of it), e.g. ``force=PeelForce.cubic(),
-        coef=("c", [250, 300, 350])``.  Each record holds its ``coef`` value and
-        its law; :meth:`SweepResult.values` arrays are then 3-D.
+        True: rate-limited progress with an ETA on stderr; a callable gets ``(done, total, record)``.
+    resume, retry_failed : bool
+        Skip the finished points of the same sweep in ``out`` (another sweep there is a ValueError naming what
+        differs; ``resume=False`` refuses a non-empty ``out``); compute its failed points again.
+    force, coef : PeelForce, (str, sequence of float), optional
+        The law at every point (default fvV), and a coefficient of that family law swept as a third axis.
     max_wall : float or None
-        Wall-clock budget [s] of this call (None: unbounded; default
-        :data:`exact.DEFAULT_MAX_WALL`, 3600 s).  Each point's measures get what
-        is left of it as the option ``max_wall`` (the built-ins pass it on to
-        their runs); once it is spent no point is started, and the points it
-        cut are not recorded.  The records written stay in ``out``, and the
-        call raises ``SolverBudgetExceeded`` (``budget="max_wall"``, a
-        RuntimeError, ``partial`` the :class:`SweepResult` so far): calling
-        :func:`sweep` again with the same arguments computes the rest.  The
-        deadline is a time of the system clock, shared by the workers of a
-        cluster to their clocks' skew; a registered measure that ignores the
-        option ends its point in its own time.
+        Wall-clock budget [s] (default :data:`exact.DEFAULT_MAX_WALL`); each point's measures get what is left as
+        the option ``max_wall``.  Once spent no point starts and the points it cut are not recorded.
 
     Returns
     -------
     SweepResult
-        All records in ``out`` (the resumed and the new ones).
+        All records in ``out``, the resumed and the new ones.
 
     Raises
     ------
     ValueError
-        Invalid arguments or options (naming the argument or option and its
-        valid range), unknown measures (listing the known ones), a measure
-        the workers can neither import nor be sent, an ``out`` holding
-        another sweep, a malformed or symbolically linked file in ``out``, an
-        ``out`` this process cannot write while points remain to compute.
+        An invalid argument or option, unknown measure, or unusable ``out``, before anything is written.
     RuntimeError
-        ``out`` is locked by another sweep; or tasks were lost to the
-        executor (a worker died): the records written stay, and calling
-        :func:`sweep` again computes the lost points.
+        ``out`` is locked by another sweep, or a worker died (the records written stay: call again).
     peelapprox.SolverBudgetExceeded
-        ``max_wall`` was spent (a RuntimeError; above).
-
-    Notes
-    -----
-    A point whose measure raises is recorded with ``status = "error: ..."``
-    and the sweep goes on; such points count as finished on resume unless
-    ``retry_failed=True``.  Nothing is written before every argument and
-    option has been checked; with every point left to compute, the manifest
-    is written before the first one.
+        ``max_wall`` was spent; ``partial`` is the result so far, and the same call again computes the rest.
     """
     t0 = time.time()
     sizes = {"I_values": grid_length(I_values), "V_values": grid_length(V_values)}
@@ -210,12 +161,11 @@ def sweep(
         raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
     if not (isinstance(progress, bool) or progress is None or callable(progress)):
         raise ValueError("progress must be a bool, None or a callable (done, total, record)")
-    for name, flag in (("resume", resume), ("retry_failed", retry_failed)):
-        if not isinstance(flag, bool):
-            raise ValueError(f"{name} must be True or False, got {flag!r}")
+    resume = flag("resume", resume)
+    retry_failed = flag("retry_failed", retry_failed)
     if max_workers == 0:
         executor = SERIAL
-    refs = {name: _ref(MEASURES[name]) for name in measures}
+    refs = {name: measure_ref(MEASURES[name]) for name in measures}
     task_refs = refs if executor == SERIAL else worker_refs(measures)
 
     out = _path("out", out)
@@ -249,7 +199,7 @@ def _check_options(measures: Sequence[str], options: Mapping, force: PeelForce |
             from None
     frozen = MappingProxyType(options)
     for name in measures:
-        check = _OPTION_CHECKS.get(name)
+        check = OPTION_CHECKS.get(name)
         if check is not None:
             try:
                 check(frozen)

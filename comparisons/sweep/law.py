@@ -1,4 +1,4 @@
-"""The peel-force law of a sweep (issue 15): one law at every point, or a family coefficient as a third axis.
+"""The peel-force law of a sweep: one law at every point, or a family coefficient as a third axis.
 
 A sweep runs the law ``force`` (a :class:`peelapprox.PeelForce`; default the paper's fvV) at every point.  With
 ``coef=(name, values)`` the coefficient ``name`` of a family law (``PeelForce.family``, e.g. ``c`` of

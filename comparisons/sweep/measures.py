@@ -11,7 +11,13 @@ calls it before the first point:
 
 The built-ins: ``regime`` (:func:`peelapprox.estimate`, closed form), ``jumps`` (jump statistics of one
 windowed exact run), ``period`` (the return map's period over the same run), ``lyapunov`` (the largest
-Lyapunov exponent of :func:`peelapprox.lyapunov`, bits/s).
+Lyapunov exponent of :func:`peelapprox.lyapunov`, bits/s).  Their options: ``jumps`` and ``period`` share
+the one run of :func:`exact.window_run` and read ``t_transient`` (30 s), ``t_end`` (t_transient + 20 s),
+``rtol`` (1e-10) and ``alpha0`` (0), ``period`` also ``period_rtol``; ``lyapunov`` reads ``t_transient`` and
+``lyapunov_time`` (50 s); ``solver`` (default: the method's) is the scipy solver of a model variant's runs,
+one of :func:`solvers`.  The engine reads the other :class:`~peelapprox.PeelParams` fields (``k, R, l,
+geometry`` and the variant's ``tape_mass, loading, load_mass, load``) and adds ``max_wall``, what is left of
+the sweep's wall-clock budget, which the built-ins pass on to their runs.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from exact import lyapunov, window_run
+from exact import METHODS, lyapunov, window_run
 from peelapprox import (
     LYAPUNOV_TAU,
     T_TRANSIENT,
@@ -48,13 +54,15 @@ OptionCheck = Callable[[Mapping], Any]
 
 #: name -> measure function.  Add entries with :func:`register_measure`.
 MEASURES: dict[str, Measure] = {}
-#: name -> its options check (``check_options`` of :func:`register_measure`).
-_OPTION_CHECKS: dict[str, OptionCheck] = {}
+#: name -> its options check (``check_options`` of :func:`register_measure`), called by the engine before the
+#: first point.
+OPTION_CHECKS: dict[str, OptionCheck] = {}
 
 _NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
-def _ref(fn: Callable) -> str:
+def measure_ref(fn: Callable) -> str:
+    """How workers import ``fn``: ``"module:qualname"`` (the manifest's ``measure_refs``)."""
     return f"{getattr(fn, '__module__', '?')}:{getattr(fn, '__qualname__', '?')}"
 
 
@@ -96,13 +104,14 @@ def register_measure(name: str, fn: Measure | None = None, *, replace: bool = Fa
     if check_options is not None and not callable(check_options):
         raise ValueError(f"measure {name!r}: check_options must be callable (options) or None, got {check_options!r}")
     old = MEASURES.get(name)
-    if old is not None and old is not fn and _ref(old) != _ref(fn) and not replace:
-        raise ValueError(f"measure {name!r} is already registered as {_ref(old)}; pass replace=True to replace it")
+    if old is not None and old is not fn and measure_ref(old) != measure_ref(fn) and not replace:
+        raise ValueError(f"measure {name!r} is already registered as {measure_ref(old)}; "
+                         "pass replace=True to replace it")
     MEASURES[name] = fn
     if check_options is None:
-        _OPTION_CHECKS.pop(name, None)
+        OPTION_CHECKS.pop(name, None)
     else:
-        _OPTION_CHECKS[name] = check_options
+        OPTION_CHECKS[name] = check_options
     return fn
 
 
@@ -170,14 +179,20 @@ def _measure_jumps(params: PeelParams, options: Mapping) -> dict:
     }
 
 
-#: The scipy solvers of a model variant's method (option ``solver``).
-SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
+def solvers() -> tuple[str, ...]:
+    """The valid values of the option ``solver``: every scipy solver of :data:`exact.METHODS`, read when an
+    option is checked (so a method added to the table is accepted)."""
+    return tuple(dict.fromkeys(s for m in METHODS.values() for s in m.solvers))
+
+
+def _check_solver(options: Mapping) -> str | None:
+    return optional(choice, "solver", options.get("solver"), solvers())
 
 
 def _solver(params: PeelParams, options: Mapping) -> dict:
     """``{"solver": options["solver"]}`` for a model variant's runs (``params.variant``), else ``{}`` (the
     hybrid method has its own integrator); the option checked (ValueError naming it and the solvers)."""
-    solver = optional(choice, "solver", options.get("solver"), SOLVERS)
+    solver = _check_solver(options)
     return {"solver": solver} if solver is not None and params.variant is not None else {}
 
 
@@ -191,7 +206,7 @@ def _window_options(options) -> dict:
     ``solver`` checked here, passed by :func:`_solver`),
     checked by the same validators as :func:`window_run` (ValueError/TypeError naming the option and its valid
     range; the sweep calls this before the first point)."""
-    optional(choice, "solver", options.get("solver"), SOLVERS)
+    _check_solver(options)
     kw = dict(WINDOW_DEFAULTS)
     kw.update({key: options[key] for key in kw if options.get(key) is not None})
     kw["t_transient"] = duration("t_transient", kw["t_transient"], zero=True)
@@ -222,7 +237,7 @@ def _lyapunov_options(options) -> dict:
             "lyapunov_time": in_range("lyapunov_time", options.get("lyapunov_time", 50.0), 2 * LYAPUNOV_TAU,
                                       TIME_MAX),
             "alpha0": state("alpha0", options.get("alpha0", 0.0), "alpha"),
-            "solver": optional(choice, "solver", options.get("solver"), SOLVERS)}
+            "solver": _check_solver(options)}
 
 
 def measure_period(params: PeelParams, options) -> dict:

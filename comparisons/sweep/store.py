@@ -1,9 +1,20 @@
-"""The on-disk format of a sweep: manifest, records and lock (the files are described in :mod:`comparisons.sweep`).
+"""The on-disk format of a sweep: the output directory ``out`` and its three files.
+
+``out/sweep.json``, the manifest: grid values, measures, options, each measure's import reference, package
+versions, creation time; written once, atomically, before the first point.  ``out/results.jsonl``: one JSON
+object per finished point, in completion order: ``I``, ``V``, ``status``, then the measures' keys (no timings
+or host names: the same inputs give the same records; non-finite floats as ``NaN``/``Infinity``).
+``status`` is ``"ok"`` when every measure is, else the first ``"error: <Type>: <message>"`` of a measure that
+raised (recorded as ``"<name>_status"`` too; the others still run), else the first non-ok status a measure
+reported (e.g. ``"breakdown:no_root"``, a result).  Error points count as finished on resume;
+``retry_failed`` drops their records (rewriting the file atomically) and computes them again.
+``out/.lock`` is held (``flock``) while a sweep writes, so two sweeps cannot share ``out``.
 
 Every file is opened without following a symbolic link (``os.O_NOFOLLOW``) and must be a regular file, so
 a link planted in the output directory cannot redirect a write (or a read) out of it.  Whatever is read is
 checked before use: a crafted or corrupted manifest or record is one ``ValueError`` saying which file (and
-line) is malformed and why, never another exception further on.
+line) is malformed and why, never another exception further on.  A directory this process cannot write is
+read only: a complete sweep there is returned, computing anything there is a ValueError.
 """
 
 from __future__ import annotations

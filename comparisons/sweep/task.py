@@ -22,7 +22,7 @@ from peelapprox.io import jsonable
 
 from .._worker import error_text
 from .law import LAW_KEYS, law_fields, point_law
-from .measures import MEASURES, Measure, _ref, record_key
+from .measures import MEASURES, Measure, measure_ref, record_key
 from .store import RESERVED
 
 __all__ = ["NOT_RUN", "PARAM_OPTIONS", "import_ref", "run_point", "make_params", "worker_refs"]
@@ -60,7 +60,7 @@ def _resolve(name: str, ref: None | str | bytes) -> Measure:
                               "or define the measure in an importable module") from None
     if ref is not None:
         fn = MEASURES.get(name)
-        if fn is not None and _ref(fn) == ref:
+        if fn is not None and measure_ref(fn) == ref:
             return fn
         try:
             return import_ref(ref)
@@ -158,11 +158,11 @@ def _cloudpickle() -> ModuleType | None:
 
 def _importable(fn: Callable) -> bool:
     """Whether a worker process can import ``fn`` by its ``module:qualname`` (as this process resolves it)."""
-    mod, _, qual = _ref(fn).partition(":")
+    mod, _, qual = measure_ref(fn).partition(":")
     if mod in ("__main__", "__mp_main__", "?") or "<" in qual:
         return False
     try:
-        return import_ref(_ref(fn)) is fn
+        return import_ref(measure_ref(fn)) is fn
     except Exception:
         return False
 
@@ -170,7 +170,7 @@ def _importable(fn: Callable) -> bool:
 def worker_refs(measures: Sequence[str]) -> dict[str, str | bytes]:
     """What the workers get for each measure: its import reference, or its cloudpickle bytes if they could not
     import it.  ValueError (before any point runs) if such a measure cannot be shipped."""
-    refs: dict[str, str | bytes] = {name: _ref(MEASURES[name]) for name in measures}
+    refs: dict[str, str | bytes] = {name: measure_ref(MEASURES[name]) for name in measures}
     lone = [name for name in measures if not _importable(MEASURES[name])]
     if not lone:
         return refs

@@ -11,7 +11,7 @@ import re
 import sys
 import textwrap
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any, NoReturn
 
 from .. import GEOMETRIES, GRAVITY, LOAD_MASS_RANGE, LOAD_RANGE, LOADINGS, TAPE_MASS_RANGE, PeelForce, PeelParams
@@ -22,9 +22,10 @@ from ..io import fmt_number, write_csv, write_rows
 from ._checks import clip, positive_float
 from ._force import add_force_options, force_from_args, law_fields
 
-__all__ = ["FORMATS", "HYBRID_ONLY", "MAX_WALL", "NEGATIVE_NUMBER", "ArgumentParser", "HelpFormatter", "REDUCED_ONLY",
-           "UNITS", "add_format", "add_max_wall_option", "add_params", "add_variant_options", "params_from_args",
-           "print_mapping", "variant_summary", "say", "subcommand", "wall_left", "wall_spent", "write_table"]
+__all__ = ["FORMATS", "HYBRID_ONLY", "MAX_WALL", "NEGATIVE_NUMBER", "ArgumentParser", "FromMethods", "HelpFormatter",
+           "HelpFromMethods", "REDUCED_ONLY", "UNITS", "add_format", "add_max_wall_option", "add_params",
+           "add_variant_options", "methods", "params_from_args", "print_mapping", "scipy_solvers", "variant_summary",
+           "say", "subcommand", "wall_left", "wall_spent", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
 #: header and one row), ``json``.
@@ -35,6 +36,54 @@ FORMATS = ("table", "csv", "json")
 #: argparse's own rule (``^-\d+$|^-\d*\.\d+$`` before Python 3.13) misses the exponent form, so ``--I -1e-5``
 #: was read as an unknown option ``-1e-5`` and ``--I`` as missing its value ("expected one argument").
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
+def methods() -> Mapping[str, Any]:
+    """exact's table of solver methods (name -> class), imported when first needed."""
+    from exact import METHODS
+
+    return METHODS
+
+
+class FromMethods(Sequence[str]):
+    """A list read from the table of solver methods when argparse first needs it (to check a value or to print
+    the help): building the parser loads no ``exact``."""
+
+    def __init__(self, read: Callable[[Mapping[str, Any]], Iterable[str]]):
+        self._read: Callable[[Mapping[str, Any]], Iterable[str]] = read
+        self._items: tuple[str, ...] | None = None
+
+    def _all(self) -> tuple[str, ...]:
+        if self._items is None:
+            self._items = tuple(self._read(methods()))
+        return self._items
+
+    def __getitem__(self, i):  # type: ignore[override]
+        return self._all()[i]
+
+    def __len__(self) -> int:
+        return len(self._all())
+
+    def __repr__(self) -> str:
+        return repr(self._all())
+
+
+class HelpFromMethods(str):
+    """An option's help written from the table of solver methods when printed (argparse formats a help as
+    ``help % params``); ``short`` stands for it until then."""
+
+    def __new__(cls, short: str, write: Callable[[Mapping[str, Any]], str]) -> HelpFromMethods:
+        obj = super().__new__(cls, short)
+        obj._write = write  # type: ignore[attr-defined]
+        return obj
+
+    def __mod__(self, params: Any) -> str:
+        return self._write(methods()) % params  # type: ignore[attr-defined]
+
+
+def scipy_solvers(table: Mapping[str, Any]) -> Iterable[str]:
+    """Every scipy solver of the methods in ``table``, in its order (the valid ``--solver`` values)."""
+    return dict.fromkeys(s for m in table.values() for s in m.solvers)
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -112,8 +161,8 @@ def wall_left(wall: WallBudget) -> float | None:
 
 
 def add_variant_options(v: Any, *, loading_default: str | None = "velocity") -> None:
-    """The model variant's options ``--tape-mass --loading --load-mass --load`` (issue 18) in the argument group
-    ``v``; ``loading_default=None`` for a command that records only the options given (``sweep``)."""
+    """The model variant's options ``--tape-mass --loading --load-mass --load`` (docs/tape-mass.md) in the
+    argument group ``v``; ``loading_default=None`` for a command that records only the options given (``sweep``)."""
     v.add_argument("--tape-mass", type=float, default=None, metavar="KG",
                    help=f"mass m of the peeled ribbon [kg], in [{TAPE_MASS_RANGE[0]:g}, {TAPE_MASS_RANGE[1]:g}]: "
                         "the tape-mass model, a smooth ODE (method smooth) (default: none, the paper's massless "
@@ -133,8 +182,8 @@ def add_variant_options(v: Any, *, loading_default: str | None = "velocity") -> 
 def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True, variants: str | None = None) -> None:
     """The options ``--V --I --k --R`` of :class:`peelapprox.PeelParams` and, with ``geometry`` (for the exact
     model; the reduced equations are the paper's linear closure), ``--l --geometry``, its law ``force``
-    (:func:`peelapprox.cli._force.add_force_options`) and the model variant (issue 18): ``--tape-mass
-    --loading --load-mass --load``; :func:`params_from_args` builds them.
+    (:func:`peelapprox.cli._force.add_force_options`) and the model variant (a tape mass, a load):
+    ``--tape-mass --loading --load-mass --load``; :func:`params_from_args` builds them.
 
     ``variants``: None if the subcommand runs the variants; else why it does not (e.g. "runs the paper's reduced
     equations, derived for the massless tape under velocity control"): the variant options are still there,

@@ -1,4 +1,4 @@
-"""The peel-force law on the command line: ``--force``, ``--force-table``, ``--force-family`` (issue 15).
+"""The peel-force law on the command line: ``--force``, ``--force-table``, ``--force-family`` (a tape's own law).
 
 Every subcommand that builds a :class:`peelapprox.PeelParams` takes one law (:func:`add_force_options`,
 called by :func:`peelapprox.cli._common.add_params`), at most one of

@@ -4,58 +4,25 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import fields
 from typing import Any
 
 from ._checks import check_output_path, positive_float, positive_int
-from ._common import add_format, add_params, params_from_args, print_mapping, subcommand, variant_summary
+from ._common import (
+    FromMethods,
+    HelpFromMethods,
+    add_format,
+    add_params,
+    params_from_args,
+    print_mapping,
+    scipy_solvers,
+    subcommand,
+    variant_summary,
+)
 from ._force import law_fields
 
 __all__ = ["add_parser", "run"]
-
-
-def _methods() -> Mapping[str, Any]:
-    """exact's table of solver methods (name -> class), imported when first needed."""
-    from exact import METHODS
-
-    return METHODS
-
-
-class _FromMethods(Sequence[str]):
-    """A list read from the table of solver methods when argparse first needs it (to check a value or to print
-    the help): building the parser loads no ``exact``."""
-
-    def __init__(self, read: Callable[[Mapping[str, Any]], Iterable[str]]):
-        self._read: Callable[[Mapping[str, Any]], Iterable[str]] = read
-        self._items: tuple[str, ...] | None = None
-
-    def _all(self) -> tuple[str, ...]:
-        if self._items is None:
-            self._items = tuple(self._read(_methods()))
-        return self._items
-
-    def __getitem__(self, i):  # type: ignore[override]
-        return self._all()[i]
-
-    def __len__(self) -> int:
-        return len(self._all())
-
-    def __repr__(self) -> str:
-        return repr(self._all())
-
-
-class _HelpFromMethods(str):
-    """An option's help written from the table of solver methods when printed (argparse formats a help as
-    ``help % params``); ``short`` stands for it until then."""
-
-    def __new__(cls, short: str, write: Callable[[Mapping[str, Any]], str]) -> _HelpFromMethods:
-        obj = super().__new__(cls, short)
-        obj._write = write  # type: ignore[attr-defined]
-        return obj
-
-    def __mod__(self, params: Any) -> str:
-        return self._write(_methods()) % params  # type: ignore[attr-defined]
 
 
 def _default_solver(method: Any) -> str:
@@ -96,10 +63,10 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g.add_argument("--F0", type=float, default=None, help="initial pull force [N] (default: 1.01 f(V, V))")
     g.add_argument("--branch0", choices=("AB", "CD"), default=None,
                    help="initial branch of f (default: the lowest-velocity stable root)")
-    g.add_argument("--method", choices=_FromMethods(lambda methods: methods), default=None,
-                   help=_HelpFromMethods("the solver method", _method_help))
-    g.add_argument("--solver", default=None, help=_HelpFromMethods("the scipy solver", _solver_help),
-                   choices=_FromMethods(lambda methods: dict.fromkeys(s for m in methods.values() for s in m.solvers)))
+    g.add_argument("--method", choices=FromMethods(lambda methods: methods), default=None,
+                   help=HelpFromMethods("the solver method", _method_help))
+    g.add_argument("--solver", default=None, help=HelpFromMethods("the scipy solver", _solver_help),
+                   choices=FromMethods(scipy_solvers))
     g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the integration")
     g.add_argument("--eps", type=float, default=None,
                    help="the paper's regularisation parameter epsilon of --method regularized (default: 1e-7)")

@@ -10,7 +10,7 @@ import time
 
 from .. import GEOMETRIES
 from ._checks import check_output_path, check_sweep_plot_key, nonnegative_int, positive_int, worker_pool
-from ._common import add_max_wall_option, add_variant_options, subcommand
+from ._common import FromMethods, add_max_wall_option, add_variant_options, scipy_solvers, subcommand
 from ._force import add_force_options, force_from_args
 
 __all__ = ["MEASURES_HELP", "add_parser", "run"]
@@ -84,7 +84,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                               "jumps, period and lyapunov run it, regime refuses it; to sweep m, one sweep per "
                               "mass into its own --out)")
     add_variant_options(v, loading_default=None)
-    v.add_argument("--solver", choices=("LSODA", "Radau", "BDF", "DOP853", "RK45"), default=None,
+    v.add_argument("--solver", choices=FromMethods(scipy_solvers), default=None,
                    help="the variant's scipy solver (default: the method's, LSODA for a tape mass)")
     sw.add_argument("--retry-failed", action="store_true",
                     help="compute again the points of DIR whose status is an error (else they count as done)")

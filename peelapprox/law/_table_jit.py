@@ -5,64 +5,13 @@ cached on disk): its coefficients ``coef`` are the packed tables of a ``PeelForc
 pull speed V, built by :func:`table_coefficients`.  A new table, of any length, is new data and recompiles
 nothing.  It plays the part of Eq. (fvV) for a measured curve.
 
-What it evaluates
------------------
-Exactly the piecewise cubic that :class:`~peelapprox.law._table.TableLaw` evaluates with scipy: for each table
-the :class:`~scipy.interpolate.PchipInterpolator` of f in ``u = ln v`` (its breakpoints ``.x`` and its
-coefficients ``.c`` are packed as they are), evaluated on the interval ``x[i] <= u < x[i+1]`` (the last one
-closed at the right, as scipy's ``find_interval``), found by binary search between the bounds of a guide
-(below), at ``s = u - x[i]`` in the order
-of operations of scipy's ``PPoly`` (``_ppoly.evaluate_poly1``: the power sum in ascending powers, not
-Horner)::
-
-    p   = ((c3 + c2 s) + c1 (s s)) + c0 ((s s) s)
-    p'  = (c2 + (c1 s) 2) + (c0 (s s)) 3
-    p'' = c1 2 + (c0 s) 6
-
-with ``c0..c3 = c[0..3, i]`` (highest power first).  Several tables at several V are combined linearly in V
-with the weights of ``TableLaw._weights`` (one table, or the two around V), summed as TableLaw sums them:
-``f = w0 p_0 + w1 p_1`` (likewise p', p'').  The derivatives in v follow from ``u = ln v``::
-
-    f'(v) = p'(u) / v,      f''(v) = (p''(u) - p'(u)) / v²
-
-and the three forms are ``LAW_LNV: (v, f, p'(u))`` (p'(u) is ``v f'(v)``), ``LAW_FP: (f, f', NaN)``,
-``LAW_FPP: (f, f', f'')``.  With one table, at the same u, the numbers are scipy's bitwise (the same
-operations in the same order; tests/test_law_table_jit.py); with two, the sum is formed in u before the
-division by v, so f' and f'' differ from TableLaw's by rounding; in the forms that take v, ``u = ln v`` is
-numba's log, which may differ from numpy's by an ulp.
-
-Outside the table: a C¹ continuation for the solvers, not extrapolation
--------------------------------------------------------------------------
-A tabulated law is **not extrapolated**: ``PeelForce``/``TableLaw`` refuse a v outside the tables' common
-range ``[lo, hi]`` and the drivers stop a run that leaves it (the law's domain).  But a Runge-Kutta step
-evaluates its stages before it can see that, and they must get finite numbers, so outside ``[ln lo, ln hi]``
-this law continues C¹-linearly in u from the nearer end ``u0``::
-
-    f(u) = f(u0) + p'(u0) (u - u0),     p'(u) = p'(u0),     p''(u) = 0
-
-(f and f' are continuous at the ends; f'' jumps there, as it does at every knot).  These numbers only keep a
-stage finite; no result of a run may rest on them.  (A NaN argument, or v <= 0 in the forms that take v, gives
-non-finite numbers, never a read outside ``coef``; the drivers pass neither.)
-
-The coefficient vector (:func:`table_coefficients`)
---------------------------------------------------
-``coef = [m, ln lo, ln hi, block_1, ..., block_m]`` with ``m`` in {1, 2} the number of tables used at V
-(those of nonzero weight) and ``[lo, hi]`` the common v range of **all** the law's tables (TableLaw's
-``v_range()``, whatever V), then for each table used a block::
-
-    [w, n, r, x_0 .. x_{n-1}, g_0 .. g_{n-1}, c[0,0], c[1,0], c[2,0], c[3,0], ..., c[0,n-2], .., c[3,n-2]]
-
-its weight ``w``, its number of knots ``n`` (a float holding an integer), ``r = (n - 1) / (x_{n-1} - x_0)``, its
-knots in u (``PchipInterpolator.x``), the guide ``g`` of the interval search and the four coefficients of each
-of its ``n - 1`` intervals, interval by interval (``.c[:, i]``, highest power first); a block is ``6 n - 1``
-numbers long.  The guide cuts ``[x_0, x_{n-1}]`` into ``n - 1`` equal cells (``r`` per unit of u): ``g_j`` is the
-interval holding the left edge of cell j (``g_{n-1} = n - 2``), so the interval of a u in cell
-``j = int((u - x_0) r)`` lies in ``[g_j, g_{j+1}]``: the bisection looks at the knots in that cell only, none
-or one for knots spread evenly in ln v, ``log2`` of their number where knots bunch.  So the cost of a call
-hardly grows with the length of an even table, nor depends on where the previous call was (a bisection over
-the whole table costs ``log2 n`` steps, mispredicted when successive calls are far apart: measured in
-comparisons/benchmark/table_cost.py).  The kernel reads only what :func:`table_coefficients` wrote:
-a vector from elsewhere is not checked (numba does not check bounds).
+It evaluates exactly the piecewise cubic that :class:`~peelapprox.law._table.TableLaw` evaluates with scipy (the
+PCHIP of f in ``u = ln v``, in scipy's order of operations: :func:`_pchip_sums`), so with one table the numbers
+are scipy's bitwise (tests/test_law_table_jit.py).  It is **not extrapolated**: ``PeelForce`` refuses a v
+outside the tables' common range and the drivers stop a run that leaves it, but a Runge-Kutta stage evaluated
+there still gets finite numbers (:func:`table_law`).  The interval of a u is found by bisection between the
+bounds of a guide (:func:`_interval`), so a call's cost hardly grows with the length of an even table
+(measured in comparisons/benchmark/table_cost.py).
 """
 
 from __future__ import annotations
@@ -76,6 +25,13 @@ from ._table import TableLaw, check_tables
 __all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "table_law", "table_coefficients"]
 
 #: Indices of the header of ``coef``: the number of tables used, ln lo, ln hi; the first block starts at T_HEAD.
+#: ``coef = [m, ln lo, ln hi, block_1, ..., block_m]``: ``m`` in {1, 2} tables of nonzero weight at V, ``[lo,
+#: hi]`` the common v range of **all** the law's tables (``TableLaw.v_range()``, whatever V), then per table
+#: ``[w, n, r, x_0 .. x_{n-1}, g_0 .. g_{n-1}, c[0,0], c[1,0], c[2,0], c[3,0], ..., c[3,n-2]]``: its weight, its
+#: number of knots (a float holding an integer), ``r = (n - 1) / (x_{n-1} - x_0)`` (guide cells per unit of u),
+#: its knots in u (``PchipInterpolator.x``), the guide of :func:`_interval`, and the four coefficients of each of
+#: its ``n - 1`` intervals (``.c[:, i]``, highest power first): ``6 n - 1`` numbers.  The kernel reads only what
+#: :func:`table_coefficients` wrote; a vector from elsewhere is not checked (numba does not check bounds).
 T_COUNT, T_ULO, T_UHI, T_HEAD = 0, 1, 2, 3
 
 
@@ -87,7 +43,8 @@ def _interval(coef, xo, go, n, ginv, u):
     The guide ``coef[go:go+n]`` holds, for each of the ``n - 1`` equal cells of ``[x[0], x[n-1]]`` (``ginv`` is
     cells per unit of u), the interval holding the cell's left edge (and ``n - 2`` for the right end): the
     interval of u lies between the guide entries of its cell and of the next, one or two intervals apart
-    for evenly spread knots.  Should rounding put u in a neighbouring cell, the bounds are widened to the
+    for evenly spread knots (a bisection over the whole table costs ``log2 n`` steps, mispredicted when
+    successive calls are far apart).  Should rounding put u in a neighbouring cell, the bounds are widened to the
     table's end on that side (the answer stays exact, only slower)."""
     j = int((u - coef[xo]) * ginv)
     if j > n - 2:
@@ -111,7 +68,18 @@ def _interval(coef, xo, go, n, ginv, u):
 
 @kernel(inline="always")
 def _pchip_sums(coef, u):
-    """``(Σ w p, Σ w p', Σ w p'')`` of the packed tables at ``u`` in ``[ln lo, ln hi]`` (module docstring)."""
+    """``(Σ w p, Σ w p', Σ w p'')`` of the packed tables at ``u`` in ``[ln lo, ln hi]``.
+
+    Each table's PCHIP of f in u (scipy's :class:`~scipy.interpolate.PchipInterpolator`) on its interval
+    ``x[i] <= u < x[i+1]`` (the last closed at the right, as scipy's ``find_interval``), at ``s = u - x[i]``, in
+    the order of operations of scipy's ``PPoly`` (``_ppoly.evaluate_poly1``: ascending powers, not Horner)::
+
+        p   = ((c3 + c2 s) + c1 (s s)) + c0 ((s s) s)
+        p'  = (c2 + (c1 s) 2) + (c0 (s s)) 3
+        p'' = c1 2 + (c0 s) 6
+
+    with ``c0..c3 = c[0..3, i]``; two tables (the two around V) are summed with ``TableLaw._weights``' weights,
+    as TableLaw sums them, so one table gives scipy's numbers bitwise and two differ by rounding."""
     F = 0.0
     D = 0.0
     D2 = 0.0
@@ -142,8 +110,14 @@ def _pchip_sums(coef, u):
 @kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a tabulated law: the default path needs none
 def table_law(x, coef, form):
     """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox.law._abi`), ``coef`` from
-    :func:`table_coefficients`: PCHIP in ``u = ln v`` as scipy evaluates it, continued C¹-linearly in u outside
-    the tables' common range (for Runge-Kutta stages only: module docstring)."""
+    :func:`table_coefficients`: ``LAW_LNV: (v, f, p'(u))`` (p' is ``v f'(v)``), ``LAW_FP: (f, f', NaN)``,
+    ``LAW_FPP: (f, f', f'')`` with ``f' = p'/v`` and ``f'' = (p'' - p')/v²`` (``u = ln v`` by numba's log, which
+    may differ from numpy's by an ulp).
+
+    Outside ``[ln lo, ln hi]`` the law is continued C¹-linearly in u from the nearer end ``u0``, ``f(u) = f(u0) +
+    p'(u0) (u - u0)``, ``p'' = 0``: only so that a Runge-Kutta stage evaluated there before the driver stops the
+    run gets finite numbers; no result may rest on them.  A NaN argument (or v <= 0) gives non-finite numbers,
+    never a read outside ``coef``."""
     if form == LAW_LNV:
         u = x
         v = np.exp(x)
@@ -152,7 +126,7 @@ def table_law(x, coef, form):
         u = np.log(x)
     ulo = coef[T_ULO]
     uhi = coef[T_UHI]
-    if not (ulo <= u <= uhi):  # the C¹ continuation (module docstring); NaN: NaN, never an index from it
+    if not (ulo <= u <= uhi):  # the C¹ continuation (docstring); NaN: NaN, never an index from it
         u0 = ulo if u < ulo else uhi
         F, D, _ = _pchip_sums(coef, u0)
         F = F + D * (u - u0)
@@ -175,7 +149,7 @@ def _guide(x: np.ndarray) -> np.ndarray:
 
 
 def table_coefficients(tables, V: float) -> np.ndarray:
-    """``coef`` of :func:`table_law` for a tabulated law at the pull speed V (layout: module docstring).
+    """``coef`` of :func:`table_law` for a tabulated law at the pull speed V (layout: :data:`T_HEAD`).
 
     Parameters
     ----------

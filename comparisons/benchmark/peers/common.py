@@ -138,46 +138,33 @@ def run_peer(
         See :mod:`comparisons.benchmark.peers`.
     params : PeelParams
         Physical parameters and ``geometry`` (closure of ``cos θ``).
-    t_end : float
-        Final time [s], > 0.
-    eps : float
-        Regularisation ε > 0 (the paper: 1e-7).
-    rtol : float
-        Relative tolerance, in (0, 1).
+    t_end, eps, rtol : float
+        Final time [s], > 0; regularisation ε > 0 (the paper: 1e-7); relative tolerance in (0, 1).
     atol : None, float or 4 floats, optional
-        Absolute tolerances for ``(α, ω, F, v)``, all > 0; default
-        ``rtol * exact.ATOL_SCALE["regularized"]`` as in
+        Absolute tolerances of ``(α, ω, F, v)``, > 0; default ``rtol * exact.ATOL_SCALE["regularized"]``, as
         ``exact.simulate(method="regularized")``.
     alpha0 : float
-        Initial α; the rest of the initial state is
-        :func:`exact.initial_state` ``(params, alpha0=alpha0)``.
+        Initial α; the rest of the start is :func:`exact.initial_state` ``(params, alpha0=alpha0)``.
 
     Returns
     -------
     PeerResult
-        Crossings of the inflection velocity, counters and timings.  A solver
-        failure does not raise: ``status`` is ``"failed: <message>"``.
+        Crossings of the inflection velocity, counters and timings.  A solver failure does not raise:
+        ``status`` is ``"failed: <message>"``.
 
     Raises
     ------
     ValueError
-        Unknown ``peer``, ``eps <= 0``, ``rtol`` outside (0, 1), bad
-        ``t_end``/``atol``/``params``, or an ``alpha0`` with no consistent
-        initial state; the message names the argument and its valid range.
+        A bad argument, or an ``alpha0`` with no consistent start; the message names it and its range.
     PeerUnavailableError
-        (an ``ImportError``) if the peer's package is not installed.
+        (an ``ImportError``) The peer's package is not installed.
 
     Notes
     -----
-    Options set beyond tolerances: SUNDIALS ``max_num_steps`` = 1e8 (the
-    whole run is one ``solve``), analytic Jacobians, dense LU, all else at
-    SUNDIALS' defaults (BDF up to order 5).  diffsol:
-    :data:`peelapprox.kernels.DIFFSOL_OPTIONS`.
-    With diffsol's defaults the stale Jacobian across a fold makes Newton
-    fail ("Exceeded maximum number of nonlinear solver failures") at, e.g.,
-    ε = 1e-7, rtol = 1e-6, and the restart after a crossing needs steps
-    below the default ``min_timestep`` = 1e-13 s ("Step size is too small")
-    at ε = 1e-9 or rtol <= 1e-10.
+    SUNDIALS runs with ``max_num_steps`` = 1e8 (the run is one ``solve``), the analytic Jacobian, dense LU, the
+    rest at its defaults (BDF up to order 5); diffsol with :data:`peelapprox.kernels.DIFFSOL_OPTIONS`, since at
+    its defaults the stale Jacobian across a fold fails Newton (ε = 1e-7, rtol = 1e-6) and the restart after a
+    crossing needs steps below ``min_timestep`` = 1e-13 s (ε = 1e-9 or rtol <= 1e-10).
     """
     t_end, eps, rtol, a = _check(peer, params, t_end, eps, rtol, atol)
     s0 = initial_state(params, alpha0=alpha0)

@@ -1,6 +1,7 @@
 """The diffsol peer through pydiffsol: the DiffSL model printed from the symbolic source
 (:func:`peelapprox.kernels.diffsl_code`), JIT-compiled by LLVM, integrated by diffsol's BDF with the mass
-matrix; its root finder stops at the crossings of ``v = v_infl`` (details in :mod:`comparisons.benchmark.peers`)."""
+matrix; its root finder stops at the crossings of ``v = v_infl`` (:mod:`comparisons.benchmark.peers` has the
+common rules)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """The SUNDIALS peers through scikit-sundae: IDA on the residual ``M Ẋ − φ(X)`` and CVODE on ``Ẋ = M⁻¹ φ(X)``,
 both BDF with the analytic Jacobian and dense LU, the crossings of ``v = v_infl`` by their root finders
-(the package docstring, :mod:`comparisons.benchmark.peers`, has the details)."""
+(:mod:`comparisons.benchmark.peers` has the common rules)."""
 
 from __future__ import annotations
 
