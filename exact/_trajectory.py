@@ -24,7 +24,7 @@ _VARIANT_UNITS = {"tape_mass": "kg", "loading": "", "load_mass": "kg", "load": "
 
 
 def _variant_fields(params) -> dict:
-    """The variant fields of ``params`` that are set (issue 18): ``{}`` for the paper's model."""
+    """The variant fields of ``params`` that are set (tape mass, load): ``{}`` for the paper's model."""
     if params.variant is None:
         return {}
     return {n: getattr(params, n) for n in _VARIANT_UNITS if getattr(params, n) is not None}

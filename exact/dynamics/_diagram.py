@@ -1,4 +1,4 @@
-"""The brute-force orbit diagram: the return map's values after a transient over a grid of a parameter (issue 16).
+"""The brute-force orbit diagram: the return map's values after a transient over a grid of a parameter.
 
 :func:`orbit_diagram` runs ``exact.simulate`` at each value of the parameter (V, I, k or a family law's
 coefficient, as :func:`exact.continue_orbit`), drops the transient and keeps F at the AB→CD jumps of the window

@@ -1,4 +1,4 @@
-"""Continuation of a periodic orbit in a parameter, with its bifurcations located (issue 16).
+"""Continuation of a periodic orbit in a parameter, with its bifurcations located.
 
 :func:`continue_orbit` follows a :class:`exact.PeriodicOrbit` in V, I, k or a coefficient of a family law
 (``"force.c"``) by **pseudo-arclength continuation** in ``w = (α, ω R/V, λ/Λ)`` (the first section state,

@@ -1,4 +1,4 @@
-"""The parameter of a continuation and the bordered Newton corrector (issue 16).
+"""The parameter of a continuation and the bordered Newton corrector.
 
 A branch point is ``w = (α, ω R/V, λ/Λ)``: the scaled section state of an orbit's first AB→CD jump and the
 parameter λ (V, I, k or a family law's coefficient) over a scale Λ.  :func:`bordered_newton` solves
