@@ -179,6 +179,63 @@ class PeelForce:
         return cls("tabulated", tables=((V, v, f),))
 
     @classmethod
+    def fit(cls, v: Any, f: Any, family: Any = "cubic", *, sigma: Any = None, V: float | None = None,
+            p0: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float, float]] | None = None) -> PeelForce:
+        """The law of a family (or an expression) whose coefficients fit the points ``(v, f)`` best, with its
+        statistics in ``law.fit_result``.
+
+        Weighted least squares (``scipy.optimize.least_squares``) of ``(f(v_i) - f_i) / sigma_i``; a family is
+        evaluated by numpy (nothing is compiled).  Details: :mod:`peelapprox.law._fit`.
+
+        Parameters
+        ----------
+        v, f : array_like
+            The points: peel velocities [m/s] (> 0, strictly increasing) and forces [N], finite, more of them
+            than fitted coefficients.
+        family : str or PeelForce
+            A family's name or constructor (``"cubic"``, ``"paper_family"``, ``"power_branches"``; start: its
+            defaults), a family law (start: its coefficients), or an expression's text whose constants are the
+            keys of ``p0`` (e.g. ``"a + b*v - c*v**2 + d*v**3"``).
+        sigma : float or array_like, optional
+            Standard deviation [N] of each f (or one for all): chi^2 is then meaningful and the covariance
+            absolute.  None: unit weights, the covariance scaled by the residual variance ``chi^2 / dof``.
+        V : float, optional
+            The pull speed [m/s] of the points: needed by a law that depends on V; where the folds are given
+            (default 1.0 for a V-independent law).
+        p0 : mapping, optional
+            Starting values by name (a family: over its defaults; an expression: required, its constants).
+        bounds : mapping, optional
+            ``{name: (lo, hi)}``; ``lo == hi`` holds that coefficient fixed at that value (not fitted).  A family's
+            positive coefficients are bounded below by 0 anyway.
+
+        Returns
+        -------
+        PeelForce
+            The fitted law, equal to the same law built by hand; ``law.fit_result`` is a
+            :class:`~peelapprox.law._fit.FitResult` (coefficients by name, covariance, standard errors,
+            residuals, chi^2, dof, chi^2/dof, the folds at V with their standard errors by the delta method).
+
+        Raises
+        ------
+        ValueError
+            Naming the argument and index: a NaN or inf, v not > 0 or not strictly increasing (unsorted or
+            duplicate), fewer points than coefficients + 1, a bad sigma, p0 or bounds; an unknown family; a
+            start where the law is not finite; a fit that does not converge; points that do not identify a
+            coefficient (the message names the coefficients involved: fix them with ``bounds`` or add data).
+        TypeError
+            An argument of the wrong type.
+        """
+        from ._fit import fit
+
+        return fit(cls, v, f, family, sigma=sigma, V=V, p0=p0, bounds=bounds)
+
+    @property
+    def fit_result(self) -> Any:
+        """What :meth:`fit` measured (:class:`~peelapprox.law._fit.FitResult`), or None for a law not made by
+        :meth:`fit`.  Not part of the law's value: not compared, hashed, keyed, pickled or in ``asdict``."""
+        return self.__dict__.get("_fit_result")
+
+    @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
         """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated."""
         if not isinstance(d, Mapping):
