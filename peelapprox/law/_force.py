@@ -26,7 +26,7 @@ __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "PeelForce", "law_label", "
 #: The kinds of law.
 KINDS = tuple(KIND_IMPLS)
 #: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
-ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated")
+ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated", "spline")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -39,7 +39,7 @@ class PeelForce:
 
     Attributes
     ----------
-    kind : {"paper", "family", "expression", "tabulated"}
+    kind : {"paper", "family", "expression", "tabulated", "spline"}
     name : str or None
         The family's name (``"paper"``, ``"cubic"``, ``"power_branches"``) of a family law.
     coefficients : tuple of (name, float)
@@ -47,7 +47,7 @@ class PeelForce:
     source : str or None
         An expression law's canonical text (sympy ``srepr``, constants substituted).
     tables : tuple of (V or None, v tuple, f tuple)
-        A tabulated law's tables.
+        A tabulated law's tables; a spline law's one ``(V or None, knots in ln v, B-spline coefficients)``.
     display : str
         What ``repr`` shows of an expression or a table, derived from the canonical content (an expression:
         its canonical text, constants substituted); a ``display`` passed in (e.g. by :meth:`from_dict`) is
@@ -179,8 +179,9 @@ class PeelForce:
         return cls("tabulated", tables=((V, v, f),))
 
     @classmethod
-    def fit(cls, v: Any, f: Any, family: Any = "cubic", *, sigma: Any = None, V: float | None = None,
-            p0: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float, float]] | None = None) -> PeelForce:
+    def fit(cls, v: Any, f: Any, family: Any, *, sigma: Any = None, V: float | None = None,
+            p0: Mapping[str, float] | None = None,
+            bounds: Mapping[str, tuple[float, float]] | None = None) -> PeelForce:
         """The law of a family (or an expression) whose coefficients fit the points ``(v, f)`` best, with its
         statistics in ``law.fit_result``.
 
@@ -234,6 +235,47 @@ class PeelForce:
         """What :meth:`fit` measured (:class:`~peelapprox.law._fit.FitResult`), or None for a law not made by
         :meth:`fit`.  Not part of the law's value: not compared, hashed, keyed, pickled or in ``asdict``."""
         return self.__dict__.get("_fit_result")
+
+    @classmethod
+    def smoothed(cls, v: Any, f: Any, *, lam: float | str = "gcv", V: float | None = None) -> PeelForce:
+        """Noisy measured points smoothed by a C² cubic spline in ln v: a law of kind ``"spline"``.
+
+        scipy's ``make_smoothing_spline`` of f in ``u = ln v`` (knots at the data), then the N shape is checked on
+        the result: exactly one maximum then one minimum inside the data range.  f, f' and f'' are continuous
+        (f'' too, unlike a table's PCHIP), the folds are the roots of the spline's derivative (between data, not
+        at a datum), and a compiled run evaluates it by the table kernel at a table's cost per call.  Details:
+        :mod:`peelapprox.law._spline`.
+
+        Parameters
+        ----------
+        v, f : array_like
+            Peel velocities [m/s] (> 0, strictly increasing) and forces [N], finite, at least 5 points.
+        lam : "gcv" or float
+            The smoothing penalty: ``"gcv"`` chooses it by generalised cross-validation (scipy's ``lam=None``);
+            0 interpolates (a natural cubic spline through the points); larger is smoother.
+        V : float, optional
+            The pull speed [m/s] the points were measured at: the law is then used at that V only; None (default)
+            uses it at every V.
+
+        Returns
+        -------
+        PeelForce
+            Kind ``"spline"``: its ``tables`` hold ``((V, knots in ln v, B-spline coefficients),)``, plain tuples
+            of floats (immutable, hashable, ``dataclasses.asdict``/:meth:`from_dict` round-trip).  Refuses v outside
+            the data range (never extrapolated).
+
+        Raises
+        ------
+        ValueError
+            Naming the argument and index: a NaN or inf, v not > 0 or not strictly increasing (unsorted or
+            duplicate), fewer than 5 points, lengths differ; a bad ``lam`` or V; a smoothed curve that is not
+            N-shaped (the extrema it has are listed: smooth more, with a larger ``lam``).
+        TypeError
+            v or f not arrays of real numbers.
+        """
+        from ._spline import smooth
+
+        return cls("spline", tables=smooth(v, f, lam, V))
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
