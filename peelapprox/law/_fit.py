@@ -373,8 +373,9 @@ def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = No
         return np.where(logs, np.exp(np.where(logs, y, 0.0)), y)
 
     y0 = np.where(logs, np.log(np.where(logs, x0, 1.0)), x0)
-    sol = least_squares(lambda y: res(to_x(y)), y0, jac="3-point", bounds=(blo, bhi), method="trf", x_scale="jac",
-                        ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=200 * (k + 1))
+    with np.errstate(all="ignore"):  # a trial step may overflow: least_squares rejects it and shrinks the region
+        sol = least_squares(lambda y: res(to_x(y)), y0, jac="3-point", bounds=(blo, bhi), method="trf",
+                            x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=200 * (k + 1))
     x = to_x(np.asarray(sol.x, dtype=float))
     if sol.status <= 0 or not np.all(np.isfinite(sol.fun)):
         if np.all(np.isfinite(sol.fun)):
