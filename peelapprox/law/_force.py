@@ -278,6 +278,46 @@ class PeelForce:
         return cls("spline", tables=smooth(v, f, lam, V))
 
     @classmethod
+    def from_csv(cls, path: Any, *, columns: Any = None, delimiter: str | None = None) -> PeelForce:
+        """The tabulated law (:meth:`tabulated`) of a CSV file's peel-force curve(s).
+
+        The header names the columns ``v`` and ``f``, or ``V``, ``v`` and ``f`` (one table per pull speed V, the
+        rows of a V in file order), in any order, each optionally with its unit -- ``v [m/s]``, ``v [mm/s]``,
+        ``f [N]``, ``f (kN)``, ... (:data:`peelapprox._csvread.UNITS`): converted to m/s and N; an unknown unit or
+        one of another dimension is refused, named.  ``#`` starts a comment; blank lines are skipped.  The file
+        must be a regular UTF-8 file of at most 16 MiB (a spreadsheet's byte-order mark is fine).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        columns : mapping or sequence of str, optional
+            The header cells to read instead of ``v``, ``f`` (``V``): ``{"v": "speed", "f": "force [kN]"}`` or
+            ``("speed", "force")``; other columns are then ignored.  A unit given here is the unit of a header
+            cell that states none (the units are "stated").
+        delimiter : str, optional
+            The cell separator (default ``,``).
+
+        Returns
+        -------
+        PeelForce
+            A tabulated law (to smooth or fit the same points, read them with
+            :func:`peelapprox.law._tablefile.read_points`, or use the CLI's ``--smooth`` and ``--force-fit``).
+
+        Raises
+        ------
+        ValueError
+            Naming the file and the line (and column): not a regular file, too large, empty, binary (not UTF-8),
+            a wrong header, an unknown unit, a bad cell or row, or :meth:`tabulated`'s error with the file line
+            of the point it names.
+        TypeError
+            ``path`` is not a path, ``columns`` of the wrong type.
+        """
+        from ._tablefile import from_csv
+
+        return from_csv(cls, path, columns, delimiter)
+
+    @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
         """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated."""
         if not isinstance(d, Mapping):
