@@ -191,7 +191,7 @@ def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter
     col = {n: names.index(n) for n in columns if n in names}
     factor = {}
     for n, i in col.items():
-        unit = units[i] if units[i] is not None else (stated or {}).get(n, columns[n])
+        unit = str(units[i] if units[i] is not None else (stated or {}).get(n, columns[n]))
         factor[n] = convert(n, unit, columns[n], where) if columns[n] or unit else 1.0
     out: dict[str, list[float]] = {n: [] for n in col}
     line_of = []

@@ -136,7 +136,7 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
     if (fit is None) != (fit_family is None):
         raise ValueError("--force-fit FILE and --family NAME go together (the family fitted to the file's points)")
     if fit is not None:
-        return fitted_table(fit, fit_family)
+        return fitted_table(fit, str(fit_family))
     if consts and expr is None:
         raise ValueError("--const sets a constant of --force EXPR; there is no --force")
     if coefs and family is None:

@@ -139,9 +139,9 @@ def check_points(v: Any, f: Any, *, need: int, what: str) -> tuple[np.ndarray, n
     """
     out = []
     for name, x in (("v", v), ("f", f)):
-        bad = x is None or isinstance(x, (str, bytes, bool, np.bool_))
+        refused = x is None or isinstance(x, (str, bytes, bool, np.bool_))
         try:
-            a = None if bad else np.asarray(x)
+            a = None if refused else np.asarray(x)
         except (TypeError, ValueError):
             a = None
         if a is None or a.dtype.kind not in "iuf":
@@ -330,11 +330,10 @@ def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = No
     if sigma is None:
         w = np.ones_like(va)
     else:
-        w = np.broadcast_to(reals("sigma", sigma), va.shape).copy() if np.ndim(sigma) in (0, 1) and np.size(
-            sigma) in (1, va.size) else None
-        if w is None:
+        if not (np.ndim(sigma) in (0, 1) and np.size(sigma) in (1, va.size)):
             raise ValueError(f"sigma must be one standard deviation [N] or one per point ({va.size}), got shape "
                              f"{np.shape(sigma)}")
+        w = np.broadcast_to(reals("sigma", sigma), va.shape).copy()
         bad = np.flatnonzero(~(w > 0))
         if bad.size:
             raise ValueError(f"sigma must be > 0 (standard deviations of f [N]): sigma[{int(bad[0])}] = "

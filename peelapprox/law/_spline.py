@@ -53,7 +53,7 @@ def spline_shape(t: Any, c: Any) -> list[tuple[str, float]]:
     pp = PPoly.from_spline(_bspline(t, c))
     d1 = pp.derivative()
     u_lo, u_hi = float(t[0]), float(t[-1])
-    out = []
+    out: list[tuple[str, float]] = []
     for u in np.sort(d1.roots(extrapolate=False)):
         u = float(u)
         if not (u_lo < u < u_hi) or (out and u == out[-1][1]):

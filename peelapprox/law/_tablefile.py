@@ -77,10 +77,11 @@ def read_points(path: Any, *, columns: Any = None, delimiter: str | None = None,
     if "V" not in names or names["V"] not in cols:
         return [(None, v, f, lines)]
     Vs = cols[names["V"]]
-    bad = np.flatnonzero(~np.isfinite(Vs))
-    if bad.size:
-        raise ValueError(f"{where} line {lines[bad[0]]} (V): must be finite, got {float(Vs[bad[0]])!r}")
-    out = []
+    nonfinite = np.flatnonzero(~np.isfinite(Vs))
+    if nonfinite.size:
+        i = int(nonfinite[0])
+        raise ValueError(f"{where} line {lines[i]} (V): must be finite, got {float(Vs[i])!r}")
+    out: list[tuple[float | None, np.ndarray, np.ndarray, np.ndarray]] = []
     for V in dict.fromkeys(Vs.tolist()):
         sel = Vs == V
         out.append((float(V), v[sel], f[sel], lines[sel]))
