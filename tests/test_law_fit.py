@@ -171,7 +171,7 @@ def test_smoothed_noisy_cubic_folds_and_round_trip():
     back = PeelForce.from_dict(json.loads(json.dumps(dataclasses.asdict(law))))
     assert back == law and hash(back) == hash(law) and back.key == law.key
     assert pickle.loads(pickle.dumps(law)) == law
-    assert law.kind == "spline" and repr(law).startswith("PeelForce.smoothed(")
+    assert law.kind == "smoothed" and repr(law).startswith("PeelForce.smoothed(")
 
 
 def test_smoothed_second_derivative_is_continuous():
@@ -182,8 +182,8 @@ def test_smoothed_second_derivative_is_continuous():
 
     v, f, _ = _noisy_cubic()
     law = PeelForce.smoothed(v, f)
-    t = np.asarray(law.tables[0][1])
-    knots = np.exp(t[4:-4])
+    t = np.log(law.tables[0][1])
+    knots = np.asarray(law.tables[0][1])[4:-4]
     eps = 1e-12  # the pieces' own change over 2 eps in ln v: |p'''| 2e-12, below 1e-10 of max |f''|
     below, above = knots * math.exp(-eps), knots * math.exp(eps)
     scale = np.max(np.abs(law.d2f(np.exp(np.linspace(t[0], t[-1], 2001)), 1.0)))

@@ -26,7 +26,8 @@ __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "PeelForce", "law_label", "
 #: The kinds of law.
 KINDS = tuple(KIND_IMPLS)
 #: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
-ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated", "spline")
+ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated",
+            "smoothed")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -39,7 +40,7 @@ class PeelForce:
 
     Attributes
     ----------
-    kind : {"paper", "family", "expression", "tabulated", "spline"}
+    kind : {"paper", "family", "expression", "tabulated", "smoothed"}
     name : str or None
         The family's name (``"paper"``, ``"cubic"``, ``"power_branches"``) of a family law.
     coefficients : tuple of (name, float)
@@ -47,7 +48,7 @@ class PeelForce:
     source : str or None
         An expression law's canonical text (sympy ``srepr``, constants substituted).
     tables : tuple of (V or None, v tuple, f tuple)
-        A tabulated law's tables; a spline law's one ``(V or None, knots in ln v, B-spline coefficients)``.
+        A tabulated law's tables; a smoothed law's one ``(V or None, knots [m/s], B-spline coefficients)``.
     display : str
         What ``repr`` shows of an expression or a table, derived from the canonical content (an expression:
         its canonical text, constants substituted); a ``display`` passed in (e.g. by :meth:`from_dict`) is
@@ -238,7 +239,7 @@ class PeelForce:
 
     @classmethod
     def smoothed(cls, v: Any, f: Any, *, lam: float | str = "gcv", V: float | None = None) -> PeelForce:
-        """Noisy measured points smoothed by a C² cubic spline in ln v: a law of kind ``"spline"``.
+        """Noisy measured points smoothed by a C² cubic spline in ln v: a law of kind ``"smoothed"``.
 
         scipy's ``make_smoothing_spline`` of f in ``u = ln v`` (knots at the data), then the N shape is checked on
         the result: exactly one maximum then one minimum inside the data range.  f, f' and f'' are continuous
@@ -260,9 +261,9 @@ class PeelForce:
         Returns
         -------
         PeelForce
-            Kind ``"spline"``: its ``tables`` hold ``((V, knots in ln v, B-spline coefficients),)``, plain tuples
-            of floats (immutable, hashable, ``dataclasses.asdict``/:meth:`from_dict` round-trip).  Refuses v outside
-            the data range (never extrapolated).
+            Kind ``"smoothed"``: its ``tables`` hold ``((V, knots [m/s], B-spline coefficients),)`` (a spline in
+            ln v), plain tuples of floats (immutable, hashable, ``dataclasses.asdict``/:meth:`from_dict`
+            round-trip).  Refuses v outside the data range (never extrapolated).
 
         Raises
         ------
@@ -275,7 +276,7 @@ class PeelForce:
         """
         from ._spline import smooth
 
-        return cls("spline", tables=smooth(v, f, lam, V))
+        return cls("smoothed", tables=smooth(v, f, lam, V))
 
     @classmethod
     def from_csv(cls, path: Any, *, columns: Any = None, delimiter: str | None = None) -> PeelForce:

@@ -336,15 +336,14 @@ class SplineKind(TabulatedKind):
     """Points smoothed by a C² cubic spline in ln v (``PeelForce.smoothed``): its knots and B-spline coefficients as
     data; evaluated by scipy's BSpline, compiled through the table kernel; never extrapolated."""
 
-    name = "spline"
+    name = "smoothed"
 
     def canonical(self, force: Any) -> dict[str, Any]:
         return {"tables": _spline.check_spline(force.tables, PARAM_RANGES["V"])}
 
     def display(self, force: Any) -> str:
         V, t, _ = force.tables[0]
-        return (f"V={V!r}: C2 spline in ln v, {len(t) - 6} knots, v in [{math.exp(t[0]):.6g}, {math.exp(t[-1]):.6g}] "
-                "m/s")
+        return f"V={V!r}: C2 spline in ln v, {len(t) - 6} knots, v in [{t[0]:.6g}, {t[-1]:.6g}] m/s"
 
     def show(self, force: Any) -> str:
         return f"PeelForce.smoothed(<{force.display}>)"

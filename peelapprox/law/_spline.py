@@ -1,4 +1,4 @@
-"""Smoothed peel-force laws: a C² cubic smoothing spline of noisy points in ln v (kind ``"spline"``).
+"""Smoothed peel-force laws: a C² cubic smoothing spline of noisy points in ln v (kind ``"smoothed"``).
 
 :func:`smooth` makes the law's data from measured points ``(v_i, f_i)``: scipy's
 :func:`~scipy.interpolate.make_smoothing_spline` of f in ``u = ln v`` (a natural cubic smoothing spline, knots
@@ -7,11 +7,13 @@ of the result: the roots of its derivative inside the data range must be exactly
 minimum (a ``ValueError`` says what it found otherwise).  The folds are roots of the spline's derivative,
 between data points (not at a datum, as a table's PCHIP puts them).
 
-The data of a spline law (``PeelForce.tables`` of a ``"spline"`` law, plain tuples of floats, so the law is
+The data of a smoothed law (``PeelForce.tables`` of a ``"smoothed"`` law, plain tuples of floats, so the law is
 immutable, hashable and JSON-able as the others) are one triple ``(V, knots, coefficients)``: the pull speed the
-points were measured at (None: used at every V), the B-spline knots in ``u = ln v`` (degree 3, the end knots
-repeated four times, the interior ones simple and increasing: the spline is C² everywhere) and its B-spline
-coefficients (``len(knots) - 4`` of them).  :func:`check_spline` validates them (for a law read back by
+points were measured at (None: used at every V), the B-spline knots as peel velocities [m/s] (the spline is in
+``u = ln v``, its knots at ``ln knots``; degree 3, the end knots repeated four times, the interior ones simple and
+increasing: the spline is C² everywhere; as velocities, like a table's v, so that code reading a law's ``tables``
+sees velocities whatever its kind) and its B-spline coefficients (``len(knots) - 4`` of them).
+:func:`check_spline` validates them (for a law read back by
 ``PeelForce.from_dict``).
 
 Evaluation: by numpy, :class:`SplineLaw` (scipy's ``BSpline`` and its derivatives in u; ``f' = p'/v``,
@@ -40,19 +42,20 @@ _LAM_RATIO, _LAM_STEPS = 1.25, 250
 
 
 def _bspline(t: Any, c: Any) -> Any:
+    """The B-spline in ``u = ln v`` of the knots ``t`` given as velocities [m/s] and the coefficients ``c``."""
     from scipy.interpolate import BSpline
 
-    return BSpline(np.asarray(t, dtype=float), np.asarray(c, dtype=float), _DEGREE, extrapolate=False)
+    return BSpline(np.log(np.asarray(t, dtype=float)), np.asarray(c, dtype=float), _DEGREE, extrapolate=False)
 
 
 def spline_shape(t: Any, c: Any) -> list[tuple[str, float]]:
-    """The interior extrema of the spline ``(t, c)`` in u, in order: ``[("max" | "min", u), ...]`` (roots of its
-    derivative where the derivative changes sign, found from its piecewise-polynomial form)."""
+    """The interior extrema of the spline ``(t, c)`` (knots as velocities), in order: ``[("max" | "min", u), ...]``,
+    u = ln v (roots of its derivative where the derivative changes sign, from its piecewise-polynomial form)."""
     from scipy.interpolate import PPoly
 
     pp = PPoly.from_spline(_bspline(t, c))
     d1 = pp.derivative()
-    u_lo, u_hi = float(t[0]), float(t[-1])
+    u_lo, u_hi = math.log(t[0]), math.log(t[-1])
     out: list[tuple[str, float]] = []
     for u in np.sort(d1.roots(extrapolate=False)):
         u = float(u)
@@ -79,7 +82,7 @@ def _shape_error(t: Any, c: Any, label: str) -> str | None:
 
 
 def smooth(v: Any, f: Any, lam: Any = "gcv", V: Any = None) -> tuple:
-    """The tables of a ``"spline"`` law smoothing the points ``(v, f)`` (module docstring).
+    """The tables of a ``"smoothed"`` law smoothing the points ``(v, f)`` (module docstring).
 
     ``lam``: ``"gcv"`` or a penalty >= 0 (0: the interpolating natural spline; larger: smoother).  ``"gcv"``
     takes the penalty of generalised cross-validation (scipy's ``lam=None``); GCV often follows the noise near
@@ -115,7 +118,7 @@ def smooth(v: Any, f: Any, lam: Any = "gcv", V: Any = None) -> tuple:
                 spl = make_smoothing_spline(u, fa, lam=lam)
             except (ValueError, np.linalg.LinAlgError) as exc:
                 raise ValueError(f"v, f: the smoothing spline cannot be made of these points ({exc})") from None
-        t, c = tuple(float(x) for x in spl.t), tuple(float(x) for x in spl.c)
+        t, c = tuple(math.exp(float(x)) for x in spl.t), tuple(float(x) for x in spl.c)
         if not all(math.isfinite(x) for x in c):
             raise ValueError("v, f: the smoothing spline of these points is not finite (f too large, or v too close "
                              "together in ln v)")
@@ -160,7 +163,9 @@ def check_spline(tables: Any, V_range: tuple[float, float]) -> tuple:
     ends = (ta[:_DEGREE + 1], ta[-_DEGREE - 1:])
     if np.any(ends[0] != ta[0]) or np.any(ends[1] != ta[-1]):
         raise ValueError(f"the knots of a spline law must repeat each end {_DEGREE + 1} times (a clamped cubic)")
-    inner = ta[_DEGREE:-_DEGREE]
+    if ta[0] <= 0:
+        raise ValueError(f"the knots of a spline law are peel velocities, > 0 [m/s]: knots[0] = {ta[0]!r}")
+    inner = np.log(ta[_DEGREE:-_DEGREE])
     bad = np.flatnonzero(np.diff(inner) <= 0)
     if bad.size:
         i = int(bad[0]) + _DEGREE
@@ -190,8 +195,8 @@ class SplineLaw:
         self.V = V
         spl = _bspline(t, c)
         self.derivs = (spl, spl.derivative(1), spl.derivative(2))
-        self.lo, self.hi = math.exp(t[0]), math.exp(t[-1])
-        self.u_lo, self.u_hi = float(t[0]), float(t[-1])
+        self.lo, self.hi = float(t[0]), float(t[-1])
+        self.u_lo, self.u_hi = math.log(t[0]), math.log(t[-1])
 
     def v_range(self) -> tuple[float, float]:
         return self.lo, self.hi
