@@ -140,6 +140,8 @@ def test_fit_bad_arguments():
         PeelForce.fit(v, f, "paper_family")
     with pytest.raises(TypeError, match="v must be an array"):
         PeelForce.fit("abc", f, "cubic")
+    with pytest.raises(ValueError, match=r"p0: the family power_branches at its start .* not finite at v\[0\]"):
+        PeelForce.fit(v, f, "power_branches", p0={"n2": -1000.0})
 
 
 def test_fit_family_compiles_nothing():

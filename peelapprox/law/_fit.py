@@ -390,7 +390,7 @@ def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = No
     dof = va.size - k
     if sigma is None:
         cov = cov * (chi2 / dof)
-    se = np.sqrt(np.diag(cov))
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))  # (J^T J)^-1 is positive semi-definite: clip rounding
     d = np.where(se > 0, se, 1.0)
     folds, note = _fold_estimate(model, theta_of, x, se, cov, lo, hi, Vf, (va[0], va[-1]))
     result = FitResult(model.label, names, values, dict(zip(names, se.tolist())), cov,
