@@ -39,6 +39,9 @@ MIN_POINTS = 5
 _DEGREE = 3
 #: The grid of penalties ``lam="gcv"`` searches upward when GCV's spline is not N-shaped (:func:`smooth`).
 _LAM_RATIO, _LAM_STEPS = 1.25, 250
+#: The searched spline must follow the data as noise does: its RMS residual at most this many times the noise
+#: estimated from the data's second differences (:func:`_noise`), else it is refused.
+_NOISE_FACTOR = 5.0
 
 
 def _bspline(t: Any, c: Any) -> Any:
@@ -88,7 +91,9 @@ def smooth(v: Any, f: Any, lam: Any = "gcv", V: Any = None) -> tuple:
     takes the penalty of generalised cross-validation (scipy's ``lam=None``); GCV often follows the noise near
     the flat folds (on 40 points of the cubic with 1 % noise its spline has 6 to 10 extrema), and then the
     smallest penalty on a grid of ratio 1.25 upward from ``1e-4 h^3`` (h the mean spacing of the data in ln v)
-    whose spline has exactly one maximum then one minimum is taken instead.  ValueError naming the argument (and
+    whose spline has exactly one maximum then one minimum is taken instead -- provided it still follows the data as
+    noise would (RMS residual at most 5 times the noise estimated from the data's second differences); a spline
+    N-shaped only at a penalty that misses the data is refused.  ValueError naming the argument (and
     index) for bad points, a bad ``lam``, or a smoothed curve that is not N-shaped (what it has, named: with
     ``"gcv"``, GCV's spline, when no penalty on the grid gives the N shape).
     """
@@ -134,14 +139,29 @@ def smooth(v: Any, f: Any, lam: Any = "gcv", V: Any = None) -> tuple:
             tt, cc = spline(lam)
             kinds = [k for k, _ in spline_shape(tt, cc)]
             if kinds == ["max", "min"]:
-                return ((V0, tt, cc),)
+                rms = math.sqrt(float(np.mean((_bspline(tt, cc)(u) - fa) ** 2)))
+                if rms <= _NOISE_FACTOR * _noise(fa):
+                    return ((V0, tt, cc),)
+                break  # the N shape only at a penalty that misses the data: not a smoothing of noise
             if not kinds:  # monotone: smoothing more cannot bring the folds back
                 break
             lam *= _LAM_RATIO
     if msg:
-        used = "GCV's, and no larger one gave it" if penalty is None else repr(penalty)
+        used = repr(penalty) if penalty is not None else (
+            f"GCV's; no larger penalty gave the N shape while following the data (RMS residual at most "
+            f"{_NOISE_FACTOR:g}x the noise estimated from second differences)")
         raise ValueError(f"{msg}; lam: {used} (a larger lam smooths more)")
     return ((V0, t, c),)
+
+
+def _noise(f: np.ndarray) -> float:
+    """A robust estimate of the noise's standard deviation in f: the median absolute second difference
+    ``f[i-1] - 2 f[i] + f[i+1]`` (standard deviation sqrt(6) sigma for independent noise), scaled to a standard
+    deviation (1.4826, the normal distribution's MAD factor).  Smooth data give ~0 where they are flat in the
+    median; steep data overestimate it where they curve (then the search is permissive only by the data's own
+    curvature)."""
+    d2 = f[:-2] - 2.0 * f[1:-1] + f[2:]
+    return 1.4826 * float(np.median(np.abs(d2))) / math.sqrt(6.0)
 
 
 def check_spline(tables: Any, V_range: tuple[float, float]) -> tuple:
