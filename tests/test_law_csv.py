@@ -106,6 +106,8 @@ def test_cli_smooth_and_fit(tmp_path, capsys):
     f = _cubic(V_PTS) * (1 + 0.01 * np.random.default_rng(3).standard_normal(V_PTS.size))
     path = _write(tmp_path / "noisy.csv", "v [m/s],f [N]", zip(V_PTS, f))
     assert _law("--force-table", path, "--smooth") == PeelForce.smoothed(V_PTS, f)
+    with pytest.raises(ValueError, match="local minimum.*; for noisy points add --smooth, or fit a family"):
+        _law("--force-table", path)
     assert _law("--force-fit", path, "--family", "cubic") == PeelForce.fit(V_PTS, f, "cubic")
     assert main(["folds", "--V", "1", "--force-fit", path, "--family", "cubic", "--format", "json"]) == 0
     row = json.loads(capsys.readouterr().out)

@@ -165,7 +165,13 @@ def read_force_table(path: str) -> PeelForce:
     ``--force-table PATH`` and the file line (and column)."""
     from ..law._tablefile import from_csv
 
-    return from_csv(PeelForce, path, None, None, where=f"--force-table {shown(path)}")
+    try:
+        return from_csv(PeelForce, path, None, None, where=f"--force-table {shown(path)}")
+    except ValueError as exc:
+        if "exactly one local maximum followed by one local minimum" not in str(exc):
+            raise
+        raise ValueError(f"{exc}; for noisy points add --smooth, or fit a family (--force-fit FILE --family NAME)"
+                         ) from None
 
 
 def _one_table(option: str, path: str) -> tuple[np.ndarray, np.ndarray, list]:
