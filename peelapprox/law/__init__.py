@@ -18,11 +18,13 @@ The modules, one concern each (private: the public names are offered by :mod:`pe
 
 from __future__ import annotations
 
+from ._fit import FitResult, FoldEstimate
 from ._folds import BRANCHES, BREAKDOWN_LEVEL, BranchStructure, Folds
 from ._force import ALL_LAWS, KINDS, PeelForce, law_label, require_law
 from ._paper import branch_inverse, peel_force, peel_force_derivative
 from ._structure import FixedPoint, branch_structure, fixed_point
 
-__all__ = ["ALL_LAWS", "BRANCHES", "BREAKDOWN_LEVEL", "KINDS", "BranchStructure", "FixedPoint", "Folds", "PeelForce",
+__all__ = ["ALL_LAWS", "BRANCHES", "BREAKDOWN_LEVEL", "KINDS", "BranchStructure", "FitResult", "FixedPoint",
+           "FoldEstimate", "Folds", "PeelForce",
            "branch_inverse", "branch_structure", "fixed_point", "law_label", "peel_force", "peel_force_derivative",
            "require_law"]

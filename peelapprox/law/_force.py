@@ -214,7 +214,7 @@ class PeelForce:
         -------
         PeelForce
             The fitted law, equal to the same law built by hand; ``law.fit_result`` is a
-            :class:`~peelapprox.law._fit.FitResult` (coefficients by name, covariance, standard errors,
+            :class:`~peelapprox.FitResult` (coefficients by name, covariance, standard errors,
             residuals, chi^2, dof, chi^2/dof, the folds at V with their standard errors by the delta method).
 
         Raises
@@ -233,7 +233,7 @@ class PeelForce:
 
     @property
     def fit_result(self) -> Any:
-        """What :meth:`fit` measured (:class:`~peelapprox.law._fit.FitResult`), or None for a law not made by
+        """What :meth:`fit` measured (:class:`~peelapprox.FitResult`), or None for a law not made by
         :meth:`fit`.  Not part of the law's value: not compared, hashed, keyed, pickled or in ``asdict``."""
         return self.__dict__.get("_fit_result")
 
