@@ -239,3 +239,32 @@ def test_smoothed_runs_in_the_solver():
             for x in (law, PeelForce.cubic())]
     (t1, F1), (t2, F2) = [(j.t[j.from_branch == 0][:4], j.F[j.from_branch == 0][:4]) for j in runs]
     assert t1.size == 4 and np.allclose(t1, t2, atol=0.01) and np.allclose(F1, F2, rtol=0.02)
+
+
+def test_fit_from_a_family_law_start_and_fixed_coefficient():
+    """A family law as ``family`` starts from its coefficients; ``bounds={name: (x, x)}`` holds one: the held
+    coefficient is exactly x and the others are fitted (the same estimates as from the defaults, 1e-6: two
+    least-squares runs from different starts)."""
+    v, f, sigma = _noisy_cubic()
+    a = PeelForce.fit(v, f, PeelForce.cubic(a=100.0, d=60.0), sigma=sigma).fit_result
+    b = PeelForce.fit(v, f, "cubic", sigma=sigma).fit_result
+    for n in "abcd":
+        assert a.coefficients[n] == pytest.approx(b.coefficients[n], rel=1e-6)
+    held = PeelForce.fit(v, f, "cubic", sigma=sigma, bounds={"d": (80.0, 80.0)}).fit_result
+    assert held.coefficients["d"] == 80.0 and held.fixed == ("d",) and held.names == ("a", "b", "c")
+
+
+def test_smoothed_law_data_are_checked_when_read_back():
+    """A smoothed law rebuilt from stored data is validated: knots out of order, a wrong number of coefficients,
+    or a non-N shape are ValueErrors naming what is wrong."""
+    v, f, _ = _noisy_cubic()
+    d = dataclasses.asdict(PeelForce.smoothed(v, f))
+    V0, t, c = d["tables"][0]
+    bad_t = list(t)
+    bad_t[10], bad_t[11] = bad_t[11], bad_t[10]
+    with pytest.raises(ValueError, match=r"strictly increasing inside .*knots\[10\]"):
+        PeelForce.from_dict({**d, "tables": [(V0, bad_t, c)]})
+    with pytest.raises(ValueError, match="len\\(knots\\) - 4 coefficients"):
+        PeelForce.from_dict({**d, "tables": [(V0, t, c[:-1])]})
+    with pytest.raises(ValueError, match="found none"):
+        PeelForce.from_dict({**d, "tables": [(V0, t, [100.0 + i for i in range(len(c))])]})
