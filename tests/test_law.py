@@ -335,6 +335,7 @@ LAW_KINDS = {
     "power_branches": PeelForce.power_branches(),
     "expression": PeelForce.expression(PAPER_TEXT),
     "tabulated": PeelForce.tabulated(np.logspace(-8, 2, 300), PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
+    "smoothed": PeelForce.smoothed(np.logspace(-8, 2, 300), PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
 }
 CONSUMERS = {
     "estimate": lambda p: pa.estimate(p).v_max,

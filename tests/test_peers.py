@@ -12,8 +12,8 @@ import exact
 from comparisons.benchmark import peers as P
 from comparisons.benchmark.peers import common as PC
 from comparisons.benchmark.peers import diffsol as PD
-from exact.dynamics import _variational as LV
 from exact._regularized import _fun
+from exact.dynamics import _variational as LV
 from peelapprox import PeelParams, branch_structure
 from peelapprox import kernels as K
 

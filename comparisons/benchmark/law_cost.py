@@ -12,7 +12,8 @@ One run prints a table of:
 * **per step**: µs per accepted step of ``exact.simulate`` (rtol 1e-8, save="jumps", the best of the rounds)
   on the benchmark scenes, with the paper's law inlined (the default), and with fvV given as each other kind
   of law -- the paper family (its 14 numbers as data), the expression typed as text, a table of 600 points
-  sampled from it (PCHIP in ln v) -- which follow the same orbits (to rounding, or to the table's
+  sampled from it (PCHIP in ln v), the same points smoothed (``PeelForce.smoothed``) -- which follow the same
+  orbits (to rounding, or to the table's
   interpolation error), so the ratios are the cost of the law alone; each in its own process, alternating, so
   all see the same machine load; optionally for the tree at ``--before`` too;
 * **second law**: the wall time of the first ``simulate`` with a second cubic (other coefficients) in a
@@ -62,16 +63,19 @@ def _cubic_params(I: float) -> PeelParams:
 
 
 #: fvV as every kind of law, by name: the law each per-step and field figure is measured with (module docstring).
-LAWS_OF_FVV = ("paper_family", "expression", "tabulated")
+LAWS_OF_FVV = ("paper_family", "expression", "tabulated", "smoothed")
 
 
 def fvv_as(kind: str, V: float) -> PeelForce:
-    """fvV as a law of ``kind`` (:data:`LAWS_OF_FVV`; a table: 600 points log-spaced over 1e-8-100 m/s at V)."""
+    """fvV as a law of ``kind`` (:data:`LAWS_OF_FVV`; a table: 600 points log-spaced over 1e-8-100 m/s at V; smoothed:
+    the same points through ``PeelForce.smoothed``, a C² spline in ln v, its penalty by GCV)."""
     if kind == "paper_family":
         return PeelForce.paper_family()
     if kind == "expression":
         return PeelForce.expression(FVV_TEXT)
     v = np.logspace(-8.0, 2.0, 600)
+    if kind == "smoothed":
+        return PeelForce.smoothed(v, peel_force(v, V))
     return PeelForce.tabulated(v, peel_force(v, V))
 
 
@@ -198,15 +202,9 @@ def _load_times(tree: Path) -> tuple[float, float]:
     return cold, warm
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m comparisons.benchmark.law_cost", description=__doc__.split("\n")[0])
-    ap.add_argument("--before", type=Path, default=None,
-                    help="a checkout of an earlier tree to compare the default path's per-step cost with")
-    ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of the per-step runs (default 3)")
-    ap.add_argument("--json", type=Path, default=None, help="also write the figures as JSON")
-    args = ap.parse_args(argv)
-    res: dict = {"field_ns": field_costs()}
-    trees = {"after": _ROOT} | ({"before": args.before.resolve()} if args.before else {})
+def _steps(args: argparse.Namespace, res: dict | None) -> dict[str, dict[str, float]]:
+    """µs per step of each run (the default, each kind of :data:`LAWS_OF_FVV`, optionally the tree ``--before``),
+    the best of ``--rounds`` alternating rounds; stored in ``res["us_per_step"]`` if ``res`` is given."""
     runs = [("after", _ROOT, "default")] + [(k, _ROOT, k) for k in LAWS_OF_FVV]
     runs += [("before", args.before.resolve(), "default")] if args.before else []
     steps: dict[str, dict[str, float]] = {k: {} for k, _, _ in runs}
@@ -214,7 +212,38 @@ def main(argv: list[str] | None = None) -> int:
         for k, tree, kind in runs:
             for name, us in _per_step(tree, kind).items():
                 steps[k][name] = min(steps[k].get(name, math.inf), us)
-    res["us_per_step"] = steps
+    if res is not None:
+        res["us_per_step"] = steps
+    return steps
+
+
+def _print_steps(steps: dict[str, dict[str, float]], args: argparse.Namespace | None) -> int:
+    """Print the per-step table (and write it as JSON with ``--per-step-only --json``)."""
+    print("\nper step [us], best of rounds: fvV inlined ('after', the default) and as each kind of law (ratio)")
+    print("  scene        " + "".join(f"{k:>24}" for k in steps))
+    for name in steps["after"]:
+        row = "".join(f"{fmt_number(steps[k][name], 4):>14} ({fmt_number(steps[k][name] / steps['after'][name], 3):>7})"
+                      for k in steps)
+        print(f"  {name:<12} {row}")
+    if args is not None and args.json:
+        args.json.write_text(json.dumps({"us_per_step": steps}, indent=1))
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m comparisons.benchmark.law_cost", description=__doc__.split("\n")[0])
+    ap.add_argument("--before", type=Path, default=None,
+                    help="a checkout of an earlier tree to compare the default path's per-step cost with")
+    ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of the per-step runs (default 3)")
+    ap.add_argument("--json", type=Path, default=None, help="also write the figures as JSON")
+    ap.add_argument("--per-step-only", action="store_true",
+                    help="measure and print the per-step table only (no field, second-law or load timings)")
+    args = ap.parse_args(argv)
+    if args.per_step_only:
+        return _print_steps(_steps(args, None), args)
+    res: dict = {"field_ns": field_costs()}
+    trees = {"after": _ROOT} | ({"before": args.before.resolve()} if args.before else {})
+    steps = _steps(args, res)
     env = dict(os.environ, PYTHONPATH=str(_ROOT))
     res["second_law"] = json.loads(subprocess.check_output([sys.executable, "-c", _SECOND_CODE], env=env,
                                                            cwd=tempfile.gettempdir()).decode().splitlines()[-1])
@@ -224,12 +253,7 @@ def main(argv: list[str] | None = None) -> int:
     print("field evaluation [ns] (fvV at V = 1 as each kind of law; the cubic)     ns   / paper inlined")
     for key, ns in f.items():
         print(f"  {key:<24} {fmt_number(ns, 4):>10}   {fmt_number(ns / f['inline'], 3):>8}")
-    print("\nper step [us], best of rounds: fvV inlined ('after', the default) and as each kind of law (ratio)")
-    print("  scene        " + "".join(f"{k:>24}" for k in steps))
-    for name in steps["after"]:
-        row = "".join(f"{fmt_number(steps[k][name], 4):>14} ({fmt_number(steps[k][name] / steps['after'][name], 3):>7})"
-                      for k in steps)
-        print(f"  {name:<12} {row}")
+    _print_steps(steps, None)
     s = res["second_law"]
     print("\nsecond cubic (other coefficients), first simulate (0.05 s) in a process that ran a first cubic: "
           f"{fmt_number(1e3 * s['t_cubic'], 3)} ms, {s['compiles']} numba compilations\n  (the first cubic's first "

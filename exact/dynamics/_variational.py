@@ -50,7 +50,7 @@ VARIATIONAL_LAWS_NOTE = ("lyapunov method 'variational' (lyapunov_variational: i
                          "law's closed form, which a table lacks; the methods 'two-trajectory', 'tangent' and "
                          "'return-map' run any law)")
 #: The laws the variational method runs (:func:`peelapprox._law.law_label` names): every law with a closed form.
-VARIATIONAL_LAWS = tuple(x for x in ALL_LAWS if x != "tabulated")
+VARIATIONAL_LAWS = tuple(x for x in ALL_LAWS if x not in ("tabulated", "smoothed"))  # no closed form
 
 #: pydiffsol options of the tangent model: :data:`peelapprox.kernels.DIFFSOL_OPTIONS` and a
 #: practically unlimited number of error-test failures per solve (the default,

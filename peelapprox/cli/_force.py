@@ -6,6 +6,8 @@ called by :func:`peelapprox.cli._common.add_params`), at most one of
 * ``--force EXPR`` with ``--const NAME=VALUE`` (repeatable): :meth:`PeelForce.expression`;
 * ``--force-table FILE.csv``: a measured curve, :meth:`PeelForce.tabulated` (:func:`read_force_table`);
 * ``--force-family NAME`` with ``--coef NAME=VALUE`` (repeatable): :meth:`PeelForce.family`;
+* ``--force-table FILE.csv --smooth``: the file's noisy points smoothed, :meth:`PeelForce.smoothed`;
+* ``--force-fit FILE.csv --family NAME``: a family fitted to the file's points, :meth:`PeelForce.fit`;
 
 and none means the paper's fvV (:meth:`PeelForce.paper`).  :func:`force_from_args` builds the law; a
 consumer that cannot run it (a table where a closed form is needed, a table too short for the run) raises its
@@ -20,24 +22,19 @@ What a subcommand prints and writes records the law it ran (:func:`law_fields`):
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
-import errno
-import math
-import os
-import re
-import stat
 import textwrap
 from typing import Any
 
+import numpy as np
+
 from .. import PeelForce
+from .._csvread import MAX_BYTES
+from ..law._tablefile import TABLE_COLUMNS
 from ..validate import shown
 
-__all__ = ["MAX_TABLE_BYTES", "TABLE_COLUMNS", "add_force_options", "families_help", "force_from_args", "law_fields",
-           "name_value", "read_force_table"]
-
-#: The headers ``--force-table`` accepts: one table, or several grouped by the pull speed V [m/s].
-TABLE_COLUMNS = (("v", "f"), ("V", "v", "f"))
+__all__ = ["MAX_TABLE_BYTES", "TABLE_COLUMNS", "add_force_options", "families_help", "fitted_table",
+           "force_from_args", "law_fields", "name_value", "read_force_table", "smoothed_table"]
 
 
 def _family_names() -> tuple[str, ...]:
@@ -96,6 +93,14 @@ def add_force_options(sp: argparse.ArgumentParser) -> None:
                            "V,v,f (one table per pull speed V); lines starting with # are comments")
     kind.add_argument("--force-family", metavar="NAME",
                       help=f"a family (PeelForce.family): {', '.join(_family_names())}; coefficients by --coef")
+    kind.add_argument("--force-fit", metavar="FILE.csv",
+                      help="a family (--family) fitted to a measured curve (PeelForce.fit): the CSV of "
+                           "--force-table, one curve; units in the header (v [mm/s], f [kN]) are converted")
+    g.add_argument("--family", metavar="NAME",
+                   help=f"the family --force-fit fits: {', '.join(_family_names())}")
+    g.add_argument("--smooth", action="store_true",
+                   help="with --force-table: smooth the (noisy) points by a C2 spline in ln v (PeelForce.smoothed) "
+                        "instead of interpolating them")
     g.add_argument("--const", type=name_value, action="append", metavar="NAME=VALUE",
                    help="a constant of --force (repeatable)")
     g.add_argument("--coef", type=name_value, action="append", metavar="NAME=VALUE",
@@ -124,6 +129,14 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
     expr, table, family = getattr(args, "force", None), getattr(args, "force_table", None), \
         getattr(args, "force_family", None)
     consts, coefs = getattr(args, "const", None), getattr(args, "coef", None)
+    fit, fit_family, smooth = getattr(args, "force_fit", None), getattr(args, "family", None), \
+        getattr(args, "smooth", False)
+    if smooth and table is None:
+        raise ValueError("--smooth smooths the points of --force-table FILE; there is no --force-table")
+    if (fit is None) != (fit_family is None):
+        raise ValueError("--force-fit FILE and --family NAME go together (the family fitted to the file's points)")
+    if fit is not None:
+        return fitted_table(fit, str(fit_family))
     if consts and expr is None:
         raise ValueError("--const sets a constant of --force EXPR; there is no --force")
     if coefs and family is None:
@@ -137,157 +150,61 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
         option = "--force" if expr is not None else "--force-family"
         raise ValueError(f"{option}: {exc}") from None
     if table is not None:
-        return read_force_table(table)
+        return smoothed_table(table) if smooth else read_force_table(table)
     return PeelForce.paper()
 
 
 # --------------------------------------------------------------------------------------------- the table file
 
-#: Largest ``--force-table`` file read [bytes], 16 MiB: a measured peel-force curve has hundreds to a few thousand
-#: rows of ~30 bytes, so 16 MiB (about 500,000 rows, parsed and checked in a few seconds) is far beyond any real
-#: table, while a path to a huge file (a log, a disk image) is refused at once instead of filling the memory.
-MAX_TABLE_BYTES = 16 * 1024 * 1024
-
-_FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
-               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
-
-
-def _read_regular(path: str, where: str) -> bytes:
-    """The bytes of the regular file ``path``, at most :data:`MAX_TABLE_BYTES`, or a ValueError beginning with
-    ``where``.
-
-    The file is opened without blocking (``O_NONBLOCK``: opening a FIFO for reading would otherwise wait for a
-    writer forever) and its kind is read from the open descriptor (``fstat``), so the file checked is the file
-    read.  A FIFO, a device, a socket or a directory is refused, and so is a file of more than
-    :data:`MAX_TABLE_BYTES` (by its size, and again by what is read: a file growing meanwhile is caught too).
-    """
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
-    try:
-        fd = os.open(path, flags)
-    except OSError as exc:
-        if exc.errno == errno.EISDIR:
-            raise ValueError(f"{where}: is a directory; a table must be a regular file (a CSV on disk)") from None
-        raise ValueError(f"{where}: cannot read it ({exc.strerror or exc})") from None
-    st = os.fstat(fd)
-    if not stat.S_ISREG(st.st_mode):
-        os.close(fd)
-        kind = next((what for test, what in _FILE_KINDS if test(st.st_mode)), "not a regular file")
-        raise ValueError(f"{where}: is {kind}; a table must be a regular file (a CSV on disk)")
-    limit = f"{MAX_TABLE_BYTES // (1024 * 1024)} MiB"
-    if st.st_size > MAX_TABLE_BYTES:
-        os.close(fd)
-        raise ValueError(f"{where}: {st.st_size} bytes, more than the {limit} a table may have (a measured curve "
-                         "is a few thousand rows; is this the right file?)")
-    with os.fdopen(fd, "rb") as fh:
-        try:
-            data = fh.read(MAX_TABLE_BYTES + 1)
-        except OSError as exc:
-            raise ValueError(f"{where}: cannot read it ({exc.strerror or exc})") from None
-    if len(data) > MAX_TABLE_BYTES:
-        raise ValueError(f"{where}: more than the {limit} a table may have (a measured curve is a few thousand "
-                         "rows; is this the right file?)")
-    return data
-
-
-def _data_lines(text: str) -> list[tuple[int, str]]:
-    """``(line number, text)`` of the lines that are not blank or comments (``#`` to the end of a line)."""
-    out = []
-    for n, line in enumerate(re.split(r"\r\n|\r|\n", text), start=1):  # universal newlines, as open() reads
-        line = line.split("#", 1)[0].strip()
-        if line:
-            out.append((n, line))
-    return out
-
-
-def _csv_rows(lines: list[tuple[int, str]], where: str) -> list[list[str]]:
-    """The cells of each data line (:mod:`csv`), a csv error (e.g. a field over csv's size limit, an unclosed
-    quote) as a ValueError naming the file line."""
-    rows = []
-    for lineno, text in lines:
-        try:
-            cells = next(csv.reader([text]), [])
-        except csv.Error as exc:
-            raise ValueError(f"{where} line {lineno}: not a CSV row ({exc})") from None
-        rows.append(cells)
-    return rows
+#: Largest ``--force-table`` file read [bytes]: :data:`peelapprox._csvread.MAX_BYTES` (16 MiB).
+MAX_TABLE_BYTES = MAX_BYTES
 
 
 def read_force_table(path: str) -> PeelForce:
-    """The law :meth:`PeelForce.tabulated` makes of the CSV file ``path`` (``--force-table``).
+    """The law :meth:`PeelForce.from_csv` makes of the CSV file ``path`` (``--force-table``), its errors naming
+    ``--force-table PATH`` and the file line (and column)."""
+    from ..law._tablefile import from_csv
 
-    The first data line is the header, ``v,f`` (one table, used at every V) or ``V,v,f`` in any order
-    (one table per distinct V, the rows of a V in file order, the tables in order of first appearance).
-    ``#`` starts a comment (whole line or its end); blank lines are skipped.  The file is UTF-8 text (a
-    byte-order mark before the header, as spreadsheets write it, is skipped), a regular file of at most
-    :data:`MAX_TABLE_BYTES`.
+    try:
+        return from_csv(PeelForce, path, None, None, where=f"--force-table {shown(path)}")
+    except ValueError as exc:
+        if "exactly one local maximum followed by one local minimum" not in str(exc):
+            raise
+        raise ValueError(f"{exc}; for noisy points add --smooth, or fit a family (--force-fit FILE --family NAME)"
+                         ) from None
 
-    Raises
-    ------
-    ValueError
-        Naming the file (and for a cell its line and column): missing or unreadable; not a regular file (a
-        FIFO, a device, a directory: refused without waiting on it); larger than :data:`MAX_TABLE_BYTES`; not
-        UTF-8 text; no header, a header other than those of :data:`TABLE_COLUMNS`; a line that is not a CSV
-        row (csv's error, e.g. a field longer than its limit); a row with too few or too many cells, a cell
-        that is not a number; or :meth:`PeelForce.tabulated`'s error (which names the offending point
-        ``v[i]``/``f[i]``), with the file line of that point added.
-    """
-    where = f"--force-table {shown(path)}"
-    data = _read_regular(path, where)
+
+def _one_table(option: str, path: str) -> tuple[np.ndarray, np.ndarray, list]:
+    """``(v, f, tables)`` of the file of ``option``: one table (no V column, or one V)."""
+    from ..law._tablefile import read_points
+
+    tables = read_points(path, where=f"{option} {shown(path)}")
+    if len(tables) != 1:
+        raise ValueError(f"{option} {shown(path)}: {len(tables)} tables (one per V); {option} takes one curve")
+    return tables[0][1], tables[0][2], tables
+
+
+def smoothed_table(path: str) -> PeelForce:
+    """``--force-table FILE --smooth``: :meth:`PeelForce.smoothed` of the file's points (one curve)."""
+    from ..law._tablefile import with_line
+
+    v, f, tables = _one_table("--force-table", path)
     try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise ValueError(f"{where} line {line}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    lines = _data_lines(text)
-    if not lines:
-        raise ValueError(f"{where}: no header (expected {' or '.join(','.join(c) for c in TABLE_COLUMNS)})")
-    rows = _csv_rows(lines, where)
-    header = [h.strip() for h in rows[0]]
-    if sorted(header) not in [sorted(c) for c in TABLE_COLUMNS] or len(set(header)) != len(header):
-        raise ValueError(f"{where} line {lines[0][0]}: header {shown(','.join(header))}: expected the columns "
-                         f"{' or '.join(','.join(c) for c in TABLE_COLUMNS)} (V is the pull speed, v the peel "
-                         "velocity [m/s], f the force [N])")
-    col = {name: i for i, name in enumerate(header)}
-    groups: dict[float | None, list[tuple[int, float, float]]] = {}
-    for (lineno, _), cells in zip(lines[1:], rows[1:]):
-        if len(cells) != len(header):
-            raise ValueError(f"{where} line {lineno}: {len(cells)} column(s), expected {len(header)} "
-                             f"({','.join(header)})")
-        vals = {}
-        for name, i in col.items():
-            cell = cells[i].strip()
-            try:
-                vals[name] = float(cell)
-            except ValueError:
-                raise ValueError(f"{where} line {lineno} column {i + 1} ({name}): not a number: "
-                                 f"{shown(cell)}") from None
-        V = vals.get("V")
-        if V is not None and not math.isfinite(V):
-            raise ValueError(f"{where} line {lineno} column {col['V'] + 1} (V): must be finite, got {V!r}")
-        groups.setdefault(V, []).append((lineno, vals["v"], vals["f"]))
-    if not groups:
-        raise ValueError(f"{where}: no data rows after the header")
-    tables = [(V, [r[1] for r in pts], [r[2] for r in pts]) for V, pts in groups.items()]
-    try:
-        if "V" in col:
-            return PeelForce.tabulated(tables=tables)
-        return PeelForce.tabulated(tables[0][1], tables[0][2])
+        return PeelForce.smoothed(v, f, V=tables[0][0])
     except (ValueError, TypeError) as exc:
-        raise ValueError(f"{where}: {_with_line(str(exc), list(groups.values()))}") from None
+        raise ValueError(f"--force-table {shown(path)} --smooth: {with_line(str(exc), tables)}") from None
 
 
-def _with_line(msg: str, groups: list[list[tuple[int, float, float]]]) -> str:
-    """``msg`` with the file line of the point it names (``v[i]``/``f[i]`` of ``tables[n]``, or of the only
-    table) appended, when it names one."""
-    m = re.search(r"\b[vf]\[(\d+)\]", msg)
-    if not m:
-        return msg
-    t = re.search(r"tables\[(\d+)\]", msg)
-    n = int(t.group(1)) if t else (0 if len(groups) == 1 else None)
-    i = int(m.group(1))
-    if n is None or n >= len(groups) or i >= len(groups[n]):
-        return msg
-    return f"{msg} (line {groups[n][i][0]})"
+def fitted_table(path: str, family: str) -> PeelForce:
+    """``--force-fit FILE --family NAME``: :meth:`PeelForce.fit` of the family to the file's points (one curve;
+    a V column gives the V of a V-dependent family)."""
+    from ..law._tablefile import with_line
+
+    v, f, tables = _one_table("--force-fit", path)
+    try:
+        return PeelForce.fit(v, f, family, V=tables[0][0])
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"--force-fit {shown(path)} --family {family}: {with_line(str(exc), tables)}") from None
 
 
 # --------------------------------------------------------------------------------------------- the record

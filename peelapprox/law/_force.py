@@ -26,7 +26,8 @@ __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "PeelForce", "law_label", "
 #: The kinds of law.
 KINDS = tuple(KIND_IMPLS)
 #: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
-ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated")
+ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated",
+            "smoothed")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -39,7 +40,7 @@ class PeelForce:
 
     Attributes
     ----------
-    kind : {"paper", "family", "expression", "tabulated"}
+    kind : {"paper", "family", "expression", "tabulated", "smoothed"}
     name : str or None
         The family's name (``"paper"``, ``"cubic"``, ``"power_branches"``) of a family law.
     coefficients : tuple of (name, float)
@@ -47,7 +48,7 @@ class PeelForce:
     source : str or None
         An expression law's canonical text (sympy ``srepr``, constants substituted).
     tables : tuple of (V or None, v tuple, f tuple)
-        A tabulated law's tables.
+        A tabulated law's tables; a smoothed law's one ``(V or None, knots [m/s], B-spline coefficients)``.
     display : str
         What ``repr`` shows of an expression or a table, derived from the canonical content (an expression:
         its canonical text, constants substituted); a ``display`` passed in (e.g. by :meth:`from_dict`) is
@@ -177,6 +178,145 @@ class PeelForce:
         if v is None or f is None:
             raise ValueError("tabulated needs v and f (arrays of peel velocities [m/s] and forces [N])")
         return cls("tabulated", tables=((V, v, f),))
+
+    @classmethod
+    def fit(cls, v: Any, f: Any, family: Any, *, sigma: Any = None, V: float | None = None,
+            p0: Mapping[str, float] | None = None,
+            bounds: Mapping[str, tuple[float, float]] | None = None) -> PeelForce:
+        """The law of a family (or an expression) whose coefficients fit the points ``(v, f)`` best, with its
+        statistics in ``law.fit_result``.
+
+        Weighted least squares (``scipy.optimize.least_squares``) of ``(f(v_i) - f_i) / sigma_i``; a family is
+        evaluated by numpy (nothing is compiled).  Details: :mod:`peelapprox.law._fit`.
+
+        Parameters
+        ----------
+        v, f : array_like
+            The points: peel velocities [m/s] (> 0, strictly increasing) and forces [N], finite, more of them
+            than fitted coefficients.
+        family : str or PeelForce
+            A family's name or constructor (``"cubic"``, ``"paper_family"``, ``"power_branches"``; start: its
+            defaults), a family law (start: its coefficients), or an expression's text whose constants are the
+            keys of ``p0`` (e.g. ``"a + b*v - c*v**2 + d*v**3"``).
+        sigma : float or array_like, optional
+            Standard deviation [N] of each f (or one for all): chi^2 is then meaningful and the covariance
+            absolute.  None: unit weights, the covariance scaled by the residual variance ``chi^2 / dof``.
+        V : float, optional
+            The pull speed [m/s] of the points: needed by a law that depends on V; where the folds are given
+            (default 1.0 for a V-independent law).
+        p0 : mapping, optional
+            Starting values by name (a family: over its defaults; an expression: required, its constants).
+        bounds : mapping, optional
+            ``{name: (lo, hi)}``; ``lo == hi`` holds that coefficient fixed at that value (not fitted).  A family's
+            positive coefficients are bounded below by 0 anyway.
+
+        Returns
+        -------
+        PeelForce
+            The fitted law, equal to the same law built by hand; ``law.fit_result`` is a
+            :class:`~peelapprox.FitResult` (coefficients by name, covariance, standard errors,
+            residuals, chi^2, dof, chi^2/dof, the folds at V with their standard errors by the delta method).
+
+        Raises
+        ------
+        ValueError
+            Naming the argument and index: a NaN or inf, v not > 0 or not strictly increasing (unsorted or
+            duplicate), fewer points than coefficients + 1, a bad sigma, p0 or bounds; an unknown family; a
+            start where the law is not finite; a fit that does not converge; points that do not identify a
+            coefficient (the message names the coefficients involved: fix them with ``bounds`` or add data).
+        TypeError
+            An argument of the wrong type.
+        """
+        from ._fit import fit
+
+        return fit(cls, v, f, family, sigma=sigma, V=V, p0=p0, bounds=bounds)
+
+    @property
+    def fit_result(self) -> Any:
+        """What :meth:`fit` measured (:class:`~peelapprox.FitResult`), or None for a law not made by
+        :meth:`fit`.  Not part of the law's value: not compared, hashed, keyed, pickled or in ``asdict``."""
+        return self.__dict__.get("_fit_result")
+
+    @classmethod
+    def smoothed(cls, v: Any, f: Any, *, lam: float | str = "gcv", V: float | None = None) -> PeelForce:
+        """Noisy measured points smoothed by a C² cubic spline in ln v: a law of kind ``"smoothed"``.
+
+        scipy's ``make_smoothing_spline`` of f in ``u = ln v`` (knots at the data), then the N shape is checked on
+        the result: exactly one maximum then one minimum inside the data range.  f, f' and f'' are continuous
+        (f'' too, unlike a table's PCHIP), the folds are the roots of the spline's derivative (between data, not
+        at a datum), and a compiled run evaluates it by the table kernel at a table's cost per call.  Details:
+        :mod:`peelapprox.law._spline`.
+
+        Parameters
+        ----------
+        v, f : array_like
+            Peel velocities [m/s] (> 0, strictly increasing) and forces [N], finite, at least 5 points.
+        lam : "gcv" or float
+            The smoothing penalty: ``"gcv"`` chooses it by generalised cross-validation (scipy's ``lam=None``);
+            0 interpolates (a natural cubic spline through the points); larger is smoother.
+        V : float, optional
+            The pull speed [m/s] the points were measured at: the law is then used at that V only; None (default)
+            uses it at every V.
+
+        Returns
+        -------
+        PeelForce
+            Kind ``"smoothed"``: its ``tables`` hold ``((V, knots [m/s], B-spline coefficients),)`` (a spline in
+            ln v), plain tuples of floats (immutable, hashable, ``dataclasses.asdict``/:meth:`from_dict`
+            round-trip).  Refuses v outside the data range (never extrapolated).
+
+        Raises
+        ------
+        ValueError
+            Naming the argument and index: a NaN or inf, v not > 0 or not strictly increasing (unsorted or
+            duplicate), fewer than 5 points, lengths differ; a bad ``lam`` or V; a smoothed curve that is not
+            N-shaped (the extrema it has are listed: smooth more, with a larger ``lam``).
+        TypeError
+            v or f not arrays of real numbers.
+        """
+        from ._spline import smooth
+
+        return cls("smoothed", tables=smooth(v, f, lam, V))
+
+    @classmethod
+    def from_csv(cls, path: Any, *, columns: Any = None, delimiter: str | None = None) -> PeelForce:
+        """The tabulated law (:meth:`tabulated`) of a CSV file's peel-force curve(s).
+
+        The header names the columns ``v`` and ``f``, or ``V``, ``v`` and ``f`` (one table per pull speed V, the
+        rows of a V in file order), in any order, each optionally with its unit -- ``v [m/s]``, ``v [mm/s]``,
+        ``f [N]``, ``f (kN)``, ... (:data:`peelapprox._csvread.UNITS`): converted to m/s and N; an unknown unit or
+        one of another dimension is refused, named.  ``#`` starts a comment; blank lines are skipped.  The file
+        must be a regular UTF-8 file of at most 16 MiB (a spreadsheet's byte-order mark is fine).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        columns : mapping or sequence of str, optional
+            The header cells to read instead of ``v``, ``f`` (``V``): ``{"v": "speed", "f": "force [kN]"}`` or
+            ``("speed", "force")``; other columns are then ignored.  A unit given here is the unit of a header
+            cell that states none (the units are "stated").
+        delimiter : str, optional
+            The cell separator (default ``,``).
+
+        Returns
+        -------
+        PeelForce
+            A tabulated law (to smooth or fit the same points, read them with
+            :func:`peelapprox.law._tablefile.read_points`, or use the CLI's ``--smooth`` and ``--force-fit``).
+
+        Raises
+        ------
+        ValueError
+            Naming the file and the line (and column): not a regular file, too large, empty, binary (not UTF-8),
+            a wrong header, an unknown unit, a bad cell or row, or :meth:`tabulated`'s error with the file line
+            of the point it names.
+        TypeError
+            ``path`` is not a path, ``columns`` of the wrong type.
+        """
+        from ._tablefile import from_csv
+
+        return from_csv(cls, path, columns, delimiter)
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:

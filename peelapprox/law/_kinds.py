@@ -8,7 +8,8 @@ finds its folds, becomes a compiled kernel and a sympy expression.  The base cla
 * :class:`PaperKind` — the built-in fvV, through :mod:`peelapprox.law._paper` (bitwise), inlined by the drivers;
 * :class:`FamilyKind` — a formula of :mod:`peelapprox.law._families` with its coefficients as data;
 * :class:`ExpressionKind` — a sympy expression kept as canonical text (:mod:`peelapprox.law._expression`);
-* :class:`TabulatedKind` — measured curves, PCHIP in ln v (:mod:`peelapprox.law._table`).
+* :class:`TabulatedKind` — measured curves, PCHIP in ln v (:mod:`peelapprox.law._table`);
+* :class:`SplineKind` — noisy measured points smoothed by a C² spline in ln v (:mod:`peelapprox.law._spline`).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 
 from .._checks import in_range, reals, shown
 from .._ranges import PARAM_RANGES, STATE_RANGES
-from . import _expression, _families, _table
+from . import _expression, _families, _spline, _table
 from ._abi import LAWS, paper_coefficients
 from ._compiled import law_structure
 from ._folds import BranchStructure, find_folds
@@ -318,13 +319,46 @@ class TabulatedKind(LawKind):
         return _table.TableLaw(force.tables)
 
     def kernel(self, force: Any, V: float) -> tuple[Any, np.ndarray]:
+        self.check_start(force)
+        return table_law, table_coefficients(force.tables, V)
+
+    @staticmethod
+    def check_start(force: Any) -> None:
+        """ValueError if the data start below ``STATE_RANGES["v"]`` (the compiled f'' would underflow)."""
         lo, v_lo = force.v_range[0], STATE_RANGES["v"][0]
         if lo < v_lo:
             raise ValueError(f"params.force: the table starts at v={lo!r} m/s, below the model's velocities "
                              f"STATE_RANGES['v'] = ({v_lo:g}, {STATE_RANGES['v'][1]:g}] m/s (v^2 underflows in f'' "
                              "there): give the table's v in m/s, within that range")
-        return table_law, table_coefficients(force.tables, V)
+
+
+class SplineKind(TabulatedKind):
+    """Points smoothed by a C² cubic spline in ln v (``PeelForce.smoothed``): its knots and B-spline coefficients as
+    data; evaluated by scipy's BSpline, compiled through the table kernel; never extrapolated."""
+
+    name = "smoothed"
+
+    def canonical(self, force: Any) -> dict[str, Any]:
+        return {"tables": _spline.check_spline(force.tables, PARAM_RANGES["V"])}
+
+    def display(self, force: Any) -> str:
+        V, t, _ = force.tables[0]
+        return f"V={V!r}: C2 spline in ln v, {len(t) - 6} knots, v in [{t[0]:.6g}, {t[-1]:.6g}] m/s"
+
+    def show(self, force: Any) -> str:
+        return f"PeelForce.smoothed(<{force.display}>)"
+
+    def depends_on_V(self, force: Any) -> bool:
+        return False
+
+    def evaluator(self, force: Any) -> Evaluator:
+        return _spline.SplineLaw(force.tables)
+
+    def kernel(self, force: Any, V: float) -> tuple[Any, np.ndarray]:
+        self.check_start(force)
+        return table_law, _spline.spline_coefficients(force.tables, V)
 
 
 #: The implementation of each kind, by ``PeelForce.kind``, in the order of the module docstring.
-KIND_IMPLS: dict[str, LawKind] = {k.name: k for k in (PaperKind(), FamilyKind(), ExpressionKind(), TabulatedKind())}
+KIND_IMPLS: dict[str, LawKind] = {k.name: k for k in (PaperKind(), FamilyKind(), ExpressionKind(), TabulatedKind(),
+                                                      SplineKind())}

@@ -22,7 +22,7 @@ from .._jit import kernel
 from ._abi import LAW_FP, LAW_LNV, LAW_SIG
 from ._table import TableLaw, check_tables
 
-__all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "table_law", "table_coefficients"]
+__all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "pack_blocks", "table_law", "table_coefficients"]
 
 #: Indices of the header of ``coef``: the number of tables used, ln lo, ln hi; the first block starts at T_HEAD.
 #: ``coef = [m, ln lo, ln hi, block_1, ..., block_m]``: ``m`` in {1, 2} tables of nonzero weight at V, ``[lo,
@@ -180,13 +180,20 @@ def table_coefficients(tables, V: float) -> np.ndarray:
     law = TableLaw(tables)
     u_lo = max(float(p.x[0]) for p in law.pchips)
     u_hi = min(float(p.x[-1]) for p in law.pchips)
-    parts = []
     used = [(j, w) for j, w in law._weights(V) if w != 0.0]
-    for j, w in used:
-        p = law.pchips[j]
-        x = np.asarray(p.x, dtype=float)
-        c = np.asarray(p.c, dtype=float)
-        if c.shape != (4, x.size - 1):  # pragma: no cover - PchipInterpolator is a cubic PPoly
-            raise RuntimeError(f"unexpected PCHIP coefficient shape {c.shape} for {x.size} knots")
+    return pack_blocks([(w, law.pchips[j].x, law.pchips[j].c) for j, w in used], u_lo, u_hi)
+
+
+def pack_blocks(blocks, u_lo: float, u_hi: float) -> np.ndarray:
+    """``coef`` of :func:`table_law` from ``(w, x, c)`` blocks -- a weight, the breakpoints in u and the ``(4,
+    n - 1)`` power coefficients of a piecewise cubic (scipy's ``PPoly.x``, ``PPoly.c``) -- and the common range
+    ``[u_lo, u_hi]`` (layout: module docstring).  A tabulated law's blocks are its PCHIPs'; a smoothed law's, its
+    spline's piecewise-polynomial form (:mod:`peelapprox.law._spline`)."""
+    parts = []
+    for w, x, c in blocks:
+        x = np.asarray(x, dtype=float)
+        c = np.asarray(c, dtype=float)
+        if c.shape != (4, x.size - 1):  # pragma: no cover - PCHIPs and splines are cubic PPolys
+            raise RuntimeError(f"unexpected piecewise-cubic coefficient shape {c.shape} for {x.size} knots")
         parts += [np.array([w, float(x.size), (x.size - 1) / (x[-1] - x[0])]), x, _guide(x), c.T.reshape(-1)]
-    return np.ascontiguousarray(np.concatenate([np.array([float(len(used)), u_lo, u_hi]), *parts]), dtype=float)
+    return np.ascontiguousarray(np.concatenate([np.array([float(len(blocks)), u_lo, u_hi]), *parts]), dtype=float)

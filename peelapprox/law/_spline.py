@@ -1,0 +1,258 @@
+"""Smoothed peel-force laws: a C² cubic smoothing spline of noisy points in ln v (kind ``"smoothed"``).
+
+:func:`smooth` makes the law's data from measured points ``(v_i, f_i)``: scipy's
+:func:`~scipy.interpolate.make_smoothing_spline` of f in ``u = ln v`` (a natural cubic smoothing spline, knots
+at the data, its penalty ``lam`` chosen by generalised cross-validation unless given), then checks the N shape
+of the result: the roots of its derivative inside the data range must be exactly one maximum followed by one
+minimum (a ``ValueError`` says what it found otherwise).  The folds are roots of the spline's derivative,
+between data points (not at a datum, as a table's PCHIP puts them).
+
+The data of a smoothed law (``PeelForce.tables`` of a ``"smoothed"`` law, plain tuples of floats, so the law is
+immutable, hashable and JSON-able as the others) are one triple ``(V, knots, coefficients)``: the pull speed the
+points were measured at (None: used at every V), the B-spline knots as peel velocities [m/s] (the spline is in
+``u = ln v``, its knots at ``ln knots``; degree 3, the end knots repeated four times, the interior ones simple and
+increasing: the spline is C² everywhere; as velocities, like a table's v, so that code reading a law's ``tables``
+sees velocities whatever its kind) and its B-spline coefficients (``len(knots) - 4`` of them).
+:func:`check_spline` validates them (for a law read back by
+``PeelForce.from_dict``).
+
+Evaluation: by numpy, :class:`SplineLaw` (scipy's ``BSpline`` and its derivatives in u; ``f' = p'/v``,
+``f'' = (p'' - p')/v²``); compiled, by the table kernel :func:`peelapprox.law._table_jit.table_law`, the spline
+being converted to its piecewise-polynomial form (``PPoly.from_spline``: the same cubic on each knot interval,
+to rounding) and packed as a one-table block (:func:`spline_coefficients`): a smoothed law costs per call what a
+table does.  Outside the data range a spline law is refused (never extrapolated), as a table is.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .._checks import in_range, shown
+
+__all__ = ["MIN_POINTS", "SplineLaw", "check_spline", "smooth", "spline_coefficients", "spline_shape"]
+
+#: Fewest points to smooth: one maximum and one minimum, each with a neighbour on either side.
+MIN_POINTS = 5
+_DEGREE = 3
+#: The grid of penalties ``lam="gcv"`` searches upward when GCV's spline is not N-shaped (:func:`smooth`).
+_LAM_RATIO, _LAM_STEPS = 1.25, 250
+#: The searched spline must follow the data as noise does: its RMS residual at most this many times the noise
+#: estimated from the data's second differences (:func:`_noise`), else it is refused.
+_NOISE_FACTOR = 5.0
+
+
+def _bspline(t: Any, c: Any) -> Any:
+    """The B-spline in ``u = ln v`` of the knots ``t`` given as velocities [m/s] and the coefficients ``c``."""
+    from scipy.interpolate import BSpline
+
+    return BSpline(np.log(np.asarray(t, dtype=float)), np.asarray(c, dtype=float), _DEGREE, extrapolate=False)
+
+
+def spline_shape(t: Any, c: Any) -> list[tuple[str, float]]:
+    """The interior extrema of the spline ``(t, c)`` (knots as velocities), in order: ``[("max" | "min", u), ...]``,
+    u = ln v (roots of its derivative where the derivative changes sign, from its piecewise-polynomial form)."""
+    from scipy.interpolate import PPoly
+
+    pp = PPoly.from_spline(_bspline(t, c))
+    d1 = pp.derivative()
+    u_lo, u_hi = math.log(t[0]), math.log(t[-1])
+    out: list[tuple[str, float]] = []
+    for u in np.sort(d1.roots(extrapolate=False)):
+        u = float(u)
+        if not (u_lo < u < u_hi) or (out and u == out[-1][1]):
+            continue
+        h = 1e-7 * max(1.0, u_hi - u_lo)
+        a, b = float(d1(max(u - h, u_lo))), float(d1(min(u + h, u_hi)))
+        if a > 0 > b:
+            out.append(("max", u))
+        elif a < 0 < b:
+            out.append(("min", u))
+    return out
+
+
+def _shape_error(t: Any, c: Any, label: str) -> str | None:
+    """None if the spline has exactly one maximum then one minimum, else what it has (for a message)."""
+    ext = spline_shape(t, c)
+    if [k for k, _ in ext] == ["max", "min"]:
+        return None
+    spl = _bspline(t, c)
+    found = ", ".join(f"a local {k} at v = {math.exp(u):.6g} m/s (f = {float(spl(u)):.6g} N)" for k, u in ext)
+    return (f"{label} must have exactly one local maximum followed by one local minimum inside the data range (the "
+            f"N shape of a stick-slip law); found {found or 'none (it is monotone: no folds, no stick-slip)'}")
+
+
+def smooth(v: Any, f: Any, lam: Any = "gcv", V: Any = None) -> tuple:
+    """The tables of a ``"smoothed"`` law smoothing the points ``(v, f)`` (module docstring).
+
+    ``lam``: ``"gcv"`` or a penalty >= 0 (0: the interpolating natural spline; larger: smoother).  ``"gcv"``
+    takes the penalty of generalised cross-validation (scipy's ``lam=None``); GCV often follows the noise near
+    the flat folds (on 40 points of the cubic with 1 % noise its spline has 6 to 10 extrema), and then the
+    smallest penalty on a grid of ratio 1.25 upward from ``1e-4 h^3`` (h the mean spacing of the data in ln v)
+    whose spline has exactly one maximum then one minimum is taken instead -- provided it still follows the data as
+    noise would (RMS residual at most 5 times the noise estimated from the data's second differences); a spline
+    N-shaped only at a penalty that misses the data is refused.  ValueError naming the argument (and
+    index) for bad points, a bad ``lam``, or a smoothed curve that is not N-shaped (what it has, named: with
+    ``"gcv"``, GCV's spline, when no penalty on the grid gives the N shape).
+    """
+    from scipy.interpolate import make_smoothing_spline
+
+    from .._ranges import PARAM_RANGES
+    from ._fit import check_points
+
+    va, fa = check_points(v, f, need=MIN_POINTS, what="a smoothed law needs (one maximum then one minimum, "
+                                                       "each between two others)")
+    if isinstance(lam, str):
+        if lam != "gcv":
+            raise ValueError(f"lam must be 'gcv' (chosen by generalised cross-validation) or a number >= 0, got "
+                             f"{shown(lam)}")
+        penalty = None
+    else:
+        penalty = in_range("lam", lam, 0.0)
+    V0 = None if V is None else in_range("V", V, *PARAM_RANGES["V"])
+    u = np.log(va)
+    if np.any(np.diff(u) <= 0):
+        i = int(np.flatnonzero(np.diff(u) <= 0)[0])
+        raise ValueError(f"v must be strictly increasing in ln v: v[{i}] = {va[i]!r} and v[{i + 1}] = {va[i + 1]!r} "
+                         "have the same logarithm")
+    def spline(lam: float | None) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        with np.errstate(all="ignore"):
+            try:
+                spl = make_smoothing_spline(u, fa, lam=lam)
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                raise ValueError(f"v, f: the smoothing spline cannot be made of these points ({exc})") from None
+        t, c = tuple(math.exp(float(x)) for x in spl.t), tuple(float(x) for x in spl.c)
+        if not all(math.isfinite(x) for x in c):
+            raise ValueError("v, f: the smoothing spline of these points is not finite (f too large, or v too close "
+                             "together in ln v)")
+        return t, c
+
+    t, c = spline(penalty)
+    msg = _shape_error(t, c, "the smoothed f (PeelForce.smoothed)")
+    if msg and penalty is None:
+        # GCV follows the noise near the flat folds: the smallest penalty on a grid of ratio 1.25 upward from
+        # 1e-4 h^3 (h the mean spacing in u; the penalty is of order h^3 where smoothing starts) with the N shape
+        lam = 1e-4 * ((u[-1] - u[0]) / (u.size - 1)) ** 3
+        for _ in range(_LAM_STEPS):
+            tt, cc = spline(lam)
+            kinds = [k for k, _ in spline_shape(tt, cc)]
+            if kinds == ["max", "min"]:
+                rms = math.sqrt(float(np.mean((_bspline(tt, cc)(u) - fa) ** 2)))
+                if rms <= _NOISE_FACTOR * _noise(fa):
+                    return ((V0, tt, cc),)
+                break  # the N shape only at a penalty that misses the data: not a smoothing of noise
+            if not kinds:  # monotone: smoothing more cannot bring the folds back
+                break
+            lam *= _LAM_RATIO
+    if msg:
+        used = repr(penalty) if penalty is not None else (
+            f"GCV's; no larger penalty gave the N shape while following the data (RMS residual at most "
+            f"{_NOISE_FACTOR:g}x the noise estimated from second differences)")
+        raise ValueError(f"{msg}; lam: {used} (a larger lam smooths more)")
+    return ((V0, t, c),)
+
+
+def _noise(f: np.ndarray) -> float:
+    """A robust estimate of the noise's standard deviation in f: the median absolute second difference
+    ``f[i-1] - 2 f[i] + f[i+1]`` (standard deviation sqrt(6) sigma for independent noise), scaled to a standard
+    deviation (1.4826, the normal distribution's MAD factor).  Smooth data give ~0 where they are flat in the
+    median; steep data overestimate it where they curve (then the search is permissive only by the data's own
+    curvature)."""
+    d2 = f[:-2] - 2.0 * f[1:-1] + f[2:]
+    return 1.4826 * float(np.median(np.abs(d2))) / math.sqrt(6.0)
+
+
+def check_spline(tables: Any, V_range: tuple[float, float]) -> tuple:
+    """The canonical ``((V, knots, coefficients),)`` of a spline law (module docstring), or ValueError/TypeError."""
+    try:
+        items = list(tables)
+    except TypeError:
+        raise TypeError(f"tables of a spline law must be one (V, knots, coefficients) triple in a sequence, got "
+                        f"{type(tables).__name__}") from None
+    if len(items) != 1 or not isinstance(items[0], (tuple, list)) or len(items[0]) != 3:
+        raise ValueError("tables of a spline law must hold exactly one (V, knots, coefficients) triple")
+    V, t, c = items[0]
+    V = None if V is None else in_range("V", V, *V_range)
+    ta = _floats("knots", t)
+    ca = _floats("coefficients", c)
+    if ta.size < 2 * (_DEGREE + 1) + 1 or ca.size != ta.size - _DEGREE - 1:
+        raise ValueError(f"a spline law needs at least {2 * _DEGREE + 3} knots and len(knots) - {_DEGREE + 1} "
+                         f"coefficients, got {ta.size} knots and {ca.size} coefficients")
+    ends = (ta[:_DEGREE + 1], ta[-_DEGREE - 1:])
+    if np.any(ends[0] != ta[0]) or np.any(ends[1] != ta[-1]):
+        raise ValueError(f"the knots of a spline law must repeat each end {_DEGREE + 1} times (a clamped cubic)")
+    if ta[0] <= 0:
+        raise ValueError(f"the knots of a spline law are peel velocities, > 0 [m/s]: knots[0] = {ta[0]!r}")
+    inner = np.log(ta[_DEGREE:-_DEGREE])
+    bad = np.flatnonzero(np.diff(inner) <= 0)
+    if bad.size:
+        i = int(bad[0]) + _DEGREE
+        raise ValueError(f"the knots of a spline law must be strictly increasing inside (simple knots: f'' "
+                         f"continuous): knots[{i}] = {ta[i]!r} >= knots[{i + 1}] = {ta[i + 1]!r}")
+    tt, cc = tuple(float(x) for x in ta), tuple(float(x) for x in ca)
+    msg = _shape_error(tt, cc, "a spline law")
+    if msg:
+        raise ValueError(msg)
+    return ((V, tt, cc),)
+
+
+def _floats(name: str, x: Any) -> np.ndarray:
+    from .._checks import reals
+
+    a = reals(f"{name} of a spline law", x)
+    if a.ndim != 1:
+        raise ValueError(f"{name} of a spline law must be 1-D, got shape {a.shape}")
+    return a
+
+
+class SplineLaw:
+    """The numpy evaluator of a spline law: scipy's ``BSpline`` in ``u = ln v``, refused outside its range."""
+
+    def __init__(self, tables: tuple):
+        V, t, c = tables[0]
+        self.V = V
+        spl = _bspline(t, c)
+        self.derivs = (spl, spl.derivative(1), spl.derivative(2))
+        self.lo, self.hi = float(t[0]), float(t[-1])
+        self.u_lo, self.u_hi = math.log(t[0]), math.log(t[-1])
+
+    def v_range(self) -> tuple[float, float]:
+        return self.lo, self.hi
+
+    def check_V(self, V: float) -> None:
+        if self.V is not None and V != self.V:
+            raise ValueError(f"V={V!r} m/s: this smoothed law was measured at V={self.V!r} m/s only (smooth with "
+                             "V=None to use it at every pull speed)")
+
+    def __call__(self, v: np.ndarray, V: float, order: int) -> np.ndarray:
+        self.check_V(V)
+        if v.size and (v.min() < self.lo or v.max() > self.hi):
+            bad = v.ravel()[np.flatnonzero(((v < self.lo) | (v > self.hi)).ravel())[0]]
+            raise ValueError(f"v={float(bad)!r} m/s is outside the smoothed law's range [{self.lo!r}, {self.hi!r}] "
+                             "m/s (its data): a smoothed law is not extrapolated")
+        u = np.clip(np.log(v), self.u_lo, self.u_hi)  # exp then log may leave the range by an ulp
+        if order == 0:
+            return np.asarray(self.derivs[0](u), dtype=float)
+        d1 = np.asarray(self.derivs[1](u), dtype=float)
+        if order == 1:
+            return d1 / v
+        return (np.asarray(self.derivs[2](u), dtype=float) - d1) / (v * v)
+
+
+def spline_coefficients(tables: tuple, V: float) -> np.ndarray:
+    """``coef`` of the table kernel for a spline law at V: its piecewise-polynomial form packed as one table
+    (:func:`peelapprox.law._table_jit.pack_blocks`)."""
+    from scipy.interpolate import PPoly
+
+    from ._table_jit import pack_blocks
+
+    V0, t, c = tables[0]
+    SplineLaw(tables).check_V(V)
+    pp = PPoly.from_spline(_bspline(t, c))
+    x = np.asarray(pp.x, dtype=float)
+    idx = np.flatnonzero(np.diff(x) > 0)  # the intervals of the repeated end knots are empty
+    xs = np.append(x[idx], x[idx[-1] + 1])
+    cs = np.asarray(pp.c, dtype=float)[:, idx]
+    return pack_blocks([(1.0, xs, cs)], float(xs[0]), float(xs[-1]))
