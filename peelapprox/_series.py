@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._checks import shown
 from ._observables import StickSlipObservables, jump_statistics
 from .io import fmt_number, jsonable, write_rows
 from .validate import integer, optional, positive, reals
@@ -55,6 +56,8 @@ __all__ = ["ForceSeries", "Slips", "Spectrum", "detect_slips", "noise_level", "M
 
 #: The fewest samples a trace may have.
 MIN_SAMPLES = 16
+#: The largest trace file read [bytes]: 50 s at 20 kHz is ~25 MB of text; 256 MiB is ten million rows.
+MAX_TRACE_BYTES = 256 * 1024 * 1024
 #: The default threshold in units of the averaged force's noise, σ/√smooth (module docstring, step 2).
 THRESHOLD_SIGMAS = 12.0
 
@@ -313,6 +316,41 @@ class ForceSeries:
         V = "" if self.V is None else f", V = {fmt_number(self.V, 4)} m/s"
         return (f"ForceSeries({len(self)} samples over {fmt_number(self.duration, 4)} s at "
                 f"{fmt_number(self.rate, 4)} Hz{V}, {self.source})")
+
+    @classmethod
+    def from_csv(cls, path: str, *, columns: tuple[str, str] = ("t", "F"), V: float | None = None,
+                 delimiter: str | None = None, units: dict[str, str] | None = None) -> ForceSeries:
+        """A trace read from a CSV file: a header naming the time and force columns (``columns``), then one
+        sample per row; other columns are ignored.
+
+        Units in the header (``t [ms], F [kN]``; :data:`peelapprox._csvread.UNITS`: s, ms, us, min; N, mN, cN,
+        kN) are converted to s and N, or stated with ``units={"t": "ms"}`` where the header gives none (none:
+        s and N).  The file is read by the package's one CSV reader (a regular UTF-8 file of at most 256 MiB,
+        ``#`` comments), which never executes anything.
+
+        Raises
+        ------
+        ValueError
+            Naming the file and, for a cell, its line and column (a missing column, an unknown unit, a cell
+            that is not a number); or the trace's own checks with the file line of the offending sample.
+        """
+        from ._csvread import read_columns
+
+        if not (isinstance(columns, tuple) and len(columns) == 2 and all(isinstance(c, str) for c in columns)):
+            raise TypeError(f"columns must be a pair of column names (time, force), got {columns!r}")
+        where = f"ForceSeries.from_csv({shown(str(path))})"
+        tc, fc = columns
+        data = read_columns(str(path), {tc: "s", fc: "N"}, where=where, delimiter=delimiter,
+                            max_bytes=MAX_TRACE_BYTES, stated=units)
+        try:
+            return cls(data[tc], data[fc], V=V, source=f"measured: {path}")
+        except ValueError as exc:
+            import re
+
+            m = re.search(r"\[(\d+)\]", str(exc))  # the sample the trace's check names
+            i = int(m.group(1)) if m else -1
+            line = f" (file line {int(data['line'][i])})" if 0 <= i < data["line"].size else ""
+            raise ValueError(f"{where}: {exc}{line}") from None
 
     @property
     def duration(self) -> float:

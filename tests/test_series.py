@@ -153,3 +153,24 @@ def test_bad_options_are_named():
                           ({"rate": 1e3, "drift": math.inf}, "drift")):
         with pytest.raises(ValueError, match=match):
             tr.as_series(**kwargs)
+
+
+def test_from_csv_reads_units_and_names_bad_rows(tmp_path):
+    """A trace in ms and kN is read back in s and N to rounding (1e-12 relative: the decimal text of savetxt);
+    a time that does not increase is named with its file line; a cell that is not a number with its line and
+    column; an unknown unit by name."""
+    t = np.arange(200) / 1000.0
+    F = 100.0 + 50.0 * np.sin(7 * t)
+    np.savetxt(tmp_path / "a.csv", np.c_[t * 1e3, F / 1e3], delimiter=",", header="t [ms],F [kN]", comments="",
+               fmt="%.17g")
+    s = ForceSeries.from_csv(str(tmp_path / "a.csv"), V=1.0)
+    assert np.allclose(s.t, t, rtol=1e-12, atol=1e-15) and np.allclose(s.F, F, rtol=1e-12) and s.V == 1.0
+    np.savetxt(tmp_path / "b.csv", np.c_[np.r_[t[:100], t[:100]], F], delimiter=",", header="t,F", comments="")
+    with pytest.raises(ValueError, match=r"t must increase: t\[100\].*file line 102"):
+        ForceSeries.from_csv(str(tmp_path / "b.csv"))
+    (tmp_path / "c.csv").write_text("t,F\n0,1\n0.1,x\n")
+    with pytest.raises(ValueError, match="line 3 column 2"):
+        ForceSeries.from_csv(str(tmp_path / "c.csv"))
+    (tmp_path / "d.csv").write_text("t [h],F\n0,1\n")
+    with pytest.raises(ValueError, match="unknown unit"):
+        ForceSeries.from_csv(str(tmp_path / "d.csv"))
