@@ -31,6 +31,7 @@ FIGURES = {
     "04_your_own_tape": "your_own_tape.png",
     "05_sweep_phase_diagram": "sweep_phase_diagram.png",
     "06_orbits_bifurcation": "orbits_bifurcation.png",
+    "07_your_data": "your_data.png",
 }
 
 
@@ -210,3 +211,22 @@ def test_06_orbits_bifurcation(runs):
     assert _num(r"neimark_sacker at V = ([\d.]+)", out) == pytest.approx(0.977, abs=2e-3)
     assert _num(r"ends: crest at V = ([\d.]+)", out) == pytest.approx(1.103, abs=2e-3)
     assert "long run at V = 1.000: period-8" in out
+
+
+def test_07_your_data(runs):
+    """A synthetic experiment (V = 1, I = 1e-2, k = 1000 N/m, 20 s at 10 kHz, 0.5 N noise, 5 N drift) written in
+    ms and kN and read back: every slip of the run found (the run's own count: exact), the slip interval to 1 %
+    and the drop to 2 % of the run's (the detector's stated goals), period 8 (the paper's); λ within 0.1
+    bits/s of 0 (a periodic orbit; the tolerance of tests/test_series_lyapunov.py); k within 5 % of the truth
+    with its interval covering it (the inference's goal)."""
+    out = _output(runs, "07_your_data")
+    found, made = _num(r"(\d+) slips found", out), _num(r"the run has (\d+)", out)
+    assert found == made
+    assert _num(r"slip interval ([\d.]+) s", out) == pytest.approx(_num(r"\(exact ([\d.]+) s\), force", out),
+                                                                   rel=0.01)
+    assert _num(r"force drop ([\d.]+) N", out) == pytest.approx(_num(r"\(exact ([\d.]+) N\)", out), rel=0.02)
+    assert "period-8 (exact period-8)" in out
+    assert abs(_num(r"Lyapunov exponent ([-\d.]+) bits/s", out)) < 0.1
+    k = _num(r"k = ([\d.]+) \(truth", out)
+    lo, hi = _num(r"95 % in \[([\d.]+),", out), _num(r"95 % in \[[\d.]+, ([\d.]+)\]", out)
+    assert abs(k / 1000 - 1) < 0.05 and lo <= 1000 <= hi
