@@ -43,7 +43,9 @@ from typing import Any, Literal
 
 from numba import njit
 from numba.core import config as numba_config
+from numba.core import targetconfig as _targetconfig
 from numba.core import types as _nbtypes
+from numba.core.typing import templates as _templates
 from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
@@ -235,7 +237,7 @@ def _check_source(fn: Callable) -> None:
 
 def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "never", fastmath: bool = False,
            name: str | None = None, signature: Any = None, nrt: bool = True, outside: bool = False,
-           lazy: bool = False) -> Any:
+           lazy: bool = False, inner: bool = False) -> Any:
     """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 
     Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.
@@ -275,10 +277,19 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         from Python, the first conversion to a function-typed argument of a compiled driver, the first compiled
         caller -- instead of now, and never for another (issue 17: importing the package compiles nothing, and a
         job compiles only the kernels it runs).
+    inner : bool
+        True for a helper that only compiled code calls (a DOP853 stage sum, a driver's bookkeeping): returns
+        the plain function ``fn``, registered (numba's ``register_jitable``, no IR inlining) so that a kernel
+        calling it compiles it once per process and plain argument types as a separate function linked into its
+        own code, as a dispatcher callee is (LLVM inlines it there as before), but without the wrappers that
+        make a dispatcher callable from Python and as a first-class function, and without cache files of its
+        own: its machine code is cached inside each caller, the only thing a warm process loads.  These were
+        half of a cold start's compilations and about a fifth of its time (``docs/performance.md``, "Cold
+        start").  A Python caller runs the plain function (correct, interpreted).  No other option applies.
 
     Returns
     -------
-    numba dispatcher
+    numba dispatcher, or ``fn`` itself when ``inner``
 
     Raises
     ------
@@ -287,7 +298,9 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
     """
     if fn is None:
         return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name, signature=signature, nrt=nrt,
-                                outside=outside, lazy=lazy)
+                                outside=outside, lazy=lazy, inner=inner)
+    if inner:
+        return _inner(fn)
     d = _compile(fn, inline, fastmath, name, nrt, outside)
     if signature is not None:
         if lazy:
@@ -296,6 +309,41 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
             d.compile(signature)
             d.disable_compile()
     return d
+
+
+#: The options of an ``inner`` helper's compilation: no Python wrapper, no first-class-function wrapper.
+_INNER_OPTIONS = {"nopython": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+
+
+def _inner(fn: Callable) -> Callable:
+    """``kernel(fn, inner=True)``: ``fn`` registered as numba's ``register_jitable`` does (an ``@overload`` whose
+    implementation is ``fn``), with :data:`_INNER_OPTIONS`, keeping one compilation per argument types however
+    its callers were compiled.  numba keys an overload's compilations on the caller's compile flags as well;
+    those of a kernel and of another helper differ in their wrapper options only, which do not reach the
+    helper's code (they are not inherited), so the key takes the caller's flags with those two set as the
+    helper's: without this, a helper called from both compiled ``interp1`` and ``solve_theta`` twice."""
+    _check_source(fn)
+
+    def implementation(*args: Any, **kws: Any) -> Callable:
+        return fn
+
+    base: Any = _templates.make_overload_template(fn, implementation, dict(_INNER_OPTIONS), False, "never", False)
+
+    class Inner(base):  # type: ignore[misc, valid-type]
+        def _get_impl(self, args: Any, kws: Any) -> Any:
+            flags = _targetconfig.ConfigStack.top_or_none()
+            if flags is not None:
+                flags = flags.copy()
+                flags.no_cpython_wrapper = flags.no_cfunc_wrapper = True
+            key = (self.context, tuple(args), tuple(kws.items()), flags)
+            if key in self._impl_cache:
+                return self._impl_cache[key]
+            return self._build_impl(key, args, kws)
+
+    Inner.__name__ = Inner.__qualname__ = base.__name__
+    _templates.infer(Inner)
+    _templates.infer_global(fn, _nbtypes.Function(Inner))
+    return fn
 
 
 def _compile_on_first_use(d: Any, signature: Any) -> None:
@@ -394,3 +442,4 @@ def jitable(fn: Callable) -> Callable:
     """
     _check_source(fn)
     return register_jitable(inline="always")(fn)
+
