@@ -40,7 +40,7 @@ from collections.abc import Callable
 import numpy as np
 
 from . import _dop853_tableau as _dop
-from ._jit import _renamed, kernel
+from ._jit import kernel
 
 __all__ = [
     "Dop853",
@@ -229,7 +229,7 @@ def make_dop853(rhs) -> Dop853:
     tag = _cache_tag(rhs)
 
     def jit(fn):
-        return kernel(_renamed(fn, f"{fn.__name__}__{tag}"), inner=True)
+        return kernel(fn, name=f"{fn.__name__}__{tag}", inner=True)
 
     def initial_step(y0, f0, p, rtol, atol, work):
         n = y0.shape[0]

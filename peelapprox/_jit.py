@@ -285,7 +285,8 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         make a dispatcher callable from Python and as a first-class function, and without cache files of its
         own: its machine code is cached inside each caller, the only thing a warm process loads.  These were
         half of a cold start's compilations and about a fifth of its time (``docs/performance.md``, "Cold
-        start").  A Python caller runs the plain function (correct, interpreted).  No other option applies.
+        start").  A Python caller runs the plain function (correct, interpreted).  Of the other options only
+        ``name`` applies (the name in numba's compile events).
 
     Returns
     -------
@@ -300,7 +301,7 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name, signature=signature, nrt=nrt,
                                 outside=outside, lazy=lazy, inner=inner)
     if inner:
-        return _inner(fn)
+        return _inner(fn if name is None else _renamed(fn, name))
     d = _compile(fn, inline, fastmath, name, nrt, outside)
     if signature is not None:
         if lazy:
