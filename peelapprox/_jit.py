@@ -283,9 +283,10 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         calling it compiles it once per process and plain argument types as a separate function linked into its
         own code, as a dispatcher callee is (LLVM inlines it there as before), but without the wrappers that
         make a dispatcher callable from Python and as a first-class function, and without cache files of its
-        own: its machine code is cached inside each caller, the only thing a warm process loads.  These were
-        half of a cold start's compilations and about a fifth of its time (``docs/performance.md``, "Cold
-        start").  A Python caller runs the plain function (correct, interpreted).  Of the other options only
+        own: its machine code is cached inside each caller, the only thing a warm process loads.  Such helpers
+        were 23 of the 27 functions a cold first ``simulate`` compiled, and their wrappers and cache files about
+        a seventh of its compile time (``docs/performance.md``, "Cold start").  A Python caller runs the plain
+        function (correct, interpreted).  Of the other options only
         ``name`` applies (the name in numba's compile events).
 
     Returns
@@ -322,7 +323,8 @@ def _inner(fn: Callable) -> Callable:
     its callers were compiled.  numba keys an overload's compilations on the caller's compile flags as well;
     those of a kernel and of another helper differ in their wrapper options only, which do not reach the
     helper's code (they are not inherited), so the key takes the caller's flags with those two set as the
-    helper's: without this, a helper called from both compiled ``interp1`` and ``solve_theta`` twice."""
+    helper's.  Without this, ``interp1``, called from a driver and from ``solve_theta``, was compiled twice.
+    Overrides the private ``_get_impl`` of numba's overload template (its key as in numba 0.58-0.68)."""
     _check_source(fn)
 
     def implementation(*args: Any, **kws: Any) -> Callable:
