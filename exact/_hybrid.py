@@ -183,7 +183,7 @@ def _rhs(y, p, out):
     _field(y, p, v, f, g, out)
 
 
-@kernel
+@kernel(inner=True)
 def _store(out, nrow, t, y, v, F, br_arr, br):
     out[nrow, O_T] = t
     out[nrow, O_AL] = y[1]
@@ -193,7 +193,7 @@ def _store(out, nrow, t, y, v, F, br_arr, br):
     br_arr[nrow] = br
 
 
-@kernel
+@kernel(inner=True)
 def _in_domain(y, p):
     """A state the driver may use: finite, v = exp(u) > 0 and 1 + c(α) > 0 (where the field is defined)."""
     for i in range(4):
@@ -205,7 +205,7 @@ def _in_domain(y, p):
     return 1.0 + c > 0.0
 
 
-@kernel
+@kernel(inner=True)
 def _finite_rows(Fc):
     """All dense-output coefficients finite (the extra stages stayed in the domain)."""
     for r in range(Fc.shape[0]):
@@ -215,7 +215,7 @@ def _finite_rows(Fc):
     return True
 
 
-@kernel
+@kernel(inner=True)
 def _save(st, y, h):
     """Write the resumable solver state (y and the next step size) into st."""
     st[S_TAU] = y[0]
@@ -225,7 +225,7 @@ def _save(st, y, h):
     st[S_H] = h
 
 
-@kernel
+@kernel(inner=True)
 def _resume(st, y):
     """Read the resumable solver state into y; returns ``(t0, branch, h)``."""
     y[0] = st[S_TAU]
@@ -235,7 +235,7 @@ def _resume(st, y):
     return st[S_T0], int(st[S_BR]), st[S_H]
 
 
-@kernel
+@kernel(inner=True)
 def _end(st, y, ye, h, status):
     """Stop the call at ``ye`` (copied into y; the next call continues with step h) and return ``status``."""
     for i in range(4):
@@ -247,7 +247,7 @@ def _end(st, y, ye, h, status):
 _GO = -1  # _room_left: nothing stops the call before the next step
 
 
-@kernel
+@kernel(inner=True)
 def _room_left(calls, max_call_steps, save_mode, cnt, nout_cap, njump_cap):
     """The status that ends the call before the next step (its step quota used, or a buffer without room for what
     a step may store), else ``_GO``: budgets and buffers are checked between steps only."""
@@ -260,7 +260,7 @@ def _room_left(calls, max_call_steps, save_mode, cnt, nout_cap, njump_cap):
     return _GO
 
 
-@kernel
+@kernel(inner=True)
 def _fold_crossing(y, y_new, p, br):
     """``(crossed, u_event, g_start, g_end)``: whether the step ``[y, y_new]`` reaches the fold event of branch br
     (AB: u rises to ``P_UEV_AB``; CD: falls to ``P_UEV_CD``), the event level and ``u - u_event`` at both ends."""
@@ -270,7 +270,7 @@ def _fold_crossing(y, y_new, p, br):
     return (gB >= 0.0 if br == 0 else gB <= 0.0), uf, gA, gB
 
 
-@kernel
+@kernel(inner=True)
 def _record_jump(jbuf, cnt, tj, br, ye, F, v_before, v_after):
     """Store the jump at ``tj`` from branch br at state ``ye`` (α, ω; F the pull force) in the next row of jbuf."""
     k = cnt[C_NJOUT]
@@ -285,7 +285,7 @@ def _record_jump(jbuf, cnt, tj, br, ye, F, v_before, v_after):
     cnt[C_NJOUT] += 1
 
 
-@kernel
+@kernel(inner=True)
 def _land(st, y, ye, tj, br, v_after):
     """The state after the jump at ``tj`` onto branch br: τ from 0, (α, ω) those of ``ye``, v the landing root."""
     y[0] = 0.0
@@ -296,7 +296,7 @@ def _land(st, y, ye, tj, br, v_after):
     st[S_BR] = br
 
 
-@kernel
+@kernel(inner=True)
 def _advance(y, y_new, f0, K):
     """Accept the plain step to ``y_new``: it becomes y, with its last stage as the field f0 there.  t(s)
     increases on a stable branch, but near a folded singularity its increments fall below the step's error

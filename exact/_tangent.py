@@ -145,7 +145,7 @@ TO_FOLD_SIG = _t.UniTuple(_t.int64, 2)(_A1, _A1, LAW_TYPE, _A1, _t.int64, _t.flo
 
 
 def _make_to_fold(field, jac, pack, tag: str):
-    rhs_t = kernel(rebind(_rhs_tangent, _FIELD=field, _JAC=jac), name=f"rhs_tangent_{tag}")
+    rhs_t = kernel(rebind(_rhs_tangent, _FIELD=field, _JAC=jac), name=f"rhs_tangent_{tag}", inner=True)
     return kernel(rebind(_to_fold, _PACK=pack, _RHS_T=rhs_t, _dop_t=make_dop853(rhs_t)), name=f"to_fold_{tag}")
 
 

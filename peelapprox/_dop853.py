@@ -17,25 +17,25 @@ is below 1, with the combined 5th/3rd-order error estimate of DOP853.
 
 Use
 ---
-``make_dop853(rhs)`` compiles the pieces that call a vector field
+``make_dop853(rhs)`` binds the pieces that call a vector field
 ``rhs(y, p, out)`` (a numba-jitted function writing dy/dx into ``out``) and
-returns them as a :class:`Dop853` tuple.  The field is bound as a closure
-variable, not passed as an argument: numba caches closures over jitted
-functions across processes, but not functions taking a dispatcher argument
-(numba issue #2956); each field's pieces are renamed after the field so
-that their cache files are distinct.  numba alone would not invalidate a
-cached function when a function it calls changes in *another* file; every
-kernel is compiled by :func:`peelapprox._jit.kernel`, whose cache names carry
-a hash of all kernel sources, so a changed field or ``_generated.py`` is
-always recompiled.
-The pieces that do not call the field (``combine``,
-``interp1``, ``interp``, ``solve_theta``) are module-level.
+returns them as a :class:`Dop853` module object.  The field is bound as a
+closure variable, not passed as an argument, so that it is inlined into the
+stages (through a first-class function argument it is an indirect call LLVM
+cannot inline: ``docs/performance.md``).  Every piece here, bound or not, is
+a ``kernel(inner=True)`` helper (:func:`peelapprox._jit.kernel`): compiled
+into the driver that calls it, without Python wrappers or cache files of its
+own, and cached inside that driver, whose cache index carries a hash of all
+kernel sources, so a changed field, tableau or ``_generated.py`` is always
+recompiled.  The bound pieces are renamed after the field, so that a cold
+run's compile listing (``comparisons.benchmark.cold_start --detail``) tells
+the fields apart.
 """
 
 from __future__ import annotations
 
+import types
 from collections.abc import Callable
-from typing import NamedTuple
 
 import numpy as np
 
@@ -80,8 +80,11 @@ STEP_OK = 0
 STEP_FAILED = 1
 
 
-class Dop853(NamedTuple):
+class Dop853(types.ModuleType):
     """Compiled DOP853 pieces bound to one vector field (see :func:`make_dop853`).
+
+    A module object rather than a tuple: numba reads a global module's attributes as the functions they are,
+    and each piece is a ``kernel(inner=True)`` helper (plain function, compiled into the driver that calls it).
 
     Attributes
     ----------
@@ -109,7 +112,7 @@ class Dop853(NamedTuple):
     ensure_dense: Callable
 
 
-@kernel
+@kernel(inner=True)
 def workspace(n):
     """Scratch arrays for a driver on an n-dimensional state:
     ``(K, y_new, f0, tmp, sc, work, Fc, ye)`` with K of shape (16, n), work (3, n), Fc (7, n)."""
@@ -117,7 +120,7 @@ def workspace(n):
             np.empty((7, n)), np.empty(n))
 
 
-@kernel
+@kernel(inner=True)
 def _norm(x):
     n = x.shape[0]
     s = 0.0
@@ -126,7 +129,7 @@ def _norm(x):
     return np.sqrt(s / n)
 
 
-@kernel
+@kernel(inner=True)
 def combine(y, h, K, coef, n, out):
     """out = y + h * sum_{j<n} coef[j] K[j]  (an RK stage argument or the step result)."""
     for i in range(y.shape[0]):
@@ -136,7 +139,7 @@ def combine(y, h, K, coef, n, out):
         out[i] = y[i] + h * acc
 
 
-@kernel
+@kernel(inner=True)
 def interp1(y_old, Fc, x, i):
     """Component i of the dense output at fraction x ∈ [0, 1] of the step."""
     yv = 0.0
@@ -149,14 +152,14 @@ def interp1(y_old, Fc, x, i):
     return yv + y_old[i]
 
 
-@kernel
+@kernel(inner=True)
 def interp(y_old, Fc, x, out):
     """The whole dense-output state at fraction x of the step."""
     for i in range(y_old.shape[0]):
         out[i] = interp1(y_old, Fc, x, i)
 
 
-@kernel
+@kernel(inner=True)
 def solve_theta(y_old, Fc, i, target, g0, xb, g1):
     """x in [0, xb] with interp1(x, i) = target.
 
@@ -190,7 +193,7 @@ def solve_theta(y_old, Fc, i, target, g0, xb, g1):
     return b if abs(gb) < abs(ga) else a
 
 
-@kernel
+@kernel(inner=True)
 def crossing(y_old, Fc, i, target, xb, value_b):
     """Fraction x in [0, xb] of the step where the increasing component i reaches
     ``target`` (0 if it is already there); ``value_b`` is its value at xb."""
@@ -199,7 +202,7 @@ def crossing(y_old, Fc, i, target, xb, value_b):
     return solve_theta(y_old, Fc, i, target, y_old[i] - target, xb, value_b - target)
 
 
-@kernel
+@kernel(inner=True)
 def state_at(y_old, Fc, i, target, xb, value_b, out):
     """Dense-output state where the increasing component i equals ``target``
     (a ``t_eval`` point); component i is set to ``target`` exactly."""
@@ -208,7 +211,7 @@ def state_at(y_old, Fc, i, target, xb, value_b, out):
 
 
 def make_dop853(rhs) -> Dop853:
-    """Compile the DOP853 step, starting-step and dense-output pieces for ``rhs``.
+    """The DOP853 step, starting-step and dense-output pieces bound to ``rhs`` (compiled by the driver calling them).
 
     Parameters
     ----------
@@ -226,7 +229,7 @@ def make_dop853(rhs) -> Dop853:
     tag = _cache_tag(rhs)
 
     def jit(fn):
-        return kernel(fn, name=f"{fn.__name__}__{tag}")
+        return kernel(fn, name=f"{fn.__name__}__{tag}", inner=True)
 
     def initial_step(y0, f0, p, rtol, atol, work):
         n = y0.shape[0]
@@ -334,12 +337,14 @@ def make_dop853(rhs) -> Dop853:
             cnt[i_rhs] += _NX - _NS - 1
         return True
 
-    return Dop853(jit(initial_step), jit(step), dense_j, jit(ensure_dense))
+    pieces = Dop853(f"dop853__{tag}")
+    pieces.initial_step, pieces.step, pieces.dense, pieces.ensure_dense = (jit(initial_step), jit(step), dense_j,
+                                                                          jit(ensure_dense))
+    return pieces
 
 
 def _cache_tag(rhs) -> str:
-    # Each field gets its own cache files: numba names them after the
-    # qualname, and closures of one factory would otherwise share an index
-    # and load each other's machine code.
+    # The field's module and qualname, as a name suffix for its pieces (their
+    # compile events then say which field they were compiled for).
     py = getattr(rhs, "py_func", rhs)
     return f"{py.__module__}.{py.__qualname__}".replace(".", "_").replace("<", "").replace(">", "")

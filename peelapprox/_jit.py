@@ -5,7 +5,7 @@ stamp and size) and bytecode.  A kernel that inlines or calls functions from
 other files (the generated model in ``_generated.py``, the peel force, the
 DOP853 step) embeds their machine code, so after one of those files changes
 (a regenerated model, a package upgrade) numba would load the old kernel: the
-stale-kernel bug of issue 13 (a changed fvV coefficient gave CONSTR residuals
+stale-kernel bug once seen here (a changed fvV coefficient gave CONSTR residuals
 of 37 N).  :func:`kernel` therefore stamps every compiled function's cache
 index with a hash of **all** the files compiled into kernels
 (:data:`KERNEL_SOURCES`, :data:`SOURCE_TAG`) next to numba's own stamp: numba
@@ -43,7 +43,9 @@ from typing import Any, Literal
 
 from numba import njit
 from numba.core import config as numba_config
+from numba.core import targetconfig as _targetconfig
 from numba.core import types as _nbtypes
+from numba.core.typing import templates as _templates
 from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
@@ -68,7 +70,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_alpha.py",
     "peelapprox/_segment_kernel.py",
     "peelapprox/_packing.py",  # the parameter-vector layouts, frozen into the kernels
-    "peelapprox/_variant_fields.py",  # the tape-mass and load fields (issue 18)
+    "peelapprox/_variant_fields.py",  # the tape-mass and load fields
     "peelapprox/_model_jit.py",  # the model's inline kernels (closures, rates, XDAE)
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "peelapprox/kernels.py",
@@ -235,7 +237,7 @@ def _check_source(fn: Callable) -> None:
 
 def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "never", fastmath: bool = False,
            name: str | None = None, signature: Any = None, nrt: bool = True, outside: bool = False,
-           lazy: bool = False) -> Any:
+           lazy: bool = False, inner: bool = False) -> Any:
     """Compile ``fn`` with numba (``njit``), cached with an index stamped by :data:`SOURCE_TAG`.
 
     Use as ``@kernel``, ``@kernel(inline="always")`` or ``kernel(inline="always")(f)``.
@@ -273,12 +275,23 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
     lazy : bool
         With ``signature``: compile (or load from the cache) for that signature on first use -- the first call
         from Python, the first conversion to a function-typed argument of a compiled driver, the first compiled
-        caller -- instead of now, and never for another (issue 17: importing the package compiles nothing, and a
+        caller -- instead of now, and never for another (importing the package compiles nothing, and a
         job compiles only the kernels it runs).
+    inner : bool
+        True for a helper that only compiled code calls (a DOP853 stage sum, a driver's bookkeeping): returns
+        the plain function ``fn``, registered (numba's ``register_jitable``, no IR inlining) so that a kernel
+        calling it compiles it once per process and plain argument types as a separate function linked into its
+        own code, as a dispatcher callee is (LLVM inlines it there as before), but without the wrappers that
+        make a dispatcher callable from Python and as a first-class function, and without cache files of its
+        own: its machine code is cached inside each caller, the only thing a warm process loads.  Such helpers
+        were 23 of the 27 functions a cold first ``simulate`` compiled, and their wrappers and cache files about
+        a seventh of its compile time (``docs/performance.md``, "Cold start").  A Python caller runs the plain
+        function (correct, interpreted).  Of the other options only
+        ``name`` applies (the name in numba's compile events).
 
     Returns
     -------
-    numba dispatcher
+    numba dispatcher, or ``fn`` itself when ``inner``
 
     Raises
     ------
@@ -287,7 +300,9 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
     """
     if fn is None:
         return lambda f: kernel(f, inline=inline, fastmath=fastmath, name=name, signature=signature, nrt=nrt,
-                                outside=outside, lazy=lazy)
+                                outside=outside, lazy=lazy, inner=inner)
+    if inner:
+        return _inner(fn if name is None else _renamed(fn, name))
     d = _compile(fn, inline, fastmath, name, nrt, outside)
     if signature is not None:
         if lazy:
@@ -296,6 +311,42 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
             d.compile(signature)
             d.disable_compile()
     return d
+
+
+#: The options of an ``inner`` helper's compilation: no Python wrapper, no first-class-function wrapper.
+_INNER_OPTIONS = {"nopython": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+
+
+def _inner(fn: Callable) -> Callable:
+    """``kernel(fn, inner=True)``: ``fn`` registered as numba's ``register_jitable`` does (an ``@overload`` whose
+    implementation is ``fn``), with :data:`_INNER_OPTIONS`, keeping one compilation per argument types however
+    its callers were compiled.  numba keys an overload's compilations on the caller's compile flags as well;
+    those of a kernel and of another helper differ in their wrapper options only, which do not reach the
+    helper's code (they are not inherited), so the key takes the caller's flags with those two set as the
+    helper's.  Without this, ``interp1``, called from a driver and from ``solve_theta``, was compiled twice.
+    Overrides the private ``_get_impl`` of numba's overload template (its key as in numba 0.58-0.68)."""
+    _check_source(fn)
+
+    def implementation(*args: Any, **kws: Any) -> Callable:
+        return fn
+
+    base: Any = _templates.make_overload_template(fn, implementation, dict(_INNER_OPTIONS), False, "never", False)
+
+    class Inner(base):  # type: ignore[misc, valid-type]
+        def _get_impl(self, args: Any, kws: Any) -> Any:
+            flags = _targetconfig.ConfigStack.top_or_none()
+            if flags is not None:
+                flags = flags.copy()
+                flags.no_cpython_wrapper = flags.no_cfunc_wrapper = True
+            key = (self.context, tuple(args), tuple(kws.items()), flags)
+            if key in self._impl_cache:
+                return self._impl_cache[key]
+            return self._build_impl(key, args, kws)
+
+    Inner.__name__ = Inner.__qualname__ = base.__name__
+    _templates.infer(Inner)
+    _templates.infer_global(fn, _nbtypes.Function(Inner))
+    return fn
 
 
 def _compile_on_first_use(d: Any, signature: Any) -> None:
@@ -325,7 +376,7 @@ def _unliteral_calls(d: Any) -> Any:
     numba compiles a function called from compiled code for the argument types as the caller typed them, literal
     constants included: ``interp1(y, Fc, x, 3)`` and ``interp1(y, Fc, x, 0)`` were two more compilations of
     ``interp1`` than ``interp1(y, Fc, x, i)`` (eight extra specialisations in the hybrid driver alone, ~0.1 s
-    each, issue 17).  The literal value still reaches the machine code: LLVM inlines the small callee and
+    each).  The literal value still reaches the machine code: LLVM inlines the small callee and
     propagates the constant.  Returns ``d``.
     """
     cls_template = type(d).get_call_template
@@ -394,3 +445,4 @@ def jitable(fn: Callable) -> Callable:
     """
     _check_source(fn)
     return register_jitable(inline="always")(fn)
+

@@ -13,7 +13,7 @@ Parameter vector ``q``: the model block of :mod:`peelapprox._packing` (``M_V``, 
 ``M_B``, ``M_A``; the reduced equations are linear in α and read neither ``M_L`` nor ``M_GEOM``), then this
 driver's fields ``Q_*`` from index ``N_M``.
 
-The peel-force law (issue 15): the driver body :func:`_run` is compiled twice (:func:`peelapprox._jit.rebind`),
+The peel-force law: the driver body :func:`_run` is compiled twice (:func:`peelapprox._jit.rebind`),
 as the hybrid solver's (``exact._hybrid_driver``):
 
 * ``run(False)`` -- the paper's law fvV **inlined** (:func:`field`, ``q`` carrying ``b, A``): the default path,
@@ -173,7 +173,7 @@ def _store(out, row, y, q):
 def alpha_at(y: np.ndarray, q: np.ndarray) -> tuple[float, float]:
     """(α, α̇) at the state ``y`` (:func:`alpha_of`) from Python, through the driver's own compiled :func:`_store`
     (compiled with it, or loaded from the cache): calling :func:`alpha_of` from Python compiled it, and the
-    closed forms it inlines, a second time (issue 17)."""
+    closed forms it inlines, a second time."""
     row = np.empty((1, 5))
     _store(row, 0, y, q)
     return float(row[0, 3]), float(row[0, 4])
