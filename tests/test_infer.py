@@ -26,7 +26,7 @@ def high_inertia() -> ForceSeries:
 def test_k_alone_is_recovered():
     """Hypothesis: with I known, the stiffness k of a periodic high-inertia trace (V = 1, I = 1e-2, k = 1000 N/m;
     5 s of it, 20 cycles of the period-8 orbit, to keep the test short) is recovered from a start at 900 N/m
-    within 5 % (the goal; measured 1.3 % from 20 s with I free too), identified, its 95 % interval covering the
+    within 5 % (the goal; measured 0.2 % from 20 s with I free too), identified, its 95 % interval covering the
     truth."""
     res = infer(_trace(1.0, 1e-2, seconds=5.0), PeelParams(V=1.0, I=1e-2, k=900.0), ("k",), search=1.5,
                 max_wall=300)
@@ -42,7 +42,7 @@ def test_k_alone_is_recovered():
 def test_I_and_k_at_high_inertia(high_inertia):
     """Hypothesis (the stated goal): at V = 1, I = 1e-2 (period 8) I is recovered within 10 % and k within 5 %
     from a start at I = 1.3e-2, k = 900, both identified with 95 % intervals covering the truth (measured: I
-    0.6 % off, k 1.3 %; ~100 exact runs, 1-3 min)."""
+    1.0 % off, k 0.2 %; ~120 exact runs, 0.5-3 min)."""
     res = infer(high_inertia, PeelParams(V=1.0, I=1.3e-2, k=900.0), ("I", "k"), max_wall=900)
     assert res.identified == {"I": True, "k": True}
     assert abs(res.values["I"] / 1e-2 - 1) < 0.10 and abs(res.values["k"] / 1000.0 - 1) < 0.05

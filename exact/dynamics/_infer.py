@@ -389,7 +389,8 @@ def _result(params0: PeelParams, names: list[str], sel: np.ndarray, jac: np.ndar
     if x is None:
         raise ValueError("max_wall was spent before the first model run: give a larger max_wall")
     s = max(1.0, chi2 / dof) if dof > 0 else 1.0
-    p_fit = float(chi2_dist.sf(chi2, dof)) if dof > 0 else 1.0
+    # as many statistics as parameters (dof 0) should fit exactly: judge its χ² as on one degree of freedom
+    p_fit = float(chi2_dist.sf(chi2, max(dof, 1)))
     poor = p_fit < POOR_FIT
     accept = [e[0] for e in evaluated if e[1] <= chi2 + 3.84 * s]
     values = dict(zip(names, _values(names, x)))
