@@ -138,7 +138,7 @@ def run_regularized(params: PeelParams, t_end: float, s0: State, method: Method,
         arr = np.array(rows, dtype=float).reshape(-1, 1 + n_y)
         njac = getattr(ode, "njev", 0)
         nlu = getattr(ode, "nlu", 0)
-        stats = SolverStats(n_steps=n_steps, n_rejected=-1, n_rhs=int(ode.nfev), n_jumps=n_jumps,
+        stats = SolverStats(n_steps=n_steps, n_rejected=None, n_rhs=int(ode.nfev), n_jumps=n_jumps,
                             wall_time=time.perf_counter() - wall0, n_jac=int(njac), n_lu=int(nlu))
         return Trajectory(
             t=arr[:, 0], alpha=arr[:, 1], omega=arr[:, 2], F=arr[:, 3], v=arr[:, 4], branch=np.array(brs, np.int8),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -104,7 +105,23 @@ class Jumps:
     def __len__(self) -> int:
         return len(self.t)
 
-    def __getitem__(self, i: int) -> Jump:
+    @overload
+    def __getitem__(self, i: int | np.integer) -> Jump: ...
+
+    @overload
+    def __getitem__(self, i: slice | np.ndarray | list) -> Jumps: ...
+
+    def __getitem__(self, i):
+        """``jumps[k]``: one :class:`Jump`; ``jumps[2:5]``, ``jumps[mask]`` (a boolean array of ``len(jumps)``)
+        or ``jumps[[0, 3]]``: the selected jumps as :class:`Jumps` (numpy's indexing of every field)."""
+        if isinstance(i, (slice, list, np.ndarray)):
+            idx = np.asarray(i) if not isinstance(i, slice) else i
+            if isinstance(idx, np.ndarray) and idx.dtype == bool and idx.shape != self.t.shape:
+                raise IndexError(f"a boolean mask of Jumps must have {len(self)} entries, got shape {idx.shape}")
+            return Jumps(**{f: getattr(self, f)[idx] for f in self.FIELDS})
+        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+            raise TypeError(f"Jumps indices are integers, slices, boolean masks or integer lists, got "
+                            f"{type(i).__name__}")
         return Jump(
             float(self.t[i]),
             BRANCHES[int(self.from_branch[i])],
@@ -171,8 +188,8 @@ class Jumps:
 class SolverStats:
     """Work counters of one run.
 
-    ``n_steps`` accepted steps, ``n_rejected`` rejected step attempts (-1 where
-    the solver does not report it: scipy's stiff solvers),
+    ``n_steps`` accepted steps, ``n_rejected`` rejected step attempts (None where
+    the solver does not report it: scipy's solvers),
     ``n_rhs`` right-hand-side evaluations (all stages, dense-output stages and
     starting-step probes), ``n_jac`` Jacobian evaluations and ``n_lu`` LU
     factorisations (regularised method only), ``n_jumps`` all jumps (also
@@ -182,7 +199,7 @@ class SolverStats:
     """
 
     n_steps: int
-    n_rejected: int
+    n_rejected: int | None
     n_rhs: int
     n_jumps: int
     wall_time: float

@@ -84,8 +84,12 @@ def seed(params: PeelParams, start: Any, n: int | None, t_transient: float, wind
     if n is None:
         per = periodicity(F, max_period=max_period)
         if per.period is None:
-            raise ValueError(f"start: the run's return map is {per.kind} for periods up to max_period={max_period}; "
-                             "give n (the jumps per period) to look for an unstable orbit near a recurrence")
+            why = ("too short to test every period" if per.kind == "too short" else
+                   f"its smallest mismatch {per.mismatch:.2g} relative is above {per.rtol:g}")
+            raise ValueError(f"start: no period up to max_period={max_period} found in the run's return map "
+                             f"({F.size} returns, {why}): raise max_period (a long period, e.g. 49 at V = 4, "
+                             "I = 1e-2), lengthen the window, or give n (the jumps per period) to look for an "
+                             "unstable orbit near a recurrence")
         n = int(per.period)
     if F.size <= n:
         raise ValueError(f"n={n} needs more than {n} AB->CD jumps after the transient; the run has {F.size}")

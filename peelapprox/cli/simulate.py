@@ -124,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
         "points": int(len(traj.t)),
         "jumps": int(len(traj.jumps)),
         "steps": s.n_steps,
-        "rejected": s.n_rejected,
+        "rejected": s.n_rejected if s.n_rejected is not None else f"not reported by {traj.solver}",
         "rhs_evaluations": s.n_rhs,
         "wall_time_s": round(s.wall_time, 6),
         "compile_time_s": round(s.compile_time, 3),

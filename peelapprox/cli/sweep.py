@@ -156,8 +156,8 @@ def run(args: argparse.Namespace) -> int:
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3
-    print(f"sweep: {len(result.records)} points in {args.out}/{RESULTS} ({time.perf_counter() - t0:.1f} s)",
-          file=sys.stderr)
+    where = os.path.join(args.out, RESULTS)
+    print(f"sweep: {len(result.records)} points in {where} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     csv_path = os.path.join(args.out, "results.csv")
     try:
         result.to_csv(csv_path)

@@ -1,0 +1,47 @@
+"""What a new user trips on, fixed: each test is one friction a first session met."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import exact
+from peelapprox import PeelParams
+
+
+@pytest.fixture(scope="module")
+def run():
+    return exact.simulate(PeelParams(V=1.0, I=1e-5), 1.0)
+
+
+def test_jumps_slice_and_mask_give_jumps(run):
+    """``tr.jumps[:5]`` and ``tr.jumps[mask]`` are ``Jumps`` holding exactly numpy's selection of every field;
+    ``jumps[k]`` stays one ``Jump``; a wrong-length mask and a string index are named errors."""
+    j = run.jumps
+    head = j[:5]
+    assert isinstance(head, exact.Jumps) and len(head) == 5
+    assert np.array_equal(head.t, j.t[:5]) and np.array_equal(head.F, j.F[:5])
+    up = j[j.from_branch == 0]
+    assert np.array_equal(up.t, j.t[j.from_branch == 0]) and set(up.from_branch.tolist()) == {0}
+    assert isinstance(j[0], exact.Jump) and j[0].t == float(j.t[0])
+    assert np.array_equal(j[[0, 2]].F, j.F[[0, 2]])
+    with pytest.raises(IndexError, match="boolean mask"):
+        j[np.array([True, False])]
+    with pytest.raises(TypeError, match="Jumps indices"):
+        j["t"]
+
+
+def test_unreported_rejections_are_none_not_minus_one():
+    """scipy's solvers do not report rejected steps: ``n_rejected`` is None (unknown), not -1; the hybrid
+    solver reports its count (an int >= 0)."""
+    reg = exact.simulate(PeelParams(V=1.0, I=1e-5), 0.05, method="regularized")
+    assert reg.stats.n_rejected is None
+    hyb = exact.simulate(PeelParams(V=1.0, I=1e-5), 0.05)
+    assert isinstance(hyb.stats.n_rejected, int) and hyb.stats.n_rejected >= 0
+
+
+def test_no_period_found_says_raise_max_period():
+    """A period-3 orbit searched with max_period=2: the message says no period was found up to 2 and to raise
+    max_period, not that the map is aperiodic."""
+    with pytest.raises(ValueError, match=r"no period up to max_period=2 found.*raise max_period"):
+        exact.periodic_orbit(PeelParams(V=1.0, I=1e-5), max_period=2)
