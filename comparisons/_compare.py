@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 from peelapprox import ModelBreakdown, SolverBudgetExceeded, reduced_segment
-from peelapprox.io import optional_import
+from peelapprox.io import fmt_number, html_table, optional_import
 from peelapprox.validate import params as _params
 
 from ._segments import Segment, _crossings, _extrema, local_period, segments
@@ -87,6 +87,36 @@ class RowTable(list):
         df = pd.DataFrame([r.as_dict() for r in self], columns=cols)
         df.attrs["units"] = dict(getattr(kind, "UNITS", {}))
         return df
+
+    def _summary(self) -> dict[str, Any]:
+        """Counts and medians a person reads first: the row type, the statuses, the reductions and the median
+        relative errors where the rows have them."""
+        if not self:
+            return {"rows": 0}
+        out: dict[str, Any] = {"rows": f"{len(self)} {type(self[0]).__name__}"}
+        for name in ("status", "verdict"):
+            if hasattr(self[0], name):
+                counts: dict[str, int] = {}
+                for r in self:
+                    key = str(getattr(r, name)).split(":")[0]
+                    counts[key] = counts.get(key, 0) + 1
+                out[name] = ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])[:4])
+        if hasattr(self[0], "alpha_model"):
+            models = sorted({f"{r.branch} {r.alpha_model}/{r.v_equation}" for r in self})
+            out["reductions"] = f"{len(models)}: " + ", ".join(models[:6]) + (" ..." if len(models) > 6 else "")
+        for col in ("dt_rel_error", "dF_rel_error"):
+            vals = [abs(getattr(r, col)) for r in self if getattr(r, col, None) is not None]
+            if vals:
+                out[f"median |{col}|"] = f"{fmt_number(100 * sorted(vals)[len(vals) // 2], 3)} %"
+        return out
+
+    def __repr__(self) -> str:
+        """A short summary (the rows themselves: ``list(table)``, ``table.to_dataframe()``)."""
+        parts = "; ".join(f"{k} {v}" if k != "rows" else str(v) for k, v in self._summary().items())
+        return f"RowTable({parts}; .to_dataframe() or list(...) for the rows)"
+
+    def _repr_html_(self) -> str:
+        return html_table("RowTable", self._summary())
 
 
 def run_reduction(params, branch: str, alpha_model: str, v_equation: str, **seed):

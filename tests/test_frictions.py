@@ -45,3 +45,14 @@ def test_no_period_found_says_raise_max_period():
     max_period, not that the map is aperiodic."""
     with pytest.raises(ValueError, match=r"no period up to max_period=2 found.*raise max_period"):
         exact.periodic_orbit(PeelParams(V=1.0, I=1e-5), max_period=2)
+
+
+def test_compare_rows_repr_is_a_short_summary(run):
+    """``compare(run)`` in a REPL shows a summary of a few hundred characters (it printed a 129,504-character
+    list): the row count, statuses, reductions and median errors; the rows are still the list's."""
+    from comparisons import compare
+
+    rows = compare(run)
+    text = repr(rows)
+    assert len(text) < 600 and f"{len(rows)} ComparisonRow" in text and "median |dt_rel_error|" in text
+    assert isinstance(rows, list) and rows[0].segment == 0 and "<table>" in rows._repr_html_()
