@@ -56,3 +56,19 @@ def test_compare_rows_repr_is_a_short_summary(run):
     text = repr(rows)
     assert len(text) < 600 and f"{len(rows)} ComparisonRow" in text and "median |dt_rel_error|" in text
     assert isinstance(rows, list) and rows[0].segment == 0 and "<table>" in rows._repr_html_()
+
+
+def test_periodic_orbit_reports_its_smallest_fold_rate_and_warns_near_a_grazing():
+    """The period-8 orbit at V = 1, I = 1e-2 reports its smallest |Gdot| at a fold (1215 N/s, far from grazing:
+    no warning); fold rates whose smallest is 2e-7 of their median (as the period-49 orbit at V = 4, I = 1e-2
+    passes a fold at ~2e-5 N/s) warn."""
+    import warnings
+
+    from exact.orbits._periodic import grazing_warning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        o = exact.periodic_orbit(PeelParams(V=1.0, I=1e-2))
+    assert o.min_fold_rate == pytest.approx(1215.45, rel=1e-3)
+    with pytest.warns(RuntimeWarning, match="near a grazing"):
+        grazing_warning(np.array([120.0, 2e-5, 300.0, 95.0]), 2)
