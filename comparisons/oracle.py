@@ -44,7 +44,8 @@ def _trajectory(arrays: dict, name: str, tr) -> None:
     for a in exact.Jumps.FIELDS:
         arrays[f"{name}.jumps.{a}"] = np.asarray(getattr(tr.jumps, a))
     for a in ("n_steps", "n_rejected", "n_rhs", "n_jumps", "n_jac", "n_lu"):
-        arrays[f"{name}.stats.{a}"] = np.asarray(getattr(tr.stats, a))
+        value = getattr(tr.stats, a)  # None where the solver does not count it: NaN in the file (no pickle)
+        arrays[f"{name}.stats.{a}"] = np.asarray(np.nan if value is None else value)
 
 
 def write(out: str | os.PathLike) -> int:

@@ -34,6 +34,7 @@ from peelapprox.kernels import (
     LAW_LNV,
     LAW_TYPE,
     CompiledLaw,
+    compile_only,
     compiled_law,
     kernel,
     make_dop853,
@@ -93,10 +94,7 @@ def _field_law(y, p, law, coef, out):
 def field_law() -> Any:
     """``field(y, p, law, coef, out)``: the hybrid field d(τ, α, ω, u)/ds of the law ``law``, compiled for that one
     signature on first use: the saltation tangent's field outside its compiled driver."""
-    if not _field_law.signatures:
-        _field_law.compile(_t.void(_A1, _A1, LAW_TYPE, _A1, _A1))
-        _field_law.disable_compile()
-    return _field_law
+    return compile_only(_field_law, _t.void(_A1, _A1, LAW_TYPE, _A1, _A1))
 
 
 #: The one signature of both drivers: ``(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out,
@@ -123,11 +121,7 @@ def driver(law_argument: bool) -> Any:
     """The compiled hybrid loop (:func:`exact._hybrid._run`), compiled for :data:`RUN_SIG` on first use (loaded
     from numba's cache when it is there): ``law_argument=False`` with fvV inlined (``law``, ``coef`` unused),
     True with the law ``law`` and its coefficients ``coef``."""
-    d = _DRIVERS[bool(law_argument)]
-    if not d.signatures:
-        d.compile(RUN_SIG)
-        d.disable_compile()
-    return d
+    return compile_only(_DRIVERS[bool(law_argument)], RUN_SIG)
 
 
 def law_for(params: PeelParams) -> CompiledLaw:

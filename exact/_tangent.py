@@ -37,6 +37,7 @@ from peelapprox.errors import SolverBudgetExceeded, WallBudget
 from peelapprox.kernels import (
     LAW_TYPE,
     STEP_FAILED,
+    compile_only,
     crossing,
     interp,
     interp1,
@@ -156,11 +157,7 @@ _TO_FOLD = {False: _make_to_fold(H._rhs, jacobian_paper, pack_inlined, "inlined"
 def to_fold(law_argument: bool) -> Any:
     """The tangent driver :func:`_to_fold` with the paper's law inlined (False, the default path) or with the
     law as an argument (True), compiled for :data:`TO_FOLD_SIG` on first use (loaded from numba's cache)."""
-    d = _TO_FOLD[bool(law_argument)]
-    if not d.signatures:
-        d.compile(TO_FOLD_SIG)
-        d.disable_compile()
-    return d
+    return compile_only(_TO_FOLD[bool(law_argument)], TO_FOLD_SIG)
 
 
 @dataclass(frozen=True)

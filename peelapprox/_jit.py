@@ -35,6 +35,7 @@ import pickle  # only its exception, for numba's cache files (numba unpickles th
 import stat
 import struct
 import tempfile
+import threading
 import types
 import warnings
 from collections.abc import Callable
@@ -50,7 +51,7 @@ from numba.extending import register_jitable
 
 from .errors import KernelCacheWarning
 
-__all__ = ["kernel", "jitable", "rebind", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
+__all__ = ["kernel", "jitable", "rebind", "compile_only", "COMPILE_LOCK", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
            "caching_enabled", "unsafe_dir"]
 
 _ROOT = Path(__file__).resolve().parent.parent
@@ -308,8 +309,7 @@ def kernel(fn: Callable | None = None, *, inline: Literal["never", "always"] = "
         if lazy:
             _compile_on_first_use(d, signature)
         else:
-            d.compile(signature)
-            d.disable_compile()
+            compile_only(d, signature)
     return d
 
 
@@ -349,6 +349,24 @@ def _inner(fn: Callable) -> Callable:
     return fn
 
 
+#: Serialises compiling a dispatcher and freezing it (:func:`compile_only`): threads of one process (a sweep's
+#: thread pool) may ask for the same driver at once; the second waits for the first instead of finding it frozen.
+COMPILE_LOCK = threading.RLock()
+
+
+def compile_only(d: Any, *signatures: Any) -> Any:
+    """Compile the dispatcher ``d`` for ``signatures`` and allow no other, once (loaded from numba's cache when it
+    is there); safe under threads.  Returns ``d``."""
+    if not d._can_compile:  # compiled and frozen already: the common, lock-free path
+        return d
+    with COMPILE_LOCK:
+        if d._can_compile:
+            for sig in signatures:
+                d.compile(sig)
+            d.disable_compile()
+    return d
+
+
 def _compile_on_first_use(d: Any, signature: Any) -> None:
     """Make the first compilation request of the dispatcher ``d`` compile ``signature`` (the same cache entry as
     the eager ``d.compile(signature)``) and disable compiling: every request goes through ``d.compile`` (a call
@@ -356,12 +374,12 @@ def _compile_on_first_use(d: Any, signature: Any) -> None:
     ``get_compile_result``, a compiled caller via ``get_call_template``), so an instance attribute shadowing the
     method sees them all.  After that first request the class method serves again."""
     cls_compile = type(d).compile
-
     def compile_fixed(sig: Any) -> Any:
-        if d._can_compile:
-            cls_compile(d, signature)
-            d.disable_compile()
-        del d.compile  # the class method from now on
+        with COMPILE_LOCK:  # two threads' first calls: one compiles, the other waits for it
+            if d._can_compile:
+                cls_compile(d, signature)
+                d.disable_compile()
+            d.__dict__.pop("compile", None)  # the class method from now on
         try:
             return cls_compile(d, sig)  # the entry point when ``sig`` is the fixed signature's arguments
         except RuntimeError:  # other argument types: numba converts them to the one signature, as when eager
@@ -408,11 +426,11 @@ def _dispatcher(fn: Callable, inline: Literal["never", "always"], fastmath: bool
         fn = _renamed(fn, name.replace("<locals>.", "").replace(".", "_"))
     if _state["cache"]:
         try:
-            d = _njit(cache=True, inline=inline, fastmath=fastmath, _nrt=nrt)(fn)
+            d = _njit(cache=True, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(fn)
             if not _stamp_with_tag(d):  # a numba without the private stamp: tag the cache file names instead
                 # (old files then accumulate in __pycache__)
                 base = fn.__qualname__.replace("<locals>.", "").replace(".", "_")
-                d = _njit(cache=True, inline=inline, fastmath=fastmath, _nrt=nrt)(
+                d = _njit(cache=True, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(
                     _renamed(fn, f"{base}__src{SOURCE_TAG}"))
             return d
         except RuntimeError as e:  # numba: "cannot cache function ...: no locator available"
@@ -426,7 +444,7 @@ def _dispatcher(fn: Callable, inline: Literal["never", "always"], fastmath: bool
                 KernelCacheWarning,
                 stacklevel=3,
             )
-    return _njit(cache=False, inline=inline, fastmath=fastmath, _nrt=nrt)(fn)
+    return _njit(cache=False, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(fn)
 
 
 def jitable(fn: Callable) -> Callable:

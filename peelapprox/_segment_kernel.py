@@ -38,7 +38,7 @@ from numba import types as _t
 from ._alpha import _decay, _harmonic, _restoring, _sinusoid
 from ._dop853 import N_STAGES as _NS
 from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
-from ._jit import kernel, rebind
+from ._jit import compile_only, kernel, rebind
 from ._packing import M_A, M_B, M_I, M_K, M_R, M_V, N_M
 from ._status import DONE, F_NONPOSITIVE, MAX_STEPS, NONFINITE, OUT_FULL, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
 from .law._abi import LAW_LNV, LAW_TYPE, pack_inlined, pack_law
@@ -295,8 +295,4 @@ def run(law_argument: bool) -> Any:
         ``run(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt)
         -> status`` (:func:`_run`).
     """
-    d = _RUNS[bool(law_argument)]
-    if not d.signatures:
-        d.compile(RUN_SIG)
-        d.disable_compile()
-    return d
+    return compile_only(_RUNS[bool(law_argument)], RUN_SIG)

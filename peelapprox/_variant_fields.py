@@ -27,7 +27,7 @@ from numba import njit
 from numba import types as _nb
 
 from . import _generated as _g
-from ._jit import kernel, rebind
+from ._jit import compile_only, kernel, rebind
 from ._model_jit import closure_d2, regularized_rhs
 from ._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
 from .law import ALL_LAWS
@@ -143,9 +143,7 @@ def _compile_once(fun: Any, jac: Any, *args: Any) -> None:
     """Compile a field (returning a 1-d array) and its Jacobian (a 2-d array) for the one signature ``args``, on
     first use only, and allow no other."""
     for d, ret in ((fun, _nb.float64[::1]), (jac, _nb.float64[:, ::1])):
-        if not d.signatures:
-            d.compile(ret(*args))
-            d.disable_compile()
+        compile_only(d, ret(*args))
 
 
 

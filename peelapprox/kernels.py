@@ -53,7 +53,7 @@ from ._dop853 import (
     state_at,
     workspace,
 )
-from ._jit import kernel, rebind
+from ._jit import compile_only, kernel, rebind
 from ._model_jit import (
     closure,
     closure_d2,
@@ -91,7 +91,7 @@ from .law._table_jit import table_coefficients, table_law
 Q_EPS = N_M
 
 __all__ = [
-    "kernel", "rebind", "status",
+    "kernel", "rebind", "compile_only", "status",
     "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit",
     "LAW_SIG", "LAW_TYPE", "LAW_LNV", "LAW_FP", "LAW_FPP", "LAWS", "paper_law", "paper_coefficients",
     "pack_inlined", "pack_law",
@@ -180,8 +180,5 @@ def regularized_law_field() -> tuple[Any, Any]:
     a1 = _nb.float64[::1]
     ro = _nb.Array(_nb.float64, 1, "C", readonly=True)  # the state as SUNDIALS passes it
     for d, ret in ((_regularized_field_law, a1), (_regularized_field_jacobian_law, _nb.float64[:, ::1])):
-        if not d.signatures:
-            d.compile(ret(a1, a1, LAW_TYPE, a1))
-            d.compile(ret(ro, a1, LAW_TYPE, a1))
-            d.disable_compile()
+        compile_only(d, ret(a1, a1, LAW_TYPE, a1), ret(ro, a1, LAW_TYPE, a1))
     return _regularized_field_law, _regularized_field_jacobian_law

@@ -83,7 +83,7 @@ API = {
     },
     # the door through which exact (and comparisons) reach the compiled model and integrator
     "peelapprox.kernels": {
-        "ALL_LAWS", "BuildExpired", "CompiledLaw", "caller_budget", "pack_inlined", "pack_law",
+        "ALL_LAWS", "BuildExpired", "CompiledLaw", "caller_budget", "compile_only", "pack_inlined", "pack_law",
         "U_ZERO", "compiled_law", "law_domain", "rebind", "regularized_law_field", "VARIANT_MODELS", "variant_field",
         "variant_parameters", "bound_variant_field",
         "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",

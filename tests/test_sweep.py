@@ -275,7 +275,7 @@ def test_validation_messages(tmp_path):
         lock = __import__("threading").Lock()
         register_measure("tmp_closure", lambda p, o: {"x": int(lock.locked())}, replace=True)
         try:
-            sweep(I2, V2, "tmp_closure", out=out)
+            sweep(I2, V2, "tmp_closure", out=out, executor="processes")
         finally:
             MEASURES.pop("tmp_closure")
     with pytest.raises(ValueError, match="already registered"):
@@ -569,7 +569,7 @@ def test_unshippable_measure_fails_before_any_point(tmp_path, monkeypatch):
     register_measure("tmp_main", nb, replace=True)
     try:
         with pytest.raises(ValueError, match=r"tmp_main.*importable module.*max_workers=0"):
-            sweep(I2, V2, "tmp_main", out=tmp_path / "sw", max_workers=1, progress=False)
+            sweep(I2, V2, "tmp_main", out=tmp_path / "sw", executor="processes", max_workers=1, progress=False)
     finally:
         MEASURES.pop("tmp_main")
     assert not (tmp_path / "sw").exists()
@@ -733,3 +733,27 @@ def test_python_m_comparisons_sweep_is_the_cli(tmp_path):
     assert proc.returncode == 0, proc.stderr
     ref = sweep([1e-5], [1.0], "regime", out=tmp_path / "api", max_workers=0, progress=False)
     assert json.loads(proc.stdout) == ref.rows()
+
+
+def test_a_script_without_main_guard_sweeps_on_threads(tmp_path):
+    """Hypothesis: ``sweep()`` at a script's top level (no ``if __name__ == "__main__":``) runs on the default
+    thread pool, whose threads re-run nothing of the script: it exits 0, the script's top level ran once, and
+    its 4 records are those of a serial sweep (same values, exact)."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "plain.py"
+    script.write_text(
+        "import json, sys\n"
+        "from comparisons.sweep import sweep\n"
+        "print('top level ran', flush=True)\n"
+        f"r = sweep([1e-5, 1e-3], [1.0, 2.0], 'regime', out={str(tmp_path / 'thr')!r}, progress=False)\n"
+        f"s = sweep([1e-5, 1e-3], [1.0, 2.0], 'regime', out={str(tmp_path / 'ser')!r}, max_workers=0, progress=False)\n"
+        "key = lambda x: (x['I'], x['V'])\n"
+        "strip = lambda rs: [{k: v for k, v in x.items() if 'wall' not in k} for x in sorted(rs, key=key)]\n"
+        "print('equal', strip(r.records) == strip(s.records))\n")
+    env = dict(__import__("os").environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300, env=env,
+                          cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.count("top level ran") == 1 and "equal True" in done.stdout

@@ -20,7 +20,7 @@ from peelapprox.io import ProgressLine, jsonable
 from peelapprox.validate import ArgumentTypeError, flag, integer, optional, positive
 from peelapprox.validate import path as _path
 
-from .._worker import SERIAL, run_tasks
+from .._worker import PROCESSES, SERIAL, THREADS, run_tasks
 from .grid import check_grid_size, grid_length
 from .law import check_coef, check_force, manifest_fields
 from .measures import MEASURES, OPTION_CHECKS, measure_ref
@@ -85,9 +85,12 @@ def sweep(
         Names in :data:`MEASURES` (``"regime,jumps"`` is split at commas).
     out : path
         Output directory, created; its files: :mod:`comparisons.sweep.store`.
-    executor : None, "serial" or concurrent.futures.Executor
-        None: a local spawn :class:`ProcessPoolExecutor` of ``max_workers`` processes (default: the CPUs; 0 runs
-        in this process, as ``"serial"``).  Any Executor is used as is, e.g. a dask client's.
+    executor : None, "threads", "processes", "serial" or concurrent.futures.Executor
+        None or "threads": a local thread pool of ``max_workers`` threads (default: the CPUs; 0 runs in this
+        process, as ``"serial"``): the compiled kernels release the GIL, and a script or notebook needs no
+        ``__main__`` guard (measured faster than processes on 2 cores: ``comparisons._worker.THREADS``).
+        "processes": a local spawned process pool (a script then needs the guard).  Any Executor is used as is,
+        e.g. a dask client's.
     options : mapping, optional
         JSON-serialisable settings passed to every measure (:mod:`comparisons.sweep.measures`).
     progress : bool or callable
@@ -152,13 +155,14 @@ def sweep(
                          "each point's measures what is left of it), not an option")
     _check_options(measures, options, force)
     max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
-    if max_workers is not None:
-        if executor is not None:
-            raise ValueError("max_workers applies only to the local process pool (executor=None); "
-                             "size your executor instead")
-    if executor is not None and not (isinstance(executor, str) and executor == SERIAL) \
-            and not callable(getattr(executor, "submit", None)):
-        raise ValueError(f"executor must be None, 'serial' or a concurrent.futures.Executor, got {executor!r}")
+    local = (None, THREADS, PROCESSES)
+    if max_workers is not None and not any(executor is x or executor == x for x in local):
+        raise ValueError("max_workers applies only to the local pools (executor None, 'threads' or 'processes'); "
+                         "size your executor instead")
+    if not (executor is None or (isinstance(executor, str) and executor in (SERIAL, THREADS, PROCESSES))
+            or callable(getattr(executor, "submit", None))):
+        raise ValueError(f"executor must be None, 'threads', 'processes', 'serial' or a concurrent.futures.Executor, "
+                         f"got {executor!r}")
     if not (isinstance(progress, bool) or progress is None or callable(progress)):
         raise ValueError("progress must be a bool, None or a callable (done, total, record)")
     resume = flag("resume", resume)
@@ -166,7 +170,8 @@ def sweep(
     if max_workers == 0:
         executor = SERIAL
     refs = {name: measure_ref(MEASURES[name]) for name in measures}
-    task_refs = refs if executor == SERIAL else worker_refs(measures)
+    # in this process (serial, threads) the measures are the objects themselves; elsewhere import references
+    task_refs = refs if executor is None or executor in (SERIAL, THREADS) else worker_refs(measures)
 
     out = _path("out", out)
     if os.path.exists(out) and not os.path.isdir(out):
@@ -266,7 +271,7 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress, dea
             budget="max_wall", limit=max_wall, t=0.0, state={"t": 0.0}, partial=_result(p))
     if lost:
         hint = ""
-        if executor is None and any("BrokenProcessPool" in err for _, err in lost):
+        if executor == PROCESSES and any("BrokenProcessPool" in err for _, err in lost):
             hint = ("; a worker process died (crash, out of memory, killed) or could not start: with the 'spawn' "
                     "start method a script that calls sweep() must do so under `if __name__ == '__main__':`")
         first = ", ".join(f"{n}={x}" for n, x in zip(("I", "V", "coef"), lost[0][0]))

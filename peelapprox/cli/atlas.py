@@ -51,7 +51,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                          "whose function is importable)")
     where = at.add_mutually_exclusive_group()
     where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
-                       help="local worker processes (default: all CPUs; 0: in this process)")
+                       help="local worker threads (default: all CPUs; 0: in this process)")
     where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
                        help="start a dask LocalCluster with N single-threaded worker processes")
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",

@@ -33,7 +33,7 @@ MEASURES_HELP = {
 
 def add_parser(sub) -> argparse.ArgumentParser:
     sw = subcommand(
-        sub, "sweep", help="measures over an (I, V) grid on a process pool or a dask cluster; incremental output, "
+        sub, "sweep", help="measures over an (I, V) grid on a thread pool or a dask cluster; incremental output, "
                            "resumes automatically",
         description="Measures over an (I, V) grid (and optionally a coefficient of a family law as a third axis), "
                     "one point a task on a local process pool or a dask cluster; every finished point is appended "
@@ -58,7 +58,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                          "an existing DIR with the same grid, measures and options is resumed")
     where = sw.add_mutually_exclusive_group()
     where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
-                       help="local worker processes (default: all CPUs; 0: in this process)")
+                       help="local worker threads (default: all CPUs; 0: in this process)")
     where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
                        help="start a dask LocalCluster with N single-threaded worker processes")
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
