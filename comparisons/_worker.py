@@ -1,7 +1,9 @@
-"""Worker processes shared by the experiments that run many points: the stress suite and the (I, V) sweep.
+"""Workers shared by the experiments that run many points: the stress suite and the (I, V) sweep.
 
-Both run each point in a separate, spawned process, turn whatever a point raises into fields of its record
-instead of a crash of the whole run, and report progress on stderr (rate-limited: ``peelapprox.io.ProgressLine``).
+The stress suite runs each point in a spawned process it can kill; the sweep on a thread pool by default (the
+compiled kernels release the GIL), a spawned process pool or any executor.  Both turn whatever a point raises
+into fields of its record instead of a crash of the whole run, and report progress on stderr (rate-limited:
+``peelapprox.io.ProgressLine``).
 
 * :func:`watch_parent` — a worker exits when the process that started it dies (e.g. SIGKILL), instead of
   idling (or hanging in a point) as an orphan.
@@ -9,8 +11,8 @@ instead of a crash of the whole run, and report progress on stderr (rate-limited
   killed with its worker and a crashed worker is noticed, and either is restarted for the next task (the
   stress suite's :class:`~comparisons.stress.StressRunner`).
 * :func:`run_tasks` — many tasks on a :class:`concurrent.futures.Executor`: in this process, on a local
-  spawned process pool, or on any executor (a dask cluster); tasks the executor loses (a worker died) are
-  returned, not raised (the sweep's engine).
+  thread pool (the default) or spawned process pool, or on any executor (a dask cluster); tasks the executor
+  loses (a worker died) are returned, not raised (the sweep's engine).
 * :func:`message`, :func:`error_text` — an exception as record fields; :func:`write_line` — a progress
   line (the stress suite's; the sweep's is :class:`peelapprox.io.ProgressLine`).
 """
