@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
                            options=options, executor=executor, max_workers=max_workers, progress=not args.quiet,
                            retry_failed=args.retry_failed, max_wall=args.max_wall, **model)
     except RuntimeError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"peelapprox atlas: error: {exc}", file=sys.stderr)
         return 3
     print(f"atlas: {len(result.sweep.records)} points in {args.out} ({time.perf_counter() - t0:.1f} s)"
           + (f"; skipped (not importable yet): {', '.join(result.skipped)}" if result.skipped else ""),

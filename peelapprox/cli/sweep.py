@@ -154,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
                            max_workers=max_workers, options=options, progress=not args.quiet,
                            retry_failed=args.retry_failed, force=force, coef=coef, max_wall=args.max_wall)
     except RuntimeError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"peelapprox sweep: error: {exc}", file=sys.stderr)
         return 3
     where = os.path.join(args.out, RESULTS)
     print(f"sweep: {len(result.records)} points in {where} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
