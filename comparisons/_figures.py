@@ -49,6 +49,9 @@ def _phase(ax, v, F, branch, V, title):
         m = branch == br
         ax.plot(v[m], F[m], ".", ms=1.5, color=c, label="AB" if br == 0 else "CD")
     ax.set_xscale("log")
+    lo, hi = float(np.min(F)), float(np.max(F))
+    pad = 0.15 * (hi - lo) if hi > lo else 0.05 * abs(hi) + 1.0
+    ax.set_ylim(lo - pad, hi + pad)  # the orbit's range: f(v) rises to ~1400 N beyond it and would squash it
     ax.set_xlabel("v [m/s]")
     ax.set_ylabel("F [N]")
     ax.set_title(title, fontsize=9)
