@@ -104,13 +104,18 @@ def test_undetermined_windows():
 
 
 def test_process_pool_and_executor_give_identical_results(cubic_basins):
-    """Determinism: a 2-worker spawned process pool and a thread executor give the in-process labels, texts and
-    cycles bit for bit (each start is the same deterministic run; outcomes are put in grid order before
-    grouping)."""
+    """Determinism: the default 2-thread pool, a spawned process pool and a thread executor give the in-process
+    labels, texts and cycles bit for bit (each start is the same deterministic run; outcomes are put in grid
+    order before grouping)."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
     pool = exact.basins(CUBIC, **GRID, max_workers=2, progress=False)
+    with ProcessPoolExecutor(2, mp_context=mp.get_context("spawn")) as ex:
+        procs = exact.basins(CUBIC, **GRID, executor=ex, progress=False)
     with ThreadPoolExecutor(2) as ex:
         threads = exact.basins(CUBIC, **GRID, executor=ex, progress=False)
-    for r in (pool, threads):
+    for r in (pool, procs, threads):
         assert np.array_equal(r.labels, cubic_basins.labels)
         assert r.texts.tolist() == cubic_basins.texts.tolist()
         assert r.cycles == cubic_basins.cycles

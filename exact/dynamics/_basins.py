@@ -334,12 +334,13 @@ def basins(
         Also find each periodic attractor's :class:`exact.PeriodicOrbit` (:func:`exact.periodic_orbit` seeded
         by its first start's run, in this process): Floquet multipliers, stability.
     executor : concurrent.futures.Executor, optional
-        Runs the starts (e.g. a dask ``Client.get_executor()``), used as is and left running; the function
-        shipped is :func:`exact.dynamics._basins_run.run_start`, its arguments plain data (PeelParams pickles
-        with its law).
+        Runs the starts (e.g. a dask ``Client.get_executor()``, or a ``ProcessPoolExecutor`` with the spawn
+        context), used as is and left running; the function shipped is
+        :func:`exact.dynamics._basins_run.run_start`, its arguments plain data (PeelParams pickles with its law).
     max_workers : int, optional
-        Without ``executor``: 0 runs in this process; n > 0 a local spawned process pool of n workers; None
-        (default) one worker per CPU available, at most one per start.
+        Without ``executor``: 0 runs in this process; n > 0 a local thread pool of n threads (the compiled
+        kernels release the GIL; a script needs no ``__main__`` guard); None (default) one thread per CPU
+        available, at most one per start.
     progress : bool or callable
         True: a line on stderr per ~5 % of the starts (and per failed start; one updating line in Jupyter); a
         callable gets ``(done, total, outcome)`` after each.
@@ -388,7 +389,7 @@ def basins(
         if not callable(getattr(executor, "submit", None)):
             raise ArgumentTypeError(f"executor must be None or a concurrent.futures.Executor, got {executor!r}")
         if max_workers is not None:
-            raise ValueError("max_workers applies only to the local process pool (executor=None); size your "
+            raise ValueError("max_workers applies only to the local thread pool (executor=None); size your "
                              "executor instead")
     if not (progress is None or isinstance(progress, bool) or callable(progress)):
         raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")

@@ -11,11 +11,10 @@ cancels the starts not begun once it has passed.  Either way the start's outcome
 
 from __future__ import annotations
 
-import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ThreadPoolExecutor, wait
 from typing import Any
 
 import numpy as np
@@ -118,7 +117,8 @@ def run_all(tasks: list[tuple], executor: Executor | None, max_workers: int | No
     own = executor is None
     if executor is None:
         n = max_workers or (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-        executor = ProcessPoolExecutor(max_workers=max(1, min(n, len(tasks))), mp_context=mp.get_context("spawn"))
+        # threads: the compiled kernels release the GIL, and no process re-imports the caller's script
+        executor = ThreadPoolExecutor(max_workers=max(1, min(n, len(tasks))), thread_name_prefix="peelapprox-basin")
     futs: dict[Future, int] = {}
     try:
         for k, t in enumerate(tasks):
