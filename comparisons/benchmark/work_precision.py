@@ -55,9 +55,10 @@ def _simulate_row(scene, ref, repeats, method, solver, eps, rtol):
     try:
         wall, tr = timed(lambda: simulate(scene.params, scene.horizon, **kw), repeats, warm)
     except (SolverFailure, ModelBreakdown, SolverBudgetExceeded) as exc:
-        msg = str(exc).split(":")[0] if len(str(exc)) > 120 else str(exc)
+        text = " ".join(str(exc).split())  # the whole message, its reason included, on one line
+        msg = text if len(text) <= 200 else text[:199] + "…"
         return _row(scene, method, solver, eps, rtol, ref, np.array([]), np.array([]), math.nan, 0, 0,
-                    status=f"failed at t={getattr(exc, 't', math.nan):.4g} s: {msg[:100]}")
+                    status=f"failed at t={getattr(exc, 't', math.nan):.4g} s: {msg}")
     return _row(scene, method, solver, eps, rtol, ref, tr.jumps.t, tr.jumps.F, wall, tr.stats.n_steps,
                 tr.stats.n_rhs, )
 
