@@ -73,7 +73,7 @@ def test_cli_dynamics_lyapunov_methods(capsys):
 
 
 def test_cli_lyapunov_methods_are_exact_lyapunov_methods():
-    """Issue 14: ``dynamics --lyapunov-method`` takes exact.lyapunov's method names (the CLI writes them out so
+    """``dynamics --lyapunov-method`` takes exact.lyapunov's method names (the CLI writes them out so
     that building the parser loads no ``exact``) and maps the earlier names saltation and regularized onto
     tangent and variational.  Hypothesis: exact set equality with ``exact.dynamics._lyapunov_options.METHODS``."""
     from exact.dynamics._lyapunov_options import METHODS
@@ -88,7 +88,7 @@ DYN_LY = ["dynamics", "--V", "1", "--I", "1e-3", "--t-transient", "0.5", "--wind
 
 @pytest.mark.parametrize("name", ["two-trajectory", "tangent", "saltation"])
 def test_cli_lyapunov_is_exact_lyapunov_bitwise(name, capsys):
-    """Issue 14: the CLI calls ``exact.lyapunov(p, method, t_transient=..., alpha0=..., max_wall=..., T=...)``.
+    """the CLI calls ``exact.lyapunov(p, method, t_transient=..., alpha0=..., max_wall=..., T=...)``.
     Hypothesis: its exponent equals, exactly, the call the CLI made before (two-trajectory: ``n =
     max(2, int(round(T/tau)))`` intervals of LYAPUNOV_TAU; saltation: ``lyapunov_tangent(p, T=T, ...)``), and
     the alias saltation gives tangent's number."""
@@ -107,7 +107,7 @@ def test_cli_lyapunov_is_exact_lyapunov_bitwise(name, capsys):
 
 
 def test_cli_return_map_lyapunov_starts_from_alpha0(capsys):
-    """Issue 14: ``--lyapunov-method return-map`` with ``--alpha0`` was refused (the named function started
+    """``--lyapunov-method return-map`` with ``--alpha0`` was refused (the named function started
     from alpha0 = 0 only); it now runs ``exact.lyapunov(p, "return-map", alpha0=...)``.  Hypothesis: the CLI's
     exponent equals that call with the CLI's ``n_returns = max(2, round(returns / window * T))`` exactly."""
     import exact
@@ -122,7 +122,7 @@ def test_cli_return_map_lyapunov_starts_from_alpha0(capsys):
 
 
 def test_cli_bad_lyapunov_option_is_refused_before_the_window_run(monkeypatch, capsys):
-    """Issue 14: a bad ``--eps`` was reported only after the window run.  Hypothesis: with ``exact.simulate``
+    """a bad ``--eps`` was reported only after the window run.  Hypothesis: with ``exact.simulate``
     replaced by a function that fails the test, ``--lyapunov-method regularized --eps 1e-30`` still exits
     with status 2 naming eps and its range: the option is checked before any run (categorical)."""
     import exact
@@ -149,7 +149,7 @@ def test_cli_figures_list_and_bad_name(capsys):
 
 
 def test_folds_loads_neither_solvers_nor_harness():
-    """Issue 14: the CLI crosses the doors lazily per subcommand; ``peelapprox folds`` needs only the peel-force
+    """the CLI crosses the doors lazily per subcommand; ``peelapprox folds`` needs only the peel-force
     law.  Hypothesis: after it runs, neither ``exact`` nor ``comparisons`` is imported (exact: module set)."""
     import subprocess
     import sys

@@ -187,7 +187,7 @@ def test_user_v_floor_stops_earlier(p_low):
 
 
 def test_no_false_breakdown_at_low_speeds():
-    """Issue 13 item 9: at V=1, I=1e-4 runs stopped at the old v_floor = 1e-9 m/s and were reported as a
+    """at V=1, I=1e-4 runs stopped at the old v_floor = 1e-9 m/s and were reported as a
     breakdown although F(1 + sin a) was still ~5 N above f(0+).  Integrating ln v, the run follows v down to
     ~5e-11 m/s and goes on for 50 s (hypothesis: no breakdown; the lowest level stays > 1 N above f(0+),
     measured 3.2 N).  V=0.5, I=1e-4 is a genuine breakdown (the level reaches f(0+) at t = 0.0183 s)."""

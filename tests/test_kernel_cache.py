@@ -96,7 +96,7 @@ def test_source_tag_changes_with_any_kernel_source(tmp_path):
 
 
 def test_changed_model_source_recompiles_the_kernel(tmp_path):
-    """Issue 13 item 3: after a change of one fvV coefficient in ``_generated.py`` the cached kernels used to be
+    """after a change of one fvV coefficient in ``_generated.py`` the cached kernels used to be
     loaded unchanged (the pull force of the kernel then disagreed with the numpy law by ~37 N).  Hypothesis:
     the kernel follows the changed source.  The kernel and numpy evaluate the same expression, so they agree
     to rounding (1e-12 relative); the change of 400 v^0.35 -> 401 v^0.35 at v = 0.1 moves f by 0.447 N (F by 0.373 N),
@@ -125,7 +125,7 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
 
 
 def test_import_and_simulate_without_writable_cache(tmp_path):
-    """Issue 13 item 4: with no writable cache location (NUMBA_CACHE_DIR, HOME and XDG_CACHE_HOME unwritable,
+    """with no writable cache location (NUMBA_CACHE_DIR, HOME and XDG_CACHE_HOME unwritable,
     the packages' __pycache__ unusable) ``import peelapprox`` raised 'cannot cache function ...: no locator
     available'.  Hypothesis: import and a first simulate work, uncached, with exactly one KernelCacheWarning,
     and the result is right (CONSTR residual at rounding level, 1e-13 relative as in tests/test_exact.py).

@@ -81,7 +81,7 @@ def test_an_option_of_another_method_is_refused_by_name(method, option, owner):
     """Hypothesis: an option the chosen method does not take raises before any run a TypeError (also a
     ValueError, peelapprox's ArgumentTypeError) naming the option, the chosen method and, when it is another
     method's option, that method (substrings; categorical).  The variational case needs no pydiffsol: the
-    check comes first.  (Issue 14: T is now also an option of two-trajectory, so the row that refused T for
+    check comes first.  (T is now also an option of two-trajectory, so the row that refused T for
     two-trajectory asks return-map, the one method without T.)"""
     t0 = time.perf_counter()
     with pytest.raises(TypeError) as ei:
@@ -157,7 +157,7 @@ def test_variational_method_refuses_a_bad_eps_and_equals_lyapunov_variational():
 
 
 def test_two_trajectory_T_is_round_T_over_tau_intervals_and_excludes_n():
-    """Issue 14: ``T`` (measured seconds) is common to the methods that measure a time.  Hypothesis: for
+    """``T`` (measured seconds) is common to the methods that measure a time.  Hypothesis: for
     two-trajectory ``T`` runs ``n = max(2, round(T/tau))`` intervals, bitwise the run with that ``n`` (0.1 s is
     20 intervals of 0.005 s; 0.0124 s rounds to 2); giving both ``T`` and ``n`` is a ValueError naming both,
     raised before any run (substrings)."""
@@ -195,7 +195,7 @@ def test_check_lyapunov_options_checks_without_running():
 
 
 def test_return_map_takes_alpha0_like_the_dispatcher():
-    """Issue 14: ``lyapunov_return_map`` takes ``alpha0`` as ``lyapunov(p, "return-map", ...)`` does.
+    """``lyapunov_return_map`` takes ``alpha0`` as ``lyapunov(p, "return-map", ...)`` does.
     Hypothesis: from alpha0 = 0.1 the two are equal bitwise (exponent, standard error, local rates), and the
     start matters (a different exponent than from 0: the transient's last section crossing moves)."""
     kw = dict(t_transient=1.0, n_returns=6, h=1e-6)

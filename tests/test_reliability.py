@@ -33,7 +33,7 @@ def _finite_state(t: float, state: dict) -> bool:
     ids=["V1-I0.1-atol1e-3", "V1-I1e-6-rtol1e-2", "V8-I1e-2-atol1"],
 )
 def test_loose_tolerance_reproducers_end_finite(pkw, t_end, kw):
-    """Issue 13 items 1-2: these runs ended in ModelBreakdown('geometry') with t = NaN and a NaN state, or
+    """these runs ended in ModelBreakdown('geometry') with t = NaN and a NaN state, or
     'reached t_end' with v = -1.29 and F = NaN, because the dense output of an accepted step left the
     model's domain.  Hypothesis: the kernel now rejects such steps, so the run reaches t_end (it does at
     default tolerances) or ends in a documented exception, and every stored value is finite with v > 0.
@@ -53,7 +53,7 @@ def test_loose_tolerance_reproducers_end_finite(pkw, t_end, kw):
 
 
 def test_loose_reproducer_matches_default_tolerance_jump_count():
-    """Issue 13 item 1: at default tolerances V=1, I=0.1, alpha0=0.5 makes 341 jumps in 5 s; with atol=1e-3
+    """at default tolerances V=1, I=0.1, alpha0=0.5 makes 341 jumps in 5 s; with atol=1e-3
     the run used to stop after 209 with a NaN 'geometry' breakdown.  A loose run need not match the jump
     count exactly (it is a different approximation of a relaxation oscillation with ~70 jumps/s), but it
     must be the same orbit: within 2 % of the default run's count."""
@@ -65,7 +65,7 @@ def test_loose_reproducer_matches_default_tolerance_jump_count():
 
 
 def test_loose_tolerance_grid_has_no_nan():
-    """Issue 13: over the 432-run loose-tolerance grid (rtol 1e-2 or atol >= 1e-3; 66 runs ended with a NaN
+    """over the 432-run loose-tolerance grid (rtol 1e-2 or atol >= 1e-3; 66 runs ended with a NaN
     state before the fix) every run ends in an allowed outcome with finite values and v > 0 in the
     trajectory, the final state and any exception's state.  Counts are exact (0 of 432)."""
     recs = [run_point(p) for p in loose_points()]
@@ -77,7 +77,7 @@ def test_loose_tolerance_grid_has_no_nan():
 
 
 def test_max_wall_bounds_a_huge_horizon():
-    """Issue 13 item 5: ``simulate(p, 1e300, save="jumps")`` ran ~4 min before its step budget raised (t_end is
+    """``simulate(p, 1e300, save="jumps")`` ran ~4 min before its step budget raised (t_end is
     now at most TIME_MAX = 1e6 s, ``test_validate``).  Hypothesis: with ``max_wall=1`` a 1e6 s run raises
     SolverBudgetExceeded(budget="max_wall") with a finite state,
     after at least 1 s of wall time (the check runs between kernel calls of <= 250k steps, so it cannot
@@ -92,7 +92,7 @@ def test_max_wall_bounds_a_huge_horizon():
 
 
 def test_max_wall_regularized():
-    """Issue 13 item 5 for the regularised scheme (~11 h before its budget raised): the wall budget is checked
+    """For the regularised scheme (~11 h before its budget raised): the wall budget is checked
     at every step, so 0.5 s suffices to stop it; same contract as the hybrid method."""
     with pytest.raises(SolverBudgetExceeded) as ei:
         simulate(PeelParams(V=1, I=1e-5), 1e6, method="regularized", save="jumps", max_wall=0.5)
@@ -100,7 +100,7 @@ def test_max_wall_regularized():
 
 
 def test_default_step_budget_scales_with_horizon():
-    """Issue 13 item 5: ``simulate(PeelParams(V=100, I=1e-12), 0.5)`` took over a minute (1.6e8 steps per
+    """``simulate(PeelParams(V=100, I=1e-12), 0.5)`` took over a minute (1.6e8 steps per
     simulated second).  The default budget is now 1e6 steps per simulated second with a floor of 1e6, so this
     run stops at exactly 1e6 steps (an integer budget: exact)."""
     from exact import default_max_steps
@@ -120,7 +120,7 @@ def test_default_step_budget_scales_with_horizon():
     ("attractors", dict(t_transient=1e5, max_wall=0.5)),
 ], ids=["lyapunov", "attractors"])
 def test_dynamics_max_wall(fn, kw):
-    """Issue 13 item 5: lyapunov and attractors are made of many solver runs (lyapunov: 2 per 5 ms interval,
+    """lyapunov and attractors are made of many solver runs (lyapunov: 2 per 5 ms interval,
     20,000 by default), so a per-run budget does not bound the call.  Hypothesis: ``max_wall`` bounds the
     whole call: SolverBudgetExceeded(budget="max_wall", limit=max_wall) with a finite state (v > 0) from the
     orbit.  Categorical outcome; no wall time asserted (benchmarks measure time)."""
@@ -134,7 +134,7 @@ def test_dynamics_max_wall(fn, kw):
 
 
 def test_composite_calls_have_a_default_wall_budget():
-    """Issue 13 item 5: lyapunov(n=1e15) or lyapunov_return_map(n_returns=1e15) are valid counts that no step
+    """lyapunov(n=1e15) or lyapunov_return_map(n_returns=1e15) are valid counts that no step
     budget bounds.  Hypothesis: their default max_wall (DEFAULT_MAX_WALL = 3600 s) and the saltation
     tangent's default step cap (1e9) state a bound for every default call.  Exact: defaults read from the
     signatures."""
@@ -172,7 +172,7 @@ def test_max_wall_at_a_high_jump_rate(save):
 
 
 def test_regularized_failure_reports_last_state_in_domain():
-    """Issue 13, regularised scheme: at V=0.5, I=1e-4 the orbit approaches the no_root breakdown, which the
+    """regularised scheme: at V=0.5, I=1e-4 the orbit approaches the no_root breakdown, which the
     ε-scheme cannot follow to the hybrid solver's 1e-67 m/s; Radau fails (step size below spacing).
     Hypothesis: the SolverFailure carries a finite state with v > 0 both as ``state`` and as the partial
     trajectory's final state (it used to be the solver's last, rejected state), and the message gives the

@@ -160,7 +160,7 @@ def test_long_run_constraint_does_not_drift_short():
 
 def test_bad_inputs_raise_value_error():
     """Hypothesis: bad arguments to the stress API raise ValueError naming the
-    argument and its valid range.  (Issue 14: the budgets are checked by peelapprox.validate.integer, whose
+    argument and its valid range.  (the budgets are checked by peelapprox.validate.integer, whose
     one message pattern, "an integer in [1, 1e15]", replaced the hand-written "a positive integer"; an
     integral float such as 3.0 is now refused as well, as counts are integers.)
 

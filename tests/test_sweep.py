@@ -254,7 +254,7 @@ def test_resume_tolerates_rebuilt_grid_roundoff(tmp_path):
 
 def test_validation_messages(tmp_path):
     """Hypothesis: bad arguments raise ValueError naming the argument and its valid range (or the known measures).
-    (Issue 14: max_workers is checked by peelapprox.validate.integer, whose one message pattern replaced the
+    (max_workers is checked by peelapprox.validate.integer, whose one message pattern replaced the
     hand-written "an integer in [0, inf) (0: in this process)".)"""
     out = tmp_path / "sw"
     with pytest.raises(ValueError, match=r"I_values .*empty array"):

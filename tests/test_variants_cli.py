@@ -1,4 +1,4 @@
-"""Issue 18 downstream of the solver: the model variants (tape mass, constant load) on the command line, the
+"""Downstream of the solver: the model variants (tape mass, constant load) on the command line, the
 paper's reduced equations refusing them, and a variant trajectory's repr, DataFrame, .npz and plot.
 
 The CLI runs are checked against the Python API run with the same settings: the CLI calls
