@@ -196,7 +196,7 @@ def test_version_single_sourced():
 
 
 def test_import_peelapprox_does_not_import_exact():
-    """(rooms) the core imports no sibling package; the names it offers that live in ``exact``
+    """The rooms: the core imports no sibling package; the names it offers that live in ``exact``
     (the Lyapunov family, attractors) are imported on first access.  Hypothesis, in a fresh interpreter:
     after ``import peelapprox`` ``exact`` is not in ``sys.modules``; ``dir(peelapprox)`` lists the lazy names;
     accessing ``peelapprox.lyapunov`` imports ``exact`` and gives the very object ``exact.lyapunov``
@@ -238,7 +238,7 @@ def test_sweep_names_are_the_same_objects_both_ways():
 
 
 def test_matplotlib_is_imported_by_plotting_only():
-    """(one matplotlib set-up, :func:`peelapprox.plotting.pyplot`) importing the packages, the CLI and
+    """One matplotlib set-up (:func:`peelapprox.plotting.pyplot`): importing the packages, the CLI and
     the plotting module itself loads no matplotlib; drawing does.  Fresh interpreter (categorical: module set)."""
     code = ("import sys, peelapprox, peelapprox.cli, peelapprox.plotting, exact, comparisons, comparisons.benchmark\n"
             "print('matplotlib' in sys.modules)\n"
