@@ -68,8 +68,9 @@ from ._ranges import (
 )
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
-from ._series import ForceSeries, Slips, Spectrum
+from ._series import ForceSeries, Spectrum
 from ._series_lyapunov import SeriesLyapunov, SurrogateTest
+from ._slips import Slips
 from ._version import __version__ as __version__
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from .law import (

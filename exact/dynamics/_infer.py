@@ -196,7 +196,7 @@ def _stats(series: ForceSeries, threshold: float | None) -> tuple[np.ndarray | N
     """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables and
     the detector's threshold."""
     slips = series.slips(threshold)
-    o = series.observables(slips.threshold)
+    o = series.observables(slips=slips)  # read off these slips, not detected a second time
     if o.status != "stick-slip" or len(slips) < 2:
         return None, o, slips.threshold
     assert o.slip_interval is not None  # stick-slip with two slips or more
