@@ -25,6 +25,7 @@ from ..validate import shown
 
 __all__ = [
     "DASK_CONNECT_TIMEOUT_S",
+    "add_pool_options",
     "EXIT_INTERNAL",
     "EXIT_INTERRUPTED",
     "EXIT_OK",
@@ -289,6 +290,18 @@ def connect_dask_scheduler(address: str):
 MESSAGE_LIMIT = 2000
 
 
+
+
+def add_pool_options(parser: argparse.ArgumentParser) -> None:
+    """``--workers``, ``--dask-local`` and ``--dask-scheduler`` (mutually exclusive) of a grid command (sweep,
+    atlas), which :func:`worker_pool` reads."""
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
+                       help="local worker threads (default: all CPUs; 0: in this process)")
+    where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
+                       help="start a dask LocalCluster with N single-threaded worker processes")
+    where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
+                       help="connect to a running dask scheduler, e.g. tcp://host:8786")
 
 @contextlib.contextmanager
 def worker_pool(args: argparse.Namespace) -> Iterator[tuple[Any, int | None]]:

@@ -9,7 +9,7 @@ import sys
 import time
 
 from .. import GEOMETRIES, PeelForce
-from ._checks import check_output_path, nonnegative_int, positive_int, worker_pool
+from ._checks import add_pool_options, check_output_path, nonnegative_int, positive_int, worker_pool
 from ._common import FORMATS, add_max_wall_option, subcommand
 from ._force import add_force_options, force_from_args
 
@@ -49,13 +49,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     at.add_argument("--approximations", metavar="NAMES",
                     help="comma-separated names of comparisons.atlas.APPROXIMATIONS (default: every registered one "
                          "whose function is importable)")
-    where = at.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
-                       help="local worker threads (default: all CPUs; 0: in this process)")
-    where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
-                       help="start a dask LocalCluster with N single-threaded worker processes")
-    where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
-                       help="connect to a running dask scheduler, e.g. tcp://host:8786")
+    add_pool_options(at)
     w = at.add_argument_group("the exact window and the segments (left out: the default given)")
     w.add_argument("--t-transient", type=float, default=None,
                    help="transient skipped [s] (default: 100: the slowest orbits of the (0.2-5 m/s, 1e-6-0.1 kg m^2) "

@@ -9,7 +9,12 @@ import sys
 import time
 
 from .. import GEOMETRIES
-from ._checks import check_output_path, check_sweep_plot_key, nonnegative_int, positive_int, worker_pool
+from ._checks import (
+    add_pool_options,
+    check_output_path,
+    check_sweep_plot_key,
+    worker_pool,
+)
 from ._common import FromMethods, add_max_wall_option, add_variant_options, scipy_solvers, subcommand
 from ._force import add_force_options, force_from_args
 
@@ -56,13 +61,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sw.add_argument("--out", required=True, metavar="DIR",
                     help="output directory: sweep.json, results.jsonl (one line per point), results.csv; "
                          "an existing DIR with the same grid, measures and options is resumed")
-    where = sw.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
-                       help="local worker threads (default: all CPUs; 0: in this process)")
-    where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
-                       help="start a dask LocalCluster with N single-threaded worker processes")
-    where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
-                       help="connect to a running dask scheduler, e.g. tcp://host:8786")
+    add_pool_options(sw)
     m = sw.add_argument_group("options of the measures (left out: the measure's default)")
     m.add_argument("--t-end", type=float, default=None,
                    help="final time [s] (jumps, period; default: t_transient + window)")
