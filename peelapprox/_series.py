@@ -82,8 +82,8 @@ class ForceSeries:
         bad = np.flatnonzero(dt <= 0)
         if bad.size:
             i = int(bad[0]) + 1
-            raise ValueError(f"t must increase: t[{i}] = {fmt_number(float(t_arr[i]), 6)} s does not exceed "
-                             f"t[{i - 1}] = {fmt_number(float(t_arr[i - 1]), 6)} s")
+            raise _SampleError(i, f"t must increase: t[{i}] = {fmt_number(float(t_arr[i]), 6)} s does not exceed "
+                                  f"t[{i - 1}] = {fmt_number(float(t_arr[i - 1]), 6)} s")
         self.t: np.ndarray = t_arr
         self.F: np.ndarray = F_arr
         self.V: float | None = optional(positive, "V", V)
@@ -126,13 +126,10 @@ class ForceSeries:
                             max_bytes=MAX_TRACE_BYTES, stated=units)
         try:
             return cls(data[tc], data[fc], V=V, source=f"measured: {path}")
+        except _SampleError as exc:  # the sample the trace's check names, as a line of the file
+            raise ValueError(f"{where}: {exc} (file line {int(data['line'][exc.index])})") from None
         except ValueError as exc:
-            import re
-
-            m = re.search(r"\[(\d+)\]", str(exc))  # the sample the trace's check names
-            i = int(m.group(1)) if m else -1
-            line = f" (file line {int(data['line'][i])})" if 0 <= i < data["line"].size else ""
-            raise ValueError(f"{where}: {exc}{line}") from None
+            raise ValueError(f"{where}: {exc}") from None
 
     @property
     def duration(self) -> float:
@@ -383,9 +380,26 @@ class ForceSeries:
         return {"t": jsonable(self.t), "F": jsonable(self.F), "V": self.V, "source": self.source}
 
 
+class _SampleError(ValueError):
+    """A bad sample of a trace, with its index (so a file reader can name its line)."""
+
+    def __init__(self, index: int, message: str) -> None:
+        super().__init__(message)
+        self.index = index
+
+
 def _samples(name: str, x: ArrayLike) -> np.ndarray:
-    """``x`` as a 1-D float array of finite samples (:func:`peelapprox.validate.reals` names the first that is
-    not)."""
+    """``x`` as a 1-D float array of finite samples: the first sample that is not finite is named with its index
+    (:class:`_SampleError`); anything else :func:`peelapprox.validate.reals` refuses."""
+    try:
+        raw = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):  # text, ragged nesting: reals names it below
+        raw = None
+    if raw is not None and raw.ndim == 1:
+        bad = np.flatnonzero(~np.isfinite(raw))
+        if bad.size:
+            i = int(bad[0])
+            raise _SampleError(i, f"{name}[{i}] = {float(raw[i])!r} is not finite (sample {i} of {raw.size})")
     a = reals(name, x)
     if a.ndim != 1:
         raise ValueError(f"{name} must be 1-D, got shape {a.shape}")
