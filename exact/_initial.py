@@ -4,7 +4,16 @@ from __future__ import annotations
 
 import math
 
-from peelapprox import BRANCHES, STATE_RANGES, TIME_MAX, PeelParams, branch_inverse, branch_structure, peel_force
+from peelapprox import (
+    BRANCHES,
+    F0_FACTOR,
+    STATE_RANGES,
+    TIME_MAX,
+    PeelParams,
+    branch_inverse,
+    branch_structure,
+    peel_force,
+)
 from peelapprox.validate import choice, in_range, interval, optional, shown, state
 from peelapprox.validate import params as _params
 
@@ -75,7 +84,7 @@ def initial_state(
     else:
         fVV = law.f(params.V)
     if F0 is None:
-        F = 1.01 * fVV
+        F = F0_FACTOR * fVV
         f_lo, f_hi = STATE_RANGES["F"]
         if not (math.isfinite(F) and f_lo <= F <= f_hi):
             raise ValueError(f"F0 was not given, so its default 1.01 f(V, V) = {F:.6g} N was used (f of params.force="

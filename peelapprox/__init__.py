@@ -52,6 +52,7 @@ from ._params import PeelParams
 from ._ranges import (
     EPS_DEFAULT,
     EPS_RANGE,
+    F0_FACTOR,
     GEOMETRIES,
     GRAVITY,
     LOAD_MASS_RANGE,
@@ -115,6 +116,7 @@ __all__ = [
     "T_TRANSIENT",
     "LYAPUNOV_TAU",
     "WINDOW_DEFAULTS",
+    "F0_FACTOR",
     "BREAKDOWN_LEVEL",
     "peel_force",
     "peel_force_derivative",

@@ -31,6 +31,7 @@ import numpy as np
 
 from ._observables import StickSlipObservables, jump_statistics
 from ._params import PeelParams
+from ._ranges import F0_FACTOR
 from ._regime import regime
 from ._segment import SegmentPlan, run_segment, segment_plan, segment_status
 from ._segment_kernel import ALPHA_MODELS, AM_EXP, AM_HARM, AM_SIN, AM_STATIC, V_EQUATIONS, alpha_at
@@ -208,14 +209,14 @@ def _rest(law: Any) -> Start:
 
 
 def _solver_start(params: PeelParams, law: Any) -> Start:
-    """The exact solver's default start (:func:`exact.initial_state`, α = 0, ω = V/R so α̇ = (V - v)/R): F = 1.01
+    """The exact solver's default start (:func:`exact.initial_state`, α = 0, ω = V/R so α̇ = (V - v)/R): F = F0_FACTOR
     f(V, V) on the branch with the lowest root; the AB landing with F = f_min where f(V) is outside the law's
     domain or the level has no root."""
     bs = law.structure
     lo, hi = law.domain
     kick = lambda v: (params.V - v) / params.R  # noqa: E731
     if lo <= params.V <= hi:
-        F = 1.01 * law.f(params.V)
+        F = F0_FACTOR * law.f(params.V)
         for code, branch in enumerate(("AB", "CD")):
             if bs.has_root(F, branch):
                 try:

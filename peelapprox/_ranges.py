@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import types
 
-__all__ = ["EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE", "LOAD_MASS_RANGE",
+__all__ = ["F0_FACTOR", "EPS_DEFAULT", "EPS_RANGE", "GRAVITY", "LOADINGS", "TAPE_MASS_RANGE", "LOAD_MASS_RANGE",
            "LOAD_RANGE", "LYAPUNOV_TAU", "RTOL_RANGE", "T_TRANSIENT", "WINDOW_DEFAULTS", "GEOMETRIES",
            "L_OVER_R_MIN", "PARAM_RANGES", "STATE_RANGES", "TIME_MAX", "default_load_masses"]
 
@@ -102,6 +102,9 @@ LYAPUNOV_TAU = 0.005
 #: Defaults of the windowed run (``exact.window_run``) shared by the attractors, the sweep measures ``period``
 #: and ``jumps`` and ``peelapprox dynamics``: 20 s of jumps after the transient, at rtol 1e-10, from α0 = 0.
 #: Read-only (a ``types.MappingProxyType``): the one place these defaults are written.
+#: The default start's pull force in units of f(V, V): ``F0 = 1.01 f(V, V)``, just above steady sliding
+#: (:func:`exact.initial_state`; the reduced return map starts there too).
+F0_FACTOR = 1.01
 WINDOW_DEFAULTS = types.MappingProxyType(dict(t_transient=T_TRANSIENT, window=20.0, rtol=1e-10, alpha0=0.0))
 
 #: Valid regularisation ε of the ε-regularised scheme (XDAE): the ε study (comparisons.benchmark.eps) goes

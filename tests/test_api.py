@@ -18,7 +18,8 @@ import pytest
 API = {
     "peelapprox": {
         "ALPHA_FORMS", "ALPHA_MODELS", "Attractor", "BRANCHES", "BREAKDOWN_LEVEL", "EPS_RANGE", "LYAPUNOV_TAU",
-        "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "BranchStructure", "FixedPoint",
+        "RTOL_RANGE", "STATE_RANGES", "TIME_MAX", "T_TRANSIENT", "WINDOW_DEFAULTS", "F0_FACTOR",
+        "BranchStructure", "FixedPoint",
         "EPS_DEFAULT", "GEOMETRIES", "TAPE_MASS_RANGE", "LOADINGS", "LOAD_MASS_RANGE", "LOAD_RANGE", "GRAVITY",
         "INERTIA_RULE", "InertialPeriods", "KernelCacheWarning", "LyapunovResult", "MEASURES", "ModelBreakdown",
         "PARAM_RANGES", "PeelParams", "PeelForce", "Folds", "FitResult", "FoldEstimate", "periodic_orbit",
