@@ -6,11 +6,14 @@ and read by the same slip detector with the same threshold, gives the same stati
 several (one series per V).
 
 * **Statistics** (:data:`OBSERVABLES`): the slip interval, force drop, stick and slip times of
-  :meth:`ForceSeries.observables`, the mean slope of the sticks (``k (V - v)``: mostly k) and the mean force at
-  a slip's start (set by the law and the α oscillation: mostly I).  The model's are read off an exact run
+  :meth:`ForceSeries.observables`, the mean slope of the sticks (``k (V - v)``: mostly k), the mean force at
+  a slip's start (set by the law and the α oscillation: mostly I; the trace's linear trend removed, so a
+  machine's slow drift does not read as force) and the cycle frequency (left out where no line stands out of the
+  periodogram below half the slip frequency, :data:`LINE_RATIO`: a period-1 trace holds only drift and noise
+  there).  The model's are read off an exact run
   (``t_transient`` seconds, then the series' duration at its sampling times) with white noise of the series'
   level added (σ of :meth:`ForceSeries.noise`, a fixed seed), by the same detector with the same threshold, so
-  the detector's biases under noise (a 10 % smaller drop where sticks are 40 samples long) cancel.
+  the detector's remaining biases under noise cancel.
 * **Residuals.**  ``(model - data) / σ``, σ the detector's repeatability under noise
   (:data:`REPEATABILITY`, relative, measured) and, for an aperiodic trace, the standard error of the mean in
   quadrature; a periodic trace's means are over whole cycles.
@@ -43,7 +46,7 @@ from peelapprox.validate import choice, positive
 
 from .._simulate import simulate
 
-__all__ = ["DIFF_STEP", "GRID_RUNS", "Inference", "OBSERVABLES", "POOR_FIT", "REPEATABILITY", "infer"]
+__all__ = ["DIFF_STEP", "GRID_RUNS", "Inference", "LINE_RATIO", "OBSERVABLES", "POOR_FIT", "REPEATABILITY", "infer"]
 
 #: The statistics fitted, in this order (module docstring).
 OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -55,6 +58,11 @@ OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise",
 #: map's cycle, 1/(n · slip interval), which follows the α oscillation, ∝ I^-1/2 at high inertia) gets 3 %.
 REPEATABILITY = {"slip_interval": 0.02, "force_drop": 0.02, "stick_time": 0.02, "slip_time": 0.05, "rise": 0.02,
                  "F_start": 0.005, "f_cycle": 0.03}
+#: The height over the periodogram's median (in the band below half the slip frequency) from which its strongest
+#: peak is a line of the stick-slip, the cycle frequency fitted: white noise's largest of N bins is about
+#: ln N / ln 2 times their median (17 for 1e5 bins; measured 10-12 on 20 s at 10 kHz with 0.5 N of noise), a
+#: period-3 orbit's line 4e6 times (V = 1 m/s, I = 1e-5, the same noise).
+LINE_RATIO = 100.0
 #: The seed of the noise added to every model trace (the same at every parameter point: the statistics move with
 #: the parameters, not with a new draw).
 NOISE_SEED = 20041
@@ -193,41 +201,56 @@ def _apply(params0: PeelParams, names: list[str], x: np.ndarray, V: float) -> Pe
 
 
 def _stats(series: ForceSeries, threshold: float | None) -> tuple[np.ndarray | None, Any, float]:
-    """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables and
-    the detector's threshold."""
+    """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables (and
+    the cycle line's height over the periodogram's floor) and the detector's threshold."""
     slips = series.slips(threshold)
     o = series.observables(slips=slips)  # read off these slips, not detected a second time
     if o.status != "stick-slip" or len(slips) < 2:
-        return None, o, slips.threshold
+        return None, (o, 0.0), slips.threshold
     assert o.slip_interval is not None  # stick-slip with two slips or more
-    vals = [getattr(o, n) for n in OBSERVABLES[:4]] + [float(np.mean(slips.rise)), float(np.mean(slips.F_before)),
-                                                       _cycle_frequency(series, 1.0 / o.slip_interval)]
-    return np.asarray(vals, dtype=float), o, slips.threshold
+    f_cycle, line = _cycle_frequency(series, 1.0 / o.slip_interval)
+    vals = [getattr(o, n) for n in OBSERVABLES[:4]] + [float(np.mean(slips.rise)), _start_force(slips), f_cycle]
+    return np.asarray(vals, dtype=float), (o, line), slips.threshold
 
 
-def _cycle_frequency(series: ForceSeries, f_slip: float) -> float:
+def _start_force(slips: Any) -> float:
+    """The mean force at a slip's start with the trace's linear trend removed, referred to its first slip: a
+    machine's slow drift (tared at the start) does not read as a larger force.  A periodic model trace has no
+    trend, so this is its plain mean there."""
+    t, F = np.asarray(slips.t_start), np.asarray(slips.F_before)
+    if t.size < 3 or t[-1] <= t[0]:
+        return float(np.mean(F))
+    slope = np.polyfit(t - t[0], F, 1)[0]
+    return float(np.mean(F - slope * (t - t[0])))
+
+
+def _cycle_frequency(series: ForceSeries, f_slip: float) -> tuple[float, float]:
     """The strongest line of the trace's periodogram (Hann window, linear trend removed) between 3 / duration
-    and half the slip frequency, refined by a parabola through its log power and its neighbours [Hz]."""
+    and half the slip frequency, refined by a parabola through its log power and its neighbours [Hz], and its
+    power over the band's median (a line stands out by :data:`LINE_RATIO` or more)."""
     from scipy.signal import periodogram
 
     f, p = periodogram(series.F, fs=(len(series) - 1) / series.duration, window="hann", detrend="linear")
     band = np.flatnonzero((f >= 3.0 / series.duration) & (f <= 0.5 * f_slip))
     if band.size < 3:
-        return 0.5 * f_slip
+        return 0.5 * f_slip, 0.0
     i = int(band[np.argmax(p[band])])
+    floor = float(np.median(p[band]))
+    ratio = float(p[i] / floor) if floor > 0 else math.inf
     if 0 < i < f.size - 1 and min(p[i - 1], p[i], p[i + 1]) > 0:
         a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
         shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
-        return float(f[i] + max(-0.5, min(0.5, shift)) * (f[1] - f[0]))
-    return float(f[i])
+        return float(f[i] + max(-0.5, min(0.5, shift)) * (f[1] - f[0])), ratio
+    return float(f[i]), ratio
 
 
-def _data(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """The series' statistics, their σ (module docstring: residuals), the detector's threshold and the noise
-    level."""
+def _data(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
+    """The series' statistics, their σ (module docstring: residuals), the detector's threshold, the noise
+    level and which statistics it carries: not the cycle frequency where no line stands out of the periodogram
+    below half the slip frequency (a period-1 trace: only drift and noise there)."""
     if series.V is None:
         raise ValueError(f"{series!r} has no pull speed: give ForceSeries(..., V=...) (the model needs V)")
-    vals, o, threshold = _stats(series, None)
+    vals, (o, line), threshold = _stats(series, None)
     if vals is None:
         raise ValueError(f"the series at V = {fmt_number(series.V, 4)} m/s does not stick-slip ({o.status}: "
                          f"{o.reason}): there is nothing to fit")
@@ -237,7 +260,9 @@ def _data(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float]:
         for j, n in enumerate(OBSERVABLES[:4]):
             spread = getattr(o, f"{n}_spread") or 0.0
             sig[j] = math.hypot(sig[j], spread / math.sqrt(max(o.n_slips - 1, 1)))
-    return vals, sig, threshold, series.noise
+    used = np.ones(len(OBSERVABLES), dtype=bool)
+    used[OBSERVABLES.index("f_cycle")] = line >= LINE_RATIO
+    return vals, sig, threshold, series.noise, used
 
 
 def _model(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float, rtol: float,
@@ -346,9 +371,10 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
             raise _Spent
         out: list[np.ndarray] = []
         models: list[np.ndarray | None] = []
-        for s, V, (vals, sig, threshold, noise) in zip(all_series, Vs, data):
+        for s, V, (vals, sig, threshold, noise, used) in zip(all_series, Vs, data):
             m = _model(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol, max(1.0, left))
-            out.append(np.full(sel.size, _PENALTY) if m is None else ((m - vals) / sig)[sel])
+            use = sel[used[sel]]
+            out.append(np.full(use.size, _PENALTY) if m is None else ((m - vals) / sig)[use])
             models.append(m)
         res = np.concatenate(out)
         evaluated.append((np.array(x), float(res @ res), models))
@@ -383,7 +409,7 @@ def _result(params0: PeelParams, names: list[str], sel: np.ndarray, jac: np.ndar
     """The :class:`Inference` at the best evaluated point: intervals and verdicts (module docstring)."""
     from scipy.stats import chi2 as chi2_dist
 
-    n_obs = sel.size * len(data)
+    n_obs = sum(int(np.count_nonzero(d[4][sel])) for d in data)
     dof = n_obs - len(names)
     x, chi2, model = min(evaluated, key=lambda e: e[1]) if evaluated else (None, math.inf, None)
     if x is None:
@@ -428,8 +454,8 @@ def _result(params0: PeelParams, names: list[str], sel: np.ndarray, jac: np.ndar
             verdicts[name] = (f"not identified: its 95 % interval spans more than "
                               f"{'a factor 2' if log else 'its value'}")
     residuals = []
-    for V, (vals, sig, _, _), m in zip(Vs, data, model or [None] * len(data)):
-        for j in sel.tolist():
+    for V, (vals, sig, _, _, used), m in zip(Vs, data, model or [None] * len(data)):
+        for j in sel[used[sel]].tolist():
             obs = OBSERVABLES[j]
             mv = None if m is None else float(m[j])
             residuals.append({"V": V, "observable": obs, "data": float(vals[j]), "sigma": float(sig[j]),
