@@ -21,7 +21,8 @@ v)`` changes sign when v crosses V, which happens in the jumps).
    with one fitted to the fall next to it, and F there is the stick line's value.  The knee is not the force
    maximum: where ``v_max > V`` (V = 1 m/s in the paper's law) F peaks on AB, a little before the jump, and
    falls slowly until it.  The knee is first where the smoothed gradient, walked back from the steepest fall,
-   is half as steep as the mean fall; then, at most that late, the sample that splits the stick and the fall
+   is half as steep as the mean fall; then, where noise makes that test unreliable (:data:`KNEE_NOISE`), at
+   most that late, the sample that splits the stick and the fall
    into two straight lines of least total squared residual (segmented regression): under noise a single
    noisy sample of the fall passes the gradient test, and the knee alone came 3.5 samples late and the drop 8 %
    low where sticks and slips are 40 samples long (V = 3.95 m/s, I = 1.43e-5, 0.5 N of noise; 0.6 % with the
@@ -42,10 +43,16 @@ import numpy as np
 
 from .io import fmt_number, write_rows
 
-__all__ = ["Slips", "detect_slips", "noise_level", "THRESHOLD_SIGMAS"]
+__all__ = ["KNEE_NOISE", "Slips", "detect_slips", "noise_level", "THRESHOLD_SIGMAS"]
 
 #: The default threshold in units of the averaged force's noise, σ/√smooth (module docstring, step 2).
 THRESHOLD_SIGMAS = 12.0
+#: The averaged noise σ/√smooth, as a fraction of a slip's mean fall per sample, above which its knee is found
+#: by segmented regression instead of the gradient alone (module docstring, step 3): 0.6 at V = 3.95 m/s,
+#: I = 1.43e-5 with 0.5 N of noise (the gradient's knee 3.5 samples late), 0 without noise (where the
+#: gradient's knee is exact to a sample and the split's, on a stick curving into the fold, moves with the
+#: sampling grid's phase).
+KNEE_NOISE = 0.05
 
 
 def noise_level(F: np.ndarray) -> float:
@@ -234,6 +241,12 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
     if half:  # the ends of a 'same' convolution are averages over fewer samples: keep the raw force there
         Fs[:half], Fs[-half:] = F[:half], F[-half:]
     peaks, valleys = _zigzag(Fs, h)
+
+    def noisy_gradient(fall_per_sample: float) -> bool:
+        """Whether the averaged noise is more than :data:`KNEE_NOISE` of the slip's fall per sample, so that
+        the gradient's knee is not to be trusted (module docstring, step 3)."""
+        return sigma / math.sqrt(smooth) > KNEE_NOISE * abs(fall_per_sample)
+
     if peaks and peaks[0] == 0:
         peaks, valleys = peaks[1:], valleys[1:]
     n = len(peaks)
@@ -252,10 +265,11 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
         knee = p + (int(flat[-1]) + 1 if flat.size else 0)
         L = max(2, min(fit, (v - knee) // 3))
         lo = max(before + (knee - before) // 2, knee - half - fit)
-        # the gradient's knee is late under noise (a noisy sample of the fall passes for half as steep): the
-        # split of least squares between the stick's line and the fall's, searched from the maximum on
-        knee = _split(t, F, lo, min(knee + half + L, v - half), p - half, knee)
-        L = max(2, min(fit, (v - knee) // 3))
+        if noisy_gradient(mean_fall * (t[v] - t[p]) / max(v - p, 1)):
+            # a noisy sample of the fall passes for half as steep, so the gradient's knee is late: the split
+            # of least squares between the stick's line and the fall's, searched from the maximum on
+            knee = _split(t, F, lo, min(knee + half + L, v - half), p - half, knee)
+            L = max(2, min(fit, (v - knee) // 3))
         ts[k], fb[k], rise[k] = _corner(t, F, (lo, knee - half), (knee + half, min(knee + half + L, v - half)), knee,
                                (max(p - half - 1, 0), min(knee + half + 1, last)))
         hi = min(v + (after - v) // 2, v + half + 1 + fit)
