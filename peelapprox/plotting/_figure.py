@@ -14,12 +14,12 @@ __all__ = ["new_figure", "pyplot", "save_figure"]
 #: The fixed metadata each format gets from :func:`save_figure`: no software version, no creation date (the
 #: keys matplotlib would otherwise fill with the running version and the clock), so that the same figure
 #: gives the same bytes on any machine and at any time.
-_METADATA = {
+_METADATA: dict[str, dict[str, str | None]] = {
     "png": {"Software": None},
     "pdf": {"Creator": None, "Producer": None, "CreationDate": None},
     "svg": {"Creator": None, "Date": None},
-    "ps": {"Creator": None},
-    "eps": {"Creator": None},
+    "ps": {"Creator": "peelapprox"},  # PostScript prints None as "None"; its date comes from SOURCE_DATE_EPOCH
+    "eps": {"Creator": "peelapprox"},
 }
 
 #: The SVG writer's id salt (its default is random per process: ids, hence bytes, would differ between runs).
@@ -59,17 +59,25 @@ def save_figure(fig: Any, path: str | os.PathLike, *, dpi: float = 120, **kwargs
     same bytes on every write, on any machine with the same matplotlib and fonts.
 
     The file gets fixed metadata (no software version, no creation date: PNG ``Software``, PDF ``Creator``,
-    ``Producer`` and ``CreationDate``, SVG ``Creator`` and ``Date``, PS ``Creator``) and SVG ids from a fixed
-    salt (``svg.hashsalt``).  ``kwargs`` go to ``savefig`` (a ``metadata`` given there is added to the fixed
-    one).  The figure stays open (whoever made it owns it: a :func:`new_figure` needs no closing).
+    ``Producer`` and ``CreationDate``, SVG ``Creator`` and ``Date``, PS ``Creator``; the PS ``CreationDate``
+    from ``SOURCE_DATE_EPOCH``, 0 unless set) and SVG ids from a fixed salt (``svg.hashsalt``).  ``kwargs`` go
+    to ``savefig`` (a ``metadata`` given there is added to the fixed one).  The figure stays open (whoever
+    made it owns it: a :func:`new_figure` needs no closing).
     """
     import matplotlib
 
     fmt = kwargs.pop("format", None) or os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or \
         matplotlib.rcParams["savefig.format"]
     metadata = {**_METADATA.get(fmt, {}), **(kwargs.pop("metadata", None) or {})}
-    with matplotlib.rc_context({"svg.hashsalt": _SVG_HASHSALT}):
-        fig.savefig(path, dpi=dpi, format=fmt, metadata=metadata or None, **kwargs)
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    try:
+        if fmt in ("ps", "eps") and epoch is None:  # the one date the PostScript writer takes from outside
+            os.environ["SOURCE_DATE_EPOCH"] = "0"
+        with matplotlib.rc_context({"svg.hashsalt": _SVG_HASHSALT}):
+            fig.savefig(path, dpi=dpi, format=fmt, metadata=metadata or None, **kwargs)
+    finally:
+        if fmt in ("ps", "eps") and epoch is None:
+            os.environ.pop("SOURCE_DATE_EPOCH", None)
 
 
 def _save(fig: Any, path: str | None, dpi: int = 120) -> None:
