@@ -14,6 +14,10 @@ __all__ = ["MAX_BRANCHES", "plot_bifurcation"]
 #: The branches :func:`plot_bifurcation` draws by default (the first ones): 30 overlapping branches are a tangle.
 MAX_BRANCHES = 12
 
+#: The legend's names of the bifurcation kinds (exact.orbits' table); another kind: its name, spaced.
+_KIND_NAMES = {"fold": "fold", "period_doubling": "period doubling", "neimark_sacker": "Neimark–Sacker",
+               "branch_point": "branch point"}
+
 #: Families (branches continued from one orbit) named one by one in the legend up to this many.
 _NAMED_FAMILIES = 6
 
@@ -108,7 +112,8 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
         for b in br.bifurcations:  # once per bifurcation: on the branch's highest line there
             marker, c = b.marker  # from the kinds' table of exact.orbits
             ax.plot([b.value], [float(np.max(b.orbit.return_map_values))], marker, color=c, ms=8, mec="k", zorder=3)
-            handles.setdefault(b.kind.replace("_", " "), Line2D([], [], ls="", marker=marker, color=c, ms=8, mec="k"))
+            handles.setdefault(_KIND_NAMES.get(b.kind, b.kind.replace("_", " ")),
+                               Line2D([], [], ls="", marker=marker, color=c, ms=8, mec="k"))
         if br.end_marker is not None:  # the non-smooth end, at its (extrapolated) parameter value
             ax.plot([br.end_value], [float(Fs[-1].max())], br.end_marker, color="k", ms=7, zorder=3)
             handles.setdefault(f"end: {br.stopped}", Line2D([], [], ls="", marker=br.end_marker, color="k", ms=7))
