@@ -1,5 +1,6 @@
 """Plots.  Every plot function draws into ``ax=`` (its axes) or ``fig=`` (an empty figure) when given, else into a
-new :class:`matplotlib.figure.Figure` made without pyplot (:func:`new_figure`), and returns the figure.
+new :class:`matplotlib.figure.Figure` made without pyplot (:func:`new_figure`), and returns the figure.  A
+figure drawn into that has no layout engine gets the constrained layout: titles clear the labels above them.
 
 The package never calls ``matplotlib.use`` and never changes the backend of the session it runs in.  A figure it
 makes itself is not registered with pyplot: it needs no backend, nothing has to close it, and in Jupyter it is
