@@ -312,3 +312,27 @@ def test_bifurcation_plot_draws_a_chosen_subset_of_many_branches():
     assert folds(plot_bifurcation(None, many, max_branches=None)) == 30
     with pytest.raises(ValueError, match="select"):
         plot_bifurcation(None, many, select=[31])
+
+
+def test_phase_diagram_title_names_the_fixed_parameters_and_axes_their_units():
+    """Hypothesis: a sweep at k = 500 N/m has k in the phase diagram's title (V and I are its axes, not
+    repeated), and both axes carry units (exact: strings)."""
+    from types import SimpleNamespace as NS
+
+    from peelapprox.plotting import plot_phase_diagram
+
+    result = NS(values=lambda key: np.array([[1.0, 2.0], [3.0, 4.0]]), I_values=[1e-5, 1e-2], V_values=[1.0, 2.0],
+                records=[{}] * 4, options={"k": 500.0}, force=None)
+    ax = plot_phase_diagram(result, "jumps_mean_period").axes[0]
+    assert "k = 500 N/m" in ax.get_title() and "V =" not in ax.get_title() and "4/4 points" in ax.get_title()
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("V [m/s]", "I [kg m²]")
+
+
+def test_bifurcation_plot_select_refuses_a_non_number_before_any_run(capsys):
+    """Hypothesis: ``bifurcation --plot-select 0`` (branches are numbered from 1) is a usage error, exit status
+    2, before the diagram's runs start (exact: the status and the option named)."""
+    from peelapprox.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["bifurcation", "--V", "1", "--I", "1e-2", "--param", "V", "--range", "0.9:1.1:3", "--plot-select", "0,2"])
+    assert exc.value.code == 2 and "--plot-select" in capsys.readouterr().err

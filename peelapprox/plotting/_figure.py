@@ -136,16 +136,17 @@ def axis_label(name: str) -> str:
     return f"{name} [{unit}]" if unit else f"{name} (law coefficient)"
 
 
-def params_label(params: Any, *, skip: str | None = None) -> str:
+def params_label(params: Any, *, skip: str | tuple[str, ...] = ()) -> str:
     """The parameters of a run for a title: ``"V = 1 m/s, I = 0.01 kg m²"``, then k, R, l where they differ
     from the defaults, the law when it is not the paper's and the model variant (:func:`model_label`);
-    ``skip`` leaves out the one a plot sweeps (its x axis)."""
+    ``skip`` leaves out the ones a plot sweeps (its axes)."""
     if params is None:
         return ""
-    parts = [f"{name} = {getattr(params, name):g} {UNITS[name]}" for name in ("V", "I") if name != skip]
+    skip = (skip,) if isinstance(skip, str) else tuple(skip)
+    parts = [f"{name} = {getattr(params, name):g} {UNITS[name]}" for name in ("V", "I") if name not in skip]
     for name, (default, unit) in _DEFAULTS.items():
         value = getattr(params, name, default)
-        if name != skip and value != default:
+        if name not in skip and value != default:
             parts.append(f"{name} = {value:g} {unit}")
     law = law_label(getattr(params, "force", None))
     if law:
@@ -172,5 +173,7 @@ def model_label(params: Any) -> str:
     if getattr(params, "loading", "velocity") == "load":
         if not m:
             parts.append("massless tape")
-        parts.append(f"load F_L = {params.load:.4g} N on M = {params.load_mass:g} kg")
+        load, mass = getattr(params, "load", None), getattr(params, "load_mass", None)
+        parts.append((f"load F_L = {load:.4g} N" if load is not None else "load")
+                     + (f" on M = {mass:g} kg" if mass is not None else ""))
     return "".join(", " + x for x in parts)

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
-from ._figure import _canvas, _save
+from ._figure import _canvas, _save, params_label
 
 __all__ = ["cell_edges", "plot_phase_diagram"]
 
@@ -89,6 +90,9 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
         ax.set_xscale("log")
     ax.set(xlabel="V [m/s]", ylabel="I [kg m²]", xlim=(VE[0], VE[-1]), ylim=(IE[0], IE[-1]))
     n_done = sum(1 for _ in result.records)
-    ax.set_title(title or f"{key} over (V, I): {n_done}/{I.size * V.size} points")
+    opts = dict(getattr(result, "options", None) or {})
+    fixed = params_label(SimpleNamespace(**{**{n: None for n in ("tape_mass", "load", "load_mass")}, **opts,
+                                            "force": getattr(result, "force", None)}), skip=("V", "I"))
+    ax.set_title(title or f"{key} over (V, I){', ' + fixed if fixed else ''}: {n_done}/{I.size * V.size} points")
     _save(fig, path)
     return fig
