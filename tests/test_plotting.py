@@ -288,8 +288,8 @@ def test_bifurcation_plot_units_title_legend_and_one_marker_per_bifurcation():
     assert ax.get_xlabel() == "V [m/s]" and ax.get_ylabel().endswith("[N]")
     assert "I = 0.01 kg m²" in ax.get_title() and "V =" not in ax.get_title()
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert texts == ["brute-force runs: F at each AB→CD jump", "period-4 orbit from V = 1", "fold", "end: grazing",
-                     "stable orbit", "unstable orbit"]
+    assert texts == ["brute-force runs: F at each AB→CD jump", "period-4 orbit from V = 1", "stable orbit",
+                     "unstable orbit", "fold", "end: grazing"]
     folds = [ln for ln in ax.lines if ln.get_marker() == "s"]
     assert len(folds) == 1 and len(folds[0].get_xdata()) == 1
     assert {ln.get_linewidth() for ln in ax.lines if ln.get_linestyle() in ("-", "--")} == {0.9}

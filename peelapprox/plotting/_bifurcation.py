@@ -81,7 +81,8 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
     branches = list(branches)
     if params is None and branches:
         params = branches[0].points[0].orbit.params
-    handles: dict[str, Any] = {}
+    handles: dict[str, Any] = {}  # the legend: the dots, the starting orbits, the line styles, the markers
+    markers: dict[str, Any] = {}
     if diagram is not None:
         xs_d = [np.full(F.size, x) for x, F in zip(diagram.values, diagram.returns)]
         if xs_d:
@@ -112,14 +113,15 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
         for b in br.bifurcations:  # once per bifurcation: on the branch's highest line there
             marker, c = b.marker  # from the kinds' table of exact.orbits
             ax.plot([b.value], [float(np.max(b.orbit.return_map_values))], marker, color=c, ms=8, mec="k", zorder=3)
-            handles.setdefault(_KIND_NAMES.get(b.kind, b.kind.replace("_", " ")),
+            markers.setdefault(_KIND_NAMES.get(b.kind, b.kind.replace("_", " ")),
                                Line2D([], [], ls="", marker=marker, color=c, ms=8, mec="k"))
         if br.end_marker is not None:  # the non-smooth end, at its (extrapolated) parameter value
             ax.plot([br.end_value], [float(Fs[-1].max())], br.end_marker, color="k", ms=7, zorder=3)
-            handles.setdefault(f"end: {br.stopped}", Line2D([], [], ls="", marker=br.end_marker, color="k", ms=7))
+            markers.setdefault(f"end: {br.stopped}", Line2D([], [], ls="", marker=br.end_marker, color="k", ms=7))
     for style, what in (("-", "stable orbit"), ("--", "unstable orbit")):
         if style in styles:
             handles[what] = Line2D([], [], ls=style, color="0.2", lw=1.2)
+    handles.update(markers)
     if handles:
         ax.legend(handles.values(), handles.keys(), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     swept = str(name) if name else "parameter"
