@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from peelapprox import PeelParams, branch_structure, peel_force
-from peelapprox.plotting import new_figure
+from peelapprox.plotting import new_figure, save_figure
 
 __all__ = ["Figure", "FIGURES", "make_figures", "figures_markdown"]
 
@@ -60,7 +60,7 @@ def _phase(ax, v, F, branch, V, title):
 def _save(fig, out, name):
     path = os.path.join(out, f"{name}.png")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)  # a figure made without pyplot (new_figure): nothing to close
+    save_figure(fig, path, dpi=110)  # reproducible bytes; a figure made without pyplot: nothing to close
     return [path]
 
 

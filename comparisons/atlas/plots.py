@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox.plotting import cell_edges, new_figure
+from peelapprox.plotting import cell_edges, new_figure, save_figure
 
 from .approximations import OBSERVABLES, TOLERANCE, key_of
 
@@ -153,7 +153,7 @@ def plot_error_map(result: Any, name: str, observable: str, path: str | None = N
         ax.legend(handles=legend, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=len(legend), fontsize=8,
                   frameon=False)
     if path:
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
     return fig
 
 
@@ -207,7 +207,7 @@ def plot_dynamics_map(result: Any, path: str | None = None, *, regimes: bool = T
     n_ss = int(result.stick_slip().sum())
     ax.set_title(f"exact dynamics ({n_ss}/{classes.size} points stick-slip) and estimate's regimes", fontsize=10)
     if path:
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
     return fig
 
 
@@ -256,7 +256,7 @@ def plot_segment_maps(result: Any, stat: str = "dt_median", path: str | None = N
     fig.suptitle(f"reductions seeded from exact branch entries: {stat.replace('_', ' ')} over each point's "
                  f"stays (outlined: within {tol:.0%})", fontsize=10)
     if path:
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
     return fig
 
 

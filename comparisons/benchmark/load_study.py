@@ -41,6 +41,7 @@ from peelapprox.kernels import (
     variant_field,
     variant_parameters,
 )
+from peelapprox.plotting import save_figure
 
 from .eps import fit_power_law
 
@@ -276,7 +277,7 @@ _MARKERS = {"stick-slip": ("o", "C3"), "transient->AB": ("v", "C0"), "transient-
 def _save(plt: Any, fig: Any, path: Path, paths: list[Path]) -> None:
     """Lay out, write (80 dpi) and close ``fig``; append ``path`` to ``paths``."""
     fig.tight_layout()
-    fig.savefig(path, dpi=80)
+    save_figure(fig, path, dpi=80)
     plt.close(fig)
     paths.append(path)
 

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox.plotting import new_figure
+from peelapprox.plotting import new_figure, save_figure
 
 from .report import BenchmarkReport
 from .scenes import BENCH_SCENES
@@ -38,7 +38,7 @@ def plot_work_precision(rep: BenchmarkReport, path=None, *, fig: Any = None):
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     if path:
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
     return fig
 
 
@@ -63,5 +63,5 @@ def plot_eps_study(rep: BenchmarkReport, path=None, *, ax: Any = None, fig: Any 
     ax.legend()
     fig.tight_layout()
     if path:
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
     return fig

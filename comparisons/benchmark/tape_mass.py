@@ -31,6 +31,7 @@ import numpy as np
 
 import exact
 from peelapprox import PeelParams, branch_structure, peel_force_derivative
+from peelapprox.plotting import save_figure
 
 __all__ = ["MASSES", "RTOLS", "SCENES", "SOLVERS", "TMRow", "fast_time", "main", "plot_solvers", "step_rates",
            "tape_mass_benchmark"]
@@ -176,7 +177,7 @@ def plot_solvers(rows: list[dict], path: Path, scene: str = "V1 I1e-5", masses=(
     axes[0].set_ylabel("wall time [s] (0.05 s simulated)")
     axes[-1].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path, dpi=fig.dpi)
     plt.close(fig)
 
 

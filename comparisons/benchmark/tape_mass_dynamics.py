@@ -32,6 +32,7 @@ import numpy as np
 import exact
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, classify, force_drops, return_map
 from peelapprox.errors import SolverFailure
+from peelapprox.plotting import save_figure
 
 __all__ = ["REGIMES", "MASSES", "measure_point", "measure_lyapunov", "main"]
 
@@ -141,7 +142,7 @@ def figures(src: Path, dest: Path) -> None:
     axes[-1].set_xlabel("t [s]")
     fig.suptitle(f"V = {w['V']:g} m/s, I = {w['I']:g} kg m²", fontsize=10)
     fig.tight_layout()
-    fig.savefig(dest / "tape_mass_dyn_windows.png", dpi=90)
+    save_figure(fig, dest / "tape_mass_dyn_windows.png", dpi=90)
     rows = json.loads((src / "diagram.json").read_text())
     fig, ax = plt.subplots(figsize=(6, 3.5))
     ms = np.array([r["tape_mass"] for r in rows if r["F"] is not None])
@@ -152,7 +153,7 @@ def figures(src: Path, dest: Path) -> None:
     ax.set_ylabel("F at AB→CD jumps [N]")
     ax.set_title(f"orbit diagram over m, V = {DIAGRAM_POINT[0]:g} m/s, I = {DIAGRAM_POINT[1]:g} kg m²", fontsize=9)
     fig.tight_layout()
-    fig.savefig(dest / "tape_mass_dyn_diagram.png", dpi=90)
+    save_figure(fig, dest / "tape_mass_dyn_diagram.png", dpi=90)
 
 
 def _diagram(out: Path, t_transient: float, window: float) -> None:

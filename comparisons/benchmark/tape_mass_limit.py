@@ -31,6 +31,7 @@ import numpy as np
 
 import exact
 from peelapprox import PeelParams
+from peelapprox.plotting import save_figure
 
 from .eps import fit_power_law
 
@@ -173,7 +174,7 @@ def plot_limit(conv: dict, path: Path) -> None:
     ax.legend(fontsize=7)
     ax.grid(True, which="major", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path, dpi=fig.dpi)
     plt.close(fig)
 
 

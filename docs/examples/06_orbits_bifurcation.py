@@ -16,7 +16,7 @@ from _gallery import arguments, output_dir
 
 import exact
 import peelapprox as pa
-from peelapprox.plotting import plot_bifurcation
+from peelapprox.plotting import plot_bifurcation, save_figure
 
 
 def main() -> None:
@@ -46,7 +46,8 @@ def main() -> None:
     for V, label in zip(diagram.values, diagram.labels):
         print(f"  long run at V = {V:.3f}: {label}")
     path = out / "orbits_bifurcation.png"
-    plot_bifurcation(diagram, branches, title=f"I = {p.I:g} kg m²: the period-{orbit.n} branch in V").savefig(path)
+    # The title names the fixed parameters (params=), the legend every line style and marker.
+    save_figure(plot_bifurcation(diagram, branches, params=p), path)
     print(f"wrote {path}")
 
 

@@ -83,13 +83,14 @@ class PeriodicOrbit:
     steps: int = 0
     wall_time: float = 0.0
 
-    def trajectory(self, *, rtol: float = 1e-12, save: str = "steps") -> Any:
-        """One period of the orbit by ``exact.simulate``, from the first AB→CD jump (just after it, on CD)."""
+    def trajectory(self, *, rtol: float = 1e-12, save: str = "steps", t_eval: Any = None) -> Any:
+        """One period of the orbit by ``exact.simulate``, from the first AB→CD jump (just after it, on CD);
+        ``t_eval`` (times in [0, period]) samples it there instead of at the steps (``save``)."""
         from .._simulate import simulate
 
         a, w = self.section_states[0]
         return simulate(self.params, self.period, alpha0=float(a), omega0=float(w),
-                        F0=float(self.return_map_values[0]), branch0="CD", rtol=rtol, save=save)
+                        F0=float(self.return_map_values[0]), branch0="CD", rtol=rtol, save=save, t_eval=t_eval)
 
     @property
     def min_fold_rate(self) -> float | None:

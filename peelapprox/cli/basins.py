@@ -108,7 +108,9 @@ def run(args: argparse.Namespace) -> int:
         else:
             write_table(out, r.rows(), p.force)
     if plot:
-        r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²").savefig(plot, dpi=130)
+        from ..plotting import save_figure
+
+        save_figure(r.plot(title=f"basins, V = {p.V} m/s, I = {p.I:g} kg m²"), plot, dpi=130)
         say(f"wrote {plot}")
     cut = int(np.count_nonzero(r.texts == "failure:max_wall"))
     if cut:

@@ -81,10 +81,14 @@ def run_orbit(args: argparse.Namespace) -> int:
         write_table(out, [{k: v for k, v in row.items() if k not in ("law", "law_key", "law_spec")}], p.force)
     if plot:
         from ..plotting import plot_trajectory
+        from ..plotting._figure import params_label
+        from .simulate import PLOT_SAMPLES
 
         mus = ", ".join(f"{abs(m):.4g}" for m in o.multipliers)
+        # one period, its steps and (smooth curves) the same period sampled densely by the solver's dense output
         plot_trajectory(o.trajectory(), plot, cycles=None,
-                        title=f"period-{o.n} orbit, V = {p.V} m/s, I = {p.I:g} kg m²: T = {o.period:.6g} s, "
+                        dense=o.trajectory(t_eval=np.linspace(0.0, o.period, PLOT_SAMPLES)),
+                        title=f"period-{o.n} orbit, {params_label(p)}\nT = {o.period:.6g} s, "
                               f"|μ| = {mus} ({'stable' if o.stable else 'unstable'})")
         say(f"wrote {plot}")
     return 0
@@ -124,6 +128,10 @@ def add_bifurcation_parser(sub) -> argparse.ArgumentParser:
                          "[unit of --param], bifurcations, end), csv or json (the same as rows)")
     sp.add_argument("--out", help="write every diagram point and branch point to this .csv or .json")
     sp.add_argument("--plot", help="draw the diagram and the branches to this image file")
+    sp.add_argument("--plot-branches", type=positive_int, default=12, metavar="N",
+                    help="--plot draws at most N branches, the first ones (the title says how many of how many)")
+    sp.add_argument("--plot-select", metavar="K,K,...",
+                    help="--plot draws only these branches, numbered from 1 as printed")
     add_max_wall_option(sp, what="the whole command (the diagram's runs, the orbits, the branches)",
                         spent="when it is spent the diagram's values left are labelled budget:max_wall, no branch "
                               "is started and a running one ends (stopped: max_wall); what was computed is "
@@ -169,6 +177,12 @@ def run_bifurcation(args: argparse.Namespace) -> int:
                          f"about a day at ~1 s each, more is most likely a typo), got {n} in {args.range!r}")
     out = check_output_path(args.out, "table", "--out") if args.out else None
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
+    try:
+        select = None if args.plot_select is None else [int(k) for k in args.plot_select.split(",")]
+        if select is not None and min(select) < 1:
+            raise ValueError
+    except ValueError:
+        raise ValueError(f"--plot-select must be branch numbers K,K,..., got {args.plot_select!r}") from None
     p = params_from_args(args)
     auto = args.seeds in (None, "auto")
     try:
@@ -235,7 +249,11 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     if plot:
         from ..plotting import plot_bifurcation
 
-        plot_bifurcation(diagram, branches, plot, title=f"{args.param} in [{lo:g}, {hi:g}]")
+        if select is not None and max(select) > len(branches):  # known only now: drawn without them
+            say(f"--plot-select: no branch {', '.join(str(k) for k in select if k > len(branches))} "
+                f"(there are {len(branches)})")
+            select = [k for k in select if k <= len(branches)]
+        plot_bifurcation(diagram, branches, plot, params=p, select=select, max_branches=args.plot_branches)
         say(f"wrote {plot}")
     if wall_spent(wall) or "budget:max_wall" in diagram.labels or any(b.stopped == "max_wall" for b in branches):
         say(f"stopped: the --max-wall budget of {args.max_wall:g} s was spent; the output holds what was computed "

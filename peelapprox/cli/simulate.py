@@ -8,6 +8,8 @@ from collections.abc import Mapping
 from dataclasses import fields
 from typing import Any
 
+import numpy as np
+
 from ._checks import check_output_path, positive_float, positive_int
 from ._common import (
     FromMethods,
@@ -22,7 +24,10 @@ from ._common import (
 )
 from ._force import law_fields
 
-__all__ = ["add_parser", "run"]
+__all__ = ["PLOT_SAMPLES", "add_parser", "run"]
+
+#: The points ``--plot`` samples its window at (by the solver's dense output, besides the stored steps).
+PLOT_SAMPLES = 4000
 
 
 def _default_solver(method: Any) -> str:
@@ -80,7 +85,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     o.add_argument("--jumps-csv", help="write the jumps to this CSV")
     o.add_argument("--plot", help="write F(t), alpha(t), v(t) and the v-F plane to this image (.png, .pdf, .svg, ...)")
     o.add_argument("--plot-cycles", type=positive_int, default=5, metavar="N",
-                   help="--plot shows the last N stick-slip cycles (AB->CD jump to AB->CD jump)")
+                   help="--plot shows at least the last N stick-slip cycles (AB->CD jump to AB->CD jump), whole "
+                        "periods of the return map when the run has settled on a periodic orbit")
     o.add_argument("--plot-all", action="store_true", help="--plot shows the whole stored run")
     o.add_argument("--quiet", action="store_true", help="no progress on stderr")
     return sp
@@ -96,22 +102,11 @@ def run(args: argparse.Namespace) -> int:
     plot = check_output_path(args.plot, "image", "--plot") if args.plot else None
     params = params_from_args(args)
     law = params.force
-    traj = simulate(
-        params,
-        args.t_end,
-        alpha0=args.alpha0,
-        omega0=args.omega0,
-        F0=args.F0,
-        branch0=args.branch0,
-        method=args.method,
-        solver=args.solver,
-        rtol=args.rtol,
-        eps=args.eps,
-        t_transient=args.t_transient,
-        save="jumps" if args.jumps_only else "steps",
-        max_wall=args.max_wall,
-        progress=not args.quiet,
-    )
+    kwargs: dict[str, Any] = dict(alpha0=args.alpha0, omega0=args.omega0, F0=args.F0, branch0=args.branch0,
+                                  method=args.method, solver=args.solver, rtol=args.rtol, eps=args.eps,
+                                  t_transient=args.t_transient, max_wall=args.max_wall)
+    traj = simulate(params, args.t_end, save="jumps" if args.jumps_only else "steps", progress=not args.quiet,
+                    **kwargs)
     s = traj.stats
     summary: dict[str, Any] = {
         "V": params.V,
@@ -143,8 +138,14 @@ def run(args: argparse.Namespace) -> int:
         traj.jumps.to_csv(jumps_csv, extra=law_fields(law))  # the run's law on every row
         print(f"wrote {jumps_csv}", file=sys.stderr)
     if plot:
-        from ..plotting import plot_trajectory
+        from ..plotting import plot_trajectory, trajectory_window
 
-        plot_trajectory(traj, plot, cycles=None if args.plot_all else args.plot_cycles)
+        cycles = None if args.plot_all else args.plot_cycles
+        w = trajectory_window(traj, cycles)
+        # smooth curves: the same run again (the same steps, ~the first run's cost) up to the window's end,
+        # sampled densely over the window by the solver's own dense output, merged with the stored steps
+        dense = simulate(params, w.end, **{**kwargs, "t_eval": np.linspace(w.start, w.end, PLOT_SAMPLES),
+                                           "save": "steps", "progress": False}) if w.end > w.start else None
+        plot_trajectory(traj, plot, cycles=cycles, dense=dense)
         print(f"wrote {plot}", file=sys.stderr)
     return 0
