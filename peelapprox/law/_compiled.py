@@ -99,7 +99,12 @@ class CompiledLaw:
         bs = self.structure
 
         def g(u: float) -> float:
-            return self.f(math.exp(u)) - G
+            f = self.f(math.exp(u))
+            if not math.isfinite(f):
+                raise ValueError(f"params.force: {self.force!r} at V={self.V!r} m/s evaluates to {f!r} at v = "
+                                 f"{math.exp(u):.6g} m/s while the root of f = {G!r} N on {branch} is sought: its "
+                                 "coefficients overflow there (a smaller v range or other coefficients)")
+            return f - G
 
         lo_d, hi_d = self.domain
         if branch == "AB":
