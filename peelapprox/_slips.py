@@ -25,7 +25,7 @@ v)`` changes sign when v crosses V, which happens in the jumps).
    most that late, the sample that splits the stick and the fall
    into two straight lines of least total squared residual (segmented regression): under noise a single
    noisy sample of the fall passes the gradient test, and the knee alone came 3.5 samples late and the drop 8 %
-   low where sticks and slips are 40 samples long (V = 3.95 m/s, I = 1.43e-5, 0.5 N of noise; 0.6 % with the
+   low where sticks and slips are 40 samples long (V = 3.95 m/s, I = 1.43e-5, 0.5 N of noise; 0.3 % with the
    split).  Noise averages out in the fits (standard error ~2σ/√n) where a raw extremum would
    be biased by it (the largest of n noisy samples), and the crossing is not tied to the sampling grid.
 

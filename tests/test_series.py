@@ -63,7 +63,7 @@ def test_a_fast_low_inertia_trace_gives_back_every_slip():
     15 N), 10 s at 10 kHz with 0.5 N of noise and a 5 N drift give back every exact slip and nothing else, the
     slip interval within 1 % and the mean drop within 2 % of the noiseless run's (the detector's goals).  With
     the stick's end taken where the gradient first flattens, noise put the knee 3.5 samples late and the drop
-    8 % low; the split of least squares measures 2e-6 and 0.6 %."""
+    8 % low; the split of least squares measures 4e-6 and 0.3 % on 20 s."""
     t1 = T0 + 10.0
     tr = exact.simulate(PeelParams(V=3.95, I=1.43e-5), t1, t_eval=T0 + np.arange(int(10.0 * RATE)) / RATE)
     exact_obs = StickSlipObservables.from_trajectory(tr, T0)
