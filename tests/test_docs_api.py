@@ -172,3 +172,37 @@ def test_every_chapter_is_in_the_site():
     chapters = {p.relative_to(DOCS).with_suffix("").as_posix() for p in DOCS.rglob("*.md")
                 if "_build" not in p.parts and p.name != "index.md"}
     assert chapters <= listed, sorted(chapters - listed)
+
+
+def _private_citations(line: str) -> list[str]:
+    """The code spans of a markdown line that cite a private dotted name (``exact._hybrid._rhs``,
+    ``_generated.slow_rates(...)``): a dotted name (before any call parentheses) with a part that starts with
+    one underscore.  A file (``peelapprox/_symbolic.py``), a dunder (``__main__``) or a command (``python -m
+    peelapprox._symbolic``) is not one."""
+    found = []
+    for span in re.findall(r"`([^`]+)`", line):
+        name = re.match(r"[\w.]+", span)
+        if name is None or span.startswith("python -m ") or name.group(0).endswith(".py"):
+            continue
+        parts = name.group(0).split(".")
+        if len(parts) > 1 and any(p.startswith("_") and not p.startswith("__") for p in parts):
+            found.append(span)
+    return found
+
+
+def test_chapters_cite_no_private_dotted_name():
+    """Hypothesis: no markdown chapter (docs/**/*.md, README.md) cites code by a private dotted name
+    (``exact._hybrid._rhs``), which reads like an import path but is no API; internals are cited as a source
+    file (``_rhs`` in ``exact/_hybrid.py``; CONTRIBUTING.md, "Docs cite what a reader can use").  Categorical:
+    the count of such citations is 0."""
+    assert _private_citations("`exact._hybrid._rhs` and `_generated.slow_rates(x)`") == \
+        ["exact._hybrid._rhs", "_generated.slow_rates(x)"]
+    assert _private_citations("`peelapprox/_symbolic.py`, `_generated.py`, `python -m peelapprox._symbolic`, "
+                              "`__main__`, `peelapprox.kernels.diffsl_code(tangent=True)`") == []
+    found = []
+    for path in [DOCS.parent / "README.md", *sorted(DOCS.rglob("*.md"))]:
+        if "_build" in path.parts:
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            found += [f"{path.relative_to(DOCS.parent)}:{n}: {span}" for span in _private_citations(line)]
+    assert not found, found
