@@ -15,7 +15,12 @@ download its own browser here).  Checks, per page:
 * the site is whole and self-contained: every file a page asks for is served (no 404; the browser's own
   ``/favicon.ico`` aside), no request leaves localhost (MathJax is served from ``_static``), and no
   JavaScript error was thrown;
-* API reference: each public module's page links every name of its ``__all__`` to an existing page.
+* API reference: each public module's page links every name of its ``__all__`` to an existing page;
+* layout, at the 1280 px wide window every page is opened in: the code blocks of the pages in
+  ``NO_SCROLL_PAGES`` fit their column (no ``<pre>`` with ``scrollWidth > clientWidth``: a reader of the landing
+  page does not scroll sideways), the left column's site navigation links every chapter of the landing page
+  (every page but the landing page itself and the generated API pages) and the right column's page contents
+  list the sections of the pages in ``TOC_PAGES``.
 
 Prints one line per page and a summary; exits 1 on any failure.
 """
@@ -41,6 +46,10 @@ API_MODULES = (
 #: Pages that must hold typeset formulas (the landing page states the model's equations; the theory page maps
 #: the paper's equations to the code).
 MATH_PAGES = ("index.html", "theory.html")
+#: Pages whose code blocks must fit the content column at 1280 px (no sideways scrolling).
+NO_SCROLL_PAGES = ("index.html",)
+#: Pages whose right column ("On this page") must list their sections, at least this many links.
+TOC_PAGES = {"theory.html": 10}
 #: Chromium's switches for a quiet, offline, sandbox-free headless run.
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
@@ -65,6 +74,12 @@ _PROBE = """async () => {
     broken: imgs.filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.getAttribute('src')),
     links: Array.from(document.querySelectorAll('table.autosummary a.reference.internal'))
                 .map(a => [a.textContent.trim(), a.getAttribute('href')]),
+    scrolling: Array.from(document.querySelectorAll('article pre'))
+                .filter(p => p.scrollWidth > p.clientWidth)
+                .map(p => `${p.scrollWidth} > ${p.clientWidth} px: ${p.textContent.split('\\n')[0].slice(0, 50)}`),
+    nav: [...new Set(Array.from(document.querySelectorAll('.bd-sidebar-primary nav.bd-docs-nav a.reference'))
+                .filter(a => a.offsetParent !== null).map(a => a.href.split('#')[0]))],
+    toc: Array.from(document.querySelectorAll('.bd-sidebar-secondary nav.page-toc a.nav-link')).length,
   };
 }"""
 
@@ -76,6 +91,16 @@ def _pages(site: Path) -> list[str]:
     pages += sorted(p.relative_to(site).as_posix() for p in site.glob("*/*.html")
                     if p.parent.name not in ("_static", "_sources", "_modules"))
     return pages
+
+
+def _chapters(site: Path) -> set[str]:
+    """The pages the landing page's toctrees list (its ``toctree-wrapper`` blocks), as paths in the site."""
+    import re
+
+    html = (site / "index.html").read_text(encoding="utf-8")
+    blocks = re.findall(r'<div class="toctree-wrapper compound">(.*?)</div>', html, re.S)
+    links = (re.findall(r'<li class="toctree-l1"><a[^>]*href="([^"]+)"', b) for b in blocks)
+    return {href.split("#")[0] for hrefs in links for href in hrefs}
 
 
 def _serve(site: Path) -> http.server.ThreadingHTTPServer:
@@ -113,6 +138,7 @@ def check(site: Path, *, chromium: str, screenshot: Path | None = None) -> list[
             r.abort()
 
     totals = {"pages": 0, "math": 0, "images": 0}
+    chapters = _chapters(site)
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=chromium, args=CHROMIUM_ARGS)
         page = browser.new_page(viewport={"width": 1280, "height": 900})
@@ -137,6 +163,13 @@ def check(site: Path, *, chromium: str, screenshot: Path | None = None) -> list[
                 bad.append("no typeset formula")
             if r["broken"]:
                 bad.append(f"images not loaded: {r['broken']}")
+            if name in NO_SCROLL_PAGES and r["scrolling"]:
+                bad.append(f"code blocks wider than their column at 1280 px: {r['scrolling']}")
+            unlisted = chapters - {urlparse(h).path.lstrip("/") for h in r["nav"]}
+            if name != "index.html" and not name.startswith("api/generated/") and unlisted:
+                bad.append(f"the left column's navigation lacks the chapters {sorted(unlisted)}")
+            if name in TOC_PAGES and r["toc"] < TOC_PAGES[name]:
+                bad.append(f"the right column lists {r['toc']} sections (at least {TOC_PAGES[name]} expected)")
             module = name.removeprefix("api/").removesuffix(".html")
             if name.startswith("api/") and module in API_MODULES:
                 bad += _check_api(site, name, module, r["links"])

@@ -114,14 +114,28 @@ html_theme_options = {
 html_show_sourcelink = False
 
 
-def setup(app):
-    """Let a class re-exported by several public modules be documented on each module's page.
+def _reexport_targets() -> dict[str, str]:
+    """``{"peelapprox.periodic_orbit": "exact.periodic_orbit", ...}``: each name an API page lists as a
+    pointer (``~home.name`` in an autosummary list without ``:toctree:``) -> the one page it points to."""
+    import re
 
-    autodoc marks each page's entry with the class's canonical (defining) name, e.g.
-    ``exact.dynamics._attractors.Attractor`` for ``peelapprox.Attractor`` and ``exact.Attractor``; the Python domain
-    would report the second alias of one canonical name as a duplicate description.  Two aliases of one
-    object are not a duplicate: keep the first.  Real duplicates (two entries of one documented name) still
-    warn.
+    targets = {}
+    for page in sorted((ROOT / "docs" / "api").glob("*.rst")):
+        for home_name in re.findall(r"^   ~([\w.]+)$", page.read_text(encoding="utf-8"), re.M):
+            targets[f"{page.stem}.{home_name.rpartition('.')[2]}"] = home_name
+    return targets
+
+
+def setup(app):
+    """Resolve a re-export's name to its home's page, and let one module's two names of a class each have one.
+
+    A name offered by several modules has one page, in its home module (``docs/api/*.rst``; a cross-reference
+    to ``peelapprox.periodic_orbit`` or ``peelapprox.SolverFailure`` in a docstring finds no page of that name:
+    it is sent to the home's, ``exact.periodic_orbit``'s).  autodoc marks each page's entry with the object's
+    canonical (defining) name, so a module's alias of its own class (``peelapprox.Folds`` of
+    ``peelapprox.BranchStructure``, canonical ``peelapprox.law._folds.BranchStructure``) would be reported as a
+    second description of one canonical name: two names of one object are not a duplicate, keep the first.
+    Real duplicates (two entries of one documented name) still warn.
     """
     from sphinx.domains.python import PythonDomain
 
@@ -133,3 +147,14 @@ def setup(app):
             super().note_object(name, objtype, node_id, aliased=aliased, location=location)
 
     app.add_domain(Python, override=True)
+    targets = _reexport_targets()
+
+    def to_home(app, env, node, contnode):
+        home = targets.get(node.get("reftarget", "")) if node.get("refdomain") == "py" else None
+        if home is None:
+            return None
+        node["reftarget"] = home
+        return env.domains["py"].resolve_xref(env, node["refdoc"], app.builder, node["reftype"], home, node,
+                                              contnode)
+
+    app.connect("missing-reference", to_home)

@@ -16,7 +16,8 @@ dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lya
 (``return_map``, ``periodicity``, ``classify``,
 ``force_drops``, ``settle_time``) is the core's own, and so is the one definition of a stick-slip attractor's
 observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObservables.from_trajectory``;
-``attractor_observables`` runs the exact solver for them).
+``attractor_observables`` runs the exact solver for them).  Each re-exported name is its home module's very
+object (``peelapprox.periodic_orbit is exact.periodic_orbit``), documented once, on its home's API page.
 """
 
 from ._alpha import (

@@ -36,12 +36,12 @@ TIMEOUT = 900  # s
 
 # Commands too long for the default tier: a prefix of the command -> why (measured wall time, warm, 2 cores).
 SLOW = {
-    "peelapprox benchmark": "work-precision runs of every solver and the ε study, ~80 s",
-    "peelapprox bifurcation": "a 21-point brute-force diagram and continued branches, ~60 s",
+    "peelapprox benchmark": "work-precision runs of every solver and the ε study (--quick), ~40 s",
+    "peelapprox bifurcation": "a 21-point brute-force diagram and continued branches, ~55 s",
     "peelapprox dynamics": "Lyapunov exponents over 50-200 s of orbit, 8-12 s each",
     "peelapprox sweep": "16 exact runs of 50 s, ~11 s",
-    "peelapprox figures": "the paper's Figs. 2-9, ~9 s",
-    "peelapprox basins": "54 starts of 60 s each with their orbits, ~20 s",
+    "peelapprox figures": "the paper's Figs. 2-9, ~11 s",
+    "peelapprox basins": "54 starts of 60 s each with their orbits, ~24 s",
 }
 
 

@@ -34,7 +34,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     "reductions' median per-segment errors.  Prints the summary: per approximation and observable "
                     "the share of the exact stick-slip points predicted within 10 %.  --cost N instead times each "
                     "part at N sample points of the grid and prints the projected time, computing nothing else.",
-        examples=["peelapprox atlas --V 0.2:5:8 --I 1e-6:1e-1:8:log --out atlas/ --plot   # 64 points, < 1 min",
+        examples=["peelapprox atlas --V 0.2:5:8 --I 1e-6:1e-1:8:log --out atlas/ --plot   # 64 points, ~80 s",
                   "peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --out atlas40/ --workers 2 --max-wall 900",
                   "peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --cost 16   # the projected time first",
                   "peelapprox atlas --V 0.5:4:6 --I 1e-5:1e-2:6:log --force-family cubic --out cubic/ --plot"])

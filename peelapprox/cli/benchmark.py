@@ -19,15 +19,17 @@ __all__ = ["add_parser", "run"]
 def add_parser(sub) -> argparse.ArgumentParser:
     bm = subcommand(
         sub, "benchmark", help="work-precision vs the paper's regularised scheme and peers, eps study, speed targets "
-                               "(minutes)",
+                               "(209 s; --quick 40-85 s)",
         description="The solver benchmark: work precision (wall time against error at the jumps) of the hybrid "
                     "solver, the paper's eps-regularised scheme (scipy's Radau, BDF, LSODA) and the optional peers "
                     "(SUNDIALS IDA via scikit-sundae, diffsol; pip install 'peelapprox[bench]'); the eps study "
                     "(the jump delay of the regularised scheme against eps, with its power law); the speed "
-                    "targets.  Minutes; --quick in under 5 minutes on 2 cores.",
+                    "targets.  Measured on 2 cores: the full run 209 s with the peers, --quick 85 s with them and 40 s "
+                    "without.",
         examples=["peelapprox benchmark --quick --out bench/      # work precision vs the paper's scheme, eps study",
                   "peelapprox benchmark --no-peers --format json"])
-    bm.add_argument("--quick", action="store_true", help="thinner grids, eps = 1e-7 only (< 5 min on 2 cores)")
+    bm.add_argument("--quick", action="store_true",
+                    help="thinner grids, eps = 1e-7 only (85 s with the peers, 40 s without, on 2 cores)")
     bm.add_argument("--no-peers", action="store_true", help="skip the optional SUNDIALS/diffsol peers")
     bm.add_argument("--format", choices=("table", "md", "csv", "json"), default="table",
                     help="what is printed: table (markdown tables; md is the same), csv (the work-precision rows) or "
