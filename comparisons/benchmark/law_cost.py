@@ -68,7 +68,7 @@ LAWS_OF_FVV = ("paper_family", "expression", "tabulated", "smoothed")
 
 def fvv_as(kind: str, V: float) -> PeelForce:
     """fvV as a law of ``kind`` (:data:`LAWS_OF_FVV`; a table: 600 points log-spaced over 1e-8-100 m/s at V; smoothed:
-    the same points through ``PeelForce.smoothed``, a C² spline in ln v, its penalty by GCV)."""
+    the same points through ``PeelForce.smoothed``, a C⁴ spline in ln v, its penalty by GCV)."""
     if kind == "paper_family":
         return PeelForce.paper_family()
     if kind == "expression":

@@ -4,7 +4,7 @@
 
 One run prints ns per call of ``peelapprox.kernels.table_law`` (tables of 20, 100 and 1000 points of the
 paper's law at V = 1 m/s over v in [1e-3, 30] m/s, two tables of 100 points at V = 1.5 between V = 1 and 2, and
-``PeelForce.smoothed`` of 40 and 100 of those points, a C² spline evaluated by the same kernel)
+``PeelForce.smoothed`` of 40 and 100 of those points, a C⁴ quintic spline: its own kernel, the same guide)
 and of ``peelapprox.kernels.paper_law`` (V = 1), each called through a loop compiled once for the law's function
 type ``FunctionType(LAW_SIG)`` (as the solvers' drivers take it, so the call is indirect and not specialised
 away), over the same points of ln v in the common range:
@@ -89,7 +89,7 @@ def law_costs(n: int = 50_000, rounds: int = 31, seed: int = 1) -> dict[str, dic
         laws[f"table {m} pts"] = (table_law, table_coefficients(tables, 1.0))
     two = PeelForce.tabulated(tables=[_tables(100, 1.0), _tables(100, 2.0)]).tables
     laws["2 tables x 100 (V=1.5)"] = (table_law, table_coefficients(two, 1.5))
-    for m in (40, 100):  # PeelForce.smoothed: a C2 spline in ln v, packed for the same kernel
+    for m in (40, 100):  # PeelForce.smoothed: a C4 quintic spline in ln v, its own kernel
         cl = compiled_law(PeelForce.smoothed(*_tables(m, 1.0)[1:]), 1.0)
         laws[f"smoothed {m} pts"] = (cl.fn, cl.coef)
     u_lo, u_hi = math.log(V_LO), math.log(V_HI)

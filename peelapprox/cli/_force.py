@@ -99,7 +99,7 @@ def add_force_options(sp: argparse.ArgumentParser) -> None:
     g.add_argument("--family", metavar="NAME",
                    help=f"the family --force-fit fits: {', '.join(_family_names())}")
     g.add_argument("--smooth", action="store_true",
-                   help="with --force-table: smooth the (noisy) points by a C2 spline in ln v (PeelForce.smoothed) "
+                   help="with --force-table: smooth the (noisy) points by a C4 spline in ln v (PeelForce.smoothed) "
                         "instead of interpolating them")
     g.add_argument("--const", type=name_value, action="append", metavar="NAME=VALUE",
                    help="a constant of --force (repeatable)")

@@ -6,7 +6,7 @@ The modules, one concern each (private: the public names are offered by :mod:`pe
 * ``_kinds`` — what each kind of law (paper, family, expression, tabulated) does: one object per kind;
 * ``_paper`` — the paper's law fvV, bitwise; ``_families`` — the families, each formula next to its defaults;
   ``_expression`` and ``_grammar`` — expression laws, parsed, never evaluated; ``_table`` — tabulated laws;
-  ``_spline`` — smoothed laws (a C² spline in ln v); ``_fit`` — fits to measured points (``PeelForce.fit``);
+  ``_spline`` — smoothed laws (a C⁴ spline in ln v); ``_fit`` — fits to measured points (``PeelForce.fit``);
   ``_tablefile`` — a law from a CSV file (``PeelForce.from_csv``);
 * ``_folds`` — the one fold record (:class:`BranchStructure`, also named ``Folds``) and the fold search;
   ``_structure`` — :func:`branch_structure` and :func:`fixed_point` of any law;

@@ -239,12 +239,14 @@ class PeelForce:
 
     @classmethod
     def smoothed(cls, v: Any, f: Any, *, lam: float | str = "gcv", V: float | None = None) -> PeelForce:
-        """Noisy measured points smoothed by a C² cubic spline in ln v: a law of kind ``"smoothed"``.
+        """Noisy measured points smoothed by a C⁴ spline in ln v: a law of kind ``"smoothed"``.
 
-        scipy's ``make_smoothing_spline`` of f in ``u = ln v`` (knots at the data), then the N shape is checked on
-        the result: exactly one maximum then one minimum inside the data range.  f, f' and f'' are continuous
-        (f'' too, unlike a table's PCHIP), the folds are the roots of the spline's derivative (between data, not
-        at a datum), and a compiled run evaluates it by the table kernel at a table's cost per call.  Details:
+        scipy's ``make_smoothing_spline`` of f in ``u = ln v`` (knots at the data), projected on quintic
+        B-splines with the same knots, then the N shape is checked on the result: exactly one maximum then one
+        minimum inside the data range.  f and its first four derivatives are continuous (f'' too, unlike a
+        table's PCHIP; f‴ too, unlike a cubic spline, so the solver's steps are not rejected at the knots), the
+        folds are the roots of the spline's derivative (between data, not at a datum), and a compiled run
+        evaluates it by the quintic kernel at about a table's cost per call.  Details:
         :mod:`peelapprox.law._spline`.
 
         Parameters

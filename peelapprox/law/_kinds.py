@@ -9,7 +9,7 @@ finds its folds, becomes a compiled kernel and a sympy expression.  The base cla
 * :class:`FamilyKind` — a formula of :mod:`peelapprox.law._families` with its coefficients as data;
 * :class:`ExpressionKind` — a sympy expression kept as canonical text (:mod:`peelapprox.law._expression`);
 * :class:`TabulatedKind` — measured curves, PCHIP in ln v (:mod:`peelapprox.law._table`);
-* :class:`SplineKind` — noisy measured points smoothed by a C² spline in ln v (:mod:`peelapprox.law._spline`).
+* :class:`SplineKind` — noisy measured points smoothed by a C⁴ spline in ln v (:mod:`peelapprox.law._spline`).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from ._compiled import law_structure
 from ._folds import BranchStructure, find_folds
 from ._kernels import expression_kernel, family_kernel
 from ._paper import paper_structure, paper_value_slope, peel_force, peel_force_derivative
-from ._table_jit import table_coefficients, table_law
+from ._table_jit import quintic_law, table_coefficients, table_law
 
 __all__ = ["FOLD_GRID_DENSITY", "KIND_IMPLS", "LawKind", "shown_law"]
 
@@ -333,8 +333,9 @@ class TabulatedKind(LawKind):
 
 
 class SplineKind(TabulatedKind):
-    """Points smoothed by a C² cubic spline in ln v (``PeelForce.smoothed``): its knots and B-spline coefficients as
-    data; evaluated by scipy's BSpline, compiled through the table kernel; never extrapolated."""
+    """Points smoothed by a spline in ln v (``PeelForce.smoothed``: C⁴ quintic; C² cubic from older data): its knots
+    and B-spline coefficients as data; evaluated by scipy's BSpline, compiled through the quintic kernel (a cubic
+    through the table kernel); never extrapolated."""
 
     name = "smoothed"
 
@@ -343,7 +344,8 @@ class SplineKind(TabulatedKind):
 
     def display(self, force: Any) -> str:
         V, t, _ = force.tables[0]
-        return f"V={V!r}: C2 spline in ln v, {len(t) - 6} knots, v in [{t[0]:.6g}, {t[-1]:.6g}] m/s"
+        k = _spline.degree(force.tables)
+        return f"V={V!r}: C{k - 1} spline in ln v, {len(t) - 2 * k} knots, v in [{t[0]:.6g}, {t[-1]:.6g}] m/s"
 
     def show(self, force: Any) -> str:
         return f"PeelForce.smoothed(<{force.display}>)"
@@ -356,7 +358,8 @@ class SplineKind(TabulatedKind):
 
     def kernel(self, force: Any, V: float) -> tuple[Any, np.ndarray]:
         self.check_start(force)
-        return table_law, _spline.spline_coefficients(force.tables, V)
+        fn = quintic_law if _spline.degree(force.tables) == _spline.LAW_DEGREE else table_law
+        return fn, _spline.spline_coefficients(force.tables, V)
 
 
 #: The implementation of each kind, by ``PeelForce.kind``, in the order of the module docstring.

@@ -12,6 +12,11 @@ outside the tables' common range and the drivers stop a run that leaves it, but 
 there still gets finite numbers (:func:`table_law`).  The interval of a u is found by bisection between the
 bounds of a guide (:func:`_interval`), so a call's cost hardly grows with the length of an even table
 (measured in comparisons/benchmark/table_cost.py).
+
+:func:`quintic_law` is its sibling for a smoothed law (``PeelForce.smoothed``): one piecewise quintic in u, C⁴,
+packed by :func:`pack_quintic` as one block of the same layout with six coefficients per interval, the interval
+found by the same guide.  A smoothed law's f‴ is continuous, so the solver's 8th-order steps are not rejected
+at its knots as they are at a cubic's (docs/your-own-tape.md, "Cost").
 """
 
 from __future__ import annotations
@@ -22,7 +27,8 @@ from .._jit import kernel
 from ._abi import LAW_FP, LAW_LNV, LAW_SIG
 from ._table import TableLaw, check_tables
 
-__all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "pack_blocks", "table_law", "table_coefficients"]
+__all__ = ["T_COUNT", "T_ULO", "T_UHI", "T_HEAD", "pack_blocks", "pack_quintic", "quintic_law", "table_law",
+           "table_coefficients"]
 
 #: Indices of the header of ``coef``: the number of tables used, ln lo, ln hi; the first block starts at T_HEAD.
 #: ``coef = [m, ln lo, ln hi, block_1, ..., block_m]``: ``m`` in {1, 2} tables of nonzero weight at V, ``[lo,
@@ -197,3 +203,64 @@ def pack_blocks(blocks, u_lo: float, u_hi: float) -> np.ndarray:
             raise RuntimeError(f"unexpected piecewise-cubic coefficient shape {c.shape} for {x.size} knots")
         parts += [np.array([w, float(x.size), (x.size - 1) / (x[-1] - x[0])]), x, _guide(x), c.T.reshape(-1)]
     return np.ascontiguousarray(np.concatenate([np.array([float(len(blocks)), u_lo, u_hi]), *parts]), dtype=float)
+
+
+@kernel(inline="always")
+def _quintic_sums(coef, u):
+    """``(p, p', p'')`` of the packed piecewise quintic (:func:`pack_quintic`) at ``u`` in ``[ln lo, ln hi]``: on
+    its interval ``x[i] <= u < x[i+1]``, at ``s = u - x[i]``, by Horner's rule with ``c0..c5 = c[0..5, i]``
+    (highest power first)."""
+    n = int(coef[T_HEAD + 1])
+    xo = T_HEAD + 3
+    go = xo + n
+    i = _interval(coef, xo, go, n, coef[T_HEAD + 2], u)
+    s = u - coef[xo + i]
+    co = go + n + 6 * i
+    c0 = coef[co]
+    c1 = coef[co + 1]
+    c2 = coef[co + 2]
+    c3 = coef[co + 3]
+    c4 = coef[co + 4]
+    c5 = coef[co + 5]
+    p = ((((c0 * s + c1) * s + c2) * s + c3) * s + c4) * s + c5
+    p1 = ((((c0 * 5.0) * s + c1 * 4.0) * s + c2 * 3.0) * s + c3 * 2.0) * s + c4
+    p2 = (((c0 * 20.0) * s + c1 * 12.0) * s + c2 * 6.0) * s + c3 * 2.0
+    return p, p1, p2
+
+
+@kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a smoothed law
+def quintic_law(x, coef, form):
+    """The smoothed law at ``x`` in the form ``form``, ``coef`` from :func:`pack_quintic`: as :func:`table_law`
+    (the same forms, the same C¹-linear continuation outside ``[ln lo, ln hi]``), of a piecewise quintic."""
+    if form == LAW_LNV:
+        u = x
+        v = np.exp(x)
+    else:
+        v = x
+        u = np.log(x)
+    ulo = coef[T_ULO]
+    uhi = coef[T_UHI]
+    if not (ulo <= u <= uhi):  # the C¹ continuation (table_law); NaN: NaN, never an index from it
+        u0 = ulo if u < ulo else uhi
+        F, D, _ = _quintic_sums(coef, u0)
+        F = F + D * (u - u0)
+        D2 = 0.0
+    else:
+        F, D, D2 = _quintic_sums(coef, u)
+    if form == LAW_LNV:
+        return v, F, D
+    if form == LAW_FP:
+        return F, D / v, np.nan
+    return F, D / v, (D2 - D) / (v * v)
+
+
+def pack_quintic(x, c) -> np.ndarray:
+    """``coef`` of :func:`quintic_law` from the breakpoints ``x`` in u and the ``(6, n - 1)`` power coefficients
+    of a piecewise quintic (scipy's ``PPoly.x``, ``PPoly.c``): the header of :data:`T_HEAD` with one block of
+    weight 1 whose intervals carry six coefficients each."""
+    x = np.asarray(x, dtype=float)
+    c = np.asarray(c, dtype=float)
+    if c.shape != (6, x.size - 1):  # pragma: no cover - the smoothed law's PPoly is quintic
+        raise RuntimeError(f"unexpected piecewise-quintic coefficient shape {c.shape} for {x.size} knots")
+    head = [1.0, float(x[0]), float(x[-1]), 1.0, float(x.size), (x.size - 1) / (x[-1] - x[0])]
+    return np.ascontiguousarray(np.concatenate([np.array(head), x, _guide(x), c.T.reshape(-1)]), dtype=float)
