@@ -92,3 +92,16 @@ def test_bad_input_is_named(high_inertia):
     for kwargs, error, match in cases:
         with pytest.raises(error, match=match):
             infer(**kwargs)
+
+
+def test_a_statistic_the_trace_does_not_carry_is_named():
+    """A period-1 trace (V = 3.95 m/s, I = 1.43e-5) has no cycle line below half its slip frequency, so
+    ``statistics=("f_cycle",)`` leaves nothing to fit: a ValueError naming ``statistics`` and why, before any
+    model run, not a "converged" fit of an empty residual; with every statistic the report notes what was left
+    out."""
+    p = PeelParams(V=3.95, I=1.43e-5)
+    s = exact.simulate(p, 32.0, t_eval=30.0 + np.arange(20000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    with pytest.raises(ValueError, match=r"statistics: 0 fitted statistic\(s\) for 1 free.*f_cycle is not fitted"):
+        infer(s, p, ("k",), statistics=("f_cycle",))
+    with pytest.raises(ValueError, match=r"statistics: 1 fitted statistic\(s\) for 2 free"):
+        infer(s, p, ("I", "k"), statistics=("rise", "f_cycle"))

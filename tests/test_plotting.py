@@ -336,3 +336,37 @@ def test_bifurcation_plot_select_refuses_a_non_number_before_any_run(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["bifurcation", "--V", "1", "--I", "1e-2", "--param", "V", "--range", "0.9:1.1:3", "--plot-select", "0,2"])
     assert exc.value.code == 2 and "--plot-select" in capsys.readouterr().err
+
+
+def test_bad_plot_arguments_are_named(run):
+    """Hypothesis: every malformed argument of the trajectory and bifurcation plots is a TypeError or ValueError
+    naming it (cycles 0, -1, "5", NaN, 2.5; panels None, 5, a nested list; dense not a run; select an int, empty
+    or out of range), never an unrelated exception from numpy or matplotlib."""
+    from peelapprox.plotting import plot_bifurcation, plot_trajectory, trajectory_window
+
+    for bad in (0, -1, "5", float("nan"), 2.5, True):
+        with pytest.raises((TypeError, ValueError), match="cycles"):
+            trajectory_window(run, bad)
+    for kw in (dict(panels=None), dict(panels=5), dict(panels=("F", ["v"])), dict(panels=()), dict(dense=5)):
+        with pytest.raises((TypeError, ValueError), match=next(iter(kw))):
+            plot_trajectory(run, **kw)
+    for select in (1, [], [1]):
+        with pytest.raises((TypeError, ValueError), match="select"):
+            plot_bifurcation(None, [], select=select)
+
+
+def test_law_label_names_every_kind_but_the_default():
+    """Hypothesis: a title names the law unless it is the paper's fvV: a family by name and coefficients, an
+    expression by its formula, a table or a smoothed law by kind and display (cut at 60 characters)."""
+    import numpy as np
+
+    from peelapprox import PeelForce
+    from peelapprox.plotting._figure import law_label
+
+    v = np.logspace(-1, 1, 30)
+    f = PeelForce.cubic().f(v, 1.0)
+    assert law_label(PeelForce.paper()) == ""
+    assert law_label(PeelForce.cubic()) == "law cubic(a=150, b=300, c=300, d=80)"
+    assert law_label(PeelForce.expression("300 - 110*v + 21*v**2")) == "law f = 21*v**2 - 110*v + 300"
+    assert law_label(PeelForce.tabulated(v, f)).startswith("law tabulated (V=None: 30 points")
+    assert law_label(PeelForce.smoothed(v, f)).startswith("law smoothed (V=None: C4 spline")

@@ -101,7 +101,7 @@ class CompiledLaw:
         def g(u: float) -> float:
             f = self.f(math.exp(u))
             if not math.isfinite(f):
-                raise ValueError(f"params.force: {self.force!r} at V={self.V!r} m/s evaluates to {f!r} at v = "
+                raise ValueError(f"params.force: {self.force!r} at V={self.V!r} m/s is not finite at v = "
                                  f"{math.exp(u):.6g} m/s while the root of f = {G!r} N on {branch} is sought: its "
                                  "coefficients overflow there (a smaller v range or other coefficients)")
             return f - G

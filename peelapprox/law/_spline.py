@@ -232,13 +232,13 @@ def check_spline(tables: Any, V_range: tuple[float, float]) -> tuple:
     if np.any(ends[0] != ta[0]) or np.any(ends[1] != ta[-1]):
         raise ValueError(f"the knots of a spline law of degree {k} must repeat each end {k + 1} times (clamped)")
     if ta[0] <= 0:
-        raise ValueError(f"the knots of a spline law are peel velocities, > 0 [m/s]: knots[0] = {ta[0]!r}")
+        raise ValueError(f"the knots of a spline law are peel velocities, > 0 [m/s]: knots[0] = {float(ta[0])!r}")
     inner = np.log(ta[k:-k])
     bad = np.flatnonzero(np.diff(inner) <= 0)
     if bad.size:
         i = int(bad[0]) + k
         raise ValueError(f"the knots of a spline law must be strictly increasing inside (simple knots: f'' "
-                         f"continuous): knots[{i}] = {ta[i]!r} >= knots[{i + 1}] = {ta[i + 1]!r}")
+                         f"continuous): knots[{i}] = {float(ta[i])!r} >= knots[{i + 1}] = {float(ta[i + 1])!r}")
     tt, cc = tuple(float(x) for x in ta), tuple(float(x) for x in ca)
     msg = _shape_error(tt, cc, "a spline law")
     if msg:

@@ -128,6 +128,8 @@ def table_law(x, coef, form):
         u = x
         v = np.exp(x)
     else:
+        if not x > 0.0:  # v <= 0 or NaN: no law there (never a division by zero)
+            return np.nan, np.nan, np.nan
         v = x
         u = np.log(x)
     ulo = coef[T_ULO]
@@ -236,6 +238,8 @@ def quintic_law(x, coef, form):
         u = x
         v = np.exp(x)
     else:
+        if not x > 0.0:  # v <= 0 or NaN: no law there (never a division by zero)
+            return np.nan, np.nan, np.nan
         v = x
         u = np.log(x)
     ulo = coef[T_ULO]

@@ -29,7 +29,12 @@ def _chosen(branches: list, select: Sequence[int] | None, max_branches: int | No
 
     numbered = list(enumerate(branches, start=1))
     if select is not None:
-        wanted = [integer("select", k, lo=1, hi=max(len(branches), 1)) for k in select]
+        if isinstance(select, (str, bytes)) or not isinstance(select, Sequence):
+            raise TypeError(f"select must be a sequence of branch numbers (from 1), got {select!r}")
+        if not select or not branches:
+            raise ValueError(f"select must name at least one of the {len(branches)} branches (numbered from 1), "
+                             f"got {list(select)!r}")
+        wanted = [integer("select", k, lo=1, hi=len(branches)) for k in select]
         numbered = [numbered[k - 1] for k in dict.fromkeys(wanted)]
     if max_branches is not None:
         numbered = numbered[:integer("max_branches", max_branches, lo=1)]

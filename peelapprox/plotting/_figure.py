@@ -155,11 +155,20 @@ def params_label(params: Any, *, skip: str | tuple[str, ...] = ()) -> str:
 
 
 def law_label(force: Any) -> str:
-    """``"law cubic(a=150, b=300, c=280, d=80)"`` for a law other than the paper's fvV; ``""`` for it."""
-    if force is None or getattr(force, "name", None) is None:
+    """``"law cubic(a=150, b=300, c=280, d=80)"`` for a family law, ``"law f = 21*v**2 - 110*v + 300"`` for an
+    expression, ``"law tabulated (V=None: 30 points, ...)"`` for a table or a smoothed law (its display, cut at
+    60 characters); ``""`` for the paper's fvV (the default)."""
+    if force is None or getattr(force, "kind", "paper") == "paper":
         return ""
-    shown = ", ".join(f"{k}={v:g}" for k, v in dict(getattr(force, "coefficients", None) or ()).items())
-    return f"law {force.name}" + (f"({shown})" if shown else "")
+    name = getattr(force, "name", None)
+    if name is not None:
+        shown = ", ".join(f"{k}={v:g}" for k, v in dict(getattr(force, "coefficients", None) or ()).items())
+        return f"law {name}" + (f"({shown})" if shown else "")
+    text = str(getattr(force, "display", "") or "")
+    text = text if len(text) <= 60 else text[:57] + "..."
+    if force.kind == "expression":
+        return f"law f = {text.strip(chr(39))}"
+    return f"law {force.kind} ({text})" if text else f"law {force.kind}"
 
 
 def model_label(params: Any) -> str:

@@ -57,6 +57,10 @@ def trajectory_window(traj: Any, cycles: int | None = TRAJECTORY_CYCLES) -> Traj
     -------
     TrajectoryWindow
     """
+    from ..validate import integer
+
+    if cycles is not None:
+        cycles = integer("cycles", cycles, lo=1)
     t = np.asarray(traj.t, float)
     lo, hi = (float(t[0]), float(t[-1])) if t.size else (0.0, 0.0)
     jumps = getattr(traj, "jumps", None)
@@ -172,9 +176,16 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
 
     if cycles is not None:
         cycles = integer("cycles", cycles, lo=1)
-    panels = tuple(panels) if not isinstance(panels, str) else (panels,)
+    if isinstance(panels, str):
+        panels = (panels,)
+    if not isinstance(panels, (tuple, list)) or not all(isinstance(x, str) for x in panels):
+        raise TypeError(f"panels must be a tuple of names of {TRAJECTORY_PANELS}, got {panels!r}")
+    panels = tuple(panels)
     if not panels or len(set(panels)) != len(panels) or not set(panels) <= set(TRAJECTORY_PANELS):
         raise ValueError(f"panels must be distinct names of {TRAJECTORY_PANELS}, got {panels!r}")
+    if dense is not None and not all(hasattr(dense, a) for a in ("t", "F", "alpha", "v")):
+        raise TypeError(f"dense must be a Trajectory of the same run (exact.simulate(..., t_eval=...)), got "
+                        f"{type(dense).__name__}")
     shape, size = _panel_shape(len(panels))
     fig, axs = _canvas(ax, fig, shape, size)
     at = dict(zip(panels, np.ravel(axs)))
