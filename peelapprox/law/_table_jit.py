@@ -113,17 +113,42 @@ def _pchip_sums(coef, u):
     return F, D, D2
 
 
-@kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a tabulated law: the default path needs none
-def table_law(x, coef, form):
-    """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox.law._abi`), ``coef`` from
-    :func:`table_coefficients`: ``LAW_LNV: (v, f, p'(u))`` (p' is ``v f'(v)``), ``LAW_FP: (f, f', NaN)``,
-    ``LAW_FPP: (f, f', f'')`` with ``f' = p'/v`` and ``f'' = (p'' - p')/v²`` (``u = ln v`` by numba's log, which
-    may differ from numpy's by an ulp).
+@kernel(inline="always")
+def _quintic_sums(coef, u):
+    """``(p, p', p'')`` of the packed piecewise quintic (:func:`pack_quintic`) at ``u`` in ``[ln lo, ln hi]``: on
+    its interval ``x[i] <= u < x[i+1]``, at ``s = u - x[i]``, by Horner's rule with ``c0..c5 = c[0..5, i]``
+    (highest power first)."""
+    n = int(coef[T_HEAD + 1])
+    xo = T_HEAD + 3
+    go = xo + n
+    i = _interval(coef, xo, go, n, coef[T_HEAD + 2], u)
+    s = u - coef[xo + i]
+    co = go + n + 6 * i
+    c0 = coef[co]
+    c1 = coef[co + 1]
+    c2 = coef[co + 2]
+    c3 = coef[co + 3]
+    c4 = coef[co + 4]
+    c5 = coef[co + 5]
+    p = ((((c0 * s + c1) * s + c2) * s + c3) * s + c4) * s + c5
+    p1 = ((((c0 * 5.0) * s + c1 * 4.0) * s + c2 * 3.0) * s + c3 * 2.0) * s + c4
+    p2 = (((c0 * 20.0) * s + c1 * 12.0) * s + c2 * 6.0) * s + c3 * 2.0
+    return p, p1, p2
 
-    Outside ``[ln lo, ln hi]`` the law is continued C¹-linearly in u from the nearer end ``u0``, ``f(u) = f(u0) +
-    p'(u0) (u - u0)``, ``p'' = 0``: only so that a Runge-Kutta stage evaluated there before the driver stops the
-    run gets finite numbers; no result may rest on them.  A NaN argument (or v <= 0) gives non-finite numbers,
-    never a read outside ``coef``."""
+
+@kernel(inline="always")
+def _sums(coef, u, quintic):
+    """``(p, p', p'')`` at u of the packed table(s) (:func:`_pchip_sums`) or piecewise quintic
+    (:func:`_quintic_sums`)."""
+    if quintic:
+        return _quintic_sums(coef, u)
+    return _pchip_sums(coef, u)
+
+
+@kernel(inline="always")
+def _law_at(x, coef, form, quintic):
+    """The body of :func:`table_law` (``quintic`` False) and :func:`quintic_law` (True): the forms, the
+    C¹-linear continuation outside ``[ln lo, ln hi]`` and ``v <= 0`` (their docstrings)."""
     if form == LAW_LNV:
         u = x
         v = np.exp(x)
@@ -136,16 +161,30 @@ def table_law(x, coef, form):
     uhi = coef[T_UHI]
     if not (ulo <= u <= uhi):  # the C¹ continuation (docstring); NaN: NaN, never an index from it
         u0 = ulo if u < ulo else uhi
-        F, D, _ = _pchip_sums(coef, u0)
+        F, D, _ = _sums(coef, u0, quintic)
         F = F + D * (u - u0)
         D2 = 0.0
     else:
-        F, D, D2 = _pchip_sums(coef, u)
+        F, D, D2 = _sums(coef, u, quintic)
     if form == LAW_LNV:
         return v, F, D
     if form == LAW_FP:
         return F, D / v, np.nan
     return F, D / v, (D2 - D) / (v * v)
+
+
+@kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a tabulated law: the default path needs none
+def table_law(x, coef, form):
+    """The tabulated law at ``x`` in the form ``form`` (:mod:`peelapprox.law._abi`), ``coef`` from
+    :func:`table_coefficients`: ``LAW_LNV: (v, f, p'(u))`` (p' is ``v f'(v)``), ``LAW_FP: (f, f', NaN)``,
+    ``LAW_FPP: (f, f', f'')`` with ``f' = p'/v`` and ``f'' = (p'' - p')/v²`` (``u = ln v`` by numba's log, which
+    may differ from numpy's by an ulp).
+
+    Outside ``[ln lo, ln hi]`` the law is continued C¹-linearly in u from the nearer end ``u0``, ``f(u) = f(u0) +
+    p'(u0) (u - u0)``, ``p'' = 0``: only so that a Runge-Kutta stage evaluated there before the driver stops the
+    run gets finite numbers; no result may rest on them.  A NaN argument (or v <= 0) gives non-finite numbers,
+    never a read outside ``coef``."""
+    return _law_at(x, coef, form, False)
 
 
 def _guide(x: np.ndarray) -> np.ndarray:
@@ -207,55 +246,11 @@ def pack_blocks(blocks, u_lo: float, u_hi: float) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([np.array([float(len(blocks)), u_lo, u_hi]), *parts]), dtype=float)
 
 
-@kernel(inline="always")
-def _quintic_sums(coef, u):
-    """``(p, p', p'')`` of the packed piecewise quintic (:func:`pack_quintic`) at ``u`` in ``[ln lo, ln hi]``: on
-    its interval ``x[i] <= u < x[i+1]``, at ``s = u - x[i]``, by Horner's rule with ``c0..c5 = c[0..5, i]``
-    (highest power first)."""
-    n = int(coef[T_HEAD + 1])
-    xo = T_HEAD + 3
-    go = xo + n
-    i = _interval(coef, xo, go, n, coef[T_HEAD + 2], u)
-    s = u - coef[xo + i]
-    co = go + n + 6 * i
-    c0 = coef[co]
-    c1 = coef[co + 1]
-    c2 = coef[co + 2]
-    c3 = coef[co + 3]
-    c4 = coef[co + 4]
-    c5 = coef[co + 5]
-    p = ((((c0 * s + c1) * s + c2) * s + c3) * s + c4) * s + c5
-    p1 = ((((c0 * 5.0) * s + c1 * 4.0) * s + c2 * 3.0) * s + c3 * 2.0) * s + c4
-    p2 = (((c0 * 20.0) * s + c1 * 12.0) * s + c2 * 6.0) * s + c3 * 2.0
-    return p, p1, p2
-
-
 @kernel(signature=LAW_SIG, lazy=True)  # compiled by the first run of a smoothed law
 def quintic_law(x, coef, form):
     """The smoothed law at ``x`` in the form ``form``, ``coef`` from :func:`pack_quintic`: as :func:`table_law`
     (the same forms, the same C¹-linear continuation outside ``[ln lo, ln hi]``), of a piecewise quintic."""
-    if form == LAW_LNV:
-        u = x
-        v = np.exp(x)
-    else:
-        if not x > 0.0:  # v <= 0 or NaN: no law there (never a division by zero)
-            return np.nan, np.nan, np.nan
-        v = x
-        u = np.log(x)
-    ulo = coef[T_ULO]
-    uhi = coef[T_UHI]
-    if not (ulo <= u <= uhi):  # the C¹ continuation (table_law); NaN: NaN, never an index from it
-        u0 = ulo if u < ulo else uhi
-        F, D, _ = _quintic_sums(coef, u0)
-        F = F + D * (u - u0)
-        D2 = 0.0
-    else:
-        F, D, D2 = _quintic_sums(coef, u)
-    if form == LAW_LNV:
-        return v, F, D
-    if form == LAW_FP:
-        return F, D / v, np.nan
-    return F, D / v, (D2 - D) / (v * v)
+    return _law_at(x, coef, form, True)
 
 
 def pack_quintic(x, c) -> np.ndarray:
