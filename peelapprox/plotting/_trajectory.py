@@ -48,7 +48,7 @@ def trajectory_window(traj: Any, cycles: int | None = TRAJECTORY_CYCLES) -> Traj
         Any object with a ``t`` array and ``jumps`` (the AB→CD jumps give the cycles).
     cycles : int or None
         At least this many stick-slip cycles (AB→CD jump to AB→CD jump).  When the last returns repeat with a
-        period n (within 1e-3 of max |F|: closed to the eye), the window is the last whole periods holding
+        period n (within 1e-3 of the largest F: closed to the eye), the window is the last whole periods holding
         at least ``cycles`` returns (``n * ceil(cycles / n)``, fewer periods if the run has fewer), from one
         AB→CD jump to the last; otherwise it runs from the jump ``cycles`` returns before the last one to the
         run's end.  None, or a run with no more cycles than that: the whole run.
