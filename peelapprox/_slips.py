@@ -241,12 +241,7 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
     if half:  # the ends of a 'same' convolution are averages over fewer samples: keep the raw force there
         Fs[:half], Fs[-half:] = F[:half], F[-half:]
     peaks, valleys = _zigzag(Fs, h)
-
-    def noisy_gradient(fall_per_sample: float) -> bool:
-        """Whether the averaged noise is more than :data:`KNEE_NOISE` of the slip's fall per sample, so that
-        the gradient's knee is not to be trusted (module docstring, step 3)."""
-        return sigma / math.sqrt(smooth) > KNEE_NOISE * abs(fall_per_sample)
-
+    knee_noise = sigma / math.sqrt(smooth) / KNEE_NOISE  # the smallest fall per sample the gradient is trusted on
     if peaks and peaks[0] == 0:
         peaks, valleys = peaks[1:], valleys[1:]
     n = len(peaks)
@@ -265,7 +260,7 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
         knee = p + (int(flat[-1]) + 1 if flat.size else 0)
         L = max(2, min(fit, (v - knee) // 3))
         lo = max(before + (knee - before) // 2, knee - half - fit)
-        if noisy_gradient(mean_fall * (t[v] - t[p]) / max(v - p, 1)):
+        if knee_noise > abs(mean_fall) * (t[v] - t[p]) / max(v - p, 1):
             # a noisy sample of the fall passes for half as steep, so the gradient's knee is late: the split
             # of least squares between the stick's line and the fall's, searched from the maximum on
             knee = _split(t, F, lo, min(knee + half + L, v - half), p - half, knee)

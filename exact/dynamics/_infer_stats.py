@@ -1,0 +1,140 @@
+"""The statistics :func:`exact.infer` fits: a force trace's, measured or the model's, read the same way.
+
+* **Statistics** (:data:`OBSERVABLES`): the slip interval, force drop, stick and slip times of
+  :meth:`ForceSeries.observables`, the mean slope of the sticks (``k (V - v)``: mostly k), the mean force at
+  a slip's start (set by the law and the α oscillation: mostly I; the trace's linear trend removed, so a
+  machine's slow drift does not read as force) and the cycle frequency (left out where no line stands out of the
+  periodogram below half the slip frequency, :data:`LINE_RATIO`: a period-1 trace holds only drift and noise
+  there).  The model's are read off an exact run
+  (``t_transient`` seconds, then the series' duration at its sampling times) with white noise of the series'
+  level added (σ of :meth:`ForceSeries.noise`, a fixed seed), by the same detector with the same threshold, so
+  the detector's remaining biases under noise cancel.
+* **Residuals.**  ``(model - data) / σ``, σ the detector's repeatability under noise
+  (:data:`REPEATABILITY`, relative, measured) and, for an aperiodic trace, the standard error of the mean in
+  quadrature; a periodic trace's means are over whole cycles.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from peelapprox import ForceSeries, PeelParams
+from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded
+from peelapprox.io import fmt_number
+
+from .._simulate import simulate
+
+__all__ = ["LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "data_statistics", "model_statistics",
+           "trace_statistics"]
+
+#: The statistics fitted, in this order (module docstring).
+OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
+#: The σ of each statistic, relative: not the detector's repeatability under noise (a 20 s, 10 kHz model trace
+#: read with 0.5 N of white noise and without differs by 2e-6 in the slip interval, 0.2 % in the drop, 4.5 % in
+#: the slip time) but the model's own roughness: from one periodic window to the next (I varied by 5 % steps
+#: at V = 1 m/s, I = 1e-2) the means jump by 0.3 to 4 %, so a σ below that makes χ² a comb whose teeth no search
+#: can resolve.  The cycle frequency (the strongest spectral line below half the slip frequency: the return
+#: map's cycle, 1/(n · slip interval), which follows the α oscillation, ∝ I^-1/2 at high inertia) gets 3 %.
+REPEATABILITY = {"slip_interval": 0.02, "force_drop": 0.02, "stick_time": 0.02, "slip_time": 0.05, "rise": 0.02,
+                 "F_start": 0.005, "f_cycle": 0.03}
+#: The height over the periodogram's median (in the band below half the slip frequency) from which its strongest
+#: peak is a line of the stick-slip, the cycle frequency fitted: white noise's largest of N bins is about
+#: ln N / ln 2 times their median (17 for 1e5 bins; measured 10-12 on 20 s at 10 kHz with 0.5 N of noise), a
+#: period-3 orbit's line 4e6 times (V = 1 m/s, I = 1e-5, the same noise).
+LINE_RATIO = 100.0
+#: The seed of the noise added to every model trace (the same at every parameter point: the statistics move with
+#: the parameters, not with a new draw).
+NOISE_SEED = 20041
+
+
+def trace_statistics(series: ForceSeries, threshold: float | None
+                     ) -> tuple[np.ndarray | None, Any, bool, float]:
+    """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables,
+    whether its periodogram holds a cycle line (:func:`_cycle_frequency`) and the detector's threshold."""
+    slips = series.slips(threshold)
+    o = series.observables(slips=slips)  # read off these slips, not detected a second time
+    if o.status != "stick-slip" or len(slips) < 2:
+        return None, o, False, slips.threshold
+    assert o.slip_interval is not None  # stick-slip with two slips or more
+    f_cycle, line = _cycle_frequency(series, 1.0 / o.slip_interval)
+    vals = [getattr(o, n) for n in OBSERVABLES[:4]] + [float(np.mean(slips.rise)), _start_force(slips), f_cycle]
+    return np.asarray(vals, dtype=float), o, line, slips.threshold
+
+
+def _start_force(slips: Any) -> float:
+    """The mean force at a slip's start with the trace's linear trend removed, referred to its first slip: a
+    machine's slow drift (tared at the start) does not read as a larger force.  A periodic model trace has no
+    trend, so this is its plain mean there."""
+    t, F = np.asarray(slips.t_start), np.asarray(slips.F_before)
+    if t.size < 3 or t[-1] <= t[0]:
+        return float(np.mean(F))
+    slope = np.polyfit(t - t[0], F, 1)[0]
+    return float(np.mean(F - slope * (t - t[0])))
+
+
+def _cycle_frequency(series: ForceSeries, f_slip: float) -> tuple[float, bool]:
+    """The cycle frequency [Hz] and whether it is a line of the periodogram.
+
+    The strongest line of the trace's periodogram (Hann window, linear trend removed) between 3 / duration and
+    half the slip frequency, refined by a parabola through its log power and its neighbours, if it stands out
+    of the band's median by :data:`LINE_RATIO` and lies within two bins of ``f_slip / n`` for an integer
+    n >= 2 (a period-n return map's cycle); else no line: ``(f_slip, False)``, the cycle of a period-1 map. A
+    noiseless period-1 trace's strongest peak is an aliased harmonic of the slips (21.5 Hz = 85 f_slip - 10 kHz
+    at V = 3.95 m/s), which moves wildly with the parameters."""
+    from scipy.signal import periodogram
+
+    f, p = periodogram(series.F, fs=(len(series) - 1) / series.duration, window="hann", detrend="linear")
+    band = np.flatnonzero((f >= 3.0 / series.duration) & (f <= 0.5 * f_slip))
+    if band.size < 3:
+        return f_slip, False
+    i = int(band[np.argmax(p[band])])
+    floor = float(np.median(p[band]))
+    if floor > 0 and p[i] < LINE_RATIO * floor:
+        return f_slip, False
+    line = float(f[i])
+    if 0 < i < f.size - 1 and min(p[i - 1], p[i], p[i + 1]) > 0:
+        a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
+        shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
+        line += max(-0.5, min(0.5, shift)) * float(f[1] - f[0])
+    n = round(f_slip / line) if line > 0 else 0
+    if n < 2 or abs(f_slip / n - line) > 2.0 * float(f[1] - f[0]):
+        return f_slip, False
+    return line, True
+
+
+def data_statistics(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
+    """The series' statistics, their σ (module docstring: residuals), the detector's threshold, the noise
+    level and which statistics it carries: not the cycle frequency where no line stands out of the periodogram
+    below half the slip frequency (a period-1 trace: only drift and noise there)."""
+    if series.V is None:
+        raise ValueError(f"{series!r} has no pull speed: give ForceSeries(..., V=...) (the model needs V)")
+    vals, o, line, threshold = trace_statistics(series, None)
+    if vals is None:
+        raise ValueError(f"the series at V = {fmt_number(series.V, 4)} m/s does not stick-slip ({o.status}: "
+                         f"{o.reason}): there is nothing to fit")
+    sig = np.array([REPEATABILITY[n] * abs(v) for n, v in zip(OBSERVABLES, vals)])
+    sig[-1] = max(sig[-1], 0.5 / series.duration)  # at least half a periodogram bin
+    if o.period is None:  # an aperiodic trace: its means scatter
+        for j, n in enumerate(OBSERVABLES[:4]):
+            spread = getattr(o, f"{n}_spread") or 0.0
+            sig[j] = math.hypot(sig[j], spread / math.sqrt(max(o.n_slips - 1, 1)))
+    used = np.ones(len(OBSERVABLES), dtype=bool)
+    used[OBSERVABLES.index("f_cycle")] = line
+    return vals, sig, threshold, series.noise, used
+
+
+def model_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                     rtol: float, max_wall: float) -> np.ndarray | None:
+    """The statistics of the model's trace at ``p``, sampled at the series' times after ``t_transient`` with
+    white noise of the series' level added (a fixed seed), read with the series' threshold; None where it does
+    not stick-slip or breaks down."""
+    t_eval = t_transient + (series.t - series.t[0])
+    try:
+        tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall)
+    except (ModelBreakdown, SolverBudgetExceeded):
+        return None
+    F = tr.F + np.random.default_rng(NOISE_SEED).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
+    return trace_statistics(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)[0]
