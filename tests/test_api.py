@@ -52,6 +52,7 @@ API = {
         "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor", "MAX_BASIN_STARTS", "infer",
         "Inference",
         "attractor_observables",
+        "attractor_set", "AttractorSet", "SetAttractor", "SetOutcome", "SetStart", "EscapePrediction",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
