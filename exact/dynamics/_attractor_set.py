@@ -10,8 +10,8 @@ does not depend on where or in which order they ran:
    as a period-n orbit: Newton on the section map (:func:`exact.solve_orbit`, seeded at the window's nearest
    recurrence) closes it and gives its Floquet multipliers.  A stable orbit is an attractor.  On an unstable one
    the run is a transient: the amplitude law ``A_k = A_k0 |μ|^(k - k0)`` (:mod:`exact.dynamics._escape`) predicts
-   when it leaves, unless it has already left (its deviation is beyond :data:`ESCAPE_DEVIATION`), in which case
-   the window is read as aperiodic.
+   when it leaves, unless it is not sitting on it (a return of the window, or the fitted amplitude at its end, is
+   beyond :data:`ESCAPE_DEVIATION` of the orbit's force), in which case the window is read as aperiodic.
 3. The other windows are aperiodic attractors, grouped by their observables (slip interval and force drop within
    :data:`APERIODIC_RTOL`) and their return-map range; each group's largest Lyapunov exponent
    (:func:`exact.lyapunov`, ``"tangent"``, from a start that sets α0 only) tells chaos (at least
@@ -41,7 +41,7 @@ from ..orbits._periodic import minimal_period, solve_orbit
 from ..orbits._section import system_of
 from ._attractor_set_result import AttractorSet, SetAttractor, SetOutcome, SetStart
 from ._attractor_set_runs import Deadline, check_starts, default_starts, run_all
-from ._escape import ESCAPE_DEVIATION, predict_escape
+from ._escape import ESCAPE_DEVIATION, escape_index, predict_escape
 
 __all__ = ["APERIODIC_RTOL", "CHAOS_BITS", "NEAR_RTOL", "ORBIT_MATCH", "WINDOW_MATCH", "attractor_set",
            "default_starts"]
@@ -114,8 +114,8 @@ def attractor_set(
     executor : concurrent.futures.Executor, optional
         Runs the starts (any executor: a process pool, a shared pool, dask's), left running.
     progress : bool or callable, optional
-        A callable gets ``(done, total, message)`` after each start and before each stability step; True writes
-        those lines on stderr.
+        A callable gets ``(done, total, message)`` after each start's run (done of total starts) and before each
+        stability step (done = total); True writes those lines on stderr.
     max_wall : float or None
         Wall-clock budget [s] of the whole call (default :data:`exact.DEFAULT_MAX_WALL`): a start it leaves
         out or cuts is an outcome ``"max_wall"``, a stability step it cuts a note; the set is then of the starts
@@ -208,9 +208,11 @@ class _Reader:
         self.attractors: list[SetAttractor] = []
         self.counters: dict[str, float] = {"steps": 0.0, "rhs": 0.0, "orbits": 0.0, "lyapunov": 0.0}
         self.orbits: dict[tuple, Any] = {}
+        self.n_starts = 0
 
     # ------------------------------------------------------------------------------------------ per start
     def read(self, starts: list[SetStart], runs: list[dict[str, Any]]) -> list[SetOutcome]:
+        self.n_starts = len(starts)
         pending: list[tuple[int, str, Any]] = []  # (start index, group key kind, payload)
         outcomes: list[SetOutcome | None] = [None] * len(starts)
         for i, (s, r) in enumerate(zip(starts, runs, strict=True)):
@@ -264,7 +266,8 @@ class _Reader:
             orbit, note = self._orbit(tr, n) if self.stability and self.params.variant is None else (None, "")
             if orbit is not None and not orbit.stable:
                 esc = self._escape(tr, orbit)
-                if esc is not None and esc.deviation < ESCAPE_DEVIATION:
+                sitting = escape_index(x, orbit.return_map_values) is None  # every return within 1 % of the orbit's
+                if esc is not None and sitting and esc.deviation < ESCAPE_DEVIATION:
                     mu = max(abs(m) for m in orbit.multipliers)
                     pair = ", a complex pair" if abs(orbit.multipliers[0].imag) > 0 else ""
                     msg = (f"transient: {'weakly ' if mu < 1.01 else ''}unstable period-{orbit.n}, |μ|="
@@ -327,7 +330,7 @@ class _Reader:
         key = (n, round(float(a[k]), 6), round(float(w[k]), 4))
         if key in self.orbits:
             return self.orbits[key]
-        self.say(0, 0, f"period-{n} orbit by Newton")
+        self.say(self.n_starts, self.n_starts, f"period-{n} orbit by Newton")
         try:
             left = self.deadline.left()
             if left is not None and left <= 0:
@@ -382,7 +385,7 @@ class _Reader:
         if left is not None and left <= 0:
             g["note"] = "no exponent: max_wall spent"
             return
-        self.say(0, 0, f"Lyapunov exponent from {alpha[0].name}")
+        self.say(self.n_starts, self.n_starts, f"Lyapunov exponent from {alpha[0].name}")
         try:
             L = lyapunov(self.params, "tangent", t_transient=self.t_transient, alpha0=alpha[0].alpha0,
                          T=self.lyapunov_T, max_wall=left)
