@@ -26,7 +26,9 @@ costs), :mod:`.run` (:func:`run_benchmark`), :mod:`.report` (the report and its 
 ``python -m comparisons.benchmark.compare_cost`` (``peelapprox compare``, cold and warm, :mod:`.compare_cost`).
 The tape-mass model (docs/tape-mass.md): ``python -m comparisons.benchmark.tape_mass`` (its solvers' work precision
 across the mass range, :mod:`.tape_mass`) and ``python -m comparisons.benchmark.tape_mass_limit`` (the low-mass
-limit and the ε of a tape mass, :mod:`.tape_mass_limit`).
+limit and the ε of a tape mass, :mod:`.tape_mass_limit`).  ``python -m comparisons.benchmark.attractor_sets`` times
+:func:`exact.attractor_set` against one :func:`exact.attractor_observables` call on seeded random points
+(:mod:`.attractor_sets`).
 """
 
 from .eps import EpsRow, eps_study, fit_power_law, small_eps_check
