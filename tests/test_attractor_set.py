@@ -207,6 +207,23 @@ def test_default_design_and_where_it_runs():
     assert calls[-1] == (2, 2)
 
 
+def test_a_lost_start_is_an_outcome():
+    """An executor whose workers die: every start an outcome "failure" naming the cause, the set's status "no
+    attractor", no exception."""
+    from concurrent.futures import Executor, Future
+
+    class Dying(Executor):
+        def submit(self, fn, /, *args, **kwargs):
+            f: Future = Future()
+            f.set_exception(RuntimeError("worker died"))
+            return f
+
+    s = attractor_set(PeelParams(V=2.0, I=1e-3), starts=[0.0, 0.1], executor=Dying())
+    assert s.status == "no attractor" and not s.attractors
+    assert [o.outcome for o in s.outcomes] == ["failure", "failure"]
+    assert "worker died" in s.outcomes[0].message
+
+
 def test_max_wall_is_a_status():
     """A budget too small for any run: every start an outcome "max_wall", the set's status "max_wall", no
     exception, and the call returns within the budget plus the overhead of reading (a second)."""

@@ -140,6 +140,11 @@ def run_start(params: PeelParams, start: SetStart, t_transient: float, t_window:
     return out
 
 
+def _lost(exc: BaseException, what: str) -> dict[str, Any]:
+    return {"trajectory": None, "outcome": "failure", "reason": "", "wall": 0.0,
+            "message": f"{what}: {type(exc).__name__}: {_msg(exc)}"}
+
+
 def _msg(exc: BaseException) -> str:
     return " ".join(str(exc).split())[:300]
 
@@ -157,7 +162,10 @@ def run_all(params: PeelParams, starts: list[SetStart], t_transient: float, t_wi
     results: list[dict[str, Any]] = []
     if executor is None and (workers == 0 or total == 1):
         for k, a in enumerate(args):
-            results.append(run_start(*a))
+            try:
+                results.append(run_start(*a))
+            except Exception as exc:  # as the executor's path: an outcome, not an exception
+                results.append(_lost(exc, "this start's run raised"))
             note(k, k + 1, results[-1])
         return results
     own = executor is None
@@ -170,8 +178,7 @@ def run_all(params: PeelParams, starts: list[SetStart], t_transient: float, t_wi
             try:
                 res = f.result()
             except Exception as exc:  # the executor lost the start: an outcome, not an exception
-                res = {"trajectory": None, "outcome": "failure", "reason": "", "wall": 0.0,
-                       "message": f"the executor lost this start: {type(exc).__name__}: {_msg(exc)}"}
+                res = _lost(exc, "the executor lost this start")
             results.append(res)
             note(k, k + 1, res)
         return results
