@@ -15,6 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 
 #: Prints, as JSON, which of the kernels a plain hybrid simulate must not need were compiled (or loaded).
@@ -113,3 +115,17 @@ def test_after_warmup_the_first_calls_compile_nothing(tmp_path):
     assert doc["verdict"].startswith("warm for this CPU"), doc["verdict"]
     assert [w["fresh"] and w["this_cpu"] for w in doc["warmups"]] == [True]
     assert doc["folders"] and all(f["problem"] is None and f["not_private"] == 0 for f in doc["folders"])
+
+
+@pytest.mark.slow
+def test_a_generic_warmup_serves_generic_processes(tmp_path):
+    """Hypothesis: ``peelapprox warmup --cpu generic`` (compiled in a child with NUMBA_CPU_NAME=generic) makes a new
+    process run with NUMBA_CPU_NAME=generic compile nothing for its first calls, and ``doctor`` in a process
+    compiling for the host CPU says the warm-up is for another CPU (never "warm").  Exact counts.  Slow: a full
+    compilation of the first calls."""
+    report = json.loads(_run(tmp_path, ["-m", "peelapprox", "warmup", "--cpu", "generic", "--format", "json"]))
+    assert report["status"] == 0 and report["cpu"] == "generic", report
+    out = json.loads(_run(tmp_path, ["-c", FIRST_CALLS], {"NUMBA_CPU_NAME": "generic"}).strip().splitlines()[-1])
+    assert out["compiled"] == [], out["compiled"]
+    doc = json.loads(_run(tmp_path, ["-m", "peelapprox", "doctor", "--format", "json"]))
+    assert doc["cpu"] != "generic" and "NUMBA_CPU_NAME=generic" in doc["verdict"], doc["verdict"]
