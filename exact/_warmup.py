@@ -92,11 +92,11 @@ class _Count(event.Listener):
         pass
 
 
-_DONE: dict[str, WarmupReport] = {}
+_DONE: dict[tuple[str, tuple[str, ...]], WarmupReport] = {}
 
 
-def compile_kernels(*, cpu: str | None = None, progress: Callable[[str], None] | None = None,
-                    max_wall: float = 900.0) -> WarmupReport:
+def compile_kernels(*, calls: tuple[str, ...] = FIRST_CALLS, cpu: str | None = None,
+                    progress: Callable[[str], None] | None = None, max_wall: float = 900.0) -> WarmupReport:
     """Compile, or load from the private kernel cache, every kernel a user's first calls need (:data:`FIRST_CALLS`:
     ``simulate`` with the paper's law, ``approximate_attractor``, ``attractor_observables``), so that the first
     such call of a later process loads its kernels instead of compiling them (``docs/performance.md``, "Cold
@@ -107,6 +107,10 @@ def compile_kernels(*, cpu: str | None = None, progress: Callable[[str], None] |
 
     Parameters
     ----------
+    calls : tuple of str
+        The first calls to warm, a subset of :data:`FIRST_CALLS` (default all; ``("simulate",)`` loads the hybrid
+        driver only, as a benchmark or a worker process does before timing).  The warm-up record is written only
+        for all of them.
     cpu : str, optional
         The CPU to compile for, numba's ``NUMBA_CPU_NAME``: ``"generic"`` for a cache shared by several machines of
         one architecture (each process that should load it then runs with ``NUMBA_CPU_NAME=generic``); default
@@ -122,18 +126,23 @@ def compile_kernels(*, cpu: str | None = None, progress: Callable[[str], None] |
     -------
     WarmupReport
     """
+    if (not isinstance(calls, tuple) or not calls or len(set(calls)) != len(calls)
+            or not all(isinstance(c, str) and c in FIRST_CALLS for c in calls)):
+        raise ValueError(f"calls must be a tuple of distinct names from {FIRST_CALLS}, got {calls!r}")
     if cpu is not None and (not isinstance(cpu, str) or not cpu.strip() or cpu != cpu.strip()):
         raise ValueError(f"cpu must be a CPU name of numba's (e.g. 'generic'), got {cpu!r}")
     if not (isinstance(max_wall, (int, float)) and 0 < max_wall <= 86400):
         raise ValueError(f"max_wall must be in (0, 86400] s, got {max_wall!r}")
     if cpu is not None and cpu != cpu_name():
-        return _in_child(cpu, max_wall, progress)
-    key = cpu_name()
+        return _in_child(cpu, calls, max_wall, progress)
+    key = (cpu_name(), calls)
     if key in _DONE:
         return _DONE[key]
     t0 = time.perf_counter()
     rows = []
-    for name, call in _calls().items():
+    jobs = _calls()
+    for name in calls:
+        call = jobs[name]
         count, before, t = _Count(), _loaded(), time.perf_counter()
         error = None
         try:
@@ -147,9 +156,9 @@ def compile_kernels(*, cpu: str | None = None, progress: Callable[[str], None] |
         if progress is not None:
             progress(f"{name}: {row['seconds']:.1f} s, {count.n} compiled, {row['loaded']} loaded"
                      + (f" ({error})" if error else ""))
-    record = record_warmup(rows)
+    record = record_warmup(rows) if set(calls) == set(FIRST_CALLS) else None
     status = cache_status()
-    report = _report(rows, key, status.get("kernel_root"), time.perf_counter() - t0, record)
+    report = _report(rows, key[0], status.get("kernel_root"), time.perf_counter() - t0, record)
     if report.status == 0:
         _DONE[key] = report
     return report
@@ -165,11 +174,12 @@ def _report(rows: list[dict[str, Any]], cpu: str, root: str | None, seconds: flo
                         jobs=tuple(rows), record=str(record) if record else None)
 
 
-_CHILD = ("import json, exact; r = exact.compile_kernels(max_wall={max_wall!r}); "
+_CHILD = ("import json, exact; r = exact.compile_kernels(calls={calls!r}, max_wall={max_wall!r}); "
           "print(json.dumps(dict(jobs=r.rows(), cpu=r.cpu, cache=r.cache, record=r.record)))")
 
 
-def _in_child(cpu: str, max_wall: float, progress: Callable[[str], None] | None) -> WarmupReport:
+def _in_child(cpu: str, calls: tuple[str, ...], max_wall: float,
+              progress: Callable[[str], None] | None) -> WarmupReport:
     """:func:`compile_kernels` for another CPU than this process's: a child process with ``NUMBA_CPU_NAME``."""
     env = dict(os.environ, NUMBA_CPU_NAME=cpu)
     env.pop("NUMBA_CPU_FEATURES", None)
@@ -177,7 +187,7 @@ def _in_child(cpu: str, max_wall: float, progress: Callable[[str], None] | None)
         progress(f"compiling for CPU {cpu} in a child process ...")
     t0 = time.perf_counter()
     try:
-        r = subprocess.run([sys.executable, "-c", _CHILD.format(max_wall=float(max_wall))], env=env,
+        r = subprocess.run([sys.executable, "-c", _CHILD.format(calls=calls, max_wall=float(max_wall))], env=env,
                            capture_output=True, text=True, timeout=max_wall)
     except subprocess.TimeoutExpired:
         return WarmupReport(status=1, message=f"the warm-up for CPU {cpu} took more than max_wall={max_wall:g} s",

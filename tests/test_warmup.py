@@ -82,3 +82,13 @@ def test_compile_kernels_checks_its_arguments():
     for bad in (0, -1.0, float("nan"), 1e9):
         with pytest.raises(ValueError, match="max_wall must be"):
             compile_kernels(max_wall=bad)
+
+
+def test_compile_kernels_refuses_unknown_calls():
+    """Hypothesis: a call name outside FIRST_CALLS, an empty or repeated selection, or a list instead of a tuple is a
+    ValueError listing the valid names."""
+    from exact import compile_kernels
+
+    for bad in (("nope",), (), ("simulate", "simulate"), ["simulate"]):
+        with pytest.raises(ValueError, match="calls must be a tuple of distinct names from"):
+            compile_kernels(calls=bad)  # type: ignore[arg-type]
