@@ -569,6 +569,24 @@ def test_a_planted_data_file_is_not_loaded(kroot, tmp_path):
     assert not marker.exists()
 
 
+def test_a_planted_index_of_an_expression_law_is_not_loaded(law_dir, kroot, tmp_path):
+    """The probe's reproducer 1 through an expression law: its numba index (in the kernels' private root, no longer
+    in the law directory's ``__pycache__``) made writable by others and replaced by a pickle that runs a command.
+    Hypothesis: not unpickled (a KernelCacheWarning), the marker not created, the law still f(1) = 211 exactly."""
+    law = PeelForce.expression(_LAW)
+    _check_law(law)
+    assert not (law_dir / "__pycache__").exists()
+    index = list(kroot.glob("laws_*/law_*.nbi"))
+    assert len(index) == 1
+    marker = tmp_path / "ran"
+    _plant(index[0], marker)
+    os.chmod(index[0], 0o666)
+    C._EXPRESSION_KERNELS.clear()
+    with pytest.warns(KernelCacheWarning, match="writable by others.*not read"):
+        _check_law(law)
+    assert not marker.exists()
+
+
 @_as_root
 def test_a_foreign_module_folder_is_replaced(kroot, tmp_path):
     """Hypothesis: a module folder owned by another user (mode 0755: only that user can write it, and did) is
