@@ -46,6 +46,7 @@ from numba.core import types as _nbtypes
 from numba.core.typing import templates as _templates
 from numba.extending import register_jitable
 
+from ._kcache import SUPPORTED as KCACHE_SUPPORTED
 from ._kcache import PrivateCache, root_problem
 from ._private import private_dir
 from .errors import KernelCacheWarning
@@ -379,6 +380,9 @@ def _dispatcher(fn: Callable, inline: Literal["never", "always"], fastmath: bool
 def _cached(fn: Callable, inline: Literal["never", "always"], fastmath: bool, nrt: bool) -> Any:
     """numba's dispatcher of ``fn`` with its cache in the private root (:class:`peelapprox._kcache.PrivateCache`),
     never in numba's own locations.  Raises numba's "no locator available" RuntimeError when there is none."""
+    if not KCACHE_SUPPORTED:
+        raise RuntimeError(f"cannot cache function {fn.__qualname__!r}: no locator available (this numba's cache "
+                           "internals are not the ones peelapprox checks)")
     d = _njit(cache=False, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(fn)
     d._cache = PrivateCache(d.py_func)
     return d

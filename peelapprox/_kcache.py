@@ -39,7 +39,16 @@ from numba.core import config as numba_config
 from ._private import cache_home, open_private, private_dir
 from .errors import KernelCacheWarning
 
-__all__ = ["PrivateCache", "default_root", "kernel_root", "root_problem"]
+__all__ = ["SUPPORTED", "PrivateCache", "default_root", "kernel_root", "root_problem"]
+
+#: Whether this numba's cache classes have the methods the classes below override (numba 0.58-0.68 have them);
+#: without them the kernels are compiled uncached (:mod:`peelapprox._jit`), never cached where the checks do not
+#: reach (the classes themselves are in every numba since 0.49).
+_BASES = ("_CacheLocator", "_SourceFileBackedLocatorMixin", "CompileResultCacheImpl", "IndexDataCacheFile",
+          "FunctionCache", "Cache")
+SUPPORTED = (all(hasattr(_caching, n) for n in _BASES)
+             and all(hasattr(_caching.IndexDataCacheFile, n) for n in ("_load_index", "_load_data", "_open_for_write"))
+             and hasattr(_caching.Cache, "_save_overload"))
 
 _LOCK = threading.RLock()
 #: (NUMBA_CACHE_DIR, default root) -> the root chosen, or None with the reason (``_NOTES``).
