@@ -63,7 +63,8 @@ class WarmupReport:
         return [dict(j) for j in self.jobs]
 
 
-def _calls() -> dict[str, Callable[[], Any]]:
+def _calls() -> dict[str, Callable[[float], Any]]:
+    """Each first call, taking its wall budget [s]."""
     from peelapprox import PeelParams, approximate_attractor
 
     from ._simulate import simulate
@@ -71,9 +72,9 @@ def _calls() -> dict[str, Callable[[], Any]]:
 
     p = PeelParams(V=1.0, I=1e-5)
     return {
-        "simulate": lambda: (load_hybrid(), simulate(p, 0.01, max_wall=600.0)),
-        "approximate_attractor": lambda: approximate_attractor(p, n_transient=2, n_returns=4, max_wall=600.0),
-        "attractor_observables": lambda: attractor_observables(p, t_transient=0.05, t_window=0.1, max_wall=600.0),
+        "simulate": lambda left: (load_hybrid(), simulate(p, 0.01, max_wall=left)),
+        "approximate_attractor": lambda left: approximate_attractor(p, n_transient=2, n_returns=4, max_wall=left),
+        "attractor_observables": lambda left: attractor_observables(p, t_transient=0.05, t_window=0.1, max_wall=left),
     }
 
 
@@ -93,10 +94,11 @@ class _Count(event.Listener):
 
 
 _DONE: dict[tuple[str, tuple[str, ...]], WarmupReport] = {}
+_clock = time.perf_counter  # the warm-up's clock (a test replaces it)
 
 
 def compile_kernels(*, calls: tuple[str, ...] = FIRST_CALLS, cpu: str | None = None,
-                    progress: Callable[[str], None] | None = None, max_wall: float = 900.0) -> WarmupReport:
+                    progress: Callable[[str], None] | None = None, max_wall: float = 600.0) -> WarmupReport:
     """Compile, or load from the private kernel cache, every kernel a user's first calls need (:data:`FIRST_CALLS`:
     ``simulate`` with the paper's law, ``approximate_attractor``, ``attractor_observables``), so that the first
     such call of a later process loads its kernels instead of compiling them (``docs/performance.md``, "Cold
@@ -110,7 +112,7 @@ def compile_kernels(*, calls: tuple[str, ...] = FIRST_CALLS, cpu: str | None = N
     calls : tuple of str
         The first calls to warm, a subset of :data:`FIRST_CALLS` (default all; ``("simulate",)`` loads the hybrid
         driver only, as a benchmark or a worker process does before timing).  The warm-up record is written only
-        for all of them.
+        for all of them, when none failed.
     cpu : str, optional
         The CPU to compile for, numba's ``NUMBA_CPU_NAME``: ``"generic"`` for a cache shared by several machines of
         one architecture (each process that should load it then runs with ``NUMBA_CPU_NAME=generic``); default
@@ -120,7 +122,8 @@ def compile_kernels(*, calls: tuple[str, ...] = FIRST_CALLS, cpu: str | None = N
         Called with one line per job.
     max_wall : float
         Wall-time budget of the whole warm-up [s] (a child process is stopped at it; in this process each job gets
-        what is left as its ``max_wall``).
+        what is left as its ``max_wall``, and a job is not started once it is spent; a numba compilation under way
+        is not interrupted, so one job may overrun it by its compile time).
 
     Returns
     -------
@@ -138,27 +141,29 @@ def compile_kernels(*, calls: tuple[str, ...] = FIRST_CALLS, cpu: str | None = N
     key = (cpu_name(), calls)
     if key in _DONE:
         return _DONE[key]
-    t0 = time.perf_counter()
+    t0 = _clock()
     rows = []
     jobs = _calls()
     for name in calls:
         call = jobs[name]
-        count, before, t = _Count(), _loaded(), time.perf_counter()
-        error = None
+        count, before, t = _Count(), _loaded(), _clock()
+        error, left = None, max_wall - (_clock() - t0)
         try:
+            if left <= 0:
+                raise TimeoutError(f"not run: the warm-up's max_wall={max_wall:g} s was spent")
             with event.install_listener("numba:compile", count):
-                call()
+                call(left)
         except Exception as exc:  # reported in the row, the other jobs still run
             error = f"{type(exc).__name__}: {exc}".splitlines()[0][:300]
-        row = dict(name=name, seconds=round(time.perf_counter() - t, 3), compiled=count.n,
+        row = dict(name=name, seconds=round(_clock() - t, 3), compiled=count.n,
                    loaded=_loaded() - before, error=error)
         rows.append(row)
         if progress is not None:
             progress(f"{name}: {row['seconds']:.1f} s, {count.n} compiled, {row['loaded']} loaded"
                      + (f" ({error})" if error else ""))
-    record = record_warmup(rows) if set(calls) == set(FIRST_CALLS) else None
+    record = record_warmup(rows) if set(calls) == set(FIRST_CALLS) and not any(r["error"] for r in rows) else None
     status = cache_status()
-    report = _report(rows, key[0], status.get("kernel_root"), time.perf_counter() - t0, record)
+    report = _report(rows, key[0], status.get("kernel_root"), _clock() - t0, record)
     if report.status == 0:
         _DONE[key] = report
     return report

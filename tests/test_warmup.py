@@ -92,3 +92,30 @@ def test_compile_kernels_refuses_unknown_calls():
     for bad in (("nope",), (), ("simulate", "simulate"), ["simulate"]):
         with pytest.raises(ValueError, match="calls must be a tuple of distinct names from"):
             compile_kernels(calls=bad)  # type: ignore[arg-type]
+
+
+def test_warmup_max_wall_defaults_to_600_seconds():
+    """``peelapprox warmup --max-wall`` defaults to 600 s, as every subcommand's (tests/test_bounded.py), and says so
+    in its help (exact value and text)."""
+    import argparse
+
+    from peelapprox.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices["warmup"]
+    action = next(a for a in sub._actions if "--max-wall" in a.option_strings)
+    assert action.default == 600.0 and "(default: 600)" in " ".join(sub.format_help().split())
+
+
+def test_a_spent_budget_skips_the_jobs(monkeypatch):
+    """Hypothesis: with the budget already spent (a clock that jumps 10 s per reading against max_wall=1 s) no job
+    is started: every row says so, status 1, nothing recorded; the call returns (never hangs)."""
+    import itertools
+
+    import exact._warmup as W
+
+    clock = itertools.count(0.0, 10.0)
+    monkeypatch.setattr(W, "_clock", lambda: float(next(clock)))
+    monkeypatch.setattr(W, "_DONE", {})
+    r = W.compile_kernels(max_wall=1.0)
+    assert r.status == 1 and r.record is None
+    assert all(j["error"].startswith("TimeoutError: not run") and j["compiled"] == 0 for j in r.jobs)

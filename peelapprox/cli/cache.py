@@ -27,7 +27,7 @@ def add_warmup_parser(sub) -> argparse.ArgumentParser:
                     help="CPU to compile for, numba's NUMBA_CPU_NAME (generic: any machine of this architecture; "
                          "default: this one)")
     add_format(wu, "the report")
-    add_max_wall_option(wu, default=900.0, what="the warm-up")
+    add_max_wall_option(wu, what="the warm-up")
     return wu
 
 
