@@ -19,7 +19,7 @@ Every public name is importable from ``exact`` itself; the return-map analysis o
 
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
-from ._hybrid_driver import compile_kernels, hybrid_field
+from ._hybrid_driver import hybrid_field
 from ._initial import initial_state
 from ._method_contract import default_atol
 from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
@@ -27,6 +27,7 @@ from ._options import METHODS, Budget, SaveAt, default_max_steps
 from ._shared import DEFAULT_MAX_WALL
 from ._simulate import simulate
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
+from ._warmup import WarmupReport, compile_kernels
 from .dynamics import (
     MAX_BASIN_STARTS,
     MAX_DIAGRAM_VALUES,
@@ -85,6 +86,7 @@ __all__ = [
     "Budget",
     "initial_state",
     "compile_kernels",
+    "WarmupReport",
     "ATOL_SCALE",
     "STEP_BUDGET",
     "METHODS",

@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     from ._method_contract import Method
     from ._options import Budget, SaveAt
 
-__all__ = ["RUN_SIG", "V_RUNAWAY", "compile_kernels", "domain_status", "driver", "field_law", "hybrid_field",
+__all__ = ["RUN_SIG", "V_RUNAWAY", "load_hybrid", "domain_status", "driver", "field_law", "hybrid_field",
            "law_for", "param_vector", "pull_force_law", "run_hybrid"]
 
 #: On CD, v above this [m/s] is a runaway of the pull force (status ``V_CEILING``, ModelBreakdown "v_ceiling").
@@ -199,8 +199,9 @@ def hybrid_field(params: PeelParams, v_floor: float | None = None, *,
 _COMPILE_TIME: dict[str, float | None] = {"hybrid": None}
 
 
-def compile_kernels() -> float:
-    """Compile (or load from numba's on-disk cache) the hybrid kernel (the driver with the paper's law inlined).
+def load_hybrid() -> float:
+    """Compile (or load from numba's on-disk cache) the hybrid kernel (the driver with the paper's law inlined);
+    ``exact.compile_kernels`` warms every kernel of a user's first calls.
 
     Returns the seconds spent in this process the first time; 0 afterwards.
     """
@@ -284,7 +285,7 @@ def run_hybrid(params: PeelParams, t_end: float, s0: State, method: Method, save
     resolved: the compiled loop called until t_end, emptying its buffers and checking the wall budget between
     calls; a stop of the model or the integrator raises its documented exception with the partial trajectory.
     The first run of a process records the seconds spent compiling in ``stats.compile_time``."""
-    ct = compile_kernels()
+    ct = load_hybrid()
     traj = _drive(params, t_end, s0, method, saveat, budget, progress)
     if ct:
         traj.stats = SolverStats(**{**traj.stats.__dict__, "compile_time": ct})

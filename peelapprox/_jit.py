@@ -15,10 +15,13 @@ overwritten), and a cache written by other sources is never read.  On a numba
 without the private stamp attribute the tag goes into the cache file names
 instead.
 
-Where no cache location is writable (read-only install, HOME, XDG cache and
-``NUMBA_CACHE_DIR``: containers, HPC nodes) the kernels are compiled without
-caching, with one :class:`~peelapprox.errors.KernelCacheWarning`: the
-package works, and every new process compiles again.
+The cache files are numba's (pickles it loads), kept in a private root: ``NUMBA_CACHE_DIR`` when set and private,
+else ``~/.cache/peelapprox/numba``, every folder made 0700 and checked, every file checked before numba reads it
+(:mod:`peelapprox._kcache`, :mod:`peelapprox._private`): a cache another user could have written is refused with a
+:class:`~peelapprox.errors.KernelCacheWarning` and replaced by a private one.  Where there is no private location
+(an unwritable home and ``NUMBA_CACHE_DIR``: containers, HPC nodes) the kernels are compiled without caching,
+with one warning: the package works, and every new process compiles again.  Nothing is written beside the
+package (a read-only install works).
 
 Every function compiled by the package goes through :func:`kernel` (or, for a
 formula that plain Python and numpy call as well, :func:`jitable`); both
@@ -30,11 +33,6 @@ from __future__ import annotations
 
 import hashlib
 import inspect
-import os
-import pickle  # only its exception, for numba's cache files (numba unpickles them itself)
-import stat
-import struct
-import tempfile
 import threading
 import types
 import warnings
@@ -43,12 +41,14 @@ from pathlib import Path
 from typing import Any, Literal
 
 from numba import njit
-from numba.core import config as numba_config
 from numba.core import targetconfig as _targetconfig
 from numba.core import types as _nbtypes
 from numba.core.typing import templates as _templates
 from numba.extending import register_jitable
 
+from ._kcache import SUPPORTED as KCACHE_SUPPORTED
+from ._kcache import PrivateCache, root_problem
+from ._private import private_dir
 from .errors import KernelCacheWarning
 
 __all__ = ["kernel", "jitable", "rebind", "compile_only", "COMPILE_LOCK", "KERNEL_SOURCES", "SOURCE_TAG", "source_tag",
@@ -113,49 +113,11 @@ def caching_enabled() -> bool:
     return bool(_state["cache"])
 
 
-def unsafe_dir(d: Path) -> str | None:
-    """Why ``d`` may not hold code this process runs (None: it may): it must be a real directory (not a
-    symbolic link), owned by this user and writable by no one else, in a parent that others cannot rename it in
-    (not writable by others, or sticky as ``/tmp``), so that nobody else can plant or replace a law module or
-    numba's cache files (pickles numba loads) in it.  Created (mode 0700) if missing."""
-    try:
-        if not os.path.lexists(d):
-            d.mkdir(parents=True, exist_ok=True, mode=0o700)
-        st = os.lstat(d)
-        parent = os.stat(d.parent)
-    except OSError as exc:
-        return f"cannot be created or read ({exc.strerror or exc})"
-    if stat.S_ISLNK(st.st_mode):
-        return "is a symbolic link"
-    if not stat.S_ISDIR(st.st_mode):
-        return "is not a directory"
-    if hasattr(os, "geteuid") and st.st_uid != os.geteuid():
-        return f"is owned by another user (uid {st.st_uid})"
-    if st.st_mode & 0o022:
-        return f"is writable by {'others' if st.st_mode & 0o002 else 'its group'} (mode {stat.S_IMODE(st.st_mode):o})"
-    if parent.st_mode & 0o002 and not parent.st_mode & stat.S_ISVTX:
-        return f"is in a directory others can write to without the sticky bit (mode {stat.S_IMODE(parent.st_mode):o})"
-    try:
-        with tempfile.NamedTemporaryFile(dir=d, prefix=".probe-"):
-            pass
-    except OSError as exc:
-        return f"is not writable ({exc.strerror or exc})"
-    return None
-
-
-def _check_numba_cache_dir() -> None:
-    """Once per process: a ``NUMBA_CACHE_DIR`` that others could write to (numba loads the pickles it finds there)
-    turns caching off, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why."""
-    if _state.get("dir_checked"):
-        return
-    _state["dir_checked"] = True
-    env = getattr(numba_config, "CACHE_DIR", "") or ""
-    why = unsafe_dir(Path(env)) if env else None
-    if why is not None:
-        _state["cache"] = False
-        warnings.warn(f"peelapprox: NUMBA_CACHE_DIR={env!r} {why}; numba loads the pickled files it finds there, so "
-                      "kernels are compiled without caching in this process (point NUMBA_CACHE_DIR to a directory "
-                      "of yours that only you can write)", KernelCacheWarning, stacklevel=4)
+def unsafe_dir(d: Path, *, replace: bool = False) -> str | None:
+    """Why ``d`` may not hold code this process runs (None: it may): :func:`peelapprox._private.private_dir` (a real
+    directory of this user's that no one else can write, every parent checked, made 0700 if missing; with
+    ``replace``, one the package made itself is replaced when it fails)."""
+    return private_dir(d, replace=replace)
 
 
 def _stamp_with_tag(dispatcher: Any) -> bool:
@@ -170,37 +132,7 @@ def _stamp_with_tag(dispatcher: Any) -> bool:
     if cf is None or not hasattr(cf, "_source_stamp"):
         return False
     cf._source_stamp = (cf._source_stamp, SOURCE_TAG)
-    _corrupt_is_miss(cf)
     return True
-
-
-#: What unpickling a truncated or garbled cache file raises (pickle's own errors and those of the objects it
-#: rebuilds from damaged bytes).
-_CORRUPT = (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError, IndexError,
-            KeyError, struct.error, UnicodeDecodeError, MemoryError)
-
-
-def _corrupt_is_miss(cf: Any) -> None:
-    """Make a corrupt numba cache file (a truncated index, a garbled data file) a cache miss, as a missing one
-    is, instead of an ``UnpicklingError`` out of the user's call: numba then compiles and writes the files anew.
-    Wraps numba's private ``_load_index`` and ``_load_data`` of the dispatcher's cache file (numba 0.58-0.68)."""
-    load_index, load_data = getattr(cf, "_load_index", None), getattr(cf, "_load_data", None)
-    if load_index is None or load_data is None:
-        return
-
-    def _load_index() -> Any:
-        try:
-            return load_index()
-        except _CORRUPT:
-            return {}
-
-    def _load_data(name: Any) -> Any:
-        try:
-            return load_data(name)
-        except _CORRUPT:
-            return None
-
-    cf._load_index, cf._load_data = _load_index, _load_data
 
 
 def _renamed(fn: Callable, name: str) -> Callable:
@@ -421,30 +353,39 @@ def _dispatcher(fn: Callable, inline: Literal["never", "always"], fastmath: bool
     """The numba dispatcher of :func:`_compile`."""
     if not outside:
         _check_source(fn)
-    _check_numba_cache_dir()
     if name is not None:  # distinct cache files for the pieces of each vector field (make_dop853)
         fn = _renamed(fn, name.replace("<locals>.", "").replace(".", "_"))
     if _state["cache"]:
         try:
-            d = _njit(cache=True, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(fn)
+            d = _cached(fn, inline, fastmath, nrt)
             if not _stamp_with_tag(d):  # a numba without the private stamp: tag the cache file names instead
-                # (old files then accumulate in __pycache__)
+                # (old files then accumulate in the cache folder)
                 base = fn.__qualname__.replace("<locals>.", "").replace(".", "_")
-                d = _njit(cache=True, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(
-                    _renamed(fn, f"{base}__src{SOURCE_TAG}"))
+                d = _cached(_renamed(fn, f"{base}__src{SOURCE_TAG}"), inline, fastmath, nrt)
             return d
-        except RuntimeError as e:  # numba: "cannot cache function ...: no locator available"
+        except RuntimeError as e:  # no private cache location: "cannot cache function ...: no locator available"
             if "no locator available" not in str(e):
                 raise
             _state["cache"] = False
             warnings.warn(
-                "peelapprox: no writable numba cache location (NUMBA_CACHE_DIR, the package's __pycache__, "
-                "the user cache directory); kernels are compiled without caching, so every new process "
-                "compiles them again (~20 s). Set NUMBA_CACHE_DIR to a writable directory to cache them.",
+                f"peelapprox: no private kernel cache ({root_problem() or 'no usable location'}); kernels are "
+                "compiled without caching, so every new process compiles them again (~20 s). Set NUMBA_CACHE_DIR "
+                "to a directory of yours that only you can write to cache them.",
                 KernelCacheWarning,
                 stacklevel=3,
             )
     return _njit(cache=False, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(fn)
+
+
+def _cached(fn: Callable, inline: Literal["never", "always"], fastmath: bool, nrt: bool) -> Any:
+    """numba's dispatcher of ``fn`` with its cache in the private root (:class:`peelapprox._kcache.PrivateCache`),
+    never in numba's own locations.  Raises numba's "no locator available" RuntimeError when there is none."""
+    if not KCACHE_SUPPORTED:
+        raise RuntimeError(f"cannot cache function {fn.__qualname__!r}: no locator available (this numba's cache "
+                           "internals are not the ones peelapprox checks)")
+    d = _njit(cache=False, inline=inline, fastmath=fastmath, _nrt=nrt, nogil=True)(fn)
+    d._cache = PrivateCache(d.py_func)
+    return d
 
 
 def jitable(fn: Callable) -> Callable:

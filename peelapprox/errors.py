@@ -110,4 +110,6 @@ class SolverFailure(RuntimeError):
 
 
 class KernelCacheWarning(RuntimeWarning):
-    """No writable numba cache location: kernels are compiled without on-disk caching (see ``peelapprox._jit``)."""
+    """A kernel or law cache that another user could have written was refused (and replaced by a private one), or
+    there is no private cache location and kernels are compiled without on-disk caching (docs/usage.md, "Where
+    the caches are, and what is refused")."""

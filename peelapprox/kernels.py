@@ -29,6 +29,7 @@ import numpy as np
 from numba import types as _nb
 
 from . import _status as status
+from ._cachestatus import cache_status, cpu_name, record_warmup
 from ._deadline import Expired as BuildExpired
 from ._deadline import caller_budget
 from ._diffsl import (
@@ -108,6 +109,7 @@ __all__ = [
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
     "diffsl_inputs", "diffsl_model", "import_optional",
     "BuildExpired", "caller_budget",  # a public call's max_wall handed down to the law compilation it triggers
+    "cache_status", "cpu_name", "record_warmup",  # the private kernel cache: its state, the warm-up's record
 ]
 
 def regularized_parameters(params, eps: float, laws: tuple[str, ...] = ("paper",)) -> np.ndarray:

@@ -42,6 +42,7 @@ API = {
         "STEP_BUDGET",
         "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
+        "WarmupReport",
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",
         "window_run", "attractors", "Attractor", "DEFAULT_MAX_WALL", "lyapunov", "lyapunov_tangent",
         "lyapunov_return_map", "LyapunovResult", "benettin", "BenettinResult", "check_lyapunov_options",
@@ -86,7 +87,8 @@ API = {
     },
     # the door through which exact (and comparisons) reach the compiled model and integrator
     "peelapprox.kernels": {
-        "ALL_LAWS", "BuildExpired", "CompiledLaw", "caller_budget", "compile_only", "pack_inlined", "pack_law",
+        "ALL_LAWS", "BuildExpired", "CompiledLaw", "caller_budget", "cache_status", "cpu_name", "record_warmup",
+        "compile_only", "pack_inlined", "pack_law",
         "U_ZERO", "compiled_law", "law_domain", "rebind", "regularized_law_field", "VARIANT_MODELS", "variant_field",
         "variant_parameters", "bound_variant_field",
         "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "LAWS", "LAW_FP", "LAW_FPP", "LAW_LNV",

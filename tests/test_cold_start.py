@@ -15,6 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 
 #: Prints, as JSON, which of the kernels a plain hybrid simulate must not need were compiled (or loaded).
@@ -70,3 +72,60 @@ def test_plain_hybrid_simulate_compiles_only_the_hybrid_driver(tmp_path):
     assert second["at_import"] == 0
     assert (second["driver"], second["misses"], second["hits"]) == (1, 0, 1)
     assert second["compiled"] == first["compiled"]
+
+
+#: A user's first calls after the README's set-up, other parameters than the warm-up's own: what they compiled.
+FIRST_CALLS = """
+import json
+from numba.core import event
+rec = event.RecordingListener()
+event.register("numba:compile", rec)
+import exact
+from peelapprox import PeelParams, approximate_attractor
+tr = exact.simulate(PeelParams(V=1.2, I=1e-4), 0.05)
+a = approximate_attractor(PeelParams(V=1.0, I=1e-2))
+o = exact.attractor_observables(PeelParams(V=1.0, I=1e-5), t_transient=0.3, t_window=0.3)
+names = [e.data["dispatcher"].py_func.__qualname__ for _, e in rec.buffer if e.is_start]
+print(json.dumps(dict(compiled=names, n=len(tr.t))))
+"""
+
+
+def _run(tmp: Path, args: list[str], extra: dict | None = None) -> str:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp / "numba"), PEELAPPROX_CACHE_DIR=str(tmp / "laws"),
+               XDG_CACHE_HOME=str(tmp / "xdg"), PYTHONDONTWRITEBYTECODE="1", **(extra or {}))
+    r = subprocess.run([sys.executable, *args], cwd=tmp, env=env, capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stderr[-3000:]
+    return r.stdout
+
+
+def test_after_warmup_the_first_calls_compile_nothing(tmp_path):
+    """Hypothesis: after ``peelapprox warmup`` (the README's set-up), a new process's first ``simulate``,
+    ``approximate_attractor`` and ``attractor_observables`` (other parameters than the warm-up's) compile no
+    function at all: every kernel they need is loaded from the private cache.  ``peelapprox doctor`` then says the
+    cache is warm for this CPU, with a fresh record.  Exact counts (numba's compile events); no timing (measured by
+    ``python -m comparisons.benchmark.cold_start``)."""
+    report = json.loads(_run(tmp_path, ["-m", "peelapprox", "warmup", "--format", "json"]))
+    assert report["status"] == 0 and report["cache"] == str(tmp_path / "numba"), report
+    assert [j["name"] for j in report["jobs"]] == ["simulate", "approximate_attractor", "attractor_observables"]
+    assert report["jobs"][0]["compiled"] > 0  # an empty cache: the warm-up compiled
+    out = json.loads(_run(tmp_path, ["-c", FIRST_CALLS]).strip().splitlines()[-1])
+    assert out["compiled"] == [] and out["n"] > 10, out["compiled"]
+    doc = json.loads(_run(tmp_path, ["-m", "peelapprox", "doctor", "--format", "json"]))
+    assert doc["verdict"].startswith("warm for this CPU"), doc["verdict"]
+    assert [w["fresh"] and w["this_cpu"] for w in doc["warmups"]] == [True]
+    assert doc["folders"] and all(f["problem"] is None and f["not_private"] == 0 for f in doc["folders"])
+
+
+@pytest.mark.slow
+def test_a_generic_warmup_serves_generic_processes(tmp_path):
+    """Hypothesis: ``peelapprox warmup --cpu generic`` (compiled in a child with NUMBA_CPU_NAME=generic) makes a new
+    process run with NUMBA_CPU_NAME=generic compile nothing for its first calls, and ``doctor`` in a process
+    compiling for the host CPU says the warm-up is for another CPU (never "warm").  Exact counts.  Slow: a full
+    compilation of the first calls."""
+    report = json.loads(_run(tmp_path, ["-m", "peelapprox", "warmup", "--cpu", "generic", "--format", "json"]))
+    assert report["status"] == 0 and report["cpu"] == "generic", report
+    out = json.loads(_run(tmp_path, ["-c", FIRST_CALLS], {"NUMBA_CPU_NAME": "generic"}).strip().splitlines()[-1])
+    assert out["compiled"] == [], out["compiled"]
+    doc = json.loads(_run(tmp_path, ["-m", "peelapprox", "doctor", "--format", "json"]))
+    assert doc["cpu"] != "generic" and "NUMBA_CPU_NAME=generic" in doc["verdict"], doc["verdict"]

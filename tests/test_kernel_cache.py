@@ -58,7 +58,7 @@ def _probe(cwd: Path, env_extra: dict | None = None, simulate: bool = False) -> 
     import json
 
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
-    env.update(PYTHONDONTWRITEBYTECODE="1", **(env_extra or {}))
+    env.update({"PYTHONDONTWRITEBYTECODE": "1", "XDG_CACHE_HOME": str(cwd / "xdg"), **(env_extra or {})})
     code = PROBE.replace("{simulate}", "True" if simulate else "False")
     r = subprocess.run([sys.executable, "-c", code], cwd=cwd, env=env, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr[-3000:]
@@ -105,11 +105,12 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     loaded from the cache by a second process (a cache hit, no miss, one signature) and compiled anew after the
     change (a miss)."""
     _copy_packages(tmp_path)
-    before = _probe(tmp_path)  # compiles and caches in the copy's __pycache__
+    before = _probe(tmp_path)  # compiles and caches in $XDG_CACHE_HOME/peelapprox/numba (the private root)
     assert abs(before["kern"] - before["ref"]) <= 1e-12 * abs(before["ref"])
     assert before["kern_law"] == before["kern"]  # the paper law through the ABI is the inlined law, bitwise
     assert (before["run_hits"], before["run_misses"], before["n_run"]) == (0, 1, 1)
-    assert list((tmp_path / "exact" / "__pycache__").glob("*pull_force*.nbi")), "the first run did not cache"
+    assert list((tmp_path / "xdg" / "peelapprox" / "numba").glob("exact_*/*pull_force*.nbi")), "no cache written"
+    assert not list(tmp_path.glob("*/__pycache__/*.nbi")), "numba wrote beside the package"
     again = _probe(tmp_path)
     assert (again["run_hits"], again["run_misses"], again["n_run"]) == (1, 0, 1)
     assert again["kern_law"] == before["kern_law"]

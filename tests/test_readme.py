@@ -42,6 +42,7 @@ SLOW = {
     "peelapprox sweep": "16 exact runs of 50 s, ~11 s",
     "peelapprox figures": "the paper's Figs. 2-9, ~11 s",
     "peelapprox basins": "54 starts of 60 s each with their orbits, ~24 s",
+    "peelapprox warmup": "compiles the first calls' kernels when not cached (--cpu generic: always in CI), ~80 s",
 }
 
 

@@ -15,6 +15,7 @@ import ast
 import json
 import os
 import stat
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -381,7 +382,8 @@ def test_a_parent_others_can_write_is_refused(tmp_path, monkeypatch):
 
 def test_a_numba_cache_dir_others_can_write_is_not_used(tmp_path, monkeypatch):
     """Hypothesis: a ``NUMBA_CACHE_DIR`` others can write to (a sticky 1777 directory: anyone may plant a pickled
-    index there, which numba loads) turns caching off with a warning; the kernel still computes (x + 2 = 3
+    index there, which numba loads) is refused with a warning naming it, and the private default root
+    (``$XDG_CACHE_HOME/peelapprox/numba``, made 0700) caches the kernel instead; the kernel computes (x + 2 = 3
     exactly) and nothing is read from or written to that directory."""
     import numba
 
@@ -391,15 +393,16 @@ def test_a_numba_cache_dir_others_can_write_is_not_used(tmp_path, monkeypatch):
     d.mkdir()
     os.chmod(d, 0o1777)
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(d))
-    monkeypatch.setitem(J._state, "dir_checked", False)
-    monkeypatch.setitem(J._state, "cache", True)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
 
     def add_two(x):
         return x + 2.0
 
-    with pytest.warns(KernelCacheWarning, match="NUMBA_CACHE_DIR"):
+    with pytest.warns(KernelCacheWarning, match="NUMBA_CACHE_DIR.*writable by others.*cached in"):
         k = J.kernel(outside=True)(add_two)
     assert k(1.0) == 3.0 and list(d.iterdir()) == []
+    root = tmp_path / "xdg" / "peelapprox" / "numba"
+    assert list(root.glob("*/*add_two*.nbi")) and stat.S_IMODE(root.stat().st_mode) == 0o700
 
 
 def test_a_good_cache_is_used_without_a_warning(law_dir, recwarn):
@@ -437,6 +440,275 @@ def test_a_truncated_numba_index_is_a_cache_miss(tmp_path, monkeypatch):
     for f in (tmp_path / "nb").rglob("*add_one*.nbc"):
         f.write_bytes(b"\x80\x04garbage")
     assert kernel(outside=True)(add_one)(2.5) == 3.5
+
+
+# ------------------------------------------------------------------ the kernel cache (numba's pickles), issue 34
+#: uid of the "other user" the tests below make owner of a file or folder (as root: ``os.chown``).
+_NOBODY = 65534
+_as_root = pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0,
+                              reason="simulating another user's file needs root (os.chown)")
+
+
+class _Payload:
+    """Unpickled, runs ``touch marker``: what another user would plant as numba's index or data file."""
+
+    def __init__(self, marker: Path):
+        self.marker = str(marker)
+
+    def __reduce__(self):
+        return (os.system, (f"touch {self.marker}",))
+
+
+def _plant(path: Path, marker: Path) -> None:
+    import pickle
+
+    path.write_bytes(pickle.dumps(_Payload(marker)))
+
+
+@pytest.fixture
+def kroot(tmp_path, monkeypatch):
+    """A fresh private kernel root (``NUMBA_CACHE_DIR``, as numba.config reads it) and home cache."""
+    import numba
+
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "nb"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    return tmp_path / "nb"
+
+
+def _mul_three(x):
+    return 3.0 * x
+
+
+def _compile_mul_three() -> object:
+    """A new dispatcher of the same function (what a new process makes): its cache is looked up on disk."""
+    from peelapprox._jit import kernel
+
+    return kernel(outside=True)(_mul_three)
+
+
+def _index_of(root: Path) -> Path:
+    found = list(root.glob("*/*_mul_three*.nbi"))
+    assert len(found) == 1, found
+    return found[0]
+
+
+def test_cache_folders_and_files_are_private_under_umask_000(kroot):
+    """Hypothesis: under ``umask 000`` (numba made its per-module folders 0777 there) every folder of the kernel
+    cache is made 0700 and every file 0600: the modes do not follow the umask.  Exact: the modes compared."""
+    old = os.umask(0)
+    try:
+        assert _compile_mul_three()(2.0) == 6.0
+    finally:
+        os.umask(old)
+    paths = [kroot, *kroot.rglob("*")]
+    assert len(paths) >= 3
+    for p in paths:
+        want = 0o700 if p.is_dir() else 0o600
+        assert stat.S_IMODE(p.lstat().st_mode) == want, (p, oct(p.lstat().st_mode))
+
+
+def test_a_planted_index_in_a_loose_folder_is_not_loaded(kroot, tmp_path):
+    """The probe's reproducer 1: a module folder left writable by others (numba under ``umask 000``) and an index
+    replaced by a pickle that runs a command.  Hypothesis: the folder is refused with a KernelCacheWarning and
+    replaced by a private one (0700) before numba reads anything; the marker is not created; the kernel is
+    compiled anew and computes 3 * 2 = 6 exactly."""
+    _compile_mul_three()(1.0)
+    index = _index_of(kroot)
+    os.chmod(index.parent, 0o777)
+    marker = tmp_path / "ran"
+    _plant(index, marker)
+    with pytest.warns(KernelCacheWarning, match="writable by others.*replaces it"):
+        k = _compile_mul_three()
+    assert k(2.0) == 6.0 and not marker.exists()
+    assert stat.S_IMODE(index.parent.stat().st_mode) == 0o700
+    assert sum(k.stats.cache_misses.values()) == 1 and sum(k.stats.cache_hits.values()) == 0
+
+
+@pytest.mark.parametrize("how", ["world-writable", "symlink", pytest.param("foreign", marks=_as_root)])
+def test_a_planted_index_file_is_not_loaded(kroot, tmp_path, how):
+    """Hypothesis: an index file in a private folder that is writable by others (0666: numba under umask 000), a
+    symbolic link, or owned by another user (root chowns it to nobody) is not unpickled: a KernelCacheWarning
+    names why, the file is removed, the kernel compiles anew (3 * 2 = 6 exactly), the marker is not created."""
+    _compile_mul_three()(1.0)
+    index = _index_of(kroot)
+    marker = tmp_path / "ran"
+    if how == "symlink":
+        target = tmp_path / "evil.nbi"
+        _plant(target, marker)
+        index.unlink()
+        index.symlink_to(target)
+        says = "symbolic link"
+    else:
+        _plant(index, marker)
+        if how == "foreign":
+            os.chown(index, _NOBODY, _NOBODY)
+            says = "owned by another user"
+        else:
+            os.chmod(index, 0o666)
+            says = "writable by others"
+    with pytest.warns(KernelCacheWarning, match=f"{says}.*not read"):
+        k = _compile_mul_three()
+        assert k(2.0) == 6.0
+    assert not marker.exists() and sum(k.stats.cache_misses.values()) == 1
+    assert not index.is_symlink() and index.stat().st_uid == os.geteuid()
+    assert stat.S_IMODE(index.stat().st_mode) == 0o600  # written anew, private
+
+
+def test_a_planted_data_file_is_not_loaded(kroot, tmp_path):
+    """Hypothesis: the same for numba's data file (``*.nbc``, also a pickle) made writable by others: not read,
+    removed, compiled anew (3 * 2 = 6), the marker not created."""
+    _compile_mul_three()(1.0)
+    data = list(kroot.glob("*/*_mul_three*.nbc"))
+    assert len(data) == 1
+    marker = tmp_path / "ran"
+    _plant(data[0], marker)
+    os.chmod(data[0], 0o646)
+    with pytest.warns(KernelCacheWarning, match="writable by others.*not read"):
+        k = _compile_mul_three()
+        assert k(2.0) == 6.0
+    assert not marker.exists()
+
+
+def test_a_planted_index_of_an_expression_law_is_not_loaded(law_dir, kroot, tmp_path):
+    """The probe's reproducer 1 through an expression law: its numba index (in the kernels' private root, no longer
+    in the law directory's ``__pycache__``) made writable by others and replaced by a pickle that runs a command.
+    Hypothesis: not unpickled (a KernelCacheWarning), the marker not created, the law still f(1) = 211 exactly."""
+    law = PeelForce.expression(_LAW)
+    _check_law(law)
+    assert not (law_dir / "__pycache__").exists()
+    index = list(kroot.glob("laws_*/law_*.nbi"))
+    assert len(index) == 1
+    marker = tmp_path / "ran"
+    _plant(index[0], marker)
+    os.chmod(index[0], 0o666)
+    C._EXPRESSION_KERNELS.clear()
+    with pytest.warns(KernelCacheWarning, match="writable by others.*not read"):
+        _check_law(law)
+    assert not marker.exists()
+
+
+@_as_root
+def test_a_foreign_module_folder_is_replaced(kroot, tmp_path):
+    """Hypothesis: a module folder owned by another user (mode 0755: only that user can write it, and did) is
+    refused and replaced by a private one of ours; the planted index in it is never read."""
+    _compile_mul_three()(1.0)
+    index = _index_of(kroot)
+    marker = tmp_path / "ran"
+    _plant(index, marker)
+    os.chown(index, _NOBODY, _NOBODY)
+    os.chown(index.parent, _NOBODY, _NOBODY)
+    os.chmod(index.parent, 0o755)
+    with pytest.warns(KernelCacheWarning, match="owned by another user"):
+        k = _compile_mul_three()
+        assert k(2.0) == 6.0
+    assert not marker.exists() and index.parent.stat().st_uid == os.geteuid()
+
+
+@_as_root
+@pytest.mark.parametrize("cache", ["laws", "kernels"])
+def test_a_cache_inside_another_users_directory_is_refused(tmp_path, monkeypatch, cache):
+    """The probe's reproducer 2: a cache directory inside a directory owned by another user (mode 0755), who can
+    swap it for one holding a planted index.  Hypothesis: refused before anything is read, with a warning naming
+    the parent; the law (PEELAPPROX_CACHE_DIR: a private temporary directory instead) or the kernel
+    (NUMBA_CACHE_DIR: the private default root instead) still computes exactly."""
+    import numba
+
+    other = tmp_path / "other"
+    other.mkdir()
+    os.chmod(other, 0o755)
+    os.chown(other, _NOBODY, _NOBODY)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
+    if cache == "laws":
+        monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(other / "laws"))
+        with pytest.warns(KernelCacheWarning, match="owned by another user"):
+            _check_law(PeelForce.expression(_LAW))
+        assert LC._FALLBACK["dir"] != other / "laws"
+    else:
+        monkeypatch.setattr(numba.config, "CACHE_DIR", str(other / "nb"))
+        with pytest.warns(KernelCacheWarning, match="NUMBA_CACHE_DIR.*owned by another user"):
+            assert _compile_mul_three()(2.0) == 6.0
+    assert list(other.iterdir()) == [] or cache == "kernels" and not list(other.rglob("*.nbi"))
+
+
+@pytest.mark.parametrize("cache", ["laws", "kernels"])
+def test_a_symlinked_path_component_is_refused(tmp_path, monkeypatch, cache):
+    """Hypothesis: a cache path with a symbolic link as an intermediate component (``link/laws`` with ``link ->
+    real``) is refused with a warning naming the link, and nothing is written through it."""
+    import numba
+
+    real = tmp_path / "real"
+    real.mkdir(mode=0o700)
+    (tmp_path / "link").symlink_to(real)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    monkeypatch.setattr(C, "_EXPRESSION_KERNELS", {})
+    monkeypatch.setattr(LC, "_FALLBACK", {})
+    if cache == "laws":
+        monkeypatch.setenv("PEELAPPROX_CACHE_DIR", str(tmp_path / "link" / "laws"))
+        with pytest.warns(KernelCacheWarning, match="symbolic link in its path"):
+            _check_law(PeelForce.expression(_LAW))
+    else:
+        monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "link" / "nb"))
+        with pytest.warns(KernelCacheWarning, match="symbolic link in its path"):
+            assert _compile_mul_three()(2.0) == 6.0
+    assert list(real.iterdir()) == []
+
+
+def test_a_good_kernel_cache_is_loaded_without_a_warning(kroot, recwarn):
+    """Hypothesis: what this package wrote into its private cache is loaded by the next dispatcher (one hit, no
+    miss), with no warning: the checks refuse only what others could have written."""
+    _compile_mul_three()(1.0)
+    k = _compile_mul_three()
+    assert k(2.0) == 6.0
+    assert (sum(k.stats.cache_hits.values()), sum(k.stats.cache_misses.values())) == (1, 0)
+    assert not [w for w in recwarn if issubclass(w.category, KernelCacheWarning)]
+
+
+_SIMULATE = """
+import json, warnings
+warnings.simplefilter("always")
+with warnings.catch_warnings(record=True) as w:
+    from exact import simulate
+    from peelapprox import PeelParams
+    tr = simulate(PeelParams(V=1, I=1e-5), 0.01)
+print(json.dumps(dict(n=len(tr.t), F=float(tr.F[-1]), warnings=[str(x.message) for x in w
+                                                                if type(x.message).__name__ == "KernelCacheWarning"])))
+"""
+
+
+@pytest.mark.slow
+def test_the_probe_reproducer_end_to_end(tmp_path):
+    """The probe's reproducer 1 as it ran: ``simulate(PeelParams(V=1, I=1e-5), 0.01)`` in a process under
+    ``umask 000``, then every index file of its cache replaced by a pickle that runs a command and its folders
+    made 0777, then the same call in a new process.  Hypothesis: the folders were made 0700 (nothing to replace
+    them in), the planted files are refused with a warning, the marker is not created, and the second run gives
+    bitwise the first's final force (the same kernels, compiled anew).  Slow: two compilations of the solver."""
+    env = {k: x for k, x in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp_path / "nb"), XDG_CACHE_HOME=str(tmp_path / "xdg"),
+               PYTHONDONTWRITEBYTECODE="1")
+
+    def run() -> dict:
+        r = subprocess.run([sys.executable, "-c", _SIMULATE], cwd=tmp_path, env=env, capture_output=True,
+                           text=True, timeout=900, preexec_fn=lambda: os.umask(0))
+        assert r.returncode == 0, r.stderr[-3000:]
+        return json.loads(r.stdout.strip().splitlines()[-1])
+
+    first = run()
+    assert first["warnings"] == [] and first["n"] > 10
+    folders = [p for p in (tmp_path / "nb").rglob("*") if p.is_dir()]
+    assert folders and all(stat.S_IMODE(p.stat().st_mode) == 0o700 for p in folders)
+    marker = tmp_path / "ran"
+    indexes = list((tmp_path / "nb").rglob("*.nbi"))
+    assert indexes
+    for f in indexes:
+        _plant(f, marker)
+        os.chmod(f, 0o666)
+    for p in folders:
+        os.chmod(p, 0o777)
+    second = run()
+    assert not marker.exists()
+    assert second["warnings"] and second["F"] == first["F"] and second["n"] == first["n"]
 
 
 # ------------------------------------------------------------------------------------- nothing to execute

@@ -12,6 +12,11 @@ second process reusing those directories (every kernel is loaded from numba's on
   compiled, callees and numba's own helpers included): 0 when warm means the second process only loaded;
 * ``loaded`` -- kernels loaded from the on-disk cache (numba's dispatcher cache hits).
 
+With ``--first-call [NAME]`` (default ``simulate hybrid``) it prints the first-call table instead: the entry point's
+first call in a new process for a **fresh install without warm-up** (empty caches), **after warm-up** (new empty
+caches, ``exact.compile_kernels()`` -- what ``peelapprox warmup`` runs -- in one process, then the entry point in a
+new one) and **warm** (a second process after the first), with cold/warm and after-warm-up/warm ratios.
+
 With ``--detail NAME`` the cold run of one entry point prints which functions compiled and their exclusive
 compile time (its own time, the nested compilations of its callees excluded), largest first.
 """
@@ -27,7 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
-__all__ = ["ENTRY_POINTS", "measure", "detail", "main"]
+__all__ = ["ENTRY_POINTS", "measure", "first_call", "detail", "main"]
 
 #: name -> (imports, the call): the code a new user's first call runs.
 ENTRY_POINTS: dict[str, tuple[str, str]] = {
@@ -123,6 +128,38 @@ def measure(name: str) -> dict:
     return dict(name=name, cold=cold, warm=warm)
 
 
+_WARMUP = "import exact\nr = exact.compile_kernels()\nassert r.status == 0, r.message\nprint('{}')"
+
+
+def first_call(name: str = "simulate hybrid") -> dict:
+    """The first-call rows of ``name`` (module docstring): ``fresh``, ``after_warmup``, ``warm`` (each as a row of
+    :func:`measure`), and ``warmup`` (the warm-up process itself)."""
+    imports, call = ENTRY_POINTS[name]
+    code = _CHILD.format(imports=imports, call=call)
+    with tempfile.TemporaryDirectory(prefix="cold-start-") as d:
+        env = _env(Path(d))
+        fresh = _run_child(code, env)
+        warm = _run_child(code, env)
+    with tempfile.TemporaryDirectory(prefix="cold-start-") as d:
+        env = _env(Path(d))
+        t = time.perf_counter()
+        _run_child(_WARMUP, env)
+        warmup = dict(wall=time.perf_counter() - t)
+        after = _run_child(code, env)
+    return dict(name=name, fresh=fresh, after_warmup=after, warm=warm, warmup=warmup)
+
+
+def _first_call_table(r: dict) -> str:
+    lines = [f"first call of `{r['name']}` in a new process (warm-up itself: {r['warmup']['wall']:.1f} s wall)", "",
+             "| state | wall [s] | call [s] | CPU [s] | compiled | loaded | wall / warm wall |", "|" + "---|" * 7]
+    for key, label in (("fresh", "fresh install, no warm-up"), ("after_warmup", "after `peelapprox warmup`"),
+                       ("warm", "warm (second process)")):
+        x = r[key]
+        lines.append(f"| {label} | {x['wall']:.2f} | {x['call']:.2f} | {x['cpu']:.2f} | {x['compiled']} | "
+                     f"{x['loaded']} | {x['wall'] / r['warm']['wall']:.2f} |")
+    return "\n".join(lines)
+
+
 def detail(name: str) -> str:
     """The functions compiled by a cold run of ``name`` with their exclusive compile times (module docstring)."""
     imports, call = ENTRY_POINTS[name]
@@ -152,11 +189,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=Path, help="also write the rows as JSON to this file")
     ap.add_argument("--only", action="append", choices=list(ENTRY_POINTS), help="measure only this entry point "
                     "(repeatable; default: all)")
+    ap.add_argument("--first-call", nargs="?", const="simulate hybrid", choices=list(ENTRY_POINTS), default=None,
+                    help="print the first-call table (fresh install, after warm-up, warm) of this entry point "
+                         "(default: simulate hybrid) and exit")
     ap.add_argument("--detail", choices=list(ENTRY_POINTS), help="print what a cold run of this entry point "
                     "compiles, with exclusive compile times, and exit")
     args = ap.parse_args(argv)
     if args.detail:
         print(detail(args.detail))
+        return 0
+    if args.first_call:
+        r = first_call(args.first_call)
+        print(_first_call_table(r))
+        if args.json:
+            args.json.write_text(json.dumps(r, indent=1))
         return 0
     rows = []
     for name in args.only or list(ENTRY_POINTS):

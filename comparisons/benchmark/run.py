@@ -30,7 +30,7 @@ def run_benchmark(*, quick: bool = False, peers: Sequence[str] | None = None,
     import platform
 
     t_start = time.perf_counter()
-    compile_kernels()
+    compile_kernels(calls=("simulate",))
     if peers is None:
         try:
             peers = available_peers()

@@ -150,7 +150,7 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
 
     rec = _empty_record(point)
     if point.method == "hybrid":
-        exact.compile_kernels()
+        exact.compile_kernels(calls=("simulate",))
     params = PeelParams(V=point.V, I=point.I, k=point.k, geometry=point.geometry)
     t0 = time.perf_counter()
     try:

@@ -1,7 +1,8 @@
 """The on-disk cache of the compiled expression laws: where it is, and the checks that keep it from being planted.
 
-:func:`law_dir` is the verified directory (``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``; it, its
-``__pycache__`` and ``NUMBA_CACHE_DIR`` must pass :func:`peelapprox._jit.unsafe_dir`), else a private temporary
+:func:`law_dir` is the verified directory (``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``; it and its
+parents must pass :func:`peelapprox._jit.unsafe_dir`; numba's cache of the laws is in the kernels' private root),
+else a private temporary
 one with a :class:`~peelapprox.errors.KernelCacheWarning`; :func:`read_verified` reads a law module without
 following links and only from a regular file of this user's; :func:`write_atomic` replaces it.  What runs is
 decided by :func:`peelapprox.law._kernels.expression_kernel`, which compares the file with the module it renders.
@@ -18,45 +19,32 @@ import warnings
 from pathlib import Path
 
 from .._jit import unsafe_dir
+from .._private import cache_home
 from ..errors import KernelCacheWarning
 
-__all__ = ["MAX_MODULE_BYTES", "cache_dir", "law_dir", "numba_cache_dir", "read_verified", "write_atomic"]
+__all__ = ["MAX_MODULE_BYTES", "cache_dir", "law_dir", "read_verified", "write_atomic"]
 
 
 def cache_dir() -> Path:
-    """Where expression laws are written: ``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``."""
+    """Where expression laws are written: ``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``
+    (``$XDG_CACHE_HOME/peelapprox/laws``)."""
     env = os.environ.get("PEELAPPROX_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "peelapprox" / "laws"
+    return Path(env) if env else cache_home() / "peelapprox" / "laws"
 
 
 #: The largest law module read back from the cache [bytes] (a rendered law is a few kB).
 MAX_MODULE_BYTES = 1 << 20
 
-
-def numba_cache_dir() -> Path:
-    """The directory numba's caches of this process go to when ``NUMBA_CACHE_DIR`` is set (its pickled index
-    and data files are loaded by numba: it must be as private as the law cache), else the law cache's
-    ``__pycache__``."""
-    import numba
-
-    env = getattr(numba.config, "CACHE_DIR", "") or ""
-    return Path(env) if env else cache_dir() / "__pycache__"
-
-
 _FALLBACK: dict[str, Path] = {}
 
 
 def law_dir() -> Path:
-    """The verified cache directory (:func:`cache_dir` and its ``__pycache__``, where numba writes), else a
-    private temporary one for this process, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why."""
+    """The verified cache directory (:func:`cache_dir`, which must pass :func:`peelapprox._jit.unsafe_dir`: its
+    parents too; the default one, the package's own, is replaced when it fails), else a private temporary one for
+    this process, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why.  numba's cache of the laws
+    is not here but in the kernels' private root (:mod:`peelapprox._kcache`)."""
     d = cache_dir()
-    why = unsafe_dir(d)
-    if why is None:  # numba's cache files (pickles it loads) go to __pycache__ beside the module, or NUMBA_CACHE_DIR
-        nb = numba_cache_dir()
-        why = unsafe_dir(nb)
-        if why is not None:
-            why = (f"has a __pycache__ that {why}" if nb == d / "__pycache__" else
-                   f"is fine, but NUMBA_CACHE_DIR={str(nb)!r}, where numba keeps the compiled laws, {why}")
+    why = unsafe_dir(d, replace="PEELAPPROX_CACHE_DIR" not in os.environ)
     if why is None:
         return d
     if "dir" not in _FALLBACK:

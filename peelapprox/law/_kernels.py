@@ -2,7 +2,7 @@
 
 :func:`family_kernel` compiles a family's law from :mod:`peelapprox.law._generated` (numba's on-disk cache: once
 per machine).  :func:`expression_kernel` renders an expression law (:func:`peelapprox.law._render.render_law`)
-into a module of the user's cache directory (``PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``;
+into a module of the user's private cache directory (``PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``;
 :mod:`peelapprox.law._cache`), named by the SHA-256 of its canonical text and :func:`codegen_version` (a changed
 expression or renderer is a new file, never a stale kernel), written atomically, built from the text rendered
 in this process (never from the file) and compiled with numba's on-disk cache: a second process loads the law
@@ -106,11 +106,12 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     this process; ``<cache_dir()>/law_<sha256>.py`` (hash of ``source`` and :func:`codegen_version`) must hold
     exactly that text, else it is written anew, atomically (a planted, replaced or truncated file, or a link,
     is replaced with a :class:`~peelapprox.errors.KernelCacheWarning`).  The module is built from the rendered
-    text, not from the file, which names it for numba's on-disk cache (``__pycache__`` next to it, or
-    ``NUMBA_CACHE_DIR``): a second process renders again (tens of ms), loads the compiled law and compiles
-    nothing.  The cache directory and its ``__pycache__`` must be real directories of this user's that no one
-    else can write; otherwise (a link, another owner, group- or world-writable, unwritable) a private temporary
-    directory is used for this process, with a :class:`~peelapprox.errors.KernelCacheWarning` naming why.
+    text, not from the file, which names it for numba's on-disk cache (in the kernels' private root,
+    :mod:`peelapprox._kcache`, its files checked before numba reads them): a second process renders again (tens
+    of ms), loads the compiled law and compiles nothing.  The cache directory and its parents must be real
+    directories that no one else can write (the directory this user's, the parents this user's or root's);
+    otherwise (a link, another owner, group- or world-writable, unwritable) a private temporary directory is used
+    for this process, with a :class:`~peelapprox.errors.KernelCacheWarning` naming why.
     Memoised per process.
 
     Bounded in wall time: :data:`peelapprox._deadline.LAW_BUILD_SECONDS`, or the caller's budget
