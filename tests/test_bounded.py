@@ -310,3 +310,87 @@ def test_every_cli_max_wall_defaults_to_600_seconds(command):
     action = next(a for a in sub._actions if "--max-wall" in a.option_strings)
     assert action.default == 600.0
     assert "(default: 600)" in " ".join(sub.format_help().split())
+
+
+# ---------------------------------------------------------------------------------------------- CSV headers
+def _header_file(tmp_path, size: int) -> str:
+    """The probe's header ``'v,f,a' + ' ' * n + '[' + ' ' * n + 'x'`` (``size`` bytes with its newline) and one
+    row: a backtracking pattern took minutes on its 1,018-byte form."""
+    n = (size - 8) // 2
+    path = tmp_path / f"h{size}.csv"
+    path.write_text("v,f,a" + " " * n + "[" + " " * n + "x\n1,2,3\n")
+    return str(path)
+
+
+def _parse_events(fn, *args, **kwargs) -> int:
+    """Python line events executed in peelapprox's CSV modules during ``fn(*args, **kwargs)`` (its error
+    swallowed): a count of the work done there, the same on any machine."""
+    import sys
+
+    count = 0
+
+    def tracer(frame, event, arg):
+        nonlocal count
+        if "_csvread" in frame.f_code.co_filename or "_tablefile" in frame.f_code.co_filename:
+            if event == "line":
+                count += 1
+            return tracer
+        return None
+
+    sys.settrace(tracer)
+    try:
+        fn(*args, **kwargs)
+    except ValueError:
+        pass
+    finally:
+        sys.settrace(None)
+    return count
+
+
+@pytest.mark.parametrize("size", [1018, 2048, 100_000])
+def test_a_long_header_is_parsed_and_refused_at_once(tmp_path, size):
+    """The ReDoS reproducer (1,018 bytes: past 120 s; 2 kB: 20 s in from_csv) and a 100 kB header are refused as
+    a header without the columns (categorical: the class and the message naming the header), within
+    :data:`BOUND`: whether the parse ends at all is what is tested, not its speed (it takes milliseconds)."""
+    from peelapprox import ForceSeries
+
+    path = _header_file(tmp_path, size)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"header .*expected the columns v,f"):
+        PeelForce.from_csv(path)
+    with pytest.raises(ValueError, match=r"expected the columns t,F"):
+        ForceSeries.from_csv(path)
+    assert time.perf_counter() - t0 < BOUND
+
+
+def test_header_parsing_work_is_linear_in_its_length(tmp_path):
+    """The work of parsing a header grows linearly with its length, counted, not timed (a count does not depend
+    on the machine's speed or load): Python line events in the CSV reader for the 100 kB header are at most
+    1.2 x 100 times those for the 1 kB one (a scan per character, ~1 event each, plus a constant; the old
+    pattern was cubic).  No regular expression reads a header cell (the count cannot see work inside ``re``,
+    so that is asserted too, on the module's source)."""
+    import inspect
+
+    from peelapprox import _csvread
+
+    small = _parse_events(PeelForce.from_csv, _header_file(tmp_path, 1000))
+    large = _parse_events(PeelForce.from_csv, _header_file(tmp_path, 100_000))
+    assert small > 0
+    assert large <= 1.2 * 100 * small, (small, large)
+    assert "re." not in inspect.getsource(_csvread.header_cell)
+    assert "re.compile" not in inspect.getsource(_csvread)
+
+
+def test_column_specs_with_units_still_read(tmp_path):
+    """The linear header scan reads what the pattern read: units in brackets or parentheses, in the file's header
+    or in a ``columns`` spec, converted: compared exactly, each value being one product by a factor of
+    :data:`UNITS` (1e-3, 1e3) whose float equals the literal asserted."""
+    from peelapprox.law._tablefile import read_points
+
+    path = tmp_path / "u.csv"
+    path.write_text("v [mm/s],f (kN)\n1,0.2\n2,0.1\n")
+    [(V, v, f, _)] = read_points(str(path))
+    assert V is None and v.tolist() == [1e-3, 2e-3] and f.tolist() == [200.0, 100.0]
+    path.write_text("speed,force\n1,200\n2,100\n")
+    [(V, v, f, _)] = read_points(str(path), columns={"v": "speed (mm/s)", "f": "force [N]"})
+    assert v.tolist() == [1e-3, 2e-3] and f.tolist() == [200.0, 100.0]
