@@ -350,3 +350,64 @@ def test_a_law_that_overflows_while_its_root_is_sought_is_named():
     with pytest.raises(ValueError, match=r"params.force: .* is not finite at v = .* m/s") as e:
         exact.simulate(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(a=0.001, b=1e-300, c=0, d=0)), 1.0)
     assert "x=" not in str(e.value) and "nan" not in str(e.value).lower()
+
+
+# ------------------------------------------------------------------------------------ stored laws, traces
+@pytest.mark.parametrize("d, match", [
+    ({"kind": "family", "name": ["cubic"]}, r"name must be a string or None, got list \['cubic'\]"),
+    ({"kind": "family", "name": "cubic", "coefficients": [1, 2]}, r"coefficients must be \(name, value\) pairs"),
+    ({"kind": "family", "name": "cubic", "coefficients": "abc"}, r"coefficients must be \(name, value\) pairs"),
+    ({"kind": ["family"]}, r"kind must be a string, got list"),
+    ({"kind": "expression", "source": 3}, r"source must be a string or None, got int"),
+])
+def test_from_dict_names_a_field_of_the_wrong_type(d, match):
+    """A stored law with a list as its family name (``unhashable type: 'list'``) or a flat list as coefficients
+    ("dictionary update sequence element #0") is a TypeError naming the field (categorical)."""
+    with pytest.raises(TypeError, match=match):
+        PeelForce.from_dict(d)
+
+
+def test_from_dict_takes_coefficients_as_json_lists_or_a_mapping():
+    """What ``json.dumps(dataclasses.asdict(law))`` gives back (pairs as lists) and a mapping both rebuild the law
+    (equality of the canonical content: exact)."""
+    law = PeelForce.cubic(a=120.0)
+    assert PeelForce.from_dict({"kind": "family", "name": "cubic", "coefficients": [["a", 120.0]]}) == law
+    assert PeelForce.from_dict({"kind": "family", "name": "cubic", "coefficients": {"a": 120.0}}) == law
+
+
+@pytest.mark.parametrize("t, match", [
+    (1e-300 * np.arange(2000), r"t must step by at least 1e-12 s .*t\[1\] - t\[0\] = 1e-300 s"),
+    (1e4 * np.arange(2000), r"t must span at most 1e\+06 s"),
+])
+def test_force_series_time_steps_out_of_range_are_named(t, match):
+    """Times 1e-300 s apart used to reach numpy's LinAlgError (and six LAPACK lines) in ``observables()``; now
+    the trace is refused when built, naming t and the range (categorical)."""
+    from peelapprox import ForceSeries
+
+    F = 200.0 + 50.0 * ((np.arange(2000) * 0.0073) % 1.0)
+    with pytest.raises(ValueError, match=match):
+        ForceSeries(t, F, V=1.0)
+
+
+def test_force_series_refuses_more_samples_than_its_limit():
+    """A trace of more than MAX_SAMPLES samples (1e8 took 11 GB in infer) is refused before any copy, naming the
+    limit (categorical); checked on a read-only broadcast view, which costs no memory."""
+    from peelapprox import ForceSeries
+    from peelapprox._series import MAX_SAMPLES
+
+    big = np.broadcast_to(np.float64(200.0), (MAX_SAMPLES + 1,))
+    with pytest.raises(ValueError, match=rf"more than the {MAX_SAMPLES} a force series may have"):
+        ForceSeries(big, big, V=1.0)
+
+
+def test_flat_trace_has_no_spectral_peak():
+    """A constant trace (its peak was 0.7996 Hz, rounding's largest bin) and a pure ramp have no peak (None);
+    a sine of 1e-6 N on 200 N (5e-9 of it, above FLAT_RTOL 1e-9) still has its peak at 37 Hz within one bin
+    (Welch's resolution, the tolerance of tests/test_series.py)."""
+    from peelapprox import ForceSeries
+
+    t = np.arange(2000) * 1e-3
+    assert ForceSeries(t, np.full(2000, 200.0), V=1.0).spectrum().peak is None
+    assert ForceSeries(t, 200.0 + 3.0 * t, V=1.0).spectrum().peak is None
+    sp = ForceSeries(t, 200.0 + 1e-6 * np.sin(2 * np.pi * 37.0 * t), V=1.0).spectrum()
+    assert sp.peak is not None and abs(sp.peak - 37.0) <= float(sp.frequency[1] - sp.frequency[0])
