@@ -442,3 +442,27 @@ def test_observables_take_a_bounded_memory_per_sample(n):
 
     s = ForceSeries(*_trace(n), V=1.0)
     assert _peak_bytes(s.observables) <= 64 * n
+
+
+# ---------------------------------------------------------------------------------------------- law size
+def _product(n: int) -> str:
+    return "*".join(f"(v-{0.1 * (i + 1):.1f})" for i in range(n)) + " + 200"
+
+
+@pytest.mark.parametrize("n", [30, 65])
+def test_a_law_whose_derivatives_compile_for_minutes_is_refused_at_once(n):
+    """A product of 60-65 linear factors built for 33 s and compiled for 54 s under ``--max-wall 10`` (numba's
+    LLVM passes, which no timer interrupts).  Its derivative f' is counted before f'' is formed and refused past
+    MAX_DERIVATIVE_NODES (categorical: the message names the limit), within :data:`BOUND`: boundedness, not
+    speed (it takes about a second: one derivative of the product)."""
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"derivative f' has more than 1000 terms and factors \(MAX_DERIVATIVE"):
+        PeelForce.expression(_product(n))
+    assert time.perf_counter() - t0 < BOUND
+
+
+def test_the_size_limit_leaves_ordinary_laws_alone():
+    """The paper's law written out, a product of 12 factors and a degree-12 polynomial are built (their f'' has
+    at most ~2,050 nodes, under the limit of 2,500)."""
+    PeelForce.expression(_product(12))
+    PeelForce.expression(" + ".join(f"{k + 1}*v**{k}" for k in range(13)))

@@ -411,3 +411,41 @@ def test_flat_trace_has_no_spectral_peak():
     assert ForceSeries(t, 200.0 + 3.0 * t, V=1.0).spectrum().peak is None
     sp = ForceSeries(t, 200.0 + 1e-6 * np.sin(2 * np.pi * 37.0 * t), V=1.0).spectrum()
     assert sp.peak is not None and abs(sp.peak - 37.0) <= float(sp.frequency[1] - sp.frequency[0])
+
+
+def test_out_to_a_device_is_refused(capsys):
+    """``simulate --out /dev/full`` used to write ``/dev/full.npz`` beside the device, silently: a device given
+    as an output is now a usage error naming it, before any run (categorical: exit status 2 and the message)."""
+    code, _out, err = _cli([*SIM, "--out", "/dev/full"], capsys)
+    assert code == 2
+    assert "--out '/dev/full' is a character device; an output must be a regular file" in _one_error_line(err)
+    assert not os.path.exists("/dev/full.npz")
+
+
+# ------------------------------------------------------------------------------------ big numbers in laws
+@pytest.mark.parametrize("text, constants, at_1", [
+    ("1e20*v", {}, 1e20),
+    ("a*v", {"a": 1e20}, 1e20),
+    ("2**70*v", {}, 2.0**70),
+    ("1e20*v + 1/v", {}, 1e20 + 1.0),
+    ("v/2**70 + 100", {}, 100.0 + 2.0**-70),
+])
+def test_numbers_beyond_two_to_the_53_are_floats(text, constants, at_1):
+    """Constants >= 2**64 (``1e20``, ``2**70``) used to be Python integers: numpy's ``ufunc 'isfinite' not
+    supported`` at construction, numba's ``TypingError: Int value is too large`` in simulate.  Now every number
+    of magnitude >= 2**53 is a float: the law is built and f(1) is the float sum, to 1e-15 relative (one
+    rounding of each term)."""
+    import sympy as sp
+
+    from peelapprox.law._expression import from_text
+
+    law = PeelForce.expression(text, **constants)
+    assert law.f(np.array([1.0]), 1.0)[0] == pytest.approx(at_1, rel=1e-15)
+    big = [n for n in from_text(law.source).atoms(sp.Rational) if abs(n.p) >= 2**53 or n.q >= 2**53]
+    assert big == []
+
+
+def test_numbers_beyond_the_float_range_are_named():
+    """A product of literals beyond the float range is refused by name (categorical)."""
+    with pytest.raises(ValueError, match=r"exceeds"):
+        PeelForce.expression("1e300*1e300*v")
