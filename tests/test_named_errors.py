@@ -449,3 +449,109 @@ def test_numbers_beyond_the_float_range_are_named():
     """A product of literals beyond the float range is refused by name (categorical)."""
     with pytest.raises(ValueError, match=r"exceeds"):
         PeelForce.expression("1e300*1e300*v")
+
+
+# ------------------------------------------------------------------------------------ trajectory files
+@pytest.fixture(scope="module")
+def npz_arrays(tmp_path_factory):
+    """The arrays of a short run's file (0.02 s of the period-3 orbit's neighbourhood: one jump or more)."""
+    import json
+
+    path = tmp_path_factory.mktemp("npz") / "run.npz"
+    exact.simulate(PeelParams(V=1.0, I=1e-5), 0.02).to_npz(path)
+    with np.load(path, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    return arrays, json.loads(str(arrays["meta"]))
+
+
+def _npz_with(tmp_path, npz_arrays, change) -> str:
+    """The run's file with ``change(arrays, meta)`` applied, written to a new file."""
+    import copy
+    import json
+
+    arrays, meta = npz_arrays
+    original = arrays["meta"]
+    arrays, meta = dict(arrays), copy.deepcopy(meta)
+    change(arrays, meta)
+    if arrays.get("meta") is original:  # the metadata as changed, unless the change replaced or dropped it
+        arrays["meta"] = np.array(json.dumps(meta))
+    path = tmp_path / "bad.npz"
+    np.savez(path, **arrays)
+    return str(path)
+
+
+def _arr(key, value):
+    def change(arrays, meta):
+        arrays[key] = value
+    return change
+
+
+def _set(key, value):
+    def change(arrays, meta):
+        *path, last = key.split(".")
+        for p in path:
+            meta = meta[p]
+        meta[last] = value
+    return change
+
+
+def _drop(key):
+    def change(arrays, meta):
+        del (arrays if key in arrays else meta)[key]
+    return change
+
+
+@pytest.mark.parametrize("change, field", [
+    (_arr("t", np.array([0.0, 0.01])), r"field alpha: \d+ values, but t has 2"),
+    (_arr("F", np.zeros(150)), r"field F: 150 values, but t has \d+"),
+    (_arr("t", np.array(["a", "b"])), r"field t: must be a 1-D array of numbers, got dtype <U1"),
+    (_arr("branch", np.array(["__import__('os')"])), r"field branch: must be \d+ integer codes"),
+    (_arr("jumps", np.zeros(7)), r"field jumps: must be rows of 8 numbers"),
+    (_arr("meta", np.array("{not json")), r"field meta: not JSON"),
+    (_arr("meta", np.array("[" * 100_000 + "]" * 100_000)), r"field meta: (JSON nested too deeply|must be a JSON)"),
+    (_arr("meta", np.array(3.0)), r"field meta: must be one JSON text"),
+    (_drop("atol"), r"field atol: missing"),
+    (_drop("stats"), r"field meta.stats: missing"),
+    (_arr("extra", np.zeros(2)), r"field extra: unknown"),
+    (_set("method", "<script>alert(1)</script>"), r"field meta.method: must be a name"),
+    (_set("solver", {"a": 1}), r"field meta.solver: must be a name"),
+    (_set("status", "0; rm -rf"), r"field meta.status: must be an integer"),
+    (_set("status", True), r"field meta.status: must be an integer"),
+    (_set("t_end", -1), r"field meta.t_end: must be finite and in \[0, inf\], got -1"),
+    (_set("t_transient", 1e9), r"field meta.t_transient: must be finite and in \[0, 0.02\]"),
+    (_set("rtol", 2.0), r"field meta.rtol: must be finite and in \(0, 1\)"),
+    (_set("stats.n_steps", -3), r"field meta.stats.n_steps: must be finite and in \[0, inf\]"),
+    (_set("stats.bogus", 1), r"field meta.stats.bogus: unknown"),
+    (_set("initial_state.branch", "XY"), r"field meta.initial_state.branch: must be one of AB, CD"),
+    (_set("final_state", [1, 2]), r"field meta.final_state: must be a JSON object, got list"),
+    (_set("params.V", "fast"), r"field meta.params: .*V"),
+    (_set("params.hack", 1), r"field meta.params.hack: unknown"),
+    (_set("message", "x" * 5000), r"field meta.message: must be a string of at most 2000"),
+])
+def test_trajectory_file_fields_are_checked(tmp_path, npz_arrays, change, field):
+    """Each malformed field of a trajectory file (the probe's KeyError, unexpected keyword, RecursionError,
+    JSONDecodeError, reshape errors; t of 2 samples beside F of 150, a payload string as branch, method or
+    status, t_end = -1 accepted) is a ValueError naming the file and the field (categorical)."""
+    path = _npz_with(tmp_path, npz_arrays, change)
+    with pytest.raises(ValueError, match=rf"Trajectory\.from_npz\('.*bad\.npz'\): {field}"):
+        exact.Trajectory.from_npz(path)
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04truncated", b"\x93NUMPY garbage", b"just text"])
+def test_a_file_that_is_no_npz_is_named(tmp_path, content):
+    """Empty, truncated, a broken .npy or text: a ValueError naming the file (EOFError, BadZipFile before)."""
+    path = tmp_path / "bad.npz"
+    path.write_bytes(content)
+    with pytest.raises(ValueError, match=r"Trajectory\.from_npz\('.*bad\.npz'\): "):
+        exact.Trajectory.from_npz(path)
+
+
+def test_a_trajectory_file_round_trips(tmp_path, npz_arrays):
+    """The unchanged file reads back: every array equal (exact, as written) and the metadata's fields."""
+    path = _npz_with(tmp_path, npz_arrays, lambda arrays, meta: None)
+    back = exact.Trajectory.from_npz(path)
+    arrays, meta = npz_arrays
+    for name in ("t", "alpha", "omega", "F", "v", "branch", "atol"):
+        assert np.array_equal(getattr(back, name), arrays[name])
+    assert back.t_end == meta["t_end"] and back.method == meta["method"] and back.status == 0
+    assert back.stats.n_steps == meta["stats"]["n_steps"] and back.final_state.branch == meta["final_state"]["branch"]

@@ -53,10 +53,7 @@ def _symbols():
     return sp.Symbol("v", positive=True), sp.Symbol("V", positive=True)
 
 
-#: The largest integer kept as an integer [magnitude]: 2**53, below which every integer is a float exactly.  A
-#: number beyond (``1e20``, ``2**70``) is a float: as a Python integer it made numpy's evaluator an object array
-#: (``ufunc 'isfinite' not supported``) and numba's kernel an integer literal over 64 bits (``TypingError``).
-MAX_EXACT_INTEGER = 2**53
+MAX_EXACT_INTEGER = _grammar.MAX_EXACT_INTEGER  # beyond: a float (the grammar module's docstring of it)
 
 
 def _number(x: float) -> Any:
