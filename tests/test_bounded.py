@@ -466,3 +466,32 @@ def test_the_size_limit_leaves_ordinary_laws_alone():
     at most ~2,050 nodes, under the limit of 2,500)."""
     PeelForce.expression(_product(12))
     PeelForce.expression(" + ".join(f"{k + 1}*v**{k}" for k in range(13)))
+
+
+# ---------------------------------------------------------------------------------------------- atlas cost
+def test_atlas_cost_sample_has_a_range(capsys):
+    """``--cost 1000000`` was accepted (a cost projection running for days): the sample is 1 to MAX_SAMPLE
+    (400), refused by name before any run, in the library and on the command line (categorical)."""
+    from comparisons.atlas import atlas_cost
+
+    with pytest.raises(ValueError, match=r"sample must be .*400"):
+        atlas_cost([1e-5], [1.0], sample=1_000_000)
+    rc, took = _cli(["atlas", "--V", "0.2:5:10", "--I", "1e-6:1e-1:10:log", "--cost", "1000000", "--quiet"])
+    assert rc == 2 and "--cost must be an integer in [1, 400]" in capsys.readouterr().err
+
+
+def test_atlas_cost_keeps_its_wall_budget(capsys):
+    """``atlas --cost 30 --max-wall 5`` ran 64.8 s (its budget was never handed to the cost): now each exact run
+    gets what is left and no part starts once it is spent.  With 0.5 s, SolverBudgetExceeded naming max_wall and
+    the points timed, within :data:`BOUND` (one exact run of the sample and the parts under way overrun the
+    budget by at most seconds; boundedness is what is tested), and exit status 3 on the command line."""
+    from comparisons.atlas import atlas_cost
+
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"atlas_cost: more than 0.5 s .*sample points timed") as info:
+        atlas_cost(np.geomspace(1e-6, 1e-1, 10), np.linspace(0.2, 5.0, 10), sample=30, max_wall=BUDGET)
+    assert time.perf_counter() - t0 < BOUND and info.value.budget == "max_wall"
+    rc, took = _cli(["atlas", "--V", "0.2:5:10", "--I", "1e-6:1e-1:10:log", "--cost", "30", "--max-wall", "0.5",
+                     "--quiet"])
+    assert rc == 3 and took < BOUND
+    assert "more than 0.5 s of wall time (--max-wall)" in capsys.readouterr().err
