@@ -495,3 +495,18 @@ def test_atlas_cost_keeps_its_wall_budget(capsys):
                      "--quiet"])
     assert rc == 3 and took < BOUND
     assert "more than 0.5 s of wall time (--max-wall)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, n", [
+    (["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--max-wall", "10", "--quiet"], 65),
+    (["sweep", "--I", "1e-5", "--V", "1:2:2", "--max-wall", "10", "--workers", "2", "--quiet"], 55),
+])
+def test_cli_refuses_a_law_too_large_to_compile_in_its_budget(tmp_path, capsys, argv, n):
+    """``simulate --max-wall 10`` with a 65-factor law ran 54 s (its kernel compiled past the budget), ``sweep
+    --max-wall 10 --workers 2`` with a 55-factor law 176 s (compiled in the worker threads, which no timer
+    interrupts): the law is now refused when read, exit status 2 naming MAX_DERIVATIVE_NODES, within
+    :data:`BOUND` (about a second: one derivative)."""
+    extra = ["--out", str(tmp_path / "sw")] if argv[0] == "sweep" else []
+    rc, took = _cli([*argv, *extra, "--force", _product(n)])
+    assert rc == 2 and took < BOUND
+    assert "MAX_DERIVATIVE_NODES" in capsys.readouterr().err
