@@ -12,7 +12,7 @@ The slips are found by :func:`peelapprox._slips.detect_slips` (its module docstr
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sized
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -418,7 +418,7 @@ class _SampleError(ValueError):
 def _samples(name: str, x: ArrayLike) -> np.ndarray:
     """``x`` as a 1-D float array of finite samples: the first sample that is not finite is named with its index
     (:class:`_SampleError`); anything else :func:`peelapprox.validate.reals` refuses."""
-    size = x.size if isinstance(x, np.ndarray) else len(x) if hasattr(x, "__len__") else 0
+    size = x.size if isinstance(x, np.ndarray) else len(x) if isinstance(x, Sized) else 0
     if size > MAX_SAMPLES:
         raise ValueError(f"{name} has {size} samples, more than the {MAX_SAMPLES} a force series may have (its "
                          "statistics take ~60 bytes a sample; decimate or cut the trace)")
