@@ -36,8 +36,9 @@ MIN_SAMPLES = 16
 #: The largest trace file read [bytes]: 50 s at 20 kHz is ~25 MB of text; 256 MiB is ten million rows.
 MAX_TRACE_BYTES = 256 * 1024 * 1024
 #: The most samples a trace may have: ten million (the rows a file of :data:`MAX_TRACE_BYTES` holds at ~25 bytes a
-#: row).  Memory is linear in the samples (a trace is 16 bytes a sample, :meth:`ForceSeries.observables` adds at
-#: most ~40, ``exact.infer`` ~100): the limit keeps a call on a trace under ~1.5 GB (docs/your-data.md).
+#: row).  Memory is linear in the samples: a trace is 16 bytes a sample, :meth:`ForceSeries.observables` adds
+#: ~40 (measured, tests/test_bounded.py), ``exact.infer`` took ~110 in all (a probe: 11 GB on 1e8 samples), so a
+#: call on a trace at the limit stays near 1 GB (docs/your-data.md).
 MAX_SAMPLES = 10_000_000
 #: A trace whose detrended fluctuations are below this fraction of its largest |F| is flat: no spectral peak
 #: (rounding of a float64 force is ~1e-16 of it; a measured trace's noise is > 1e-6).

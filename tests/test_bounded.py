@@ -510,3 +510,15 @@ def test_cli_refuses_a_law_too_large_to_compile_in_its_budget(tmp_path, capsys, 
     rc, took = _cli([*argv, *extra, "--force", _product(n)])
     assert rc == 2 and took < BOUND
     assert "MAX_DERIVATIVE_NODES" in capsys.readouterr().err
+
+
+def test_a_file_with_more_rows_than_allowed_is_refused_at_the_first_row_beyond(tmp_path):
+    """read_columns' ``max_rows`` (a trace file: MAX_SAMPLES rows) stops at the first row beyond, naming its line
+    and the limit (categorical), so a file of many short rows is not parsed whole before the trace refuses it."""
+    from peelapprox._csvread import read_columns
+
+    path = tmp_path / "rows.csv"
+    path.write_text("t,F\n" + "".join(f"{i},{200 + i}\n" for i in range(5)))
+    assert read_columns(str(path), {"t": "s", "F": "N"}, where="f", max_rows=5)["t"].tolist() == [0, 1, 2, 3, 4]
+    with pytest.raises(ValueError, match=r"f line 5: more than the 3 data rows"):
+        read_columns(str(path), {"t": "s", "F": "N"}, where="f", max_rows=3)

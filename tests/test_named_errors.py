@@ -13,6 +13,7 @@ blaming a ``--load`` the user never gave; ``--out x.txt`` writing ``x.txt.npz``;
 from __future__ import annotations
 
 import os
+import re
 import stat
 import threading
 
@@ -443,6 +444,10 @@ def test_numbers_beyond_two_to_the_53_are_floats(text, constants, at_1):
     assert law.f(np.array([1.0]), 1.0)[0] == pytest.approx(at_1, rel=1e-15)
     big = [n for n in from_text(law.source).atoms(sp.Rational) if abs(n.p) >= 2**53 or n.q >= 2**53]
     assert big == []
+    from peelapprox.law._kernels import expression_source
+
+    src = expression_source(law.source)  # what numba compiles: no integer literal of 17 digits or more
+    assert re.search(r"(?<![\w.])\d{17,}(?![\w.])", src) is None, src
 
 
 def test_numbers_beyond_the_float_range_are_named():
