@@ -522,3 +522,12 @@ def test_a_file_with_more_rows_than_allowed_is_refused_at_the_first_row_beyond(t
     assert read_columns(str(path), {"t": "s", "F": "N"}, where="f", max_rows=5)["t"].tolist() == [0, 1, 2, 3, 4]
     with pytest.raises(ValueError, match=r"f line 5: more than the 3 data rows"):
         read_columns(str(path), {"t": "s", "F": "N"}, where="f", max_rows=3)
+
+
+def test_cli_force_table_with_the_redos_header_is_a_usage_error(tmp_path, capsys):
+    """``simulate --force-table f.csv --max-wall 5`` on the probe's 1,018-byte header ran past 120 s: now exit
+    status 2 naming the header, within :data:`BOUND` (boundedness; it takes a second of start-up)."""
+    rc, took = _cli(["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--max-wall", "5", "--quiet",
+                     "--force-table", _header_file(tmp_path, 1018)])
+    assert rc == 2 and took < BOUND
+    assert "expected the columns" in capsys.readouterr().err
