@@ -531,3 +531,32 @@ def test_cli_force_table_with_the_redos_header_is_a_usage_error(tmp_path, capsys
                      "--force-table", _header_file(tmp_path, 1018)])
     assert rc == 2 and took < BOUND
     assert "expected the columns" in capsys.readouterr().err
+
+
+def test_sweep_compiles_an_expression_law_in_the_calling_thread_under_its_budget(tmp_path, monkeypatch):
+    """A sweep's worker threads compiled the law where no timer interrupts (a 55-factor law: 176 s under
+    ``max_wall=10``): the law is now compiled first in the calling thread, under the sweep's budget.  A stand-in
+    compilation that would run for minutes (sleeping in short steps, as sympy's Python does) inside the real
+    ``time_limit`` is interrupted at the 0.5 s budget in the main thread; the sweep then stops by its budget
+    (``SolverBudgetExceeded``, no point recorded) within :data:`BOUND`."""
+    import threading
+
+    from comparisons.sweep import sweep
+    from peelapprox import kernels
+    from peelapprox._deadline import time_limit
+
+    threads = []
+
+    def slow_compile(source):
+        threads.append(threading.current_thread() is threading.main_thread())
+        with time_limit(600.0):
+            for _ in range(60_000):
+                time.sleep(0.01)
+
+    monkeypatch.setattr(kernels, "expression_kernel", slow_compile)
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"max_wall=0.5 s was spent with 0/4 points done"):
+        sweep([1e-5, 1e-4], [1.0, 2.0], "period", out=tmp_path / "s", max_workers=2, max_wall=BUDGET,
+              force=PeelForce.expression("153 + 300*v - 300*v**2 + 80*v**3"), progress=False)
+    assert time.perf_counter() - t0 < BOUND
+    assert threads == [True]
