@@ -12,10 +12,12 @@ null), ``rtol`` in (0, 1), ``eps`` null or > 0, ``initial_state`` and ``final_st
 t_end``, ``status`` an integer in [-99, 99] and ``message`` a string of at most 2,000 characters.  Nothing is
 unpickled (``allow_pickle=False``) and the JSON is parsed, never evaluated.
 
-Every violation is a ``ValueError`` beginning ``Trajectory.from_npz(<file>): field <name>``: a file that is not an
-``.npz`` (truncated, another format), a missing or unknown field, a wrong type, shape or length, a value out of
-its range.  What the probe found before: ``KeyError``, ``TypeError`` (unexpected keyword), ``RecursionError``,
-``EOFError``, ``JSONDecodeError`` and reshape errors naming no file, and ``t`` of 2 samples beside ``F`` of 150, a
+A path that cannot be opened raises what :func:`open` raises (``FileNotFoundError``, ``PermissionError``,
+``IsADirectoryError``, naming the path).  Every violation of the file's content is a ``ValueError`` beginning
+``Trajectory.from_npz(<file>): field <name>``: a file that is not an ``.npz`` (truncated, another format), a
+missing or unknown field, a wrong type, shape or length, a value out of its range.  What the probe found before:
+``KeyError``, ``TypeError`` (unexpected keyword), ``RecursionError``, ``EOFError``, ``JSONDecodeError`` and
+reshape errors naming no file, and ``t`` of 2 samples beside ``F`` of 150, a
 payload string as branch, method or status, or ``t_end = -1`` accepted.
 """
 
@@ -65,6 +67,8 @@ def read_trajectory(cls: Any, path: Any, parts: dict[str, Any]) -> Any:
         return cls(**_fields(arrays, parts))
     except _Bad as exc:
         raise ValueError(f"{where}: {exc}") from None
+    except (FileNotFoundError, PermissionError, IsADirectoryError):  # the path, not the file's content: as open()
+        raise
     except (OSError, EOFError, zipfile.BadZipFile, ValueError) as exc:  # not an npz, truncated, unreadable
         raise ValueError(f"{where}: not a trajectory file written by Trajectory.to_npz ({type(exc).__name__}: "
                          f"{shown(str(exc), 200)})") from None

@@ -560,3 +560,10 @@ def test_a_trajectory_file_round_trips(tmp_path, npz_arrays):
         assert np.array_equal(getattr(back, name), arrays[name])
     assert back.t_end == meta["t_end"] and back.method == meta["method"] and back.status == 0
     assert back.stats.n_steps == meta["stats"]["n_steps"] and back.final_state.branch == meta["final_state"]["branch"]
+
+
+def test_a_missing_trajectory_file_is_what_open_raises(tmp_path):
+    """A path that does not exist is FileNotFoundError naming it, as open() gives (the CLI's exit status 1 for a
+    failed read), not a content error (categorical)."""
+    with pytest.raises(FileNotFoundError, match="nope.npz"):
+        exact.Trajectory.from_npz(tmp_path / "nope.npz")
