@@ -1,16 +1,17 @@
 """Reading a trajectory file (:meth:`exact.Trajectory.from_npz`): every field checked against its schema.
 
-A ``.npz`` written by :meth:`exact.Trajectory.to_npz` holds the arrays ``t, alpha, omega, F, v`` (float, one
-length n >= 1, finite, ``t`` non-decreasing), ``branch`` (n integer codes into :data:`peelapprox.BRANCHES`),
-optionally ``Vp`` (n finite floats, under a load), ``jumps`` (m rows of 8 finite floats, the branch codes 0 or 1),
-``atol`` (finite floats >= 0) and ``meta``, a JSON object (at most :data:`MAX_META` characters) of exactly the
-fields of :data:`META_FIELDS`: ``params`` (a :class:`peelapprox.PeelParams` as ``dataclasses.asdict`` writes it,
-checked by PeelParams itself), ``stats`` (the counters of :class:`exact.SolverStats`: integers >= 0, times
-finite >= 0), ``method`` and ``solver`` (names: letters, digits, ``_.-``, at most 64 characters; solver may be
-null), ``rtol`` in (0, 1), ``eps`` null or > 0, ``initial_state`` and ``final_state`` (the fields of
-:class:`exact.State`, finite, a branch name), ``t_end`` and ``t_transient`` finite >= 0 with ``t_transient <=
-t_end``, ``status`` an integer in [-99, 99] and ``message`` a string of at most 2,000 characters.  Nothing is
-unpickled (``allow_pickle=False``) and the JSON is parsed, never evaluated.
+A ``.npz`` written by :meth:`exact.Trajectory.to_npz` holds the arrays ``t, alpha, omega, F, v`` (float, one length
+n, 0 for a run saved with ``save="jumps"``, finite, ``t`` non-decreasing), ``branch`` (n integer codes into
+:data:`peelapprox.BRANCHES`), optionally ``Vp`` (n finite floats, under a load), ``jumps`` (m rows of 8 finite
+floats, the branch codes 0 or 1), ``atol`` (finite floats >= 0) and ``meta``, a JSON object (at most
+:data:`MAX_META` characters) of exactly the fields of :data:`META_FIELDS`: ``params`` (a
+:class:`peelapprox.PeelParams` as ``dataclasses.asdict`` writes it, checked by PeelParams itself), ``stats`` (the
+counters of :class:`exact.SolverStats`: integers >= 0, times finite >= 0), ``method`` and ``solver`` (names:
+letters, digits, ``_.-``, at most 64 characters; solver may be null), ``rtol`` in (0, 1), ``eps`` null or > 0,
+``initial_state`` and ``final_state`` (the fields of :class:`exact.State`, finite, a branch name), ``t_end`` and
+``t_transient`` finite >= 0 with ``t_transient <= t_end``, ``status`` an integer in [-99, 99] and ``message`` a
+string of at most 2,000 characters. Nothing is unpickled (``allow_pickle=False``) and the JSON is parsed, never
+evaluated.
 
 A path that cannot be opened raises what :func:`open` raises (``FileNotFoundError``, ``PermissionError``,
 ``IsADirectoryError``, naming the path).  Every violation of the file's content is a ``ValueError`` beginning
@@ -101,8 +102,6 @@ def _fields(a: dict[str, np.ndarray], parts: dict[str, Any]) -> dict[str, Any]:
         x = _floats(name, a[name], ndim=1)
         if n is not None and x.size != n:
             raise _Bad(name, f"{x.size} values, but t has {n}: the columns of a trajectory have one length")
-        if x.size == 0:
-            raise _Bad(name, "empty: a trajectory stores at least one point")
         n = x.size
         cols[name] = x
     if np.any(np.diff(cols["t"]) < 0):
