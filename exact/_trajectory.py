@@ -352,32 +352,11 @@ class Trajectory:
 
     @classmethod
     def from_npz(cls, path) -> Trajectory:
-        """Load a trajectory written by :meth:`to_npz`."""
-        with np.load(path, allow_pickle=False) as z:
-            meta = json.loads(str(z["meta"]))
-            return cls(
-                t=z["t"],
-                alpha=z["alpha"],
-                omega=z["omega"],
-                F=z["F"],
-                v=z["v"],
-                branch=z["branch"],
-                Vp=z["Vp"] if "Vp" in z.files else None,
-                jumps=Jumps.from_buffer(z["jumps"]),
-                stats=SolverStats(**meta["stats"]),
-                params=PeelParams(**meta["params"]),
-                method=meta["method"],
-                solver=meta["solver"],
-                rtol=meta["rtol"],
-                atol=z["atol"],
-                eps=meta["eps"],
-                initial_state=State(**meta["initial_state"]),
-                final_state=State(**meta["final_state"]),
-                t_end=meta["t_end"],
-                t_transient=meta["t_transient"],
-                status=meta["status"],
-                message=meta["message"],
-            )
+        """Load a trajectory written by :meth:`to_npz`, every field checked against its schema
+        (``exact/_trajectory_file.py``): a ValueError naming the file and the field otherwise."""
+        from ._trajectory_file import read_trajectory
+
+        return read_trajectory(cls, path, {"State": State, "SolverStats": SolverStats, "Jumps": Jumps})
 
     def _repr_html_(self) -> str:
         p, st = self.params, self.stats

@@ -27,13 +27,14 @@ import errno
 import os
 import re
 import stat
-from collections.abc import Collection, Mapping
+from array import array
+from collections.abc import Collection, Iterator, Mapping
 
 import numpy as np
 
 from ._checks import shown
 
-__all__ = ["MAX_BYTES", "UNITS", "convert", "read_columns", "read_regular"]
+__all__ = ["MAX_BYTES", "UNITS", "convert", "header_cell", "read_columns", "read_regular"]
 
 #: Largest file read [bytes], 16 MiB: a measured curve has hundreds to a few thousand rows of ~30 bytes (a force
 #: trace of 20 s at 10 kHz ~ 5 MB), so 16 MiB (~500,000 rows, parsed in seconds) is beyond any real table, while a
@@ -50,7 +51,32 @@ UNITS: dict[str, tuple[str, float]] = {
 
 _FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
                (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
-_CELL = re.compile(r"^\s*([^\[\](){}]*?)\s*(?:[\[(]\s*([^\[\]()]*?)\s*[\])])?\s*$")
+_BRACKETS = frozenset("[](){}")
+_NEWLINE = re.compile(r"\r\n|\r|\n")
+
+
+def header_cell(cell: str, any_name: bool = False) -> tuple[str, str | None]:
+    """A header cell's ``(name, unit)``: ``name``, ``name [unit]`` or ``name (unit)`` (unit None when the cell
+    states none); a cell of another shape (a bracket in the name, text after the unit, an unclosed bracket) is
+    all name, and so matches no column.  ``any_name``: the name may hold brackets itself (a caller's column spec,
+    ``"f [a] [N]"``), the unit being the last bracketed group.
+
+    Linear in the cell's length: a scan for the bracket opening the unit and one over the unit, no regular
+    expression (a backtracking pattern with a lazy name beside optional blanks took seconds on a 2 kB header and
+    minutes on ``'v,f,a' + ' ' * 500 + '[' + ' ' * 500 + 'x'``).
+    """
+    text = cell.strip()
+    if any_name:
+        k = max(text.rfind(ch, 0, len(text) - 1) for ch in "[]()") if len(text) > 1 else -1
+        k = k if k >= 0 else len(text)
+    else:
+        k = next((i for i, ch in enumerate(text) if ch in _BRACKETS), len(text))
+    if k == len(text) or text[k] not in "[(" or text[-1] not in "])" or len(text) - k < 2:
+        return text, None
+    unit = text[k + 1:-1]
+    if any(ch in "[]()" for ch in unit):
+        return text, None
+    return text[:k].rstrip(), unit.strip()
 
 
 def convert(name: str, unit: str, to: str, where: str) -> float:
@@ -90,42 +116,48 @@ def read_regular(path: str, where: str, max_bytes: int = MAX_BYTES) -> bytes:
         raise ValueError(f"{where}: {st.st_size} bytes, more than the {limit} a table may have (a measured curve "
                          "is a few thousand rows; is this the right file?)")
     with os.fdopen(fd, "rb") as fh:
-        try:
-            data = fh.read(max_bytes + 1)
+        try:  # the size fstat gave (a buffer of max_bytes would cost that much whatever the file), then the rest
+            parts = [fh.read(st.st_size + 1)]  # of a file that grew, or of one whose size reads 0 (/proc), in MiBs
+            total = len(parts[0])
+            while total > st.st_size and total <= max_bytes and parts[-1]:
+                parts.append(fh.read(min(1 << 20, max_bytes + 1 - total)))
+                total += len(parts[-1])
         except OSError as exc:
             raise ValueError(f"{where}: cannot read it ({exc.strerror or exc})") from None
+    data = parts[0] if len(parts) == 1 else b"".join(parts)
     if len(data) > max_bytes:
         raise ValueError(f"{where}: more than the {limit} a table may have (a measured curve is a few thousand "
                          "rows; is this the right file?)")
     return data
 
 
-def _data_lines(text: str) -> list[tuple[int, str]]:
-    """``(line number, text)`` of the lines that are not blank or comments (``#`` to the end of a line)."""
-    out = []
-    for n, line in enumerate(re.split(r"\r\n|\r|\n", text), start=1):  # universal newlines, as open() reads
-        line = line.split("#", 1)[0].strip()
+def _data_lines(text: str) -> Iterator[tuple[int, str]]:
+    """``(line number, text)`` of the lines that are not blank or comments (``#`` to the end of a line), one at a
+    time (a list of them cost ~60 bytes per byte of the file)."""
+    start, n = 0, 1
+    for m in _NEWLINE.finditer(text):  # universal newlines, as open() reads
+        line = text[start:m.start()].split("#", 1)[0].strip()
         if line:
-            out.append((n, line))
-    return out
+            yield n, line
+        start, n = m.end(), n + 1
+    line = text[start:].split("#", 1)[0].strip()
+    if line:
+        yield n, line
 
 
-def _csv_rows(lines: list[tuple[int, str]], where: str, delimiter: str) -> list[list[str]]:
-    """The cells of each data line (:mod:`csv`), a csv error (a NUL byte, an unclosed quote, a field over csv's
+def _csv_row(lineno: int, text: str, where: str, delimiter: str) -> list[str]:
+    """The cells of one data line (:mod:`csv`), a csv error (a NUL byte, an unclosed quote, a field over csv's
     size limit) as a ValueError naming the file line."""
-    rows = []
-    for lineno, text in lines:
-        try:
-            cells = next(csv.reader([text], delimiter=delimiter), [])
-        except csv.Error as exc:
-            raise ValueError(f"{where} line {lineno}: not a CSV row ({exc})") from None
-        rows.append(cells)
-    return rows
+    try:
+        return next(csv.reader([text], delimiter=delimiter), [])
+    except csv.Error as exc:
+        raise ValueError(f"{where} line {lineno}: not a CSV row ({exc})") from None
 
 
 def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter: str | None = None,
                  max_bytes: int = MAX_BYTES, optional: Collection[str] = (), stated: Mapping[str, str] | None = None,
-                 exact: bool = False, expected: str | None = None) -> dict[str, np.ndarray]:
+                 exact: bool = False, expected: str | None = None,
+                 max_rows: int | None = None) -> dict[str, np.ndarray]:
     """The named columns of the CSV file ``path`` as float arrays, in the units asked for.
 
     Parameters
@@ -149,6 +181,9 @@ def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter
         Refuse columns other than those of ``columns`` (else they are ignored).
     expected : str, optional
         What a wrong header is told to be (default: the names of ``columns``).
+    max_rows : int, optional
+        The most data rows read (a ValueError naming the limit at the first row beyond).  Memory is the file's
+        bytes, its text (1-4 bytes a character) and 8 bytes a value read.
 
     Returns
     -------
@@ -172,30 +207,36 @@ def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter
         line = data[:exc.start].count(b"\n") + 1
         raise ValueError(f"{where} line {line}: not UTF-8 text ({exc.reason} at byte {exc.start}); is this a "
                          "CSV file?") from None
+    del data  # the text alone from here on
     want = expected or ",".join(columns)
     lines = _data_lines(text)
-    if not lines:
+    first = next(lines, None)
+    if first is None:
         raise ValueError(f"{where}: no header (expected {want})")
-    rows = _csv_rows(lines, where, delimiter or ",")
-    raw = [h.strip() for h in rows[0]]
+    delim = delimiter or ","
+    raw = [h.strip() for h in _csv_row(*first, where, delim)]
     names, units = [], []
     for cell in raw:
-        m = _CELL.match(cell)
-        names.append(m.group(1) if m else cell)
-        units.append(m.group(2) if m and m.group(2) is not None else None)
+        name, unit = header_cell(cell)
+        names.append(name)
+        units.append(unit)
     shown_header = shown(",".join(raw))
     required = [n for n in columns if n not in optional]
     if (len(set(names)) != len(names) or any(n not in names for n in required)
             or (exact and any(n not in columns for n in names))):
-        raise ValueError(f"{where} line {lines[0][0]}: header {shown_header}: expected the columns {want}")
+        raise ValueError(f"{where} line {first[0]}: header {shown_header}: expected the columns {want}")
     col = {n: names.index(n) for n in columns if n in names}
     factor = {}
     for n, i in col.items():
         unit = str(units[i] if units[i] is not None else (stated or {}).get(n, columns[n]))
         factor[n] = convert(n, unit, columns[n], where) if columns[n] or unit else 1.0
-    out: dict[str, list[float]] = {n: [] for n in col}
-    line_of = []
-    for (lineno, _), cells in zip(lines[1:], rows[1:]):
+    # 8 bytes a value (array), not a Python float and a list slot (~32): memory module docstring
+    out = {n: array("d") for n in col}
+    line_of = array("q")
+    for lineno, text_line in lines:
+        if max_rows is not None and len(line_of) >= max_rows:
+            raise ValueError(f"{where} line {lineno}: more than the {max_rows} data rows a file may have here")
+        cells = _csv_row(lineno, text_line, where, delim)
         if len(cells) != len(raw):
             raise ValueError(f"{where} line {lineno}: {len(cells)} column(s), expected {len(raw)} "
                              f"({','.join(raw)})")
@@ -208,6 +249,6 @@ def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter
         line_of.append(lineno)
     if not line_of:
         raise ValueError(f"{where}: no data rows after the header")
-    result = {n: np.asarray(x, dtype=float) for n, x in out.items()}
-    result["line"] = np.asarray(line_of, dtype=int)
+    result = {n: np.frombuffer(x, dtype=float) for n, x in out.items()}
+    result["line"] = np.frombuffer(line_of, dtype=np.int64)
     return result

@@ -4,7 +4,8 @@ A solver checks its wall budget between steps; differentiating a law with sympy 
 one long call that checks nothing.  :func:`time_limit` bounds such a call: in the main thread of a POSIX
 process it arms an interval timer (``signal.setitimer``) whose handler raises :class:`Expired` inside the
 running code (sympy and numba's front end are Python, so the exception lands within milliseconds; a single
-LLVM optimisation pass is not interrupted but is itself bounded by the size limits of the expression grammar).
+LLVM optimisation pass is not interrupted but is itself bounded by the size limits of the expression grammar and
+of a law's derivatives, ``MAX_DERIVATIVE_NODES`` of ``peelapprox/law/_expression.py``, checked before rendering).
 Elsewhere (another thread, Windows, a caller's own timer already armed) it cannot interrupt and checks the
 clock when the call returns instead.  The previous signal handler and timer are restored on exit.
 

@@ -12,7 +12,7 @@ The slips are found by :func:`peelapprox._slips.detect_slips` (its module docstr
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sized
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike
 
 from ._checks import shown
 from ._observables import StickSlipObservables, jump_statistics
+from ._ranges import TIME_MAX
 from ._slips import Slips, detect_slips, noise_level
 from .io import fmt_number, jsonable
 from .validate import integer, optional, positive, reals
@@ -28,12 +29,25 @@ from .validate import integer, optional, positive, reals
 if TYPE_CHECKING:
     from ._series_lyapunov import SeriesLyapunov
 
-__all__ = ["ForceSeries", "Spectrum", "MIN_SAMPLES"]
+__all__ = ["ForceSeries", "Spectrum", "MAX_SAMPLES", "MIN_SAMPLES", "MIN_STEP"]
 
 #: The fewest samples a trace may have.
 MIN_SAMPLES = 16
 #: The largest trace file read [bytes]: 50 s at 20 kHz is ~25 MB of text; 256 MiB is ten million rows.
 MAX_TRACE_BYTES = 256 * 1024 * 1024
+#: The most samples a trace may have: ten million (the rows a file of :data:`MAX_TRACE_BYTES` holds at ~25 bytes a
+#: row).  Memory is linear in the samples: a trace is 16 bytes a sample, :meth:`ForceSeries.observables` adds
+#: ~40 (measured, tests/test_bounded.py), ``exact.infer`` took ~110 in all (a probe: 11 GB on 1e8 samples), so a
+#: call on a trace at the limit stays near 1 GB (docs/your-data.md).
+MAX_SAMPLES = 10_000_000
+#: A trace whose detrended fluctuations are below this fraction of its largest |F| is flat: no spectral peak
+#: (rounding of a float64 force is ~1e-16 of it; a measured trace's noise is > 1e-6).
+FLAT_RTOL = 1e-9
+#: The shortest time step between two samples [s]: a picosecond, a sampling rate of 1 THz; below it (a trace whose
+#: times were written in the wrong unit, ``1e-300 * arange(n)``) the statistics' fits are singular.
+MIN_STEP = 1e-12
+#: The longest trace [s]: :data:`peelapprox._ranges.TIME_MAX`, the longest run the model simulates.
+MAX_DURATION = TIME_MAX
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,13 +60,15 @@ class Spectrum:
         [Hz], from 0 to the Nyquist frequency.
     power : ndarray
         [N² / Hz], one-sided.
-    peak : float
-        The frequency of the largest power above the lowest non-zero bin [Hz].
+    peak : float or None
+        The frequency of the largest power above the lowest non-zero bin [Hz]; None when the trace is flat
+        (its power above the lowest bin, integrated, is that of fluctuations below :data:`FLAT_RTOL` times its
+        largest |F|: rounding, not a signal, whose largest bin falls at an arbitrary frequency).
     """
 
     frequency: np.ndarray
     power: np.ndarray
-    peak: float
+    peak: float | None
 
     def as_rows(self) -> list[dict[str, float]]:
         """One row per frequency: ``frequency, power``."""
@@ -84,6 +100,14 @@ class ForceSeries:
             i = int(bad[0]) + 1
             raise _SampleError(i, f"t must increase: t[{i}] = {fmt_number(float(t_arr[i]), 6)} s does not exceed "
                                   f"t[{i - 1}] = {fmt_number(float(t_arr[i - 1]), 6)} s")
+        short = np.flatnonzero(dt < MIN_STEP)
+        if short.size:
+            i = int(short[0]) + 1
+            raise _SampleError(i, f"t must step by at least {MIN_STEP:g} s (a sampling rate of at most 1 THz; are "
+                                  f"the times in seconds?): t[{i}] - t[{i - 1}] = {float(dt[i - 1]):.3g} s")
+        if t_arr[-1] - t_arr[0] > MAX_DURATION:
+            raise ValueError(f"t must span at most {MAX_DURATION:g} s (are the times in seconds?), got "
+                             f"{float(t_arr[-1] - t_arr[0]):.6g} s")
         self.t: np.ndarray = t_arr
         self.F: np.ndarray = F_arr
         self.V: float | None = optional(positive, "V", V)
@@ -123,7 +147,7 @@ class ForceSeries:
         where = f"ForceSeries.from_csv({shown(str(path))})"
         tc, fc = columns
         data = read_columns(str(path), {tc: "s", fc: "N"}, where=where, delimiter=delimiter,
-                            max_bytes=MAX_TRACE_BYTES, stated=units)
+                            max_bytes=MAX_TRACE_BYTES, stated=units, max_rows=MAX_SAMPLES)
         try:
             return cls(data[tc], data[fc], V=V, source=f"measured: {path}")
         except _SampleError as exc:  # the sample the trace's check names, as a line of the file
@@ -228,7 +252,11 @@ class ForceSeries:
         Fu = np.interp(tu, self.t, self.F)
         nper = int(min(n, max(16, round(seg * rate))))
         f, p = welch(Fu, fs=(n - 1) / self.duration, nperseg=nper, detrend=detrend)
-        peak = float(f[1 + int(np.argmax(p[1:]))]) if f.size > 1 else 0.0
+        # a trace flat to rounding (fluctuations below FLAT_RTOL of its size after detrending) has no peak: the
+        # largest of its rounding noise is at an arbitrary frequency
+        scale = float(np.max(np.abs(Fu)))
+        flat = f.size < 2 or float(np.sum(p[1:])) * float(f[1] - f[0]) <= (FLAT_RTOL * scale) ** 2
+        peak = None if flat else float(f[1 + int(np.argmax(p[1:]))])
         return Spectrum(frequency=f, power=p, peak=peak)
 
     def lyapunov(self, *, embed: str = "returns", dimension: int | None = None, delay: int | None = None,
@@ -391,6 +419,10 @@ class _SampleError(ValueError):
 def _samples(name: str, x: ArrayLike) -> np.ndarray:
     """``x`` as a 1-D float array of finite samples: the first sample that is not finite is named with its index
     (:class:`_SampleError`); anything else :func:`peelapprox.validate.reals` refuses."""
+    size = x.size if isinstance(x, np.ndarray) else len(x) if isinstance(x, Sized) else 0
+    if size > MAX_SAMPLES:
+        raise ValueError(f"{name} has {size} samples, more than the {MAX_SAMPLES} a force series may have (its "
+                         "statistics take ~60 bytes a sample; decimate or cut the trace)")
     try:
         raw = np.asarray(x, dtype=float)
     except (TypeError, ValueError):  # text, ragged nesting: reals names it below

@@ -310,3 +310,253 @@ def test_every_cli_max_wall_defaults_to_600_seconds(command):
     action = next(a for a in sub._actions if "--max-wall" in a.option_strings)
     assert action.default == 600.0
     assert "(default: 600)" in " ".join(sub.format_help().split())
+
+
+# ---------------------------------------------------------------------------------------------- CSV headers
+def _header_file(tmp_path, size: int) -> str:
+    """The probe's header ``'v,f,a' + ' ' * n + '[' + ' ' * n + 'x'`` (``size`` bytes with its newline) and one
+    row: a backtracking pattern took minutes on its 1,018-byte form."""
+    n = (size - 8) // 2
+    path = tmp_path / f"h{size}.csv"
+    path.write_text("v,f,a" + " " * n + "[" + " " * n + "x\n1,2,3\n")
+    return str(path)
+
+
+def _parse_events(fn, *args, **kwargs) -> int:
+    """Python line events executed in peelapprox's CSV modules during ``fn(*args, **kwargs)`` (its error
+    swallowed): a count of the work done there, the same on any machine."""
+    import sys
+
+    count = 0
+
+    def tracer(frame, event, arg):
+        nonlocal count
+        if "_csvread" in frame.f_code.co_filename or "_tablefile" in frame.f_code.co_filename:
+            if event == "line":
+                count += 1
+            return tracer
+        return None
+
+    sys.settrace(tracer)
+    try:
+        fn(*args, **kwargs)
+    except ValueError:
+        pass
+    finally:
+        sys.settrace(None)
+    return count
+
+
+@pytest.mark.parametrize("size", [1018, 2048, 100_000])
+def test_a_long_header_is_parsed_and_refused_at_once(tmp_path, size):
+    """The ReDoS reproducer (1,018 bytes: past 120 s; 2 kB: 20 s in from_csv) and a 100 kB header are refused as
+    a header without the columns (categorical: the class and the message naming the header), within
+    :data:`BOUND`: whether the parse ends at all is what is tested, not its speed (it takes milliseconds)."""
+    from peelapprox import ForceSeries
+
+    path = _header_file(tmp_path, size)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"header .*expected the columns v,f"):
+        PeelForce.from_csv(path)
+    with pytest.raises(ValueError, match=r"expected the columns t,F"):
+        ForceSeries.from_csv(path)
+    assert time.perf_counter() - t0 < BOUND
+
+
+def test_header_parsing_work_is_linear_in_its_length(tmp_path):
+    """The work of parsing a header grows linearly with its length, counted, not timed (a count does not depend
+    on the machine's speed or load): Python line events in the CSV reader for the 100 kB header are at most
+    1.2 x 100 times those for the 1 kB one (a scan per character, ~1 event each, plus a constant; the old
+    pattern was cubic).  No regular expression reads a header cell, and the reader's one pattern (newlines) has
+    no quantifier (the count cannot see work inside ``re``, so that is asserted on the module's source)."""
+    import inspect
+
+    from peelapprox import _csvread
+
+    small = _parse_events(PeelForce.from_csv, _header_file(tmp_path, 1000))
+    large = _parse_events(PeelForce.from_csv, _header_file(tmp_path, 100_000))
+    assert small > 0
+    assert large <= 1.2 * 100 * small, (small, large)
+    assert "re." not in inspect.getsource(_csvread.header_cell)
+    patterns = re.findall(r"re\.compile\(r?\"([^\"]*)\"\)", inspect.getsource(_csvread))
+    assert patterns == ["\\r\\n|\\r|\\n"]  # the newline: no quantifier, so no backtracking
+
+
+def test_column_specs_with_units_still_read(tmp_path):
+    """The linear header scan reads what the pattern read: units in brackets or parentheses, in the file's header
+    or in a ``columns`` spec, converted: compared exactly, each value being one product by a factor of
+    :data:`UNITS` (1e-3, 1e3) whose float equals the literal asserted."""
+    from peelapprox.law._tablefile import read_points
+
+    path = tmp_path / "u.csv"
+    path.write_text("v [mm/s],f (kN)\n1,0.2\n2,0.1\n")
+    [(V, v, f, _)] = read_points(str(path))
+    assert V is None and v.tolist() == [1e-3, 2e-3] and f.tolist() == [200.0, 100.0]
+    path.write_text("speed,force\n1,200\n2,100\n")
+    [(V, v, f, _)] = read_points(str(path), columns={"v": "speed (mm/s)", "f": "force [N]"})
+    assert v.tolist() == [1e-3, 2e-3] and f.tolist() == [200.0, 100.0]
+
+
+# ---------------------------------------------------------------------------------------------- memory
+def _trace(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A sawtooth stick-slip trace of n samples at 10 kHz (7.3 slips a second), noise 0.05 N (seeded)."""
+    t = np.arange(n) * 1e-4
+    F = 200.0 + 50.0 * ((t * 7.3) % 1.0) + np.random.default_rng(0).normal(0.0, 0.05, n)
+    return t, F
+
+
+def _peak_bytes(fn, *args, **kwargs) -> int:
+    """The peak of memory allocated during ``fn(*args, **kwargs)`` (tracemalloc: Python objects and numpy's
+    arrays, which numpy reports to it): a count of bytes, the same on any machine."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        fn(*args, **kwargs)
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+@pytest.mark.parametrize("n", [10_000, 40_000])
+def test_reading_a_trace_file_takes_a_few_bytes_per_byte(tmp_path, n):
+    """``ForceSeries.from_csv`` of a 241 MB file peaked at 6.8 GB (a 256 MiB read buffer whatever the file's size,
+    then a list of lines and of cells: ~65 bytes a byte).  Now at most 4 bytes per byte of the file, at two
+    sizes 4x apart (so the bound is per byte, not a constant): the bytes (1), their text (1, ASCII), 8 bytes per
+    value and line number (~1.2 at ~20 bytes a row), the trace's own copy (~0.8); measured 2.5."""
+    from peelapprox import ForceSeries
+
+    t, F = _trace(n)
+    path = tmp_path / "trace.csv"
+    path.write_text("t,F\n" + "\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(t, F)) + "\n")
+    peak = _peak_bytes(ForceSeries.from_csv, str(path))
+    assert peak <= 4.0 * path.stat().st_size, peak / path.stat().st_size
+
+
+@pytest.mark.parametrize("n", [10_000, 40_000])
+def test_observables_take_a_bounded_memory_per_sample(n):
+    """``observables()`` took 7.8 GB on 1e8 samples (a trace is now refused beyond MAX_SAMPLES, 1e7); its memory
+    is linear in the samples: at most 64 bytes a sample (eight float64 arrays of the trace's length) at two
+    sizes 4x apart; measured 40 (five)."""
+    from peelapprox import ForceSeries
+
+    s = ForceSeries(*_trace(n), V=1.0)
+    assert _peak_bytes(s.observables) <= 64 * n
+
+
+# ---------------------------------------------------------------------------------------------- law size
+def _product(n: int) -> str:
+    return "*".join(f"(v-{0.1 * (i + 1):.1f})" for i in range(n)) + " + 200"
+
+
+@pytest.mark.parametrize("n", [30, 65])
+def test_a_law_whose_derivatives_compile_for_minutes_is_refused_at_once(n):
+    """A product of 60-65 linear factors built for 33 s and compiled for 54 s under ``--max-wall 10`` (numba's
+    LLVM passes, which no timer interrupts).  Its derivative f' is counted before f'' is formed and refused past
+    MAX_DERIVATIVE_NODES (categorical: the message names the limit), within :data:`BOUND`: boundedness, not
+    speed (it takes about a second: one derivative of the product)."""
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"derivative f' has more than 1000 terms and factors \(MAX_DERIVATIVE"):
+        PeelForce.expression(_product(n))
+    assert time.perf_counter() - t0 < BOUND
+
+
+def test_the_size_limit_leaves_ordinary_laws_alone():
+    """The paper's law written out, a product of 12 factors and a degree-12 polynomial are built (their f'' has
+    at most ~2,050 nodes, under the limit of 2,500)."""
+    PeelForce.expression(_product(12))
+    PeelForce.expression(" + ".join(f"{k + 1}*v**{k}" for k in range(13)))
+
+
+# ---------------------------------------------------------------------------------------------- atlas cost
+def test_atlas_cost_sample_has_a_range(capsys):
+    """``--cost 1000000`` was accepted (a cost projection running for days): the sample is 1 to MAX_SAMPLE
+    (400), refused by name before any run, in the library and on the command line (categorical)."""
+    from comparisons.atlas import atlas_cost
+
+    with pytest.raises(ValueError, match=r"sample must be .*400"):
+        atlas_cost([1e-5], [1.0], sample=1_000_000)
+    rc, took = _cli(["atlas", "--V", "0.2:5:10", "--I", "1e-6:1e-1:10:log", "--cost", "1000000", "--quiet"])
+    assert rc == 2 and "--cost must be an integer in [1, 400]" in capsys.readouterr().err
+
+
+def test_atlas_cost_keeps_its_wall_budget(capsys):
+    """``atlas --cost 30 --max-wall 5`` ran 64.8 s (its budget was never handed to the cost): now each exact run
+    gets what is left and no part starts once it is spent.  With 0.5 s, SolverBudgetExceeded naming max_wall and
+    the points timed, within :data:`BOUND` (one exact run of the sample and the parts under way overrun the
+    budget by at most seconds; boundedness is what is tested), and exit status 3 on the command line."""
+    from comparisons.atlas import atlas_cost
+
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"atlas_cost: more than 0.5 s .*sample points timed") as info:
+        atlas_cost(np.geomspace(1e-6, 1e-1, 10), np.linspace(0.2, 5.0, 10), sample=30, max_wall=BUDGET)
+    assert time.perf_counter() - t0 < BOUND and info.value.budget == "max_wall"
+    rc, took = _cli(["atlas", "--V", "0.2:5:10", "--I", "1e-6:1e-1:10:log", "--cost", "30", "--max-wall", "0.5",
+                     "--quiet"])
+    assert rc == 3 and took < BOUND
+    assert "more than 0.5 s of wall time (--max-wall)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, n", [
+    (["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--max-wall", "10", "--quiet"], 65),
+    (["sweep", "--I", "1e-5", "--V", "1:2:2", "--max-wall", "10", "--workers", "2", "--quiet"], 55),
+])
+def test_cli_refuses_a_law_too_large_to_compile_in_its_budget(tmp_path, capsys, argv, n):
+    """``simulate --max-wall 10`` with a 65-factor law ran 54 s (its kernel compiled past the budget), ``sweep
+    --max-wall 10 --workers 2`` with a 55-factor law 176 s (compiled in the worker threads, which no timer
+    interrupts): the law is now refused when read, exit status 2 naming MAX_DERIVATIVE_NODES, within
+    :data:`BOUND` (about a second: one derivative)."""
+    extra = ["--out", str(tmp_path / "sw")] if argv[0] == "sweep" else []
+    rc, took = _cli([*argv, *extra, "--force", _product(n)])
+    assert rc == 2 and took < BOUND
+    assert "MAX_DERIVATIVE_NODES" in capsys.readouterr().err
+
+
+def test_a_file_with_more_rows_than_allowed_is_refused_at_the_first_row_beyond(tmp_path):
+    """read_columns' ``max_rows`` (a trace file: MAX_SAMPLES rows) stops at the first row beyond, naming its line
+    and the limit (categorical), so a file of many short rows is not parsed whole before the trace refuses it."""
+    from peelapprox._csvread import read_columns
+
+    path = tmp_path / "rows.csv"
+    path.write_text("t,F\n" + "".join(f"{i},{200 + i}\n" for i in range(5)))
+    assert read_columns(str(path), {"t": "s", "F": "N"}, where="f", max_rows=5)["t"].tolist() == [0, 1, 2, 3, 4]
+    with pytest.raises(ValueError, match=r"f line 5: more than the 3 data rows"):
+        read_columns(str(path), {"t": "s", "F": "N"}, where="f", max_rows=3)
+
+
+def test_cli_force_table_with_the_redos_header_is_a_usage_error(tmp_path, capsys):
+    """``simulate --force-table f.csv --max-wall 5`` on the probe's 1,018-byte header ran past 120 s: now exit
+    status 2 naming the header, within :data:`BOUND` (boundedness; it takes a second of start-up)."""
+    rc, took = _cli(["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--max-wall", "5", "--quiet",
+                     "--force-table", _header_file(tmp_path, 1018)])
+    assert rc == 2 and took < BOUND
+    assert "expected the columns" in capsys.readouterr().err
+
+
+def test_sweep_compiles_an_expression_law_in_the_calling_thread_under_its_budget(tmp_path, monkeypatch):
+    """A sweep's worker threads compiled the law where no timer interrupts (a 55-factor law: 176 s under
+    ``max_wall=10``): the law is now compiled first in the calling thread, under the sweep's budget.  A stand-in
+    compilation that would run for minutes (sleeping in short steps, as sympy's Python does) inside the real
+    ``time_limit`` is interrupted at the 0.5 s budget in the main thread; the sweep then stops by its budget
+    (``SolverBudgetExceeded``, no point recorded) within :data:`BOUND`."""
+    import threading
+
+    from comparisons.sweep import sweep
+    from peelapprox import kernels
+    from peelapprox._deadline import time_limit
+
+    threads = []
+
+    def slow_compile(source):
+        threads.append(threading.current_thread() is threading.main_thread())
+        with time_limit(600.0):
+            for _ in range(60_000):
+                time.sleep(0.01)
+
+    monkeypatch.setattr(kernels, "expression_kernel", slow_compile)
+    t0 = time.perf_counter()
+    with pytest.raises(SolverBudgetExceeded, match=r"max_wall=0.5 s was spent with 0/4 points done"):
+        sweep([1e-5, 1e-4], [1.0, 2.0], "period", out=tmp_path / "s", max_workers=2, max_wall=BUDGET,
+              force=PeelForce.expression("153 + 300*v - 300*v**2 + 80*v**3"), progress=False)
+    assert time.perf_counter() - t0 < BOUND
+    assert threads == [True]

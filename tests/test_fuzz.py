@@ -51,7 +51,7 @@ from hypothesis import strategies as st
 
 import exact
 import peelapprox as pa
-from peelapprox import EPS_RANGE, PARAM_RANGES, STATE_RANGES, TIME_MAX, PeelParams
+from peelapprox import EPS_RANGE, PARAM_RANGES, STATE_RANGES, TIME_MAX, PeelForce, PeelParams
 from peelapprox.cli import main as cli_main
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
@@ -1074,3 +1074,102 @@ def test_fuzz_regression_cli_attractors_named_as_written():
     assert exc.value.code == 2
     assert err.getvalue().startswith("peelapprox dynamics: error: --attractors must be finite and in [-3.14159, ")
     assert err.getvalue().count("\n") == 1
+
+
+# ---------------------------------------------------------------------------------------- stored files
+#: Any JSON value: what a malformed file's metadata or a stored law's field may hold.
+_JSON = st.recursive(st.none() | st.booleans() | st.integers(-2**70, 2**70) | st.floats(allow_nan=False)
+                     | st.text(max_size=30),
+                     lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner,
+                                                                                 max_size=4), max_leaves=12)
+_META_KEYS = ("params", "stats", "method", "solver", "rtol", "eps", "initial_state", "final_state", "t_end",
+              "t_transient", "status", "message", "stats.n_steps", "stats.wall_time", "initial_state.t",
+              "final_state.branch", "params.V", "params.force", "params.force.kind", "params.force.name")
+_ARRAYS = st.sampled_from(["t", "alpha", "omega", "F", "v", "branch", "jumps", "atol", "Vp"])
+_ARRAY_VALUES = st.one_of(
+    st.lists(st.floats(), max_size=6).map(np.array),
+    st.lists(st.integers(-3, 3), max_size=6).map(np.array),
+    st.lists(st.text(max_size=5), max_size=3).map(np.array),
+    st.floats().map(np.array),
+    st.integers(0, 20).map(lambda n: np.zeros((n, 8))),
+    st.integers(0, 3).map(lambda n: np.zeros((n, 3, 2))),
+)
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    from exact import simulate
+
+    path = tmp_path_factory.mktemp("npzfuzz") / "run.npz"
+    simulate(PeelParams(V=1.0, I=1e-5, force=PeelForce.cubic()), 0.02).to_npz(path)
+    with np.load(path, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    return arrays, json.loads(str(arrays["meta"]))
+
+
+def _load_classified(path) -> str:
+    """``Trajectory.from_npz(path)``: "result" (every array finite) or "named" (a ValueError naming the file and
+    a field, or the file as no npz); anything else fails."""
+    from exact import Trajectory
+
+    try:
+        tr = Trajectory.from_npz(path)
+    except ValueError as exc:
+        msg = str(exc)
+        assert msg.startswith("Trajectory.from_npz(") and ("field " in msg or "not a trajectory file" in msg), msg
+        return "named"
+    for name in ("t", "alpha", "omega", "F", "v"):
+        assert np.all(np.isfinite(getattr(tr, name)))
+    assert tr.t.size == tr.F.size and tr.t_end >= 0 and tr.final_state.branch in ("AB", "CD")
+    return "result"
+
+
+@pytest.mark.slow
+@settings(max_examples=400, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(key=st.sampled_from(_META_KEYS), value=_JSON)
+def test_fuzz_trajectory_file_metadata(run_file, tmp_path, key, value):
+    """One metadata field of a valid run's file replaced by any JSON value: the file loads with finite arrays or
+    is refused by a ValueError naming the file and the field (never KeyError, TypeError, RecursionError...)."""
+    import copy
+
+    arrays, meta = run_file
+    meta = copy.deepcopy(meta)
+    *path, last = key.split(".")
+    target = meta
+    for p in path:
+        target = target[p] if isinstance(target, dict) else {}
+    target[last] = value
+    out = tmp_path / "f.npz"
+    np.savez(out, **{**arrays, "meta": np.array(json.dumps(meta))})
+    _load_classified(out)
+
+
+@pytest.mark.slow
+@settings(max_examples=300, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(key=_ARRAYS, value=_ARRAY_VALUES)
+def test_fuzz_trajectory_file_arrays(run_file, tmp_path, key, value):
+    """One array of a valid run's file replaced by an array of another length, shape, dtype or with NaN: loads
+    or is refused by name (as above)."""
+    arrays, _meta = run_file
+    out = tmp_path / "f.npz"
+    np.savez(out, **{**arrays, key: value})
+    _load_classified(out)
+
+
+@pytest.mark.slow
+@settings(max_examples=400, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(d=st.fixed_dictionaries({"kind": st.sampled_from(["paper", "family", "expression", "tabulated", "smoothed"])
+                                | _JSON},
+                               optional={"name": st.sampled_from(["cubic", "paper", "power_branches"]) | _JSON,
+                                         "coefficients": _JSON, "source": _JSON, "tables": _JSON,
+                                         "display": _JSON}))
+def test_fuzz_peelforce_from_dict(d):
+    """A stored law's fields of any JSON value: a law, or a ValueError/TypeError (never another exception:
+    ``unhashable type``, ``dictionary update sequence``, an AttributeError)."""
+    try:
+        law = PeelForce.from_dict(d)
+    except (ValueError, TypeError):
+        return
+    assert isinstance(law, PeelForce)

@@ -13,6 +13,7 @@ blaming a ``--load`` the user never gave; ``--out x.txt`` writing ``x.txt.npz``;
 from __future__ import annotations
 
 import os
+import re
 import stat
 import threading
 
@@ -350,3 +351,219 @@ def test_a_law_that_overflows_while_its_root_is_sought_is_named():
     with pytest.raises(ValueError, match=r"params.force: .* is not finite at v = .* m/s") as e:
         exact.simulate(PeelParams(V=1.2, I=1e-5, force=PeelForce.cubic(a=0.001, b=1e-300, c=0, d=0)), 1.0)
     assert "x=" not in str(e.value) and "nan" not in str(e.value).lower()
+
+
+# ------------------------------------------------------------------------------------ stored laws, traces
+@pytest.mark.parametrize("d, match", [
+    ({"kind": "family", "name": ["cubic"]}, r"name must be a string or None, got list \['cubic'\]"),
+    ({"kind": "family", "name": "cubic", "coefficients": [1, 2]}, r"coefficients must be \(name, value\) pairs"),
+    ({"kind": "family", "name": "cubic", "coefficients": "abc"}, r"coefficients must be \(name, value\) pairs"),
+    ({"kind": ["family"]}, r"kind must be a string, got list"),
+    ({"kind": "expression", "source": 3}, r"source must be a string or None, got int"),
+])
+def test_from_dict_names_a_field_of_the_wrong_type(d, match):
+    """A stored law with a list as its family name (``unhashable type: 'list'``) or a flat list as coefficients
+    ("dictionary update sequence element #0") is a TypeError naming the field (categorical)."""
+    with pytest.raises(TypeError, match=match):
+        PeelForce.from_dict(d)
+
+
+def test_from_dict_takes_coefficients_as_json_lists_or_a_mapping():
+    """What ``json.dumps(dataclasses.asdict(law))`` gives back (pairs as lists) and a mapping both rebuild the law
+    (equality of the canonical content: exact)."""
+    law = PeelForce.cubic(a=120.0)
+    assert PeelForce.from_dict({"kind": "family", "name": "cubic", "coefficients": [["a", 120.0]]}) == law
+    assert PeelForce.from_dict({"kind": "family", "name": "cubic", "coefficients": {"a": 120.0}}) == law
+
+
+@pytest.mark.parametrize("t, match", [
+    (1e-300 * np.arange(2000), r"t must step by at least 1e-12 s .*t\[1\] - t\[0\] = 1e-300 s"),
+    (1e4 * np.arange(2000), r"t must span at most 1e\+06 s"),
+])
+def test_force_series_time_steps_out_of_range_are_named(t, match):
+    """Times 1e-300 s apart used to reach numpy's LinAlgError (and six LAPACK lines) in ``observables()``; now
+    the trace is refused when built, naming t and the range (categorical)."""
+    from peelapprox import ForceSeries
+
+    F = 200.0 + 50.0 * ((np.arange(2000) * 0.0073) % 1.0)
+    with pytest.raises(ValueError, match=match):
+        ForceSeries(t, F, V=1.0)
+
+
+def test_force_series_refuses_more_samples_than_its_limit():
+    """A trace of more than MAX_SAMPLES samples (1e8 took 11 GB in infer) is refused before any copy, naming the
+    limit (categorical); checked on a read-only broadcast view, which costs no memory."""
+    from peelapprox import ForceSeries
+    from peelapprox._series import MAX_SAMPLES
+
+    big = np.broadcast_to(np.float64(200.0), (MAX_SAMPLES + 1,))
+    with pytest.raises(ValueError, match=rf"more than the {MAX_SAMPLES} a force series may have"):
+        ForceSeries(big, big, V=1.0)
+
+
+def test_flat_trace_has_no_spectral_peak():
+    """A constant trace (its peak was 0.7996 Hz, rounding's largest bin) and a pure ramp have no peak (None);
+    a sine of 1e-6 N on 200 N (5e-9 of it, above FLAT_RTOL 1e-9) still has its peak at 37 Hz within one bin
+    (Welch's resolution, the tolerance of tests/test_series.py)."""
+    from peelapprox import ForceSeries
+
+    t = np.arange(2000) * 1e-3
+    assert ForceSeries(t, np.full(2000, 200.0), V=1.0).spectrum().peak is None
+    assert ForceSeries(t, 200.0 + 3.0 * t, V=1.0).spectrum().peak is None
+    sp = ForceSeries(t, 200.0 + 1e-6 * np.sin(2 * np.pi * 37.0 * t), V=1.0).spectrum()
+    assert sp.peak is not None and abs(sp.peak - 37.0) <= float(sp.frequency[1] - sp.frequency[0])
+
+
+def test_out_to_a_device_is_refused(capsys):
+    """``simulate --out /dev/full`` used to write ``/dev/full.npz`` beside the device, silently: a device given
+    as an output is now a usage error naming it, before any run (categorical: exit status 2 and the message)."""
+    code, _out, err = _cli([*SIM, "--out", "/dev/full"], capsys)
+    assert code == 2
+    assert "--out '/dev/full' is a character device; an output must be a regular file" in _one_error_line(err)
+    assert not os.path.exists("/dev/full.npz")
+
+
+# ------------------------------------------------------------------------------------ big numbers in laws
+@pytest.mark.parametrize("text, constants, at_1", [
+    ("1e20*v", {}, 1e20),
+    ("a*v", {"a": 1e20}, 1e20),
+    ("2**70*v", {}, 2.0**70),
+    ("1e20*v + 1/v", {}, 1e20 + 1.0),
+    ("v/2**70 + 100", {}, 100.0 + 2.0**-70),
+])
+def test_numbers_beyond_two_to_the_53_are_floats(text, constants, at_1):
+    """Constants >= 2**64 (``1e20``, ``2**70``) used to be Python integers: numpy's ``ufunc 'isfinite' not
+    supported`` at construction, numba's ``TypingError: Int value is too large`` in simulate.  Now every number
+    of magnitude >= 2**53 is a float: the law is built and f(1) is the float sum, to 1e-15 relative (one
+    rounding of each term)."""
+    import sympy as sp
+
+    from peelapprox.law._expression import from_text
+
+    law = PeelForce.expression(text, **constants)
+    assert law.f(np.array([1.0]), 1.0)[0] == pytest.approx(at_1, rel=1e-15)
+    big = [n for n in from_text(law.source).atoms(sp.Rational) if abs(n.p) >= 2**53 or n.q >= 2**53]
+    assert big == []
+    from peelapprox.law._kernels import expression_source
+
+    src = expression_source(law.source)  # what numba compiles: no integer literal of 17 digits or more
+    assert re.search(r"(?<![\w.])\d{17,}(?![\w.])", src) is None, src
+
+
+def test_numbers_beyond_the_float_range_are_named():
+    """A product of literals beyond the float range is refused by name (categorical)."""
+    with pytest.raises(ValueError, match=r"exceeds"):
+        PeelForce.expression("1e300*1e300*v")
+
+
+# ------------------------------------------------------------------------------------ trajectory files
+@pytest.fixture(scope="module")
+def npz_arrays(tmp_path_factory):
+    """The arrays of a short run's file (0.02 s of the period-3 orbit's neighbourhood: one jump or more)."""
+    import json
+
+    path = tmp_path_factory.mktemp("npz") / "run.npz"
+    exact.simulate(PeelParams(V=1.0, I=1e-5), 0.02).to_npz(path)
+    with np.load(path, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    return arrays, json.loads(str(arrays["meta"]))
+
+
+def _npz_with(tmp_path, npz_arrays, change) -> str:
+    """The run's file with ``change(arrays, meta)`` applied, written to a new file."""
+    import copy
+    import json
+
+    arrays, meta = npz_arrays
+    original = arrays["meta"]
+    arrays, meta = dict(arrays), copy.deepcopy(meta)
+    change(arrays, meta)
+    if arrays.get("meta") is original:  # the metadata as changed, unless the change replaced or dropped it
+        arrays["meta"] = np.array(json.dumps(meta))
+    path = tmp_path / "bad.npz"
+    np.savez(path, **arrays)
+    return str(path)
+
+
+def _arr(key, value):
+    def change(arrays, meta):
+        arrays[key] = value
+    return change
+
+
+def _set(key, value):
+    def change(arrays, meta):
+        *path, last = key.split(".")
+        for p in path:
+            meta = meta[p]
+        meta[last] = value
+    return change
+
+
+def _drop(key):
+    def change(arrays, meta):
+        del (arrays if key in arrays else meta)[key]
+    return change
+
+
+@pytest.mark.parametrize("change, field", [
+    (_arr("t", np.array([0.0, 0.01])), r"field alpha: \d+ values, but t has 2"),
+    (_arr("F", np.zeros(150)), r"field F: 150 values, but t has \d+"),
+    (_arr("t", np.array(["a", "b"])), r"field t: must be a 1-D array of numbers, got dtype <U1"),
+    (_arr("branch", np.array(["__import__('os')"])), r"field branch: must be \d+ integer codes"),
+    (_arr("jumps", np.zeros(7)), r"field jumps: must be rows of 8 numbers"),
+    (_arr("meta", np.array("{not json")), r"field meta: not JSON"),
+    (_arr("meta", np.array("[" * 100_000 + "]" * 100_000)), r"field meta: (JSON nested too deeply|must be a JSON)"),
+    (_arr("meta", np.array(3.0)), r"field meta: must be one JSON text"),
+    (_drop("atol"), r"field atol: missing"),
+    (_drop("stats"), r"field meta.stats: missing"),
+    (_arr("extra", np.zeros(2)), r"field extra: unknown"),
+    (_set("method", "<script>alert(1)</script>"), r"field meta.method: must be a name"),
+    (_set("solver", {"a": 1}), r"field meta.solver: must be a name"),
+    (_set("status", "0; rm -rf"), r"field meta.status: must be an integer"),
+    (_set("status", True), r"field meta.status: must be an integer"),
+    (_set("t_end", -1), r"field meta.t_end: must be finite and in \[0, inf\], got -1"),
+    (_set("t_transient", 1e9), r"field meta.t_transient: must be finite and in \[0, 0.02\]"),
+    (_set("rtol", 2.0), r"field meta.rtol: must be finite and in \(0, 1\)"),
+    (_set("stats.n_steps", -3), r"field meta.stats.n_steps: must be finite and in \[0, inf\]"),
+    (_set("stats.bogus", 1), r"field meta.stats.bogus: unknown"),
+    (_set("initial_state.branch", "XY"), r"field meta.initial_state.branch: must be one of AB, CD"),
+    (_set("final_state", [1, 2]), r"field meta.final_state: must be a JSON object, got list"),
+    (_set("params.V", "fast"), r"field meta.params: .*V"),
+    (_set("params.hack", 1), r"field meta.params.hack: unknown"),
+    (_set("message", "x" * 5000), r"field meta.message: must be a string of at most 2000"),
+])
+def test_trajectory_file_fields_are_checked(tmp_path, npz_arrays, change, field):
+    """Each malformed field of a trajectory file (the probe's KeyError, unexpected keyword, RecursionError,
+    JSONDecodeError, reshape errors; t of 2 samples beside F of 150, a payload string as branch, method or
+    status, t_end = -1 accepted) is a ValueError naming the file and the field (categorical)."""
+    path = _npz_with(tmp_path, npz_arrays, change)
+    with pytest.raises(ValueError, match=rf"Trajectory\.from_npz\('.*bad\.npz'\): {field}"):
+        exact.Trajectory.from_npz(path)
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04truncated", b"\x93NUMPY garbage", b"just text"])
+def test_a_file_that_is_no_npz_is_named(tmp_path, content):
+    """Empty, truncated, a broken .npy or text: a ValueError naming the file (EOFError, BadZipFile before)."""
+    path = tmp_path / "bad.npz"
+    path.write_bytes(content)
+    with pytest.raises(ValueError, match=r"Trajectory\.from_npz\('.*bad\.npz'\): "):
+        exact.Trajectory.from_npz(path)
+
+
+def test_a_trajectory_file_round_trips(tmp_path, npz_arrays):
+    """The unchanged file reads back: every array equal (exact, as written) and the metadata's fields."""
+    path = _npz_with(tmp_path, npz_arrays, lambda arrays, meta: None)
+    back = exact.Trajectory.from_npz(path)
+    arrays, meta = npz_arrays
+    for name in ("t", "alpha", "omega", "F", "v", "branch", "atol"):
+        assert np.array_equal(getattr(back, name), arrays[name])
+    assert back.t_end == meta["t_end"] and back.method == meta["method"] and back.status == 0
+    assert back.stats.n_steps == meta["stats"]["n_steps"] and back.final_state.branch == meta["final_state"]["branch"]
+
+
+def test_a_missing_trajectory_file_is_what_open_raises(tmp_path):
+    """A path that does not exist is FileNotFoundError naming it, as open() gives (the CLI's exit status 1 for a
+    failed read), not a content error (categorical)."""
+    with pytest.raises(FileNotFoundError, match="nope.npz"):
+        exact.Trajectory.from_npz(tmp_path / "nope.npz")

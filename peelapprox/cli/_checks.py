@@ -15,6 +15,7 @@ import contextlib
 import math
 import os
 import re
+import stat
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
@@ -161,6 +162,22 @@ def _file_name(path: str, kind: str, option: str) -> str:
     return path
 
 
+def _refuse_special(name: str, path: str, option: str) -> None:
+    """ValueError if ``name`` exists and is not a regular file (a device, a FIFO, a socket): an output is written
+    as a regular file, and a device given as the output (``--out /dev/full``) is a mistake to name, not a name
+    to append ``.npz`` to."""
+    try:
+        mode = os.stat(name).st_mode
+    except OSError:
+        return
+    if not stat.S_ISREG(mode):
+        kind = ("a character device" if stat.S_ISCHR(mode) else "a block device" if stat.S_ISBLK(mode)
+                else "a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode)
+                else "not a regular file")
+        what = "" if name == path else f" would write {shown(name)}, which"
+        raise ValueError(f"{option} {shown(path)}{what} is {kind}; an output must be a regular file")
+
+
 def _writable_dir(d: str) -> bool:
     return os.access(d, os.W_OK | os.X_OK)
 
@@ -217,7 +234,9 @@ def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool =
         return path
     if os.path.isdir(path):
         raise ValueError(f"{option} {shown(path)} is a directory, expected a file name")
+    _refuse_special(path, path, option)  # /dev/full: not silently /dev/full.npz beside it
     name = _file_name(path, kind, option)
+    _refuse_special(name, path, option)
     if os.path.isdir(name):
         raise ValueError(f"{option} {shown(path)} would write {shown(name)}, which is a directory")
     parent = os.path.dirname(name) or "."

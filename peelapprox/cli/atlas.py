@@ -75,8 +75,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     at.add_argument("--plot", action="store_true", help="write every map as a PNG under DIR/maps/")
     at.add_argument("--cost", type=positive_int, default=None, metavar="N",
                     help="time each part (exact run, segments, each approximation) at about N sample points of the "
-                         "grid in this process and print the projected time of the grid on --workers (default 2) "
-                         "processes; nothing is written")
+                         "grid (1 to 400) in this process, within --max-wall, and print the projected time of the grid "
+                         "on --workers (default 2) processes; nothing is written")
     at.add_argument("--format", choices=FORMATS, default="table",
                     help="how the summary is printed: table (markdown), csv or json")
     at.add_argument("--quiet", action="store_true", help="no per-point progress on stderr")
@@ -93,6 +93,7 @@ _WINDOW = {"t_transient": "t_transient", "window": "t_window", "rtol": "rtol", "
 
 def run(args: argparse.Namespace) -> int:
     from comparisons.atlas import atlas, atlas_cost
+    from comparisons.atlas.cost import MAX_SAMPLE
     from comparisons.sweep import check_grid_size, parse_grid
 
     V_values = parse_grid(args.V, name="--V")
@@ -107,9 +108,11 @@ def run(args: argparse.Namespace) -> int:
         if force != PeelForce.paper() or args.out or args.plot:
             raise ValueError("--cost times the paper's law and writes nothing: leave out --out, --plot and the law "
                              "options")
+        if args.cost > MAX_SAMPLE:
+            raise ValueError(f"--cost must be an integer in [1, {MAX_SAMPLE}] (sample points timed), got {args.cost}")
         cost = atlas_cost(I_values, V_values, sample=args.cost, workers=args.workers or 2,
                           approximations=approximations, k=args.k, R=args.R, options=options,
-                          progress=not args.quiet)
+                          progress=not args.quiet, max_wall=args.max_wall)
         if args.format == "table":
             print(cost)
         else:

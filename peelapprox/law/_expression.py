@@ -28,12 +28,21 @@ from .._checks import shown
 from .._deadline import LAW_BUILD_SECONDS, Expired, time_limit
 from . import _grammar
 
-__all__ = ["PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical", "from_stored", "from_text"]
+__all__ = ["MAX_DERIVATIVE_NODES", "PROBE_PULL", "PROBE_V", "V_DOMAIN", "ExpressionLaw", "canonical", "from_stored",
+           "from_text"]
 
 #: The peel velocities [m/s] on which an expression law is probed and may be evaluated.
 V_DOMAIN = (1e-6, 1e3)
 #: The probe grid of v: 241 points log-spaced over V_DOMAIN (9 decades, neighbours ≈ 9 % apart).
 PROBE_V = np.logspace(math.log10(V_DOMAIN[0]), math.log10(V_DOMAIN[1]), 241)
+#: The largest f' and f'' (first and second derivatives in v) an expression law may have [sympy tree nodes], f'
+#: checked before f'' is formed (f'' grows about as f' squared over f).  The kernel is rendered from f, f', f''
+#: (sympy's expansion, a time growing with their size) and compiled by numba (LLVM passes, which no timer
+#: interrupts): a product of 65 factors ran 54 s under ``simulate --max-wall 10``, one of 60 took 33 s to build
+#: and 62 s to find its folds.  Measured (2 loaded cores, ``expression_source`` of a product of n linear
+#: factors): n = 12, f'' 2,049 nodes, 12 s; n = 16, 5,163, 29 s; n = 20, 10,453, 64 s.  The paper's law has 34
+#: nodes in f'', the families at most 48: a law over the limit is refused, named, in about a second.
+MAX_DERIVATIVE_NODES = (1_000, 2_500)
 #: Pull speeds [m/s] of the probe when the law depends on V (the paper's range is 0.05-8 m/s).
 PROBE_PULL = (0.01, 0.1, 1.0, 10.0)
 
@@ -44,17 +53,35 @@ def _symbols():
     return sp.Symbol("v", positive=True), sp.Symbol("V", positive=True)
 
 
+MAX_EXACT_INTEGER = _grammar.MAX_EXACT_INTEGER  # beyond: a float (the grammar module's docstring of it)
+
+
 def _number(x: float) -> Any:
-    """A constant as sympy number: an integral float is the integer (a=150 and a=150.0 are one law)."""
+    """A constant as sympy number: an integral float is the integer (a=150 and a=150.0 are one law), up to
+    :data:`MAX_EXACT_INTEGER`; beyond, the float."""
     import sympy as sp
 
-    return sp.Integer(int(x)) if float(x).is_integer() else sp.Float(float(x))
+    x = float(x)
+    return sp.Integer(int(x)) if x.is_integer() and abs(x) < MAX_EXACT_INTEGER else sp.Float(x)
 
 
 def _integral_floats(e: Any) -> Any:
+    """``e`` with machine numbers only (:data:`MAX_EXACT_INTEGER`): integral floats below it as integers, integers
+    and fractions of integers beyond it as floats (``2**70``, ``1/2**70``; ValueError if beyond the float range)."""
     import sympy as sp
 
-    return e.xreplace({x: sp.Integer(int(x)) for x in e.atoms(sp.Float) if float(x).is_integer()})
+    swap = {x: sp.Integer(int(x)) for x in e.atoms(sp.Float) if float(x).is_integer()
+            and abs(float(x)) < MAX_EXACT_INTEGER}
+    for r in e.atoms(sp.Rational):
+        if abs(r.p) >= MAX_EXACT_INTEGER or r.q >= MAX_EXACT_INTEGER:
+            try:
+                x = float(r)
+            except OverflowError:
+                x = math.inf
+            if not math.isfinite(x):
+                raise ValueError(f"the number {shown(str(r), 40)} exceeds the float range (about 1.8e308)")
+            swap[r] = sp.Float(x)
+    return e.xreplace(swap) if swap else e
 
 
 def _grammar_round_trip(e: Any, label: str) -> str:
@@ -139,7 +166,7 @@ def _checked_text(text: str, values: dict[str, Any], label: str) -> str:
     if v not in e.free_symbols:
         raise ValueError(f"expression {label} does not depend on v (it is {shown(str(e), 60)}): a peel "
                          "force must vary with the peel velocity")
-    ExpressionLaw(e).probe(label)  # before printing: a complex law is named by the point where it is complex
+    ExpressionLaw(e, label).probe(label)  # before printing: a complex law is named by the point where it is complex
     return _grammar_round_trip(e, label)
 
 
@@ -169,22 +196,54 @@ def from_stored(text: Any) -> str:
 def from_text(text: str) -> Any:
     """The sympy expression of a canonical text (:func:`canonical`), by the grammar: never evaluated."""
     v, V = _symbols()
-    return _grammar.parse(text, {"v": v, "V": V})[0]
+    return _integral_floats(_grammar.parse(text, {"v": v, "V": V})[0])  # 1e+20 reads as an integer: a float again
+
+
+def _exact_float_printer() -> Any:
+    """lambdify's numpy printer (its own settings), floats printed exactly (``repr``) as the compiled kernel prints
+    them: sympy's prints 15 digits (2**70 read 1.18059162071741e+21, 1.1e-15 off)."""
+    from sympy.printing.numpy import NumPyPrinter
+
+    class _Printer(NumPyPrinter):
+        def _print_Float(self, expr: Any) -> str:
+            return repr(float(expr))
+
+    return _Printer({"fully_qualified_modules": False, "inline": True, "allow_unknown_functions": True,
+                     "user_functions": {}})
+
+
+def _check_size(e: Any, what: str, limit: int, label: str) -> None:
+    """ValueError if the tree of ``e`` has more than ``limit`` nodes (counted up to limit + 1: linear, bounded)."""
+    import sympy as sp
+
+    n = 0
+    for _ in sp.preorder_traversal(e):
+        n += 1
+        if n > limit:
+            raise ValueError(f"expression {label}: its derivative {what} has more than {limit} terms and factors "
+                             f"(MAX_DERIVATIVE_NODES, {MAX_DERIVATIVE_NODES[0]} for f' and {MAX_DERIVATIVE_NODES[1]} "
+                             "for f''): compiling it would take minutes; write the law expanded or with fewer "
+                             "factors")
 
 
 class ExpressionLaw:
     """The evaluator of an expression law, rebuilt from its canonical text."""
 
-    def __init__(self, text: Any):
-        """From the canonical text (or the checked sympy expression itself, at construction)."""
+    def __init__(self, text: Any, label: str = "law"):
+        """From the canonical text (or the checked sympy expression itself, at construction); ValueError if f'
+        or f'' exceeds :data:`MAX_DERIVATIVE_NODES`."""
         import sympy as sp
 
         v, V = _symbols()
         e = from_text(text) if isinstance(text, str) else text
         self.depends_on_V = V in e.free_symbols
         d1 = sp.diff(e, v)
-        self.exprs = (e, d1, sp.diff(d1, v))
-        self.funcs = [sp.lambdify((v, V), x, modules="numpy") for x in self.exprs]
+        _check_size(d1, "f'", MAX_DERIVATIVE_NODES[0], label)
+        d2 = sp.diff(d1, v)
+        _check_size(d2, "f''", MAX_DERIVATIVE_NODES[1], label)
+        self.exprs = (e, d1, d2)
+        printer = _exact_float_printer()
+        self.funcs = [sp.lambdify((v, V), x, modules="numpy", printer=printer) for x in self.exprs]
 
     def raw(self, v: np.ndarray, V: float, order: int) -> np.ndarray:
         with np.errstate(all="ignore"):

@@ -30,6 +30,24 @@ ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "exp
             "smoothed")
 
 
+def _check_field_types(force: Any) -> None:
+    """TypeError naming the field whose type is wrong (a list as a family's name, coefficients as a flat list),
+    before any kind uses it; coefficients given as a mapping or as JSON's ``[name, value]`` lists become pairs."""
+    for field in ("kind", "name", "source"):
+        value = getattr(force, field)
+        if not (isinstance(value, str) or (value is None and field != "kind")):
+            raise TypeError(f"{field} must be a string{'' if field == 'kind' else ' or None'}, got "
+                            f"{type(value).__name__} {shown(value)}")
+    coefs = force.coefficients
+    if isinstance(coefs, Mapping):
+        coefs = tuple(coefs.items())
+    if (isinstance(coefs, (str, bytes)) or not isinstance(coefs, (tuple, list))
+            or not all(isinstance(p, (tuple, list)) and len(p) == 2 and isinstance(p[0], str) for p in coefs)):
+        raise TypeError(f"coefficients must be (name, value) pairs or a mapping of name to value, got "
+                        f"{shown(force.coefficients)}")
+    object.__setattr__(force, "coefficients", tuple(tuple(p) for p in coefs))
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class PeelForce:
     """A peel-force law ``f(v, V)`` [N]: the paper's fvV, a family, an expression or a table.
@@ -72,6 +90,7 @@ class PeelForce:
 
     # ------------------------------------------------------------------ construction
     def __post_init__(self) -> None:
+        _check_field_types(self)
         if self.kind not in KINDS:
             raise ValueError(f"kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
         impl = KIND_IMPLS[self.kind]

@@ -48,6 +48,10 @@ MAX_NODES = 400
 MAX_CALL_DEPTH = 6
 #: The largest magnitude of a number in a law (a literal, or a power of two numbers).
 MAX_LITERAL = 1e300
+#: The largest integer kept as an integer [magnitude]: 2**53, below which every integer is a float exactly.  A
+#: number beyond (``1e20``, ``2**70``) is a float: as a Python integer it made numpy's evaluator an object array
+#: (``ufunc 'isfinite' not supported``) and numba's kernel an integer literal over 64 bits (``TypingError``).
+MAX_EXACT_INTEGER = 2**53
 #: The largest magnitude of a numeric exponent.
 MAX_EXPONENT = 1000
 
@@ -72,6 +76,13 @@ _LEGACY_CALLS = frozenset({"Add", "Mul", "Pow", "Integer", "Float", "Rational", 
 
 def _supported() -> str:
     return ", ".join(sorted(set(FUNCTIONS)))
+
+
+def _number(x: float) -> Any:
+    """A float as a sympy number: the integer if it is one below :data:`MAX_EXACT_INTEGER`, else the float."""
+    import sympy as sp
+
+    return sp.Integer(int(x)) if x.is_integer() and abs(x) < MAX_EXACT_INTEGER else sp.Float(x)
 
 
 class _Builder:
@@ -115,10 +126,10 @@ class _Builder:
                 if abs(value) > MAX_LITERAL:
                     raise self.fail(f"the integer literal has {len(str(abs(value)))} digits: numbers are bounded "
                                     f"by {MAX_LITERAL:g} in magnitude")
-                return sp.Integer(value)
+                return sp.Integer(value) if abs(value) < MAX_EXACT_INTEGER else sp.Float(float(value))
             if not math.isfinite(value) or abs(value) > MAX_LITERAL:
                 raise self.fail(f"the literal {value!r} is not finite or exceeds {MAX_LITERAL:g} in magnitude")
-            return sp.Integer(int(value)) if value.is_integer() else sp.Float(value)
+            return _number(value)
         if isinstance(node, ast.Name):
             return self.name(node.id)
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
@@ -205,7 +216,7 @@ class _Builder:
             raise self.fail(f"{text} is not real (it is {z}): a peel force is real")
         if not math.isfinite(z.real) or abs(z.real) > MAX_LITERAL:
             raise self.fail(f"{text} is not finite or exceeds {MAX_LITERAL:g} in magnitude")
-        return sp.Integer(int(z.real)) if z.real.is_integer() else sp.Float(z.real)
+        return _number(z.real)
 
     def legacy_call(self, fname: str, node: ast.Call, depth: int) -> Any:
         """A constructor of sympy's ``srepr`` (a stored law of peelapprox 0.2), built from checked arguments."""

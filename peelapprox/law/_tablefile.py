@@ -17,14 +17,13 @@ from typing import Any
 import numpy as np
 
 from .._checks import shown
-from .._csvread import read_columns
+from .._csvread import header_cell, read_columns
 
 __all__ = ["TABLE_COLUMNS", "read_points", "with_line"]
 
 #: The headers accepted without ``columns``: one table, or several grouped by the pull speed V [m/s].
 TABLE_COLUMNS = (("v", "f"), ("V", "v", "f"))
 _UNIT = {"V": "m/s", "v": "m/s", "f": "N"}
-_SPEC = re.compile(r"^\s*(.*?)\s*(?:[\[(]\s*([^\[\]()]*?)\s*[\])])?\s*$")
 
 
 def read_points(path: Any, *, columns: Any = None, delimiter: str | None = None,
@@ -64,8 +63,7 @@ def read_points(path: Any, *, columns: Any = None, delimiter: str | None = None,
                              f"{shown(columns)}")
         names, stated = {}, {}
         for key, text in spec.items():
-            m = _SPEC.match(text)
-            name, unit = (m.group(1), m.group(2)) if m else (text, None)
+            name, unit = header_cell(text, any_name=True)
             names[key] = name
             if unit:
                 stated[name] = unit
