@@ -1,0 +1,169 @@
+"""The reduced return map on the exact model's section, its periodic orbits by Newton and their multipliers.
+
+The map (:func:`peelapprox.approximate_attractor`, module docstring of :mod:`peelapprox._approximate`) chains a
+reduced AB segment to the fold ``v_max``, the AB→CD jump, a reduced CD segment to ``v_min`` and the CD→AB jump.
+Here its state is the section of the exact model: the point on AB just before the AB→CD jump, where CONSTR,
+``F (1 - c(α)) = f_max`` (``1 - c = 1 + sin α`` for the paper's geometry), ties F to α, so the map is a map of
+the plane ``x = (α, α̇)``.  At each fold F is put back on CONSTR (``F = f_fold/(1 - c(α))``) instead of carried
+over from the reduced segment, whose linearised constraint drifts under approxvdot (issue 35: the residual of
+``F(1 + α) = f(v)`` changes at rate ``Ḟα``, -88…+83 N over 50 s); the map then lives on the exact section and its
+fixed points are comparable with :func:`exact.periodic_orbit`'s.
+
+A period-n orbit is a zero of ``P^n(x) - x``, found by Newton with a finite-difference Jacobian (central
+differences, step :data:`FD_STEP` of the orbit's scale, at :data:`NEWTON_RTOL`); its multipliers are the
+eigenvalues of that Jacobian.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from ._params import PeelParams
+from ._segment import SegmentPlan, run_segment, segment_plan
+from ._segment_kernel import AM_EXP, AM_HARM, AM_SIN, AM_STATIC, alpha_at
+from ._status import DONE
+
+__all__: list[str] = []
+
+#: Step budget of one segment: the most step-hungry stays (I = 1e-6, V = 0.5, ~190 α oscillations on AB) take
+#: ~2000 steps at rtol 1e-6.
+SEGMENT_MAX_STEPS = 200_000
+#: Segment tolerance of the Newton iterations and the Jacobian: the map is then smooth to ~1e-9 of its scale,
+#: so differences of step :data:`FD_STEP` carry ~3e-5 of noise (the reduction's own multiplier error is ~0.06).
+NEWTON_RTOL = 1e-9
+#: The finite-difference step, relative to the orbit's scale in each coordinate.
+FD_STEP = 3e-5
+#: Newton converged when the scaled step is below this.
+NEWTON_TOL = 1e-8
+#: Newton iterations at most.
+NEWTON_MAX_IT = 8
+_CLOSED = {AM_SIN, AM_HARM, AM_EXP, AM_STATIC}
+
+
+class MapStop(Exception):
+    """A segment of the map did not reach its fold (its plan, its run and where the map was), or the wall-clock
+    deadline passed (``timeout``)."""
+
+    def __init__(self, plan: SegmentPlan | None, run: Any, returns: int, timeout: bool = False) -> None:
+        super().__init__("timeout" if timeout else getattr(plan, "branch", ""))
+        self.plan, self.run, self.returns, self.timeout = plan, run, returns, timeout
+
+
+class ReturnMap:
+    """The reduced return map of one chain at one segment tolerance (module docstring)."""
+
+    def __init__(self, params: PeelParams, law: Any, models: tuple[tuple[str, str], tuple[str, str]],
+                 rtol: float, deadline: float = math.inf) -> None:
+        bs = law.structure
+        self.params, self.law, self.models, self.rtol = params, law, models, rtol
+        self.plans = (self.plan("AB", bs.v_land_ab), self.plan("CD", bs.v_land_cd))
+        R = params.R
+        # the jump of ω-continuity: α̇ after = α̇ before + (v before - v after)/R
+        self.kick = ((bs.v_max - bs.v_land_cd) / R, (bs.v_min - bs.v_land_ab) / R)
+        self.fold = (float(bs.f_max), float(bs.f_min))
+        self.paper = params.geometry == "paper"
+        self.omega = math.sqrt(self.fold[0] * R / params.I)
+        self.returns = 0
+        self.deadline = deadline
+
+    def plan(self, branch: str, v_in: float) -> SegmentPlan:
+        bs = self.law.structure
+        code = 0 if branch == "AB" else 1
+        am, ve = self.models[code]
+        return segment_plan(self.params, self.law, branch, v_in=v_in, v_f=bs.v_max if code == 0 else bs.v_min,
+                            alpha_model=am, v_equation=ve, F_rate=None, rtol=self.rtol, t_max=None,
+                            max_steps=SEGMENT_MAX_STEPS)
+
+    def force(self, branch: int, a: float) -> float:
+        """F on CONSTR at the fold of ``branch`` (0 AB: f_max, 1 CD: f_min) with the angle ``a``."""
+        one_minus_c = 1.0 + math.sin(a) if self.paper else 1.0 - float(self.params.closure(a)[0])
+        return self.fold[branch] / one_minus_c
+
+    def segment(self, plan: SegmentPlan, F: float, a: float, ad: float) -> tuple[float, float, float]:
+        """One stay: ``(duration, α, α̇)`` at its fold; :class:`MapStop` if it does not get there."""
+        if time.perf_counter() > self.deadline:
+            raise MapStop(None, None, self.returns, timeout=True)
+        run = run_segment(plan, F, a, ad)
+        if run.code != DONE:
+            raise MapStop(plan, run, self.returns)
+        y = run.y
+        a, ad = alpha_at(y, run.q) if plan.alpha_model in _CLOSED else (float(y[3]), float(y[4]))
+        return float(y[0]), a, ad
+
+    def ret(self, x: np.ndarray | tuple[float, float]) -> tuple[np.ndarray, tuple[float, ...]]:
+        """One return from the section point ``x = (α, α̇)``: the next one, and ``(F at the AB→CD jump, F at the
+        CD→AB jump, the CD stay, the AB stay, α at the two jumps)``."""
+        a0, ad = float(x[0]), float(x[1])
+        F = self.force(0, a0)
+        t_cd, a, ad = self.segment(self.plans[1], F, a0, ad + self.kick[0])
+        G = self.force(1, a)
+        t_ab, a1, ad = self.segment(self.plans[0], G, a, ad + self.kick[1])
+        self.returns += 1
+        return np.array([a1, ad]), (F, G, t_cd, t_ab, a0, a)
+
+    def power(self, x: np.ndarray, n: int) -> np.ndarray:
+        for _ in range(n):
+            x = self.ret(x)[0]
+        return x
+
+    def enter(self, start: tuple[int, float, float, float, float]) -> np.ndarray:
+        """The first section point from a start ``(branch code, F, v, α, α̇)`` anywhere on a branch."""
+        branch, F, v, a, ad = start
+        if branch == 1:
+            dt, a, ad = self.segment(self.plan("CD", v), F, a, ad)
+            F, v, ad = self.force(1, a), self.law.structure.v_land_ab, ad + self.kick[1]
+        dt, a, ad = self.segment(self.plan("AB", v), F, a, ad)
+        return np.array([a, ad])
+
+    def scale(self, x: np.ndarray) -> np.ndarray:
+        """The coordinates' scales at ``x``: ``(A, A Ω)``, ``A = max(|α|, |α̇|/Ω, 1e-4)``."""
+        A = max(abs(float(x[0])), abs(float(x[1])) / self.omega, 1e-4)
+        return np.array([A, A * self.omega])
+
+    def jacobian(self, x: np.ndarray, n: int, s: np.ndarray, fx: np.ndarray | None = None) -> np.ndarray:
+        """``D P^n`` at ``x`` by central differences of step ``FD_STEP s``, or forward ones from ``fx = P^n(x)``
+        when given."""
+        J = np.empty((2, 2))
+        for j in range(2):
+            h = np.zeros(2)
+            h[j] = FD_STEP * s[j]
+            if fx is None:
+                J[:, j] = (self.power(x + h, n) - self.power(x - h, n)) / (2.0 * h[j])
+            else:
+                J[:, j] = (self.power(x + h, n) - fx) / h[j]
+        return J
+
+
+def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The period-n orbit's section point near ``x`` and ``D P^n`` there (multipliers: its eigenvalues), or
+    None when the chord iteration (a forward-difference Jacobian at ``x``, renewed once after three steps) does not
+    converge in :data:`NEWTON_MAX_IT` steps, diverges (a step over half the scale) or a segment stops.
+
+    ``m`` is any map with ``power(x, n)``, ``scale(x)`` and ``jacobian(x, n, s, fx)`` (:class:`ReturnMap`)."""
+    s = m.scale(x)
+    try:
+        fx = m.power(x, n)
+        J = m.jacobian(x, n, s, fx)
+        for it in range(NEWTON_MAX_IT):
+            r = fx - x
+            if np.max(np.abs(r / s)) < NEWTON_TOL:  # on the orbit already (a neutral direction need not be solved)
+                return x, m.jacobian(x, n, s)
+            try:
+                dx = np.linalg.solve(J - np.eye(2), -r)
+            except np.linalg.LinAlgError:
+                return None
+            if not np.all(np.isfinite(dx)) or np.max(np.abs(dx / s)) > 0.5:
+                return None
+            x = x + dx
+            if np.max(np.abs(dx / s)) < NEWTON_TOL:
+                return x, m.jacobian(x, n, s)
+            fx = m.power(x, n)
+            if it == 2:
+                J = m.jacobian(x, n, s, fx)  # a fresh Jacobian once, near the orbit
+    except MapStop:
+        return None
+    return None
