@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -124,46 +125,48 @@ class ReturnMap:
         A = max(abs(float(x[0])), abs(float(x[1])) / self.omega, 1e-4)
         return np.array([A, A * self.omega])
 
-    def jacobian(self, x: np.ndarray, n: int, s: np.ndarray, fx: np.ndarray | None = None) -> np.ndarray:
-        """``D P^n`` at ``x`` by central differences of step ``FD_STEP s``, or forward ones from ``fx = P^n(x)``
-        when given."""
-        J = np.empty((2, 2))
-        for j in range(2):
-            h = np.zeros(2)
-            h[j] = FD_STEP * s[j]
-            if fx is None:
-                J[:, j] = (self.power(x + h, n) - self.power(x - h, n)) / (2.0 * h[j])
-            else:
-                J[:, j] = (self.power(x + h, n) - fx) / h[j]
-        return J
+
+
+def jacobian(power: Callable[[np.ndarray, int], np.ndarray], x: np.ndarray, n: int, s: np.ndarray,
+             fx: np.ndarray | None = None) -> np.ndarray:
+    """``D P^n`` at ``x`` by central differences of step ``FD_STEP s``, or forward ones from ``fx = P^n(x)`` when
+    given."""
+    J = np.empty((x.size, x.size))
+    for j in range(x.size):
+        h = np.zeros(x.size)
+        h[j] = FD_STEP * s[j]
+        J[:, j] = (power(x + h, n) - power(x - h, n)) / (2.0 * h[j]) if fx is None else (power(x + h, n) - fx) / h[j]
+    return J
 
 
 def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | None:
-    """The period-n orbit's section point near ``x`` and ``D P^n`` there (multipliers: its eigenvalues), or
-    None when the chord iteration (a forward-difference Jacobian at ``x``, renewed once after three steps) does not
-    converge in :data:`NEWTON_MAX_IT` steps, diverges (a step over half the scale) or a segment stops.
+    """The period-n orbit's point near ``x`` and ``D P^n`` there (multipliers: its eigenvalues), or None when the
+    chord iteration (a forward-difference Jacobian at ``x``, renewed once after three steps) does not converge to
+    :data:`NEWTON_TOL` (the step relative to ``m.scale(x)``) in :data:`NEWTON_MAX_IT` steps, diverges (a step over
+    half the scale) or a segment stops.
 
-    ``m`` is any map with ``power(x, n)``, ``scale(x)`` and ``jacobian(x, n, s, fx)`` (:class:`ReturnMap`)."""
+    ``m`` is any map of the plane with ``power(x, n)`` (``P^n(x)``) and ``scale(x)`` (:class:`ReturnMap`)."""
     s = m.scale(x)
+    eye = np.eye(x.size)
     try:
         fx = m.power(x, n)
-        J = m.jacobian(x, n, s, fx)
+        J = jacobian(m.power, x, n, s, fx)
         for it in range(NEWTON_MAX_IT):
             r = fx - x
             if np.max(np.abs(r / s)) < NEWTON_TOL:  # on the orbit already (a neutral direction need not be solved)
-                return x, m.jacobian(x, n, s)
+                return x, jacobian(m.power, x, n, s)
             try:
-                dx = np.linalg.solve(J - np.eye(2), -r)
+                dx = np.linalg.solve(J - eye, -r)
             except np.linalg.LinAlgError:
                 return None
             if not np.all(np.isfinite(dx)) or np.max(np.abs(dx / s)) > 0.5:
                 return None
             x = x + dx
             if np.max(np.abs(dx / s)) < NEWTON_TOL:
-                return x, m.jacobian(x, n, s)
+                return x, jacobian(m.power, x, n, s)
             fx = m.power(x, n)
             if it == 2:
-                J = m.jacobian(x, n, s, fx)  # a fresh Jacobian once, near the orbit
+                J = jacobian(m.power, x, n, s, fx)  # a fresh Jacobian once, near the orbit
     except MapStop:
         return None
     return None
