@@ -246,7 +246,6 @@ def test_estimate_offers_the_attractor_and_says_how_often_it_holds():
     """Hypothesis: ``estimate(p).attractor()`` is ``approximate_attractor(p)`` (deterministic: equal fields), and
     ``estimate(p).validity`` quotes the atlas's measured percentage of p's regime (the CSV's fraction, rounded to a
     whole percent, computed here from the file)."""
-    import dataclasses
 
     from peelapprox import PeelParams, approximate_attractor, estimate
 
