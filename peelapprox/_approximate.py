@@ -74,8 +74,9 @@ CANDIDATE_RTOL = 0.2
 #: Periods tried by Newton at most, best repeating first.
 MAX_CANDIDATES = 2
 #: An unstable orbit is left (:attr:`ApproximateAttractor.escape_returns`) when the deviation of the force at
-#: the AB→CD jumps from the orbit's reaches this fraction of the orbit's force drop.
-ESCAPE_FRACTION = 0.1
+#: the AB→CD jumps from the orbit's reaches this fraction of the orbit's force drop: the deviation is then as
+#: large as the orbit itself, and the run goes over to another attractor.
+ESCAPE_FRACTION = 1.0
 #: The map leaves an unstable orbit from a force deviation of this fraction of its force drop (along its own
 #: deviation), where the orbit's linearisation no longer holds the map near it.
 ESCAPE_PUSH = 1.0
