@@ -23,8 +23,9 @@ from typing import Any
 
 import numpy as np
 
+from . import _segment_kernel as K
 from ._params import PeelParams
-from ._segment import SegmentPlan, run_segment, segment_plan
+from ._segment import SegmentPlan, SegmentRun, run_segment, segment_plan
 from ._segment_kernel import AM_EXP, AM_HARM, AM_SIN, AM_STATIC, alpha_at
 from ._status import DONE
 
@@ -43,6 +44,7 @@ NEWTON_TOL = 1e-8
 #: Newton iterations at most.
 NEWTON_MAX_IT = 8
 _CLOSED = {AM_SIN, AM_HARM, AM_EXP, AM_STATIC}
+_NO_T = np.empty(0)
 
 
 class MapStop(Exception):
@@ -70,6 +72,8 @@ class ReturnMap:
         self.omega = math.sqrt(self.fold[0] * R / params.I)
         self.returns = 0
         self.deadline = deadline
+        # run_segment's default horizon, its entry-independent part: 20 quasi-static passages of the fold gap
+        self.horizon = 20.0 * (self.fold[0] - self.fold[1]) / (params.k * params.V)
 
     def plan(self, branch: str, v_in: float) -> SegmentPlan:
         bs = self.law.structure
@@ -88,12 +92,36 @@ class ReturnMap:
         """One stay: ``(duration, α, α̇)`` at its fold; :class:`MapStop` if it does not get there."""
         if time.perf_counter() > self.deadline:
             raise MapStop(None, None, self.returns, timeout=True)
-        run = run_segment(plan, F, a, ad)
-        if run.code != DONE:
-            raise MapStop(plan, run, self.returns)
-        y = run.y
-        a, ad = alpha_at(y, run.q) if plan.alpha_model in _CLOSED else (float(y[3]), float(y[4]))
-        return float(y[0]), a, ad
+        if plan.alpha_model in _CLOSED:
+            run = run_segment(plan, F, a, ad)
+            if run.code != DONE:
+                raise MapStop(plan, run, self.returns)
+            a, ad = alpha_at(run.y, run.q)
+            return float(run.y[0]), a, ad
+        y = self.lean(plan, F, a, ad)
+        return float(y[0]), float(y[3]), float(y[4])
+
+    def lean(self, plan: SegmentPlan, F: float, a: float, ad: float) -> np.ndarray:
+        """:func:`peelapprox._segment.run_segment`'s arithmetic for an integrated α model (no closed form), without
+        its per-call set-up: the same parameter vector, atol, horizon and driver call, so the same numbers bitwise;
+        the final state ``(t, ln v, F, α, α̇)``."""
+        p = self.params
+        q = plan.q.copy()
+        q[K.Q_FIN], q[K.Q_VIN], q[K.Q_FPIN], q[K.Q_S] = F, plan.v_in, plan.fp_in, plan.F_rate
+        q[K.Q_AIN], q[K.Q_ADIN], q[K.Q_TAU] = a, ad, p.R * plan.fp_in / F
+        q[K.Q_AMP] = q[K.Q_PH] = 0.0
+        Om = float(np.sqrt(p.R * F / p.I))
+        a_scale = max(abs(a), abs(ad) / Om, 1e-8)
+        atol = plan.rtol * np.array([1e-3, 1.0, F, a_scale, Om * a_scale])
+        t_max = plan.t_max if plan.t_max is not None else self.horizon + 20.0 * 2.0 * math.pi / Om
+        y = np.array([0.0, math.log(plan.v_in), F, a, ad])
+        cnt = np.zeros(5, dtype=np.int64)
+        code = plan.drive(y, q, plan.law_arg, plan.law.coef, plan.rtol, atol, plan.x_f, plan.x_lo, plan.x_hi,
+                          plan.branch == "AB", t_max, plan.max_steps, K.SAVE_NONE, _NO_T, np.empty((1, 5)), cnt)
+        if code != DONE:
+            raise MapStop(plan, SegmentRun(int(code), y, np.empty((0, 5)), cnt, q, a, ad, atol, float(t_max)),
+                          self.returns)
+        return y
 
     def ret(self, x: np.ndarray | tuple[float, float]) -> tuple[np.ndarray, tuple[float, ...]]:
         """One return from the section point ``x = (α, α̇)``: the next one, and ``(F at the AB→CD jump, F at the
