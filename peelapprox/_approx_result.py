@@ -108,7 +108,7 @@ class ApproximateAttractor(StickSlipObservables):
 
     def __repr__(self) -> str:
         base = super().__repr__().replace("StickSlipObservables(", "ApproximateAttractor(", 1)[:-1]
-        mu = "" if self.multipliers is None else ", |mu| " + "/".join(fmt_number(abs(m), 4) for m in self.multipliers)
+        mu = "" if self.multipliers is None else ", |mu| " + "/".join(fmt_number(abs(m), 6) for m in self.multipliers)
         return f"{base}{mu}, confidence {self.confidence}, {len(self.alternatives)} alternatives)"
 
     def summary(self) -> str:

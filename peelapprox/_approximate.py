@@ -311,7 +311,7 @@ def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, J: np.ndarr
     rho = max(abs(m) for m in mu)
     kind = "stable" if rho < 1.0 else ("neutral" if rho <= 1.0 + NEUTRAL else "unstable")
     how = (f"{name} start, Newton on P^{n} after {returns} returns, {kind} "
-           f"(|mu| {'/'.join(fmt_number(abs(m), 4) for m in mu)})")
+           f"(|mu| {'/'.join(fmt_number(abs(m), 6) for m in mu)})")
     obs = _observe(recs, hi.force(0, float(y[0])), period_rtol=1e-6, max_period=n, how=how, chain=chain,
                    common=common, t0=0.0, multipliers=mu, start=name)
     return obs, recs, float(np.mean([r[0] - r[1] for r in recs]))

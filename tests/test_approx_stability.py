@@ -150,3 +150,32 @@ def test_breakdown_of_the_exact_run_is_flagged():
     assert full.status == "breakdown" and "v -> 0" in full.reason
     o = approximate_attractor(p, warn=False)
     assert o.status == "stick-slip" and o.confidence == "low" and "breaks down" in o.confidence_reason
+
+
+def test_benchmark_points_and_cached_reference():
+    """The benchmark's points are the seeded draw it documents (V in [0.3, 4.8], I log-uniform in [2e-6, 8e-2],
+    the same for the same seed, others for another), and its cached reference is read, not recomputed: the file
+    holds five starts per point, α0 = 0 first (the strict reference)."""
+    from comparisons.benchmark import approx_targets as bench
+
+    pts = bench.points(100, 1)
+    assert pts == bench.points(100, 1) and pts != bench.points(100, 2)
+    assert all(0.3 <= V <= 4.8 and 2e-6 <= I <= 8e-2 for V, I in pts)
+    ref = bench.reference(100, 1)
+    assert [(r["V"], r["I"]) for r in ref] == pts
+    assert all([s["alpha0"] for s in r["starts"]] == list(bench.ALPHA0S) for r in ref)
+
+
+@pytest.mark.slow
+def test_validation_seed_meets_the_accuracy_targets():
+    """The issue's targets on the validation points (seed 2, never used to choose a rule or constant), against
+    their cached exact multi-start reference: the primary prediction matches an exact attractor of the set at
+    >= 90 % of the stick-slip points (measured 92.8 %), the default start's at >= 85 % (90.7 %); of the
+    predictions not flagged low >= 95 % match (95.4 %), and at least half are unflagged (67 %).  Deterministic:
+    the same numbers on every run (the map has no randomness), so the margins are the measured ones."""
+    from comparisons.benchmark import approx_targets as bench
+
+    s = bench.score(bench.reference(100, 2))
+    assert s["n"] == 97
+    assert s["set"] >= 0.90 and s["strict"] >= 0.85
+    assert s["high_share"] >= 0.5 and s["high_match"] >= 0.95
