@@ -301,7 +301,7 @@ def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, J: np.ndarr
     """A periodic orbit's observables over whole cycles of the orbit itself (at Newton's tolerance), its records
     and its mean force drop."""
     hi = maps[1]
-    cycles = max(3, math.ceil(24 / n))
+    cycles = 3  # the orbit itself: one cycle gives its means, three its period label (peelapprox.periodicity)
     recs = []
     y = x
     for _ in range(cycles * n):
