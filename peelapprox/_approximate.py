@@ -71,6 +71,10 @@ MAX_PERIOD = 12
 PERIOD_RTOL = 1e-4
 #: A period n is tried by Newton when the last returns repeat after n to this fraction of ``f_max - f_min``.
 CANDIDATE_RTOL = 0.2
+#: After this many transient returns, periods that repeat to :data:`EARLY_RTOL` are tried at once, and a clearly
+#: stable orbit (every multiplier inside 1 - the multiplier error) ends the transient.
+EARLY_RETURNS = 18
+EARLY_RTOL = 0.01
 #: Periods tried by Newton at most, best repeating first.
 MAX_CANDIDATES = 2
 #: An unstable orbit is left (:attr:`ApproximateAttractor.escape_returns`) when the deviation of the force at
@@ -275,7 +279,7 @@ def _observe(recs: list[tuple], F_next: float, *, period_rtol: float, max_period
                                 **{**common, "t_start": float(t[0]), "t_end": float(t[-1])}, **extra)
 
 
-def _candidates(F: list[float], scale: float) -> list[int]:
+def _candidates(F: list[float], scale: float, rtol: float = CANDIDATE_RTOL) -> list[int]:
     """Periods n <= :data:`MAX_PERIOD` after which the last returns repeat to :data:`CANDIDATE_RTOL` of
     ``scale``, best repeating first, at most :data:`MAX_CANDIDATES`; a divisor of n that repeats nearly as well
     (within 4 times n's mismatch, or 1e-3) stands for n (a period-2 orbit also repeats after 4)."""
@@ -288,7 +292,7 @@ def _candidates(F: list[float], scale: float) -> list[int]:
         mismatch[n] = float(np.max(np.abs(x[-m:] - x[-m - n:-n]))) / scale
     out: list[int] = []
     for n, r in sorted(mismatch.items(), key=lambda item: item[1]):
-        if r >= CANDIDATE_RTOL:
+        if r >= rtol:
             break
         n = min(d for d in mismatch if n % d == 0 and mismatch[d] <= max(4.0 * r, 1e-3))
         if n not in out:
@@ -328,11 +332,13 @@ def _deviation(recs: list[tuple], orbit: list[tuple], n: int) -> float:
 
 
 def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: list[tuple], name: str, chain: str,
-            common: dict[str, Any]) -> tuple[ApproximateAttractor, list[tuple], float, np.ndarray, int] | None:
-    """The periodic orbit Newton finds from ``x`` for a period n the returns ``recs`` propose (best first): its
-    observables, records, mean force drop, section point and n; None if none converges."""
+            common: dict[str, Any], rtol: float = CANDIDATE_RTOL
+            ) -> tuple[ApproximateAttractor, list[tuple], float, np.ndarray, int] | None:
+    """The periodic orbit Newton finds from ``x`` for a period n the returns ``recs`` propose (best first, those
+    repeating to ``rtol``): its observables, records, mean force drop, section point and n; None if none
+    converges."""
     bs = maps[0].law.structure
-    for n in _candidates([r[0] for r in recs], float(bs.f_max - bs.f_min)):
+    for n in _candidates([r[0] for r in recs], float(bs.f_max - bs.f_min), rtol):
         res = newton(maps[1], x.copy(), n)
         if res is not None:
             obs, orbit, drop = _orbit(maps, res[0], n, res[1], maps[0].returns, name, chain, common)
@@ -349,9 +355,13 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
     try:
         x = lo.enter(s)
         recs: list[tuple] = []
-        for _ in range(n_transient):
+        for k in range(n_transient):
             x, r = lo.ret(x)
             recs.append(r)
+            if k + 1 == EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends it
+                got = _settle(maps, x, recs, name, chain, common, EARLY_RTOL)
+                if got is not None and max(abs(m) for m in got[0].multipliers or (1.0,)) < 1.0 - MULTIPLIER_ERROR:
+                    return _Found(got[0], left, _alpha_max(got[1]))
         for _ in range(MAX_ESCAPES + 1):
             got = _settle(maps, x, recs, name, chain, common)
             if got is None:
