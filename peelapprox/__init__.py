@@ -36,6 +36,7 @@ from ._alpha import (
     wkb_amplitude_phase,
     wkb_error_bound,
 )
+from ._approx_result import ApproximateAttractor, ApproximationWarning
 from ._approximate import approximate_attractor
 from ._estimate import (
     INERTIA_RULE,
@@ -171,6 +172,8 @@ __all__ = [
     # the observables of a stick-slip attractor (exact: attractor_observables; the reduced equations' prediction)
     "StickSlipObservables",
     "approximate_attractor",
+    "ApproximateAttractor",
+    "ApproximationWarning",
     # dynamics of the exact solution: they live in exact, imported from it on first access
     "attractors",
     "Attractor",

@@ -1,50 +1,54 @@
 """The stick-slip attractor predicted from the paper's reduced branch-wise equations alone (no DAE solve).
 
 :func:`approximate_attractor` chains the reduced segments of :mod:`peelapprox._segment` (Sec. V of the paper:
-an α model coupled to the velocity equation approxvdot or fullvdot) into a return map and iterates it to its
-attractor:
+an α model coupled to the velocity equation approxvdot or fullvdot) into a return map on the exact model's
+section (:mod:`peelapprox._reducedmap`) and finds its attractors:
 
 1. **AB**: from the landing velocity ``v_land_ab`` the α model and the v equation are integrated until v reaches
-   the fold ``v_max`` (CONSTR linearised, ``F(1 + α) = f(v)``, reaches ``f_max``).  With an oscillating α that
-   happens at a crest of the oscillation, before the quasi-static force reaches ``f_max``: the exit is the
-   transversal event ``ln v = ln v_max`` of the desingularised field (``dt/ds = v f'``), met on the way up
-   whatever drives v there; a crest that stays below ``f_max`` turns v back and the segment goes on.
-2. **AB→CD jump**: F and α continuous (the fast fibre of the ε → 0 limit), v to the landing ``v_land_cd``, and
-   the roller's angular velocity ``ω = α̇ + v/R`` continuous (FLOW1; the hybrid solver's jump), so
-   ``α̇ → α̇ - (v_land_cd - v_max)/R``.
+   the fold ``v_max`` (the transversal event ``ln v = ln v_max`` of the desingularised field).
+2. **AB→CD jump**: F put on CONSTR, ``F = f_max/(1 + sin α)`` (the section), α continuous, v to the landing
+   ``v_land_cd``, and the roller's angular velocity ``ω = α̇ + v/R`` continuous (FLOW1; the hybrid solver's
+   jump), so ``α̇ → α̇ - (v_land_cd - v_max)/R``.
 3. **CD**: the CD α model and v equation from ``v_land_cd`` until v falls to ``v_min``.
-4. **CD→AB jump**: likewise, ``α̇ → α̇ + (v_min - v_land_ab)/R``.
+4. **CD→AB jump**: likewise, ``F = f_min/(1 + sin α)``, ``α̇ → α̇ + (v_min - v_land_ab)/R``.
 
-The map starts where the exact solver does, and again at rest on the relaxation cycle's foot where that start
-finds no periodic attractor (:func:`approximate_attractor`).  The force at each jump and the jump times
-make the same jump record an exact trajectory has, and the observables are read off it by
-:func:`peelapprox._observables.jump_statistics`, the one definition both sides use.
+From each start the map runs ``n_transient`` returns; the returns' near-repetition proposes a period n <= 12,
+and Newton on ``P^n(x) = x`` finds the orbit and its multipliers.  A stable orbit is the answer (its
+observables over whole cycles of the orbit itself); an unstable one is reported with the return at which
+its amplitude law ``A_k = A_k0 |μ|^((k - k0)/n)`` reaches :data:`ESCAPE_FRACTION` of its force drop, and the
+map is moved there along its own deviation and iterated on (at most :data:`MAX_ESCAPES` times); where no
+period is found the map samples ``n_returns`` returns (whole cycles of a long period, or an aperiodic
+sample).  The observables are read by :func:`peelapprox._observables.jump_statistics`, the one definition both
+sides use.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
 
 import numpy as np
 
+from ._approx_result import ALPHA_LINEAR, MULTIPLIER_ERROR, ApproximateAttractor, confidence, warn_low
 from ._observables import StickSlipObservables, jump_statistics
 from ._params import PeelParams
 from ._ranges import F0_FACTOR
+from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, newton
 from ._regime import regime
-from ._segment import SegmentPlan, run_segment, segment_plan, segment_status
-from ._segment_kernel import ALPHA_MODELS, AM_EXP, AM_HARM, AM_SIN, AM_STATIC, V_EQUATIONS, alpha_at
-from ._status import DONE, F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
+from ._segment import SegmentPlan, segment_status
+from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
+from ._status import F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
 from .io import fmt_number
 from .law import fixed_point
 from .law._compiled import compiled_law
-from .validate import choice, integer, optional, positive
+from .validate import choice, flag, integer, optional, positive
 from .validate import params as _params
 from .validate import rtol as _rtol
 
-__all__ = ["APPROX_DEFAULTS", "EARLY_RETURNS", "PERIOD_RTOL", "SEGMENT_MAX_STEPS", "STARTS", "approximate_attractor",
-           "default_models"]
+__all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "PERIOD_RTOL", "STARTS",
+           "approximate_attractor", "default_models"]
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
 #: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``; the table and its reasons are in
@@ -56,25 +60,39 @@ APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
 }
 
 #: Where the map starts (``start=``): ``"solver"``, the exact solver's default start; ``"rest"``, the foot of the
-#: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, the solver's start and, where that
-#: reaches no periodic attractor, the rest start (:func:`approximate_attractor`).
+#: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, both: the solver's attractor is the
+#: primary prediction, the rest start's an alternative (the primary where the solver's start finds none).
 STARTS = ("auto", "solver", "rest")
 
-#: The map stops early once its last ``max(EARLY_RETURNS, 3 n)`` returns repeat with a period n <= 12 to the
-#: period tolerance (:data:`PERIOD_RTOL`) and their mismatch is not growing: a periodic attractor has then been
-#: reached, and further returns would only repeat it.  An escape slower than that from an unstable small orbit
-#: is not told apart (V = 4.31, I = 7.2e-4: the map's returns stay within 303 to 306 N for 500 returns, spread to
-#: 298 to 311 N after 2000; docs/theory.md, "The approximate attractor").
-EARLY_RETURNS = 12
-#: The tolerance of the returns' period, ``max(PERIOD_RTOL, 100 rtol)`` relative to the largest return.  Some
-#: reduced maps approach their periodic orbit slowly: after 60 transient returns ``max|x_{k+n} - x_k|/max|x|`` is
-#: 5e-6 to 8e-5 at six low-inertia points (V = 0.89 to 4.3 m/s, I = 1e-6 and 5e-6), the same at rtol 1e-6, 1e-8
-#: and 1e-10 (convergence, not integration error).  1e-4 calls them periodic; their means are then within ~1e-4
-#: of the limit's, far inside the reductions' errors, and an aperiodic map's returns differ by 1e-3 or more.
+#: A periodic orbit is looked for with periods up to this (Newton on ``P^n``); longer ones are sampled.
+MAX_PERIOD = 12
+#: The returns' period tolerance of an aperiodic sample, ``max(PERIOD_RTOL, 100 rtol)`` relative to the largest
+#: return (long periods of a sample: :func:`peelapprox.periodicity`).
 PERIOD_RTOL = 1e-4
-#: Step budget of one segment: the most step-hungry stays (I = 1e-6, V = 0.5, ~190 α oscillations on AB) take
-#: ~2000 steps at rtol 1e-6.
-SEGMENT_MAX_STEPS = 200_000
+#: A period n is tried by Newton when the last returns repeat after n to this fraction of ``f_max - f_min``.
+CANDIDATE_RTOL = 0.2
+#: After this many transient returns, periods that repeat to :data:`EARLY_RTOL` are tried at once, and a clearly
+#: stable orbit (every multiplier inside 1 - the multiplier error) ends the transient.
+EARLY_RETURNS = 18
+EARLY_RTOL = 0.01
+#: Periods tried by Newton at most, best repeating first.
+MAX_CANDIDATES = 2
+#: An unstable orbit is left (:attr:`ApproximateAttractor.escape_returns`) when the deviation of the force at
+#: the AB→CD jumps from the orbit's reaches this fraction of the orbit's force drop: the deviation is then as
+#: large as the orbit itself, and the run goes over to another attractor.
+ESCAPE_FRACTION = 1.0
+#: The map leaves an unstable orbit from a force deviation of this fraction of its force drop (along its own
+#: deviation), where the orbit's linearisation no longer holds the map near it.
+ESCAPE_PUSH = 1.0
+#: The full branch dynamics linearised in α: the chain whose breakdown the default chain is checked against.
+FULL_CHAIN = (("genalpha", "fullvdot"), ("genalpha", "fullvdot"))
+#: Returns of :data:`FULL_CHAIN` from the solver's start in which a breakdown is looked for.
+PROBE_RETURNS = 5
+#: A multiplier within this of the unit circle is neutral (a family of orbits, as with α held fixed by the
+#: ``"static"`` model): the orbit is the answer, not left.
+NEUTRAL = 1e-7
+#: Unstable orbits left in turn from one start before the map samples what it reaches.
+MAX_ESCAPES = 3
 
 
 def default_models(params: PeelParams) -> tuple[tuple[str, str], tuple[str, str]]:
@@ -93,24 +111,19 @@ def approximate_attractor(
     cd_v_equation: str | None = None,
     start: str = "auto",
     n_transient: int = 40,
-    n_returns: int = 60,
+    n_returns: int = 500,
     rtol: float = 1e-6,
     max_wall: float | None = 10.0,
-) -> StickSlipObservables:
+    warn: bool = True,
+) -> ApproximateAttractor:
     """The stick-slip attractor predicted by the paper's reduced branch-wise equations, without the DAE.
 
-    Iterates the reduced return map (module docstring: AB segment to the fold, jump, CD segment to the fold,
-    jump) and reads the observables off its jumps with the definitions of :class:`StickSlipObservables` (slip
-    interval, force drop, slip and stick times, F at the jumps, the return map's period).
-
-    The map starts where :func:`exact.simulate` does (:func:`exact.initial_state`); that start's kick
-    ``α̇ = (V - v)/R`` can hold the map on a small mode around the unstable fixed point which the exact run
-    leaves only after thousands of slips, so where it reaches no periodic attractor the map starts again at rest
-    on the relaxation cycle's foot.  The default reductions, Airy1 + approxvdot on both branches,
-    keep FLOW1's kinematic term ``-v̇/R``, large near the folds, and measured best on a
-    40 x 40 grid of the paper's law (94 % of the low-inertia, low-V points within 10 % of the exact slip
-    interval and force drop, against 77 % for the paper's Case I).  docs/theory.md, "The approximate
-    attractor", has the measurements of both choices.
+    Runs the reduced return map on the exact model's section (module docstring: AB segment to the fold, jump
+    with F put on CONSTR, CD segment to the fold, jump) from the exact solver's start and from rest, finds its
+    periodic orbits by Newton with their multipliers, leaves the unstable ones, and reads the observables of
+    what it reaches with the definitions of :class:`StickSlipObservables`.  The default reductions, Airy1 +
+    approxvdot on both branches, keep FLOW1's kinematic term ``-v̇/R``, large near the folds (docs/theory.md,
+    "The approximate attractor", has the measurements of this choice and of genalpha + fullvdot).
 
     Parameters
     ----------
@@ -121,25 +134,29 @@ def approximate_attractor(
         AB's and CD's α model (:data:`peelapprox.ALPHA_MODELS`) and v equation (:data:`peelapprox.V_EQUATIONS`),
         any combination; each None is the default (:data:`APPROX_DEFAULTS`).
     start : {"auto", "solver", "rest"}
-        Where the map starts (:data:`STARTS`): ``"auto"`` the solver's, then at rest if need be (above).
+        Where the map starts (:data:`STARTS`): ``"auto"`` both, the solver's attractor first.
     n_transient : int
-        Returns (AB→CD jumps) discarded before the sample, an integer in [0, 10**6] (40).
+        Returns discarded before a period is looked for, an integer in [0, 10**6] (40).
     n_returns : int
-        Returns in the sample, in [3, 10**6] (60); fewer once they repeat with a period n <= 12 over the last
-        ``max(12, 3n)`` (:data:`EARLY_RETURNS`): an attractor reached.
+        Returns in the sample where no periodic orbit of period <= :data:`MAX_PERIOD` is found (chaotic,
+        quasi-periodic or long-period), in [3, 10**6] (500).
     rtol : float
-        Relative tolerance of each segment (1e-6: the observables agree with rtol 1e-10 to 1e-4, far inside the
-        reductions' own errors); the returns' period tolerance is :data:`PERIOD_RTOL`.
+        Relative tolerance of the segments while iterating (1e-6); Newton and its Jacobian run at 1e-10.
     max_wall : float or None
         Wall-clock budget [s] (10; None: unbounded), checked between segments, each with a step budget.
+    warn : bool
+        Warn once (:class:`peelapprox.ApproximationWarning`) when the primary prediction has low confidence
+        (True).
 
     Returns
     -------
-    StickSlipObservables
-        ``method`` names the chain, the start and the sample, ``t_start``/``t_end`` are on the map's own clock.
-        ``status``: ``"stick-slip"``; ``"steady"`` (no folds at V, or a segment settles on the stable fixed
-        point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment), with the
-        reason.  Every mean is None for the last three, never NaN.
+    ApproximateAttractor
+        A :class:`StickSlipObservables` (``method`` names the chain, the start and how the attractor was found;
+        ``t_start``/``t_end`` on the map's own clock) with ``multipliers``, ``escape_returns``, ``confidence``
+        and ``confidence_reason``, and ``alternatives``: the attractors of the other start and the unstable orbits
+        left on the way.  ``status``: ``"stick-slip"``; ``"steady"`` (no folds at V, or a segment settles on the
+        stable fixed point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment),
+        with the reason.  Every mean is None for the last three, never NaN.
 
     Raises
     ------
@@ -159,43 +176,46 @@ def approximate_attractor(
     start = choice("start", start, STARTS)
     rtol = _rtol("rtol", rtol)
     max_wall = optional(positive, "max_wall", max_wall)
+    warn = flag("warn", warn)
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
     bs = law.structure
     common: dict[str, Any] = dict(V=float(params.V), I=float(params.I), t_start=None, t_end=None)
     if not bs.has_folds:
-        return StickSlipObservables._no_slip(
+        return _promote(StickSlipObservables._no_slip(
             status="steady", method="approximate: no folds, nothing to chain", **common,
             reason=f"the law has no folds at V = {fmt_number(params.V, 4)} m/s (f increases in v): steady peeling "
-                   "at the stable fixed point v = V")
+                   "at the stable fixed point v = V"))
     (ab_am, ab_ve), (cd_am, cd_ve) = default_models(params)
-    ab_am, ab_ve = chosen[0] or ab_am, chosen[1] or ab_ve
-    cd_am, cd_ve = chosen[2] or cd_am, chosen[3] or cd_ve
-    chain = f"approximate: AB {ab_am}/{ab_ve}, CD {cd_am}/{cd_ve}"
+    models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
+    chain = f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
     if bs.v_land_ab is None or bs.v_land_cd is None:
         which = "AB (f_min <= f(0+, V))" if bs.v_land_ab is None else "CD (the law's domain ends below f_max)"
-        return StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
-                                             reason=f"a jump has no landing on {which}: no return map")
-    assert bs.v_max is not None and bs.v_min is not None  # has_folds
-    models = ((ab_am, ab_ve), (cd_am, cd_ve))
-    if start == "rest":
-        return _iterate(params, law, models, _rest(law), n_transient, n_returns, rtol, max_wall, t_wall,
-                        f"{chain}, rest start", common)[0]
-    first, periodic = _iterate(params, law, models, _solver_start(params, law), n_transient, n_returns, rtol,
-                               max_wall, t_wall, f"{chain}, solver's start", common)
-    if start == "solver" or first.status != "stick-slip" or periodic:
-        return first
-    second, _ = _iterate(params, law, models, _rest(law), n_transient, n_returns, rtol, max_wall, t_wall,
-                         f"{chain}, rest start (the solver's: no periodic attractor in {n_transient + n_returns} "
-                         "returns)", common)
-    return second if second.status == "stick-slip" else first
+        return _promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
+                                                      reason=f"a jump has no landing on {which}: no return map"))
+    deadline = math.inf if max_wall is None else t_wall + max_wall
+    maps = (ReturnMap(params, law, models, rtol, deadline), ReturnMap(params, law, models, NEWTON_RTOL, deadline))
+    names = ("solver", "rest") if start == "auto" else (start,)
+    found = []
+    for name in names:
+        s = _solver_start(params, law) if name == "solver" else _rest(law)
+        found.append(_from_start(params, maps, s, name, n_transient, n_returns, rtol, chain, common))
+    probe = _probe(params, law, rtol, deadline) if "solver" in names and models != FULL_CHAIN else None
+    primary = _assemble(found, _label(params), probe)
+    if warn:
+        warn_low(primary)
+    return primary
 
 
-def _plan(params: PeelParams, law: Any, branch: str, v_in: float, models: tuple[str, str], rtol: float
-          ) -> SegmentPlan:
-    bs = law.structure
-    return segment_plan(params, law, branch, v_in=v_in, v_f=bs.v_max if branch == "AB" else bs.v_min,
-                        alpha_model=models[0], v_equation=models[1], F_rate=None, rtol=rtol, t_max=None,
-                        max_steps=SEGMENT_MAX_STEPS)
+def _label(params: PeelParams) -> str:
+    """The regime label of :attr:`peelapprox.RegimeEstimate.label` (the key of the measured validity)."""
+    inertia, velocity = regime(params)
+    return "no stick-slip (stable fixed point)" if velocity == "stable" else f"{inertia} inertia, {velocity} V"
+
+
+def _promote(o: StickSlipObservables, **extra: Any) -> ApproximateAttractor:
+    """``o`` as an :class:`ApproximateAttractor` with ``extra`` fields."""
+    fields = {f: getattr(o, f) for f in StickSlipObservables.__dataclass_fields__}
+    return ApproximateAttractor(**{**fields, **extra})
 
 
 #: A start of the map: ``(branch code (0 AB, 1 CD), F, v, α, α̇)``.
@@ -230,109 +250,239 @@ def _solver_start(params: PeelParams, law: Any) -> Start:
     return 0, float(bs.f_min), float(bs.v_land_ab), 0.0, kick(float(bs.v_land_ab))
 
 
-def _iterate(params: PeelParams, law: Any, models: tuple[tuple[str, str], tuple[str, str]], start: Start,
-             n_transient: int, n_returns: int, rtol: float, max_wall: float | None, t_wall: float, chain: str,
-             common: dict[str, Any]) -> tuple[StickSlipObservables, bool]:
-    """Iterate the map (module docstring) from ``start``: its sample's observables, and whether it stopped early
-    on a periodic attractor."""
-    ab, cd = models
-    bs = law.structure
-    R = params.R
-    plans = (_plan(params, law, "AB", bs.v_land_ab, ab, rtol), _plan(params, law, "CD", bs.v_land_cd, cd, rtol))
-    # the jump of ω-continuity: α̇ after = α̇ before + (v before - v after)/R
-    kick = ((bs.v_max - bs.v_land_cd) / R, (bs.v_min - bs.v_land_ab) / R)
-    closed = {AM_SIN, AM_HARM, AM_EXP, AM_STATIC}
-    branch, F, v0, a, ad = start
-    t = 0.0
-    first: SegmentPlan | None = None
-    if v0 != plans[branch].v_in:
-        first = _plan(params, law, ("AB", "CD")[branch], v0, (ab, cd)[branch], rtol)
-    jt: list[float] = []
-    jF: list[float] = []
-    jb: list[int] = []
-    returns: list[float] = []  # F at the AB→CD jumps
-    ret_at: list[int] = []  # their indices in the jump record
-    total = n_transient + n_returns
-    ptol = max(PERIOD_RTOL, 100.0 * rtol)
-    sample_from: int | None = None
-    early = (0, 0)  # (period, returns) when the map stopped early
-    while len(returns) < total:
-        plan = first if first is not None else plans[branch]
-        first = None
-        run = run_segment(plan, F, a, ad)
-        if run.code != DONE:
-            return _failed(params, plan, run, len(returns), t, chain, common), False
-        y = run.y
-        t += float(y[0])
-        F = float(y[2])
-        a, ad = alpha_at(y, run.q) if plan.alpha_model in closed else (float(y[3]), float(y[4]))
-        jt.append(t)
-        jF.append(F)
-        jb.append(branch)
-        ad += kick[branch]
-        if branch == 0:
-            returns.append(F)
-            ret_at.append(len(jt) - 1)
-            n = _repeats(returns, ptol)
-            if n is not None:
-                sample_from, early = ret_at[-max(EARLY_RETURNS, 3 * n)], (n, len(returns))
-                break
-        branch = 1 - branch
-        if max_wall is not None and time.perf_counter() - t_wall > max_wall:
-            return StickSlipObservables._no_slip(
-                status="no attractor", method=chain, **common,
-                reason=f"max_wall = {fmt_number(max_wall, 3)} s spent after {len(returns)} of the {total} returns "
-                       f"(n_transient + n_returns)"), False
-    if sample_from is None:
-        sample_from = ret_at[n_transient]
-        how = f"{n_returns} returns after {n_transient}"
-    else:
-        how = f"period-{early[0]} reached after {early[1]} returns"
-    T, FF, B = (np.asarray(x[sample_from:]) for x in (jt, jF, jb))
-    n_ret = int(np.count_nonzero(B == 0))
-    stats, cycles = jump_statistics(T, FF, B, period_rtol=ptol, max_period=max(1, min(32, n_ret // 3)))
-    method = f"{chain}, {how}, rtol {fmt_number(rtol, 3)}"
-    common = {**common, "t_start": float(T[0]), "t_end": float(T[-1])}
+class _Found:
+    """What one start reached: the attractor's observables, the unstable orbits left on the way, and the
+    sample's largest |α| at a jump (the confidence rules' inputs)."""
+
+    def __init__(self, obs: ApproximateAttractor, left: list[ApproximateAttractor], alpha_max: float | None) -> None:
+        self.obs, self.left, self.alpha_max = obs, left, alpha_max
+
+
+def _observe(recs: list[tuple], F_next: float, *, period_rtol: float, max_period: int, how: str, chain: str,
+             common: dict[str, Any], t0: float, **extra: Any) -> ApproximateAttractor:
+    """The observables of the returns ``recs`` (:meth:`ReturnMap.ret`'s records) and the next AB→CD force."""
+    m = len(recs)
+    t = np.empty(2 * m + 1)
+    F = np.empty(2 * m + 1)
+    fb = np.zeros(2 * m + 1, dtype=int)
+    clock = t0
+    for i, r in enumerate(recs):
+        t[2 * i], F[2 * i] = clock, r[0]
+        clock += r[2]
+        t[2 * i + 1], F[2 * i + 1], fb[2 * i + 1] = clock, r[1], 1
+        clock += r[3]
+    t[-1], F[-1] = clock, F_next
+    stats, cycles = jump_statistics(t, F, fb, period_rtol=period_rtol, max_period=max_period)
     reason = (f"{stats['n_slips']} slips of the reduced return map ({how}), return map {stats['period_label']}"
               + (f"; means over the last {cycles} whole cycles" if cycles is not None else ""))
-    return StickSlipObservables(status="stick-slip", reason=reason, method=method, **stats, **common), early[0] > 0
+    return ApproximateAttractor(status="stick-slip", reason=reason, method=f"{chain}, {how}", **stats,
+                                **{**common, "t_start": float(t[0]), "t_end": float(t[-1])}, **extra)
 
 
-def _repeats(x: list[float], tol: float) -> int | None:
-    """The period n <= 12 with which the last ``max(EARLY_RETURNS, 3 n)`` returns repeat to ``tol`` (relative to
-    their largest) without their mismatch ``|x_{k+n} - x_k|`` growing from the first half of them to the second
-    (beyond a 1e-9 noise floor), or None; a scalar test of the newest return first, numpy only for a candidate."""
-    r = len(x)
-    if r < EARLY_RETURNS:
-        return None
-    last = x[-1]
-    scale = abs(last)
-    for n in range(1, 13):
-        m = max(EARLY_RETURNS, 3 * n)
-        if m > r:
-            return None
-        if abs(last - x[-1 - n]) <= tol * scale:
-            tail = np.asarray(x[-m:])
-            d = np.abs(tail[n:] - tail[:-n])
-            h = d.size // 2
-            top = float(np.max(np.abs(tail)))
-            # within tol, and not growing: a slow escape from an unstable orbit (returns drifting away from the
-            # unstable fixed point by less than tol per return at first) is not an attractor reached
-            if float(d.max()) <= tol * top and float(d[h:].max()) <= max(float(d[:h].max()), 1e-9 * top):
-                return n
+def _candidates(F: list[float], scale: float, rtol: float = CANDIDATE_RTOL) -> list[int]:
+    """Periods n <= :data:`MAX_PERIOD` after which the last returns repeat to :data:`CANDIDATE_RTOL` of
+    ``scale``, best repeating first, at most :data:`MAX_CANDIDATES`; a divisor of n that repeats nearly as well
+    (within 4 times n's mismatch, or 1e-3) stands for n (a period-2 orbit also repeats after 4)."""
+    x = np.asarray(F)
+    mismatch: dict[int, float] = {}
+    for n in range(1, MAX_PERIOD + 1):
+        m = max(2 * n, 6)
+        if x.size < m + n:
+            break
+        mismatch[n] = float(np.max(np.abs(x[-m:] - x[-m - n:-n]))) / scale
+    out: list[int] = []
+    for n, r in sorted(mismatch.items(), key=lambda item: item[1]):
+        if r >= rtol:
+            break
+        n = min(d for d in mismatch if n % d == 0 and mismatch[d] <= max(4.0 * r, 1e-3))
+        if n not in out:
+            out.append(n)
+    return out[:MAX_CANDIDATES]
+
+
+def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, J: np.ndarray, returns: int, name: str,
+           chain: str, common: dict[str, Any]) -> tuple[ApproximateAttractor, list[tuple], float]:
+    """A periodic orbit's observables over whole cycles of the orbit itself (at Newton's tolerance), its records
+    and its mean force drop."""
+    hi = maps[1]
+    cycles = 3  # the orbit itself: one cycle gives its means, three its period label (peelapprox.periodicity)
+    recs = []
+    y = x
+    for _ in range(cycles * n):
+        y, r = hi.ret(y)
+        recs.append(r)
+    mu = tuple(complex(m) for m in np.linalg.eigvals(J))
+    rho = max(abs(m) for m in mu)
+    kind = "stable" if rho < 1.0 else ("neutral" if rho <= 1.0 + NEUTRAL else "unstable")
+    how = (f"{name} start, Newton on P^{n} after {returns} returns, {kind} "
+           f"(|mu| {'/'.join(fmt_number(abs(m), 6) for m in mu)})")
+    obs = _observe(recs, hi.force(0, float(y[0])), period_rtol=1e-6, max_period=n, how=how, chain=chain,
+                   common=common, t0=0.0, multipliers=mu, start=name)
+    return obs, recs, float(np.mean([r[0] - r[1] for r in recs]))
+
+
+def _alpha_max(recs: list[tuple]) -> float:
+    """The largest |α| at a jump of the returns ``recs``."""
+    return max(max(abs(r[4]), abs(r[5])) for r in recs)
+
+
+def _deviation(recs: list[tuple], orbit: list[tuple], n: int) -> float:
+    """The largest deviation of the last n returns' AB→CD forces from the orbit's at the same phase."""
+    return max(abs(recs[-i][0] - orbit[(n - i) % n][0]) for i in range(1, n + 1))
+
+
+def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: list[tuple], name: str, chain: str,
+            common: dict[str, Any], rtol: float = CANDIDATE_RTOL
+            ) -> tuple[ApproximateAttractor, list[tuple], float, np.ndarray, int] | None:
+    """The periodic orbit Newton finds from ``x`` for a period n the returns ``recs`` propose (best first, those
+    repeating to ``rtol``): its observables, records, mean force drop, section point and n; None if none
+    converges."""
+    bs = maps[0].law.structure
+    for n in _candidates([r[0] for r in recs], float(bs.f_max - bs.f_min), rtol):
+        res = newton(maps[1], x.copy(), n)
+        if res is not None:
+            obs, orbit, drop = _orbit(maps, res[0], n, res[1], maps[0].returns, name, chain, common)
+            return obs, orbit, drop, res[0], n
     return None
 
 
-def _failed(params: PeelParams, plan: SegmentPlan, run: Any, n_returns: int, t: float, chain: str,
+def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start, name: str, n_transient: int,
+                n_returns: int, rtol: float, chain: str, common: dict[str, Any]) -> _Found:
+    """The attractor the map reaches from ``s`` (module docstring), with the unstable orbits it left."""
+    lo, hi = maps
+    lo.returns = 0
+    left: list[ApproximateAttractor] = []
+    try:
+        x = lo.enter(s)
+        recs: list[tuple] = []
+        for k in range(n_transient):
+            x, r = lo.ret(x)
+            recs.append(r)
+            if k + 1 == EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends it
+                got = _settle(maps, x, recs, name, chain, common, EARLY_RTOL)
+                if got is not None and max(abs(m) for m in got[0].multipliers or (1.0,)) < 1.0 - MULTIPLIER_ERROR:
+                    return _Found(got[0], left, _alpha_max(got[1]))
+        for _ in range(MAX_ESCAPES + 1):
+            got = _settle(maps, x, recs, name, chain, common)
+            if got is None:
+                break  # no period found: a sample
+            obs, orbit, drop, xs, n = got
+            if obs.stable or max(abs(m) for m in obs.multipliers or ()) <= 1.0 + NEUTRAL:
+                return _Found(obs, left, _alpha_max(orbit))
+            rho, dev, thr = max(abs(m) for m in obs.multipliers or ()), _deviation(recs, orbit, n), \
+                ESCAPE_FRACTION * drop
+            k_esc = lo.returns + (n * math.log(thr / dev) / math.log(rho) if 0.0 < dev < thr else 0.0)
+            left.append(dataclasses.replace(obs, escape_returns=k_esc))
+            if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
+                x = xs + (x - xs) * (ESCAPE_PUSH * drop / dev)
+            recs = []
+            for _ in range(max(n_transient, 3 * MAX_PERIOD)):
+                x, r = lo.ret(x)
+                recs.append(r)
+        recs = []  # the sample: n_returns after the transient
+        while len(recs) < n_returns:
+            x, r = lo.ret(x)
+            recs.append(r)
+        got = _settle(maps, x, recs, name, chain, common)  # a periodic orbit reached late, after the transient
+        if got is not None and max(abs(m) for m in got[0].multipliers or (2.0,)) <= 1.0 + NEUTRAL:
+            return _Found(got[0], left, _alpha_max(got[1]))
+        sample = recs[-n_returns:]
+        how = f"{name} start, {n_returns} returns sampled after {lo.returns - n_returns}, rtol {fmt_number(rtol, 3)}"
+        obs = _observe(sample, lo.force(0, float(x[0])), period_rtol=max(PERIOD_RTOL, 100.0 * rtol), max_period=32,
+                       how=how, chain=chain, common=common, t0=0.0, start=name)
+        return _Found(obs, left, _alpha_max(sample))
+    except MapStop as stop:
+        if stop.timeout or stop.plan is None:
+            return _Found(_promote(StickSlipObservables._no_slip(
+                status="no attractor", method=f"{chain}, {name} start", **common,
+                reason=f"max_wall spent after {lo.returns + hi.returns} returns"), start=name), left, None)
+        return _Found(_promote(_failed(params, stop.plan, stop.run, stop.returns, f"{chain}, {name} start", common),
+                               start=name), left, None)
+
+
+def _near(a: ApproximateAttractor, b: ApproximateAttractor, tol: float) -> bool:
+    """Slip interval and force drop of ``a`` within ``tol`` (relative) of ``b``'s."""
+    return all(x is not None and y is not None and abs(x - y) <= tol * abs(y)
+               for x, y in ((a.slip_interval, b.slip_interval), (a.force_drop, b.force_drop)))
+
+
+def _marginal(f: _Found) -> bool:
+    """The start reached an orbit whose stability the map cannot decide (a multiplier within the reduction's
+    multiplier error of 1), or left such an orbit on its way (the escape's amplitude is the map's guess, and what
+    follows it may still be the transient)."""
+    def undecided(o: ApproximateAttractor) -> bool:
+        return o.multipliers is not None and abs(max(abs(m) for m in o.multipliers) - 1.0) < MULTIPLIER_ERROR
+    return undecided(f.obs) or any(undecided(o) for o in f.left)
+
+
+def _probe(params: PeelParams, law: Any, rtol: float, deadline: float) -> str | None:
+    """Why the exact model breaks down from the solver's start where the default chain may not: the full branch
+    dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
+    :data:`PROBE_RETURNS` returns; None if it does not (issue 34: of 200 random points, 3 where the exact run
+    breaks down got a stick-slip prediction; at V = 0.903, I = 1.08e-4 Airy1 + approxvdot's first CD stay lasts
+    2.6 ms and lands at 247 N where the exact one lasts 11.2 ms and lands at 162 N, with α = 0.2, whose swing on
+    AB then reaches f(0+, V): the O(α) terms of the default chain, not the physics)."""
+    m = ReturnMap(params, law, FULL_CHAIN, rtol, deadline)
+    try:
+        x = m.enter(_solver_start(params, law))
+        for _ in range(PROBE_RETURNS):
+            x = m.ret(x)[0]
+    except MapStop as stop:
+        if stop.timeout or stop.plan is None or stop.plan.branch != "AB":
+            return None
+        code = segment_status(stop.plan, stop.run.code)
+        if code in (V_FLOOR, LAW_DOMAIN):
+            return (f"the full branch dynamics linearised in alpha (genalpha + fullvdot) breaks down from the solver's "
+                    f"start after {stop.returns} returns (v -> 0 on AB: F(1 + sin alpha) reaches f(0+, V)), as the "
+                    "exact model can: this chain's stick-slip may be an artefact of its O(alpha) terms")
+    return None
+
+
+def _same(a: ApproximateAttractor, b: ApproximateAttractor) -> bool:
+    """Two predictions of one attractor: the same status and period, means within 1 %."""
+    if a.status != b.status or a.period != b.period:
+        return False
+    return all(x is None and y is None or (x is not None and y is not None and abs(x - y) <= 0.01 * abs(y))
+               for x, y in ((a.slip_interval, b.slip_interval), (a.force_drop, b.force_drop)))
+
+
+def _assemble(found: list[_Found], label: str, breakdown: str | None) -> ApproximateAttractor:
+    """The primary prediction (the first start's stick-slip attractor, the map's orbits of undecided stability
+    (:func:`_marginal`) last) with its confidence, and the others as its alternatives."""
+    def rated(o: ApproximateAttractor, f: _Found | None) -> ApproximateAttractor:
+        if o.status == "stick-slip":
+            c, why = confidence(o, label, f.alpha_max if f else None, tuple(f.left) if f else (), breakdown)
+        elif o.status == "steady":
+            c, why = "high", "steady peeling: no stick-slip to doubt"
+        else:
+            c, why = "low", f"no attractor predicted ({o.status}): {o.reason}"
+        return dataclasses.replace(o, confidence=c, confidence_reason=why)
+
+    # stick-slip first, inside the linearised reductions' range of α before outside it, an attractor whose
+    # stability the map decides before one it does not, then the starts' order
+    order = sorted(found, key=lambda f: (f.obs.status != "stick-slip", (f.alpha_max or 0.0) > ALPHA_LINEAR,
+                                         _marginal(f)))
+    primary = rated(order[0].obs, order[0])
+    others: list[ApproximateAttractor] = []
+    for f in order[1:]:
+        if not _same(f.obs, primary) and not any(_same(f.obs, o) for o in others):
+            others.append(rated(f.obs, f))
+    for f in found:
+        for o in f.left:
+            if not any(_same(o, x) for x in others):
+                others.append(rated(o, None))
+    return dataclasses.replace(primary, alternatives=tuple(others))
+
+
+def _failed(params: PeelParams, plan: SegmentPlan, run: Any, n_returns: int, chain: str,
             common: dict[str, Any]) -> StickSlipObservables:
     """The observables of a map stopped by a segment that did not reach its fold: steady, no attractor or
     breakdown (:func:`approximate_attractor`'s statuses)."""
     code = segment_status(plan, run.code)
     y = run.y
     v, F = math.exp(float(y[1])), float(y[2])
-    where = (f"the {plan.branch} segment entered at t = {fmt_number(t, 6)} s on the map's clock (after {n_returns} "
-             f"returns) stopped at v = {fmt_number(v, 4)} m/s, F = {fmt_number(F, 5)} N, {fmt_number(float(y[0]), 4)} "
-             "s after its entry")
+    where = (f"the {plan.branch} segment entered after {n_returns} returns stopped at v = {fmt_number(v, 4)} m/s, "
+             f"F = {fmt_number(F, 5)} N, {fmt_number(float(y[0]), 4)} s after its entry")
     if code == T_MAX:
         fp = fixed_point(params.V, params.R, force=params.force)
         if fp.stable:

@@ -35,6 +35,7 @@ API = {
         "periodicity", "quasi_static_branch_time", "reduced_segment", "register_measure", "return_map",
         "settle_time", "sinusoid_alpha", "slope_criterion", "sweep", "wkb_alpha", "wkb_amplitude_phase",
         "wkb_error_bound", "StickSlipObservables", "attractor_observables", "approximate_attractor", "ForceSeries",
+        "ApproximateAttractor", "ApproximationWarning",
         "Slips", "Spectrum", "SeriesLyapunov", "SurrogateTest",
     },
     "exact": {

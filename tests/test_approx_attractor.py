@@ -36,14 +36,16 @@ def test_quasi_static_limit_is_the_quadrature(p_low):
     kicks of α̇ ignored), approxvdot reads ``f'(v) v̇ = Ḟ = k(V - v)``: the AB stay is ``∫ f'/(k(V - v)) dv`` from
     ``v_land_ab`` to ``v_max`` (``estimate(p).t_ab_quasi_static``, scipy quad at 1e-11), the CD stay likewise,
     F rises by ``f(v_max) - f(v_land_ab) = f_max - f_min`` on AB and falls by as much on CD, so the map is period-1
-    after one cycle and stops at :data:`EARLY_RETURNS` = 12 returns.  At rtol 1e-8 every observable agrees to
-    6.8e-9 relative (measured; 4.5e-7 at rtol 1e-6): 5e-8 is the integration's error with a margin."""
+    after one cycle; Newton finds the orbit at once, with a neutral multiplier (α is held, a family of orbits) and
+    0 (α̇ is dropped).  The orbit's observables are read at Newton's rtol 1e-9; every observable agrees to 5e-8
+    (the integration's error with a margin: 6.8e-9 measured at rtol 1e-8, 4.5e-7 at 1e-6)."""
     e = estimate(p_low)
-    o = approximate_attractor(p_low, alpha_model="static", cd_alpha_model="static", rtol=1e-8)
+    o = approximate_attractor(p_low, alpha_model="static", cd_alpha_model="static", rtol=1e-8, warn=False)
     assert (o.status, o.period, o.period_label) == ("stick-slip", 1, "period-1")
-    assert o.method == ("approximate: AB static/approxvdot, CD static/approxvdot, solver's start, period-1 reached "
-                        "after 12 returns, "
-                        "rtol 1e-08")
+    assert o.method.startswith("approximate: AB static/approxvdot, CD static/approxvdot, solver start, Newton on P^1 "
+                               "after 40 returns, neutral (|mu| 1/0)")
+    assert o.multipliers is not None and sorted(abs(m) for m in o.multipliers) == [pytest.approx(0.0, abs=1e-6),
+                                                                                   pytest.approx(1.0, abs=1e-6)]
     assert o.stick_time == pytest.approx(e.t_ab_quasi_static, rel=5e-8)
     assert o.slip_time == pytest.approx(e.t_cd_quasi_static, rel=5e-8)
     assert o.slip_interval == pytest.approx(e.t_ab_quasi_static + e.t_cd_quasi_static, rel=5e-8)
@@ -137,21 +139,21 @@ def test_defaults_follow_the_regime(p_low, p_high):
 _BAND = (3.646153846153846, 0.0006614740641230146, 0.006475450971533529, 11.830986808716183)
 
 
-def test_auto_start_leaves_the_small_jumping_mode():
-    """Hypothesis: from the solver's start (α̇ = (V - v)/R) the map stays on the small jumping mode at this
-    intermediate-inertia point (slip interval less than half the exact one, no periodic attractor within its 100
-    returns), and ``start="auto"`` then restarts it at rest on the relaxation cycle's foot, which lands on the
-    exact period-9 orbit's neighbourhood: slip interval and force drop within 10 % of the exact ones (the
-    accuracy goal's tolerance; measured -1.4 % and -6.8 %), the second start named in ``method``."""
+def test_the_map_leaves_the_unstable_small_mode():
+    """Hypothesis: from the solver's start (α̇ = (V - v)/R) the map approaches the small jumping mode at this
+    intermediate-inertia point, a period-1 orbit whose slip interval is less than half the exact one; Newton finds
+    it with a complex pair of multipliers outside the unit circle (|μ| 1.003, the issue measured 1.00014-1.00204
+    on the exact side at such points), so the map reports it with its escape return and goes on past it, to the
+    neighbourhood of the exact period-9 orbit: slip interval and force drop within 10 % of the exact ones (the
+    accuracy goal's tolerance; measured -5.5 % and -4.9 %).  The small mode is an alternative, not the answer."""
     V, I, dt_exact, dF_exact = _BAND
     p = PeelParams(V=V, I=I)
-    solver = approximate_attractor(p, start="solver")
-    assert solver.slip_interval < 0.5 * dt_exact and "solver's start, 60 returns after 40" in solver.method
-    auto = approximate_attractor(p)
-    assert "rest start (the solver's: no periodic attractor in 100 returns)" in auto.method
-    assert abs(auto.slip_interval / dt_exact - 1) < 0.1 and abs(auto.force_drop / dF_exact - 1) < 0.1
-    assert dataclasses.asdict(approximate_attractor(p, start="rest")) == dataclasses.asdict(auto) | {
-        "method": auto.method.replace(" (the solver's: no periodic attractor in 100 returns)", "")}
+    o = approximate_attractor(p, start="solver", warn=False)
+    assert abs(o.slip_interval / dt_exact - 1) < 0.1 and abs(o.force_drop / dF_exact - 1) < 0.1
+    small = [a for a in o.alternatives if a.escape_returns is not None]
+    assert len(small) == 1 and small[0].period == 1 and small[0].slip_interval < 0.5 * dt_exact
+    assert small[0].multipliers is not None and min(abs(m) for m in small[0].multipliers) > 1.0
+    assert small[0].escape_returns > 0 and small[0].confidence == "low"
 
 
 @pytest.mark.parametrize("am", ALPHA_MODELS)
@@ -244,7 +246,6 @@ def test_estimate_offers_the_attractor_and_says_how_often_it_holds():
     """Hypothesis: ``estimate(p).attractor()`` is ``approximate_attractor(p)`` (deterministic: equal fields), and
     ``estimate(p).validity`` quotes the atlas's measured percentage of p's regime (the CSV's fraction, rounded to a
     whole percent, computed here from the file)."""
-    import dataclasses
 
     from peelapprox import PeelParams, approximate_attractor, estimate
 
