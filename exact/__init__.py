@@ -52,6 +52,7 @@ from .dynamics import (
     orbit_diagram,
     window_run,
 )
+from .front import FrontTrajectory, simulate_front
 from .orbits import (
     Bifurcation,
     BranchPoint,
@@ -72,6 +73,8 @@ from .orbits import (
 
 __all__ = [
     "simulate",
+    "simulate_front",
+    "FrontTrajectory",
     "Hybrid",
     "Regularized",
     "Smooth",

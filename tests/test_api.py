@@ -36,6 +36,7 @@ API = {
         "settle_time", "sinusoid_alpha", "slope_criterion", "sweep", "wkb_alpha", "wkb_amplitude_phase",
         "wkb_error_bound", "StickSlipObservables", "attractor_observables", "approximate_attractor", "ForceSeries",
         "Slips", "Spectrum", "SeriesLyapunov", "SurrogateTest",
+        "FrontParams", "FrontPattern", "TransverseModes", "front_pattern", "transverse_growth_rates",
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
@@ -52,6 +53,7 @@ API = {
         "with_parameter", "parameter_value", "basins", "BasinResult", "BasinAttractor", "MAX_BASIN_STARTS", "infer",
         "Inference",
         "attractor_observables",
+        "simulate_front", "FrontTrajectory",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
@@ -99,6 +101,8 @@ API = {
         "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit", "regularized_field",
         "regularized_field_jacobian", "regularized_jacobian", "regularized_parameters", "regularized_rhs",
         "slow_rates", "solve_theta", "state_at", "status", "table_coefficients", "table_law", "workspace",
+        "front_rhs", "front_field", "front_parameters", "front_state_size", "FQ_N", "FQ_GAMMA", "FQ_PERIODIC",
+        "N_FQ", "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS",
     },
     "peelapprox.cli": {"build_parser", "main"},
     "comparisons.benchmark": {
