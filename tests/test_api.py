@@ -63,7 +63,8 @@ API = {
     },
     "peelapprox.io": {"TABLE_EXTENSIONS", "ProgressLine", "fmt_number", "html_table", "jsonable", "optional_import",
                       "param_attrs", "write_csv", "write_rows"},
-    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_phase_diagram",
+    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_front",
+                            "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot", "save_figure", "trajectory_window",
                             "TrajectoryWindow", "TRAJECTORY_PANELS", "MAX_BRANCHES"},
     "comparisons.atlas": {

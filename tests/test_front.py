@@ -238,3 +238,25 @@ def test_pattern_rules():
     assert p.label == "stuck-peeled" and abs(p.mixed_fraction - 0.5) < 0.011 and abs(p.walls - 3.0) < 1e-12
     with pytest.raises(ValueError, match="roughness"):
         front_pattern(t, zero, zero[:-1], zero)
+
+
+def test_cli_front(tmp_path):
+    """``peelapprox front`` runs a small front, prints its summary as JSON (the counters equal the library's for
+    the same call: the CLI adds nothing of its own), writes the series and the space-time image."""
+    import json
+    import subprocess
+    import sys
+
+    out, png = tmp_path / "s.csv", tmp_path / "f.png"
+    cmd = [sys.executable, "-m", "peelapprox", "front", "--V", "1", "--I", "1e-2", "--tape-mass", "1e-3", "--N", "4",
+           "--gamma", "0.05", "--delta0", "0.01", "--t-end", "0.004", "--format", "json", "--out", str(out),
+           "--plot", str(png)]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    row = json.loads(r.stdout)
+    fp = FrontParams(base=BASE, N=4, gamma=0.05, delta0=0.01)
+    tr = exact.simulate_front(fp, 0.004, store_front=False)
+    assert row["steps"] == tr.stats.n_steps and row["jumps"] == len(tr.jumps)
+    assert out.read_text().count("\n") == len(tr.t) + 1 and png.stat().st_size > 1000
+    bad = subprocess.run(cmd[:9] + ["0", "--t-end", "0.004"], capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and "N" in bad.stderr
