@@ -12,13 +12,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
+
+import numpy as np
 
 import exact
 from peelapprox import FrontParams, PeelParams
 from peelapprox.errors import SolverBudgetExceeded
 
-__all__ = ["front_cost", "main"]
+__all__ = ["front_cost", "convergence", "main"]
 
 STEPS = {100: 4000, 1000: 1000, 10000: 200}
 
@@ -39,6 +42,38 @@ def front_cost(n: int, steps: int) -> dict:
             "sim_s_per_wall_hour": 3600.0 * t_reached / s.wall_time if s.wall_time > 0 else float("nan")}
 
 
+def convergence(ns: tuple[int, ...] = (16, 48, 144, 432, 1296), t_star: float = 1e-3, width: float = 0.02,
+                K: float = 1e-2, G: float = 1e-5, delta: float = 0.05, rtol: float = 1e-11) -> list[dict]:
+    """The spatial convergence order of the front towards its continuum limit ``K b u_yy + G b u̇_yy``.
+
+    Continuum scaling ``k_c = K N/b``, ``Γ = G N/b`` (b = ``width`` [m]); free ends; the strips at the cell centres
+    ``y_j = (j + 1/2) b/N``; the start is the tape-mass model's (V = 1, I = 1e-2, m = 1e-3 kg) with the stretches
+    ``F_j = F0 (1 + δ cos(π y_j / b))``, F0 = 250 N (smooth, the first Neumann mode, every strip on AB).  At ``t_star`` (before the first jump)
+    each N's v_j is compared with the next finer run's (3N strips: the centre of coarse cell j is the centre of
+    fine cell 3j + 1, so no interpolation enters; strips without bonds would give e_N = 0 exactly):
+    ``e_N = max_j |v_N,j - v_3N,3j+1|``, and ``order = log3(e_N / e_3N)``.  rtol 1e-11 keeps the time error
+    below the smallest e_N."""
+    base = PeelParams(V=1.0, I=1e-2, tape_mass=1e-3)
+    vs = {}
+    for n in ns:
+        fp = FrontParams(base=base, N=n, k_c=K * n / width, Gamma=G * n / width)
+        s0 = exact.initial_state(base, F0=250.0)
+        y = (np.arange(n) + 0.5) / n
+        y0 = np.concatenate([[s0.alpha, s0.omega, 0.0], s0.F * (1 + delta * np.cos(np.pi * y)), np.full(n, s0.v)])
+        tr = exact.simulate_front(fp, t_star, rtol=rtol, y0=y0, dt_save=t_star, max_wall=None)
+        vs[n] = tr.front_v[-1]
+    rows = []
+    for n in ns[:-1]:
+        fine = vs.get(3 * n)
+        if fine is None:
+            continue
+        e = float(np.max(np.abs(vs[n] - fine[1::3])))
+        rows.append({"N": n, "error": e, "v_range": float(np.ptp(vs[n]))})
+    for a, b in zip(rows, rows[1:]):
+        a["order"] = math.log(a["error"] / b["error"], 3)
+    return rows
+
+
 def e_time(tr) -> float:
     """The simulated time a (partial) run reached: its last stored grid point."""
     return float(tr.t[-1]) if len(tr.t) else 0.0
@@ -48,7 +83,13 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m comparisons.benchmark.front", description=__doc__.splitlines()[0])
     ap.add_argument("--json", help="write the rows to this JSON file")
     ap.add_argument("--scale", type=float, default=1.0, help="multiply the step counts (default 1)")
+    ap.add_argument("--convergence", action="store_true", help="measure the spatial convergence order instead")
     a = ap.parse_args(argv)
+    if a.convergence:
+        print("| N | max|v_N - v_3N| [m/s] | spread of v_N [m/s] | order |\n|---|---|---|---|")
+        for r in convergence():
+            print(f"| {r['N']} | {r['error']:.3e} | {r['v_range']:.3e} | {r.get('order', float('nan')):.3f} |")
+        return 0
     front_cost(10, 10)  # load the compiled loop (not timed)
     rows = []
     print("| N | steps | field evals | us/step | ns/(step strip) | simulated s | simulated s per wall hour |")
