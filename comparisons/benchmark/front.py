@@ -46,9 +46,10 @@ def convergence(ns: tuple[int, ...] = (16, 48, 144, 432, 1296), t_star: float = 
                 K: float = 1e-2, G: float = 1e-5, delta: float = 0.05, rtol: float = 1e-11) -> list[dict]:
     """The spatial convergence order of the front towards its continuum limit ``K b u_yy + G b u̇_yy``.
 
-    Continuum scaling ``k_c = K N/b``, ``Γ = G N/b`` (b = ``width`` [m]); free ends; the strips at the cell centres
-    ``y_j = (j + 1/2) b/N``; the start is the tape-mass model's (V = 1, I = 1e-2, m = 1e-3 kg) with the stretches
-    ``F_j = F0 (1 + δ cos(π y_j / b))``, F0 = 250 N (smooth, the first Neumann mode, every strip on AB).  At ``t_star`` (before the first jump)
+    Continuum scaling ``k_c = K N/b``, ``Γ = G N/b`` (b = ``width`` [m]); free ends; the strips at the cell
+    centres ``y_j = (j + 1/2) b/N``; the start is the tape-mass model's (V = 1, I = 1e-2, m = 1e-3 kg, F0 = 250 N)
+    with the stretches ``F_j = F0 (1 + δ cos(π y_j / b))`` (smooth: the first Neumann mode, every strip on AB).
+    At ``t_star`` (before the first jump)
     each N's v_j is compared with the next finer run's (3N strips: the centre of coarse cell j is the centre of
     fine cell 3j + 1, so no interpolation enters; strips without bonds would give e_N = 0 exactly):
     ``e_N = max_j |v_N,j - v_3N,3j+1|``, and ``order = log3(e_N / e_3N)``.  rtol 1e-11 keeps the time error
