@@ -17,6 +17,7 @@ from peelapprox.kernels import (
     FY_OMEGA,
     FY_STRIPS,
     compiled_law,
+    front_field,
     front_parameters,
     front_state_size,
 )
@@ -293,6 +294,10 @@ class _Run:
         if status == D.NONFINITE:
             return SolverFailure(f"simulate_front: the state became non-finite after t={t:.9g}", t=t,
                                  state=self.state(y), partial=part)
+        if status == D.ARREST and not self._decelerates(y, j):
+            return SolverFailure(f"simulate_front: strip j={j}'s v_j fell to {y[FY_STRIPS + n + j]:.3g} m/s after "
+                                 f"t={t:.9g}, but at rest it would accelerate again: a numerical overshoot, not an "
+                                 "arrest; tighten rtol", t=t, state={**self.state(y), "strip": j}, partial=part)
         if status == D.ARREST:
             return ModelBreakdown(f"model breakdown after t={t:.9g}: strip j={j} of {n} came to rest (v_j <= "
                                   f"{V_ARREST_FRONT:g} m/s): the local peel front stops, outside the model (a front "
@@ -305,6 +310,15 @@ class _Run:
         return ModelBreakdown(f"model breakdown after t={t:.9g}: strip j={j}'s v_j left the domain [{lo:.6g}, "
                               f"{hi:.6g}] m/s of the peel-force law {self.fp.base.force!r}", t=t,
                               state={**self.state(y), "strip": j}, reason="law_domain", partial=part)
+
+    def _decelerates(self, y: np.ndarray, j: int) -> bool:
+        """Whether strip j, put at rest (v_j = V_ARREST_FRONT) in state y, still decelerates: the arrest is
+        physical (the tape-mass driver's test, strip by strip)."""
+        z = y.copy()
+        z[FY_STRIPS + self.fp.N + j] = V_ARREST_FRONT
+        out = np.zeros_like(z)
+        front_field()(z, self.q, self.cl.fn, self.cl.coef, out)
+        return bool(out[FY_STRIPS + self.fp.N + j] <= 0.0)
 
     def build(self, y: np.ndarray, y_init: np.ndarray, wall0: float, status: int, message: str) -> FrontTrajectory:
         self.flush()
