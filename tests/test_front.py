@@ -271,3 +271,30 @@ def test_spatial_convergence_order():
     rows = convergence(ns=(16, 48, 144, 432))
     orders = [r["order"] for r in rows if "order" in r]
     assert len(orders) == 2 and all(1.8 <= o <= 2.2 for o in orders)
+
+
+def test_series_doors():
+    """The AE power and the pull force of a gridded run are ForceSeries holding the run's very samples (the
+    library's series tools take them); a run stored at its steps is refused (those tools assume a grid)."""
+    fp = FrontParams(base=BASE, N=8, gamma=0.05, delta0=0.01)
+    tr = exact.simulate_front(fp, 0.01, dt_save=1e-5, store_front=False)
+    s = tr.ae_series()
+    assert np.array_equal(s.F, tr.ae_power) and np.array_equal(s.t, tr.t) and len(s) == 1001
+    assert np.array_equal(tr.force_series().F, tr.F)
+    with pytest.raises(ValueError, match="dt_save"):
+        exact.simulate_front(fp, 1e-4, store_front=False).ae_series()
+
+
+def test_strip_arrest_is_a_named_breakdown():
+    """γ = 10, κ = 0.1, δ₀ = 1e-2, seed 1, N = 32 (the γ sweep of docs/peel-front.md): the edge strip 31 comes to
+    rest at t = 3.953 ms (measured 0.00395281727 s) and still decelerates there, so the run ends in
+    ModelBreakdown("arrest") naming the strip, with a finite time, state and the partial trajectory; 1e-6 s is far
+    below the step (~2e-5 s) and far above the solver's time error."""
+    from peelapprox.errors import ModelBreakdown
+
+    fp = FrontParams(base=BASE, N=32, gamma=10.0, kappa=0.1, delta0=1e-2, seed=1)
+    with pytest.raises(ModelBreakdown) as e:
+        exact.simulate_front(fp, 0.006, dt_save=1e-5, store_front=False)
+    err = e.value
+    assert err.reason == "arrest" and err.state["strip"] == 31 and "strip j=31" in str(err)
+    assert abs(err.t - 0.0039528) < 1e-6 and np.isfinite(err.partial.final_y).all()

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import FrontParams, front_pattern
+from peelapprox import ForceSeries, FrontParams, front_pattern
 from peelapprox.io import optional_import
 
 from .._trajectory import Jumps, SolverStats
@@ -94,6 +94,21 @@ class FrontTrajectory:
     def final_t(self) -> float:
         """The time of ``final_y``."""
         return float(self.t[-1]) if len(self.t) and self.status == 0 else float("nan")
+
+    def ae_series(self) -> Any:
+        """The AE power as a :class:`peelapprox.ForceSeries` (its ``F`` holds R_AE [W]) for the library's series
+        tools: spectrum, return-map and embedding Lyapunov exponents, surrogates.  Those assume uniform sampling:
+        run with ``dt_save``.  ValueError for a run stored at its steps or with too few points."""
+        return self._series(self.ae_power, "AE power R_AE [W] of simulate_front")
+
+    def force_series(self) -> Any:
+        """The pull force F(t) as a :class:`peelapprox.ForceSeries` (uniform sampling: run with ``dt_save``)."""
+        return self._series(self.F, "pull force of simulate_front")
+
+    def _series(self, values: np.ndarray, source: str) -> Any:
+        if self.dt_save is None:
+            raise ValueError("the series tools need uniform sampling: run simulate_front with dt_save")
+        return ForceSeries(self.t, values, V=self.params.base.V, source=source)
 
     def pattern(self, **thresholds: Any) -> Any:
         """The front's pattern class over the stored points (:func:`peelapprox.front_pattern`)."""
