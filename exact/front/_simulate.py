@@ -79,7 +79,7 @@ def _start(fp: FrontParams, y0: Any, alpha0: float, omega0: float | None, F0: fl
 def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, atol: Any = None, alpha0: float = 0.0,
                    omega0: float | None = None, F0: float | None = None, branch0: str | None = None, y0: Any = None,
                    t_transient: float = 0.0, dt_save: float | None = None, store_front: bool = True,
-                   max_values: int = 20_000_000, max_steps: int | None = None, max_local: int = 5_000_000,
+                   max_values: int = 100_000_000, max_steps: int | None = None, max_local: int = 5_000_000,
                    max_jumps: int = 1_000_000, max_wall: float | None = 600.0,
                    progress: None | bool | Callable[[float, float], None] = None) -> FrontTrajectory:
     """Integrate the peel front (docs/peel-front.md) from t = 0 to ``t_end``.
@@ -112,7 +112,9 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
     store_front : bool
         Store F_j and v_j at every stored point (memory ``2N`` floats a point); False: the global series only.
     max_values : int
-        Memory budget: stored floats (points × (10 + 2N, or 10)), default 2e7 (160 MB).
+        Memory budget: stored floats (points × (10 + 2N, or 10)), default 1e8 (800 MB; building the result
+        copies them once more).  N = 128 over the tape-mass model's first 10 jumps at I = 1e-5 stores 240,000
+        steps × 266 floats = 6.4e7: pass ``dt_save`` or ``store_front=False`` for longer or wider runs.
     max_steps : int, optional
         Accepted steps; None: 2e7 per simulated second within [1e6, 1e9].
     max_local, max_jumps : int
