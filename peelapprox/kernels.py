@@ -77,6 +77,7 @@ from .front._field import (
     FY_OMEGA,
     FY_STRIPS,
     N_FQ,
+    N_FY_TAIL,
     front_field,
     front_parameters,
     front_rhs,
@@ -120,7 +121,7 @@ __all__ = [
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
     "front_rhs", "front_field", "front_parameters", "front_state_size", "FQ_N", "FQ_GAMMA", "FQ_PERIODIC", "N_FQ",
-    "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS",
+    "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS", "N_FY_TAIL",
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
     "diffsl_inputs", "diffsl_model", "import_optional",
     "BuildExpired", "caller_budget",  # a public call's max_wall handed down to the law compilation it triggers

@@ -103,7 +103,7 @@ API = {
         "regularized_field_jacobian", "regularized_jacobian", "regularized_parameters", "regularized_rhs",
         "slow_rates", "solve_theta", "state_at", "status", "table_coefficients", "table_law", "workspace",
         "front_rhs", "front_field", "front_parameters", "front_state_size", "FQ_N", "FQ_GAMMA", "FQ_PERIODIC",
-        "N_FQ", "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS",
+        "N_FQ", "N_FY_TAIL", "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS",
     },
     "peelapprox.cli": {"build_parser", "main"},
     "comparisons.benchmark": {

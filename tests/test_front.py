@@ -27,7 +27,7 @@ def _field(fp, y):
 def _random_state(rng, n):
     F = 250.0 + 30.0 * rng.standard_normal(n)
     v = np.exp(rng.uniform(-4.0, 2.5, n))
-    return np.concatenate([[rng.uniform(-0.2, 0.2), rng.uniform(0.0, 20.0), 0.0], F, v])
+    return np.concatenate([[rng.uniform(-0.2, 0.2), rng.uniform(0.0, 20.0), 0.0], F, v, [0.0, 0.0]])
 
 
 def _values(fp):
@@ -47,11 +47,11 @@ def test_field_is_lagrange(n, ends):
         fp = FrontParams(base=base, N=n, gamma=10 ** rng.uniform(-2, 1), kappa=10 ** rng.uniform(-2, 1), ends=ends)
         y = _random_state(rng, n)
         out = _field(fp, y)
-        v = y[3 + n:]
+        v = y[3 + n:3 + 2 * n]
         c, dc = base.closure(y[0])
         ref = front_lagrange_rates(n, ends, _values(fp), y[0], y[1], y[3:3 + n], v, base.force.f(v, base.V),
                                    float(c), float(dc))
-        mine = np.concatenate([out[:2], out[3:]])
+        mine = np.concatenate([out[:2], out[3:3 + 2 * n]])
         np.testing.assert_allclose(mine, ref, rtol=1e-12, atol=1e-12 * np.max(np.abs(ref)))
 
 
@@ -70,9 +70,10 @@ def test_energy_balance_pointwise(ends):
         h = 1e-30
         dE = float(np.imag(front_energy(y + 1j * h * ydot, n, ends, _values(fp), np.sin)) / h)
         F = y[3:3 + n].mean()
-        v = y[3 + n:]
+        v = y[3 + n:3 + 2 * n]
         p_in, p_peel, p_ae = F * base.V, float(np.mean(base.force.f(v, base.V) * v)), ydot[2]
         assert p_ae >= 0.0
+        assert abs(ydot[-2] - p_in) <= 1e-14 * abs(p_in) and abs(ydot[-1] - p_peel) <= 1e-13 * abs(p_peel)
         assert abs(dE - (p_in - p_peel - p_ae)) <= 1e-9 * max(abs(p_in), abs(p_peel), p_ae)
 
 
@@ -87,7 +88,7 @@ def test_transverse_modes(n, ends):
     fp = FrontParams(base=base, N=n, gamma=0.3, kappa=0.5, ends=ends)
     modes = transverse_growth_rates(fp)
     v0 = modes.v
-    y = np.concatenate([[0.05, 15.0, 0.0], np.full(n, 240.0), np.full(n, v0)])
+    y = np.concatenate([[0.05, 15.0, 0.0], np.full(n, 240.0), np.full(n, v0), [0.0, 0.0]])
     j = np.arange(n)
     for idx in rng.choice(n - 1, size=min(6, n - 1), replace=False):
         k_mode = modes.n[idx]
@@ -96,14 +97,15 @@ def test_transverse_modes(n, ends):
         A = np.zeros((2, 2))
         for col, (dF, dv) in enumerate(((1.0, 0.0), (0.0, 1.0))):
             hF, hv = 1e-6 * 240.0 * dF, 1e-6 * v0 * dv
-            d = np.concatenate([[0.0, 0.0, 0.0], hF * e, hv * e])
+            d = np.concatenate([[0.0, 0.0, 0.0], hF * e, hv * e, [0.0, 0.0]])
             Je = (_field(fp, y + d) - _field(fp, y - d)) / 2.0
             Je /= (hF + hv)
-            comp = (Je[3:3 + n] @ e, Je[3 + n:] @ e)
+            comp = (Je[3:3 + n] @ e, Je[3 + n:3 + 2 * n] @ e)
             A[:, col] = comp
             scale = np.hypot(*comp)
             assert abs(Je[0]) + abs(Je[1]) <= 1e-6 * scale
-            assert np.linalg.norm(Je[3:3 + n] - comp[0] * e) + np.linalg.norm(Je[3 + n:] - comp[1] * e) <= 1e-6 * scale
+            assert (np.linalg.norm(Je[3:3 + n] - comp[0] * e) + np.linalg.norm(Je[3 + n:3 + 2 * n] - comp[1] * e)
+                    <= 1e-6 * scale)
         lam = np.sort_complex(np.linalg.eigvals(A))
         ref = np.sort_complex(modes.rates[idx])
         np.testing.assert_allclose(lam, ref, rtol=1e-6)
@@ -312,9 +314,30 @@ def test_mirror_and_shift_symmetry():
         fp = FrontParams(base=BASE, N=12, gamma=0.05, kappa=0.1, ends=ends, delta0=0.01, seed=2)
         a = exact.simulate_front(fp, 0.012, rtol=rtol, dt_save=1e-3)
         y0 = a.initial_y.copy()
-        y0[3:15], y0[15:] = perm(y0[3:15]), perm(y0[15:])
+        y0[3:15], y0[15:27] = perm(y0[3:15]), perm(y0[15:27])
         b = exact.simulate_front(fp, 0.012, rtol=rtol, y0=y0, dt_save=1e-3)
         vb = np.array([back(row) for row in b.front_v])
         assert np.max(np.abs(vb[-1] - a.front_v[-1])) <= 10 * rtol * np.max(a.front_v[-1])
         assert len(a.jumps) == len(b.jumps) >= 1
         assert np.max(np.abs(a.jumps.t - b.jumps.t)) <= 10 * rtol * 0.012
+
+
+def test_energy_balance_over_ten_jumps():
+    """Integrated energy balance of a mixed front (N = 8, γ = 0.05, κ = 0.1, δ₀ = 0.01, rtol 1e-10) over the
+    tape-mass model's first 10 jumps: the mechanical energy E (front_energy, at the stored states) changes by
+    W_in - W_peel - E_AE, all three integrated as states, to 1e-6 of W_peel at every stored point (the design's
+    target; the tape-mass model reaches 7e-8; measured 1.2e-14 over 14 mean jumps and 48 local switches).  The
+    check is independent of the field's derivation: E is summed from its definition, the works from their
+    integrands."""
+    fp = FrontParams(base=BASE, N=8, gamma=0.05, kappa=0.1, delta0=0.01, seed=5)
+    _, T = _tape_jumps(BASE, t_max=0.3)
+    tr = exact.simulate_front(fp, T, rtol=1e-10, dt_save=T / 400)
+    n = 8
+    vals = _values(fp)
+    ys = [np.concatenate([[a, w, 0.0], F, v, [0.0, 0.0]])
+          for a, w, F, v in zip(tr.alpha, tr.omega, tr.front_F, tr.front_v)]
+    E = np.array([front_energy(y, n, "free", vals, np.sin) for y in ys])
+    resid = ((E - E[0]) - (tr.work_in - tr.work_in[0]) + (tr.work_peel - tr.work_peel[0])
+             + (tr.ae_energy - tr.ae_energy[0]))
+    assert tr.n_local_switches > 0 and tr.ae_energy[-1] > 0
+    assert np.max(np.abs(resid)) <= 1e-6 * tr.work_peel[-1]

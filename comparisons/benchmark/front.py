@@ -60,7 +60,8 @@ def convergence(ns: tuple[int, ...] = (16, 48, 144, 432, 1296), t_star: float = 
         fp = FrontParams(base=base, N=n, k_c=K * n / width, Gamma=G * n / width)
         s0 = exact.initial_state(base, F0=250.0)
         y = (np.arange(n) + 0.5) / n
-        y0 = np.concatenate([[s0.alpha, s0.omega, 0.0], s0.F * (1 + delta * np.cos(np.pi * y)), np.full(n, s0.v)])
+        y0 = np.concatenate([[s0.alpha, s0.omega, 0.0], s0.F * (1 + delta * np.cos(np.pi * y)), np.full(n, s0.v),
+                             [0.0, 0.0]])
         tr = exact.simulate_front(fp, t_star, rtol=rtol, y0=y0, dt_save=t_star, max_wall=None)
         vs[n] = tr.front_v[-1]
     rows = []

@@ -50,8 +50,8 @@ N_ST = 4
 C_STEPS, C_REJ, C_RHS, C_JUMPS, C_LOCAL, C_NOUT, C_NJOUT, C_NLOUT = range(8)
 N_C = 8
 # global output columns (one row per stored point)
-G_T, G_ALPHA, G_OMEGA, G_F, G_V, G_PAE, G_EAE, G_PHI, G_W, G_NDW = range(10)
-N_G = 10
+G_T, G_ALPHA, G_OMEGA, G_F, G_V, G_PAE, G_EAE, G_PHI, G_W, G_NDW, G_WIN, G_WPEEL = range(12)
+N_G = 12
 # opts: rtol, t_end, t_store, v_mid, v_arrest, v_lo, v_hi, dt_save (0: every step)
 O_RTOL, O_TEND, O_TSTORE, O_VMID, O_VARREST, O_VLO, O_VHI, O_DTSAVE = range(8)
 N_O = 8
@@ -115,6 +115,8 @@ def _diag(t, y, q, v_mid, row):
     row[G_PHI] = up / n
     row[G_W] = np.sqrt(var) if var > 0.0 else 0.0
     row[G_NDW] = ndw
+    row[G_WIN] = y[FY_STRIPS + 2 * n]
+    row[G_WPEEL] = y[FY_STRIPS + 2 * n + 1]
 
 
 @kernel(inline="always")

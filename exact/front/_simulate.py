@@ -32,7 +32,7 @@ from ._trajectory import FrontTrajectory, LocalSwitches
 __all__ = ["simulate_front", "ATOL_SCALE_FRONT", "V_ARREST_FRONT"]
 
 #: Default atol = rtol * scale per component: α [rad], ω [rad/s], E_AE [J], each F_j [N], each v_j [m/s] (the
-#: tape-mass model's scales, ``exact.ATOL_SCALE["smooth"]``, and 1e-6 J for the AE energy).
+#: tape-mass model's scales, ``exact.ATOL_SCALE["smooth"]``, and 1e-6 J for the AE energy and both works).
 ATOL_SCALE_FRONT = (1e-4, 1e-3, 1e-6, 1e-2, 1e-6)
 #: A strip slower than this [m/s] has stopped: ModelBreakdown("arrest") (the tape-mass model's V_ARREST).
 V_ARREST_FRONT = 1e-12
@@ -45,12 +45,12 @@ def _atol(atol: Any, rtol: float, n: int) -> np.ndarray:
     size = front_state_size(n)
     if atol is None:
         a, w, e, F, v = (rtol * s for s in ATOL_SCALE_FRONT)
-        return np.concatenate([[a, w, e], np.full(n, F), np.full(n, v)])
+        return np.concatenate([[a, w, e], np.full(n, F), np.full(n, v), [e, e]])
     arr = np.asarray(atol, dtype=float)
     if arr.ndim == 0:
         arr = np.full(size, float(arr))
     if arr.shape != (size,) or not np.all(np.isfinite(arr)) or not np.all(arr > 0.0):
-        raise ValueError(f"atol must be None, a positive float or {size} positive floats (3 + 2N), got shape "
+        raise ValueError(f"atol must be None, a positive float or {size} positive floats (5 + 2N), got shape "
                          f"{arr.shape}")
     return np.ascontiguousarray(arr)
 
@@ -63,9 +63,9 @@ def _start(fp: FrontParams, y0: Any, alpha0: float, omega0: float | None, F0: fl
     if y0 is not None:
         y = np.array(y0, dtype=float)
         if y.shape != (front_state_size(n),) or not np.all(np.isfinite(y)):
-            raise ValueError(f"y0 must be {front_state_size(n)} finite floats (α, ω, E_AE, F_j…, v_j…), got shape "
-                             f"{y.shape}")
-        if not np.all(y[FY_STRIPS + n:] > 0.0):
+            raise ValueError(f"y0 must be {front_state_size(n)} finite floats (α, ω, E_AE, F_j…, v_j…, W_in, "
+                             f"W_peel), got shape {y.shape}")
+        if not np.all(y[FY_STRIPS + n:FY_STRIPS + 2 * n] > 0.0):
             raise ValueError("y0's velocities v_j must be > 0")
         return y
     s0 = initial_state(fp.base, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0)
@@ -73,7 +73,7 @@ def _start(fp: FrontParams, y0: Any, alpha0: float, omega0: float | None, F0: fl
     if fp.delta0 > 0.0 and n > 1:
         xi = np.random.default_rng(fp.seed).uniform(-1.0, 1.0, n)
         xi -= xi.mean()
-    return np.concatenate([[s0.alpha, s0.omega, 0.0], s0.F * (1.0 + fp.delta0 * xi), np.full(n, s0.v)])
+    return np.concatenate([[s0.alpha, s0.omega, 0.0], s0.F * (1.0 + fp.delta0 * xi), np.full(n, s0.v), [0.0, 0.0]])
 
 
 def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, atol: Any = None, alpha0: float = 0.0,
@@ -85,7 +85,7 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
     """Integrate the peel front (docs/peel-front.md) from t = 0 to ``t_end``.
 
     The state is ``(α, ω, E_AE, F_j, v_j)`` (``F_j = k u_j``), integrated by the package's compiled DOP853
-    (explicit, order 8, scipy's tolerance semantics: the RMS over all 3 + 2N components of the scaled error
+    (explicit, order 8, scipy's tolerance semantics: the RMS over all 5 + 2N components of the scaled error
     ≤ 1) at O(N) cost per step.  Explicit: its step is limited by the fast scale m/|f'| of the strips (docs,
     "Numerics"), so very light tapes (m ≲ 1e-5 kg) take many steps; the tape-mass model's stiff solvers are
     for those (``exact.simulate(method="smooth")``, N = 1).
@@ -98,13 +98,14 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
         Final time [s], in (0, 1e6].
     rtol : float
         Relative tolerance, in [1e-14, 1e-2].
-    atol : None, float or 3 + 2N floats
+    atol : None, float or 5 + 2N floats
         Absolute tolerance; None: ``rtol * ATOL_SCALE_FRONT`` per component.
     alpha0, omega0, F0, branch0 : optional
         The uniform start, as for :func:`exact.simulate` (:func:`exact.initial_state` of ``params.base``); the
         stretches are then spread by ``params.delta0`` with seed ``params.seed`` (mean kept).
-    y0 : array of 3 + 2N floats, optional
-        The full initial state instead (say, a previous run's ``final_y``), E_AE included.
+    y0 : array of 5 + 2N floats, optional
+        The full initial state ``(α, ω, E_AE, F_j…, v_j…, W_in, W_peel)`` instead (say, a previous run's
+        ``final_y``).
     t_transient : float
         Store points, jumps and local switches from this time on, in [0, t_end].
     dt_save : float, optional
@@ -112,9 +113,9 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
     store_front : bool
         Store F_j and v_j at every stored point (memory ``2N`` floats a point); False: the global series only.
     max_values : int
-        Memory budget: stored floats (points × (10 + 2N, or 10)), default 1e8 (800 MB; building the result
+        Memory budget: stored floats (points × (12 + 2N, or 12)), default 1e8 (800 MB; building the result
         copies them once more).  N = 128 over the tape-mass model's first 10 jumps at I = 1e-5 stores 240,000
-        steps × 266 floats = 6.4e7: pass ``dt_save`` or ``store_front=False`` for longer or wider runs.
+        steps × 268 floats = 6.4e7: pass ``dt_save`` or ``store_front=False`` for longer or wider runs.
     max_steps : int, optional
         Accepted steps; None: 2e7 per simulated second within [1e6, 1e9].
     max_local, max_jumps : int
@@ -226,7 +227,7 @@ class _Run:
 
     def state(self, y: np.ndarray) -> dict:
         n = self.fp.N
-        v = y[FY_STRIPS + n:]
+        v = y[FY_STRIPS + n:FY_STRIPS + 2 * n]
         vm = float(v.mean())
         return {"t": float(self.st[D.S_T]), "alpha": float(y[FY_ALPHA]), "omega": float(y[FY_OMEGA]),
                 "F": float(y[FY_STRIPS:FY_STRIPS + n].mean()), "v": vm, "ae_energy": float(y[FY_EAE]),
@@ -335,7 +336,8 @@ class _Run:
         return FrontTrajectory(
             params=self.fp, t=g[:, D.G_T], alpha=g[:, D.G_ALPHA], omega=g[:, D.G_OMEGA], F=g[:, D.G_F],
             v=g[:, D.G_V], ae_power=g[:, D.G_PAE], ae_energy=g[:, D.G_EAE], fraction_peeling=g[:, D.G_PHI],
-            roughness=g[:, D.G_W], domain_walls=g[:, D.G_NDW].astype(np.int64),
+            roughness=g[:, D.G_W], domain_walls=g[:, D.G_NDW].astype(np.int64), work_in=g[:, D.G_WIN],
+            work_peel=g[:, D.G_WPEEL],
             front_F=None if fy is None else fy[:, :n], front_v=None if fy is None else fy[:, n:],
             jumps=Jumps.from_buffer(jb), local_switches=LocalSwitches(lb[:, 0].copy(), lb[:, 1].astype(np.int64),
                                                                         lb[:, 2].astype(np.int8)),

@@ -15,7 +15,8 @@ from .._trajectory import Jumps, SolverStats
 __all__ = ["FrontTrajectory", "LocalSwitches"]
 
 _SERIES_UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "ae_power": "W",
-                 "ae_energy": "J", "fraction_peeling": "", "roughness": "", "domain_walls": ""}
+                 "ae_energy": "J", "fraction_peeling": "", "roughness": "", "domain_walls": "", "work_in": "J",
+                 "work_peel": "J"}
 
 
 @dataclass(frozen=True)
@@ -42,13 +43,17 @@ class FrontTrajectory:
     * ``ae_power`` [W]: the acoustic emission ``R_AE = Γ Σ_bonds (v_{j+1} - v_j)²``; ``ae_energy`` [J]: its
       integral ``E_AE``, a state of the integration (so a burst's energy is a difference of two values);
     * the front's pattern: ``fraction_peeling`` φ (strips with v_j > v_infl), ``roughness`` W = std_j ln v_j,
-      ``domain_walls`` (bonds joining strips on different branches).
+      ``domain_walls`` (bonds joining strips on different branches);
+    * ``work_in`` [J] = ∫ F̄ V dt, the pull's work, and ``work_peel`` [J] = ∫ N⁻¹ Σ f(v_j) v_j dt, the energy
+      dissipated at the peel front: states of the integration, so the energy balance
+      ``ΔE = Δwork_in - Δwork_peel - Δae_energy`` holds to the solver's accuracy.
 
     The front itself, ``v_j`` [m/s] and ``u_j`` [m] (and ``F_j = k u_j`` [N]), arrays of shape (points, N), when
     stored (``store_front=True``, the default).  ``jumps``: the mean front's branch changes (v̄ crossing v_infl), as
     :func:`exact.simulate` reports the tape-mass model's (``Jumps``); ``local_switches``: every strip's.
     ``stats``: steps, rejected steps, field evaluations, mean jumps (all), wall time; ``n_local_switches`` all
-    local switches (also before ``t_transient``).  ``final_y`` is the full state ``(α, ω, E_AE, F_j…, v_j…)``
+    local switches (also before ``t_transient``).  ``final_y`` is the full state
+    ``(α, ω, E_AE, F_j…, v_j…, W_in, W_peel)``
     at ``t_end`` (or where the run stopped), a valid start for another run (``y0=``).
     """
 
@@ -63,6 +68,8 @@ class FrontTrajectory:
     fraction_peeling: np.ndarray
     roughness: np.ndarray
     domain_walls: np.ndarray
+    work_in: np.ndarray
+    work_peel: np.ndarray
     front_F: np.ndarray | None
     front_v: np.ndarray | None
     jumps: Jumps

@@ -1,11 +1,12 @@
 """The peel front's compiled vector field (docs/peel-front.md, "Equations").
 
-State ``y = (α, ω, E_AE, F_0 … F_{N-1}, v_0 … v_{N-1})`` with ``F_j = k u_j`` (the pull force the whole tape
-would carry at strip j's stretch; the pull force is ``F = mean F_j = k ū``), ``v_j`` the local peel
-velocity and ``E_AE`` the integrated acoustic emission.  The mean ``(α̇, ω̇, F̄̇, v̄̇)`` is the tape-mass model's
-field (``tape_rhs`` of :mod:`peelapprox._generated`, generated from :mod:`peelapprox._symbolic`) evaluated with
-the mean peel force ``f̄ = mean f(v_j)``: the same code as the tape-mass model's, so N = 1 is that model.  Each
-strip adds its deviation from the mean::
+State ``y = (α, ω, E_AE, F_0 … F_{N-1}, v_0 … v_{N-1}, W_in, W_peel)`` with ``F_j = k u_j`` (the pull force the
+whole tape would carry at strip j's stretch; the pull force is ``F = mean F_j = k ū``), ``v_j`` the local peel
+velocity, ``E_AE`` the integrated acoustic emission, ``W_in = ∫ F̄ V dt`` the work of the pull and
+``W_peel = ∫ N⁻¹ Σ f(v_j) v_j dt`` the energy dissipated at the peel front (the energy balance's integrals).
+The mean ``(α̇, ω̇, F̄̇, v̄̇)`` is the tape-mass model's field (``tape_rhs`` of :mod:`peelapprox._generated`,
+generated from :mod:`peelapprox._symbolic`) evaluated with the mean peel force ``f̄ = mean f(v_j)``: the same
+code as the tape-mass model's, so N = 1 is that model.  Each strip adds its deviation from the mean::
 
     Ḟ_j = k (V + c (R ω - v̄) - v_j)
     v̇_j = v̄̇ + [(F_j - F̄) - (f(v_j) - f̄) - (κ/4) (Δ F)_j + (N Γ) (Δ v)_j] / m
@@ -34,20 +35,22 @@ from ..law import ALL_LAWS
 from ..law._abi import LAW_FP, LAW_TYPE
 
 __all__ = ["FQ_MASS", "FQ_N", "FQ_KC4", "FQ_NGAMMA", "FQ_GAMMA", "FQ_PERIODIC", "N_FQ", "FY_ALPHA", "FY_OMEGA",
-           "FY_EAE", "FY_STRIPS", "front_parameters", "front_rhs", "front_field", "front_state_size"]
+           "FY_EAE", "FY_STRIPS", "N_FY_TAIL", "front_parameters", "front_rhs", "front_field", "front_state_size"]
 
 #: Parameter vector: the model block, then m [kg], N, κ/4 = N k_c/k, N Γ [N s/m], Γ [N s/m], 1.0 if periodic.
 FQ_MASS, FQ_N, FQ_KC4, FQ_NGAMMA, FQ_GAMMA, FQ_PERIODIC = range(N_M, N_M + 6)
 N_FQ = N_M + 6
-#: State layout: α, ω, E_AE, then the N forces F_j, then the N velocities v_j.
+#: State layout: α, ω, E_AE, then the N forces F_j, then the N velocities v_j, then W_in and W_peel (the last two).
 FY_ALPHA, FY_OMEGA, FY_EAE, FY_STRIPS = 0, 1, 2, 3
+#: The components after the strips: W_in, W_peel (at ``size - 2`` and ``size - 1``).
+N_FY_TAIL = 2
 
 _tape_rhs = kernel(inline="always")(_g.tape_rhs)
 
 
 def front_state_size(n: int) -> int:
-    """Length of the state vector for N = n strips: ``3 + 2 n``."""
-    return FY_STRIPS + 2 * n
+    """Length of the state vector for N = n strips: ``5 + 2 n``."""
+    return FY_STRIPS + 2 * n + N_FY_TAIL
 
 
 def front_parameters(fp: Any) -> np.ndarray:
@@ -89,6 +92,7 @@ def front_rhs(y, P, out):
     sF = 0.0
     sv = 0.0
     sf = 0.0
+    sfv = 0.0
     for j in range(n):
         v = vs[j]
         if not v > 0.0:
@@ -100,6 +104,7 @@ def front_rhs(y, P, out):
         sF += Fs[j]
         sv += v
         sf += f
+        sfv += f * v
     Fm, vm, fm = sF / n, sv / n, sf / n
     c, dc, _ = closure_d2(y[FY_ALPHA], q[M_GEOM], q[M_R], q[M_L])
     r = _tape_rhs(y[FY_ALPHA], y[FY_OMEGA], Fm, vm, q[M_V], c, dc, fm, q[FQ_MASS], q[M_I], q[M_K], q[M_R])
@@ -118,6 +123,8 @@ def front_rhs(y, P, out):
         dv[j] = r[3] + ((Fs[j] - Fm) - (dv[j] - fm) + coupling) / m
         dF[j] = k * (shift - vs[j])
     out[FY_EAE] = q[FQ_GAMMA] * eae
+    out[FY_STRIPS + 2 * n] = Fm * q[M_V]
+    out[FY_STRIPS + 2 * n + 1] = sfv / n
 
 
 @kernel(nrt=False)
