@@ -86,7 +86,7 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
 
     The state is ``(α, ω, E_AE, F_j, v_j)`` (``F_j = k u_j``), integrated by the package's compiled DOP853
     (explicit, order 8, scipy's tolerance semantics: the RMS over all 5 + 2N components of the scaled error
-    ≤ 1) at O(N) cost per step.  Explicit: its step is limited by the fast scale m/|f'| of the strips (docs,
+    ≤ 1) at O(N) cost per step.  Explicit: its step is limited by the fast scale ``m/|f'|`` of the strips (docs,
     "Numerics"), so very light tapes (m ≲ 1e-5 kg) take many steps; the tape-mass model's stiff solvers are
     for those (``exact.simulate(method="smooth")``, N = 1).
 
