@@ -59,6 +59,7 @@ from .dynamics import (
     orbit_diagram,
     window_run,
 )
+from .front import FrontTrajectory, simulate_front
 from .orbits import (
     Bifurcation,
     BranchPoint,
@@ -79,6 +80,8 @@ from .orbits import (
 
 __all__ = [
     "simulate",
+    "simulate_front",
+    "FrontTrajectory",
     "Hybrid",
     "Regularized",
     "Smooth",

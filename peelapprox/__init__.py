@@ -76,6 +76,7 @@ from ._series_lyapunov import SeriesLyapunov, SurrogateTest
 from ._slips import Slips
 from ._version import __version__ as __version__
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
+from .front import FrontParams, FrontPattern, TransverseModes, front_pattern, transverse_growth_rates
 from .law import (
     BRANCHES,
     BREAKDOWN_LEVEL,
@@ -94,6 +95,11 @@ from .law import (
 
 __all__ = [
     "PeelParams",
+    "FrontParams",
+    "FrontPattern",
+    "TransverseModes",
+    "front_pattern",
+    "transverse_growth_rates",
     "ForceSeries",
     "Slips",
     "Spectrum",

@@ -80,6 +80,8 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "exact/_jacobian.py",
     "exact/_regularized.py",
     "exact/_tangent.py",
+    "peelapprox/front/_field.py",  # the peel front's field
+    "exact/front/_driver.py",  # its compiled DOP853 loop
 )
 
 

@@ -69,6 +69,21 @@ from ._model_jit import (
 )
 from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
 from ._variant_fields import VARIANT_MODELS, bound_variant_field, variant_field, variant_parameters
+from .front._field import (
+    FQ_GAMMA,
+    FQ_N,
+    FQ_PERIODIC,
+    FY_ALPHA,
+    FY_EAE,
+    FY_OMEGA,
+    FY_STRIPS,
+    N_FQ,
+    N_FY_TAIL,
+    front_field,
+    front_parameters,
+    front_rhs,
+    front_state_size,
+)
 from .law import ALL_LAWS
 from .law._abi import (
     LAW_FP,
@@ -106,6 +121,8 @@ __all__ = [
     "VARIANT_MODELS", "variant_field", "variant_parameters", "bound_variant_field",
     "MAX_REJECTIONS", "N_STAGES", "STEP_FAILED", "crossing", "interp", "interp1", "make_dop853", "solve_theta",
     "state_at", "workspace",
+    "front_rhs", "front_field", "front_parameters", "front_state_size", "FQ_N", "FQ_GAMMA", "FQ_PERIODIC", "N_FQ",
+    "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS", "N_FY_TAIL",
     "DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
     "diffsl_inputs", "diffsl_model", "import_optional",
     "BuildExpired", "caller_budget",  # a public call's max_wall handed down to the law compilation it triggers

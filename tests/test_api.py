@@ -37,6 +37,7 @@ API = {
         "wkb_error_bound", "StickSlipObservables", "attractor_observables", "approximate_attractor", "ForceSeries",
         "ApproximateAttractor", "ApproximationWarning",
         "Slips", "Spectrum", "SeriesLyapunov", "SurrogateTest",
+        "FrontParams", "FrontPattern", "TransverseModes", "front_pattern", "transverse_growth_rates",
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
@@ -55,6 +56,7 @@ API = {
         "Inference",
         "attractor_observables",
         "attractor_set", "AttractorSet", "SetAttractor", "SetOutcome", "SetStart", "EscapePrediction",
+        "simulate_front", "FrontTrajectory",
     },
     "comparisons": {
         "CLAIM", "CompareReport", "ComparisonRow", "DEFAULT_MODELS", "ExactRun", "RUNS", "Row", "RunSpec", "SCENES",
@@ -64,7 +66,8 @@ API = {
     },
     "peelapprox.io": {"TABLE_EXTENSIONS", "ProgressLine", "fmt_number", "html_table", "jsonable", "optional_import",
                       "param_attrs", "write_csv", "write_rows"},
-    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_phase_diagram",
+    "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_front",
+                            "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot", "save_figure", "trajectory_window",
                             "TrajectoryWindow", "TRAJECTORY_PANELS", "MAX_BRANCHES"},
     "comparisons.atlas": {
@@ -103,6 +106,8 @@ API = {
         "peel_force_fp_jit", "peel_force_fpp_jit", "peel_force_lnv_jit", "regularized_field",
         "regularized_field_jacobian", "regularized_jacobian", "regularized_parameters", "regularized_rhs",
         "slow_rates", "solve_theta", "state_at", "status", "table_coefficients", "table_law", "workspace",
+        "front_rhs", "front_field", "front_parameters", "front_state_size", "FQ_N", "FQ_GAMMA", "FQ_PERIODIC",
+        "N_FQ", "N_FY_TAIL", "FY_ALPHA", "FY_OMEGA", "FY_EAE", "FY_STRIPS",
     },
     "peelapprox.cli": {"build_parser", "main"},
     "comparisons.benchmark": {
