@@ -36,6 +36,8 @@ API = {
         "settle_time", "sinusoid_alpha", "slope_criterion", "sweep", "wkb_alpha", "wkb_amplitude_phase",
         "wkb_error_bound", "StickSlipObservables", "attractor_observables", "approximate_attractor", "ForceSeries",
         "Slips", "Spectrum", "SeriesLyapunov", "SurrogateTest",
+        "burst_catalogue", "BurstCatalogue", "BURST_COLUMNS", "fit_power_law", "PowerLawFit", "MAX_XMIN_CANDIDATES",
+        "compare_power_law", "LikelihoodRatio", "ALTERNATIVES", "fit_broken_power_law", "BrokenPowerLawFit",
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
@@ -63,7 +65,7 @@ API = {
                       "param_attrs", "write_csv", "write_rows"},
     "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot", "save_figure", "trajectory_window",
-                            "TrajectoryWindow", "TRAJECTORY_PANELS", "MAX_BRANCHES"},
+                            "plot_burst_distribution", "TrajectoryWindow", "TRAJECTORY_PANELS", "MAX_BRANCHES"},
     "comparisons.atlas": {
         "atlas", "AtlasResult", "load_atlas", "APPROXIMATIONS", "register_approximation", "OBSERVABLES", "DEFAULTS",
         "TOLERANCE", "estimate_observables", "plot_error_map", "plot_dynamics_map", "plot_segment_maps",
