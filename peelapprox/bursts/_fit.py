@@ -117,12 +117,12 @@ class PowerLawFit:
         hi = math.inf if self.xmax is None else self.xmax
         return logpdf(np.asarray(x, dtype=float), self.alpha, self.xmin, hi, self.discrete)
 
-    def compare(self, alternative: str, **kwargs: Any):
+    def compare(self, alternative: str):
         """The likelihood-ratio test of this power law against ``alternative`` (``"lognormal"``,
         ``"exponential"``, ``"truncated_power_law"``) on the same tail: :func:`peelapprox.compare_power_law`."""
         from ._alternatives import compare_power_law
 
-        return compare_power_law(self, alternative, **kwargs)
+        return compare_power_law(self, alternative)
 
     def as_dict(self) -> dict[str, Any]:
         """The fit as one flat row (intervals as ``*_lo``/``*_hi``), without the data."""
@@ -301,7 +301,7 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
         gof_p, n_gof = _goodness(x, fxmin, alpha, ks, xmin, hi, min_tail, max_candidates, gof_bootstrap, rng,
                                  deadline)
     notes = [f"{'discrete' if discrete else 'continuous'} maximum likelihood on {n_tail} of {x.size} sizes"]
-    cut = alphas.size + 0 < n_bootstrap or n_gof < gof_bootstrap
+    cut = alphas.size < n_bootstrap or n_gof < gof_bootstrap
     status = 1 if time.perf_counter() > deadline and cut else 0
     if status:
         notes.append(f"max_wall = {max_wall:g} s reached: {alphas.size} of {n_bootstrap} bootstrap and {n_gof} of "
