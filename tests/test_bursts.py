@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import integrate, special, stats
 
 from peelapprox import (
@@ -387,3 +389,51 @@ def test_broken_intervals_cover_the_truth():
             hits[j] += iv[0] <= truth <= iv[1]
     print(f"\nbroken-law coverage of 50: alpha1 {hits[0]}, alpha2 {hits[1]}, break {hits[2]}")
     assert np.all(hits >= 40)
+
+
+def test_degenerate_catalogues_are_named_errors_or_empty():
+    """Hypothesis: sizes all equal (no law), a given xmin whose tail is all xmin, a power series that never
+    crosses the threshold (an empty catalogue, whose sizes then fail the fit by name): no ZeroDivisionError,
+    no NaN (categorical)."""
+    with pytest.raises(ValueError, match="more than one value"):
+        fit_power_law([5.0] * 100)
+    with pytest.raises(ValueError, match="every size in the tail equals xmin"):
+        fit_power_law([1.0] * 10 + [5.0] * 100, xmin=5.0)
+    cat = burst_catalogue(np.arange(10.0), np.zeros(10), threshold=1.0)
+    assert len(cat) == 0 and cat.as_rows() == [] and cat.n_dropped == 0
+    with pytest.raises(ValueError, match="non-empty"):
+        fit_power_law(cat.sizes("energy"))
+
+
+def test_integer_sizes_fitted_as_continuous_get_a_caveat():
+    """Hypothesis: integer sizes with a continuous fit and xmin < 6 carry the caveat to use discrete=True (the
+    cause of powerlaw issue #61; categorical)."""
+    k = stats.zipf(2.2).rvs(3000, random_state=np.random.default_rng(1)).astype(float)
+    fit = fit_power_law(k, xmin=1.0, n_bootstrap=0)
+    assert "discrete=True" in fit.message
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(st.lists(st.floats(min_value=1e-12, max_value=1e12, allow_nan=False), min_size=0, max_size=300),
+       st.booleans())
+def test_fuzz_fit_returns_a_finite_fit_or_a_named_error(sizes, rounded):
+    """Hypothesis: any list of positive floats (rounded up to integers for the discrete fit) gives a fit with
+    finite alpha, ks and loglik, or a ValueError (categorical; 40 derandomised examples)."""
+    x = np.ceil(np.asarray(sizes)) if rounded else np.asarray(sizes)
+    try:
+        fit = fit_power_law(x, discrete=rounded, n_bootstrap=0, min_tail=5)
+    except ValueError:
+        return
+    assert all(math.isfinite(v) for v in (fit.alpha, fit.ks, fit.loglik, fit.xmin))
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(st.lists(st.floats(min_value=1e-6, max_value=1e9, allow_nan=False), min_size=0, max_size=400))
+def test_fuzz_broken_returns_a_finite_fit_or_a_named_error(sizes):
+    """Hypothesis: any list of positive floats gives a broken fit with finite exponents, break and statistic,
+    or a ValueError (categorical; 25 derandomised examples)."""
+    try:
+        f = fit_broken_power_law(sizes, n_bootstrap=0, n_null=0, min_regime=5)
+    except ValueError:
+        return
+    assert all(math.isfinite(v) for v in (f.alpha1, f.alpha2, f.x_break, f.lr_statistic, f.loglik))

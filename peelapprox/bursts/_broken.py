@@ -193,8 +193,7 @@ def _fit_breaks(L: np.ndarray, n: int, s1: np.ndarray, n2: np.ndarray, s2: np.nd
     return a, b, ll
 
 
-def _broken(y: np.ndarray, min_regime: int, max_candidates: int, a0: float = 0.0
-            ) -> tuple[float, float, float, float, int, int]:
+def _broken(y: np.ndarray, min_regime: int, max_candidates: int) -> tuple[float, float, float, float, int, int]:
     """``(alpha1, alpha2, yb, loglik, n_below, candidates)`` of the sorted scaled sizes y >= 1 (module
     docstring); ValueError when no break leaves ``min_regime`` sizes on each side."""
     n = y.size
@@ -273,8 +272,8 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
     max_wall = in_range("max_wall", max_wall, 0.0, 1e6, lo_open=True)
     x0 = float(x[0]) if xmin is None else xmin
     y = x[x >= x0] / x0
-    a_s, ll_s = _single(y) if y.size else (math.nan, math.nan)
-    a1, a2, yb, ll, n1, cands = _broken(y, min_regime, max_candidates, a_s)
+    a1, a2, yb, ll, n1, cands = _broken(y, min_regime, max_candidates)  # ValueError if too few: before _single
+    a_s, ll_s = _single(y)
     lr = max(2.0 * (ll - ll_s), 0.0)
     rng = np.random.default_rng(seed)
     deadline = t0 + max_wall
@@ -284,7 +283,7 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
             break
         yr = np.sort(rng.choice(y, y.size, replace=True))
         try:
-            b1, b2, bb, *_ = _broken(yr, min_regime, max_candidates, a_s)
+            b1, b2, bb, *_ = _broken(yr, min_regime, max_candidates)
         except ValueError:
             continue
         boot.append((b1, b2, bb * x0))
@@ -294,7 +293,7 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
             break
         ys = np.sort(sample_power_law(rng, y.size, a_s, 1.0))
         try:
-            llb = _broken(ys, min_regime, max_candidates, a_s)[3]
+            llb = _broken(ys, min_regime, max_candidates)[3]
         except ValueError:
             continue
         done += 1

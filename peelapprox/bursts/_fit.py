@@ -50,7 +50,7 @@ class PowerLawFit:
     loglik : float
         The tail's log-likelihood under the fit.
     alpha_se : float
-        The asymptotic standard error of alpha at fixed xmin, ``(alpha - 1)/sqrt(n_tail)`` (CSN eq. 3.2; for a
+        The asymptotic standard error of alpha at fixed xmin, ``abs(alpha - 1)/sqrt(n_tail)`` (CSN eq. 3.2; for a
         discrete or truncated law the same expression, an approximation).
     alpha_interval, xmin_interval : (float, float) or None
         The bootstrap's 95 % percentile intervals (None: fewer than :data:`MIN_BOOTSTRAP` replicates).
@@ -163,6 +163,8 @@ def _sizes(sizes: Any, discrete: bool) -> np.ndarray:
 def _fit_tail(x: np.ndarray, xmin: float, xmax: float, discrete: bool) -> tuple[float, float, int, int]:
     """``(alpha, ks, n_tail, evaluations)`` of the tail of the sorted data at a given xmin."""
     tail = x[(x >= xmin) & (x <= xmax)]
+    if tail.size == 0 or tail[-1] == tail[0] == xmin:
+        return math.inf, math.inf, int(tail.size), 0
     a, nev = alpha_mle(tail.size, float(np.sum(np.log(tail))), xmin, xmax, discrete)
     return a, ks_distance(tail, a, xmin, xmax, discrete), int(tail.size), nev
 
@@ -175,12 +177,14 @@ def _estimate(x: np.ndarray, xmin: float | None, xmax: float, discrete: bool, mi
         scan = ks_scan(x, min_tail=min_tail, max_candidates=max_candidates, xmax=xmax, discrete=discrete)
         if scan is None:
             raise ValueError(f"sizes: too few points for a power-law fit: no xmin leaves min_tail = {min_tail} "
-                             f"sizes in the tail ({x.size} sizes given)")
+                             f"sizes of more than one value in the tail ({x.size} sizes given)")
         return scan.xmin, scan.alpha, scan.ks, scan.n_tail, scan.candidates, scan.evaluations
     a, d, m, nev = _fit_tail(x, xmin, xmax, discrete)
     if m < min_tail:
         raise ValueError(f"xmin = {xmin!r} leaves {m} sizes in the tail, fewer than min_tail = {min_tail}: "
                          "lower xmin or min_tail")
+    if not math.isfinite(a):
+        raise ValueError(f"xmin = {xmin!r}: every size in the tail equals xmin, no power law can be fitted")
     return xmin, a, d, m, 0, nev
 
 
@@ -309,12 +313,15 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
     enough = alphas.size >= MIN_BOOTSTRAP
     if n_bootstrap and not enough:
         notes.append(f"no intervals: {alphas.size} bootstrap replicates, fewer than {MIN_BOOTSTRAP}")
+    if not discrete and fxmin < 6 and np.all(x == np.round(x)):
+        notes.append("the sizes are all integers and xmin < 6: the continuous law misfits counts there (CSN "
+                     "Sec. 3.5); consider discrete=True")
     if any(abs(alpha - b) < 1e-6 for b in ALPHA_BOUNDS):
         notes.append(f"alpha on the search bound {ALPHA_BOUNDS}: the tail is not a power law in that range")
     pct = (2.5, 97.5)
     return PowerLawFit(
         alpha=float(alpha), xmin=float(fxmin), xmax=None if xmax is None else hi, discrete=discrete, n=int(x.size),
-        n_tail=int(n_tail), ks=float(ks), loglik=loglik, alpha_se=float((alpha - 1.0) / math.sqrt(n_tail)),
+        n_tail=int(n_tail), ks=float(ks), loglik=loglik, alpha_se=float(abs(alpha - 1.0) / math.sqrt(n_tail)),
         alpha_interval=tuple(float(v) for v in np.percentile(alphas, pct)) if enough else None,  # type: ignore
         xmin_interval=tuple(float(v) for v in np.percentile(xmins, pct)) if enough else None,  # type: ignore
         xmin_std=float(np.std(xmins)) if enough else None, gof_p=gof_p, n_bootstrap=int(alphas.size),

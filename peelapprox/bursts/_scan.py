@@ -57,6 +57,8 @@ def score(x: np.ndarray, lx: np.ndarray, logx_tailsum: np.ndarray, ramp: np.ndar
     ``logx_tailsum[i]`` = Σ_{j >= i} ln x_j; ``ramp = arange(n)``)."""
     m = x.size - i
     xmin = float(x[i])
+    if float(logx_tailsum[i]) - m * float(lx[i]) <= 0.0:  # every size of the tail equals xmin: no law to fit
+        return math.inf, math.inf, 0
     alpha, nev = alpha_mle(m, float(logx_tailsum[i]), xmin, xmax, discrete)
     if discrete or math.isfinite(xmax):
         return alpha, ks_distance(x[i:], alpha, xmin, xmax, discrete), nev
@@ -100,4 +102,6 @@ def ks_scan(x: np.ndarray, *, min_tail: int, max_candidates: int, xmax: float, d
     run(_subsample(fine, x, max_candidates))
     best = min(scored, key=lambda i: (scored[i][1], i))
     a, d = scored[best]
+    if not math.isfinite(d):
+        return None
     return Scan(float(x[best]), a, d, int(x.size - best), len(scored), nev)
