@@ -437,3 +437,16 @@ def test_fuzz_broken_returns_a_finite_fit_or_a_named_error(sizes):
     except ValueError:
         return
     assert all(math.isfinite(v) for v in (f.alpha1, f.alpha2, f.x_break, f.lr_statistic, f.loglik))
+
+
+def test_progress_is_reported_and_checked(capsys):
+    """Hypothesis: a callable gets (k, total) for every replicate of each loop, in order (exact lists); True
+    writes ProgressLine lines on stderr; a non-callable is refused by name before any work (categorical)."""
+    x = stats.pareto(b=1.0).rvs(300, random_state=np.random.default_rng(2))
+    calls = []
+    fit_power_law(x, n_bootstrap=5, gof_bootstrap=3, progress=lambda k, n: calls.append((k, n)))
+    assert calls == [(k, 5) for k in range(1, 6)] + [(k, 3) for k in range(1, 4)]
+    fit_broken_power_law(x, n_bootstrap=4, n_null=0, min_regime=20, progress=True)
+    assert "broken-law bootstrap" in capsys.readouterr().err
+    with pytest.raises(TypeError, match="progress must be callable"):
+        fit_power_law(x, progress="yes")

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -30,7 +31,7 @@ from scipy import special
 
 from .._checks import in_range, integer, optional, positive
 from ..io import fmt_number, optional_import, write_rows
-from ._fit import MAX_XMIN_CANDIDATES, MIN_BOOTSTRAP, _sizes, sample_power_law
+from ._fit import MAX_XMIN_CANDIDATES, MIN_BOOTSTRAP, _sizes, reporter, sample_power_law
 from ._scan import _subsample
 
 __all__ = ["BrokenPowerLawFit", "fit_broken_power_law"]
@@ -229,7 +230,8 @@ def _single(y: np.ndarray) -> tuple[float, float]:
 
 def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: int = 50, n_null: int = 50,
                          seed: int = 0, min_regime: int = 50, max_candidates: int = 40,
-                         max_wall: float = 120.0) -> BrokenPowerLawFit:
+                         max_wall: float = 120.0, progress: bool | Callable[[int, int], None] = False
+                         ) -> BrokenPowerLawFit:
     """Fit a broken (two-regime) power law and test it against a single one (module docstring).
 
     Parameters
@@ -250,6 +252,8 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
         K, break candidates per pass (2 to 10000; 40): cost O(2 K) two-parameter fits per catalogue.
     max_wall : float
         Wall-time limit of the two bootstrap loops together [s].
+    progress : bool or callable
+        Report the two bootstrap loops (as :func:`peelapprox.fit_power_law`).
 
     Returns
     -------
@@ -270,6 +274,7 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
     min_regime = integer("min_regime", min_regime, lo=5, hi=10**9)
     max_candidates = integer("max_candidates", max_candidates, lo=2, hi=MAX_XMIN_CANDIDATES)
     max_wall = in_range("max_wall", max_wall, 0.0, 1e6, lo_open=True)
+    reporter(progress, "", 0)  # checks progress before the work
     x0 = float(x[0]) if xmin is None else xmin
     y = x[x >= x0] / x0
     a1, a2, yb, ll, n1, cands = _broken(y, min_regime, max_candidates)  # ValueError if too few: before _single
@@ -278,9 +283,11 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
     rng = np.random.default_rng(seed)
     deadline = t0 + max_wall
     boot: list[tuple[float, float, float]] = []
-    for _ in range(n_bootstrap):
+    tick = reporter(progress, "broken-law bootstrap", n_bootstrap)
+    for k in range(n_bootstrap):
         if time.perf_counter() > deadline:
             break
+        tick(k + 1)
         yr = np.sort(rng.choice(y, y.size, replace=True))
         try:
             b1, b2, bb, *_ = _broken(yr, min_regime, max_candidates)
@@ -288,9 +295,11 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
             continue
         boot.append((b1, b2, bb * x0))
     worse = done = 0
-    for _ in range(n_null):
+    tick = reporter(progress, "broken-law null catalogues", n_null)
+    for k in range(n_null):
         if time.perf_counter() > deadline:
             break
+        tick(k + 1)
         ys = np.sort(sample_power_law(rng, y.size, a_s, 1.0))
         try:
             llb = _broken(ys, min_regime, max_candidates)[3]

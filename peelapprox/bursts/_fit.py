@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .._checks import flag, in_range, integer, optional, positive, reals
+from .._checks import flag, function, in_range, integer, optional, positive, reals
+from .._progress import ProgressLine
 from ..io import fmt_number, optional_import, write_rows
 from ._laws import ALPHA_BOUNDS, alpha_mle, ccdf, ks_distance, logpdf
 from ._scan import ks_scan
@@ -200,12 +202,25 @@ def sample_power_law(rng: np.random.Generator, n: int, alpha: float, xmin: float
     return (xmin**e + u * (xmax**e - xmin**e)) ** (1.0 / e)
 
 
-def _bootstrap(x, xmin_given, xmax, discrete, min_tail, max_candidates, n_boot, rng, deadline):
+def reporter(progress: Any, label: str, total: int) -> Callable[[int], None]:
+    """``tick(done)`` for a loop of ``total`` replicates: a :class:`peelapprox.io.ProgressLine` on stderr for
+    ``progress=True``, ``progress(done, total)`` for a callable, nothing for False (ArgumentTypeError else)."""
+    if progress is True and total:
+        line = ProgressLine(label, total)
+        return lambda done: line.update(done)
+    if progress is False or progress is True:
+        return lambda done: None
+    fn = function("progress", progress)
+    return lambda done: fn(done, total)
+
+
+def _bootstrap(x, xmin_given, xmax, discrete, min_tail, max_candidates, n_boot, rng, deadline, tick):
     """Alphas and xmins of up to ``n_boot`` nonparametric replicates (resample, redo the whole procedure)."""
     alphas, xmins = [], []
-    for _ in range(n_boot):
+    for k in range(n_boot):
         if time.perf_counter() > deadline:
             break
+        tick(k + 1)
         xb = np.sort(rng.choice(x, x.size, replace=True))
         try:
             xm, a, *_ = _estimate(xb, xmin_given, xmax, discrete, min_tail, max_candidates)
@@ -216,14 +231,15 @@ def _bootstrap(x, xmin_given, xmax, discrete, min_tail, max_candidates, n_boot, 
     return np.asarray(alphas), np.asarray(xmins)
 
 
-def _goodness(x, fit_xmin, alpha, ks, xmin_given, xmax, min_tail, max_candidates, n_gof, rng, deadline):
+def _goodness(x, fit_xmin, alpha, ks, xmin_given, xmax, min_tail, max_candidates, n_gof, rng, deadline, tick):
     """CSN's semi-parametric bootstrap: ``(p, replicates done)``."""
     below = x[x < fit_xmin]
     n_tail = int(np.sum((x >= fit_xmin) & (x <= xmax)))
     worse = done = 0
-    for _ in range(n_gof):
+    for k in range(n_gof):
         if time.perf_counter() > deadline:
             break
+        tick(k + 1)
         k = rng.binomial(x.size, n_tail / x.size) if below.size else x.size
         synth = np.concatenate((sample_power_law(rng, k, alpha, fit_xmin, xmax),
                                 rng.choice(below, x.size - k, replace=True) if below.size else np.empty(0)))
@@ -238,7 +254,8 @@ def _goodness(x, fit_xmin, alpha, ks, xmin_given, xmax, min_tail, max_candidates
 
 def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None = None, discrete: bool = False,
                   n_bootstrap: int = 100, gof_bootstrap: int = 0, seed: int = 0, min_tail: int = 50,
-                  max_candidates: int = 100, max_wall: float = 60.0) -> PowerLawFit:
+                  max_candidates: int = 100, max_wall: float = 60.0,
+                  progress: bool | Callable[[int, int], None] = False) -> PowerLawFit:
     """Fit a power law ``p(x) ∝ x^-alpha`` on ``[xmin, xmax]`` to burst sizes (Clauset, Shalizi & Newman 2009).
 
     Parameters
@@ -264,6 +281,9 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
         K, the candidate xmin per pass of the scan (2 to :data:`MAX_XMIN_CANDIDATES`; 100).
     max_wall : float
         Wall-time limit of the bootstrap loops [s] (the point fit and one scan, O(2 K n), always finish).
+    progress : bool or callable
+        Report the bootstrap loops: True, a line on stderr per ~5 % (:class:`peelapprox.io.ProgressLine`); a
+        callable, ``progress(k, total)`` as replicate k (from 1) of each loop starts; False, nothing.
 
     Returns
     -------
@@ -293,17 +313,19 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
     min_tail = integer("min_tail", min_tail, lo=5, hi=10**9)
     max_candidates = integer("max_candidates", max_candidates, lo=2, hi=MAX_XMIN_CANDIDATES)
     max_wall = in_range("max_wall", max_wall, 0.0, 1e6, lo_open=True)
+    reporter(progress, "", 0)  # checks progress before the work
 
     fxmin, alpha, ks, n_tail, cands, nev = _estimate(x, xmin, hi, discrete, min_tail, max_candidates)
     tail = x[(x >= fxmin) & (x <= hi)]
     loglik = float(np.sum(logpdf(tail, alpha, fxmin, hi, discrete)))
     rng = np.random.default_rng(seed)
     deadline = t0 + max_wall
-    alphas, xmins = _bootstrap(x, xmin, hi, discrete, min_tail, max_candidates, n_bootstrap, rng, deadline)
+    alphas, xmins = _bootstrap(x, xmin, hi, discrete, min_tail, max_candidates, n_bootstrap, rng, deadline,
+                               reporter(progress, "power-law bootstrap", n_bootstrap))
     gof_p, n_gof = (None, 0)
     if gof_bootstrap:
         gof_p, n_gof = _goodness(x, fxmin, alpha, ks, xmin, hi, min_tail, max_candidates, gof_bootstrap, rng,
-                                 deadline)
+                                 deadline, reporter(progress, "goodness of fit", gof_bootstrap))
     notes = [f"{'discrete' if discrete else 'continuous'} maximum likelihood on {n_tail} of {x.size} sizes"]
     cut = alphas.size < n_bootstrap or n_gof < gof_bootstrap
     status = 1 if time.perf_counter() > deadline and cut else 0
