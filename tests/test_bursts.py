@@ -450,3 +450,23 @@ def test_progress_is_reported_and_checked(capsys):
     assert "broken-law bootstrap" in capsys.readouterr().err
     with pytest.raises(TypeError, match="progress must be callable"):
         fit_power_law(x, progress="yes")
+
+
+def test_min_gap_merges_close_bursts():
+    """Hypothesis: two triangles (height 2, base 0.4) cross the threshold 1 at 1.1, 1.3 and 1.6, 1.8 (a gap of
+    0.3 s): two bursts with min_gap 0.25, one with 0.35, lasting 0.7 s, its excess the parts' sum (0.1 each: the
+    gap is below the threshold), its energy the integral of the power from 1.1 to 1.8, gap included (quadrature
+    of numpy.interp, an independent interpolant), to 1e-10."""
+    t = np.array([0.0, 1.0, 1.2, 1.4, 1.5, 1.7, 1.9, 3.0])
+    p = np.array([0.0, 0.0, 2.0, 0.0, 0.0, 2.0, 0.0, 0.0])
+    two = burst_catalogue(t, p, threshold=1.0, min_gap=0.25)
+    one = burst_catalogue(t, p, threshold=1.0, min_gap=0.35)
+    assert len(two) == 2 and len(one) == 1
+    np.testing.assert_allclose(two.start, [1.1, 1.6], rtol=1e-12)
+    np.testing.assert_allclose(two.excess, [0.1, 0.1], rtol=1e-12)
+    np.testing.assert_allclose(one.duration, [0.7], rtol=1e-12)
+    np.testing.assert_allclose(one.excess, [0.2], rtol=1e-12)
+    ref = integrate.quad(lambda s: np.interp(s, t, p), 1.1, 1.8, points=[1.2, 1.4, 1.5, 1.7], epsabs=1e-14)[0]
+    np.testing.assert_allclose(one.energy, [ref], rtol=1e-10)
+    with pytest.raises(ValueError, match="min_gap"):
+        burst_catalogue(t, p, threshold=1.0, min_gap=-1.0)

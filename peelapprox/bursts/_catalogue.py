@@ -13,7 +13,8 @@ jump with the sampling grid's phase.  Per burst:
 * ``peak``, ``t_peak`` — the largest sample and its time;
 * ``waiting`` — from the previous burst's end to this one's start (one fewer entry; the first burst has none).
 
-Integrals are exact for the interpolant (trapezoids, a triangle at each crossing).  A burst already under way at
+Integrals are exact for the interpolant (trapezoids, a triangle at each crossing).  With ``min_gap``, bursts
+separated by less than it are merged into one (an acoustic-emission "hit definition time").  A burst already under way at
 the first sample or still under way at the last is cut by the record: it is dropped and counted
 (``n_dropped``).
 """
@@ -26,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import choice, finite, reals, shown, times
+from .._checks import choice, finite, nonnegative, reals, shown, times
 from ..io import fmt_number, optional_import, write_rows
 
 __all__ = ["BURST_COLUMNS", "BurstCatalogue", "burst_catalogue"]
@@ -171,12 +172,32 @@ class BurstCatalogue:
         return f"BurstCatalogue({len(self)} bursts, columns {list(self._columns())}{th}, dropped {self.n_dropped})"
 
 
-def _crossing(t0: float, t1: float, p0: float, p1: float, h: float) -> float:
-    """Where the segment from (t0, p0) to (t1, p1) crosses the level h."""
+def _crossing(t0: np.ndarray, t1: np.ndarray, p0: np.ndarray, p1: np.ndarray, h: float) -> np.ndarray:
+    """Where the segments from (t0, p0) to (t1, p1) cross the level h."""
     return t0 + (h - p0) / (p1 - p0) * (t1 - t0)
 
 
-def burst_catalogue(t: Any, power: Any, *, threshold: float) -> BurstCatalogue:
+def _integral(t: np.ndarray, p: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """∫_{t[0]}^{at} of the piecewise-linear interpolant of p, at each time of ``at`` (within [t[0], t[-1]])."""
+    cum = np.r_[0.0, np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))]
+    i = np.clip(np.searchsorted(t, at, side="right") - 1, 0, t.size - 2)
+    frac = (at - t[i]) / (t[i + 1] - t[i])
+    p_at = p[i] + frac * (p[i + 1] - p[i])
+    return cum[i] + 0.5 * (p[i] + p_at) * (at - t[i])
+
+
+def _excess_cumulative(t: np.ndarray, p: np.ndarray, h: float) -> np.ndarray:
+    """``C[k]`` = ∫ max(p - h, 0) dt over the first k segments of the interpolant (a triangle at a crossing)."""
+    e0, e1 = p[:-1] - h, p[1:] - h
+    dt = np.diff(t)
+    both = (e0 >= 0) & (e1 >= 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        part = np.where(e0 > 0, e0, e1) ** 2 / (2.0 * np.abs(e1 - e0)) * dt  # the triangle above h at a crossing
+    seg = np.where(both, 0.5 * (e0 + e1) * dt, np.where((e0 > 0) | (e1 > 0), part, 0.0))
+    return np.r_[0.0, np.cumsum(seg)]
+
+
+def burst_catalogue(t: Any, power: Any, *, threshold: float, min_gap: float = 0.0) -> BurstCatalogue:
     """The bursts of a sampled power (module docstring of ``peelapprox/bursts/_catalogue.py``).
 
     Parameters
@@ -184,9 +205,13 @@ def burst_catalogue(t: Any, power: Any, *, threshold: float) -> BurstCatalogue:
     t : array_like
         Sample times [s], strictly increasing, at least 2.
     power : array_like
-        The power at each time (an acoustic-emission power, a dissipation rate, any signal >= 0 or not): finite.
+        The power at each time (an acoustic-emission power, a dissipation rate, any finite signal).
     threshold : float
         The level a burst exceeds (finite).
+    min_gap : float
+        Bursts separated by less than this [s] are one burst (an acoustic-emission "hit definition time"): its
+        energy is the integral of the power over the whole of it, gaps included; its excess the sum of its
+        parts' (the gaps are below the threshold); 0 (the default): every crossing pair is a burst.
 
     Returns
     -------
@@ -197,7 +222,7 @@ def burst_catalogue(t: Any, power: Any, *, threshold: float) -> BurstCatalogue:
     ------
     ValueError
         Times not strictly increasing or not finite, power not finite or of another length, fewer than 2
-        samples, a threshold that is not finite.
+        samples, a threshold that is not finite, a negative min_gap.
     """
     t = times("t", t, lo=-math.inf)
     p = reals("power", power)
@@ -206,6 +231,7 @@ def burst_catalogue(t: Any, power: Any, *, threshold: float) -> BurstCatalogue:
     if t.size < 2:
         raise ValueError(f"t and power must have at least 2 samples, got {t.size}")
     h = finite("threshold", threshold)
+    min_gap = nonnegative("min_gap", min_gap)
     above = p > h
     edges = np.diff(above.astype(np.int8))
     ups = np.flatnonzero(edges == 1) + 1  # first sample above
@@ -214,27 +240,23 @@ def burst_catalogue(t: Any, power: Any, *, threshold: float) -> BurstCatalogue:
     if above[0]:
         downs = downs[1:]
     ups = ups[: downs.size]
-    # each segment's excess integral on the interpolant, the part above h only
-    e0, e1 = p[:-1] - h, p[1:] - h
-    dt = np.diff(t)
-    both = (e0 >= 0) & (e1 >= 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        part = np.where(e0 > 0, e0, e1) ** 2 / (2.0 * np.abs(e1 - e0)) * dt  # the triangle above h at a crossing
-        frac = np.where(e0 > 0, e0, e1) / np.abs(e1 - e0)  # the share of the segment above h
-    seg_excess = np.where(both, 0.5 * (e0 + e1) * dt, np.where((e0 > 0) | (e1 > 0), part, 0.0))
-    seg_len = np.where(both, dt, np.where((e0 > 0) | (e1 > 0), frac * dt, 0.0))
-    cum_ex = np.r_[0.0, np.cumsum(seg_excess)]
-    cum_len = np.r_[0.0, np.cumsum(seg_len)]
+    start = _crossing(t[ups - 1], t[ups], p[ups - 1], p[ups], h)
+    end = _crossing(t[downs - 1], t[downs], p[downs - 1], p[downs], h)
+    if min_gap > 0 and ups.size > 1:
+        keep = np.r_[True, start[1:] - end[:-1] >= min_gap]  # a burst that starts a merged one
+        last = np.r_[keep[1:], True]  # a burst that ends one
+        ups, start = ups[keep], start[keep]
+        downs, end = downs[last], end[last]
+    cum_ex = _excess_cumulative(t, p, h)
     n = ups.size
-    start, end, peak, tpk = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    peak, tpk = np.empty(n), np.empty(n)
     for k in range(n):
-        i, j = int(ups[k]), int(downs[k])  # samples i..j-1 above; segments i-1..j-1 touch the burst
-        start[k] = _crossing(t[i - 1], t[i], p[i - 1], p[i], h)
-        end[k] = _crossing(t[j - 1], t[j], p[j - 1], p[j], h)
+        i, j = int(ups[k]), int(downs[k])  # samples i..j-1 above (and any gaps between merged parts)
         m = i + int(np.argmax(p[i:j]))
         peak[k], tpk[k] = p[m], t[m]
     excess = cum_ex[downs] - cum_ex[ups - 1]
-    length = cum_len[downs] - cum_len[ups - 1]
-    return BurstCatalogue(start=start, end=end, duration=end - start, energy=excess + h * length, excess=excess,
+    energy = _integral(t, p, end) - _integral(t, p, start)
+    gap = f", bursts closer than {fmt_number(min_gap, 3)} s merged" if min_gap > 0 else ""
+    return BurstCatalogue(start=start, end=end, duration=end - start, energy=energy, excess=excess,
                           peak=peak, t_peak=tpk, threshold=h, n_dropped=dropped,
-                          source=f"burst_catalogue: threshold {fmt_number(h, 6)}, {t.size} samples")
+                          source=f"burst_catalogue: threshold {fmt_number(h, 6)}, {t.size} samples{gap}")
