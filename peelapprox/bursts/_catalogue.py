@@ -14,8 +14,8 @@ jump with the sampling grid's phase.  Per burst:
 * ``waiting`` — from the previous burst's end to this one's start (one fewer entry; the first burst has none).
 
 Integrals are exact for the interpolant (trapezoids, a triangle at each crossing).  With ``min_gap``, bursts
-separated by less than it are merged into one (an acoustic-emission "hit definition time").  A burst already under way at
-the first sample or still under way at the last is cut by the record: it is dropped and counted
+separated by less than it are merged into one (an acoustic-emission "hit definition time").  A burst already
+under way at the first sample or still under way at the last is cut by the record: it is dropped and counted
 (``n_dropped``).
 """
 

@@ -332,6 +332,9 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
     if status:
         notes.append(f"max_wall = {max_wall:g} s reached: {alphas.size} of {n_bootstrap} bootstrap and {n_gof} of "
                      f"{gof_bootstrap} goodness-of-fit replicates done")
+    if not status and alphas.size < n_bootstrap:
+        notes.append(f"{n_bootstrap - alphas.size} of {n_bootstrap} bootstrap replicates had no fit (no tail of "
+                     f"min_tail = {min_tail} sizes) and are left out")
     enough = alphas.size >= MIN_BOOTSTRAP
     if n_bootstrap and not enough:
         notes.append(f"no intervals: {alphas.size} bootstrap replicates, fewer than {MIN_BOOTSTRAP}")
