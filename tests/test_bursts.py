@@ -470,3 +470,20 @@ def test_min_gap_merges_close_bursts():
     np.testing.assert_allclose(one.energy, [ref], rtol=1e-10)
     with pytest.raises(ValueError, match="min_gap"):
         burst_catalogue(t, p, threshold=1.0, min_gap=-1.0)
+
+
+def test_catalogue_to_fit_recovers_the_energy_exponent():
+    """Hypothesis: a power series of 5000 separated triangular pulses (base 1 s, peak 2E, so energy E) with E
+    drawn from a Pareto law of exponent 1.8 (scipy.stats.pareto, b = 0.8) gives, through burst_catalogue at
+    threshold 0 and fit_power_law at xmin = 1, the drawn energies (the interpolant is the signal: 1e-9
+    relative) and alpha within 0.05 of 1.8 (≈ 4 standard errors of 0.011; the pipeline end to end)."""
+    E = stats.pareto(b=0.8).rvs(5000, random_state=np.random.default_rng(21))
+    t0 = 2.0 * np.arange(E.size)
+    t = np.column_stack((t0, t0 + 0.5, t0 + 1.0)).ravel()
+    p = np.column_stack((np.zeros_like(E), 2 * E, np.zeros_like(E))).ravel()
+    t, p = np.r_[t, t[-1] + 1.0], np.r_[p, 0.0]
+    cat = burst_catalogue(t, p, threshold=0.0)
+    assert len(cat) == E.size
+    np.testing.assert_allclose(cat.energy, E, rtol=1e-9)
+    fit = fit_power_law(cat.sizes("energy"), xmin=1.0, n_bootstrap=0)
+    assert abs(fit.alpha - 1.8) < 0.05, fit
