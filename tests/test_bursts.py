@@ -487,3 +487,19 @@ def test_catalogue_to_fit_recovers_the_energy_exponent():
     np.testing.assert_allclose(cat.energy, E, rtol=1e-9)
     fit = fit_power_law(cat.sizes("energy"), xmin=1.0, n_bootstrap=0)
     assert abs(fit.alpha - 1.8) < 0.05, fit
+
+
+@settings(max_examples=15, deadline=None, derandomize=True)
+@given(st.lists(st.floats(min_value=1e-3, max_value=1e6, allow_nan=False), min_size=20, max_size=200),
+       st.sampled_from([None, 2.0]))
+def test_fuzz_comparisons_are_finite(sizes, xmax_factor):
+    """Hypothesis: for any fit that succeeds (xmax none or twice the largest size), each comparison gives a
+    finite R, normalized and a p-value in [0, 1] (categorical; 15 derandomised examples)."""
+    xmax = None if xmax_factor is None else xmax_factor * max(sizes)
+    try:
+        fit = fit_power_law(sizes, xmax=xmax, n_bootstrap=0, min_tail=10)
+    except ValueError:
+        return
+    for alt in ("lognormal", "exponential", "truncated_power_law"):
+        r = compare_power_law(fit, alt)
+        assert math.isfinite(r.R) and math.isfinite(r.normalized) and 0.0 <= r.p_value <= 1.0, (alt, r)
