@@ -503,3 +503,23 @@ def test_fuzz_comparisons_are_finite(sizes, xmax_factor):
     for alt in ("lognormal", "exponential", "truncated_power_law"):
         r = compare_power_law(fit, alt)
         assert math.isfinite(r.R) and math.isfinite(r.normalized) and 0.0 <= r.p_value <= 1.0, (alt, r)
+
+
+def test_discrete_comparisons():
+    """Hypothesis: a discrete fit is compared with the discrete alternatives.  On 3000 geometric draws
+    (scipy.stats.geom, p = 0.3) the exponential (geometric) law wins, its λ the closed form ln(1 + 1/mean(k - 1))
+    = -ln(1 - p̂) (1e-12) and R within 1e-3 relative of the powerlaw package's (its λ is numerical); on zipf(2.3)
+    draws at xmin = 2 the power law beats the exponential (p < 0.01) and the truncated law's λ is below 1e-3 (no
+    cut-off)."""
+    g = stats.geom(0.3).rvs(3000, random_state=np.random.default_rng(4)).astype(float)
+    fit = fit_power_law(g, discrete=True, xmin=1.0, n_bootstrap=0)
+    e = fit.compare("exponential")
+    assert e.favoured == "exponential"
+    assert abs(e.params["lambda"] - math.log1p(1.0 / np.mean(g - 1))) < 1e-12
+    powerlaw = pytest.importorskip("powerlaw")
+    R, _ = powerlaw.Fit(g, discrete=True, xmin=1, verbose=0).distribution_compare("power_law", "exponential")
+    assert abs(e.R - R) < 1e-3 * abs(R)
+    k = stats.zipf(2.3).rvs(3000, random_state=np.random.default_rng(3)).astype(float)
+    fz = fit_power_law(k, discrete=True, xmin=2.0, n_bootstrap=0)
+    assert fz.compare("exponential").favoured == "power_law" and fz.compare("exponential").p_value < 0.01
+    assert fz.compare("truncated_power_law").params["lambda"] < 1e-3

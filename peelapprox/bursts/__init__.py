@@ -9,7 +9,7 @@ The modules (private: the public names are offered by :mod:`peelapprox`):
   the bounded KS scan for xmin;
 * ``_fit`` — :func:`fit_power_law` and :class:`PowerLawFit` (bootstrap intervals, goodness of fit);
 * ``_alternatives`` — :func:`compare_power_law` and :class:`LikelihoodRatio` (lognormal, exponential, truncated
-  power law; Vuong's test, the nested χ̄² test);
+  power law; Vuong's test, the nested χ̄² test); ``_discrete`` — the same laws on the integers, for a discrete fit;
 * ``_broken`` — :func:`fit_broken_power_law` and :class:`BrokenPowerLawFit` (two regimes against one).
 
 The chapter is ``docs/bursts.md``.

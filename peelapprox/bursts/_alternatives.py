@@ -2,7 +2,7 @@
 :class:`LikelihoodRatio` (Clauset, Shalizi & Newman 2009, Sec. 5 and Appendix C).
 
 Each alternative is fitted by maximum likelihood to the tail ``[xmin, xmax]`` the power law was fitted to,
-normalised on it (continuous sizes):
+normalised on it (continuous sizes; a discrete fit gets the same laws on the integers, ``_discrete``):
 
 * ``exponential`` — ``p ∝ exp(-λ x)``;
 * ``lognormal`` — ``p ∝ exp(-(ln x - μ)² / 2σ²) / x`` (μ searched within ±50 of ln xmin, σ in [0.01, 100]:
@@ -186,7 +186,8 @@ def compare_power_law(fit: Any, alternative: str) -> LikelihoodRatio:
     Parameters
     ----------
     fit : PowerLawFit
-        A continuous power-law fit (:func:`peelapprox.fit_power_law`).
+        A power-law fit (:func:`peelapprox.fit_power_law`); a discrete one is compared with the alternatives'
+        discrete forms on the integers.
     alternative : str
         One of :data:`ALTERNATIVES`.
 
@@ -197,12 +198,15 @@ def compare_power_law(fit: Any, alternative: str) -> LikelihoodRatio:
     Raises
     ------
     ValueError
-        An unknown alternative, or a discrete fit (the alternatives are continuous laws).
+        An unknown alternative.
+    TypeError
+        ``fit`` not a :class:`PowerLawFit`.
     """
     alternative = choice("alternative", alternative, ALTERNATIVES)
-    if getattr(fit, "discrete", None) is not False:
-        raise ValueError("fit must be a continuous PowerLawFit (discrete=False): the alternatives are continuous "
-                         "laws")
+    if not isinstance(getattr(fit, "discrete", None), bool) or not hasattr(fit, "tail"):
+        raise TypeError(f"fit must be a PowerLawFit (peelapprox.fit_power_law), got {type(fit).__name__}")
+    if fit.discrete:
+        return _discrete_ratio(fit, alternative)
     y = fit.tail / fit.xmin  # scaled: ln p(x) = ln p(y) - ln xmin for every law, so R does not change
     ymax = math.inf if fit.xmax is None else fit.xmax / fit.xmin
     ll_pl = fit.logpdf(fit.tail) + math.log(fit.xmin)
@@ -215,6 +219,23 @@ def compare_power_law(fit: Any, alternative: str) -> LikelihoodRatio:
     else:
         ll_alt, params, note = _truncated(y, ymax, fit.alpha)
         params = {"alpha": params["alpha"], "lambda": params["lambda"] / fit.xmin}
+    return _ratio(alternative, ll_pl, ll_alt, params, note, -y.size * math.log(fit.xmin))
+
+
+def _discrete_ratio(fit: Any, alternative: str) -> LikelihoodRatio:
+    """:func:`compare_power_law` for a discrete fit: the alternatives on the integers (``_discrete``)."""
+    from ._discrete import discrete_alternative
+
+    k = fit.tail
+    kmax = math.inf if fit.xmax is None else float(fit.xmax)
+    ll_alt, params, note = discrete_alternative(k, int(fit.xmin), kmax, alternative, fit.alpha)
+    return _ratio(alternative, fit.logpdf(k), ll_alt, params, note, 0.0)
+
+
+def _ratio(alternative: str, ll_pl: np.ndarray, ll_alt: np.ndarray, params: dict, note: str, shift: float
+           ) -> LikelihoodRatio:
+    """The test of the pointwise log-likelihoods (module docstring); ``shift`` turns scaled log-likelihoods into
+    the sizes' own (``-n ln xmin``)."""
     if alternative == "truncated_power_law":
         R = float(np.sum(ll_pl - ll_alt))
         stat = max(-2.0 * R, 0.0)  # the alternative's maximum is at least the power law's (nested)
@@ -228,6 +249,5 @@ def compare_power_law(fit: Any, alternative: str) -> LikelihoodRatio:
         favoured = "neither" if p >= SIGNIFICANCE else ("power_law" if R > 0 else alternative)
     return LikelihoodRatio(alternative=alternative, R=R, normalized=float(z), p_value=float(p), test=test,
                            favoured=favoured, params={k: float(v) for k, v in params.items()},
-                           loglik_power_law=float(np.sum(ll_pl) - y.size * math.log(fit.xmin)),
-                           loglik_alternative=float(np.sum(ll_alt) - y.size * math.log(fit.xmin)),
-                           n=int(y.size), message=note)
+                           loglik_power_law=float(np.sum(ll_pl) + shift),
+                           loglik_alternative=float(np.sum(ll_alt) + shift), n=int(ll_pl.size), message=note)
