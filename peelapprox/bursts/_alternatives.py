@@ -126,16 +126,28 @@ def _lognormal(y: np.ndarray, ymax: float) -> tuple[np.ndarray, dict, str]:
     ly = np.log(y)
     lmax = math.log(ymax) if math.isfinite(ymax) else math.inf
 
+    def log_mass(mu: float, sig: float) -> float:
+        """ln P(0 <= ln y <= ln ymax) of the normal law of ln y, from the side where it does not round to 1."""
+        z0, z1 = (0.0 - mu) / sig, (lmax - mu) / sig
+        if not math.isfinite(z1):
+            return float(stats.norm.logsf(z0))
+        if z0 > 0:
+            top, d = float(stats.norm.logsf(z0)), float(stats.norm.logsf(z1) - stats.norm.logsf(z0))
+        else:
+            top, d = float(stats.norm.logcdf(z1)), float(stats.norm.logcdf(z0) - stats.norm.logcdf(z1))
+        return top + math.log(-math.expm1(d)) if d < 0 else -math.inf
+
     def logp(p: np.ndarray) -> np.ndarray:
         mu, sig = float(p[0]), math.exp(float(p[1]))
-        z0, z1 = (0.0 - mu) / sig, (lmax - mu) / sig
-        lo = stats.norm.logsf(z0)
-        norm = lo if not math.isfinite(z1) else lo + math.log(-math.expm1(stats.norm.logsf(z1) - lo))
-        return -ly - math.log(sig) - 0.5 * math.log(2 * math.pi) - 0.5 * ((ly - mu) / sig) ** 2 - norm
+        return -ly - math.log(sig) - 0.5 * math.log(2 * math.pi) - 0.5 * ((ly - mu) / sig) ** 2 - log_mass(mu, sig)
+
+    def nll(p: np.ndarray) -> float:
+        v = -float(np.sum(logp(p)))
+        return v if math.isfinite(v) else 1e300  # a mass that rounds to 0: never the maximum
 
     start = np.array([float(np.mean(ly)), math.log(max(float(np.std(ly)), 0.05))])
     bounds = [(-50.0, 50.0), (math.log(0.01), math.log(100.0))]
-    res = optimize.minimize(lambda p: -float(np.sum(logp(p))), start, method="L-BFGS-B", bounds=bounds)
+    res = optimize.minimize(nll, start, method="L-BFGS-B", bounds=bounds)
     p = res.x
     on_bound = any(abs(p[i] - b) < 1e-6 for i in range(2) for b in bounds[i])
     return logp(p), {"mu": float(p[0]), "sigma": math.exp(float(p[1]))}, (
