@@ -75,6 +75,19 @@ from ._series import ForceSeries, Spectrum
 from ._series_lyapunov import SeriesLyapunov, SurrogateTest
 from ._slips import Slips
 from ._version import __version__ as __version__
+from .bursts import (
+    ALTERNATIVES,
+    BURST_COLUMNS,
+    MAX_XMIN_CANDIDATES,
+    BrokenPowerLawFit,
+    BurstCatalogue,
+    LikelihoodRatio,
+    PowerLawFit,
+    burst_catalogue,
+    compare_power_law,
+    fit_broken_power_law,
+    fit_power_law,
+)
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from .front import FrontParams, FrontPattern, TransverseModes, front_pattern, transverse_growth_rates
 from .law import (
@@ -180,6 +193,18 @@ __all__ = [
     "approximate_attractor",
     "ApproximateAttractor",
     "ApproximationWarning",
+    # burst catalogues and their power-law statistics (any power series or measured catalogue)
+    "burst_catalogue",
+    "BurstCatalogue",
+    "BURST_COLUMNS",
+    "fit_power_law",
+    "PowerLawFit",
+    "MAX_XMIN_CANDIDATES",
+    "compare_power_law",
+    "LikelihoodRatio",
+    "ALTERNATIVES",
+    "fit_broken_power_law",
+    "BrokenPowerLawFit",
     # dynamics of the exact solution: they live in exact, imported from it on first access
     "attractors",
     "Attractor",

@@ -38,6 +38,8 @@ API = {
         "ApproximateAttractor", "ApproximationWarning",
         "Slips", "Spectrum", "SeriesLyapunov", "SurrogateTest",
         "FrontParams", "FrontPattern", "TransverseModes", "front_pattern", "transverse_growth_rates",
+        "burst_catalogue", "BurstCatalogue", "BURST_COLUMNS", "fit_power_law", "PowerLawFit", "MAX_XMIN_CANDIDATES",
+        "compare_power_law", "LikelihoodRatio", "ALTERNATIVES", "fit_broken_power_law", "BrokenPowerLawFit",
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
@@ -69,7 +71,7 @@ API = {
     "peelapprox.plotting": {"TRAJECTORY_CYCLES", "cell_edges", "new_figure", "plot_bifurcation", "plot_front",
                             "plot_phase_diagram",
                             "plot_segment", "plot_trajectory", "pyplot", "save_figure", "trajectory_window",
-                            "TrajectoryWindow", "TRAJECTORY_PANELS", "MAX_BRANCHES"},
+                            "plot_burst_distribution", "TrajectoryWindow", "TRAJECTORY_PANELS", "MAX_BRANCHES"},
     "comparisons.atlas": {
         "atlas", "AtlasResult", "load_atlas", "APPROXIMATIONS", "register_approximation", "OBSERVABLES", "DEFAULTS",
         "TOLERANCE", "estimate_observables", "plot_error_map", "plot_dynamics_map", "plot_segment_maps",

@@ -12,10 +12,12 @@ check (``peelapprox.cli._checks``) only asks it, lazily too, which image formats
 
 The modules: ``_figure`` (figures, axes, the writer, titles), ``_trajectory`` (a run in time and in the v–F
 plane), ``_segment`` (a reduced branch solution), ``_phase_diagram`` (a sweep over (V, I)) and
-``_bifurcation`` (orbit diagrams and branches), ``_front`` (the peel front in space and time).
+``_bifurcation`` (orbit diagrams and branches), ``_front`` (the peel front in space and time), ``_bursts`` (a
+burst-size distribution with its fits).
 """
 
 from ._bifurcation import MAX_BRANCHES, plot_bifurcation
+from ._bursts import plot_burst_distribution
 from ._figure import new_figure, pyplot, save_figure
 from ._front import plot_front
 from ._phase_diagram import cell_edges, plot_phase_diagram
@@ -23,6 +25,5 @@ from ._segment import plot_segment
 from ._trajectory import TRAJECTORY_CYCLES, TRAJECTORY_PANELS, TrajectoryWindow, plot_trajectory, trajectory_window
 
 __all__ = ["MAX_BRANCHES", "TRAJECTORY_CYCLES", "TRAJECTORY_PANELS", "TrajectoryWindow", "cell_edges", "new_figure",
-           "plot_bifurcation", "plot_front", "plot_phase_diagram", "plot_segment", "plot_trajectory", "pyplot",
-           "save_figure",
-           "trajectory_window"]
+           "plot_bifurcation", "plot_burst_distribution", "plot_front", "plot_phase_diagram", "plot_segment",
+           "plot_trajectory", "pyplot", "save_figure", "trajectory_window"]
