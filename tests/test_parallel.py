@@ -193,3 +193,27 @@ def test_keyboard_interrupt_stops_workers(tmp_path):
             os.killpg(proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
+
+
+def test_diagram_and_attractors_identical_on_every_pool_kind():
+    """Hypothesis: an orbit diagram over V (breakdowns, aperiodic, periodic and steady values) and the
+    attractors of two parameter points are the same, bit for bit, in this process, on threads and on loky
+    processes: each value or start is one independent run, put back in order.  Exact equality (module
+    docstring): the return maps' bytes and the Attractor records' reprs (floats as round-trip reprs)."""
+    import exact
+    from peelapprox import PeelParams
+
+    def diagram(kind):
+        d = exact.orbit_diagram(PeelParams(V=1.0, I=1e-4), "V", [0.3, 1.5, 4.0, 6.0], t_transient=5.0, window=5.0,
+                                executor=kind, max_workers=None if kind == "serial" else 2)
+        return d.labels, [r.tobytes() for r in d.returns]
+
+    def atts(kind):
+        return repr(exact.attractors(PeelParams(V=1.0, I=1e-5), (-0.3, 0.0, 0.3), t_transient=5.0, window=5.0,
+                                     executor=kind, max_workers=None if kind == "serial" else 2))
+
+    ref = diagram("serial")
+    assert len(set(ref[0])) >= 3
+    assert diagram("threads") == ref and diagram("processes") == ref
+    ref = atts("serial")
+    assert "Attractor(" in ref and atts("threads") == ref and atts("processes") == ref

@@ -1,7 +1,8 @@
 """Grid throughput per worker count for every pool kind, measured in one run on the machine it runs on.
 
     python -m comparisons.benchmark.scaling [--grid atlas|sweep] [--I 1e-6:1e-1:4:log] [--V 0.2:5:4]
-        [--workers 1,2] [--kinds threads,processes,dask] [--t-transient 30] [--window 10] [--out FILE.csv|.json]
+        [--workers 1,2] [--kinds threads,processes,dask] [--t-transient 30] [--window 10] [--repeat 3]
+        [--out FILE.csv|.json]
 
 The same grid runs on each pool (:mod:`peelapprox.parallel`: ``threads``, ``processes`` — loky's reusable process
 pool — and a dask ``LocalCluster`` of single-threaded worker processes when dask.distributed is installed) with
@@ -9,9 +10,13 @@ each worker count, each into its own temporary directory: an atlas (``comparison
 of every point) or a sweep of the ``period`` measure.  Before the timed runs, one untimed point in this
 process compiles or loads the kernels, and each pool is started and warmed with one untimed point per worker
 (its "warm-up" column: a reusable pool pays the start once per session).  Each row gives the wall
-time, the throughput (points/s), the speed-up over the same kind's one worker and the efficiency
+time (the best of ``--repeat`` runs, the least disturbed by other jobs, and their median), the throughput
+(points/s, of the best run), the speed-up over the same kind's one worker and the efficiency
 (throughput / (workers x one worker's throughput): the issue's target is at least 0.75), the throughput
-relative to the thread pool with as many workers, and whether its records equal the first run's (bitwise:
+relative to the thread pool with as many workers, the CPU time of this process and its workers during the best
+run (``cores used`` = CPU time / wall time: on a machine shared with other jobs a pool of N workers may get far
+fewer than N cores, which then, not the pool, bounds its speed-up; CPU s/point is the work per point, what a
+pool's overhead would raise), and whether its records equal the first run's (bitwise:
 every field of every record).  The load average before and after is printed with the table: on a shared
 machine the figures are only as quiet as it was.
 """
@@ -22,6 +27,7 @@ import argparse
 import contextlib
 import json
 import os
+import statistics
 import sys
 import tempfile
 import time
@@ -37,6 +43,28 @@ __all__ = ["KINDS", "main", "measure"]
 
 #: The pool kinds measured: the two local pools and a dask LocalCluster.
 KINDS = ("threads", "processes", "dask")
+
+
+def _cpu_seconds() -> float:
+    """CPU time [s] of this process (all its threads) and of its live child processes (a pool's workers), from
+    ``/proc`` (NaN where there is none: not Linux).  A pool's work is then measured even when the machine's
+    other jobs decide its wall time."""
+    try:
+        tick = os.sysconf("SC_CLK_TCK")
+        pid = os.getpid()
+        with open(f"/proc/{pid}/task/{pid}/children") as fh:
+            pids = [pid, *(int(c) for c in fh.read().split())]
+        total = 0.0
+        for p in pids:
+            try:
+                with open(f"/proc/{p}/stat") as fh:
+                    fields = fh.read().rsplit(")", 1)[1].split()
+            except FileNotFoundError:  # a child that has just exited
+                continue
+            total += (int(fields[11]) + int(fields[12])) / tick  # utime, stime
+        return total
+    except (OSError, ValueError, AttributeError):
+        return float("nan")
 
 
 def _records(res: Any) -> list[str]:
@@ -68,9 +96,10 @@ def _pool(kind: str, n: int) -> Iterator[tuple[Any, int | None]]:
 
 
 def measure(grid: str, I_values: Sequence[float], V_values: Sequence[float], workers: Sequence[int],
-            kinds: Sequence[str], *, t_transient: float = 30.0, window: float = 10.0,
+            kinds: Sequence[str], *, t_transient: float = 30.0, window: float = 10.0, repeat: int = 3,
             progress: bool = True) -> list[dict]:
-    """The rows of the table (module docstring): one per (kind, workers), in that order."""
+    """The rows of the table (module docstring): one per (kind, workers), in that order; ``wall_s`` the best
+    of ``repeat`` runs (the least disturbed by other jobs), ``wall_median_s`` their median."""
     opts = {"t_transient": t_transient, "window": window}
     n_points = len(I_values) * len(V_values)
     rows: list[dict] = []
@@ -87,31 +116,42 @@ def measure(grid: str, I_values: Sequence[float], V_values: Sequence[float], wor
                     _run(grid, I_values[:1], V_values[:max(1, min(n, len(V_values)))], f"{tmp}/w_{tag}", ex, mw,
                          opts)
                     start = time.perf_counter() - t0
-                    t0 = time.perf_counter()
-                    res = _run(grid, I_values, V_values, f"{tmp}/{tag}", ex, mw, opts)
-                    wall = time.perf_counter() - t0
-                recs = _records(res)
-                first = recs if first is None else first
+                    walls, same = [], True
+                    cpus: list[float] = []
+                    for r in range(repeat):
+                        c0, t0 = _cpu_seconds(), time.perf_counter()
+                        res = _run(grid, I_values, V_values, f"{tmp}/{tag}_{r}", ex, mw, opts)
+                        walls.append(time.perf_counter() - t0)
+                        cpus.append(_cpu_seconds() - c0)
+                        recs = _records(res)
+                        first = recs if first is None else first
+                        same = same and recs == first
+                best = min(range(repeat), key=walls.__getitem__)
+                wall, cpu = walls[best], cpus[best]
                 rate = n_points / wall
                 one.setdefault(kind, rate if n == min(workers) else float("nan"))
                 if kind == "threads":
                     threads[n] = rate
                 base = one[kind] * n / min(workers)
                 rows.append({"kind": kind, "workers": n, "points": n_points, "warmup_s": start, "wall_s": wall,
-                             "points_per_s": rate, "speedup": rate / one[kind], "efficiency": rate / base,
+                             "wall_median_s": statistics.median(walls), "repeats": repeat, "points_per_s": rate,
+                             "speedup": rate / one[kind], "efficiency": rate / base,
                              "vs_threads": rate / threads[n] if n in threads else None,
-                             "records_equal": recs == first})
+                             "cpu_s": cpu, "cores_used": cpu / wall, "cpu_s_per_point": cpu / n_points,
+                             "records_equal": same})
                 if progress:
                     print(f"{kind} x{n}: {wall:.2f} s ({rate:.3g} points/s)", file=sys.stderr, flush=True)
     return rows
 
 
 def _markdown(rows: list[dict]) -> str:
-    head = ("| pool | workers | warm-up [s] | wall [s] | points/s | speed-up | efficiency | vs threads | "
-            "records equal |\n|---|---|---|---|---|---|---|---|---|")
+    head = ("| pool | workers | warm-up [s] | best wall [s] | median wall [s] | points/s | speed-up | efficiency | "
+            "vs threads | cores used | CPU s/point | records equal |\n" + "|---" * 12 + "|")
     body = [f"| {r['kind']} | {r['workers']} | {fmt_number(r['warmup_s'], 3)} | {fmt_number(r['wall_s'], 3)} | "
+            f"{fmt_number(r['wall_median_s'], 3)} | "
             f"{fmt_number(r['points_per_s'], 3)} | {fmt_number(r['speedup'], 3)} | {fmt_number(r['efficiency'], 3)} "
-            f"| {fmt_number(r['vs_threads'], 3, missing='')} | {r['records_equal']} |" for r in rows]
+            f"| {fmt_number(r['vs_threads'], 3, missing='')} | {fmt_number(r['cores_used'], 3)} | "
+            f"{fmt_number(r['cpu_s_per_point'], 3)} | {r['records_equal']} |" for r in rows]
     return "\n".join([head, *body])
 
 
@@ -128,6 +168,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="comma-separated pool kinds among threads, processes, dask (dask skipped if not installed)")
     ap.add_argument("--t-transient", type=float, default=30.0, help="transient of each exact run [s] (30)")
     ap.add_argument("--window", type=float, default=10.0, help="measured window of each exact run [s] (10)")
+    ap.add_argument("--repeat", type=int, default=3, help="timed runs per pool and worker count; the best counts (3)")
     ap.add_argument("--out", default=None, help="also write the rows to FILE.csv or FILE.json")
     args = ap.parse_args(argv)
     I_values, V_values = parse_grid(args.I, name="--I"), parse_grid(args.V, name="--V")
@@ -150,7 +191,10 @@ def main(argv: list[str] | None = None) -> int:
                   file=sys.stderr)
             kinds.remove("dask")
     load0 = os.getloadavg()
-    rows = measure(args.grid, I_values, V_values, workers, kinds, t_transient=args.t_transient, window=args.window)
+    if args.repeat < 1:
+        ap.error("--repeat must be >= 1")
+    rows = measure(args.grid, I_values, V_values, workers, kinds, t_transient=args.t_transient, window=args.window,
+                   repeat=args.repeat)
     load1 = os.getloadavg()
     print(f"{args.grid} {args.I} x {args.V} ({len(I_values) * len(V_values)} points), t_transient "
           f"{args.t_transient:g} s + window {args.window:g} s; {cpus} CPUs; load average (1, 5, 15 min) before "
