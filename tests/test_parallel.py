@@ -217,3 +217,21 @@ def test_diagram_and_attractors_identical_on_every_pool_kind():
     assert diagram("threads") == ref and diagram("processes") == ref
     ref = atts("serial")
     assert "Attractor(" in ref and atts("threads") == ref and atts("processes") == ref
+
+
+def test_scaling_benchmark_writes_its_table(tmp_path, capsys):
+    """The scaling benchmark's smallest run (2 points, threads with 1 and 2 workers, one repeat): one row per
+    worker count in the printed table and in the CSV, the records equal across them, the ratios consistent
+    (the speed-up is the throughput over the 1-worker throughput: equal to 1e-12 relative, float division)."""
+    import csv
+
+    from comparisons.benchmark.scaling import main
+
+    out = tmp_path / "scaling.csv"
+    assert main(["--grid", "sweep", "--I", "1e-3:1e-2:1:log", "--V", "1:2:2", "--workers", "1,2", "--kinds",
+                 "threads", "--t-transient", "1", "--window", "1", "--repeat", "1", "--out", str(out)]) == 0
+    assert capsys.readouterr().out.count("| threads |") == 2
+    rows = list(csv.DictReader(out.open()))
+    assert [int(r["workers"]) for r in rows] == [1, 2] and all(r["records_equal"] == "True" for r in rows)
+    r1, r2 = (float(r["points_per_s"]) for r in rows)
+    assert abs(float(rows[1]["speedup"]) - r2 / r1) <= 1e-12 * r2 / r1
