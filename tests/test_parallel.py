@@ -99,6 +99,32 @@ def test_worker_death_is_a_named_loss_not_a_hang():
     assert out == {0: 0, 1: 1, 2: 2, 3: 3} and lost == []
 
 
+def _kill_in_worker_at_small_I(params, options):
+    """A sweep measure that kills its worker process at I < 1e-4 (in a pool's worker only)."""
+    if params.I < 1e-4 and os.environ.get("PEELAPPROX_WORKER") == "1":
+        os.kill(os.getpid(), signal.SIGKILL)
+    return {"I_seen": params.I}
+
+
+def test_sweep_names_a_dead_worker(tmp_path):
+    """Hypothesis: a sweep whose worker dies (SIGKILL in a measure) raises a RuntimeError naming loky's
+    TerminatedWorkerError and the lost point, within a bounded time (120 s: a hang would never return), and the
+    same sweep in this process then computes every point.  The value is I itself (exact)."""
+    from comparisons.sweep import MEASURES, register_measure
+
+    register_measure("tmp_killer", _kill_in_worker_at_small_I, replace=True)
+    try:
+        t0 = time.monotonic()
+        with pytest.raises(RuntimeError, match=r"lost by the executor.*TerminatedWorkerError"):
+            sweep([1e-5, 1e-3], [1.0], "tmp_killer", out=tmp_path / "sw", executor="processes", max_workers=2,
+                  progress=False)
+        assert time.monotonic() - t0 < 120
+        res = sweep([1e-5, 1e-3], [1.0], "tmp_killer", out=tmp_path / "sw", executor="serial", progress=False)
+        assert res.complete and sorted(r["tmp_killer_I_seen"] for r in res.records) == [1e-5, 1e-3]
+    finally:
+        MEASURES.pop("tmp_killer", None)
+
+
 def test_blas_limited_and_no_nested_pools_in_workers():
     """Hypothesis: every process worker runs its BLAS/OpenMP pools with one thread (the environment set before
     it imported numpy; threadpoolctl reads the libraries' own counts) and its ``"auto"`` pool is serial (no
