@@ -9,7 +9,9 @@ pool — and a dask ``LocalCluster`` of single-threaded worker processes when da
 each worker count, each into its own temporary directory: an atlas (``comparisons.atlas.atlas``, every measure
 of every point) or a sweep of the ``period`` measure.  Before the timed runs, one untimed point in this
 process compiles or loads the kernels, and each pool is started and warmed with one untimed point per worker
-(its "warm-up" column: a reusable pool pays the start once per session).  Each row gives the wall
+(its "warm-up" column: a reusable pool pays the start once per session); then, for each worker count, the kinds'
+runs alternate (threads, processes, dask, threads, ...), so that a change of the machine's load during the
+measurement falls on every kind alike.  Each row gives the wall
 time (the best of ``--repeat`` runs, the least disturbed by other jobs, and their median), the throughput
 (points/s, of the best run), the speed-up over the same kind's one worker and the efficiency
 (throughput / (workers x one worker's throughput): the issue's target is at least 0.75), the throughput
@@ -98,49 +100,56 @@ def _pool(kind: str, n: int) -> Iterator[tuple[Any, int | None]]:
 def measure(grid: str, I_values: Sequence[float], V_values: Sequence[float], workers: Sequence[int],
             kinds: Sequence[str], *, t_transient: float = 30.0, window: float = 10.0, repeat: int = 3,
             progress: bool = True) -> list[dict]:
-    """The rows of the table (module docstring): one per (kind, workers), in that order; ``wall_s`` the best
-    of ``repeat`` runs (the least disturbed by other jobs), ``wall_median_s`` their median."""
+    """The rows of the table (module docstring): one per (kind, workers), kinds first; ``wall_s`` the best of
+    ``repeat`` runs (the least disturbed by other jobs), ``wall_median_s`` their median.  For each worker count
+    the kinds' runs alternate (threads, processes, dask, threads, ...), so that a change of the machine's load
+    during the measurement falls on every kind alike."""
     opts = {"t_transient": t_transient, "window": window}
     n_points = len(I_values) * len(V_values)
-    rows: list[dict] = []
     first: list[str] | None = None
-    one: dict[str, float] = {}
-    threads: dict[int, float] = {}
-    with tempfile.TemporaryDirectory() as tmp:
+    got: dict[tuple[str, int], dict] = {}
+    with tempfile.TemporaryDirectory() as tmp, contextlib.ExitStack() as stack:
         _run(grid, I_values[:1], V_values[:1], f"{tmp}/warm", "serial", None, opts)
-        for kind in kinds:
-            for n in workers:
-                tag = f"{kind}_{n}"
+        for n in workers:
+            pools: dict[str, tuple[Any, int | None]] = {}
+            for kind in kinds:  # started and warmed, untimed: one point per worker
                 t0 = time.perf_counter()
-                with _pool(kind, n) as (ex, mw):  # started and warmed, untimed: one point per worker
-                    _run(grid, I_values[:1], V_values[:max(1, min(n, len(V_values)))], f"{tmp}/w_{tag}", ex, mw,
-                         opts)
-                    start = time.perf_counter() - t0
-                    walls, same = [], True
-                    cpus: list[float] = []
-                    for r in range(repeat):
-                        c0, t0 = _cpu_seconds(), time.perf_counter()
-                        res = _run(grid, I_values, V_values, f"{tmp}/{tag}_{r}", ex, mw, opts)
-                        walls.append(time.perf_counter() - t0)
-                        cpus.append(_cpu_seconds() - c0)
-                        recs = _records(res)
-                        first = recs if first is None else first
-                        same = same and recs == first
-                best = min(range(repeat), key=walls.__getitem__)
-                wall, cpu = walls[best], cpus[best]
-                rate = n_points / wall
-                one.setdefault(kind, rate if n == min(workers) else float("nan"))
-                if kind == "threads":
-                    threads[n] = rate
-                base = one[kind] * n / min(workers)
-                rows.append({"kind": kind, "workers": n, "points": n_points, "warmup_s": start, "wall_s": wall,
-                             "wall_median_s": statistics.median(walls), "repeats": repeat, "points_per_s": rate,
-                             "speedup": rate / one[kind], "efficiency": rate / base,
-                             "vs_threads": rate / threads[n] if n in threads else None,
-                             "cpu_s": cpu, "cores_used": cpu / wall, "cpu_s_per_point": cpu / n_points,
-                             "records_equal": same})
-                if progress:
-                    print(f"{kind} x{n}: {wall:.2f} s ({rate:.3g} points/s)", file=sys.stderr, flush=True)
+                pools[kind] = stack.enter_context(_pool(kind, n))
+                _run(grid, I_values[:1], V_values[:max(1, min(n, len(V_values)))], f"{tmp}/w_{kind}_{n}",
+                     *pools[kind], opts)
+                got[kind, n] = {"warmup_s": time.perf_counter() - t0, "walls": [], "cpus": [], "same": True}
+            for r in range(repeat):
+                for kind in kinds:
+                    g = got[kind, n]
+                    c0, t0 = _cpu_seconds(), time.perf_counter()
+                    res = _run(grid, I_values, V_values, f"{tmp}/{kind}_{n}_{r}", *pools[kind], opts)
+                    g["walls"].append(time.perf_counter() - t0)
+                    g["cpus"].append(_cpu_seconds() - c0)
+                    recs = _records(res)
+                    first = recs if first is None else first
+                    g["same"] = g["same"] and recs == first
+                    if progress:
+                        print(f"{kind} x{n} run {r + 1}: {g['walls'][-1]:.2f} s", file=sys.stderr, flush=True)
+            stack.close()  # a dask cluster per worker count, closed once measured
+    return _rows(got, kinds, workers, n_points, repeat)
+
+
+def _rows(got: dict, kinds: Sequence[str], workers: Sequence[int], n_points: int, repeat: int) -> list[dict]:
+    rows = []
+    for kind in kinds:
+        for n in workers:
+            g = got[kind, n]
+            best = min(range(repeat), key=g["walls"].__getitem__)
+            wall, cpu = g["walls"][best], g["cpus"][best]
+            rate = n_points / wall
+            base = n_points / min(got[kind, workers[0]]["walls"])  # the smallest worker count's throughput
+            threads = n_points / min(got["threads", n]["walls"]) if "threads" in kinds else None
+            rows.append({"kind": kind, "workers": n, "points": n_points, "warmup_s": g["warmup_s"], "wall_s": wall,
+                         "wall_median_s": statistics.median(g["walls"]), "repeats": repeat, "points_per_s": rate,
+                         "speedup": rate / base, "efficiency": rate / (base * n / workers[0]),
+                         "vs_threads": None if threads is None else rate / threads,
+                         "cpu_s": cpu, "cores_used": cpu / wall, "cpu_s_per_point": cpu / n_points,
+                         "records_equal": g["same"]})
     return rows
 
 
