@@ -108,18 +108,29 @@ def _kill_in_worker_at_small_I(params, options):
 
 def test_sweep_names_a_dead_worker(tmp_path):
     """Hypothesis: a sweep whose worker dies (SIGKILL in a measure) raises a RuntimeError naming loky's
-    TerminatedWorkerError and the lost point, within a bounded time (120 s: a hang would never return), and the
-    same sweep in this process then computes every point.  The value is I itself (exact)."""
+    TerminatedWorkerError (among the lost tasks' errors, whichever point is named first), within a bounded time
+    (120 s: a hang would never return), and the same sweep in this process then computes every point.  The
+    value is I itself (exact)."""
     from comparisons.sweep import MEASURES, register_measure
 
     register_measure("tmp_killer", _kill_in_worker_at_small_I, replace=True)
     try:
         t0 = time.monotonic()
-        with pytest.raises(RuntimeError, match=r"lost by the executor.*TerminatedWorkerError"):
+        with pytest.raises(RuntimeError, match="lost by the executor") as err:
             sweep([1e-5, 1e-3], [1.0], "tmp_killer", out=tmp_path / "sw", executor="processes", max_workers=2,
                   progress=False)
+        assert "a worker process died (" in str(err.value) and "TerminatedWorkerError" in str(err.value), err.value
         assert time.monotonic() - t0 < 120
-        res = sweep([1e-5, 1e-3], [1.0], "tmp_killer", out=tmp_path / "sw", executor="serial", progress=False)
+        # the directory's lock may stay held a moment after the call (seen under load in the full file, not
+        # reproduced alone: a child between fork and exec holding the descriptor?): wait for it, 30 s at most
+        t1 = time.monotonic()
+        while True:
+            try:
+                res = sweep([1e-5, 1e-3], [1.0], "tmp_killer", out=tmp_path / "sw", executor="serial", progress=False)
+                break
+            except RuntimeError as exc:
+                assert "is in use" in str(exc) and time.monotonic() - t1 < 30, exc
+                time.sleep(0.5)
         assert res.complete and sorted(r["tmp_killer_I_seen"] for r in res.records) == [1e-5, 1e-3]
     finally:
         MEASURES.pop("tmp_killer", None)

@@ -276,8 +276,10 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress, dea
             budget="max_wall", limit=max_wall, t=0.0, state={"t": 0.0}, partial=_result(p))
     if lost:
         hint = ""
-        if executor == PROCESSES and any("BrokenProcessPool" in err or "TerminatedWorker" in err for _, err in lost):
-            hint = "; a worker process died (a crash, out of memory, killed) or could not start"
+        died = sorted({name for _, err in lost for name in ("TerminatedWorkerError", "BrokenProcessPool")
+                       if name in err})
+        if died:
+            hint = f"; a worker process died ({', '.join(died)}: a crash, out of memory, killed) or could not start"
         first = ", ".join(f"{n}={x}" for n, x in zip(("I", "V", "coef"), lost[0][0]))
         raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: {first}: "
                            f"{lost[0][1]}); {len(done)}/{total} points are in "
