@@ -39,7 +39,8 @@ from urllib.parse import urlparse
 
 #: The public modules with an API page (docs/api/<module>.rst); tests/test_docs_api.py keeps it complete.
 API_MODULES = (
-    "peelapprox", "exact", "comparisons", "peelapprox.plotting", "peelapprox.io", "peelapprox.validate",
+    "peelapprox", "exact", "comparisons", "peelapprox.plotting", "peelapprox.io", "peelapprox.parallel",
+    "peelapprox.validate",
     "peelapprox.errors", "peelapprox.kernels", "peelapprox.cli", "comparisons.atlas", "comparisons.sweep",
     "comparisons.stress", "comparisons.benchmark", "comparisons.benchmark.peers",
 )

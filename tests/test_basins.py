@@ -164,7 +164,7 @@ def test_peelapprox_reexports():
     (dict(alpha0=[0.0], F0=[230.0], max_period=0), "max_period"),
     (dict(alpha0=[0.0], F0=[230.0], max_workers=-1), "max_workers"),
     (dict(alpha0=[0.0], F0=[230.0], max_workers=1.0), "max_workers"),
-    (dict(alpha0=[0.0], F0=[230.0], executor="serial"), "executor"),
+    (dict(alpha0=[0.0], F0=[230.0], executor="spawn"), "executor"),
     (dict(alpha0=[0.0], F0=[230.0], executor=ThreadPoolExecutor(1), max_workers=1), "max_workers"),
     (dict(alpha0=[0.0], F0=[230.0], orbits=1), "orbits"),
     (dict(alpha0=[0.0], F0=[230.0], progress="yes"), "progress"),

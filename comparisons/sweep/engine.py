@@ -5,6 +5,7 @@ wall-clock budget ``max_wall``."""
 from __future__ import annotations
 
 import datetime as _dt
+import math
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -17,10 +18,11 @@ import numpy as np
 from exact import DEFAULT_MAX_WALL
 from peelapprox import PARAM_RANGES, PeelForce, SolverBudgetExceeded
 from peelapprox.io import ProgressLine, jsonable
+from peelapprox.parallel import resolve_kind
 from peelapprox.validate import ArgumentTypeError, flag, integer, optional, positive
 from peelapprox.validate import path as _path
 
-from .._worker import PROCESSES, SERIAL, THREADS, run_tasks
+from .._worker import AUTO, PROCESSES, SERIAL, THREADS, run_tasks
 from .grid import check_grid_size, grid_length
 from .law import check_coef, check_force, manifest_fields
 from .measures import MEASURES, OPTION_CHECKS, measure_ref
@@ -85,12 +87,12 @@ def sweep(
         Names in :data:`MEASURES` (``"regime,jumps"`` is split at commas).
     out : path
         Output directory, created; its files: :mod:`comparisons.sweep.store`.
-    executor : None, "threads", "processes", "serial" or concurrent.futures.Executor
-        None or "threads": a local thread pool of ``max_workers`` threads (default: the CPUs; 0 runs in this
-        process, as ``"serial"``): the compiled kernels release the GIL, and a script or notebook needs no
-        ``__main__`` guard (measured faster than processes on 2 cores: ``comparisons._worker.THREADS``).
-        "processes": a local spawned process pool (a script then needs the guard).  Any Executor is used as is,
-        e.g. a dask client's.
+    executor : None, "auto", "threads", "processes", "serial" or concurrent.futures.Executor
+        A local pool of :mod:`peelapprox.parallel` of ``max_workers`` workers (default: the CPUs; 0 runs in this
+        process, as ``"serial"``): None or "auto" is processes on more than two CPUs and threads on one or two;
+        "threads" a thread pool (the compiled kernels release the GIL); "processes" loky's reusable process pool.
+        Either way a script or notebook needs no ``__main__`` guard.  Any Executor is used as is, e.g. a dask
+        client's.  The points are submitted the smallest I first (the longest runs), whatever the executor.
     options : mapping, optional
         JSON-serialisable settings passed to every measure (:mod:`comparisons.sweep.measures`).
     progress : bool or callable
@@ -155,23 +157,25 @@ def sweep(
                          "each point's measures what is left of it), not an option")
     _check_options(measures, options, force)
     max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
-    local = (None, THREADS, PROCESSES)
+    local = (None, AUTO, THREADS, PROCESSES)
     if max_workers is not None and not any(executor is x or executor == x for x in local):
         raise ValueError("max_workers applies only to the local pools (executor None, 'threads' or 'processes'); "
                          "size your executor instead")
-    if not (executor is None or (isinstance(executor, str) and executor in (SERIAL, THREADS, PROCESSES))
+    if not (executor is None or (isinstance(executor, str) and executor in (AUTO, SERIAL, THREADS, PROCESSES))
             or callable(getattr(executor, "submit", None))):
-        raise ValueError(f"executor must be None, 'threads', 'processes', 'serial' or a concurrent.futures.Executor, "
-                         f"got {executor!r}")
+        raise ValueError(f"executor must be None, 'auto', 'threads', 'processes', 'serial' or a "
+                         f"concurrent.futures.Executor, got {executor!r}")
     if not (isinstance(progress, bool) or progress is None or callable(progress)):
         raise ValueError("progress must be a bool, None or a callable (done, total, record)")
     resume = flag("resume", resume)
     retry_failed = flag("retry_failed", retry_failed)
     if max_workers == 0:
         executor = SERIAL
+    elif executor is None or executor == AUTO:
+        executor = resolve_kind(AUTO)  # processes on more than two CPUs, threads on two (peelapprox.parallel)
     refs = {name: measure_ref(MEASURES[name]) for name in measures}
     # in this process (serial, threads) the measures are the objects themselves; elsewhere import references
-    task_refs = refs if executor is None or executor in (SERIAL, THREADS) else worker_refs(measures)
+    task_refs = refs if executor in (SERIAL, THREADS) else worker_refs(measures)
 
     out = _path("out", out)
     if os.path.exists(out) and not os.path.isdir(out):
@@ -264,7 +268,8 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress, dea
                 report(len(done), total, rec)
 
         lost = run_tasks(run_point, [(key, _task(key, p, task_refs, deadline)) for key in todo], write,
-                         executor=executor, max_workers=max_workers, deadline=deadline)
+                         executor=executor, max_workers=max_workers, deadline=deadline,
+                         cost=[_point_cost(key) for key in todo])
     if deadline is not None and max_wall is not None and (cut or lost) and time.time() >= deadline:
         raise SolverBudgetExceeded(
             f"sweep: the wall-clock budget max_wall={max_wall:g} s was spent with {len(done)}/{total} points done "
@@ -273,9 +278,10 @@ def _sweep_locked(p: Plan, refs, task_refs, executor, max_workers, progress, dea
             budget="max_wall", limit=max_wall, t=0.0, state={"t": 0.0}, partial=_result(p))
     if lost:
         hint = ""
-        if executor == PROCESSES and any("BrokenProcessPool" in err for _, err in lost):
-            hint = ("; a worker process died (crash, out of memory, killed) or could not start: with the 'spawn' "
-                    "start method a script that calls sweep() must do so under `if __name__ == '__main__':`")
+        died = sorted({name for _, err in lost for name in ("TerminatedWorkerError", "BrokenProcessPool")
+                       if name in err})
+        if died:
+            hint = f"; a worker process died ({', '.join(died)}: a crash, out of memory, killed) or could not start"
         first = ", ".join(f"{n}={x}" for n, x in zip(("I", "V", "coef"), lost[0][0]))
         raise RuntimeError(f"{len(lost)} of {len(todo)} points were lost by the executor (first: {first}: "
                            f"{lost[0][1]}); {len(done)}/{total} points are in "
@@ -299,6 +305,13 @@ def _compile_law_here(force: PeelForce, deadline: float | None) -> None:
             kernels.expression_kernel(str(force.source))
     except kernels.BuildExpired:
         pass
+
+
+def _point_cost(key: tuple[float, ...]) -> float:
+    """A point's predicted relative cost, 1/sqrt(I): an exact run's steps follow the α oscillation, whose period
+    shrinks as sqrt(I) (docs/atlas.md, "Cost": the costliest points are at the smallest I).  Orders the tasks
+    (longest first, so that the tail does not idle the pool), never their values."""
+    return 1.0 / math.sqrt(key[0])
 
 
 def _task(key: tuple[float, ...], p: Plan, task_refs, deadline: float | None = None) -> tuple:

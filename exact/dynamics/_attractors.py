@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import functools
 import math
+import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +32,7 @@ from peelapprox import (
 )
 from peelapprox.errors import WallBudget
 from peelapprox.io import fmt_number
+from peelapprox.parallel import AUTO, DEADLINE_TEXT, POOL_KINDS, map_points
 from peelapprox.validate import duration, function, integer, optional, positive, state, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
@@ -204,6 +207,40 @@ class Attractor:
     settle_times: tuple[float | None, ...]
 
 
+def _start_outcome(params: PeelParams, a0: float, kw: dict, method: str | None, solver: str | None,
+                   period_rtol: float, deadline: float | None) -> dict:
+    """One start of :func:`attractors` as plain data (a pool's task; never raises for the run's outcome):
+    ``{"budget", "limit", "t", "message"}`` (a budget spent: the caller raises), ``{"error"}`` (a breakdown or an
+    infeasible start), or ``{"kind", "period", "label", "x", "settle"}``.  ``deadline``: the call's, a
+    ``time.time()``; a start that begins after it is not run, a running one gets what is left as its
+    ``max_wall``."""
+    left = None if deadline is None else deadline - time.time()
+    if left is not None and left <= 0:
+        return {"budget": "max_wall", "limit": None, "t": 0.0, "message": "spent before this start began"}
+    try:
+        initial_state(params, alpha0=a0)
+        tr = window_run(params, alpha0=a0, max_wall=left, method=method, solver=solver, **kw)
+    except SolverBudgetExceeded as exc:  # as data: the exception's keyword-only fields do not pickle
+        return {"budget": exc.budget, "limit": exc.limit, "t": exc.t, "message": str(exc)}
+    except (ModelBreakdown, ValueError) as exc:
+        return {"error": f"{type(exc).__name__}: {str(exc)[:80]}"}
+    per = classify(tr, period_rtol=period_rtol)
+    if per.kind == "no stick-slip":
+        return {"kind": per.kind}
+    return {"kind": per.kind, "period": per.period, "label": per.label, "x": return_map(tr),
+            "settle": settle_time(tr, rtol=period_rtol)}
+
+
+def _budget_error(out: dict, wall: WallBudget, t_end: float) -> SolverBudgetExceeded:
+    """The exception of a start whose budget was spent: the call's ``max_wall`` named as such, else the run's."""
+    if out["budget"] == "max_wall" and wall.limit is not None:
+        return SolverBudgetExceeded(f"more than {wall.limit:g} s of wall time (max_wall) at t={out['t']:.6g}; pass "
+                                    "a larger max_wall, or None", budget="max_wall", limit=wall.limit, t=out["t"],
+                                    state={"t": out["t"]}, partial=None)
+    return SolverBudgetExceeded(out["message"], budget=out["budget"], limit=out["limit"], t=out["t"],
+                                state={"t": out["t"]}, partial=None)
+
+
 def attractors(
     params: PeelParams,
     alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
@@ -217,6 +254,8 @@ def attractors(
     max_wall: float | None = DEFAULT_MAX_WALL,
     method: str | None = None,
     solver: str | None = None,
+    executor: str | Executor | None = None,
+    max_workers: int | None = None,
 ) -> list[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
@@ -242,12 +281,18 @@ def attractors(
     match_rtol : float
         Relative tolerance within which two periodic cycles are the same attractor, > 0.
     progress : callable, optional
-        Called as ``progress(message)`` before each start.
+        Called as ``progress(message)`` as each start finishes (in this process).
     max_wall : float or None
         Wall-clock budget [s] of all starts together (``SolverBudgetExceeded``, ``budget="max_wall"``; None:
         unbounded).
     method, solver : str, optional
         Of each start's :func:`window_run` (None: the model's method and its solver).
+    executor : {"auto", "threads", "processes", "serial"} or concurrent.futures.Executor, optional
+        Where the starts run: a local pool of :mod:`peelapprox.parallel` (None: ``"auto"``, processes on more
+        than two CPUs, threads on one or two), or any executor, used as is.  The starts are grouped in their
+        order whatever order they finish in: the result is the same, bit for bit, wherever they ran.
+    max_workers : int, optional
+        Of a local pool (default: the CPUs, at most one per start; 0: in this process).
 
     Returns
     -------
@@ -272,38 +317,45 @@ def attractors(
     alpha0s = [float(a) for a in np.atleast_1d(states_alpha("alpha0s", alpha0s))]
     say = optional(function, "progress", progress) or (lambda msg: None)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
+    max_workers = optional(integer, "max_workers", max_workers, 0)
+    if not (executor is None or executor in POOL_KINDS or callable(getattr(executor, "submit", None))):
+        raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
+                         f"{executor!r}")
+    deadline = None if wall.limit is None else time.time() + wall.limit - (time.perf_counter() - wall.t0)
+    tasks = [(k, (params, a0, kw, method, solver, period_rtol, deadline)) for k, a0 in enumerate(alpha0s)]
+    found: dict[int, dict] = {}
+
+    def put(k: int, out: dict) -> None:
+        say(f"attractors V={params.V:g} I={params.I:g}: alpha0={alpha0s[k]:g} done")
+        found[k] = out
+
+    lost = map_points(_start_outcome, tasks, put, pool=AUTO if executor is None else executor,
+                      max_workers=max_workers, deadline=deadline)
+    for k, text in lost:
+        found[k] = {"budget": "max_wall", "limit": wall.limit, "t": 0.0, "message": text} if text == DEADLINE_TEXT \
+            else {"error": text[:100]}
     groups: list[dict] = []
-    for a0 in alpha0s:
-        say(f"attractors V={params.V:g} I={params.I:g}: alpha0={a0:g}")
-        try:
-            s0 = initial_state(params, alpha0=a0)
-            tr = window_run(params, alpha0=a0, max_wall=wall.left(0.0, s0.__dict__, kw["t_transient"] + kw["window"]),
-                            method=method, solver=solver, **kw)
-        except SolverBudgetExceeded as exc:
-            raise wall.reraise(exc) from None
-        except (ModelBreakdown, ValueError) as exc:
-            groups.append(dict(label=f"{type(exc).__name__}: {str(exc)[:80]}", period=None, signature=(),
+    for k, a0 in enumerate(alpha0s):  # grouped in the order of the starts, wherever they ran
+        out = found[k]
+        if "budget" in out:
+            raise _budget_error(out, wall, kw["t_transient"] + kw["window"])
+        if "error" in out or out["kind"] == "no stick-slip":
+            groups.append(dict(label=out.get("error", "no stick-slip"), period=None, signature=(),
                                F_range=(math.nan, math.nan), starts=[a0], settle=[None]))
             continue
-        per = classify(tr, period_rtol=period_rtol)
-        x = return_map(tr)
-        if per.kind == "no stick-slip":
-            groups.append(dict(label=per.kind, period=None, signature=(), F_range=(math.nan, math.nan),
-                               starts=[a0], settle=[None]))
-            continue
-        if per.kind == "periodic":
-            sig = tuple(float(v) for v in np.sort(x[: per.period]))
+        x, st = out["x"], out["settle"]
+        if out["kind"] == "periodic":
+            sig = tuple(float(v) for v in np.sort(x[: out["period"]]))
         else:
             sig = (float(x.min()), float(x.max()), float(x.mean()))
-        st = settle_time(tr, rtol=period_rtol)
         for g in groups:
-            if g["period"] == per.period and g["label"] == per.label and len(g["signature"]) == len(sig) and \
+            if g["period"] == out["period"] and g["label"] == out["label"] and len(g["signature"]) == len(sig) and \
                     np.allclose(g["signature"], sig, rtol=match_rtol, atol=0.0):
                 g["starts"].append(a0)
                 g["settle"].append(st)
                 break
         else:
-            groups.append(dict(label=per.label, period=per.period, signature=sig,
+            groups.append(dict(label=out["label"], period=out["period"], signature=sig,
                                F_range=(float(x.min()), float(x.max())), starts=[a0], settle=[st]))
     return [Attractor(g["label"], g["period"], tuple(round(s, 6) for s in g["signature"]), g["F_range"],
                       tuple(float(a) for a in g["starts"]), tuple(g["settle"])) for g in groups]

@@ -5,7 +5,7 @@ Each start is one :func:`exact.simulate` run (``save="jumps"``) past a transient
 :func:`peelapprox.periodicity`.  Periodic starts are grouped into attractors: two starts reach the same
 attractor when their periods n agree and their sorted return-map cycles agree to :data:`MATCH_RTOL`
 relative (a cycle is the same set of jump forces whatever its phase).  The starts run in this process or on
-a process pool / any :class:`concurrent.futures.Executor` (as the (I, V) sweep of ``comparisons.sweep``);
+a pool of :mod:`peelapprox.parallel` or any :class:`concurrent.futures.Executor` (as the (I, V) sweep);
 the result does not depend on which, nor on the order in which the starts finish.
 
 Every call is bounded: a grid of at most :data:`MAX_BASIN_STARTS` starts (refused before any run) and a
@@ -27,6 +27,7 @@ import numpy as np
 from peelapprox import WINDOW_DEFAULTS, ModelBreakdown, PeelParams, SolverBudgetExceeded, SolverFailure
 from peelapprox.errors import WallBudget
 from peelapprox.io import fmt_number, jsonable
+from peelapprox.parallel import POOL_KINDS
 from peelapprox.validate import ArgumentTypeError, duration, flag, integer, optional, positive, states
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
@@ -296,7 +297,7 @@ def basins(
     rtol: float = WINDOW_DEFAULTS["rtol"],
     max_period: int = 32,
     orbits: bool = False,
-    executor: Executor | None = None,
+    executor: str | Executor | None = None,
     max_workers: int | None = None,
     progress: bool | Callable[[int, int, dict], None] | None = True,
     solver: str | None = None,
@@ -333,13 +334,13 @@ def basins(
     orbits : bool
         Also find each periodic attractor's :class:`exact.PeriodicOrbit` (:func:`exact.periodic_orbit` seeded
         by its first start's run, in this process): Floquet multipliers, stability.
-    executor : concurrent.futures.Executor, optional
-        Runs the starts (e.g. a dask ``Client.get_executor()``, or a ``ProcessPoolExecutor`` with the spawn
-        context), used as is and left running; the function shipped is
+    executor : {"auto", "threads", "processes", "serial"} or concurrent.futures.Executor, optional
+        A local pool of :mod:`peelapprox.parallel` (None: ``"auto"``, processes on more than two CPUs and
+        threads on one or two; a script needs no ``__main__`` guard either way), or an executor that runs the
+        starts (e.g. a dask ``Client.get_executor()``), used as is and left running; the function shipped is
         :func:`exact.dynamics._basins_run.run_start`, its arguments plain data (PeelParams pickles with its law).
     max_workers : int, optional
-        Without ``executor``: 0 runs in this process; n > 0 a local thread pool of n threads (the compiled
-        kernels release the GIL; a script needs no ``__main__`` guard); None (default) one thread per CPU
+        Of a local pool: 0 runs in this process; n > 0 a pool of n workers; None (default) one worker per CPU
         available, at most one per start.
     progress : bool or callable
         True: a line on stderr per ~5 % of the starts (and per failed start; one updating line in Jupyter); a
@@ -385,12 +386,17 @@ def basins(
     if orbits:
         paper_model_only(params, "basins(orbits=True) (exact.periodic_orbit)", "pass orbits=False")
     max_workers = optional(integer, "max_workers", max_workers, 0)
-    if executor is not None:
+    if isinstance(executor, str):
+        if executor not in POOL_KINDS:
+            raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
+                             f"{executor!r}")
+    elif executor is not None:
         if not callable(getattr(executor, "submit", None)):
-            raise ArgumentTypeError(f"executor must be None or a concurrent.futures.Executor, got {executor!r}")
+            raise ArgumentTypeError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, "
+                                    f"got {executor!r}")
         if max_workers is not None:
-            raise ValueError("max_workers applies only to the local thread pool (executor=None); size your "
-                             "executor instead")
+            raise ValueError("max_workers applies only to the local pools (executor None or a pool's name); size "
+                             "your executor instead")
     if not (progress is None or isinstance(progress, bool) or callable(progress)):
         raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")
     wall = WallBudget(optional(positive, "max_wall", max_wall))

@@ -11,16 +11,16 @@ cancels the starts not begun once it has passed.  Either way the start's outcome
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Callable
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, ThreadPoolExecutor, wait
+from concurrent.futures import Executor
 from typing import Any
 
 import numpy as np
 
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, SolverFailure, periodicity, return_map
 from peelapprox.io import ProgressLine
+from peelapprox.parallel import AUTO, DEADLINE_TEXT, map_points
 
 from .._initial import initial_state
 from .._simulate import simulate
@@ -103,52 +103,28 @@ def reporter(progress: Any, total: int) -> Callable[[int, dict], None]:
     return report
 
 
-def run_all(tasks: list[tuple], executor: Executor | None, max_workers: int | None,
+def run_all(tasks: list[tuple], executor: str | Executor | None, max_workers: int | None,
             report: Callable[[int, dict], None], deadline: float | None = None) -> list[dict]:
-    """Outcomes of ``run_start(*task, deadline)`` in task order, whatever order they finish in; once
-    ``deadline`` (a ``time.time()``) has passed, the starts not begun are cancelled (:data:`WALL_TEXT`)."""
+    """Outcomes of ``run_start(*task, deadline)`` in task order, whatever order they finish in, on
+    :func:`peelapprox.parallel.map_points` (``executor`` its ``pool``; None: ``"auto"``); once ``deadline`` (a
+    ``time.time()``) has passed, the starts not begun are cancelled (:data:`WALL_TEXT`), and a start the pool
+    lost (its worker died) is a failure naming the pool's error."""
     results: list[dict | None] = [None] * len(tasks)
-    if executor is None and max_workers == 0:
-        serial = []
-        for k, t in enumerate(tasks):
-            serial.append(run_start(*(*t, deadline)))
-            report(k + 1, serial[-1])
-        return serial
-    own = executor is None
-    if executor is None:
-        n = max_workers or (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-        # threads: the compiled kernels release the GIL, and no process re-imports the caller's script
-        executor = ThreadPoolExecutor(max_workers=max(1, min(n, len(tasks))), thread_name_prefix="peelapprox-basin")
-    futs: dict[Future, int] = {}
-    try:
-        for k, t in enumerate(tasks):
-            futs[executor.submit(run_start, *(*t, deadline))] = k
-        done, expired = 0, False
-        pending = set(futs)
-        while pending:
-            timeout = None if deadline is None or expired else max(0.0, deadline - time.time())
-            finished, pending = wait(pending, timeout=timeout, return_when=FIRST_COMPLETED)
-            if deadline is not None and not expired and time.time() >= deadline:
-                expired = True  # cancel the starts not begun; a running one ends by the deadline itself
-                cancelled = {fut for fut in pending if fut.cancel()}
-                pending -= cancelled
-                finished |= cancelled
-            for fut in finished:
-                k = futs.pop(fut)
-                if fut.cancelled():
-                    res = _wall_outcome("not run: the call's max_wall was spent before this start began")
-                else:
-                    try:
-                        res = fut.result()
-                    except Exception as exc:  # the executor lost the start (a worker died): recorded, not raised
-                        res = {"code": FAILURE, "text": f"failure:{type(exc).__name__}", "n": None, "cycle": (),
-                               "n_returns": 0, "message": f"the executor lost this start: {msg(exc)}"}
-                results[k] = res
-                done += 1
-                report(done, res)
-    finally:
-        for fut in futs:
-            fut.cancel()
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+    done = 0
+
+    def put(k: int, res: dict) -> None:
+        nonlocal done
+        results[k] = res
+        done += 1
+        report(done, res)
+
+    lost = map_points(run_start, [(k, (*t, deadline)) for k, t in enumerate(tasks)], put,
+                      pool=AUTO if executor is None else executor, max_workers=max_workers, deadline=deadline)
+    for k, text in sorted(lost, key=lambda kt: kt[0]):
+        if text == DEADLINE_TEXT:
+            put(k, _wall_outcome("not run: the call's max_wall was spent before this start began"))
+        else:  # "error: <Type>: <message>" (peelapprox.parallel.error_text)
+            kind = text.split(":")[1].strip() if text.startswith("error:") else "lost"
+            put(k, {"code": FAILURE, "text": f"failure:{kind}", "n": None, "cycle": (), "n_returns": 0,
+                    "message": f"the executor lost this start: {text[:300]}"})
     return results  # type: ignore[return-value]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +23,8 @@ import numpy as np
 from peelapprox import WINDOW_DEFAULTS, PeelParams, periodicity, return_map
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure, WallBudget
 from peelapprox.io import ProgressLine
-from peelapprox.validate import duration, function, optional, positive, reals
+from peelapprox.parallel import AUTO, DEADLINE_TEXT, POOL_KINDS, map_points
+from peelapprox.validate import duration, function, integer, optional, positive, reals
 from peelapprox.validate import params as _params
 
 from .._shared import DEFAULT_MAX_WALL
@@ -113,11 +115,36 @@ class OrbitDiagram:
         return html_table("OrbitDiagram", self._summary())
 
 
+def _diagram_value(p: PeelParams, t_transient: float, window: float, alpha0: float, rtol: float, method: str | None,
+                   solver: str | None, max_period: int, deadline: float | None) -> tuple[np.ndarray, str]:
+    """The return map and label of one value's run (a pool's task; never raises for the run's outcome).
+    ``deadline``: the diagram's, a ``time.time()``: a run that begins after it is not run
+    (``"budget:max_wall"``), a running one gets what is left of it as its ``max_wall``."""
+    from .._simulate import simulate
+
+    left = None if deadline is None else deadline - time.time()
+    if left is not None and left <= 0:
+        return np.zeros(0), "budget:max_wall"
+    try:
+        tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient,
+                      method=method, solver=solver if p.variant is not None else None, max_wall=left)
+        F = return_map(tr)
+        label = "no stick-slip" if F.size < 2 else periodicity(F, max_period=max_period).label
+    except ModelBreakdown as exc:
+        F, label = np.zeros(0), f"breakdown:{exc.reason}"
+    except SolverBudgetExceeded as exc:  # one value's budget, not the whole diagram (e.g. a tiny tape mass)
+        F, label = np.zeros(0), f"budget:{exc.budget}"
+    except SolverFailure:
+        F, label = np.zeros(0), "solver_failure"
+    return np.asarray(F, dtype=float), label
+
+
 def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | np.ndarray, *,
                   t_transient: float = WINDOW_DEFAULTS["t_transient"], window: float = WINDOW_DEFAULTS["window"],
                   rtol: float = WINDOW_DEFAULTS["rtol"], alpha0: float = 0.0, max_period: int = 32,
                   progress: bool | Callable[[int, int], None] = False, method: str | None = None,
-                  solver: str | None = None, max_wall: float | None = DEFAULT_MAX_WALL) -> OrbitDiagram:
+                  solver: str | None = None, max_wall: float | None = DEFAULT_MAX_WALL,
+                  executor: str | Executor | None = None, max_workers: int | None = None) -> OrbitDiagram:
     """The return map after ``t_transient`` over ``values`` of ``parameter`` (module docstring).
 
     Parameters
@@ -148,6 +175,12 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
         3600 s), passed on to each run as what is left of it.  When it is spent the diagram is returned as
         it stands, the rest of its values labelled ``"budget:max_wall"`` (a value whose run fails is a label, not
         an error, and so is the budget).
+    executor : {"auto", "threads", "processes", "serial"} or concurrent.futures.Executor, optional
+        Where the values run: a local pool of :mod:`peelapprox.parallel` (None: ``"auto"``, processes on more
+        than two CPUs, threads on one or two), or any executor (a dask client's), used as is.  The diagram is
+        the same, bit for bit, wherever its values ran.
+    max_workers : int, optional
+        Of a local pool (default: the CPUs; 0: in this process).
 
     Returns
     -------
@@ -159,8 +192,6 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     ValueError, TypeError
         A bad argument (named): more than :data:`MAX_DIAGRAM_VALUES` values, a value ``parameter`` cannot take.
     """
-    from .._simulate import simulate
-
     wall0 = time.perf_counter()
     params = _params("params", params)
     count = np.size(values) if isinstance(values, np.ndarray) else len(values) if hasattr(values, "__len__") else 0
@@ -178,42 +209,36 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     t_transient = duration("t_transient", t_transient, zero=True)
     window = duration("window", window)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
+    max_workers = optional(integer, "max_workers", max_workers, 0)
+    if isinstance(executor, str) and executor not in POOL_KINDS:
+        raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
+                         f"{executor!r}")
+    if not (executor is None or isinstance(executor, str) or callable(getattr(executor, "submit", None))):
+        raise TypeError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
+                        f"{executor!r}")
     report: Callable[[int, int], None] | None = None
     line = ProgressLine(f"orbit diagram over {parameter}", vals.size) if progress is True else None
     if line is None:
         report = optional(function, "progress", progress or None)
-    returns: list[np.ndarray] = []
-    labels: list[str] = []
-    for x in vals.ravel():
-        p = with_parameter(params, parameter, float(x))
-        try:
-            left = wall.left(0.0, {"t": 0.0}, t_transient + window)
-            tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient,
-                          method=method, solver=solver if p.variant is not None else None, max_wall=left)
-            F = return_map(tr)
-            if F.size < 2:
-                label = "no stick-slip"
-            else:
-                per = periodicity(F, max_period=max_period)
-                label = per.label
-        except ModelBreakdown as exc:
-            F, label = np.zeros(0), f"breakdown:{exc.reason}"
-        except SolverBudgetExceeded as exc:  # one value's budget, not the whole diagram (e.g. a tiny tape mass)
-            F, label = np.zeros(0), f"budget:{exc.budget}"
-        except SolverFailure:
-            F, label = np.zeros(0), "solver_failure"
-        returns.append(np.asarray(F, dtype=float))
-        labels.append(label)
-        if label == "budget:max_wall":  # the call's budget (each run's max_wall is what is left of it)
-            rest = vals.size - len(labels)
-            returns += [np.zeros(0)] * rest
-            labels += [label] * rest
+    flat = vals.ravel()
+    deadline = None if wall.limit is None else time.time() + wall.limit - (time.perf_counter() - wall.t0)
+    tasks = [(k, (with_parameter(params, parameter, float(x)), t_transient, window, alpha0, rtol, method, solver,
+                  max_period, deadline)) for k, x in enumerate(flat)]
+    found: dict[int, tuple[np.ndarray, str]] = {}
+
+    def put(k: int, value: tuple[np.ndarray, str]) -> None:
+        found[k] = value
         if line is not None:
-            line.update(len(labels), f"{parameter}={float(x):.6g} {label}")
+            line.update(len(found), f"{parameter}={float(flat[k]):.6g} {value[1]}")
         elif report is not None:
-            report(len(labels), vals.size)
-        if len(labels) == vals.size:
-            break
+            report(len(found), flat.size)
+
+    lost = map_points(_diagram_value, tasks, put, pool=AUTO if executor is None else executor,
+                      max_workers=max_workers, deadline=deadline)
+    for k, text in sorted(lost, key=lambda kt: kt[0]):  # not begun by the deadline, or the pool lost it
+        put(k, (np.zeros(0), "budget:max_wall" if text == DEADLINE_TEXT else "solver_failure"))
+    returns = [np.asarray(found[k][0], dtype=float) for k in range(flat.size)]
+    labels = [found[k][1] for k in range(flat.size)]
     return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
 
 

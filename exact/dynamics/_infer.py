@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,7 +33,8 @@ import numpy as np
 
 from peelapprox import PARAM_RANGES, ForceSeries, PeelParams
 from peelapprox.io import fmt_number, jsonable
-from peelapprox.validate import choice, positive
+from peelapprox.parallel import AUTO, POOL_KINDS, map_points
+from peelapprox.validate import choice, integer, optional, positive
 
 from ._infer_stats import OBSERVABLES, data_statistics, model_statistics
 
@@ -199,7 +201,8 @@ def _grid(names: list[str], x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, sear
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
           more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
           t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0,
-          progress: Callable[[str], None] | None = None) -> Inference:
+          progress: Callable[[str], None] | None = None, executor: str | Executor | None = None,
+          max_workers: int | None = None) -> Inference:
     """The model's parameters whose force traces read like the measured ones (module docstring).
 
     Parameters
@@ -226,7 +229,13 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     max_wall : float
         Wall-clock budget [s] (600): at its end the best point so far is returned with status ``"budget"``.
     progress : callable, optional
-        Called with a line of text after each model run.
+        Called with a line of text after each model run (the grid's once all of them are done).
+    executor : {"auto", "threads", "processes", "serial"} or concurrent.futures.Executor, optional
+        Where the search grid's runs go: a local pool of :mod:`peelapprox.parallel` (None: ``"auto"``,
+        processes on more than two CPUs, threads on one or two), or any executor, used as is; the least-squares
+        fits after it run here.  The result does not depend on it (the runs are recorded in grid order).
+    max_workers : int, optional
+        Of a local pool (default: the CPUs; 0: in this process).
 
     Returns
     -------
@@ -259,6 +268,10 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     if search <= 1.0:
         raise ValueError(f"search must be in (1, 100], got {search!r}")
     t_transient = positive("t_transient", t_transient, hi=1e4)
+    max_workers = optional(integer, "max_workers", max_workers, 0)
+    if not (executor is None or executor in POOL_KINDS or callable(getattr(executor, "submit", None))):
+        raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
+                         f"{executor!r}")
     data = [data_statistics(s) for s in all_series]
     notes = tuple(f"f_cycle is not fitted at V = {fmt_number(float(s.V), 4)} m/s: no line of a period-n cycle "
                   "stands out of its periodogram (a period-1 trace)"
@@ -279,29 +292,35 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     class _Spent(Exception):
         pass
 
-    def residuals(x: np.ndarray) -> np.ndarray:
-        left = max_wall - (time.perf_counter() - t_wall)
-        if left <= 0:
-            raise _Spent
-        out: list[np.ndarray] = []
-        models: list[np.ndarray | None] = []
-        for s, V, (vals, sig, threshold, noise, used) in zip(all_series, Vs, data):
-            m = model_statistics(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol, max(1.0, left))
-            use = sel[used[sel]]
-            out.append(np.full(use.size, _PENALTY) if m is None else ((m - vals) / sig)[use])
-            models.append(m)
-        res = np.concatenate(out)
+    def record(x: np.ndarray, res: np.ndarray, models: list) -> np.ndarray:
         evaluated.append((np.array(x), float(res @ res), models))
         if progress is not None:
             progress(f"infer: run {len(evaluated)}, chi2 = {fmt_number(evaluated[-1][1], 4)} at "
                      + ", ".join(f"{n} = {fmt_number(v, 5)}" for n, v in zip(names, _values(names, x))))
         return res
 
+    def residuals(x: np.ndarray) -> np.ndarray:
+        left = max_wall - (time.perf_counter() - t_wall)
+        if left <= 0:
+            raise _Spent
+        return record(x, *_residuals(params0, names, x, all_series, Vs, data, sel, t_transient, rtol, left))
+
     grid, box_lo, box_hi = _grid(names, x0, lo, hi, search, len(all_series))
     status, message, jac = "converged", "", None
     try:
-        for x in grid:
-            residuals(x)
+        # the grid's runs are independent: on the pool, then recorded in grid order (the fit's starts, its
+        # ties included, are those of a serial grid)
+        deadline = time.time() + max_wall - (time.perf_counter() - t_wall)
+        found: dict[int, tuple[np.ndarray, list] | None] = {}
+        map_points(_grid_point, [(k, (params0, names, x, all_series, Vs, data, sel, t_transient, rtol, deadline))
+                                 for k, x in enumerate(grid)], found.__setitem__,
+                   pool=AUTO if executor is None else executor, max_workers=max_workers, deadline=deadline)
+        for k, x in enumerate(grid):
+            value = found.get(k)
+            if value is not None:
+                record(x, *value)
+            else:  # not begun by the budget's end (_Spent here), or lost: run here, raising what a serial run would
+                residuals(x)
         best = None
         for start, _, _ in sorted(evaluated, key=lambda e: e[1])[:STARTS]:
             sol = least_squares(residuals, start, bounds=(box_lo, box_hi), diff_step=DIFF_STEP, max_nfev=100)
@@ -317,6 +336,32 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         status, message = "budget", f"max_wall = {fmt_number(max_wall, 3)} s spent; the best point so far"
     return _result(params0, names, sel, jac, evaluated, (box_lo, box_hi), data, Vs, status, message,
                    time.perf_counter() - t_wall, n_obs, notes)
+
+
+def _residuals(params0: PeelParams, names: list[str], x: np.ndarray, all_series: list, Vs: list[float],
+               data: list, sel: np.ndarray, t_transient: float, rtol: float, left: float
+               ) -> tuple[np.ndarray, list[np.ndarray | None]]:
+    """The weighted residuals of the model at ``x`` against every series' statistics, and the model's
+    statistics per series (None: no stick-slip), each run bounded by ``left`` seconds (at least 1)."""
+    out: list[np.ndarray] = []
+    models: list[np.ndarray | None] = []
+    for s, V, (vals, sig, threshold, noise, used) in zip(all_series, Vs, data):
+        m = model_statistics(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol, max(1.0, left))
+        use = sel[used[sel]]
+        out.append(np.full(use.size, _PENALTY) if m is None else ((m - vals) / sig)[use])
+        models.append(m)
+    return np.concatenate(out), models
+
+
+def _grid_point(params0: PeelParams, names: list[str], x: np.ndarray, all_series: list, Vs: list[float],
+                data: list, sel: np.ndarray, t_transient: float, rtol: float, deadline: float
+                ) -> tuple[np.ndarray, list[np.ndarray | None]] | None:
+    """:func:`_residuals` at a grid point as a pool's task; None when the call's ``deadline`` (a
+    ``time.time()``) passed before it began."""
+    left = deadline - time.time()
+    if left <= 0:
+        return None
+    return _residuals(params0, names, x, all_series, Vs, data, sel, t_transient, rtol, left)
 
 
 def _values(names: list[str], x: np.ndarray) -> list[float]:

@@ -311,12 +311,22 @@ MESSAGE_LIMIT = 2000
 
 
 
-def add_pool_options(parser: argparse.ArgumentParser) -> None:
-    """``--workers``, ``--dask-local`` and ``--dask-scheduler`` (mutually exclusive) of a grid command (sweep,
-    atlas), which :func:`worker_pool` reads."""
-    where = parser.add_mutually_exclusive_group()
+#: ``--pool``'s help: what each local pool is, and the default (peelapprox.parallel).
+POOL_HELP = ("local pool: 'processes' (loky's reusable process pool: tasks by cloudpickle, one BLAS thread per "
+             "worker), 'threads', or 'auto' (default: processes on more than 2 CPUs, threads on 1-2; the "
+             "environment variable PEELAPPROX_POOL overrides it)")
+
+
+def add_pool_options(parser: argparse.ArgumentParser, *, dask: bool = True) -> None:
+    """``--pool``, and ``--workers``, ``--dask-local`` and ``--dask-scheduler`` (mutually exclusive) of a grid
+    command (sweep, atlas; basins without the dask options), which :func:`worker_pool` reads."""
+    parser.add_argument("--pool", choices=("auto", "threads", "processes"), default="auto", help=POOL_HELP)
+    where = parser.add_mutually_exclusive_group() if dask else parser
     where.add_argument("--workers", type=nonnegative_int, default=None, metavar="N",
-                       help="local worker threads (default: all CPUs; 0: in this process)")
+                       help="local workers, processes or threads as --pool says (default: all CPUs; 0: in this "
+                            "process)")
+    if not dask:
+        return
     where.add_argument("--dask-local", type=positive_int, default=None, metavar="N",
                        help="start a dask LocalCluster with N single-threaded worker processes")
     where.add_argument("--dask-scheduler", default=None, metavar="ADDR",
@@ -324,8 +334,9 @@ def add_pool_options(parser: argparse.ArgumentParser) -> None:
 
 @contextlib.contextmanager
 def worker_pool(args: argparse.Namespace) -> Iterator[tuple[Any, int | None]]:
-    """``(executor, max_workers)`` of a grid command's ``--workers``, ``--dask-local`` and ``--dask-scheduler``
-    (sweep, atlas): a dask client's executor, or None and ``--workers`` (0: in this process); the dask client
+    """``(executor, max_workers)`` of a grid command's ``--pool``, ``--workers``, ``--dask-local`` and
+    ``--dask-scheduler`` (sweep, atlas): a dask client's executor, or ``--pool`` (a pool of
+    :mod:`peelapprox.parallel`) and ``--workers`` (0: in this process); the dask client
     and local cluster are closed on exit.
 
     Raises
@@ -334,7 +345,7 @@ def worker_pool(args: argparse.Namespace) -> Iterator[tuple[Any, int | None]]:
         A dask option without dask.distributed installed.
     """
     if not (args.dask_local or args.dask_scheduler):
-        yield None, args.workers
+        yield getattr(args, "pool", None), args.workers
         return
     try:
         from distributed import Client, LocalCluster

@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import WINDOW_DEFAULTS
 from ..io import write_csv
-from ._checks import check_output_path, grid_range, nonnegative_float, nonnegative_int, positive_float
+from ._checks import add_pool_options, check_output_path, grid_range, nonnegative_float, positive_float
 from ._common import (
     FORMATS,
     HYBRID_ONLY,
@@ -49,8 +49,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sp.add_argument("--t-transient", type=nonnegative_float, default=w["t_transient"],
                     help="time discarded per start [s]")
     sp.add_argument("--window", type=positive_float, default=w["window"], help="time classified per start [s]")
-    sp.add_argument("--workers", type=nonnegative_int, default=None,
-                    help="processes (default: one per CPU; 0: in this process)")
+    add_pool_options(sp, dask=False)
     sp.add_argument("--orbits", action="store_true",
                     help="also find each attractor's periodic orbit and its Floquet multipliers")
     sp.add_argument("--format", choices=FORMATS, default="table",
@@ -83,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
     values = np.linspace(*v_spec)
     axes = dict(F0=values, omega0=None) if name == "F0" else dict(F0=None, omega0=values)
     r = basins(p, alpha0=a, F0=axes["F0"], omega0=axes["omega0"], t_transient=args.t_transient,
-               window=args.window, orbits=args.orbits, max_workers=args.workers, progress=True,
+               window=args.window, orbits=args.orbits, executor=args.pool, max_workers=args.workers,
+               progress=True,
                max_wall=args.max_wall)
     if args.format == "json":
         print(r.to_json())
