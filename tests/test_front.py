@@ -355,7 +355,8 @@ def test_front_bursts_are_the_catalogue_of_the_ae_power():
     column is compared bitwise (tolerance 0), for the default threshold (0.05 × max R_AE, stated in the docstring)
     and an explicit one with min_gap.  Independent check: each burst's energy (the trapezoid of the stored samples
     on [start, end]) against the exact state E_AE interpolated at start and end; with dt_save = 1e-5 s, far below
-    a burst's duration (>= 1e-4 s here), both are second-order accurate in dt_save, to 1 % of the energy."""
+    a burst's duration (>= 1e-4 s here), the trapezoid is second-order accurate in dt_save: measured 4.5e-6
+    relative, asserted to 1e-4 (a 20× margin that still fails if the samples and the state disagreed)."""
     from peelapprox import burst_catalogue
 
     tr = exact.simulate_front(_BURST_FP, 0.06, dt_save=1e-5, store_front=False)
@@ -369,7 +370,7 @@ def test_front_bursts_are_the_catalogue_of_the_ae_power():
             np.testing.assert_array_equal(getattr(mine, col), getattr(direct, col))
     assert np.all(cat.duration >= 1e-4)
     e_state = np.interp(cat.end, tr.t, tr.ae_energy) - np.interp(cat.start, tr.t, tr.ae_energy)
-    np.testing.assert_allclose(cat.energy, e_state, rtol=1e-2)
+    np.testing.assert_allclose(cat.energy, e_state, rtol=1e-4)
 
 
 def test_front_bursts_bad_threshold():
