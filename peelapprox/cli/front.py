@@ -22,7 +22,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     "(AE).  Prints the run's counters, the mean front's jumps, the strips' branch switches, the AE "
                     "energy and the pattern class (smooth, rugged, stuck-peeled); --out writes the time series "
                     "(t, alpha, omega, F, v, ae_power, ae_energy, fraction_peeling, roughness, domain_walls), "
-                    "--plot the space-time image of the front.",
+                    "--plot the space-time image of the front; --bursts the AE bursts' catalogue and a power-law fit "
+                    "of their energies (docs/bursts.md), --out then writing the catalogue.",
         examples=["peelapprox front --V 1 --I 1e-2 --tape-mass 1e-3 --N 64 --gamma 0.05 --delta0 0.01 --t-end 0.03 "
                   "--plot front.png",
                   "peelapprox front --V 1 --I 1e-2 --tape-mass 1e-3 --N 1 --t-end 0.1 --format json"])
