@@ -135,7 +135,8 @@ class FitResult:
 def check_points(v: Any, f: Any, *, need: int, what: str) -> tuple[np.ndarray, np.ndarray]:
     """``(v, f)`` as float arrays, or a ValueError/TypeError naming the argument and the first offending index.
 
-    1-D of equal length, at least ``need`` points (``what`` says why), finite, ``v > 0`` and strictly increasing.
+    1-D of equal length, at least ``need`` points (``what`` says why), finite, ``v > 0`` and strictly increasing,
+    ``f > 0`` (a peel force, as :meth:`peelapprox.PeelForce.tabulated` requires).
     """
     out = []
     for name, x in (("v", v), ("f", f)):
@@ -167,6 +168,10 @@ def check_points(v: Any, f: Any, *, need: int, what: str) -> tuple[np.ndarray, n
         why = "a duplicate" if va[i] == va[i + 1] else "unsorted"
         raise ValueError(f"v must be strictly increasing ({why}): v[{i}] = {float(va[i])!r} >= "
                          f"v[{i + 1}] = {float(va[i + 1])!r}")
+    bad = np.flatnonzero(fa <= 0)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"f must be > 0 (a peel force in N): f[{i}] = {float(fa[i])!r} at v = {float(va[i])!r}")
     return va, fa
 
 
