@@ -95,7 +95,9 @@ def add_force_options(sp: argparse.ArgumentParser) -> None:
                       help=f"a family (PeelForce.family): {', '.join(_family_names())}; coefficients by --coef")
     kind.add_argument("--force-fit", metavar="FILE.csv",
                       help="a family (--family) fitted to a measured curve (PeelForce.fit): the CSV of "
-                           "--force-table, one curve; units in the header (v [mm/s], f [kN]) are converted")
+                           "--force-table, one curve; units in the header (v [mm/s], f [kN]) are converted; an "
+                           "optional column sigma (f's standard deviation [N]) weights the fit; standard errors and "
+                           "chi2 are printed")
     g.add_argument("--family", metavar="NAME",
                    help=f"the family --force-fit fits: {', '.join(_family_names())}")
     g.add_argument("--smooth", action="store_true",
@@ -191,11 +193,12 @@ def read_force_table(path: str) -> PeelForce:
                          ) from None
 
 
-def _one_table(option: str, path: str) -> tuple[np.ndarray, np.ndarray, list]:
-    """``(v, f, tables)`` of the file of ``option``: one table (no V column, or one V)."""
+def _one_table(option: str, path: str, sigma: bool = False) -> tuple[np.ndarray, np.ndarray, list]:
+    """``(v, f, tables)`` of the file of ``option``: one table (no V column, or one V); with ``sigma``, a sigma
+    column is read too (``tables[0][4]``, None without one)."""
     from ..law._tablefile import read_points
 
-    tables = read_points(path, where=f"{option} {shown(path)}")
+    tables = read_points(path, where=f"{option} {shown(path)}", sigma=sigma)
     if len(tables) != 1:
         raise ValueError(f"{option} {shown(path)}: {len(tables)} tables (one per V); {option} takes one curve")
     return tables[0][1], tables[0][2], tables
@@ -215,12 +218,13 @@ def smoothed_table(path: str, lam: float | str = "gcv") -> PeelForce:
 
 def fitted_table(path: str, family: str) -> PeelForce:
     """``--force-fit FILE --family NAME``: :meth:`PeelForce.fit` of the family to the file's points (one curve;
-    a V column gives the V of a V-dependent family)."""
+    a V column gives the V of a V-dependent family; a ``sigma`` column, f's standard deviation [N], weights the
+    fit: chi^2 is then meaningful and the standard errors absolute)."""
     from ..law._tablefile import with_line
 
-    v, f, tables = _one_table("--force-fit", path)
+    v, f, tables = _one_table("--force-fit", path, sigma=True)
     try:
-        return PeelForce.fit(v, f, family, V=tables[0][0])
+        return PeelForce.fit(v, f, family, sigma=tables[0][4], V=tables[0][0])
     except (ValueError, TypeError) as exc:
         raise ValueError(f"--force-fit {shown(path)} --family {family}: {with_line(str(exc), tables)}") from None
 
@@ -228,10 +232,22 @@ def fitted_table(path: str, family: str) -> PeelForce:
 # --------------------------------------------------------------------------------------------- the record
 
 def law_fields(law: PeelForce, *, spec: bool = False) -> dict[str, Any]:
-    """What a result records of its law: ``law`` (``repr``), ``law_key`` (:attr:`PeelForce.key`) and, with
+    """What a result records of its law: ``law`` (``repr``), ``law_key`` (:attr:`PeelForce.key`), for a fitted
+    law (``--force-fit``) its statistics (``fit_weighted``: a sigma column was given; ``fit_stderr_<name>`` of each
+    fitted coefficient and of the folds; ``fit_chi2``, ``fit_dof``, ``fit_chi2_dof``; ``fit_folds_note`` where the
+    folds are not estimated) and, with
     ``spec=True`` (JSON), ``law_spec``: ``dataclasses.asdict(law)``, which :meth:`PeelForce.from_dict`
     rebuilds."""
     out: dict[str, Any] = {"law": repr(law), "law_key": law.key}
+    fr = law.fit_result
+    if fr is not None:  # a fitted law (--force-fit): its statistics
+        out["fit_weighted"] = fr.absolute_sigma
+        out.update({f"fit_stderr_{n}": fr.stderr[n] for n in fr.names})
+        out.update(fit_chi2=fr.chi2, fit_dof=fr.dof, fit_chi2_dof=fr.chi2_dof)
+        if fr.folds is not None:
+            out.update({f"fit_stderr_{k}": x for k, x in fr.folds.stderr.items()})
+        else:
+            out["fit_folds_note"] = fr.folds_note
     if spec:
         out["law_spec"] = dataclasses.asdict(law)
     return out

@@ -426,8 +426,12 @@ class PeelForce:
         ------
         ValueError
             If f' < 0 throughout (no stable slow branch), or the extrema are not exactly one maximum
-            followed by one minimum (the message lists those found), or V is out of range.
+            followed by one minimum (the message lists those found), or V is out of range; or a law made by
+            :meth:`fit` from points without a significant N shape (``fit_result.folds_note`` says why).
         """
+        refused = self.__dict__.get("_no_n_shape")
+        if refused:
+            raise ValueError(refused)
         cache = self.__dict__.get("_folds")
         if cache is None:
             cache = {}
