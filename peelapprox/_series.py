@@ -379,6 +379,31 @@ class ForceSeries:
         """The trace as plain JSON data."""
         return {"t": jsonable(self.t), "F": jsonable(self.F), "V": self.V, "source": self.source}
 
+    def to_csv(self, path: str) -> None:
+        """Write the trace as CSV, the header ``t [s],F [N]`` then one sample a row (17 significant digits: it
+        reads back bitwise with :meth:`from_csv`)."""
+        import os
+
+        with open(os.fspath(path), "w", encoding="utf-8", newline="") as fh:
+            fh.write("t [s],F [N]\n")
+            np.savetxt(fh, np.column_stack([self.t, self.F]), fmt="%.17g", delimiter=",")
+
+    def to_dataframe(self) -> Any:
+        """The trace as a :class:`pandas.DataFrame`, columns ``t`` [s] and ``F`` [N] (``df.attrs["units"]``,
+        ``df.attrs["V"]``, ``df.attrs["source"]``).
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        from .io import optional_import
+
+        pd = optional_import("pandas", "ForceSeries.to_dataframe")
+        df = pd.DataFrame({"t": np.array(self.t), "F": np.array(self.F)})
+        df.attrs.update(units={"t": "s", "F": "N"}, V=self.V, source=self.source)
+        return df
+
 
 class _SampleError(ValueError):
     """A bad sample of a trace, with its index (so a file reader can name its line)."""

@@ -121,6 +121,25 @@ class Slips:
                  "drop": float(self.drop[k]), "slip_time": float(self.slip_time[k]), "rise": float(self.rise[k]),
                  "stick_before": None if k == 0 else float(self.stick_time[k - 1])} for k in range(len(self))]
 
+    def to_dataframe(self) -> Any:
+        """:meth:`as_rows` as a :class:`pandas.DataFrame` (one row per slip; ``stick_before`` NaN for the first;
+        ``df.attrs["units"]``, ``threshold``, ``noise``, ``method``).
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        from .io import optional_import
+
+        pd = optional_import("pandas", "Slips.to_dataframe")
+        cols = ["t_start", "t_end", "F_before", "F_after", "drop", "slip_time", "rise", "stick_before"]
+        df = pd.DataFrame(self.as_rows(), columns=cols).astype(float)
+        units = {"t_start": "s", "t_end": "s", "F_before": "N", "F_after": "N", "drop": "N", "slip_time": "s",
+                 "rise": "N/s", "stick_before": "s"}
+        df.attrs.update(units=units, threshold=self.threshold, noise=self.noise, method=self.method)
+        return df
+
     def write(self, path: str) -> None:
         """Write :meth:`as_rows` as CSV or JSON by the file's extension (:func:`peelapprox.io.write_rows`)."""
         write_rows(path, self.as_rows())

@@ -37,7 +37,7 @@ from typing import Any
 
 from .._deadline import WallSpent, time_limit
 from .._version import __version__
-from . import atlas, basins, benchmark, compare, dynamics, estimate, figures, orbit, simulate, sweep
+from . import atlas, basins, benchmark, compare, data, dynamics, estimate, figures, orbit, simulate, sweep
 from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, clip, exit_status, one_line
 from ._common import ArgumentParser, HelpFormatter, add_max_wall_option
 
@@ -57,6 +57,8 @@ _orbit = orbit.run_orbit
 _bifurcation = orbit.run_bifurcation
 _basins = basins.run
 _atlas = atlas.run
+_series = data.run_series
+_infer = data.run_infer
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -91,6 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
     orbit.add_bifurcation_parser(sub).set_defaults(func=_bifurcation)
     basins.add_parser(sub).set_defaults(func=_basins)
     atlas.add_parser(sub).set_defaults(func=_atlas)
+    data.add_series_parser(sub).set_defaults(func=_series)
+    data.add_infer_parser(sub).set_defaults(func=_infer)
     return ap
 
 
