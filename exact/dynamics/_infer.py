@@ -69,7 +69,8 @@ class Inference:
     params : PeelParams
         ``params0`` with the fitted values (its V that of the first series).
     values, stderr : dict
-        Fitted value and standard error of each free parameter (the error of ln θ for I, k, R).
+        Fitted value and standard error of each free parameter: **for I, k and R the standard error of ln θ**
+        (a relative error: 0.0257 is 2.6 %); :attr:`stderr_abs` gives every one in its parameter's units.
     intervals : dict
         95 % interval ``(low, high)`` of each free parameter.
     identified : dict
@@ -103,6 +104,21 @@ class Inference:
     wall_time: float
     notes: tuple[str, ...] = ()
 
+    @property
+    def stderr_abs(self) -> dict[str, float | None]:
+        """The standard error of each free parameter in its own units (I, k, R: value times the error of ln θ,
+        to first order; a coefficient's as it is)."""
+        out: dict[str, float | None] = {}
+        for name, se in self.stderr.items():
+            out[name] = None if se is None else (abs(self.values[name]) * se if name in _LOG else se)
+        return out
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{n}={fmt_number(v, 5)}" for n, v in self.values.items())
+        se = ", ".join(f"{n}: {'None' if x is None else fmt_number(x, 3)}" for n, x in self.stderr.items())
+        return (f"Inference({self.status}: {vals}; stderr of ln I, k, R (relative) / of a coefficient {{{se}}}; "
+                f"chi2 {fmt_number(self.chi2, 4)} on {self.dof} dof, {self.n_evaluations} runs)")
+
     def report(self) -> str:
         """A plain-text report: each parameter with its interval or why it is not identified, the fit's χ²
         and the residual table."""
@@ -111,7 +127,9 @@ class Inference:
         for name, value in self.values.items():
             iv = self.intervals[name]
             span = "" if iv is None else f", 95 % in [{fmt_number(iv[0], 4)}, {fmt_number(iv[1], 4)}]"
-            lines.append(f"  {name} = {fmt_number(value, 5)}{span}: {self.verdicts[name]}")
+            sa = self.stderr_abs[name]
+            se = "" if sa is None else f" ± {fmt_number(sa, 3)} (standard error)"
+            lines.append(f"  {name} = {fmt_number(value, 5)}{se}{span}: {self.verdicts[name]}")
         lines += [f"  note: {n}" for n in self.notes]
         for r in self.residuals:
             lines.append(f"  V = {fmt_number(r['V'], 4)} m/s {r['observable']}: data {fmt_number(r['data'], 5)} "
