@@ -23,6 +23,7 @@ several (one series per V).
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -217,7 +218,7 @@ def _grid(names: list[str], x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, sear
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
           more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
           t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0,
-          progress: Callable[[str], None] | None = None) -> Inference:
+          progress: Callable[[str], None] | bool | None = True) -> Inference:
     """The model's parameters whose force traces read like the measured ones (module docstring).
 
     Parameters
@@ -243,8 +244,9 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         Of every model run (1e-10).
     max_wall : float
         Wall-clock budget [s] (600): at its end the best point so far is returned with status ``"budget"``.
-    progress : callable, optional
-        Called with a line of text after each model run.
+    progress : callable, bool or None
+        Called with a line of text after each model run; True (default): those lines on stderr (a fit takes
+        tens of seconds to minutes); False or None: silent.
 
     Returns
     -------
@@ -260,6 +262,13 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     from scipy.stats import chi2 as chi2_dist
 
     t_wall = time.perf_counter()
+    if progress is True:
+        def progress(line: str) -> None:
+            print(line, file=sys.stderr, flush=True)
+    elif progress is False:
+        progress = None
+    elif progress is not None and not callable(progress):
+        raise TypeError(f"progress must be a callable, True, False or None, got {type(progress).__name__}")
     if not isinstance(params0, PeelParams):
         raise TypeError(f"params0 must be a PeelParams, got {type(params0).__name__}")
     all_series = [series, *more]

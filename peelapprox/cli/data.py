@@ -121,7 +121,7 @@ def run_infer(args: argparse.Namespace) -> int:
     params0 = params_from_args(args)
     free = tuple(x.strip() for x in str(args.free).split(",") if x.strip())
     series = _read(args, params0.V)
-    progress = None if args.quiet else (lambda line: say(f"infer: {line}"))
+    progress = None if args.quiet else say  # its lines begin with "infer: "
     res = infer(series, params0, free, search=args.search, t_transient=args.t_transient, max_wall=args.max_wall,
                 progress=progress)
     if args.format == "table":
