@@ -71,7 +71,8 @@ class Slips:
     Attributes
     ----------
     t_start, t_end : ndarray
-        Times of the force maximum before the slip and of the minimum after it [s].
+        Times of the slip's start (where the stick's line meets the fall) and end (where the fall meets the next
+        stick's line) [s]; for a fall shorter than a sample, the samples around it (module docstring, step 3).
     F_before, F_after : ndarray
         The force there [N], from straight-line fits of the sticks on either side (module docstring).
     rise : ndarray
