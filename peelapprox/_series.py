@@ -146,14 +146,18 @@ class ForceSeries:
         """The noise level σ [N] (:func:`noise_level`)."""
         return noise_level(self.F)
 
-    def slips(self, threshold: float | None = None, *, smooth: int = 5, fit: int = 40) -> Slips:
-        """The slips, one table row each (:func:`detect_slips`; its parameters)."""
+    def slips(self, threshold: float | None = None, *, smooth: int = 5, fit: int = 40,
+              method: str = "lines") -> Slips:
+        """The slips, one table row each (:func:`detect_slips`; its parameters: ``method="lines"``, the
+        three-piece line fit, or ``"knee"``, the earlier method that :func:`exact.infer` reads traces with)."""
         threshold = optional(positive, "threshold", threshold)
         smooth = integer("smooth", smooth, lo=1, hi=101)
         if smooth % 2 == 0:
             raise ValueError(f"smooth must be odd (a centred average), got {smooth}")
         fit = integer("fit", fit, lo=3, hi=10**5)
-        return detect_slips(self.t, self.F, threshold=threshold, smooth=smooth, fit=fit)
+        if method not in ("lines", "knee"):
+            raise ValueError(f"method must be 'lines' or 'knee', got {method!r}")
+        return detect_slips(self.t, self.F, threshold=threshold, smooth=smooth, fit=fit, method=method)
 
     def observables(self, threshold: float | None = None, *, period_rtol: float | None = None,
                     max_period: int = 32, slips: Slips | None = None) -> StickSlipObservables:

@@ -331,7 +331,7 @@ def _frac_time(s: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None, smooth: int = 5,
-                 fit: int = 40) -> Slips:
+                 fit: int = 40, method: str = "lines") -> Slips:
     """The slips of a sampled force (module docstring: noise, extrema with hysteresis, values).
 
     Parameters
@@ -345,6 +345,10 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
         Samples of the moving average the extrema are searched on (odd, 1 to 101; 5).
     fit : int
         At most this many samples of each stick in the line fits (3 to 10**5; 40).
+    method : {"lines", "knee"}
+        How each slip is read: ``"lines"`` (default) the three-piece line fit (module docstring, step 3);
+        ``"knee"`` the earlier knee method (:mod:`peelapprox._slips_knee`: biased low on short noisy cycles,
+        kept for :func:`exact.infer`, whose statistics were calibrated with it).
 
     Returns
     -------
@@ -358,6 +362,14 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
     if half:  # the ends of a 'same' convolution are averages over fewer samples: keep the raw force there
         Fs[:half], Fs[-half:] = F[:half], F[-half:]
     peaks, valleys = _zigzag(Fs, h)
+    if method == "knee":
+        from ._slips_knee import knee_slips
+
+        ts, te, fb, fa, rise = knee_slips(t, F, Fs, peaks, valleys, sigma, smooth, fit)
+        return Slips(t_start=ts, t_end=te, F_before=fb, F_after=fa, rise=rise, threshold=float(h), noise=sigma,
+                     method=_describe(smooth, h, sigma, threshold, fit, "knee"))
+    if method != "lines":
+        raise ValueError(f"method must be 'lines' or 'knee', got {method!r}")
     if peaks and peaks[0] == 0:
         peaks, valleys = peaks[1:], valleys[1:]
     n = len(peaks)
@@ -370,10 +382,16 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
         a = max(before + (p - before) // 2, p - half - fit, 0)
         b = min(v + (after - v) // 2, v + half + fit, last)
         ts[k], te[k], fb[k], fa[k], rise[k] = _hinge(t, F, a, b, p - half - 1.0, v + half + 1.0)
-    method = (f"slips: falls of the {smooth}-sample moving average by more than {fmt_number(h, 3)} N "
-              + (f"(12 sigma/sqrt({smooth}), sigma = {fmt_number(sigma, 3)} N from the second differences)"
-                 if threshold is None
-                 else "(given)")
-              + f", F before and after from line fits of up to {fit} stick samples")
     return Slips(t_start=ts, t_end=te, F_before=fb, F_after=fa, rise=rise, threshold=float(h), noise=sigma,
-                 method=method)
+                 method=_describe(smooth, h, sigma, threshold, fit, "lines"))
+
+
+def _describe(smooth: int, h: float, sigma: float, threshold: float | None, fit: int, method: str) -> str:
+    """The detector and its settings, in words (:attr:`Slips.method`)."""
+    how = ("a three-piece line fit (stick, fall, stick)" if method == "lines"
+           else "the knee method (line fits at the knee; biased low on short noisy cycles)")
+    return (f"slips: falls of the {smooth}-sample moving average by more than {fmt_number(h, 3)} N "
+            + (f"(12 sigma/sqrt({smooth}), sigma = {fmt_number(sigma, 3)} N from the second differences)"
+               if threshold is None
+               else "(given)")
+            + f", F before and after by {how} with up to {fit} stick samples")
