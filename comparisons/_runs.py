@@ -157,6 +157,13 @@ class ExactRun:
     transient: TransientCheck
     wall_time: float
 
+    def __repr__(self) -> str:
+        """One line: the run's name, the segments' count, the transient check and the wall time (the segments
+        themselves are in ``segments``; printing each made the repr pages long)."""
+        return (f"ExactRun({self.spec.name!r}: V={self.spec.V:g} m/s, I={self.spec.I:g} kg m^2, "
+                f"{len(self.segments)} segments, {len(self.trajectory.jumps)} jumps, transient {self.transient.kind}, "
+                f"{self.wall_time:.3g} s)")
+
 
 def exact_run(name: str | RunSpec) -> ExactRun:
     """The exact run ``RUNS[name]`` (or the run a :class:`RunSpec` describes, of any peel-force law), integrated

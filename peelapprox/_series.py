@@ -170,14 +170,18 @@ class ForceSeries:
         """The noise level σ [N] (:func:`noise_level`)."""
         return noise_level(self.F)
 
-    def slips(self, threshold: float | None = None, *, smooth: int = 5, fit: int = 40) -> Slips:
-        """The slips, one table row each (:func:`detect_slips`; its parameters)."""
+    def slips(self, threshold: float | None = None, *, smooth: int = 5, fit: int = 40,
+              method: str = "lines") -> Slips:
+        """The slips, one table row each (:func:`detect_slips`; its parameters: ``method="lines"``, the
+        three-piece line fit, or ``"knee"``, the earlier method that :func:`exact.infer` reads traces with)."""
         threshold = optional(positive, "threshold", threshold)
         smooth = integer("smooth", smooth, lo=1, hi=101)
         if smooth % 2 == 0:
             raise ValueError(f"smooth must be odd (a centred average), got {smooth}")
         fit = integer("fit", fit, lo=3, hi=10**5)
-        return detect_slips(self.t, self.F, threshold=threshold, smooth=smooth, fit=fit)
+        if method not in ("lines", "knee"):
+            raise ValueError(f"method must be 'lines' or 'knee', got {method!r}")
+        return detect_slips(self.t, self.F, threshold=threshold, smooth=smooth, fit=fit, method=method)
 
     def observables(self, threshold: float | None = None, *, period_rtol: float | None = None,
                     max_period: int = 32, slips: Slips | None = None) -> StickSlipObservables:
@@ -406,6 +410,31 @@ class ForceSeries:
     def as_dict(self) -> dict[str, Any]:
         """The trace as plain JSON data."""
         return {"t": jsonable(self.t), "F": jsonable(self.F), "V": self.V, "source": self.source}
+
+    def to_csv(self, path: str) -> None:
+        """Write the trace as CSV, the header ``t [s],F [N]`` then one sample a row (17 significant digits: it
+        reads back bitwise with :meth:`from_csv`)."""
+        import os
+
+        with open(os.fspath(path), "w", encoding="utf-8", newline="") as fh:
+            fh.write("t [s],F [N]\n")
+            np.savetxt(fh, np.column_stack([self.t, self.F]), fmt="%.17g", delimiter=",")
+
+    def to_dataframe(self) -> Any:
+        """The trace as a :class:`pandas.DataFrame`, columns ``t`` [s] and ``F`` [N] (``df.attrs["units"]``,
+        ``df.attrs["V"]``, ``df.attrs["source"]``).
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed (``pip install 'peelapprox[data]'``).
+        """
+        from .io import optional_import
+
+        pd = optional_import("pandas", "ForceSeries.to_dataframe")
+        df = pd.DataFrame({"t": np.array(self.t), "F": np.array(self.F)})
+        df.attrs.update(units={"t": "s", "F": "N"}, V=self.V, source=self.source)
+        return df
 
 
 class _SampleError(ValueError):

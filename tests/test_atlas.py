@@ -128,8 +128,10 @@ def test_small_atlas_segments_and_tables(small, tmp_path):
         if n[0, 0]:
             assert 0 <= med[0, 0] <= worst[0, 0]
         assert med[1, 0] is np.ma.masked and med[0, 2] is np.ma.masked
-    paths = small.write_tables(tmp_path)
+    told: list[tuple[int, int, str]] = []
+    paths = small.write_tables(tmp_path, progress=lambda i, n, path: told.append((i, n, path)))
     assert len(paths) == 10
+    assert told == [(i + 1, 10, p) for i, p in enumerate(paths)]  # progress after each file (issue 36, item 5)
     # the per-regime table agrees with the maps, counted here from them: for each approximation and observable,
     # the points within 10 % summed over the labels are those of within(), and each label's count is its cells'
     regimes, ss = small.regime(), small.stick_slip()

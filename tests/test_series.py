@@ -79,9 +79,10 @@ def test_a_fast_low_inertia_trace_gives_back_every_slip():
 
 
 def test_noiseless_trace_reads_the_jumps(run):
-    """Hypothesis: without noise the corners (crossings of fitted lines) sit within 0.1 ms of the jumps and F
-    there within 0.3 N of the jump's F (the sampling grid is 0.1 ms; the stick's curvature near the fold is
-    what the straight line misses: measured 0.16 N at most at V = 1, I = 1e-2)."""
+    """Hypothesis: without noise the corners (the sticks' lines meeting the fall's first and last thirds) sit
+    within 0.15 ms of the jumps and F there within 0.3 N of the jump's F (the sampling grid is 0.1 ms; measured
+    on 10 s: 0.1 ms at most at V = 1, I = 1e-5, 0.04 ms at I = 1e-2; the stick's curvature near the fold is what
+    the straight line misses: 0.22 N at most)."""
     s = run.as_series(RATE).slips()
     jt, jF = np.asarray(run.jumps.t), np.asarray(run.jumps.F)
     ab = np.asarray(run.jumps.from_branch) == 0
@@ -89,7 +90,7 @@ def test_noiseless_trace_reads_the_jumps(run):
         k = np.searchsorted(jt[mask], times)
         k = np.clip(k, 1, mask.sum() - 1)
         near = np.where(np.abs(jt[mask][k] - times) < np.abs(jt[mask][k - 1] - times), k, k - 1)
-        assert float(np.max(np.abs(jt[mask][near] - times))) < 1e-4
+        assert float(np.max(np.abs(jt[mask][near] - times))) < 1.5e-4
         assert float(np.max(np.abs(jF[mask][near] - forces))) < 0.3
 
 

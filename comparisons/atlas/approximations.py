@@ -13,7 +13,7 @@ never from the full DAE.  :data:`APPROXIMATIONS` maps a name to one of
 Adding an approximation is one line in :data:`APPROXIMATIONS` (or :func:`register_approximation`).  The
 built-ins: ``"estimate"`` (:func:`estimate_observables`: what :func:`peelapprox.estimate` predicts, the
 quasi-static cycle) and ``"approx:default"`` (``peelapprox.approximate_attractor`` with its defaults, the
-reduced return map iterated to its attractor; skipped until that function exists).
+reduced return map iterated to its attractor).
 """
 
 from __future__ import annotations

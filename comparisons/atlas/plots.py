@@ -15,6 +15,7 @@ Figures come from :func:`peelapprox.plotting.new_figure` (matplotlib imported on
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -260,20 +261,25 @@ def plot_segment_maps(result: Any, stat: str = "dt_median", path: str | None = N
     return fig
 
 
-def write_maps(result: Any, directory) -> list[str]:
+def write_maps(result: Any, directory, progress: Callable[[int, int, str], Any] | None = None) -> list[str]:
     """Every map of the atlas as a PNG in ``directory`` (created): ``dynamics.png``;
     ``error_<approximation>_<observable>.png`` for each approximation and observable (the approximation's
     :func:`~comparisons.atlas.approximations.key_of`); ``segments_dt_median.png`` and
-    ``segments_dF_median.png``.  Returns the paths."""
+    ``segments_dF_median.png``.  ``progress(i, n, path)`` is called after each map is written.  Returns the
+    paths."""
     os.makedirs(directory, exist_ok=True)
-    paths = [os.path.join(directory, "dynamics.png")]
-    plot_dynamics_map(result, paths[-1])
+    jobs: list[tuple[str, Callable[..., Any], tuple]] = [
+        (os.path.join(directory, "dynamics.png"), plot_dynamics_map, ())]
     for name in result.approximations:
         for obs in OBSERVABLES:
-            paths.append(os.path.join(directory, f"error_{key_of(name)}_{obs}.png"))
-            plot_error_map(result, name, obs, paths[-1])
+            jobs.append((os.path.join(directory, f"error_{key_of(name)}_{obs}.png"), plot_error_map, (name, obs)))
     if result.reductions:
         for stat in ("dt_median", "dF_median"):
-            paths.append(os.path.join(directory, f"segments_{stat}.png"))
-            plot_segment_maps(result, stat, paths[-1])
+            jobs.append((os.path.join(directory, f"segments_{stat}.png"), plot_segment_maps, (stat,)))
+    paths = []
+    for i, (path, draw, extra) in enumerate(jobs):
+        draw(result, *extra, path)
+        paths.append(path)
+        if progress is not None:
+            progress(i + 1, len(jobs), path)
     return paths

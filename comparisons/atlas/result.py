@@ -323,14 +323,23 @@ class AtlasResult:
         return {"points": self.point_rows(), "errors": self.error_rows(), "segments": self.segment_rows(),
                 "summary": self.summary(), "regimes": self.by_regime()}
 
-    def write_tables(self, directory, formats: tuple[str, ...] = ("csv", "json")) -> list[str]:
-        """Write each table as ``atlas_<name>.<format>`` into ``directory`` (created); returns the paths."""
+    def write_tables(self, directory, formats: tuple[str, ...] = ("csv", "json"),
+                     progress: Any = None) -> list[str]:
+        """Write each table as ``atlas_<name>.<format>`` into ``directory`` (created); returns the paths.
+        ``progress(i, n, path)`` is called after each file is written."""
         bad = [f for f in formats if f not in ("csv", "json")]
         if bad or not formats:
             raise ValueError(f"formats must be a non-empty tuple of 'csv' and/or 'json', got {formats!r}")
         os.makedirs(directory, exist_ok=True)
-        return [write_rows(os.path.join(directory, f"atlas_{name}.{fmt}"), rows)
-                for name, rows in self.tables().items() for fmt in formats]
+        tables = self.tables()
+        n = len(tables) * len(formats)
+        paths = []
+        for name, rows in tables.items():
+            for fmt in formats:
+                paths.append(write_rows(os.path.join(directory, f"atlas_{name}.{fmt}"), rows))
+                if progress is not None:
+                    progress(len(paths), n, paths[-1])
+        return paths
 
     def to_xarray(self) -> Any:
         """The atlas as an :class:`xarray.Dataset` on dimensions ``I``, ``V`` (and ``approximation``,
@@ -388,11 +397,12 @@ class AtlasResult:
 
         return plot_dynamics_map(self, path, **kwargs)
 
-    def write_maps(self, directory) -> list[str]:
-        """:func:`comparisons.atlas.plots.write_maps` of this atlas: every map as a PNG in ``directory``."""
+    def write_maps(self, directory, progress: Any = None) -> list[str]:
+        """:func:`comparisons.atlas.plots.write_maps` of this atlas: every map as a PNG in ``directory``
+        (``progress(i, n, path)`` after each)."""
         from .plots import write_maps
 
-        return write_maps(self, directory)
+        return write_maps(self, directory, progress)
 
     # ------------------------------------------------------------------------------------------ display
     def _summary(self) -> dict:

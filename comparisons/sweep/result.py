@@ -136,6 +136,13 @@ class SweepResult:
             seen.update(dict.fromkeys(rec))
         return list(seen)
 
+    def describe(self, key: str) -> tuple[str, str]:
+        """``(unit, description)`` of a record key ("" and a short description for a registered measure's keys
+        or an unknown key), as :meth:`to_xarray` labels its variables."""
+        if key in _KEY_INFO:
+            return _KEY_INFO[key]
+        return "", key.replace("_", " ")
+
     def values(self, key: str) -> np.ndarray:
         """``key`` over the grid as a 2-D array, shape ``(len(I_values), len(V_values))`` (3-D with a coefficient
         axis: :attr:`shape`).

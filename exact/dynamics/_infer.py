@@ -23,6 +23,7 @@ several (one series per V).
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
@@ -71,7 +72,8 @@ class Inference:
     params : PeelParams
         ``params0`` with the fitted values (its V that of the first series).
     values, stderr : dict
-        Fitted value and standard error of each free parameter (the error of ln θ for I, k, R).
+        Fitted value and standard error of each free parameter: **for I, k and R the standard error of ln θ**
+        (a relative error: 0.0257 is 2.6 %); :attr:`stderr_abs` gives every one in its parameter's units.
     intervals : dict
         95 % interval ``(low, high)`` of each free parameter.
     identified : dict
@@ -105,6 +107,21 @@ class Inference:
     wall_time: float
     notes: tuple[str, ...] = ()
 
+    @property
+    def stderr_abs(self) -> dict[str, float | None]:
+        """The standard error of each free parameter in its own units (I, k, R: value times the error of ln θ,
+        to first order; a coefficient's as it is)."""
+        out: dict[str, float | None] = {}
+        for name, se in self.stderr.items():
+            out[name] = None if se is None else (abs(self.values[name]) * se if name in _LOG else se)
+        return out
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{n}={fmt_number(v, 5)}" for n, v in self.values.items())
+        se = ", ".join(f"{n}: {'None' if x is None else fmt_number(x, 3)}" for n, x in self.stderr.items())
+        return (f"Inference({self.status}: {vals}; stderr of ln I, k, R (relative) / of a coefficient {{{se}}}; "
+                f"chi2 {fmt_number(self.chi2, 4)} on {self.dof} dof, {self.n_evaluations} runs)")
+
     def report(self) -> str:
         """A plain-text report: each parameter with its interval or why it is not identified, the fit's χ²
         and the residual table."""
@@ -113,7 +130,9 @@ class Inference:
         for name, value in self.values.items():
             iv = self.intervals[name]
             span = "" if iv is None else f", 95 % in [{fmt_number(iv[0], 4)}, {fmt_number(iv[1], 4)}]"
-            lines.append(f"  {name} = {fmt_number(value, 5)}{span}: {self.verdicts[name]}")
+            sa = self.stderr_abs[name]
+            se = "" if sa is None else f" ± {fmt_number(sa, 3)} (standard error)"
+            lines.append(f"  {name} = {fmt_number(value, 5)}{se}{span}: {self.verdicts[name]}")
         lines += [f"  note: {n}" for n in self.notes]
         for r in self.residuals:
             lines.append(f"  V = {fmt_number(r['V'], 4)} m/s {r['observable']}: data {fmt_number(r['data'], 5)} "
@@ -201,7 +220,7 @@ def _grid(names: list[str], x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, sear
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
           more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
           t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0,
-          progress: Callable[[str], None] | None = None, executor: str | Executor | None = None,
+          progress: Callable[[str], None] | bool | None = True, executor: str | Executor | None = None,
           max_workers: int | None = None) -> Inference:
     """The model's parameters whose force traces read like the measured ones (module docstring).
 
@@ -228,8 +247,9 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         Of every model run (1e-10).
     max_wall : float
         Wall-clock budget [s] (600): at its end the best point so far is returned with status ``"budget"``.
-    progress : callable, optional
-        Called with a line of text after each model run (the grid's once all of them are done).
+    progress : callable, bool or None
+        Called with a line of text after each model run; True (default): those lines on stderr (a fit takes
+        tens of seconds to minutes); False or None: silent.
     executor : {"auto", "threads", "processes", "serial"} or concurrent.futures.Executor, optional
         Where the search grid's runs go: a local pool of :mod:`peelapprox.parallel` (None: ``"auto"``,
         processes on more than two CPUs, threads on one or two), or any executor, used as is; the least-squares
@@ -251,6 +271,13 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     from scipy.stats import chi2 as chi2_dist
 
     t_wall = time.perf_counter()
+    if progress is True:
+        def progress(line: str) -> None:
+            print(line, file=sys.stderr, flush=True)
+    elif progress is False:
+        progress = None
+    elif progress is not None and not callable(progress):
+        raise TypeError(f"progress must be a callable, True, False or None, got {type(progress).__name__}")
     if not isinstance(params0, PeelParams):
         raise TypeError(f"params0 must be a PeelParams, got {type(params0).__name__}")
     all_series = [series, *more]

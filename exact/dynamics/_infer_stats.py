@@ -54,7 +54,7 @@ def trace_statistics(series: ForceSeries, threshold: float | None
                      ) -> tuple[np.ndarray | None, Any, bool, float]:
     """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables,
     whether its periodogram holds a cycle line (:func:`_cycle_frequency`) and the detector's threshold."""
-    slips = series.slips(threshold)
+    slips = series.slips(threshold, method="knee")  # the detector the statistics were calibrated with
     o = series.observables(slips=slips)  # read off these slips, not detected a second time
     if o.status != "stick-slip" or len(slips) < 2:
         return None, o, False, slips.threshold

@@ -37,7 +37,7 @@ from typing import Any
 
 from .._deadline import WallSpent, time_limit
 from .._version import __version__
-from . import atlas, basins, benchmark, cache, compare, dynamics, estimate, figures, front, orbit, simulate, sweep
+from . import atlas, basins, benchmark, cache, compare, data, dynamics, estimate, figures, front, orbit, simulate, sweep
 from ._checks import EXIT_INTERNAL, EXIT_INTERRUPTED, TRACEBACK_ENV, clip, exit_status, one_line
 from ._common import ArgumentParser, HelpFormatter, add_max_wall_option
 
@@ -60,6 +60,8 @@ _atlas = atlas.run
 _warmup = cache.run_warmup
 _doctor = cache.run_doctor
 _front = front.run
+_series = data.run_series
+_infer = data.run_infer
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -97,6 +99,8 @@ def build_parser() -> argparse.ArgumentParser:
     cache.add_warmup_parser(sub).set_defaults(func=_warmup)
     cache.add_doctor_parser(sub).set_defaults(func=_doctor)
     front.add_parser(sub).set_defaults(func=_front)
+    data.add_series_parser(sub).set_defaults(func=_series)
+    data.add_infer_parser(sub).set_defaults(func=_infer)
     return ap
 
 

@@ -6,7 +6,7 @@ called by :func:`peelapprox.cli._common.add_params`), at most one of
 * ``--force EXPR`` with ``--const NAME=VALUE`` (repeatable): :meth:`PeelForce.expression`;
 * ``--force-table FILE.csv``: a measured curve, :meth:`PeelForce.tabulated` (:func:`read_force_table`);
 * ``--force-family NAME`` with ``--coef NAME=VALUE`` (repeatable): :meth:`PeelForce.family`;
-* ``--force-table FILE.csv --smooth``: the file's noisy points smoothed, :meth:`PeelForce.smoothed`;
+* ``--force-table FILE.csv --smooth [--lam LAM]``: the file's noisy points smoothed, :meth:`PeelForce.smoothed`;
 * ``--force-fit FILE.csv --family NAME``: a family fitted to the file's points, :meth:`PeelForce.fit`;
 
 and none means the paper's fvV (:meth:`PeelForce.paper`).  :func:`force_from_args` builds the law; a
@@ -95,16 +95,32 @@ def add_force_options(sp: argparse.ArgumentParser) -> None:
                       help=f"a family (PeelForce.family): {', '.join(_family_names())}; coefficients by --coef")
     kind.add_argument("--force-fit", metavar="FILE.csv",
                       help="a family (--family) fitted to a measured curve (PeelForce.fit): the CSV of "
-                           "--force-table, one curve; units in the header (v [mm/s], f [kN]) are converted")
+                           "--force-table, one curve; units in the header (v [mm/s], f [kN]) are converted; an "
+                           "optional column sigma (f's standard deviation [N]) weights the fit; standard errors and "
+                           "chi2 are printed")
     g.add_argument("--family", metavar="NAME",
                    help=f"the family --force-fit fits: {', '.join(_family_names())}")
     g.add_argument("--smooth", action="store_true",
                    help="with --force-table: smooth the (noisy) points by a C4 spline in ln v (PeelForce.smoothed) "
                         "instead of interpolating them")
+    g.add_argument("--lam", type=_lam, default="gcv", metavar="LAM",
+                   help="with --smooth: the smoothing penalty, a number >= 0 (it smooths over about "
+                        "(LAM * L / n)^(1/4) in ln v, L the data's range in ln v, n the points), or 'gcv' (default: "
+                        "cross-validation's, else the least penalty that gives the N shape while following the data)")
     g.add_argument("--const", type=name_value, action="append", metavar="NAME=VALUE",
                    help="a constant of --force (repeatable)")
     g.add_argument("--coef", type=name_value, action="append", metavar="NAME=VALUE",
                    help="a coefficient of --force-family (repeatable; the others at their defaults)")
+
+
+def _lam(text: str) -> float | str:
+    """Argparse type of ``--lam``: ``gcv`` or a real number (its range is checked by :meth:`PeelForce.smoothed`)."""
+    if text.strip().lower() == "gcv":
+        return "gcv"
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be 'gcv' or a number >= 0, got {shown(text)}") from None
 
 
 def _pairs(option: str, pairs: list[tuple[str, int | float]] | None) -> dict[str, int | float]:
@@ -131,8 +147,11 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
     consts, coefs = getattr(args, "const", None), getattr(args, "coef", None)
     fit, fit_family, smooth = getattr(args, "force_fit", None), getattr(args, "family", None), \
         getattr(args, "smooth", False)
+    lam = getattr(args, "lam", "gcv")
     if smooth and table is None:
         raise ValueError("--smooth smooths the points of --force-table FILE; there is no --force-table")
+    if lam != "gcv" and not smooth:
+        raise ValueError("--lam is the penalty of --smooth; there is no --smooth")
     if (fit is None) != (fit_family is None):
         raise ValueError("--force-fit FILE and --family NAME go together (the family fitted to the file's points)")
     if fit is not None:
@@ -150,7 +169,7 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
         option = "--force" if expr is not None else "--force-family"
         raise ValueError(f"{option}: {exc}") from None
     if table is not None:
-        return smoothed_table(table) if smooth else read_force_table(table)
+        return smoothed_table(table, lam) if smooth else read_force_table(table)
     return PeelForce.paper()
 
 
@@ -174,35 +193,38 @@ def read_force_table(path: str) -> PeelForce:
                          ) from None
 
 
-def _one_table(option: str, path: str) -> tuple[np.ndarray, np.ndarray, list]:
-    """``(v, f, tables)`` of the file of ``option``: one table (no V column, or one V)."""
+def _one_table(option: str, path: str, sigma: bool = False) -> tuple[np.ndarray, np.ndarray, list]:
+    """``(v, f, tables)`` of the file of ``option``: one table (no V column, or one V); with ``sigma``, a sigma
+    column is read too (``tables[0][4]``, None without one)."""
     from ..law._tablefile import read_points
 
-    tables = read_points(path, where=f"{option} {shown(path)}")
+    tables = read_points(path, where=f"{option} {shown(path)}", sigma=sigma)
     if len(tables) != 1:
         raise ValueError(f"{option} {shown(path)}: {len(tables)} tables (one per V); {option} takes one curve")
     return tables[0][1], tables[0][2], tables
 
 
-def smoothed_table(path: str) -> PeelForce:
-    """``--force-table FILE --smooth``: :meth:`PeelForce.smoothed` of the file's points (one curve)."""
+def smoothed_table(path: str, lam: float | str = "gcv") -> PeelForce:
+    """``--force-table FILE --smooth [--lam LAM]``: :meth:`PeelForce.smoothed` of the file's points (one curve)."""
     from ..law._tablefile import with_line
 
     v, f, tables = _one_table("--force-table", path)
     try:
-        return PeelForce.smoothed(v, f, V=tables[0][0])
+        return PeelForce.smoothed(v, f, lam=lam, V=tables[0][0])
     except (ValueError, TypeError) as exc:
-        raise ValueError(f"--force-table {shown(path)} --smooth: {with_line(str(exc), tables)}") from None
+        opt = "" if lam == "gcv" else f" --lam {lam:g}"
+        raise ValueError(f"--force-table {shown(path)} --smooth{opt}: {with_line(str(exc), tables)}") from None
 
 
 def fitted_table(path: str, family: str) -> PeelForce:
     """``--force-fit FILE --family NAME``: :meth:`PeelForce.fit` of the family to the file's points (one curve;
-    a V column gives the V of a V-dependent family)."""
+    a V column gives the V of a V-dependent family; a ``sigma`` column, f's standard deviation [N], weights the
+    fit: chi^2 is then meaningful and the standard errors absolute)."""
     from ..law._tablefile import with_line
 
-    v, f, tables = _one_table("--force-fit", path)
+    v, f, tables = _one_table("--force-fit", path, sigma=True)
     try:
-        return PeelForce.fit(v, f, family, V=tables[0][0])
+        return PeelForce.fit(v, f, family, sigma=tables[0][4], V=tables[0][0])
     except (ValueError, TypeError) as exc:
         raise ValueError(f"--force-fit {shown(path)} --family {family}: {with_line(str(exc), tables)}") from None
 
@@ -210,10 +232,22 @@ def fitted_table(path: str, family: str) -> PeelForce:
 # --------------------------------------------------------------------------------------------- the record
 
 def law_fields(law: PeelForce, *, spec: bool = False) -> dict[str, Any]:
-    """What a result records of its law: ``law`` (``repr``), ``law_key`` (:attr:`PeelForce.key`) and, with
+    """What a result records of its law: ``law`` (``repr``), ``law_key`` (:attr:`PeelForce.key`), for a fitted
+    law (``--force-fit``) its statistics (``fit_weighted``: a sigma column was given; ``fit_stderr_<name>`` of each
+    fitted coefficient and of the folds; ``fit_chi2``, ``fit_dof``, ``fit_chi2_dof``; ``fit_folds_note`` where the
+    folds are not estimated) and, with
     ``spec=True`` (JSON), ``law_spec``: ``dataclasses.asdict(law)``, which :meth:`PeelForce.from_dict`
     rebuilds."""
     out: dict[str, Any] = {"law": repr(law), "law_key": law.key}
+    fr = law.fit_result
+    if fr is not None:  # a fitted law (--force-fit): its statistics
+        out["fit_weighted"] = fr.absolute_sigma
+        out.update({f"fit_stderr_{n}": fr.stderr[n] for n in fr.names})
+        out.update(fit_chi2=fr.chi2, fit_dof=fr.dof, fit_chi2_dof=fr.chi2_dof)
+        if fr.folds is not None:
+            out.update({f"fit_stderr_{k}": x for k, x in fr.folds.stderr.items()})
+        else:
+            out["fit_folds_note"] = fr.folds_note
     if spec:
         out["law_spec"] = dataclasses.asdict(law)
     return out

@@ -7,6 +7,7 @@ import json
 import os
 import sys
 import time
+from collections.abc import Callable
 
 from .. import GEOMETRIES, PeelForce
 from ._checks import add_pool_options, check_output_path, nonnegative_int, positive_int, worker_pool
@@ -24,7 +25,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     "and stick times, the force range at the jumps; 100 s of transient, 20 s measured) and its class "
                     "(period n, aperiodic, steady, breakdown); every approximation's prediction of the same "
                     "observables (estimate: the quasi-static cycle of peelapprox.estimate; approx:default: "
-                    "peelapprox.approximate_attractor once it exists, skipped until then); and each reduction of the "
+                    "peelapprox.approximate_attractor, the reduced return map iterated to its attractor); and each "
+                    "reduction of the "
                     "harness (an alpha model and a v equation per branch) seeded from the exact branch entries of the "
                     "window's last stays, with its median and worst |dt| and |dF| relative errors.  Each finished "
                     "point is appended to DIR/results.jsonl, so a killed atlas resumes where it stopped.\n\n"
@@ -133,11 +135,17 @@ def run(args: argparse.Namespace) -> int:
     print(f"atlas: {len(result.sweep.records)} points in {args.out} ({time.perf_counter() - t0:.1f} s)"
           + (f"; skipped (not importable yet): {', '.join(result.skipped)}" if result.skipped else ""),
           file=sys.stderr)
+    def told(what: str) -> Callable[[int, int, str], None] | None:
+        if args.quiet:
+            return None
+        return lambda i, n, path: print(f"atlas: {what} {i}/{n}: wrote {path}", file=sys.stderr, flush=True)
+
     try:
-        for path in result.write_tables(args.out):
-            print(f"wrote {path}", file=sys.stderr)
+        if not args.quiet:
+            print("atlas: writing the tables", file=sys.stderr, flush=True)
+        result.write_tables(args.out, progress=told("table"))
         if args.plot:
-            paths = result.write_maps(os.path.join(args.out, "maps"))
+            paths = result.write_maps(os.path.join(args.out, "maps"), progress=told("map"))
             print(f"wrote {len(paths)} maps in {os.path.join(args.out, 'maps')}", file=sys.stderr)
     except OSError as exc:  # e.g. a complete atlas in a read-only directory: still report it
         print(f"note: cannot write into {args.out} ({exc}); the summary is printed only", file=sys.stderr)

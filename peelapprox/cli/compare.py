@@ -47,7 +47,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                   "peelapprox compare --scene case-II-point-a --scene case-III-bounds --format json",
                   "peelapprox compare --out docs           # regenerates docs/tables.md and docs/figures/fig8-9"])
     cp.add_argument("--scene", action="append", metavar="NAME",
-                    help="run only this scene (repeatable; default: all); names: see --list")
+                    help="run only this scene (repeatable; default: all), and the statistics of its run only; "
+                         "names: see --list")
     cp.add_argument("--list", action="store_true", help="list the scenes and exit")
     cp.add_argument("--format", choices=("table", "md", "csv", "json"), default="table",
                     help="what is printed: table (markdown tables and a summary; md is the same), csv (the rows) or "
@@ -84,7 +85,11 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.out, "dir", "--out")
         figdir = os.path.join(args.out, "figures")
         os.makedirs(figdir, exist_ok=True)
-    report = run_compare(args.scene, statistics_runs=() if args.no_stats else STAT_RUNS,
+    stat_runs: tuple[str, ...] = () if args.no_stats else STAT_RUNS
+    if args.scene and stat_runs:  # only the statistics of the chosen scenes' runs (an unknown scene: run_compare's)
+        wanted = {SCENES[s].run for s in args.scene if s in SCENES}
+        stat_runs = tuple(r for r in stat_runs if r in wanted)
+    report = run_compare(args.scene, statistics_runs=stat_runs,
                          figures_dir=None if args.no_figures else figdir, progress=say)
     rows, stats = report.row_dicts(), report.stat_dicts()
     if args.format in ("table", "md"):

@@ -36,13 +36,17 @@ from .._ranges import PARAM_RANGES, STATE_RANGES
 from . import _families
 from ._folds import find_folds
 
-__all__ = ["IDENTIFY_RCOND", "FitResult", "FoldEstimate", "check_points", "fit"]
+__all__ = ["IDENTIFY_RCOND", "N_SIGNIFICANCE", "FitResult", "FoldEstimate", "check_points", "fit"]
 
 #: Smallest ratio of the smallest to the largest singular value of the column-scaled weighted Jacobian for which
 #: the coefficients count as identified (module docstring).  The Jacobian is a central difference (relative error
 #: ~1e-10): below 1e-9 the direction of the smallest singular value is numerical noise, and so would be the
 #: standard errors along it.
 IDENTIFY_RCOND = 1e-9
+#: The fitted folds' depth ``f_max - f_min`` must exceed this many of its standard errors (delta method) for the
+#: fit to have an N shape; else ``FitResult.folds`` is None, ``folds_note`` says why and the law's ``folds``
+#: raise a ValueError saying so.
+N_SIGNIFICANCE = 2.0
 #: Fold search density (points per unit of ln v) and window of the fits' folds, as the laws' own.
 _FOLD_DENSITY = 200
 _FOLDS = ("v_max", "f_max", "v_min", "f_min")
@@ -135,7 +139,8 @@ class FitResult:
 def check_points(v: Any, f: Any, *, need: int, what: str) -> tuple[np.ndarray, np.ndarray]:
     """``(v, f)`` as float arrays, or a ValueError/TypeError naming the argument and the first offending index.
 
-    1-D of equal length, at least ``need`` points (``what`` says why), finite, ``v > 0`` and strictly increasing.
+    1-D of equal length, at least ``need`` points (``what`` says why), finite, ``v > 0`` and strictly increasing,
+    ``f > 0`` (a peel force, as :meth:`peelapprox.PeelForce.tabulated` requires).
     """
     out = []
     for name, x in (("v", v), ("f", f)):
@@ -167,6 +172,10 @@ def check_points(v: Any, f: Any, *, need: int, what: str) -> tuple[np.ndarray, n
         why = "a duplicate" if va[i] == va[i + 1] else "unsorted"
         raise ValueError(f"v must be strictly increasing ({why}): v[{i}] = {float(va[i])!r} >= "
                          f"v[{i + 1}] = {float(va[i + 1])!r}")
+    bad = np.flatnonzero(fa <= 0)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"f must be > 0 (a peel force in N): f[{i}] = {float(fa[i])!r} at v = {float(va[i])!r}")
     return va, fa
 
 
@@ -393,12 +402,43 @@ def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = No
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))  # (J^T J)^-1 is positive semi-definite: clip rounding
     d = np.where(se > 0, se, 1.0)
     folds, note = _fold_estimate(model, theta_of, x, se, cov, lo, hi, Vf, (va[0], va[-1]))
+    if folds is not None:
+        note = _insignificant(folds, fa)
+        if note:
+            folds = None
+    elif _has_folds(model, theta_of(x), Vf):
+        note = (f"no significant N shape: the fitted law has folds at V={Vf!r} m/s but they vanish when a "
+                f"coefficient moves by a thousandth of its standard error ({note})")
     result = FitResult(model.label, names, values, dict(zip(names, se.tolist())), cov,
                        tuple(n for n in model.names if n not in free), r * w, chi2, dof, chi2 / dof,
                        sigma is not None, folds, note, bool(sol.success), str(sol.message), int(sol.nfev),
                        cov / np.outer(d, d))
     object.__setattr__(law, "_fit_result", result)
+    if note.startswith("no significant N shape"):
+        object.__setattr__(law, "_no_n_shape", f"this law was fitted (PeelForce.fit) to points without a "
+                                               f"significant N shape, so its folds are not the data's: {note}")
     return law
+
+
+def _has_folds(model: _Model, theta: tuple, V: float) -> bool:
+    try:
+        return bool(model.folds(theta, V).has_folds)
+    except ValueError:
+        return False
+
+
+def _insignificant(folds: FoldEstimate, f: np.ndarray) -> str:
+    """Why the fitted folds are no N shape of the data (:data:`N_SIGNIFICANCE`), or ``""``: the depth
+    ``f_max - f_min`` at most ``N_SIGNIFICANCE`` of its standard errors, or at most 1e-9 of the largest |f|
+    (rounding: a flat trace's fit has coefficients of 1e-16 and no residual)."""
+    depth = folds.values["f_max"] - folds.values["f_min"]
+    C = folds.covariance
+    se = math.sqrt(max(float(C[1, 1] + C[3, 3] - 2.0 * C[1, 3]), 0.0))
+    if depth > N_SIGNIFICANCE * se and depth > 1e-9 * float(np.max(np.abs(f))):
+        return ""
+    return (f"no significant N shape: the fitted depth f_max - f_min = {depth:.3g} N at V={folds.V!r} m/s, "
+            f"standard error {se:.3g} N (at most {N_SIGNIFICANCE:g} standard errors, or rounding); the points do "
+            "not show a maximum followed by a minimum")
 
 
 def _covariance(J: np.ndarray, names: tuple[str, ...], label: str) -> np.ndarray:

@@ -211,7 +211,7 @@ class PeelForce:
         Parameters
         ----------
         v, f : array_like
-            The points: peel velocities [m/s] (> 0, strictly increasing) and forces [N], finite, more of them
+            The points: peel velocities [m/s] (> 0, strictly increasing) and forces [N] (> 0), finite, more of them
             than fitted coefficients.
         family : str or PeelForce
             A family's name or constructor (``"cubic"``, ``"paper_family"``, ``"power_branches"``; start: its
@@ -271,10 +271,14 @@ class PeelForce:
         Parameters
         ----------
         v, f : array_like
-            Peel velocities [m/s] (> 0, strictly increasing) and forces [N], finite, at least 5 points.
+            Peel velocities [m/s] (> 0, strictly increasing) and forces [N] (> 0), finite, at least 5 points.
         lam : "gcv" or float
-            The smoothing penalty: ``"gcv"`` chooses it by generalised cross-validation (scipy's ``lam=None``);
-            0 interpolates (a natural cubic spline through the points); larger is smoother.
+            The smoothing penalty of ``sum (f_i - s(u_i))^2 + lam * integral s''(u)^2 du``: it smooths over a
+            length ``(lam * L / n)^(1/4)`` in ln v (L the data's range in ln v, n the points); 0 interpolates (a
+            natural cubic spline through the points).  ``"gcv"`` (default): generalised cross-validation's
+            penalty if its law is N-shaped, else the least penalty whose law is N-shaped while it follows the
+            data as noise would (a shape-constrained choice; :func:`peelapprox.law._spline.smooth`).  More than
+            1000 points are averaged in runs of consecutive points first (the work is bounded).
         V : float, optional
             The pull speed [m/s] the points were measured at: the law is then used at that V only; None (default)
             uses it at every V.
@@ -290,7 +294,7 @@ class PeelForce:
         ------
         ValueError
             Naming the argument and index: a NaN or inf, v not > 0 or not strictly increasing (unsorted or
-            duplicate), fewer than 5 points, lengths differ; a bad ``lam`` or V; a smoothed curve that is not
+            duplicate), f not > 0, fewer than 5 points, lengths differ; a bad ``lam`` or V; a smoothed curve that is not
             N-shaped (the extrema it has are listed: smooth more, with a larger ``lam``).
         TypeError
             v or f not arrays of real numbers.
@@ -441,8 +445,12 @@ class PeelForce:
         ------
         ValueError
             If f' < 0 throughout (no stable slow branch), or the extrema are not exactly one maximum
-            followed by one minimum (the message lists those found), or V is out of range.
+            followed by one minimum (the message lists those found), or V is out of range; or a law made by
+            :meth:`fit` from points without a significant N shape (``fit_result.folds_note`` says why).
         """
+        refused = self.__dict__.get("_no_n_shape")
+        if refused:
+            raise ValueError(refused)
         cache = self.__dict__.get("_folds")
         if cache is None:
             cache = {}

@@ -27,8 +27,11 @@ _UNIT = {"V": "m/s", "v": "m/s", "f": "N"}
 
 
 def read_points(path: Any, *, columns: Any = None, delimiter: str | None = None,
-                where: str | None = None) -> list[tuple[float | None, np.ndarray, np.ndarray, np.ndarray]]:
+                where: str | None = None, sigma: bool = False) -> list[tuple[Any, ...]]:
     """``[(V or None, v [m/s], f [N], file lines), ...]``: the file's tables (module docstring).
+
+    With ``sigma=True`` an optional column ``sigma`` (the standard deviation of each f [N], a unit allowed as
+    for f) is read too, and each table is ``(V or None, v, f, lines, sigma or None)``.
 
     Raises
     ------
@@ -47,7 +50,7 @@ def read_points(path: Any, *, columns: Any = None, delimiter: str | None = None,
         names = {"V": "V", "v": "v", "f": "f"}
         stated: dict[str, str] = {}
         expected = (f"{' or '.join(','.join(c) for c in TABLE_COLUMNS)} (V is the pull speed, v the peel velocity "
-                    "[m/s], f the force [N])")
+                    "[m/s], f the force [N])" + (", optionally sigma (f's standard deviation [N])" if sigma else ""))
         exact = True
     else:
         if isinstance(columns, Mapping):
@@ -68,21 +71,27 @@ def read_points(path: Any, *, columns: Any = None, delimiter: str | None = None,
             if unit:
                 stated[name] = unit
         expected, exact = ",".join(names[k] for k in ("V", "v", "f") if k in names), False
-    cols = read_columns(path, {names[k]: _UNIT[k] for k in ("V", "v", "f") if k in names}, where=where,
-                        delimiter=delimiter, optional=(names["V"],) if "V" in names else (), stated=stated,
+    wanted = {names[k]: _UNIT[k] for k in ("V", "v", "f") if k in names}
+    optional = [names["V"]] if "V" in names else []
+    if sigma:
+        wanted["sigma"] = "N"
+        optional.append("sigma")
+    cols = read_columns(path, wanted, where=where, delimiter=delimiter, optional=tuple(optional), stated=stated,
                         exact=exact, expected=expected)
     v, f, lines = cols[names["v"]], cols[names["f"]], cols["line"]
+    sd = cols.get("sigma") if sigma else None
+    extra: tuple = (sd,) if sigma else ()
     if "V" not in names or names["V"] not in cols:
-        return [(None, v, f, lines)]
+        return [(None, v, f, lines, *extra)]
     Vs = cols[names["V"]]
     nonfinite = np.flatnonzero(~np.isfinite(Vs))
     if nonfinite.size:
         i = int(nonfinite[0])
         raise ValueError(f"{where} line {lines[i]} (V): must be finite, got {float(Vs[i])!r}")
-    out: list[tuple[float | None, np.ndarray, np.ndarray, np.ndarray]] = []
+    out: list[tuple[Any, ...]] = []
     for V in dict.fromkeys(Vs.tolist()):
         sel = Vs == V
-        out.append((float(V), v[sel], f[sel], lines[sel]))
+        out.append((float(V), v[sel], f[sel], lines[sel], *((None if sd is None else sd[sel]),)[:len(extra)]))
     return out
 
 
@@ -107,6 +116,6 @@ def from_csv(cls: Any, path: Any, columns: Any, delimiter: str | None, where: st
     try:
         if len(tables) == 1 and tables[0][0] is None:
             return cls.tabulated(tables[0][1], tables[0][2])
-        return cls.tabulated(tables=[(V, v, f) for V, v, f, _ in tables])
+        return cls.tabulated(tables=[(V, v, f) for V, v, f, *_ in tables])
     except (ValueError, TypeError) as exc:
         raise ValueError(f"{label}: {with_line(str(exc), tables)}") from None

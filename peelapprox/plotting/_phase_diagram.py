@@ -25,6 +25,38 @@ def cell_edges(x: np.ndarray, log: bool = False) -> np.ndarray:
     return 10.0 ** e if log else e
 
 
+def _label(result: Any, key: str) -> str:
+    """The colour bar's label: the key's description and unit where the result describes its keys (a sweep's
+    ``describe``), else the key."""
+    describe = getattr(result, "describe", None)
+    if describe is None:
+        return key
+    unit, text = describe(key)
+    return f"{text} [{unit}]" if unit else text
+
+
+def _mark_missing(ax: Any, result: Any, vals: np.ndarray, I: np.ndarray, V: np.ndarray, oi: np.ndarray,
+                  ov: np.ndarray) -> None:
+    """An "x" on each blank cell whose point has a record (a breakdown, a failed measure), with its status in a
+    legend: a white cell is explained, not left to guess."""
+    try:
+        status = result.values("status")[np.ix_(oi, ov)]
+    except (KeyError, ValueError, AttributeError):
+        return
+    blank = ~np.isfinite(np.asarray(vals, dtype=float))
+    seen: dict[str, list[tuple[float, float]]] = {}
+    for i, j in zip(*np.nonzero(blank)):
+        st = status[i, j]
+        if st is not None and st != "ok":
+            seen.setdefault(str(st), []).append((float(V[j]), float(I[i])))
+    for n, (st, pts) in enumerate(seen.items()):
+        xs, ys = zip(*pts)
+        ax.scatter(xs, ys, marker="x", s=30, color=("0.3", "tab:red", "tab:orange", "tab:purple")[n % 4],
+                   label=f"no value: {st}")
+    if seen:
+        ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.12), fontsize=8, frameon=False)
+
+
 def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I: bool = True,
                        log_V: bool = False, title: str | None = None, ax: Any = None, fig: Any = None):
     """A sweep quantity over the (V, I) plane, one cell per grid point (pcolormesh).
@@ -83,7 +115,8 @@ def plot_phase_diagram(result: Any, key: str, path: str | None = None, *, log_I:
     else:
         cmap = colormaps["viridis"].with_extremes(bad="white")
         mesh = ax.pcolormesh(VE, IE, np.ma.masked_invalid(vals), cmap=cmap, edgecolors="face")
-        fig.colorbar(mesh, ax=ax, label=key)
+        fig.colorbar(mesh, ax=ax, label=_label(result, key))
+        _mark_missing(ax, result, vals, I, V, oi, ov)
     if log_I:
         ax.set_yscale("log")
     if log_V:
