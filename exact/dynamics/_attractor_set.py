@@ -109,8 +109,9 @@ def attractor_set(
         (the first start's first among equals); the others stay ``"aperiodic"`` with a note.  An exponent costs
         about three windowed runs.
     workers : int, optional
-        Without ``executor``: 0 runs the starts in this process, n > 0 on n threads (the compiled kernels release
-        the GIL); None one thread per CPU available, at most one per start.
+        Without ``executor``: 0 runs the starts in this process, n > 0 on n workers of the local pool of
+        :mod:`peelapprox.parallel` (``"auto"``: processes on more than two CPUs, threads on one or two); None one
+        worker per CPU available, at most one per start.  The result does not depend on it.
     executor : concurrent.futures.Executor, optional
         Runs the starts (any executor: a process pool, a shared pool, dask's), left running.
     progress : bool or callable, optional

@@ -6,14 +6,14 @@ an executor) and all of them in the order of the starts under the call's deadlin
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import Executor, ThreadPoolExecutor
+from concurrent.futures import Executor
 from typing import Any
 
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, SolverFailure
 from peelapprox.errors import WallBudget
+from peelapprox.parallel import AUTO, worker_pool
 
 from .._initial import initial_state
 from .._simulate import simulate
@@ -168,20 +168,24 @@ def run_all(params: PeelParams, starts: list[SetStart], t_transient: float, t_wi
                 results.append(_lost(exc, "this start's run raised"))
             note(k, k + 1, results[-1])
         return results
-    own = executor is None
-    if executor is None:
-        n = workers or (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-        executor = ThreadPoolExecutor(max_workers=max(1, min(n, total)), thread_name_prefix="peelapprox-attset")
-    try:
-        futs = [executor.submit(run_start, *a) for a in args]
-        for k, f in enumerate(futs):
-            try:
-                res = f.result()
-            except Exception as exc:  # the executor lost the start: an outcome, not an exception
-                res = _lost(exc, "the executor lost this start")
-            results.append(res)
-            note(k, k + 1, res)
-        return results
-    finally:
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+    if executor is not None:
+        return _collect(executor, args, note)
+    with worker_pool(AUTO, workers, n_tasks=total) as (pool, _kind, _n):
+        if pool is None:  # one CPU, or inside a worker: no nested pool
+            return run_all(params, starts, t_transient, t_window, rtol, deadline, 0, None, say)
+        return _collect(pool, args, note)
+
+
+def _collect(executor: Executor, args: list[tuple], note: Callable[[int, int, dict[str, Any]], None]
+             ) -> list[dict[str, Any]]:
+    """The starts' runs on ``executor``, in the order of ``args``; a start the executor lost is an outcome."""
+    results: list[dict[str, Any]] = []
+    futs = [executor.submit(run_start, *a) for a in args]
+    for k, f in enumerate(futs):
+        try:
+            res = f.result()
+        except Exception as exc:  # the executor lost the start: an outcome, not an exception
+            res = _lost(exc, "the executor lost this start")
+        results.append(res)
+        note(k, k + 1, res)
+    return results
