@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from peelapprox import BurstCatalogue, ForceSeries, FrontParams, burst_catalogue, front_pattern
+from peelapprox import ForceSeries, FrontParams, front_pattern
 from peelapprox.io import optional_import
 
 from .._trajectory import Jumps, SolverStats
+
+if TYPE_CHECKING:  # the burst statistics load scipy.stats: imported when bursts() is called
+    from peelapprox import BurstCatalogue
 
 __all__ = ["FrontTrajectory", "LocalSwitches"]
 
@@ -163,6 +166,8 @@ class FrontTrajectory:
             level = float(threshold)
             if not np.isfinite(level) or level < 0:
                 raise ValueError(f"threshold must be a finite AE power >= 0 [W] or None, got {threshold!r}")
+        from peelapprox import burst_catalogue
+
         cat = burst_catalogue(self.t, self.ae_power, threshold=level, min_gap=min_gap)
         return dataclasses.replace(cat, source=f"AE power of simulate_front (N={self.params.N}); {cat.source}")
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import integrate, optimize, stats
+from scipy import integrate, optimize, special
 
 __all__ = ["MAX_TERMS", "discrete_alternative"]
 
@@ -40,7 +40,7 @@ def _lognormal(k: np.ndarray, kmin: int, kmax: float) -> tuple[np.ndarray, dict,
     def log_z(mu: float, sig: float) -> float:
         def tail(a: float, b: float) -> float:
             za, zb = (math.log(a) - mu) / sig, (math.log(b) - mu) / sig if math.isfinite(b) else math.inf
-            return sig * math.sqrt(2 * math.pi) * float(stats.norm.sf(za) - (stats.norm.sf(zb) if zb < math.inf
+            return sig * math.sqrt(2 * math.pi) * float(special.ndtr(-za) - (special.ndtr(-zb) if zb < math.inf
                                                                               else 0.0))
         return _log_sum(lambda x: -np.log(x) - 0.5 * ((np.log(x) - mu) / sig) ** 2, kmin, kmax, tail)
 
