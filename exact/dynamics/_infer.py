@@ -12,6 +12,10 @@ several (one series per V).
   a grid over ``params0 / search`` to ``params0 · search`` (ln θ for I, k, R; ±30 % for coefficients; at most
   :data:`GRID_RUNS` points per series), then :func:`scipy.optimize.least_squares` from the grid's best point,
   and from the next best ones (:data:`STARTS` in all) while the fit's χ² is improbable (:data:`GOOD_FIT`).
+  Where the 95 % interval (below) reaches a side of the box, that side moves out by the initial half-width (at
+  the grid's node spacing, within :data:`peelapprox.PARAM_RANGES`), the new nodes are evaluated and the fit
+  repeated, at most :data:`MAX_EXTEND` times: a verdict "the edge of the search" then means the data, not the
+  box.
 * **Intervals.**  95 %, the union of two: the profile of every evaluated point (the parameter's range among the
   points with χ² ≤ χ²_min + 3.84 · s, s = max(1, χ²_min/dof)) and the Jacobian's at the optimum (±1.96
   standard errors of ``s (JᵀJ)⁻¹``).  A parameter is *not identified* when that interval spans more than a
@@ -36,7 +40,7 @@ from peelapprox.validate import choice, positive
 
 from ._infer_stats import OBSERVABLES, data_statistics, model_statistics
 
-__all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "POOR_FIT", "STARTS", "infer"]
+__all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "MAX_EXTEND", "POOR_FIT", "STARTS", "infer"]
 
 #: The most grid points of the search per series (an odd number per axis, params0 at the centre: 9 x 9 for two
 #: parameters).
@@ -51,6 +55,11 @@ DIFF_STEP = 1e-3
 #: best node can end in a neighbouring window (V = 1, I = 1e-2: χ² = 18.8 on 5 dof at I -3 %, k -2 %, where the
 #: truth gives 0.01).
 STARTS = 3
+#: The most times the search box is extended (each side the 95 % interval reaches moved out by the initial
+#: half-width, within :data:`peelapprox.PARAM_RANGES`) before a verdict: a start a factor 3 off puts the truth
+#: on the initial box's edge, and "not identified: the edge of the search" would then describe the box, not the
+#: data.
+MAX_EXTEND = 3
 #: The χ² probability from which a fit needs no further start (:data:`STARTS`).
 GOOD_FIT = 0.05
 #: The parameters fitted in ln θ (positive, spanning decades); the others, a law's coefficients, in θ.
@@ -185,15 +194,74 @@ def _apply(params0: PeelParams, names: list[str], x: np.ndarray, V: float) -> Pe
 
 
 def _grid(names: list[str], x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, search: float, n_series: int
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The search grid (module docstring) and its box ``(low, high)`` per parameter, in fitted coordinates."""
+          ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The search grid's nodes per axis (module docstring) and its box ``(low, high)`` per parameter, in fitted
+    coordinates."""
     half = np.array([math.log(search) if n in _LOG else 0.3 * max(abs(x), 1e-12) for n, x in zip(names, x0)])
     box_lo, box_hi = np.maximum(x0 - half, lo), np.minimum(x0 + half, hi)
     per = max(3, int(math.floor((GRID_RUNS / max(n_series, 1)) ** (1.0 / len(names)) + 1e-9)))
     per = min(per - (per % 2 == 0), 9)  # odd: params0 is a node
-    axes = [np.linspace(a, b, per) for a, b in zip(box_lo, box_hi)]
-    pts = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(names), -1).T
-    return pts, box_lo, box_hi
+    return [np.linspace(a, b, per) for a, b in zip(box_lo, box_hi)], box_lo, box_hi
+
+
+def _nodes(axes: list[np.ndarray]) -> np.ndarray:
+    """Every point of the grid whose nodes per axis are ``axes``."""
+    return np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
+
+
+def _spans(names: list[str], evaluated: list, jac: np.ndarray | None, n_obs: int
+           ) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The best evaluated point, its χ², the scale s, the 95 % interval ``(low, high)`` per parameter in fitted
+    coordinates (module docstring: the union of the profile and the Jacobian's) and the covariance (or None)."""
+    dof = n_obs - len(names)
+    x, chi2, _ = min(evaluated, key=lambda e: e[1])
+    s = max(1.0, chi2 / dof) if dof > 0 else 1.0
+    accept = np.array([e[0] for e in evaluated if e[1] <= chi2 + 3.84 * s])
+    lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
+    cov = None if jac is None else np.linalg.pinv(jac.T @ jac) * s
+    if cov is not None:
+        for i in range(len(names)):
+            if math.isfinite(float(cov[i, i])) and cov[i, i] > 0:
+                se = math.sqrt(float(cov[i, i]))
+                lo_[i], hi_[i] = min(lo_[i], x[i] - 1.96 * se), max(hi_[i], x[i] + 1.96 * se)
+    return np.asarray(x), float(chi2), s, lo_, hi_, cov
+
+
+def _edge_sides(names: list[str], evaluated: list, jac: np.ndarray | None, n_obs: int, box: tuple,
+                limits: tuple) -> list[tuple[int, int]]:
+    """The box's sides ``(parameter index, -1 low / +1 high)`` that the 95 % interval reaches and that can still
+    move outwards within :data:`peelapprox.PARAM_RANGES`."""
+    _, _, _, lo_, hi_, _ = _spans(names, evaluated, jac, n_obs)
+    out = []
+    for i in range(len(names)):
+        if lo_[i] <= box[0][i] + 1e-12 and box[0][i] > limits[0][i] + 1e-12:
+            out.append((i, -1))
+        if hi_[i] >= box[1][i] - 1e-12 and box[1][i] < limits[1][i] - 1e-12:
+            out.append((i, 1))
+    return out
+
+
+def _extend(names: list[str], axes: list[np.ndarray], box_lo: np.ndarray, box_hi: np.ndarray,
+            sides: list[tuple[int, int]], limits: tuple, search: float
+            ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The grid with each side in ``sides`` moved outwards by the initial half-width (a factor ``search`` for
+    I, k, R; 30 % of the value for a coefficient), within the limits, at the axis' node spacing: the new nodes
+    with the other axes' nodes are the points evaluated next."""
+    axes, box_lo, box_hi = [a.copy() for a in axes], box_lo.copy(), box_hi.copy()
+    for i, side in sides:
+        a = axes[i]
+        step = float(a[1] - a[0]) if a.size > 1 else 0.1
+        width = math.log(search) if names[i] in _LOG else 0.3 * max(abs(float(a[a.size // 2])), 1e-12)
+        n = max(1, int(math.ceil(width / step - 1e-9)))
+        if side < 0:
+            new = np.maximum(a[0] - step * np.arange(n, 0, -1), limits[0][i])
+            axes[i] = np.unique(np.concatenate([new, a]))
+            box_lo[i] = axes[i][0]
+        else:
+            new = np.minimum(a[-1] + step * np.arange(1, n + 1), limits[1][i])
+            axes[i] = np.unique(np.concatenate([a, new]))
+            box_hi[i] = axes[i][-1]
+    return axes, box_lo, box_hi
 
 
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
@@ -297,24 +365,40 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
                      + ", ".join(f"{n} = {fmt_number(v, 5)}" for n, v in zip(names, _values(names, x))))
         return res
 
-    grid, box_lo, box_hi = _grid(names, x0, lo, hi, search, len(all_series))
-    status, message, jac = "converged", "", None
+    axes, box_lo, box_hi = _grid(names, x0, lo, hi, search, len(all_series))
+    status, message, jac, n_extended = "converged", "", None, 0
     try:
-        for x in grid:
-            residuals(x)
-        best = None
-        for start, _, _ in sorted(evaluated, key=lambda e: e[1])[:STARTS]:
-            sol = least_squares(residuals, start, bounds=(box_lo, box_hi), diff_step=DIFF_STEP, max_nfev=100)
-            if best is None or sol.cost < best.cost:
-                best = sol
-            if chi2_dist.sf(2.0 * best.cost, max(n_obs - len(names), 1)) >= GOOD_FIT:
+        while True:
+            for x in _nodes(axes):
+                if not any(np.allclose(x, e[0], rtol=0.0, atol=1e-9) for e in evaluated):
+                    residuals(x)
+            best = None
+            for start, _, _ in sorted(evaluated, key=lambda e: e[1])[:STARTS]:
+                sol = least_squares(residuals, np.clip(start, box_lo, box_hi), bounds=(box_lo, box_hi),
+                                    diff_step=DIFF_STEP, max_nfev=100)
+                if best is None or sol.cost < best.cost:
+                    best = sol
+                if chi2_dist.sf(2.0 * best.cost, max(n_obs - len(names), 1)) >= GOOD_FIT:
+                    break
+            assert best is not None  # the grid has at least 3 points
+            jac = best.jac
+            status = "converged" if best.success else "failed"
+            message = str(best.message)
+            if n_extended >= MAX_EXTEND:
                 break
-        assert best is not None  # the grid has at least 3 points
-        jac = best.jac
-        status = "converged" if best.success else "failed"
-        message = str(best.message)
+            sides = _edge_sides(names, evaluated, jac, n_obs, (box_lo, box_hi), (lo, hi))
+            if not sides:
+                break
+            axes, box_lo, box_hi = _extend(names, axes, box_lo, box_hi, sides, (lo, hi), search)
+            n_extended += 1
+            if progress is not None:
+                progress("infer: points as good as the best reach the edge of the search; the box extended to "
+                         + ", ".join(f"{n} in [{fmt_number(a, 4)}, {fmt_number(b, 4)}]" for n, a, b in
+                                     zip(names, _values(names, box_lo), _values(names, box_hi))))
     except _Spent:
         status, message = "budget", f"max_wall = {fmt_number(max_wall, 3)} s spent; the best point so far"
+    if n_extended:
+        message += (f" (the search box extended {n_extended} time(s): the best points reached its edge)")
     return _result(params0, names, sel, jac, evaluated, (box_lo, box_hi), data, Vs, status, message,
                    time.perf_counter() - t_wall, n_obs, notes)
 
@@ -331,28 +415,22 @@ def _result(params0: PeelParams, names: list[str], sel: np.ndarray, jac: np.ndar
     from scipy.stats import chi2 as chi2_dist
 
     dof = n_obs - len(names)
-    x, chi2, model = min(evaluated, key=lambda e: e[1]) if evaluated else (None, math.inf, None)
-    if x is None:
+    if not evaluated:
         raise ValueError("max_wall was spent before the first model run: give a larger max_wall")
-    s = max(1.0, chi2 / dof) if dof > 0 else 1.0
+    x, chi2, s, lo_all, hi_all, cov = _spans(names, evaluated, jac, n_obs)
+    model = min(evaluated, key=lambda e: e[1])[2]
     # as many statistics as parameters (dof 0) should fit exactly: judge its χ² as on one degree of freedom
     p_fit = float(chi2_dist.sf(chi2, max(dof, 1)))
     poor = p_fit < POOR_FIT
-    accept = [e[0] for e in evaluated if e[1] <= chi2 + 3.84 * s]
     values = dict(zip(names, _values(names, x)))
     stderr: dict[str, float | None] = dict.fromkeys(names)
     intervals: dict[str, tuple[float, float] | None] = {}
     identified = dict.fromkeys(names, False)
     verdicts: dict[str, str] = {}
-    cov = None
-    if jac is not None:
-        cov = np.linalg.pinv(jac.T @ jac) * s
     for i, name in enumerate(names):
-        lo_i, hi_i = min(a[i] for a in accept), max(a[i] for a in accept)
+        lo_i, hi_i = float(lo_all[i]), float(hi_all[i])
         if cov is not None and math.isfinite(float(cov[i, i])) and cov[i, i] > 0:
-            se = math.sqrt(float(cov[i, i]))
-            stderr[name] = se
-            lo_i, hi_i = min(lo_i, x[i] - 1.96 * se), max(hi_i, x[i] + 1.96 * se)
+            stderr[name] = math.sqrt(float(cov[i, i]))
         edge = lo_i <= box[0][i] + 1e-12 or hi_i >= box[1][i] - 1e-12
         log = name in _LOG
         intervals[name] = (math.exp(lo_i), math.exp(hi_i)) if log else (float(lo_i), float(hi_i))
