@@ -68,6 +68,26 @@ def test_the_box_stops_at_the_parameter_range():
     assert new[0].size == 13 and np.allclose(np.diff(new[0]), np.log(3.0) / 4)
 
 
+def test_the_closest_attractor_of_the_set_is_read():
+    """Hypothesis (issue 35, item 4): at V = 1, I = 1e-5 the solver's start and the rest start reach the period-3
+    orbit, alpha0 = -0.3 the period-1 (exact.attractor_set). Given a trace of the period-1 attractor, the set's
+    reading over the first three starts picks alpha0 = -0.3, labels it period-1, and its statistics equal the data's
+    within 3 sigma (the same orbit; the data carry another noise draw and a drift); from the solver's start
+    alone the reading is period-3, off by more than 3 sigma (slip interval 0.080 vs 0.071 s: 6 sigma)."""
+    from exact.dynamics._infer_stats import data_statistics, set_statistics
+
+    p = PeelParams(V=1.0, I=1e-5)
+    tr = exact.simulate(p, 35.0, alpha0=-0.3, t_eval=30.0 + np.arange(50000) / 1e4)
+    s = tr.as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    vals, sig, threshold, noise, used = data_statistics(s)
+    r = set_statistics(p, s, threshold, noise, 30.0, 1e-10, 120.0, (vals, sig, used), 3)
+    assert r.start == "alpha0=-0.3" and r.label == "period-1" and r.n_runs == 3
+    assert r.values is not None and np.all(np.abs((r.values - vals) / sig)[used] <= 3.0)
+    one = set_statistics(p, s, threshold, noise, 30.0, 1e-10, 120.0, (vals, sig, used), 1)
+    assert one.start == "solver" and one.label == "period-3" and one.n_runs == 1
+    assert one.values is not None and abs(one.values[0] - vals[0]) > 3.0 * sig[0]
+
+
 @pytest.mark.slow
 def test_I_and_k_at_high_inertia(high_inertia):
     """Hypothesis (the stated goal): at V = 1, I = 1e-2 (period 8) I is recovered within 10 % and k within 5 %
@@ -118,6 +138,8 @@ def test_bad_input_is_named(high_inertia):
         (dict(series=high_inertia, params0=p0, free=("k",), search=1.0), ValueError, "search"),
         (dict(series=high_inertia, params0=p0, free=("k",), statistics=("period",)), ValueError, "statistics"),
         (dict(series=high_inertia, params0=p0, free=("k",), max_wall=0.0), ValueError, "max_wall"),
+        (dict(series=high_inertia, params0=p0, free=("k",), attractors=0), ValueError, "attractors"),
+        (dict(series=high_inertia, params0=p0, free=("k",), attractors=9), ValueError, "attractors"),
     ]
     for kwargs, error, match in cases:
         with pytest.raises(error, match=match):

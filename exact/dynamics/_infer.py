@@ -26,6 +26,7 @@ several (one series per V).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -38,7 +39,7 @@ from peelapprox import PARAM_RANGES, ForceSeries, PeelParams
 from peelapprox.io import fmt_number, jsonable
 from peelapprox.validate import choice, positive
 
-from ._infer_stats import OBSERVABLES, data_statistics, model_statistics
+from ._infer_stats import OBSERVABLES, SetReading, data_statistics, set_statistics
 
 __all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "MAX_EXTEND", "POOR_FIT", "STARTS", "infer"]
 
@@ -95,6 +96,9 @@ class Inference:
         Seconds.
     notes : tuple of str
         What was left out and why (a statistic a series does not carry).
+    attractors : tuple of str
+        Per series, the attractor of the best point's set the fit is on: its label, the start that reaches it
+        and its share of the set's starts (:func:`exact.attractor_set`'s design).
     """
 
     params: PeelParams
@@ -111,6 +115,7 @@ class Inference:
     n_evaluations: int
     wall_time: float
     notes: tuple[str, ...] = ()
+    attractors: tuple[str, ...] = ()
 
     def report(self) -> str:
         """A plain-text report: each parameter with its interval or why it is not identified, the fit's χ²
@@ -121,6 +126,7 @@ class Inference:
             iv = self.intervals[name]
             span = "" if iv is None else f", 95 % in [{fmt_number(iv[0], 4)}, {fmt_number(iv[1], 4)}]"
             lines.append(f"  {name} = {fmt_number(value, 5)}{span}: {self.verdicts[name]}")
+        lines += [f"  attractor: {a}" for a in self.attractors]
         lines += [f"  note: {n}" for n in self.notes]
         for r in self.residuals:
             lines.append(f"  V = {fmt_number(r['V'], 4)} m/s {r['observable']}: data {fmt_number(r['data'], 5)} "
@@ -214,7 +220,7 @@ def _spans(names: list[str], evaluated: list, jac: np.ndarray | None, n_obs: int
     """The best evaluated point, its χ², the scale s, the 95 % interval ``(low, high)`` per parameter in fitted
     coordinates (module docstring: the union of the profile and the Jacobian's) and the covariance (or None)."""
     dof = n_obs - len(names)
-    x, chi2, _ = min(evaluated, key=lambda e: e[1])
+    x, chi2 = min(evaluated, key=lambda e: e[1])[:2]
     s = max(1.0, chi2 / dof) if dof > 0 else 1.0
     accept = np.array([e[0] for e in evaluated if e[1] <= chi2 + 3.84 * s])
     lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
@@ -266,7 +272,7 @@ def _extend(names: list[str], axes: list[np.ndarray], box_lo: np.ndarray, box_hi
 
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
           more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
-          t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0,
+          t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0, attractors: int = 3,
           progress: Callable[[str], None] | None = None) -> Inference:
     """The model's parameters whose force traces read like the measured ones (module docstring).
 
@@ -293,6 +299,11 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         Of every model run (1e-10).
     max_wall : float
         Wall-clock budget [s] (600): at its end the best point so far is returned with status ``"budget"``.
+    attractors : int
+        At each trial point, the statistics are those of the attractor closest to the data among those reached
+        from the first ``attractors`` starts of :func:`exact.attractor_set`'s design (the solver's start first;
+        the further starts run only while none fits within 3 σ), in [1, 8] (3); 1: the solver's start alone.
+        At the best point every start of the design runs once, to name the attractor and its share.
     progress : callable, optional
         Called with a line of text after each model run.
 
@@ -327,6 +338,8 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     if search <= 1.0:
         raise ValueError(f"search must be in (1, 100], got {search!r}")
     t_transient = positive("t_transient", t_transient, hi=1e4)
+    if isinstance(attractors, bool) or not isinstance(attractors, (int, np.integer)) or not 1 <= attractors <= 8:
+        raise ValueError(f"attractors must be an integer in [1, 8], got {attractors!r}")
     data = [data_statistics(s) for s in all_series]
     notes = tuple(f"f_cycle is not fitted at V = {fmt_number(float(s.V), 4)} m/s: no line of a period-n cycle "
                   "stands out of its periodogram (a period-1 trace)"
@@ -342,7 +355,7 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     lo = np.array([math.log(PARAM_RANGES[n][0]) if n in _LOG else -np.inf for n in names])
     hi = np.array([math.log(PARAM_RANGES[n][1]) if n in _LOG else np.inf for n in names])
     x0 = np.clip(x0, lo, hi)
-    evaluated: list[tuple[np.ndarray, float, list]] = []
+    evaluated: list[tuple[np.ndarray, float, list, list]] = []
 
     class _Spent(Exception):
         pass
@@ -353,13 +366,19 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
             raise _Spent
         out: list[np.ndarray] = []
         models: list[np.ndarray | None] = []
+        readings: list[SetReading] = []
         for s, V, (vals, sig, threshold, noise, used) in zip(all_series, Vs, data):
-            m = model_statistics(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol, max(1.0, left))
+            use_mask = np.zeros(len(OBSERVABLES), dtype=bool)
+            use_mask[sel[used[sel]]] = True
+            r = set_statistics(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol, max(1.0, left),
+                               (vals, sig, use_mask), int(attractors))
+            m = r.values
             use = sel[used[sel]]
             out.append(np.full(use.size, _PENALTY) if m is None else ((m - vals) / sig)[use])
             models.append(m)
+            readings.append(r)
         res = np.concatenate(out)
-        evaluated.append((np.array(x), float(res @ res), models))
+        evaluated.append((np.array(x), float(res @ res), models, readings))
         if progress is not None:
             progress(f"infer: run {len(evaluated)}, chi2 = {fmt_number(evaluated[-1][1], 4)} at "
                      + ", ".join(f"{n} = {fmt_number(v, 5)}" for n, v in zip(names, _values(names, x))))
@@ -373,7 +392,7 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
                 if not any(np.allclose(x, e[0], rtol=0.0, atol=1e-9) for e in evaluated):
                     residuals(x)
             best = None
-            for start, _, _ in sorted(evaluated, key=lambda e: e[1])[:STARTS]:
+            for start, *_ in sorted(evaluated, key=lambda e: e[1])[:STARTS]:
                 sol = least_squares(residuals, np.clip(start, box_lo, box_hi), bounds=(box_lo, box_hi),
                                     diff_step=DIFF_STEP, max_nfev=100)
                 if best is None or sol.cost < best.cost:
@@ -399,8 +418,50 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         status, message = "budget", f"max_wall = {fmt_number(max_wall, 3)} s spent; the best point so far"
     if n_extended:
         message += (f" (the search box extended {n_extended} time(s): the best points reached its edge)")
-    return _result(params0, names, sel, jac, evaluated, (box_lo, box_hi), data, Vs, status, message,
-                   time.perf_counter() - t_wall, n_obs, notes)
+    shares = _shares(evaluated, all_series, data, sel, Vs, params0, names, t_transient, rtol,
+                     max_wall - (time.perf_counter() - t_wall))
+    res = _result(params0, names, sel, jac, evaluated, (box_lo, box_hi), data, Vs, status, message,
+                  time.perf_counter() - t_wall, n_obs, notes)
+    runs = sum(r.n_runs for e in evaluated for r in e[3]) + sum(r.n_runs for r in shares if r is not None)
+    names_ = _attractor_lines(evaluated, shares, Vs)
+    return dataclasses.replace(res, n_evaluations=runs, attractors=names_,
+                               verdicts={k: f"{v}; {'; '.join(names_)}" for k, v in res.verdicts.items()})
+
+
+def _shares(evaluated: list, all_series: list, data: list, sel: np.ndarray, Vs: list[float], params0: PeelParams,
+            names: list[str],
+            t_transient: float, rtol: float, left: float) -> list[SetReading | None]:
+    """At the best point, per series, the whole design of starts (:func:`set_statistics` with ``share``); None
+    where the budget is spent."""
+    if not evaluated:
+        return []
+    x = min(evaluated, key=lambda e: e[1])[0]
+    t0, out = time.perf_counter(), list[SetReading | None]()
+    for s, V, (vals, sig, threshold, noise, used) in zip(all_series, Vs, data):
+        spent = time.perf_counter() - t0
+        if left - spent <= 1.0:
+            out.append(None)
+            continue
+        use_mask = np.zeros(len(OBSERVABLES), dtype=bool)
+        use_mask[sel[used[sel]]] = True
+        out.append(set_statistics(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol,
+                                  left - spent, (vals, sig, use_mask), 8, share=True))
+    return out
+
+
+def _attractor_lines(evaluated: list, shares: list[SetReading | None], Vs: list[float]) -> tuple[str, ...]:
+    """Per series, the attractor the best point's statistics are read from, the start reaching it and its
+    share of the set's starts."""
+    if not evaluated:
+        return ()
+    best = min(evaluated, key=lambda e: e[1])[3]
+    out = []
+    padded: list[SetReading | None] = [*shares, *([None] * (len(best) - len(shares)))]
+    for V, r, full in zip(Vs, best, padded):
+        share = ("its share of the set's starts not measured (max_wall spent)" if full is None or full.share is None
+                 else f"share {fmt_number(100 * full.share, 3)} % of the set's {full.n_runs} starts")
+        out.append(f"at V = {fmt_number(V, 4)} m/s on the {r.label} attractor (from the start {r.start!r}; {share})")
+    return tuple(out)
 
 
 def _values(names: list[str], x: np.ndarray) -> list[float]:
