@@ -39,7 +39,7 @@ from peelapprox import PARAM_RANGES, ForceSeries, PeelParams
 from peelapprox.io import fmt_number, jsonable
 from peelapprox.validate import choice, positive
 
-from ._infer_stats import OBSERVABLES, SetReading, data_statistics, set_statistics
+from ._infer_stats import OBSERVABLES, REPEATABILITY, SetReading, data_statistics, replicate_spread, set_statistics
 
 __all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "MAX_EXTEND", "POOR_FIT", "STARTS", "infer"]
 
@@ -386,11 +386,17 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
 
     axes, box_lo, box_hi = _grid(names, x0, lo, hi, search, len(all_series))
     status, message, jac, n_extended = "converged", "", None, 0
+    aperiodic = [s.observables().period is None for s in all_series]
     try:
         while True:
             for x in _nodes(axes):
                 if not any(np.allclose(x, e[0], rtol=0.0, atol=1e-9) for e in evaluated):
                     residuals(x)
+            if n_extended == 0 and any(aperiodic):
+                data, n_obs, extra = _replicated(evaluated, all_series, data, aperiodic, sel, Vs, params0, names,
+                                                 t_transient, rtol, max_wall - (time.perf_counter() - t_wall),
+                                                 len(names))
+                notes += extra
             best = None
             for start, *_ in sorted(evaluated, key=lambda e: e[1])[:STARTS]:
                 sol = least_squares(residuals, np.clip(start, box_lo, box_hi), bounds=(box_lo, box_hi),
@@ -426,6 +432,45 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     names_ = _attractor_lines(evaluated, shares, Vs)
     return dataclasses.replace(res, n_evaluations=runs, attractors=names_,
                                verdicts={k: f"{v}; {'; '.join(names_)}" for k, v in res.verdicts.items()})
+
+
+def _replicated(evaluated: list, all_series: list, data: list, aperiodic: list[bool], sel: np.ndarray,
+                Vs: list[float], params0: PeelParams, names: list[str], t_transient: float, rtol: float, left: float,
+                n_free: int) -> tuple[list, int, tuple[str, ...]]:
+    """For each aperiodic series, the model's replicate spread at the best grid point (:func:`replicate_spread`)
+    added in quadrature to the statistics' σ (a diagonal synthetic likelihood, Wood 2010), and the cycle line
+    dropped where it is not stable across the replicates; the χ² of every point evaluated so far recomputed with
+    the new σ.  Returns the data, the number of fitted statistics and the notes."""
+    x = min(evaluated, key=lambda e: e[1])[0]
+    out, notes, t0 = [], [], time.perf_counter()
+    for k, (s, V, d) in enumerate(zip(all_series, Vs, data)):
+        vals, sig, threshold, noise, used = d
+        if not aperiodic[k] or left - (time.perf_counter() - t0) <= 1.0:
+            out.append(d)
+            continue
+        sd, stable, n = replicate_spread(_apply(params0, names, x, V), s, threshold, noise, t_transient, rtol,
+                                         left - (time.perf_counter() - t0))
+        if sd is None:
+            out.append(d)
+            continue
+        sig, used = np.hypot(sig, sd), used.copy()
+        notes.append(f"V = {fmt_number(V, 4)} m/s: an aperiodic trace; the model's spread over {n} replicates "
+                     "added to each statistic's sigma")
+        if used[_F_CYCLE] and not stable:
+            used[_F_CYCLE] = False
+            notes.append(f"f_cycle is not fitted at V = {fmt_number(V, 4)} m/s: the model's cycle line is not "
+                         f"stable across its replicates (absent in one, or spread over "
+                         f"{fmt_number(100 * REPEATABILITY['f_cycle'], 2)} %)")
+        out.append((vals, sig, threshold, noise, used))
+    n_obs = sum(int(np.count_nonzero(d[4][sel])) for d in out)
+    if n_obs < n_free:  # dropping the line would leave too few statistics: keep the former reading
+        return data, sum(int(np.count_nonzero(d[4][sel])) for d in data), ()
+    for i, e in enumerate(evaluated):
+        res = np.concatenate([np.full(int(np.count_nonzero(used[sel])), _PENALTY) if m is None
+                              else ((m - vals) / sig)[sel[used[sel]]]
+                              for m, (vals, sig, _, _, used) in zip(e[2], out)])
+        evaluated[i] = (e[0], float(res @ res), e[2], e[3])
+    return out, n_obs, tuple(notes)
 
 
 def _shares(evaluated: list, all_series: list, data: list, sel: np.ndarray, Vs: list[float], params0: PeelParams,

@@ -34,7 +34,7 @@ from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
 __all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SetReading", "data_statistics",
-           "model_statistics", "set_statistics", "trace_statistics"]
+           "model_statistics", "replicate_spread", "set_statistics", "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -145,16 +145,17 @@ def model_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise
 
 
 def _reading(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float, rtol: float,
-             max_wall: float, start: dict[str, Any]) -> tuple[np.ndarray | None, int | None]:
-    """:func:`model_statistics` and the return map's period of the model's trace (None: aperiodic or none)."""
+             max_wall: float, start: dict[str, Any]) -> tuple[np.ndarray | None, int | None, bool]:
+    """:func:`model_statistics`, the return map's period of the model's trace (None: aperiodic or none) and
+    whether its periodogram holds a cycle line."""
     t_eval = t_transient + (series.t - series.t[0])
     try:
         tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall, **start)
     except (ModelBreakdown, SolverBudgetExceeded, ValueError):  # ValueError: a start outside the model's domain
-        return None, None
+        return None, None, False
     F = tr.F + np.random.default_rng(NOISE_SEED).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
-    vals, o, _, _ = trace_statistics(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)
-    return vals, (o.period if vals is not None else None)
+    vals, o, line, _ = trace_statistics(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)
+    return vals, (o.period if vals is not None else None), line
 
 
 @dataclass(frozen=True)
@@ -191,7 +192,7 @@ def set_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: 
     chosen = starts[: (len(starts) if share else max(1, n_starts))]
     readings: list[tuple[float, str, np.ndarray | None, int | None]] = []
     for st in chosen:
-        m, period = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
+        m, period, _ = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
         cost = math.inf if m is None else float(np.sum((((m - vals) / sig)[used]) ** 2))
         readings.append((cost, st.name, m, period))
         if not share and m is not None and np.all(np.abs(((m - vals) / sig)[used]) <= CLOSE):
@@ -205,3 +206,25 @@ def set_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: 
             frac = sum(r[2] is not None and bool(np.all(np.abs(((r[2] - best[2]) / sig)[used]) <= 1.0))
                        for r in readings) / len(readings)
     return SetReading(best[2], best[1], best[3], len(readings), frac)
+
+
+def replicate_spread(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                     rtol: float, max_wall: float, n: int = 4) -> tuple[np.ndarray | None, bool, int]:
+    """The model's replicate spread at ``p`` for an aperiodic trace (a synthetic likelihood's covariance, Wood
+    2010, diagonal): the standard deviation of each statistic over the aperiodic traces reached from the first
+    ``n`` starts of :func:`exact.attractor_set`'s design (each a replicate: another phase of the same chaotic or
+    quasi-periodic attractor), whether the cycle line is stable across them (present in every one, its spread
+    within :data:`REPEATABILITY`) and how many replicates were read.  ``(None, False, m)`` with fewer than two
+    aperiodic replicates."""
+    reads = []
+    for st in default_starts(p)[:n]:
+        m, period, line = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
+        if m is not None and period is None:
+            reads.append((m, line))
+    if len(reads) < 2:
+        return None, False, len(reads)
+    arr = np.array([r[0] for r in reads])
+    sd = arr.std(axis=0, ddof=1)
+    j = OBSERVABLES.index("f_cycle")
+    stable = all(r[1] for r in reads) and sd[j] <= REPEATABILITY["f_cycle"] * abs(float(arr[:, j].mean()))
+    return sd, bool(stable), len(reads)
