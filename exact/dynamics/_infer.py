@@ -548,8 +548,9 @@ def _result(params0: PeelParams, names: list[str], sel: np.ndarray, jac: np.ndar
                               "describes the data")
         elif identified[name]:
             reach = max(x[i] - lo_i, hi_i - x[i])
-            verdicts[name] = (f"identified: 95 % within a factor {fmt_number(math.exp(reach), 3)}" if log
-                              else f"identified: 95 % within ± {fmt_number(reach, 3)}")
+            verdicts[name] = ((f"identified: 95 % within a factor {fmt_number(math.exp(reach), 3)}" if log
+                               else f"identified: 95 % within ± {fmt_number(reach, 3)}")
+                              + f" (chi2 = {fmt_number(chi2, 4)} on {dof} dof, probability {fmt_number(p_fit, 2)})")
         elif edge:
             verdicts[name] = ("not identified: points as good as the best reach the edge of the search "
                               f"[{fmt_number(_values([name], np.array([box[0][i]]))[0], 4)}, "
