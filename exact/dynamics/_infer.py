@@ -7,6 +7,11 @@ several (one series per V).
 
 * **Statistics and residuals** (``exact/dynamics/_infer_stats.py``): seven statistics of the trace, the model's
   read off an exact run sampled, noised and detected as the data were; residuals ``(model - data) / σ``.
+* **The attractor set.**  At each trial point the statistics are those of the attractor closest to the data
+  among those reached from the first ``attractors`` starts of :func:`exact.attractor_set`'s design
+  (:func:`set_statistics`); at the best point the whole design runs once to name that attractor and its share
+  (:attr:`Inference.attractors`).  For an aperiodic series the model's spread over replicates at the best grid
+  point joins each σ and the cycle line is kept only where it is stable across them (:func:`replicate_spread`).
 * **Search, then fit.**  An attractor's statistics are not smooth in the parameters (periodic windows,
   coexisting attractors), so a local fit alone finds a nearby minimum with an overconfident interval.  First
   a grid over ``params0 / search`` to ``params0 · search`` (ln θ for I, k, R; ±30 % for coefficients; at most
