@@ -179,3 +179,21 @@ def test_a_statistic_the_trace_does_not_carry_is_named():
         infer(s, p, ("k",), statistics=("f_cycle",))
     with pytest.raises(ValueError, match=r"statistics: 1 fitted statistic\(s\) for 2 free"):
         infer(s, p, ("I", "k"), statistics=("rise", "f_cycle"))
+
+
+def test_an_aperiodic_fit_needs_a_probable_chi2():
+    """The verdict's threshold: chi2 = 13 on 5 dof has probability 0.0233 (scipy.stats.chi2.sf; tables: 0.023),
+    above POOR_FIT (1e-3) and below GOOD_FIT (0.05).  With a tight interval inside the box the parameter is
+    identified for a periodic series (threshold POOR_FIT) and not for an aperiodic one (threshold GOOD_FIT: its
+    sigma rests on a few model replicates), and the verdict quotes the probability."""
+    from exact.dynamics._infer import GOOD_FIT, POOR_FIT, _result
+
+    x = np.log(1000.0)
+    model = np.ones(7)
+    evaluated = [(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
+    data = [(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool))]
+    box = (np.array([x - 1.0]), np.array([x + 1.0]))
+    args = (PeelParams(V=1.0, I=1e-2), ["k"], np.arange(7), None, evaluated, box, data, [1.0], "converged", "", 1.0, 6, ())
+    assert _result(*args, POOR_FIT).identified["k"]
+    strict = _result(*args, GOOD_FIT)
+    assert not strict.identified["k"] and "probability 0.023" in strict.verdicts["k"]
