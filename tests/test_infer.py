@@ -193,7 +193,8 @@ def test_an_aperiodic_fit_needs_a_probable_chi2():
     evaluated = [(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
     data = [(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool))]
     box = (np.array([x - 1.0]), np.array([x + 1.0]))
-    args = (PeelParams(V=1.0, I=1e-2), ["k"], np.arange(7), None, evaluated, box, data, [1.0], "converged", "", 1.0, 6, ())
+    args = (PeelParams(V=1.0, I=1e-2), ["k"], np.arange(7), None, evaluated, box, data, [1.0], "converged", "", 1.0,
+            6, ())
     assert _result(*args, POOR_FIT).identified["k"]
     strict = _result(*args, GOOD_FIT)
     assert not strict.identified["k"] and "probability 0.023" in strict.verdicts["k"]
