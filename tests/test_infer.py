@@ -39,6 +39,78 @@ def test_k_alone_is_recovered():
 
 
 @pytest.mark.slow
+def test_a_start_a_third_of_the_truth_extends_the_box():
+    """Hypothesis (issue 35, item 4): with I a factor 3 below the truth (V = 1, I = 1e-2, k known, 5 s of the
+    period-8 trace) the truth lies on the initial box's edge (params0 · search); the search extends the box
+    instead of calling I "not identified: ... the edge of the search", and recovers I within 10 % (the issue's
+    goal), identified, its 95 % interval inside the extended box and covering the truth (about 30 exact runs,
+    1-2 min)."""
+    res = infer(_trace(1.0, 1e-2, seconds=5.0), PeelParams(V=1.0, I=1e-2 / 3, k=1000.0), ("I",), max_wall=600)
+    assert "extended" in res.message, res.message
+    assert res.identified["I"], res.verdicts["I"]
+    assert abs(res.values["I"] / 1e-2 - 1) < 0.10
+    lo, hi = res.intervals["I"]
+    assert lo <= 1e-2 <= hi and hi > 1e-2 * 1.01
+
+
+def test_the_box_stops_at_the_parameter_range():
+    """The extension stays within PARAM_RANGES: a side at the range's limit does not move, an interior side
+    moves out by the initial half-width at the node spacing (a closed-form check of the helper)."""
+    from exact.dynamics._infer import _extend
+    from peelapprox import PARAM_RANGES
+
+    lo = np.array([np.log(PARAM_RANGES["I"][0])])
+    hi = np.array([np.log(PARAM_RANGES["I"][1])])
+    axes = [np.linspace(hi[0] - 2 * np.log(3.0), hi[0], 9)]
+    new, blo, bhi = _extend(["I"], axes, axes[0][:1].copy(), axes[0][-1:].copy(), [(0, 1), (0, -1)], (lo, hi), 3.0)
+    assert bhi[0] == hi[0]  # already at the limit: unchanged
+    assert np.isclose(blo[0], axes[0][0] - np.log(3.0))  # 4 nodes of spacing ln 3 / 4 below the old edge
+    assert new[0].size == 13 and np.allclose(np.diff(new[0]), np.log(3.0) / 4)
+
+
+def test_the_closest_attractor_of_the_set_is_read():
+    """Hypothesis (issue 35, item 4): at V = 1, I = 1e-5 the solver's start and the rest start reach the period-3
+    orbit, alpha0 = -0.3 the period-1 (exact.attractor_set). Given a trace of the period-1 attractor, the set's
+    reading over the first three starts picks alpha0 = -0.3, labels it period-1, and its statistics equal the data's
+    within 3 sigma (the same orbit; the data carry another noise draw and a drift); from the solver's start
+    alone the reading is period-3, off by more than 3 sigma (slip interval 0.080 vs 0.071 s: 6 sigma)."""
+    from exact.dynamics._infer_stats import data_statistics, set_statistics
+
+    p = PeelParams(V=1.0, I=1e-5)
+    tr = exact.simulate(p, 35.0, alpha0=-0.3, t_eval=30.0 + np.arange(50000) / 1e4)
+    s = tr.as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    vals, sig, threshold, noise, used = data_statistics(s)
+    r = set_statistics(p, s, threshold, noise, 30.0, 1e-10, 120.0, (vals, sig, used), 3)
+    assert r.start == "alpha0=-0.3" and r.label == "period-1" and r.n_runs == 3
+    assert r.values is not None and np.all(np.abs((r.values - vals) / sig)[used] <= 3.0)
+    one = set_statistics(p, s, threshold, noise, 30.0, 1e-10, 120.0, (vals, sig, used), 1)
+    assert one.start == "solver" and one.label == "period-3" and one.n_runs == 1
+    assert one.values is not None and abs(one.values[0] - vals[0]) > 3.0 * sig[0]
+
+
+def test_the_replicate_spread_of_a_chaotic_trace():
+    """Hypothesis (issue 35, item 4, synthetic likelihood): at the chaotic point V = 2.5, I = 1e-4 (5 s windows)
+    the model's spread over replicates (three starts of the attractor set's design, each another phase of the
+    attractor) of the window means of the slip interval, drop, stick and slip times matches the standard error
+    of the mean the data's own slips give (spread / sqrt(n - 1)) within a factor 4: the sd of three replicates
+    lies within [0.16, 1.92] of its true value at 95 % (chi-squared, 2 dof) and the slips' correlation makes the
+    standard error itself approximate (measured ratios 0.5-1.3).  The cycle line of a chaotic trace is not
+    stable across the replicates."""
+    from exact.dynamics._infer_stats import OBSERVABLES, data_statistics, replicate_spread
+
+    p = PeelParams(V=2.5, I=1e-4)
+    s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    o = s.observables()
+    assert o.period is None
+    vals, sig, threshold, noise, used = data_statistics(s)
+    sd, stable, n = replicate_spread(p, s, threshold, noise, 30.0, 1e-10, 120.0, 3)
+    assert sd is not None and n == 3 and not stable
+    for j, name in enumerate(OBSERVABLES[:4]):
+        sem = getattr(o, f"{name}_spread") / np.sqrt(o.n_slips - 1)
+        assert 0.25 <= sd[j] / sem <= 4.0, (name, sd[j], sem)
+
+
+@pytest.mark.slow
 def test_I_and_k_at_high_inertia(high_inertia):
     """Hypothesis (the stated goal): at V = 1, I = 1e-2 (period 8) I is recovered within 10 % and k within 5 %
     from a start at I = 1.3e-2, k = 900, both identified with 95 % intervals covering the truth (measured: I
@@ -88,6 +160,8 @@ def test_bad_input_is_named(high_inertia):
         (dict(series=high_inertia, params0=p0, free=("k",), search=1.0), ValueError, "search"),
         (dict(series=high_inertia, params0=p0, free=("k",), statistics=("period",)), ValueError, "statistics"),
         (dict(series=high_inertia, params0=p0, free=("k",), max_wall=0.0), ValueError, "max_wall"),
+        (dict(series=high_inertia, params0=p0, free=("k",), attractors=0), ValueError, "attractors"),
+        (dict(series=high_inertia, params0=p0, free=("k",), attractors=9), ValueError, "attractors"),
     ]
     for kwargs, error, match in cases:
         with pytest.raises(error, match=match):
@@ -105,3 +179,22 @@ def test_a_statistic_the_trace_does_not_carry_is_named():
         infer(s, p, ("k",), statistics=("f_cycle",))
     with pytest.raises(ValueError, match=r"statistics: 1 fitted statistic\(s\) for 2 free"):
         infer(s, p, ("I", "k"), statistics=("rise", "f_cycle"))
+
+
+def test_an_aperiodic_fit_needs_a_probable_chi2():
+    """The verdict's threshold: chi2 = 13 on 5 dof has probability 0.0233 (scipy.stats.chi2.sf; tables: 0.023),
+    above POOR_FIT (1e-3) and below GOOD_FIT (0.05).  With a tight interval inside the box the parameter is
+    identified for a periodic series (threshold POOR_FIT) and not for an aperiodic one (threshold GOOD_FIT: its
+    sigma rests on a few model replicates), and the verdict quotes the probability."""
+    from exact.dynamics._infer import GOOD_FIT, POOR_FIT, _result
+
+    x = np.log(1000.0)
+    model = np.ones(7)
+    evaluated = [(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
+    data = [(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool))]
+    box = (np.array([x - 1.0]), np.array([x + 1.0]))
+    args = (PeelParams(V=1.0, I=1e-2), ["k"], np.arange(7), None, evaluated, box, data, [1.0], "converged", "", 1.0,
+            6, ())
+    assert _result(*args, POOR_FIT).identified["k"]
+    strict = _result(*args, GOOD_FIT)
+    assert not strict.identified["k"] and "probability 0.023" in strict.verdicts["k"]

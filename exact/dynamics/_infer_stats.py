@@ -9,6 +9,10 @@
   (``t_transient`` seconds, then the series' duration at its sampling times) with white noise of the series'
   level added (σ of :meth:`ForceSeries.noise`, a fixed seed), by the same detector with the same threshold, so
   the detector's remaining biases under noise cancel.
+* **The attractor set** (:func:`set_statistics`).  A trial point may hold several attractors; the model's
+  statistics there are those of the attractor closest to the data among the ones reached from the first starts
+  of :func:`exact.attractor_set`'s design, each run sampled and read as above, so the data's attractor counts
+  even where its basin is a needle the solver's start misses.
 * **Residuals.**  ``(model - data) / σ``, σ the detector's repeatability under noise
   (:data:`REPEATABILITY`, relative, measured) and, for an aperiodic trace, the standard error of the mean in
   quadrature; a periodic trace's means are over whole cycles.
@@ -17,6 +21,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -26,9 +31,10 @@ from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded
 from peelapprox.io import fmt_number
 
 from .._simulate import simulate
+from ._attractor_set_runs import default_starts
 
-__all__ = ["LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "data_statistics", "model_statistics",
-           "trace_statistics"]
+__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SetReading", "data_statistics",
+           "model_statistics", "replicate_spread", "set_statistics", "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -45,6 +51,9 @@ REPEATABILITY = {"slip_interval": 0.02, "force_drop": 0.02, "stick_time": 0.02, 
 #: ln N / ln 2 times their median (17 for 1e5 bins; measured 10-12 on 20 s at 10 kHz with 0.5 N of noise), a
 #: period-3 orbit's line 4e6 times (V = 1 m/s, I = 1e-5, the same noise).
 LINE_RATIO = 100.0
+#: A start's trace fits the data well enough that the further starts of the set need not run when every fitted
+#: residual is within this many σ (a start far from the data's attractor is off by tens of σ).
+CLOSE = 3.0
 #: The seed of the noise added to every model trace (the same at every parameter point: the statistics move with
 #: the parameters, not with a new draw).
 NOISE_SEED = 20041
@@ -127,14 +136,95 @@ def data_statistics(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float,
 
 
 def model_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
-                     rtol: float, max_wall: float) -> np.ndarray | None:
+                     rtol: float, max_wall: float, **start: Any) -> np.ndarray | None:
     """The statistics of the model's trace at ``p``, sampled at the series' times after ``t_transient`` with
     white noise of the series' level added (a fixed seed), read with the series' threshold; None where it does
-    not stick-slip or breaks down."""
+    not stick-slip or breaks down.  ``start``: the initial state's keywords of :func:`exact.simulate` (the
+    solver's start if none)."""
+    return _reading(p, series, threshold, noise, t_transient, rtol, max_wall, start)[0]
+
+
+def _reading(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float, rtol: float,
+             max_wall: float, start: dict[str, Any]) -> tuple[np.ndarray | None, int | None, bool]:
+    """:func:`model_statistics`, the return map's period of the model's trace (None: aperiodic or none) and
+    whether its periodogram holds a cycle line."""
     t_eval = t_transient + (series.t - series.t[0])
     try:
-        tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall)
-    except (ModelBreakdown, SolverBudgetExceeded):
-        return None
+        tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall, **start)
+    except (ModelBreakdown, SolverBudgetExceeded, ValueError):  # ValueError: a start outside the model's domain
+        return None, None, False
     F = tr.F + np.random.default_rng(NOISE_SEED).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
-    return trace_statistics(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)[0]
+    vals, o, line, _ = trace_statistics(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)
+    return vals, (o.period if vals is not None else None), line
+
+
+@dataclass(frozen=True)
+class SetReading:
+    """The statistics of the attractor of a trial point's set closest to the data (:func:`set_statistics`)."""
+
+    values: np.ndarray | None
+    start: str
+    period: int | None
+    n_runs: int
+    share: float | None = None
+
+    @property
+    def label(self) -> str:
+        """``"period-n"``, ``"aperiodic"`` or ``"no stick-slip"``."""
+        if self.values is None:
+            return "no stick-slip"
+        return f"period-{self.period}" if self.period else "aperiodic"
+
+
+def set_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                   rtol: float, max_wall: float, target: tuple[np.ndarray, np.ndarray, np.ndarray], n_starts: int,
+                   *, share: bool = False) -> SetReading:
+    """The statistics of the attractor closest to the data among those reached from the first ``n_starts``
+    starts of :func:`exact.attractor_set`'s design (``default_starts``: the solver's start, the relaxation foot
+    at rest, α0 = -0.3, -0.15, ...), each trace sampled, noised and read as :func:`model_statistics`.
+
+    ``target`` is the data's ``(values, σ, used)``.  Closest: the smallest Σ ((model - data)/σ)² over the used
+    statistics; the starts stop at the first whose residuals are all within :data:`CLOSE` σ.  With ``share``
+    every start of the design runs, and the share is the fraction of them whose statistics lie within one σ of
+    the chosen one's (the same attractor: a periodic orbit's means over the window agree far closer)."""
+    vals, sig, used = target
+    starts = default_starts(p)
+    chosen = starts[: (len(starts) if share else max(1, n_starts))]
+    readings: list[tuple[float, str, np.ndarray | None, int | None]] = []
+    for st in chosen:
+        m, period, _ = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
+        cost = math.inf if m is None else float(np.sum((((m - vals) / sig)[used]) ** 2))
+        readings.append((cost, st.name, m, period))
+        if not share and m is not None and np.all(np.abs(((m - vals) / sig)[used]) <= CLOSE):
+            break
+    best = min(readings, key=lambda r: r[0])
+    frac = None
+    if share:
+        if best[2] is None:
+            frac = sum(r[2] is None for r in readings) / len(readings)
+        else:
+            frac = sum(r[2] is not None and bool(np.all(np.abs(((r[2] - best[2]) / sig)[used]) <= 1.0))
+                       for r in readings) / len(readings)
+    return SetReading(best[2], best[1], best[3], len(readings), frac)
+
+
+def replicate_spread(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                     rtol: float, max_wall: float, n: int = 4) -> tuple[np.ndarray | None, bool, int]:
+    """The model's replicate spread at ``p`` for an aperiodic trace (a synthetic likelihood's covariance, Wood
+    2010, diagonal): the standard deviation of each statistic over the aperiodic traces reached from the first
+    ``n`` starts of :func:`exact.attractor_set`'s design (each a replicate: another phase of the same chaotic or
+    quasi-periodic attractor), whether the cycle line is stable across them (present in every one, its spread
+    within :data:`REPEATABILITY`) and how many replicates were read.  ``(None, False, m)`` with fewer than two
+    aperiodic replicates."""
+    reads = []
+    for st in default_starts(p)[:n]:
+        m, period, line = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
+        if m is not None and period is None:
+            reads.append((m, line))
+    if len(reads) < 2:
+        return None, False, len(reads)
+    arr = np.array([r[0] for r in reads])
+    sd = arr.std(axis=0, ddof=1)
+    j = OBSERVABLES.index("f_cycle")
+    stable = all(r[1] for r in reads) and sd[j] <= REPEATABILITY["f_cycle"] * abs(float(arr[:, j].mean()))
+    return sd, bool(stable), len(reads)
