@@ -146,13 +146,15 @@ def test_cli_sets_tables_and_maps(tmp_path, capsys):
     out = tmp_path / "at"
     argv = ["atlas", "--V", "0.5,2", "--I", "1e-5", "--out", str(out), "--workers", "0", "--t-transient", "5",
             "--window", "3", "--segments", "0", "--approximations", "estimate", "--format", "json", "--quiet"]
-    assert main(argv + ["--sets"]) == 0
+    assert main(argv + ["--sets", "--plot"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary == json.loads(json.dumps(load_atlas(out).summary()))
     assert [r["observable"] for r in summary[-4:]] == ["set_match", "strict_match", "unflagged_match",
                                                       "unflagged_share"]
     for table in ("sets", "set_summary"):
         assert (out / f"atlas_{table}.csv").is_file() and (out / f"atlas_{table}.json").is_file()
+    for m in ("multistability.png", "confidence.png"):
+        assert (out / "maps" / m).stat().st_size > 10_000
     plain = tmp_path / "plain"
     assert main([*argv[:6], str(plain), *argv[7:]]) == 0
     assert not (plain / "atlas_sets.csv").exists()
