@@ -158,3 +158,31 @@ def test_cli_sets_tables_and_maps(tmp_path, capsys):
     plain = tmp_path / "plain"
     assert main([*argv[:6], str(plain), *argv[7:]]) == 0
     assert not (plain / "atlas_sets.csv").exists()
+
+
+def test_set_stability_compares_multipliers_and_budget_is_the_sweeps():
+    """Hypothesis: with ``set_stability`` the measure's exact multiplier is the largest |μ| of the matched
+    attractor of a direct ``attractor_set(stability=True)`` call, the predicted one ``approximate_attractor``'s,
+    and their difference is recorded (exact: deterministic, the same arithmetic), at a periodic point (V = 2,
+    I = 1e-5: both periodic on this window); a sweep budget spent inside the set raises the sweep's
+    ``SolverBudgetExceeded("max_wall")`` (the point is then computed on resume), never a partial record; a bad
+    ``sets`` is a ValueError naming it."""
+    from comparisons.atlas.sets import measure_sets
+    from peelapprox import SolverBudgetExceeded
+
+    p = PeelParams(V=2.0, I=1e-5)
+    opts = {"t_transient": 5.0, "t_window": 3.0, "set_stability": True}
+    rec = measure_sets(p, opts)
+    s = attractor_set(p, t_transient=5.0, t_window=3.0, stability=True, workers=0)
+    a = approximate_attractor(p, warn=False)
+    matched = [x for x in s.attractors if x.share >= 0.1 and x.is_stick_slip and x.label == rec["matched_label"]
+               and x.share == rec["matched_share"]]
+    assert rec["set_match"] and len(matched) == 1 and matched[0].multipliers and a.multipliers
+    assert rec["exact_max_multiplier"] == matched[0].max_multiplier
+    assert rec["predicted_max_multiplier"] == max(abs(m) for m in a.multipliers)
+    assert rec["multiplier_error"] == abs(rec["predicted_max_multiplier"] - rec["exact_max_multiplier"])
+    with pytest.raises(SolverBudgetExceeded) as exc:
+        measure_sets(p, {**opts, "max_wall": 1e-4})
+    assert exc.value.budget == "max_wall"
+    with pytest.raises(ValueError, match="sets"):
+        atlas(I_GRID, V_GRID, out="unused", sets="yes", max_workers=0, progress=False)
