@@ -109,7 +109,7 @@ def test_set_records_against_direct_calls(both):
     confidence from ``approximate_attractor``; ``set_match`` iff some stick-slip attractor of share >= 10 % has
     slip interval and force drop both within 10 % of the prediction's (relative to the exact value, recomputed
     here); ``strict_match`` the same against the set's primary.  Exact (deterministic solvers), the distance to
-    1e-12 relative (the same arithmetic); the maps are the records'."""
+    1e-12 relative (the same arithmetic); the maps and the xarray Dataset are the records'."""
     _, sets = both
     ms, conf = sets.multistability(), sets.confidence()
     for i, I in enumerate(I_GRID):
@@ -131,6 +131,8 @@ def test_set_records_against_direct_calls(both):
             assert rec["set_match"] == any(err(x) <= 0.1 for x in ss)
             assert rec["set_distance"] == pytest.approx(min(err(x) for x in ss), rel=1e-12)
             assert rec["strict_match"] == (err(s.primary) <= 0.1)
+    ds = sets.to_xarray()
+    assert (ds["n_attractors"].values == ms.filled(np.nan)).all() and (ds["confidence"].values == conf).all()
     summary = {r["observable"]: r for r in sets.set_summary()}
     rows = sets.set_rows()
     n_set = sum(r["set_match"] is not None for r in rows)

@@ -393,7 +393,8 @@ class AtlasResult:
         """The atlas as an :class:`xarray.Dataset` on dimensions ``I``, ``V`` (and ``approximation``,
         ``observable``, ``reduction``, ``stat``): ``exact`` [I, V, observable], ``predicted`` and
         ``rel_error`` (signed) [approximation, I, V, observable], ``segment_error`` [reduction, I, V, stat],
-        ``exact_class``, ``regime``, ``status`` [I, V] (str).  NaN is xarray's mark of an undefined value
+        ``exact_class``, ``regime``, ``status`` [I, V] (str); with sets ``n_attractors`` and ``confidence``
+        [I, V].  NaN is xarray's mark of an undefined value
         here; ``undefined`` [approximation, I, V, observable] says why.
 
         Raises
@@ -421,6 +422,9 @@ class AtlasResult:
                 [np.stack([filled(self.relative_error(n, o, signed=True)) for o in OBSERVABLES], -1) for n in names]))
             data["undefined"] = (("approximation", "I", "V", "observable"), np.stack(
                 [np.stack([self.undefined(n, o).astype(str) for o in OBSERVABLES], -1) for n in names]))
+        if self.has_sets:
+            data["n_attractors"] = (("I", "V"), filled(self.multistability()))
+            data["confidence"] = (("I", "V"), self.confidence().astype(str))
         if self.reductions:
             data["segment_error"] = (("reduction", "I", "V", "stat"), np.stack(
                 [np.stack([filled(self.segment_error(r, s)) for s in stats], -1) for r in self.reductions]))
