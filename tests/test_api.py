@@ -78,7 +78,8 @@ API = {
     "comparisons.atlas": {
         "atlas", "AtlasResult", "load_atlas", "APPROXIMATIONS", "register_approximation", "OBSERVABLES", "DEFAULTS",
         "TOLERANCE", "estimate_observables", "plot_error_map", "plot_dynamics_map", "plot_segment_maps",
-        "write_maps", "atlas_cost", "AtlasCost",
+        "write_maps", "atlas_cost", "AtlasCost", "match_set", "SET_DEFAULTS", "plot_multistability_map",
+        "plot_confidence_map",
     },
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",

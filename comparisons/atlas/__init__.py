@@ -15,16 +15,27 @@ Modules: :mod:`~comparisons.atlas.approximations` (the registry, :func:`register
 :mod:`~comparisons.atlas.measures` (the three measures and the options, :data:`DEFAULTS`),
 :mod:`~comparisons.atlas.engine` (:func:`atlas`), :mod:`~comparisons.atlas.result` (:class:`AtlasResult`,
 :func:`load_atlas`), :mod:`~comparisons.atlas.plots` (the maps), :mod:`~comparisons.atlas.cost`
-(:func:`atlas_cost`: each part's cost per point, measured, and the projected time).
+(:func:`atlas_cost`: each part's cost per point, measured, and the projected time),
+:mod:`~comparisons.atlas.sets` (opt-in, ``atlas(..., sets=True)``: the exact attractor set against the predicted
+set at each point, :func:`match_set`, :data:`SET_DEFAULTS`).
 """
 
 from .approximations import APPROXIMATIONS, OBSERVABLES, TOLERANCE, estimate_observables, register_approximation
 from .cost import AtlasCost, atlas_cost
 from .engine import atlas
 from .measures import DEFAULTS
-from .plots import plot_dynamics_map, plot_error_map, plot_segment_maps, write_maps
+from .plots import (
+    plot_confidence_map,
+    plot_dynamics_map,
+    plot_error_map,
+    plot_multistability_map,
+    plot_segment_maps,
+    write_maps,
+)
 from .result import AtlasResult, load_atlas
+from .sets import SET_DEFAULTS, match_set
 
 __all__ = ["atlas", "AtlasResult", "load_atlas", "APPROXIMATIONS", "register_approximation", "OBSERVABLES",
            "DEFAULTS", "TOLERANCE", "estimate_observables", "plot_error_map", "plot_dynamics_map",
-           "plot_segment_maps", "write_maps", "atlas_cost", "AtlasCost"]
+           "plot_segment_maps", "write_maps", "atlas_cost", "AtlasCost", "match_set", "SET_DEFAULTS",
+           "plot_multistability_map", "plot_confidence_map"]

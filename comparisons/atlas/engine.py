@@ -19,6 +19,7 @@ from ..sweep.store import check_axis, failed
 from .approximations import available
 from .measures import DEFAULTS, MEASURE_NAMES, check_options
 from .result import AtlasResult
+from .sets import SET_DEFAULTS, SET_MEASURE
 
 __all__ = ["atlas", "atlas_options"]
 
@@ -42,23 +43,29 @@ class _Progress:
 
 def atlas_options(*, approximations: Sequence[str] | None = None, serial: bool = True, k: float | None = None,
                   R: float | None = None, l: float | None = None, geometry: str | None = None,
-                  **window: Any) -> dict:
+                  sets: bool = False, **window: Any) -> dict:
     """The sweep options of an atlas, every one explicit (the manifest then states them all), checked.
 
     ``window`` holds the options of :data:`~comparisons.atlas.measures.DEFAULTS` to change (``t_transient``,
     ``t_window``, ``rtol``, ``alpha0``, ``segments_per_branch``, ``segment_rtol``, ``reductions``); ``k, R, l,
     geometry`` are the :class:`peelapprox.PeelParams` fields of every point (None: its default).  The
     approximations that can run now go in ``approximations`` (name -> how a worker finds it), those whose
-    function is not importable yet in ``skipped_approximations`` (name -> why).
+    function is not importable yet in ``skipped_approximations`` (name -> why).  ``sets``: also the options of
+    :data:`~comparisons.atlas.sets.SET_DEFAULTS` (``set_min_share``, ``set_stability``), which ``window`` may then
+    change; without it they are refused and absent (the manifest of an atlas without sets is unchanged).
 
     Raises
     ------
     ValueError
         Naming the first invalid option (an unknown one too), before anything runs.
     """
-    unknown = sorted(set(window) - set(DEFAULTS))
+    if not isinstance(sets, bool):
+        raise ValueError(f"sets must be True or False, got {sets!r}")
+    known = {**DEFAULTS, **SET_DEFAULTS} if sets else DEFAULTS
+    unknown = sorted(set(window) - set(known))
     if unknown:
-        raise ValueError(f"unknown atlas option(s) {unknown}; known: {sorted(DEFAULTS)} and k, R, l, geometry")
+        raise ValueError(f"unknown atlas option(s) {unknown}; known: {sorted(known)} and k, R, l, geometry"
+                         + ("" if sets else f" ({sorted(SET_DEFAULTS)} with sets=True)"))
     if isinstance(approximations, str):
         approximations = [a.strip() for a in approximations.split(",") if a.strip()]
     if approximations is not None and not (isinstance(approximations, (list, tuple))
@@ -66,7 +73,7 @@ def atlas_options(*, approximations: Sequence[str] | None = None, serial: bool =
         raise ValueError(f"approximations must be a sequence of names (None: every registered one), got "
                          f"{approximations!r}")
     run, skipped = available(None if approximations is None else list(approximations), serial=serial)
-    opts: dict[str, Any] = {**DEFAULTS, **window, "approximations": run, "skipped_approximations": skipped}
+    opts: dict[str, Any] = {**known, **window, "approximations": run, "skipped_approximations": skipped}
     fields: dict[str, Any] = {name: value for name, value in (("k", k), ("R", R), ("l", l), ("geometry", geometry))
               if value is not None}
     PeelParams(V=1.0, I=1e-5, **fields)  # ValueError naming a bad field and its range
@@ -93,6 +100,7 @@ def atlas(
     resume: bool = True,
     retry_failed: bool = False,
     max_wall: float | None = DEFAULT_MAX_WALL,
+    sets: bool = False,
 ) -> AtlasResult:
     """Where the approximations hold: the exact attractor, every approximation's prediction and each
     reduction's exact-seeded errors at every (I, V) grid point, on the sweep engine.
@@ -118,6 +126,12 @@ def atlas(
         ``t_window`` 20 s, tolerances, ``segments_per_branch``, ``reductions``).
     executor, max_workers, progress, resume, retry_failed, max_wall
         As :func:`comparisons.sweep.sweep`.
+    sets : bool
+        Also the measure over attractor sets (:mod:`comparisons.atlas.sets`: the exact set of
+        :func:`exact.attractor_set` and the predicted set of :func:`peelapprox.approximate_attractor`, the set and
+        strict matches, the confidence; about 8 exact runs more per point).  ``options`` may then set
+        ``set_min_share`` (0.1) and ``set_stability`` (False).  Default False: the atlas, its options and its
+        records as without it.
 
     Returns
     -------
@@ -139,10 +153,11 @@ def atlas(
     if options is not None and not isinstance(options, Mapping):
         raise ValueError(f"options must be a mapping of atlas options, got {options!r}")
     serial = executor == "serial" or max_workers == 0
-    opts = atlas_options(approximations=approximations, serial=serial, k=k, R=R, l=l, geometry=geometry,
+    opts = atlas_options(approximations=approximations, serial=serial, k=k, R=R, l=l, geometry=geometry, sets=sets,
                          **dict(options or {}))
+    measures = (*MEASURE_NAMES, SET_MEASURE) if sets else MEASURE_NAMES
     try:
-        res = sweep(I_values, V_values, MEASURE_NAMES, out=out, executor=executor, max_workers=max_workers,
+        res = sweep(I_values, V_values, measures, out=out, executor=executor, max_workers=max_workers,
                     options=opts, progress=_Progress() if progress is True else progress, resume=resume,
                     retry_failed=retry_failed, force=force, max_wall=max_wall)
     except SolverBudgetExceeded as exc:

@@ -7,6 +7,9 @@
 * :func:`plot_dynamics_map` — the exact dynamics' class (period n, aperiodic, steady, breakdown, ...) with
   :func:`peelapprox.estimate`'s regime labels drawn over it (their boundaries, and each label once).
 * :func:`plot_segment_maps` — every reduction's per-point median (or worst) per-segment error, one panel each.
+* :func:`plot_multistability_map`, :func:`plot_confidence_map` — with sets (``atlas(..., sets=True)``): the
+  number of exact attractors at each point, and the confidence of the primary prediction, the cells where it
+  matches no attractor of the set outlined.
 * :func:`write_maps` — all of them as PNG files.
 
 Figures come from :func:`peelapprox.plotting.new_figure` (matplotlib imported on first use only).
@@ -24,8 +27,8 @@ from peelapprox.plotting import cell_edges, new_figure, save_figure
 
 from .approximations import OBSERVABLES, TOLERANCE, key_of
 
-__all__ = ["plot_error_map", "plot_dynamics_map", "plot_segment_maps", "write_maps", "class_group",
-           "CLASS_GROUPS"]
+__all__ = ["plot_error_map", "plot_dynamics_map", "plot_segment_maps", "plot_multistability_map",
+           "plot_confidence_map", "write_maps", "class_group", "CLASS_GROUPS"]
 
 #: The groups the dynamics map colours (a period-n class falls into its period's group), in legend order.
 CLASS_GROUPS = ("period-1", "period-2", "period-3", "period 4-8", "period 9-32", "aperiodic", "too short",
@@ -261,11 +264,86 @@ def plot_segment_maps(result: Any, stat: str = "dt_median", path: str | None = N
     return fig
 
 
+def _categories(ax: Any, fig: Any, result: Any, codes: np.ndarray, names: list[str], colours: list[str],
+                title: str, path: str | None, missed: np.ndarray | None = None) -> Any:
+    """Cells coloured by category (``codes[i, j]`` an index into ``names``; -1 blank), a legend, the outline of
+    the ``missed`` cells (no attractor of the set matched) and the frame; written to ``path`` if given."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    V, I, oi, ov = _sorted(result)
+    codes = codes[np.ix_(oi, ov)]
+    fig, ax = _axes(ax, fig, (8.0, 5.0))
+    VE, IE = cell_edges(V, False), cell_edges(I, True)
+    ax.pcolormesh(VE, IE, np.ma.masked_less(codes, 0), cmap=ListedColormap(colours), vmin=-0.5,
+                  vmax=len(names) - 0.5, edgecolors="face")
+    present = sorted({int(c) for c in codes.ravel() if c >= 0})
+    handles: list[Any] = [Patch(facecolor=colours[c], edgecolor="0.5", label=names[c]) for c in present]
+    if missed is not None:
+        from matplotlib.lines import Line2D
+
+        inside = missed[np.ix_(oi, ov)]
+        _outline(ax, VE, IE, inside, colors="white", linewidths=3.0)
+        _outline(ax, VE, IE, inside, colors="black", linewidths=1.2)
+        handles.append(Line2D([], [], color="black", linewidth=1.2, label="outline: matches no attractor"))
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    _frame(ax, VE, IE)
+    ax.set_title(title, fontsize=10)
+    if path:
+        save_figure(fig, path, dpi=120)
+    return fig
+
+
+def _missed(result: Any) -> np.ndarray:
+    """Boolean map: the primary prediction matches no stick-slip attractor of the set (``set_match`` False)."""
+    rows = {(r["I"], r["V"]): r for r in result.set_rows()}
+    return np.array([[rows.get((I, V), {}).get("set_match") is False for V in result.V_values]
+                     for I in result.I_values], dtype=bool)
+
+
+def plot_multistability_map(result: Any, path: str | None = None, *, ax: Any = None, fig: Any = None) -> Any:
+    """The number of exact attractors at each point (reached from at least ``set_min_share`` of the starts;
+    an atlas with sets), 0 to 5 and "6+", the cells whose primary prediction matches no attractor of the set
+    outlined.  ``path``, ``ax``, ``fig`` as :func:`plot_error_map`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    n = result.multistability()
+    codes = np.where(np.ma.getmaskarray(n), -1, np.minimum(n.filled(0), 6)).astype(int)
+    names = ["0", "1", "2", "3", "4", "5", "6+"]
+    colours = ["#ffffff", "#c6dbef", "#6baed6", "#2171b5", "#08306b", "#54278f", "#000000"]
+    multi = int((codes >= 2).sum())
+    title = f"exact attractors per point (share >= {result.options.get('set_min_share', 0.1):g}): " \
+            f"{multi}/{codes.size} points multistable"
+    return _categories(ax, fig, result, codes, names, colours, title, path, _missed(result))
+
+
+def plot_confidence_map(result: Any, path: str | None = None, *, ax: Any = None, fig: Any = None) -> Any:
+    """The primary prediction's confidence at each point (high, low; an atlas with sets), the cells whose
+    primary prediction matches no attractor of the set outlined: a calibrated confidence has no outlined high
+    cell.  ``path``, ``ax``, ``fig`` as :func:`plot_error_map`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    conf = result.confidence()
+    names = ["high", "low", "not computed / failed"]
+    codes = np.array([[0 if c == "high" else 1 if c == "low" else 2 for c in row] for row in conf], dtype=int)
+    high = int((codes == 0).sum())
+    title = f"confidence of approximate_attractor's primary prediction: high at {high}/{codes.size} points"
+    return _categories(ax, fig, result, codes, names, ["#4daf4a", "#ff7f00", "#bdbdbd"], title, path,
+                       _missed(result))
+
+
 def write_maps(result: Any, directory, progress: Callable[[int, int, str], Any] | None = None) -> list[str]:
     """Every map of the atlas as a PNG in ``directory`` (created): ``dynamics.png``;
     ``error_<approximation>_<observable>.png`` for each approximation and observable (the approximation's
     :func:`~comparisons.atlas.approximations.key_of`); ``segments_dt_median.png`` and
-    ``segments_dF_median.png``.  ``progress(i, n, path)`` is called after each map is written.  Returns the
+    ``segments_dF_median.png``; with sets ``multistability.png`` and ``confidence.png``.  ``progress(i, n,
+    path)`` is called after each map is written.  Returns the
     paths."""
     os.makedirs(directory, exist_ok=True)
     jobs: list[tuple[str, Callable[..., Any], tuple]] = [
@@ -276,6 +354,9 @@ def write_maps(result: Any, directory, progress: Callable[[int, int, str], Any] 
     if result.reductions:
         for stat in ("dt_median", "dF_median"):
             jobs.append((os.path.join(directory, f"segments_{stat}.png"), plot_segment_maps, (stat,)))
+    if getattr(result, "has_sets", False):
+        jobs.append((os.path.join(directory, "multistability.png"), plot_multistability_map, ()))
+        jobs.append((os.path.join(directory, "confidence.png"), plot_confidence_map, ()))
     paths = []
     for i, (path, draw, extra) in enumerate(jobs):
         draw(result, *extra, path)

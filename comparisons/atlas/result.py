@@ -21,11 +21,19 @@ from ..sweep import SweepResult, load_sweep, record_key
 from ..sweep.store import failed
 from .approximations import OBSERVABLES, TOLERANCE, UNITS, key_of
 from .measures import MEASURE_NAMES, SEGMENT_STATS, SPREADS, reduction_key
+from .sets import SET_MEASURE, set_summary
 
-__all__ = ["AtlasResult", "load_atlas", "TABLES"]
+__all__ = ["AtlasResult", "load_atlas", "TABLES", "SET_FIELDS"]
 
-#: The tables of an atlas (:meth:`AtlasResult.tables`), each written as ``atlas_<name>.csv`` / ``.json``.
+#: The tables of an atlas (:meth:`AtlasResult.tables`), each written as ``atlas_<name>.csv`` / ``.json``; an atlas
+#: with sets (``atlas(..., sets=True)``) also has ``sets`` (:meth:`AtlasResult.set_rows`) and ``set_summary``.
 TABLES = ("points", "errors", "segments", "summary", "regimes")
+#: The fields of a set record (:mod:`comparisons.atlas.sets`) in :meth:`AtlasResult.set_rows`, in order.
+SET_FIELDS = ("set_status", "n_attractors", "n_stick_slip", "labels", "primary_class", "primary_share",
+              "predicted_status", "predicted_period", "confidence", "confidence_reason", "n_predicted",
+              "predicted_slip_interval", "predicted_force_drop", "set_match", "set_distance", "matched_label",
+              "matched_share", "default_stick_slip", "strict_match", "strict_distance", "predicted_max_multiplier",
+              "exact_max_multiplier", "multiplier_error", "set_wall")
 
 _NOT_COMPUTED = "not computed"
 
@@ -40,6 +48,10 @@ def _approx_key(name: str, field: str) -> str:
 
 def _segment_key(reduction: str, stat: str) -> str:
     return record_key("atlas_segments", f"{reduction}_{stat}")
+
+
+def _set_key(field: str) -> str:
+    return record_key(SET_MEASURE, field)
 
 
 def _number(v: Any) -> float | None:
@@ -86,6 +98,8 @@ class AtlasResult:
                                 for am, ve in pairs)
         self.out = sweep.out
         self.force = sweep.force
+        #: The atlas compares attractor sets (``atlas(..., sets=True)``; :mod:`comparisons.atlas.sets`).
+        self.has_sets = SET_MEASURE in sweep.measures
 
     # ------------------------------------------------------------------------------------------ the grid
     @property
@@ -242,7 +256,7 @@ class AtlasResult:
     def summary(self, tol: float = TOLERANCE) -> list[dict]:
         """:meth:`within` for every approximation and observable, then for every reduction the same of its
         per-point median ``|Δt|`` and ``|ΔF|`` errors (``approximation`` = ``segments:<reduction>``,
-        ``observable`` = ``dt_median`` / ``dF_median``)."""
+        ``observable`` = ``dt_median`` / ``dF_median``); with sets, then the rows of :meth:`set_summary`."""
         rows = [self.within(n, o, tol) for n in self.approximations for o in OBSERVABLES]
         n_ss = int(self.stick_slip().sum())
         ss = self.stick_slip()
@@ -255,6 +269,8 @@ class AtlasResult:
                              "compared": int(v.size), "within": n_in, "fraction": n_in / n_ss if n_ss else None,
                              "median_error": float(np.median(v)) if v.size else None,
                              "worst_error": float(v.max()) if v.size else None})
+        if self.has_sets:
+            rows += self.set_summary()
         return rows
 
     def by_regime(self, tol: float = TOLERANCE) -> list[dict]:
@@ -279,6 +295,35 @@ class AtlasResult:
                                  "compared": int((defined[obs] & sel).sum()), "within": n_in,
                                  "fraction": n_in / n if n else None})
         return rows
+
+    # ------------------------------------------------------------------------------------------ sets
+    def _check_sets(self) -> None:
+        if not self.has_sets:
+            raise ValueError("this atlas has no attractor sets: run it with sets=True (peelapprox atlas --sets)")
+
+    def multistability(self) -> np.ma.MaskedArray:
+        """The number of exact attractors reached from at least ``set_min_share`` of the starts (breakdowns not
+        counted) at each point, masked where the point has no set record."""
+        self._check_sets()
+        return self._masked(lambda rec: None if rec is None else _number(rec.get(_set_key("n_attractors"))))
+
+    def confidence(self) -> np.ndarray:
+        """The primary prediction's confidence at each point: ``high``, ``low``, or ``not computed`` / ``failed``
+        where the point has no set record."""
+        self._check_sets()
+        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else rec.get(_set_key("confidence"), "failed"))
+
+    def set_rows(self) -> list[dict]:
+        """One row per computed point: I, V, the exact class and the set record's :data:`SET_FIELDS` (None where
+        absent)."""
+        self._check_sets()
+        return [{"I": rec["I"], "V": rec["V"], "exact_class": rec.get(_exact_key("class")),
+                 **{f: rec.get(_set_key(f)) for f in SET_FIELDS}} for rec in self.sweep.records]
+
+    def set_summary(self) -> list[dict]:
+        """:func:`comparisons.atlas.sets.set_summary` of :meth:`set_rows`: the set-match rate, the strict rate,
+        the rate among unflagged (confidence high) predictions and the share unflagged."""
+        return set_summary(self.set_rows())
 
     # ------------------------------------------------------------------------------------------ tables
     def point_rows(self) -> list[dict]:
@@ -319,9 +364,12 @@ class AtlasResult:
 
     def tables(self) -> dict[str, list[dict]]:
         """Every table of the atlas by name (:data:`TABLES`): ``points``, ``errors``, ``segments``,
-        ``summary``, ``regimes`` (:meth:`by_regime`)."""
-        return {"points": self.point_rows(), "errors": self.error_rows(), "segments": self.segment_rows(),
-                "summary": self.summary(), "regimes": self.by_regime()}
+        ``summary``, ``regimes`` (:meth:`by_regime`); with sets also ``sets`` and ``set_summary``."""
+        tables = {"points": self.point_rows(), "errors": self.error_rows(), "segments": self.segment_rows(),
+                  "summary": self.summary(), "regimes": self.by_regime()}
+        if self.has_sets:
+            tables.update(sets=self.set_rows(), set_summary=self.set_summary())
+        return tables
 
     def write_tables(self, directory, formats: tuple[str, ...] = ("csv", "json"),
                      progress: Any = None) -> list[str]:
@@ -345,7 +393,8 @@ class AtlasResult:
         """The atlas as an :class:`xarray.Dataset` on dimensions ``I``, ``V`` (and ``approximation``,
         ``observable``, ``reduction``, ``stat``): ``exact`` [I, V, observable], ``predicted`` and
         ``rel_error`` (signed) [approximation, I, V, observable], ``segment_error`` [reduction, I, V, stat],
-        ``exact_class``, ``regime``, ``status`` [I, V] (str).  NaN is xarray's mark of an undefined value
+        ``exact_class``, ``regime``, ``status`` [I, V] (str); with sets ``n_attractors`` and ``confidence``
+        [I, V].  NaN is xarray's mark of an undefined value
         here; ``undefined`` [approximation, I, V, observable] says why.
 
         Raises
@@ -373,6 +422,9 @@ class AtlasResult:
                 [np.stack([filled(self.relative_error(n, o, signed=True)) for o in OBSERVABLES], -1) for n in names]))
             data["undefined"] = (("approximation", "I", "V", "observable"), np.stack(
                 [np.stack([self.undefined(n, o).astype(str) for o in OBSERVABLES], -1) for n in names]))
+        if self.has_sets:
+            data["n_attractors"] = (("I", "V"), filled(self.multistability()))
+            data["confidence"] = (("I", "V"), self.confidence().astype(str))
         if self.reductions:
             data["segment_error"] = (("reduction", "I", "V", "stat"), np.stack(
                 [np.stack([filled(self.segment_error(r, s)) for s in stats], -1) for r in self.reductions]))

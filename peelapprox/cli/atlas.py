@@ -72,6 +72,20 @@ def add_parser(sub) -> argparse.ArgumentParser:
     p.add_argument("--geometry", choices=GEOMETRIES, default=None,
                    help="the closure cos(theta): paper or exact (default: paper)")
     add_force_options(at)
+    st = at.add_argument_group("attractor sets (opt-in; comparisons.atlas.sets)")
+    st.add_argument("--sets", action="store_true",
+                    help="also compare sets: at each point the exact attractor set (exact.attractor_set, its default "
+                         "starts, the same window; about 8 runs more per point) and the predicted set "
+                         "(approximate_attractor's primary and alternatives); records the number of attractors, the "
+                         "primary's confidence, whether it matches ANY attractor of the set (slip interval and force "
+                         "drop within 10 %%) and the default start's; writes DIR/atlas_sets and atlas_set_summary, "
+                         "and with --plot maps/multistability.png and maps/confidence.png")
+    st.add_argument("--set-min-share", type=float, default=None, metavar="S",
+                    help="with --sets: an attractor counts when reached from at least this share of the starts "
+                         "(default: 0.1)")
+    st.add_argument("--set-stability", action="store_true",
+                    help="with --sets: also the exact multipliers and exponents (attractor_set's stability), so the "
+                         "multipliers are compared where both are periodic (about twice the cost)")
     at.add_argument("--retry-failed", action="store_true",
                     help="compute again the points of DIR whose status is an error (else they count as done)")
     at.add_argument("--plot", action="store_true", help="write every map as a PNG under DIR/maps/")
@@ -102,14 +116,20 @@ def run(args: argparse.Namespace) -> int:
     I_values = parse_grid(args.I, name="--I")
     check_grid_size({"--I": I_values.size, "--V": V_values.size})
     options = {key: getattr(args, opt) for opt, key in _WINDOW.items() if getattr(args, opt) is not None}
+    if (args.set_min_share is not None or args.set_stability) and not args.sets:
+        raise ValueError("--set-min-share and --set-stability need --sets")
+    if args.set_min_share is not None:
+        options["set_min_share"] = args.set_min_share
+    if args.set_stability:
+        options["set_stability"] = True
     model = {key: getattr(args, key) for key in ("k", "R", "l", "geometry")}
     approximations = None if args.approximations is None else \
         [a.strip() for a in args.approximations.split(",") if a.strip()]
     force = force_from_args(args)
     if args.cost is not None:
-        if force != PeelForce.paper() or args.out or args.plot:
-            raise ValueError("--cost times the paper's law and writes nothing: leave out --out, --plot and the law "
-                             "options")
+        if force != PeelForce.paper() or args.out or args.plot or args.sets:
+            raise ValueError("--cost times the paper's law and writes nothing: leave out --out, --plot, --sets and "
+                             "the law options")
         if args.cost > MAX_SAMPLE:
             raise ValueError(f"--cost must be an integer in [1, {MAX_SAMPLE}] (sample points timed), got {args.cost}")
         cost = atlas_cost(I_values, V_values, sample=args.cost, workers=args.workers or 2,
@@ -128,7 +148,7 @@ def run(args: argparse.Namespace) -> int:
         with worker_pool(args) as (executor, max_workers):
             result = atlas(I_values, V_values, out=args.out, approximations=approximations, force=force,
                            options=options, executor=executor, max_workers=max_workers, progress=not args.quiet,
-                           retry_failed=args.retry_failed, max_wall=args.max_wall, **model)
+                           retry_failed=args.retry_failed, max_wall=args.max_wall, sets=args.sets, **model)
     except RuntimeError as exc:
         print(f"peelapprox atlas: error: {exc}", file=sys.stderr)
         return 3
