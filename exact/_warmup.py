@@ -79,7 +79,9 @@ def _calls() -> dict[str, Callable[[float], Any]]:
 
 
 def _loaded() -> int:
-    return sum(sum(d.stats.cache_hits.values()) for d in gc.get_objects() if isinstance(d, CPUDispatcher))
+    """Cache hits of every numba dispatcher alive.  By ``type``, not ``isinstance``: gc's objects may include a
+    weak proxy whose referent is gone, and ``isinstance`` on it raises ``ReferenceError``."""
+    return sum(sum(d.stats.cache_hits.values()) for d in gc.get_objects() if issubclass(type(d), CPUDispatcher))
 
 
 class _Count(event.Listener):

@@ -79,7 +79,7 @@ def match_set(predicted: Any, exact: Sequence[Any], *, tol: float = TOLERANCE,
         theirs = [_get(obs, f) for f in fields]
         if any(v is None or v == 0 for v in theirs):
             continue
-        d = max(abs(a - e) / abs(e) for a, e in zip(mine, theirs, strict=True))  # type: ignore[operator]
+        d = max(abs(a - e) / abs(e) for a, e in zip(mine, theirs, strict=True))  # type: ignore[operator, arg-type]
         if best is None or d < best[1]:
             best = (k, d)
     if best is None:

@@ -67,7 +67,7 @@ with contextlib.redirect_stdout(io.StringIO()):
 t2 = time.perf_counter()
 import gc
 from numba.core.registry import CPUDispatcher
-loaded = sum(sum(d.stats.cache_hits.values()) for d in gc.get_objects() if isinstance(d, CPUDispatcher))
+loaded = sum(sum(d.stats.cache_hits.values()) for d in gc.get_objects() if issubclass(type(d), CPUDispatcher))
 ru = resource.getrusage(resource.RUSAGE_SELF)
 print(json.dumps(dict(imports=t1 - t0, call=t2 - t1, cpu=ru.ru_utime + ru.ru_stime, compiled=len(compiled),
                       loaded=loaded, names=compiled)))

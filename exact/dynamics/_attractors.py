@@ -216,12 +216,14 @@ def _start_outcome(params: PeelParams, a0: float, kw: dict, method: str | None, 
     ``max_wall``."""
     left = None if deadline is None else deadline - time.time()
     if left is not None and left <= 0:
-        return {"budget": "max_wall", "limit": None, "t": 0.0, "message": "spent before this start began"}
+        return {"budget": "max_wall", "limit": None, "t": 0.0, "message": "spent before this start began",
+                "state": _start_state(params, a0)}
     try:
         initial_state(params, alpha0=a0)
         tr = window_run(params, alpha0=a0, max_wall=left, method=method, solver=solver, **kw)
     except SolverBudgetExceeded as exc:  # as data: the exception's keyword-only fields do not pickle
-        return {"budget": exc.budget, "limit": exc.limit, "t": exc.t, "message": str(exc)}
+        return {"budget": exc.budget, "limit": exc.limit, "t": exc.t, "message": str(exc),
+                "state": dict(exc.state)}
     except (ModelBreakdown, ValueError) as exc:
         return {"error": f"{type(exc).__name__}: {str(exc)[:80]}"}
     per = classify(tr, period_rtol=period_rtol)
@@ -231,14 +233,25 @@ def _start_outcome(params: PeelParams, a0: float, kw: dict, method: str | None, 
             "settle": settle_time(tr, rtol=period_rtol)}
 
 
+def _start_state(params: PeelParams, a0: float) -> dict | None:
+    """The consistent start at ``alpha0 = a0`` as a state dict (that of a start the budget left unbegun), or None
+    where the start is infeasible."""
+    try:
+        return initial_state(params, alpha0=a0).as_dict()
+    except (ModelBreakdown, ValueError):
+        return None
+
+
 def _budget_error(out: dict, wall: WallBudget, t_end: float) -> SolverBudgetExceeded:
-    """The exception of a start whose budget was spent: the call's ``max_wall`` named as such, else the run's."""
+    """The exception of a start whose budget was spent: the call's ``max_wall`` named as such, else the run's;
+    its state is where that start's run stopped (its start, if it never began)."""
+    state = out.get("state") or {"t": out["t"]}
     if out["budget"] == "max_wall" and wall.limit is not None:
         return SolverBudgetExceeded(f"more than {wall.limit:g} s of wall time (max_wall) at t={out['t']:.6g}; pass "
                                     "a larger max_wall, or None", budget="max_wall", limit=wall.limit, t=out["t"],
-                                    state={"t": out["t"]}, partial=None)
+                                    state=state, partial=None)
     return SolverBudgetExceeded(out["message"], budget=out["budget"], limit=out["limit"], t=out["t"],
-                                state={"t": out["t"]}, partial=None)
+                                state=state, partial=None)
 
 
 def attractors(
@@ -332,8 +345,8 @@ def attractors(
     lost = map_points(_start_outcome, tasks, put, pool=AUTO if executor is None else executor,
                       max_workers=max_workers, deadline=deadline)
     for k, text in lost:
-        found[k] = {"budget": "max_wall", "limit": wall.limit, "t": 0.0, "message": text} if text == DEADLINE_TEXT \
-            else {"error": text[:100]}
+        found[k] = {"budget": "max_wall", "limit": wall.limit, "t": 0.0, "message": text,
+                    "state": _start_state(params, alpha0s[k])} if text == DEADLINE_TEXT else {"error": text[:100]}
     groups: list[dict] = []
     for k, a0 in enumerate(alpha0s):  # grouped in the order of the starts, wherever they ran
         out = found[k]

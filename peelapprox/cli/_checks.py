@@ -236,9 +236,9 @@ def check_output_path(path: str, kind: str, option: str, *, read_only_ok: bool =
         raise ValueError(f"{option} {shown(path)} is a directory, expected a file name")
     _refuse_special(path, path, option)  # /dev/full: not silently /dev/full.npz beside it
     name = _file_name(path, kind, option)
-    _refuse_special(name, path, option)
     if os.path.isdir(name):
         raise ValueError(f"{option} {shown(path)} would write {shown(name)}, which is a directory")
+    _refuse_special(name, path, option)
     parent = os.path.dirname(name) or "."
     if not os.path.exists(parent):
         raise ValueError(f"{option} {shown(path)}: directory {shown(parent)} does not exist")
