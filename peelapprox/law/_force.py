@@ -308,8 +308,9 @@ class PeelForce:
         """The tabulated law (:meth:`tabulated`) of a CSV file's peel-force curve(s).
 
         The header names the columns ``v`` and ``f``, or ``V``, ``v`` and ``f`` (one table per pull speed V, the
-        rows of a V in file order), in any order, each optionally with its unit -- ``v [m/s]``, ``v [mm/s]``,
-        ``f [N]``, ``f (kN)``, ... (:data:`peelapprox._csvread.UNITS`): converted to m/s and N; an unknown unit or
+        rows of a V in file order; at most :data:`peelapprox.law._tablefile.MAX_TABLES` = 1000 tables), in any
+        order, each optionally with its unit -- ``v [m/s]``, ``v [mm/s]``, ``f [N]``, ``f (kN)``, ...
+        (:data:`peelapprox._csvread.UNITS`): converted to m/s and N; an unknown unit or
         one of another dimension is refused, named.  ``#`` starts a comment; blank lines are skipped.  The file
         must be a regular UTF-8 file of at most 16 MiB (a spreadsheet's byte-order mark is fine).
 
