@@ -532,11 +532,17 @@ def _drop(key):
     (_set("params.V", "fast"), r"field meta.params: .*V"),
     (_set("params.hack", 1), r"field meta.params.hack: unknown"),
     (_set("message", "x" * 5000), r"field meta.message: must be a string of at most 2000"),
+    (_set("status", 10**400), r"field meta.status: must be finite and in \[-99, 99\], got 1000"),
+    (_set("stats.n_steps", 10**400), r"field meta.stats.n_steps: must be finite"),
+    (_set("rtol", -10**400), r"field meta.rtol: must be finite"),
+    (_set("t_end", 10**400), r"field meta.t_end: must be finite"),
+    (_set("final_state.alpha", 10**400), r"field meta.final_state.alpha: must be finite"),
 ])
 def test_trajectory_file_fields_are_checked(tmp_path, npz_arrays, change, field):
     """Each malformed field of a trajectory file (the probe's KeyError, unexpected keyword, RecursionError,
     JSONDecodeError, reshape errors; t of 2 samples beside F of 150, a payload string as branch, method or
-    status, t_end = -1 accepted) is a ValueError naming the file and the field (categorical)."""
+    status, t_end = -1 accepted; OverflowError on a JSON integer of 400 digits) is a ValueError naming the file
+    and the field (categorical)."""
     path = _npz_with(tmp_path, npz_arrays, change)
     with pytest.raises(ValueError, match=rf"Trajectory\.from_npz\('.*bad\.npz'\): {field}"):
         exact.Trajectory.from_npz(path)
@@ -567,3 +573,70 @@ def test_a_missing_trajectory_file_is_what_open_raises(tmp_path):
     failed read), not a content error (categorical)."""
     with pytest.raises(FileNotFoundError, match="nope.npz"):
         exact.Trajectory.from_npz(tmp_path / "nope.npz")
+
+
+def _npy_member(shape, payload=b""):
+    """The bytes of a ``.npy`` float64 array member declaring ``shape`` and holding ``payload`` as its data."""
+    import io
+
+    from numpy.lib import format as npy
+
+    buf = io.BytesIO()
+    npy.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": shape})
+    return buf.getvalue() + payload
+
+
+def _peak_bytes(fn, *args):
+    """The peak of memory allocated during ``fn(*args)`` (tracemalloc: Python objects and numpy's arrays, which
+    numpy reports to it, committed or not): a count of bytes, the same on any machine."""
+    import tracemalloc
+
+    message = ""
+    tracemalloc.start()
+    try:
+        try:
+            fn(*args)
+        except ValueError as exc:
+            message = str(exc)
+        return tracemalloc.get_traced_memory()[1], message
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_trajectory_file_declaring_a_huge_array_is_refused_before_loading(tmp_path, npz_arrays):
+    """A member whose ``.npy`` header declares 250,000,000 floats (2 GB, what numpy allocates before reading the
+    data) is refused from its header, naming the file, the field and MAX_ARRAY_BYTES, with a peak of at most 5 MB
+    allocated (tracemalloc, machine-independent; the 2 GB array was allocated before): the bound is the header
+    check, not the machine."""
+    import zipfile
+
+    arrays, _ = npz_arrays
+    path = tmp_path / "bad.npz"
+    np.savez(path, **{k: v for k, v in arrays.items() if k != "t"})
+    with zipfile.ZipFile(path, "a") as zf:
+        zf.writestr("t.npy", _npy_member((250_000_000,)))
+    peak, message = _peak_bytes(exact.Trajectory.from_npz, str(path))
+    assert re.match(r"Trajectory\.from_npz\('.*bad\.npz'\): field t: the arrays take \d+ bytes up to this one, "
+                    r"more than MAX_ARRAY_BYTES = 1073741824", message), message
+    assert peak < 5e6, peak
+
+
+def test_a_compressed_trajectory_bomb_is_refused_before_loading(tmp_path, npz_arrays, monkeypatch):
+    """A zip member that inflates far beyond its file (the probe's 1.9 MB of 250,000,000 zeros cost 2.29 GB) is
+    refused from the zip's sizes before it is inflated: with the limit lowered to 1 MB (so that the bomb, 16 MB of
+    zeros in ~16 kB, is quick to write), the peak allocated is at most 1 MB (tracemalloc: the 16 MB array, or the
+    file's bytes, were never allocated)."""
+    import zipfile
+
+    from exact import _trajectory_file
+
+    arrays, _ = npz_arrays
+    path = tmp_path / "bad.npz"
+    np.savez_compressed(path, **{k: v for k, v in arrays.items() if k != "t"}, t=np.zeros(2_000_000))
+    assert path.stat().st_size < 200_000
+    with zipfile.ZipFile(path) as zf:
+        assert zf.getinfo("t.npy").file_size > 16e6
+    monkeypatch.setattr(_trajectory_file, "MAX_ARRAY_BYTES", 1 << 20)
+    peak, message = _peak_bytes(exact.Trajectory.from_npz, str(path))
+    assert "field t: the arrays take" in message and "MAX_ARRAY_BYTES = 1048576" in message, message
+    assert peak < 1 << 20, peak
