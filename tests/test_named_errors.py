@@ -640,3 +640,36 @@ def test_a_compressed_trajectory_bomb_is_refused_before_loading(tmp_path, npz_ar
     peak, message = _peak_bytes(exact.Trajectory.from_npz, str(path))
     assert "field t: the arrays take" in message and "MAX_ARRAY_BYTES = 1048576" in message, message
     assert peak < 1 << 20, peak
+
+
+# ------------------------------------------------------------------------------------ laws without folds
+_NO_FOLDS = "300+1e-9*v"  # f rises by 1e-6 N over its v range [1e-6, 1000] m/s: no folds, AB everywhere
+
+
+def test_a_law_without_folds_whose_root_is_beyond_its_domain_is_named():
+    """``exact.simulate`` of a law without folds whose default F0 = 1.01 f(V, V) = 303 N has its AB root at
+    v ~ 3e9 m/s, beyond the law's v range [1e-6, 1000]: brentq's "f(a) and f(b) must have different signs"
+    escaped; now a ValueError naming F0, params.force, the domain, the f range there, and that the law has no
+    folds (categorical)."""
+    params = PeelParams(V=1.0, I=1e-5, force=PeelForce.expression(_NO_FOLDS))
+    with pytest.raises(ValueError) as info:
+        exact.simulate(params, 0.01)
+    msg = str(info.value)
+    assert "different signs" not in msg
+    for part in ("F0 (not given: the default 1.01 f(V, V) = 303.0", "params.force=PeelForce.expression(",
+                 "no AB root within the peel-force law's domain [1e-06, 1000.0] m/s", "a law without folds",
+                 "f runs from 300 N at v = 1e-06 m/s to 300 N at v = 1000 m/s", "cannot be bracketed"):
+        assert part in msg, (part, msg)
+
+
+def test_a_law_without_folds_still_finds_roots_inside_its_domain():
+    """The bracket check refuses only roots outside the domain: at seeded F0 whose root v = (F0 - 300)/1e-9 lies in
+    [1, 900] m/s, the initial state's v is that closed form to 2e-4 m/s (the rounding of f near 300 N, ulp 5.7e-14
+    N, over the slope 1e-9 N s/m: 5.7e-5 m/s, a few times)."""
+    params = PeelParams(V=1.0, I=1e-5, force=PeelForce.expression(_NO_FOLDS))
+    rng = np.random.default_rng(3)
+    for v_true in rng.uniform(1.0, 900.0, 5):
+        F0 = 300.0 + 1e-9 * float(v_true)
+        s = exact.initial_state(params, F0=F0)
+        assert s.branch == "AB"
+        assert s.v == pytest.approx((F0 - 300.0) / 1e-9, abs=2e-4)
