@@ -673,3 +673,29 @@ def test_a_law_without_folds_still_finds_roots_inside_its_domain():
         s = exact.initial_state(params, F0=F0)
         assert s.branch == "AB"
         assert s.v == pytest.approx((F0 - 300.0) / 1e-9, abs=2e-4)
+
+
+# ------------------------------------------------------------------------------------ traces beyond newtons
+@pytest.mark.parametrize("scale", [1e200, -1e13, 2e12])
+def test_a_trace_beyond_max_force_is_refused_naming_its_sample(scale):
+    """A trace with |F| beyond MAX_FORCE = 1e12 N (the probe's F ~ 1e202 N made ``spectrum()`` raise
+    OverflowError) is a ValueError naming F, its first offending sample and the limit (categorical)."""
+    from peelapprox import ForceSeries
+
+    t = np.linspace(0.0, 1.0, 2000)
+    F = 100.0 + 10.0 * np.sin(40.0 * t)
+    F[7:] *= scale / 100.0
+    with pytest.raises(ValueError, match=r"F\[7\] = .* N: \|F\| must be at most MAX_FORCE = 1e\+12 N"):
+        ForceSeries(t, F, V=1.0)
+
+
+def test_a_trace_at_max_force_has_its_spectral_peak():
+    """A trace reaching the limit, F = (100 + 10 sin(2 pi 6.4 t)) 1e12/110 N (|F| up to 1e12 N), has a finite
+    spectrum whose peak is its sine's 6.4 Hz to one frequency bin (the resolution of the spectrum)."""
+    from peelapprox import ForceSeries
+
+    t = np.linspace(0.0, 10.0, 20_000)
+    F = (100.0 + 10.0 * np.sin(2 * np.pi * 6.4 * t)) * (1e12 / 110.0)
+    spec = ForceSeries(t, F, V=1.0).spectrum()
+    assert np.all(np.isfinite(spec.power))
+    assert spec.peak == pytest.approx(6.4, abs=float(spec.frequency[1] - spec.frequency[0]))
