@@ -644,3 +644,28 @@ def test_a_file_of_too_many_tables_is_refused_before_building_them(tmp_path):
     assert len(read_points(str(path))) == MAX_TABLES
     with pytest.raises(ValueError, match="needs at least 5 points"):
         PeelForce.from_csv(str(path))
+
+
+def test_simulate_force_build_is_bounded_by_max_wall(monkeypatch, capsys):
+    """``simulate --force '<39-term sum of 1/(v+i)>' --max-wall 5`` ran 69 s: the law's build (sympy's
+    derivatives) honoured only LAW_BUILD_SECONDS (60 s).  A stand-in build that would run for minutes (sleeping in
+    short steps, as sympy's Python does) under ``--max-wall 0.5`` now stops at that budget: exit status 3 within
+    :data:`BOUND`, the message naming --force and --max-wall; with no budget nearer, the law's own limit is still
+    the ValueError it was (checked with the limit lowered to 0.3 s: exit status 2, 'took more than 0.3 s')."""
+    from peelapprox.law import _expression
+
+    def slow(*args, **kwargs):
+        for _ in range(60_000):
+            time.sleep(0.01)
+
+    monkeypatch.setattr(_expression, "_checked_text", slow)
+    argv = ["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--force", "300 + 2*v"]
+    rc, took = _cli([*argv, "--max-wall", str(BUDGET)])
+    err = capsys.readouterr().err
+    assert rc == 3 and took < BOUND, (rc, took, err)
+    assert "--force: more than 0.5 s of wall time (--max-wall) building the peel-force law" in err, err
+    monkeypatch.setattr(_expression, "LAW_BUILD_SECONDS", 0.3)
+    rc, took = _cli([*argv, "--max-wall", "600"])
+    err = capsys.readouterr().err
+    assert rc == 2 and took < BOUND, (rc, took, err)
+    assert "took more than 0.3 s" in err, err
