@@ -699,3 +699,22 @@ def test_a_trace_at_max_force_has_its_spectral_peak():
     spec = ForceSeries(t, F, V=1.0).spectrum()
     assert np.all(np.isfinite(spec.power))
     assert spec.peak == pytest.approx(6.4, abs=float(spec.frequency[1] - spec.frequency[0]))
+
+
+@pytest.mark.parametrize("field, kind", [("coefficients", "family"), ("tables", "tabulated"),
+                                         ("coefficients", "expression")])
+def test_from_dict_refuses_deep_nesting_by_name(field, kind):
+    """A field nested 100,000 deep (a probe's RecursionError) is a TypeError naming the field and MAX_NESTING,
+    found by an iterative walk; the laws' own dicts (nesting 3 at most) still read back equal (categorical)."""
+    import dataclasses
+
+    deep: list = [1.0]
+    for _ in range(100_000):
+        deep = [deep]
+    d = {"kind": kind, "name": "cubic" if kind == "family" else None, field: deep}
+    with pytest.raises(TypeError, match=rf"d\['{field}'\] is nested more than MAX_NESTING = 8 deep"):
+        PeelForce.from_dict(d)
+    v = [0.1, 0.2, 0.3, 0.4, 0.5]
+    for law in (PeelForce.family("cubic"), PeelForce.tabulated(tables=[(1.0, v, [200, 250, 220, 210, 260]),
+                                                                       (2.0, v, [210, 260, 230, 220, 270])])):
+        assert PeelForce.from_dict(dataclasses.asdict(law)) == law
