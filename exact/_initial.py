@@ -121,5 +121,13 @@ def initial_state(
             f"{f0} at {at} gives the level F0*(1 - cos theta)={G}, which has no root on branch0={branch0!r}; "
             f"valid F0 range on {branch0}: ({lo / (1 + c)}, {hi / (1 + c)})"
         )
-    v = branch_inverse(G, params.V, branch0) if law is None else law.branch_root(G, branch0)
+    if law is None:
+        v = branch_inverse(G, params.V, branch0)
+    else:
+        try:
+            v = law.branch_root(G, branch0)
+        except ValueError as exc:  # the root beyond the law's domain: say which F0 asked for it
+            raise ValueError(f"{f0} at {at} gives the level F0*(1 - cos theta)={G} on branch0={branch0!r} of "
+                             f"params.force={shown(params.force)}, but {exc}: give an F0 whose level has its root in "
+                             "the law's v range, or a law whose v range holds it") from None
     return State(float(t0), a0, w0, F, float(v), branch0)

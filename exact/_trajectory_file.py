@@ -10,7 +10,10 @@ counters of :class:`exact.SolverStats`: integers >= 0, times finite >= 0), ``met
 letters, digits, ``_.-``, at most 64 characters; solver may be null), ``rtol`` in (0, 1), ``eps`` null or > 0,
 ``initial_state`` and ``final_state`` (the fields of :class:`exact.State`, finite, a branch name), ``t_end`` and
 ``t_transient`` finite >= 0 with ``t_transient <= t_end``, ``status`` an integer in [-99, 99] and ``message`` a
-string of at most 2,000 characters. Nothing is unpickled (``allow_pickle=False``) and the JSON is parsed, never
+string of at most 2,000 characters (a JSON integer beyond the floats is not finite).  Before any array is loaded
+the file's members are sized from their ``.npy`` headers and the zip's sizes: together at most
+:data:`MAX_ARRAY_BYTES` (1 GiB), else refused, naming the array that passes it (a 1.9 MB file of 250,000,000
+compressed zeros cost 2.3 GB before).  Nothing is unpickled (``allow_pickle=False``) and the JSON is parsed, never
 evaluated.
 
 A path that cannot be opened raises what :func:`open` raises (``FileNotFoundError``, ``PermissionError``,
@@ -36,7 +39,7 @@ import numpy as np
 from peelapprox import BRANCHES, PeelParams
 from peelapprox.validate import shown
 
-__all__ = ["MAX_META", "META_FIELDS", "read_trajectory"]
+__all__ = ["MAX_ARRAY_BYTES", "MAX_META", "META_FIELDS", "read_trajectory"]
 
 #: The arrays of a trajectory file (``Vp`` only under a load).
 ARRAYS = ("t", "alpha", "omega", "F", "v", "branch", "jumps", "atol", "meta")
@@ -45,6 +48,9 @@ META_FIELDS = ("params", "stats", "method", "solver", "rtol", "eps", "initial_st
                "t_transient", "status", "message")
 #: The longest ``meta`` text [characters]: the parameters of a smoothed law with thousands of knots fit in 1 MB.
 MAX_META = 4_000_000
+#: The most bytes the arrays of a file may take once loaded, all together [bytes]: a run at the default
+#: ``max_points`` (5e6) stores ~250 MB (49 bytes a point); a larger file is refused before it is read.
+MAX_ARRAY_BYTES = 1 << 30
 #: The longest message kept in a file [characters].
 MAX_MESSAGE = 2_000
 _NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-")
@@ -70,7 +76,7 @@ def read_trajectory(cls: Any, path: Any, parts: dict[str, Any]) -> Any:
         raise ValueError(f"{where}: {exc}") from None
     except (FileNotFoundError, PermissionError, IsADirectoryError):  # the path, not the file's content: as open()
         raise
-    except (OSError, EOFError, zipfile.BadZipFile, ValueError) as exc:  # not an npz, truncated, unreadable
+    except (OSError, EOFError, zipfile.BadZipFile, ValueError, OverflowError) as exc:  # not an npz, truncated, ...
         raise ValueError(f"{where}: not a trajectory file written by Trajectory.to_npz ({type(exc).__name__}: "
                          f"{shown(str(exc), 200)})") from None
 
@@ -78,6 +84,7 @@ def read_trajectory(cls: Any, path: Any, parts: dict[str, Any]) -> Any:
 def _read_arrays(path: Any) -> dict[str, np.ndarray]:
     """Every array of the file, each read on its own so that an error names it."""
     out = {}
+    _check_sizes(path)
     with np.load(path, allow_pickle=False) as z:
         if not hasattr(z, "files"):
             raise _Bad("(file)", "a single .npy array, not an .npz of a trajectory's fields")
@@ -92,6 +99,45 @@ def _read_arrays(path: Any) -> dict[str, np.ndarray]:
             except (OSError, EOFError, zipfile.BadZipFile, ValueError, KeyError) as exc:
                 raise _Bad(name, f"unreadable ({type(exc).__name__}: {shown(str(exc), 120)})") from None
     return out
+
+
+def _check_sizes(path: Any) -> None:
+    """Refuse, before any array is loaded, a file whose trajectory arrays would take more than
+    :data:`MAX_ARRAY_BYTES`: each member's size is the larger of the zip's uncompressed size and what its
+    ``.npy`` header declares (the shape times the item size, which numpy allocates before reading)."""
+    if not zipfile.is_zipfile(path):
+        return  # not a zip: np.load names what it is (a single .npy is refused as such)
+    total = 0
+    with zipfile.ZipFile(path) as zf:
+        for info in zf.infolist():
+            name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+            if name not in ARRAYS and name != "Vp":
+                continue  # refused by name when the file is read
+            size = info.file_size
+            if info.filename.endswith(".npy"):
+                with zf.open(info) as fh:
+                    size = max(size, _npy_bytes(name, fh))
+            total += size
+            if total > MAX_ARRAY_BYTES:
+                raise _Bad(name, f"the arrays take {total} bytes up to this one, more than MAX_ARRAY_BYTES = "
+                                 f"{MAX_ARRAY_BYTES} (checked from the file's headers, before loading)")
+
+
+def _npy_bytes(name: str, fh: Any) -> int:
+    """The bytes the ``.npy`` array in ``fh`` declares (its header's shape times its item size)."""
+    from numpy.lib import format as npy
+
+    try:
+        version = npy.read_magic(fh)
+        if version == (1, 0):
+            shape, _, dtype = npy.read_array_header_1_0(fh)
+        elif version == (2, 0):
+            shape, _, dtype = npy.read_array_header_2_0(fh)
+        else:
+            raise ValueError(f".npy format version {version[0]}.{version[1]} (Trajectory.to_npz writes 1.0)")
+    except (ValueError, EOFError, OSError, zipfile.BadZipFile) as exc:
+        raise _Bad(name, f"unreadable ({type(exc).__name__}: {shown(str(exc), 120)})") from None
+    return math.prod(int(d) for d in shape) * int(dtype.itemsize)
 
 
 def _fields(a: dict[str, np.ndarray], parts: dict[str, Any]) -> dict[str, Any]:
@@ -168,7 +214,11 @@ def _number(name: str, x: Any, *, lo: float = -math.inf, hi: float = math.inf, o
     ok = isinstance(x, int) if integer else isinstance(x, (int, float))
     if isinstance(x, bool) or not ok:
         raise _Bad(f"meta.{name}", f"must be {'an integer' if integer else 'a number'}, got {shown(x, 60)}")
-    if not (math.isfinite(x) and (x > lo if open_lo else x >= lo) and (x < hi if open_hi else x <= hi)):
+    try:
+        finite = math.isfinite(x)
+    except OverflowError:  # a JSON integer beyond the floats
+        finite = False
+    if not (finite and (x > lo if open_lo else x >= lo) and (x < hi if open_hi else x <= hi)):
         raise _Bad(f"meta.{name}", f"must be finite and in {'(' if open_lo else '['}{lo:g}, {hi:g}"
                                    f"{')' if open_hi else ']'}, got {shown(x, 60)}")
     return x

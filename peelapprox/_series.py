@@ -29,7 +29,7 @@ from .validate import integer, optional, positive, reals
 if TYPE_CHECKING:
     from ._series_lyapunov import SeriesLyapunov
 
-__all__ = ["ForceSeries", "Spectrum", "MAX_SAMPLES", "MIN_SAMPLES", "MIN_STEP"]
+__all__ = ["ForceSeries", "Spectrum", "MAX_FORCE", "MAX_SAMPLES", "MIN_SAMPLES", "MIN_STEP"]
 
 #: The fewest samples a trace may have.
 MIN_SAMPLES = 16
@@ -40,6 +40,10 @@ MAX_TRACE_BYTES = 256 * 1024 * 1024
 #: ~40 (measured, tests/test_bounded.py), ``exact.infer`` took ~110 in all (a probe: 11 GB on 1e8 samples), so a
 #: call on a trace at the limit stays near 1 GB (docs/your-data.md).
 MAX_SAMPLES = 10_000_000
+#: The largest |F| of a trace [N]: five decades beyond the pull forces the solvers are built for
+#: (``STATE_RANGES["F"]`` up to 1e7 N), so that a trace's squares and sums (its power spectrum, variance) stay
+#: far from the float range (|F| = 1e200 overflowed the spectrum); a trace beyond is not in newtons.
+MAX_FORCE = 1e12
 #: A trace whose detrended fluctuations are below this fraction of its largest |F| is flat: no spectral peak
 #: (rounding of a float64 force is ~1e-16 of it; a measured trace's noise is > 1e-6).
 FLAT_RTOL = 1e-9
@@ -78,14 +82,15 @@ class Spectrum:
 class ForceSeries:
     """A pull-force trace F(t) [N] at times t [s], measured or sampled from a run, and its statistics.
 
-    ``ForceSeries(t, F, *, V=None, source="measured")``: t increasing and finite, F finite, one length, at
-    least :data:`MIN_SAMPLES` samples; V the pull speed [m/s] if known (it labels the observables).
+    ``ForceSeries(t, F, *, V=None, source="measured")``: t increasing and finite, F finite with |F| at most
+    :data:`MAX_FORCE` (1e12 N), one length, at least :data:`MIN_SAMPLES` samples; V the pull speed [m/s] if known
+    (it labels the observables).
 
     Raises
     ------
     ValueError
-        Naming the argument and the first offending sample: NaN or inf, non-increasing time, different
-        lengths, too few samples, V not positive.
+        Naming the argument and the first offending sample: NaN or inf, |F| beyond MAX_FORCE, non-increasing
+        time, different lengths, too few samples, V not positive.
     """
 
     def __init__(self, t: ArrayLike, F: ArrayLike, *, V: float | None = None, source: str = "measured"):
@@ -94,6 +99,11 @@ class ForceSeries:
             raise ValueError(f"t and F must have one length, got {t_arr.size} and {F_arr.size} samples")
         if t_arr.size < MIN_SAMPLES:
             raise ValueError(f"a force series needs at least {MIN_SAMPLES} samples, got {t_arr.size}")
+        big = np.flatnonzero(np.abs(F_arr) > MAX_FORCE)
+        if big.size:
+            i = int(big[0])
+            raise _SampleError(i, f"F[{i}] = {float(F_arr[i]):.6g} N: |F| must be at most MAX_FORCE = {MAX_FORCE:g} N "
+                                  "(is the force in newtons?)")
         dt = np.diff(t_arr)
         bad = np.flatnonzero(dt <= 0)
         if bad.size:

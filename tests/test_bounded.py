@@ -560,3 +560,112 @@ def test_sweep_compiles_an_expression_law_in_the_calling_thread_under_its_budget
               force=PeelForce.expression("153 + 300*v - 300*v**2 + 80*v**3"), progress=False)
     assert time.perf_counter() - t0 < BOUND
     assert threads == [True]
+
+
+# ---------------------------------------------------------------------------------------------- table files
+def _split_by_passes(Vs, v, f, lines, sd):
+    """The grouping as it was (one pass over the rows per distinct V, in order of first appearance): the oracle of
+    the grouping's definition, kept here to compare the sort-based one with."""
+    return [(float(V), v[Vs == V], f[Vs == V], lines[Vs == V], sd[Vs == V]) for V in dict.fromkeys(Vs.tolist())]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_table_file_split_is_the_per_value_split(tmp_path, seed):
+    """The sort-based split of a file's rows by V gives the tables of the old one-pass-per-V split exactly
+    (numpy.array_equal of V, v, f, sigma and file lines, same order of tables): seeded files of 1-40 pull speeds,
+    rows shuffled (so the tables interleave), V repeated in different spellings (``1``, ``1.000000``), a comment
+    line."""
+    from peelapprox.law._tablefile import read_points
+
+    rng = np.random.default_rng(seed)
+    nV = int(rng.integers(1, 41))
+    speeds = (rng.choice([0.5, 1.0, 2.0, 2.5, 3.0, 10.0], size=nV, replace=False) if nV <= 6 else
+              np.round(rng.uniform(0.1, 5.0, nV), 3)).tolist()
+    rows = [(V, float(rng.uniform(1e-3, 1.0)), float(rng.uniform(100, 300)), float(rng.uniform(0.1, 1)))
+            for V in speeds for _ in range(int(rng.integers(1, 30)))]
+    order = rng.permutation(len(rows))
+    spell = ["{:g}", "{:.6f}", "{!r}"]  # each reads back to the same float (3 decimals)
+    text = "V,v,f,sigma\n# measured\n" + "".join(
+        f"{spell[i % 3].format(rows[i][0])},{rows[i][1]!r},{rows[i][2]!r},{rows[i][3]!r}\n" for i in order)
+    path = tmp_path / "t.csv"
+    path.write_text(text)
+    got = read_points(str(path), sigma=True)
+    Vs = np.array([rows[i][0] for i in order])
+    cols = [np.array([rows[i][j] for i in order]) for j in (1, 2, 3)]
+    want = _split_by_passes(Vs, cols[0], cols[1], np.arange(3, 3 + len(order)), cols[2])
+    assert len(got) == len(want) == len(set(speeds))
+    for (V, v, f, lines, sd), (V0, v0, f0, lines0, sd0) in zip(got, want):
+        assert V == V0
+        for a, b in ((v, v0), (f, f0), (lines, lines0), (sd, sd0)):
+            assert np.array_equal(a, b)
+
+
+def test_table_split_costs_one_sort_whatever_the_number_of_pull_speeds():
+    """Splitting 1,000,000 rows costs one sort whether they hold MAX_TABLES = 1000 pull speeds (split) or 1,000,000
+    (refused, before any table is built): the split made one pass over all rows per distinct V (500 s for the
+    reproducer, 300,000 rows each at its own V; 1e12 comparisons here).  Asserted as a ratio of the best of three
+    timings, at most 10 (measured ~1.0 on a loaded machine): a ratio, so the machine's speed cancels, generous
+    for its noise, and hundreds of times below the pass per V's."""
+    from peelapprox.law._tablefile import MAX_TABLES, _split
+
+    rng = np.random.default_rng(0)
+    tables = 1.0 + rng.integers(0, MAX_TABLES, 1_000_000) * 1e-3
+    distinct = rng.uniform(1.0, 2.0, 1_000_000)
+
+    def best(Vs):
+        times, out = [], None
+        for _ in range(3):
+            t0 = time.perf_counter()
+            try:
+                out = _split(Vs, "file x")
+            except ValueError as exc:
+                out = str(exc)
+            times.append(time.perf_counter() - t0)
+        return out, min(times)
+
+    (split, t_split), (refused, t_refused) = best(tables), best(distinct)
+    assert len(split) == MAX_TABLES and sum(len(rows) for _, rows in split) == tables.size
+    assert refused == "file x (V): at most MAX_TABLES = 1000 distinct pull speeds V (one table each), got 1000000"
+    assert t_refused < 10 * t_split, (t_refused, t_split)
+
+
+def test_a_file_of_too_many_tables_is_refused_before_building_them(tmp_path):
+    """A file of MAX_TABLES + 1 distinct pull speeds is refused, naming the file, the limit and the count (the
+    reproducer, 300,000 rows each at its own V, ran 500 s); one of MAX_TABLES is split into its 1000 tables
+    (and then refused by ``tabulated`` for tables of one point: a table needs 5)."""
+    from peelapprox.law._tablefile import MAX_TABLES, read_points
+
+    path = tmp_path / "many.csv"
+    path.write_text("V,v,f\n" + "".join(f"{1 + i * 1e-3:.4f},0.01,100\n" for i in range(MAX_TABLES + 1)))
+    with pytest.raises(ValueError, match=r"many.csv.* \(V\): at most MAX_TABLES = 1000 distinct pull speeds V "
+                                         r"\(one table each\), got 1001"):
+        PeelForce.from_csv(str(path))
+    path.write_text("V,v,f\n" + "".join(f"{1 + i * 1e-3:.4f},0.01,100\n" for i in range(MAX_TABLES)))
+    assert len(read_points(str(path))) == MAX_TABLES
+    with pytest.raises(ValueError, match="needs at least 5 points"):
+        PeelForce.from_csv(str(path))
+
+
+def test_simulate_force_build_is_bounded_by_max_wall(monkeypatch, capsys):
+    """``simulate --force '<39-term sum of 1/(v+i)>' --max-wall 5`` ran 69 s: the law's build (sympy's
+    derivatives) honoured only LAW_BUILD_SECONDS (60 s).  A stand-in build that would run for minutes (sleeping in
+    short steps, as sympy's Python does) under ``--max-wall 0.5`` now stops at that budget: exit status 3 within
+    :data:`BOUND`, the message naming --force and --max-wall; with no budget nearer, the law's own limit is still
+    the ValueError it was (checked with the limit lowered to 0.3 s: exit status 2, 'took more than 0.3 s')."""
+    from peelapprox.law import _expression
+
+    def slow(*args, **kwargs):
+        for _ in range(60_000):
+            time.sleep(0.01)
+
+    monkeypatch.setattr(_expression, "_checked_text", slow)
+    argv = ["simulate", "--V", "1", "--I", "1e-5", "--t-end", "0.01", "--force", "300 + 2*v"]
+    rc, took = _cli([*argv, "--max-wall", str(BUDGET)])
+    err = capsys.readouterr().err
+    assert rc == 3 and took < BOUND, (rc, took, err)
+    assert "--force: more than 0.5 s of wall time (--max-wall) building the peel-force law" in err, err
+    monkeypatch.setattr(_expression, "LAW_BUILD_SECONDS", 0.3)
+    rc, took = _cli([*argv, "--max-wall", "600"])
+    err = capsys.readouterr().err
+    assert rc == 2 and took < BOUND, (rc, took, err)
+    assert "took more than 0.3 s" in err, err

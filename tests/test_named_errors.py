@@ -532,11 +532,17 @@ def _drop(key):
     (_set("params.V", "fast"), r"field meta.params: .*V"),
     (_set("params.hack", 1), r"field meta.params.hack: unknown"),
     (_set("message", "x" * 5000), r"field meta.message: must be a string of at most 2000"),
+    (_set("status", 10**400), r"field meta.status: must be finite and in \[-99, 99\], got 1000"),
+    (_set("stats.n_steps", 10**400), r"field meta.stats.n_steps: must be finite"),
+    (_set("rtol", -10**400), r"field meta.rtol: must be finite"),
+    (_set("t_end", 10**400), r"field meta.t_end: must be finite"),
+    (_set("final_state.alpha", 10**400), r"field meta.final_state.alpha: must be finite"),
 ])
 def test_trajectory_file_fields_are_checked(tmp_path, npz_arrays, change, field):
     """Each malformed field of a trajectory file (the probe's KeyError, unexpected keyword, RecursionError,
     JSONDecodeError, reshape errors; t of 2 samples beside F of 150, a payload string as branch, method or
-    status, t_end = -1 accepted) is a ValueError naming the file and the field (categorical)."""
+    status, t_end = -1 accepted; OverflowError on a JSON integer of 400 digits) is a ValueError naming the file
+    and the field (categorical)."""
     path = _npz_with(tmp_path, npz_arrays, change)
     with pytest.raises(ValueError, match=rf"Trajectory\.from_npz\('.*bad\.npz'\): {field}"):
         exact.Trajectory.from_npz(path)
@@ -567,3 +573,148 @@ def test_a_missing_trajectory_file_is_what_open_raises(tmp_path):
     failed read), not a content error (categorical)."""
     with pytest.raises(FileNotFoundError, match="nope.npz"):
         exact.Trajectory.from_npz(tmp_path / "nope.npz")
+
+
+def _npy_member(shape, payload=b""):
+    """The bytes of a ``.npy`` float64 array member declaring ``shape`` and holding ``payload`` as its data."""
+    import io
+
+    from numpy.lib import format as npy
+
+    buf = io.BytesIO()
+    npy.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": shape})
+    return buf.getvalue() + payload
+
+
+def _peak_bytes(fn, *args):
+    """The peak of memory allocated during ``fn(*args)`` (tracemalloc: Python objects and numpy's arrays, which
+    numpy reports to it, committed or not): a count of bytes, the same on any machine."""
+    import tracemalloc
+
+    message = ""
+    tracemalloc.start()
+    try:
+        try:
+            fn(*args)
+        except ValueError as exc:
+            message = str(exc)
+        return tracemalloc.get_traced_memory()[1], message
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_trajectory_file_declaring_a_huge_array_is_refused_before_loading(tmp_path, npz_arrays):
+    """A member whose ``.npy`` header declares 250,000,000 floats (2 GB, what numpy allocates before reading the
+    data) is refused from its header, naming the file, the field and MAX_ARRAY_BYTES, with a peak of at most 5 MB
+    allocated (tracemalloc, machine-independent; the 2 GB array was allocated before): the bound is the header
+    check, not the machine."""
+    import zipfile
+
+    arrays, _ = npz_arrays
+    path = tmp_path / "bad.npz"
+    np.savez(path, **{k: v for k, v in arrays.items() if k != "t"})
+    with zipfile.ZipFile(path, "a") as zf:
+        zf.writestr("t.npy", _npy_member((250_000_000,)))
+    peak, message = _peak_bytes(exact.Trajectory.from_npz, str(path))
+    assert re.match(r"Trajectory\.from_npz\('.*bad\.npz'\): field t: the arrays take \d+ bytes up to this one, "
+                    r"more than MAX_ARRAY_BYTES = 1073741824", message), message
+    assert peak < 5e6, peak
+
+
+def test_a_compressed_trajectory_bomb_is_refused_before_loading(tmp_path, npz_arrays, monkeypatch):
+    """A zip member that inflates far beyond its file (the probe's 1.9 MB of 250,000,000 zeros cost 2.29 GB) is
+    refused from the zip's sizes before it is inflated: with the limit lowered to 1 MB (so that the bomb, 16 MB of
+    zeros in ~16 kB, is quick to write), the peak allocated is at most 1 MB (tracemalloc: the 16 MB array, or the
+    file's bytes, were never allocated)."""
+    import zipfile
+
+    from exact import _trajectory_file
+
+    arrays, _ = npz_arrays
+    path = tmp_path / "bad.npz"
+    np.savez_compressed(path, **{k: v for k, v in arrays.items() if k != "t"}, t=np.zeros(2_000_000))
+    assert path.stat().st_size < 200_000
+    with zipfile.ZipFile(path) as zf:
+        assert zf.getinfo("t.npy").file_size > 16e6
+    monkeypatch.setattr(_trajectory_file, "MAX_ARRAY_BYTES", 1 << 20)
+    peak, message = _peak_bytes(exact.Trajectory.from_npz, str(path))
+    assert "field t: the arrays take" in message and "MAX_ARRAY_BYTES = 1048576" in message, message
+    assert peak < 1 << 20, peak
+
+
+# ------------------------------------------------------------------------------------ laws without folds
+_NO_FOLDS = "300+1e-9*v"  # f rises by 1e-6 N over its v range [1e-6, 1000] m/s: no folds, AB everywhere
+
+
+def test_a_law_without_folds_whose_root_is_beyond_its_domain_is_named():
+    """``exact.simulate`` of a law without folds whose default F0 = 1.01 f(V, V) = 303 N has its AB root at
+    v ~ 3e9 m/s, beyond the law's v range [1e-6, 1000]: brentq's "f(a) and f(b) must have different signs"
+    escaped; now a ValueError naming F0, params.force, the domain, the f range there, and that the law has no
+    folds (categorical)."""
+    params = PeelParams(V=1.0, I=1e-5, force=PeelForce.expression(_NO_FOLDS))
+    with pytest.raises(ValueError) as info:
+        exact.simulate(params, 0.01)
+    msg = str(info.value)
+    assert "different signs" not in msg
+    for part in ("F0 (not given: the default 1.01 f(V, V) = 303.0", "params.force=PeelForce.expression(",
+                 "no AB root within the peel-force law's domain [1e-06, 1000.0] m/s", "a law without folds",
+                 "f runs from 300 N at v = 1e-06 m/s to 300 N at v = 1000 m/s", "cannot be bracketed"):
+        assert part in msg, (part, msg)
+
+
+def test_a_law_without_folds_still_finds_roots_inside_its_domain():
+    """The bracket check refuses only roots outside the domain: at seeded F0 whose root v = (F0 - 300)/1e-9 lies in
+    [1, 900] m/s, the initial state's v is that closed form to 2e-4 m/s (the rounding of f near 300 N, ulp 5.7e-14
+    N, over the slope 1e-9 N s/m: 5.7e-5 m/s, a few times)."""
+    params = PeelParams(V=1.0, I=1e-5, force=PeelForce.expression(_NO_FOLDS))
+    rng = np.random.default_rng(3)
+    for v_true in rng.uniform(1.0, 900.0, 5):
+        F0 = 300.0 + 1e-9 * float(v_true)
+        s = exact.initial_state(params, F0=F0)
+        assert s.branch == "AB"
+        assert s.v == pytest.approx((F0 - 300.0) / 1e-9, abs=2e-4)
+
+
+# ------------------------------------------------------------------------------------ traces beyond newtons
+@pytest.mark.parametrize("scale", [1e200, -1e13, 2e12])
+def test_a_trace_beyond_max_force_is_refused_naming_its_sample(scale):
+    """A trace with |F| beyond MAX_FORCE = 1e12 N (the probe's F ~ 1e202 N made ``spectrum()`` raise
+    OverflowError) is a ValueError naming F, its first offending sample and the limit (categorical)."""
+    from peelapprox import ForceSeries
+
+    t = np.linspace(0.0, 1.0, 2000)
+    F = 100.0 + 10.0 * np.sin(40.0 * t)
+    F[7:] *= scale / 100.0
+    with pytest.raises(ValueError, match=r"F\[7\] = .* N: \|F\| must be at most MAX_FORCE = 1e\+12 N"):
+        ForceSeries(t, F, V=1.0)
+
+
+def test_a_trace_at_max_force_has_its_spectral_peak():
+    """A trace reaching the limit, F = (100 + 10 sin(2 pi 6.4 t)) 1e12/110 N (|F| up to 1e12 N), has a finite
+    spectrum whose peak is its sine's 6.4 Hz to one frequency bin (the resolution of the spectrum)."""
+    from peelapprox import ForceSeries
+
+    t = np.linspace(0.0, 10.0, 20_000)
+    F = (100.0 + 10.0 * np.sin(2 * np.pi * 6.4 * t)) * (1e12 / 110.0)
+    spec = ForceSeries(t, F, V=1.0).spectrum()
+    assert np.all(np.isfinite(spec.power))
+    assert spec.peak == pytest.approx(6.4, abs=float(spec.frequency[1] - spec.frequency[0]))
+
+
+@pytest.mark.parametrize("field, kind", [("coefficients", "family"), ("tables", "tabulated"),
+                                         ("coefficients", "expression")])
+def test_from_dict_refuses_deep_nesting_by_name(field, kind):
+    """A field nested 100,000 deep (a probe's RecursionError) is a TypeError naming the field and MAX_NESTING,
+    found by an iterative walk; the laws' own dicts (nesting 3 at most) still read back equal (categorical)."""
+    import dataclasses
+
+    deep: list = [1.0]
+    for _ in range(100_000):
+        deep = [deep]
+    d = {"kind": kind, "name": "cubic" if kind == "family" else None, field: deep}
+    with pytest.raises(TypeError, match=rf"d\['{field}'\] is nested more than MAX_NESTING = 8 deep"):
+        PeelForce.from_dict(d)
+    v = [0.1, 0.2, 0.3, 0.4, 0.5]
+    for law in (PeelForce.family("cubic"), PeelForce.tabulated(tables=[(1.0, v, [200, 250, 220, 210, 260]),
+                                                                       (2.0, v, [210, 260, 230, 220, 270])])):
+        assert PeelForce.from_dict(dataclasses.asdict(law)) == law

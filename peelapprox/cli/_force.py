@@ -28,8 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from .. import PeelForce
+from .. import PeelForce, SolverBudgetExceeded
 from .._csvread import MAX_BYTES
+from .._deadline import Expired, caller_budget
 from ..law._tablefile import TABLE_COLUMNS
 from ..validate import shown
 
@@ -141,6 +142,9 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
         ``--const`` without ``--force``, ``--coef`` without ``--force-family``, a name given twice, or what
         :class:`PeelForce` or :func:`read_force_table` refuses (unknown family or coefficient, bad
         expression, bad table), prefixed with the option.
+    SolverBudgetExceeded
+        Building ``--force`` (sympy's derivatives) took longer than ``--max-wall`` (the build's own limit is
+        ``LAW_BUILD_SECONDS``, 60 s, a ValueError; ``--max-wall`` applies where nearer).
     """
     expr, table, family = getattr(args, "force", None), getattr(args, "force_table", None), \
         getattr(args, "force_family", None)
@@ -160,14 +164,21 @@ def force_from_args(args: argparse.Namespace) -> PeelForce:
         raise ValueError("--const sets a constant of --force EXPR; there is no --force")
     if coefs and family is None:
         raise ValueError("--coef sets a coefficient of --force-family NAME; there is no --force-family")
+    option = "--force" if expr is not None else "--force-family"
+    max_wall = getattr(args, "max_wall", None)
     try:
-        if expr is not None:
-            return PeelForce.expression(expr, **_pairs("--const", consts))
-        if family is not None:
-            return PeelForce.family(family, **_pairs("--coef", coefs))
+        with caller_budget(max_wall):  # the law's build: at most LAW_BUILD_SECONDS, or --max-wall if nearer
+            if expr is not None:
+                return PeelForce.expression(expr, **_pairs("--const", consts))
+            if family is not None:
+                return PeelForce.family(family, **_pairs("--coef", coefs))
     except (ValueError, TypeError) as exc:
-        option = "--force" if expr is not None else "--force-family"
         raise ValueError(f"{option}: {exc}") from None
+    except Expired:  # the caller's budget only (the law's own limit is a ValueError above)
+        raise SolverBudgetExceeded(f"{option}: more than {max_wall:g} s of wall time (--max-wall) building the "
+                                   "peel-force law before the run started; pass a larger --max-wall, or write the "
+                                   "law in a simpler form (expanded, fewer factors)", budget="max_wall",
+                                   limit=float(max_wall or 0.0), t=0.0, state={"t": 0.0}) from None
     if table is not None:
         return smoothed_table(table, lam) if smooth else read_force_table(table)
     return PeelForce.paper()

@@ -95,7 +95,8 @@ class CompiledLaw:
         folds -- AB on ``(lo, v_max]`` (``lo`` the domain's start, or ``v = e^-690`` where f = f(0+) to
         rounding), CD on ``[v_min, hi)`` up to where f first exceeds G (doubling, at most to the domain's end).
         ``G`` must be in ``structure.level_range(branch)`` (the caller checks :meth:`BranchStructure.has_root`);
-        ValueError if the CD root lies beyond the domain."""
+        ValueError if the root lies beyond the domain (CD's, or AB's of a law without folds, which cannot then
+        be bracketed)."""
         bs = self.structure
 
         def g(u: float) -> float:
@@ -121,10 +122,17 @@ class CompiledLaw:
                     raise ValueError(f"the level f = {G!r} N has no CD root within the peel-force law's domain "
                                      f"[{lo_d!r}, {hi_d!r}] m/s ({self.force!r})")
                 hi = min(hi + math.log(2.0), u_end)
-        if g(hi) == 0.0:
+        g_lo, g_hi = g(lo), g(hi)
+        if g_hi == 0.0:
             return math.exp(hi)
-        if g(lo) == 0.0:
+        if g_lo == 0.0:
             return math.exp(lo)
+        if (g_lo > 0.0) == (g_hi > 0.0):  # no bracket: the root lies outside the domain (no fold bounds AB)
+            raise ValueError(f"the level f = {G!r} N has no {branch} root within the peel-force law's domain "
+                             f"[{lo_d!r}, {hi_d!r}] m/s ({self.force!r}"
+                             f"{'' if bs.has_folds else ', a law without folds: AB rises to the end of the domain'}"
+                             f"): f runs from {g_lo + G:.6g} N at v = {math.exp(lo):.6g} m/s to {g_hi + G:.6g} N at "
+                             f"v = {math.exp(hi):.6g} m/s, so the branch root cannot be bracketed")
         return math.exp(brentq(g, lo, hi, xtol=1e-15, rtol=_RTOL))
 
 

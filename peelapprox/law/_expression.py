@@ -145,7 +145,9 @@ def canonical(expr: Any, constants: dict[str, Any]) -> str:
     try:
         with time_limit(LAW_BUILD_SECONDS):
             return _checked_text(text, values, label)
-    except Expired:
+    except Expired as exc:
+        if exc.caller:  # the caller's budget (caller_budget) was nearer: its own budget exception
+            raise
         raise ValueError(f"expression {label}: building it (sympy's derivatives f' and f'' and the probe) took "
                          f"more than {LAW_BUILD_SECONDS:g} s; write it in a simpler form (expanded, fewer factors)"
                          ) from None

@@ -23,6 +23,10 @@ from ._kinds import FOLD_GRID_DENSITY, KIND_IMPLS, LawKind, shown_law
 
 __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "PeelForce", "law_label", "require_law", "shown_law"]
 
+#: The deepest nesting of lists (or tuples, mappings) in a field of :meth:`PeelForce.from_dict`'s mapping: a law's
+#: fields nest at most 3 deep (tables: a list of (V, v, f) triples of lists).
+MAX_NESTING = 8
+
 #: The kinds of law.
 KINDS = tuple(KIND_IMPLS)
 #: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
@@ -308,8 +312,9 @@ class PeelForce:
         """The tabulated law (:meth:`tabulated`) of a CSV file's peel-force curve(s).
 
         The header names the columns ``v`` and ``f``, or ``V``, ``v`` and ``f`` (one table per pull speed V, the
-        rows of a V in file order), in any order, each optionally with its unit -- ``v [m/s]``, ``v [mm/s]``,
-        ``f [N]``, ``f (kN)``, ... (:data:`peelapprox._csvread.UNITS`): converted to m/s and N; an unknown unit or
+        rows of a V in file order; at most :data:`peelapprox.law._tablefile.MAX_TABLES` = 1000 tables), in any
+        order, each optionally with its unit -- ``v [m/s]``, ``v [mm/s]``, ``f [N]``, ``f (kN)``, ...
+        (:data:`peelapprox._csvread.UNITS`): converted to m/s and N; an unknown unit or
         one of another dimension is refused, named.  ``#`` starts a comment; blank lines are skipped.  The file
         must be a regular UTF-8 file of at most 16 MiB (a spreadsheet's byte-order mark is fine).
 
@@ -345,7 +350,10 @@ class PeelForce:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
-        """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated."""
+        """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated.
+
+        A field nested deeper than :data:`MAX_NESTING` (lists in lists) is a TypeError naming it (a coefficient
+        list nested 100,000 deep raised RecursionError)."""
         if not isinstance(d, Mapping):
             raise TypeError(f"d must be a mapping of the law's fields (dataclasses.asdict(law) or its JSON), got "
                             f"{type(d).__name__}")
@@ -353,6 +361,8 @@ class PeelForce:
         if unknown:
             raise ValueError(f"d has unknown field(s) {shown(', '.join(map(str, unknown)))}: a law's fields are kind, "
                              "name, coefficients, source, tables, display")
+        for field, value in d.items():
+            _check_nesting(f"d[{field!r}]", value)
         return cls(**dict(d))  # lists for tuples: __post_init__ makes them canonical
 
     # ------------------------------------------------------------------ value semantics
@@ -496,3 +506,21 @@ def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = A
         where = sys._getframe(2).f_code.co_name
     raise ValueError(f"params.force: {where} runs the laws {', '.join(repr(x) for x in laws)} only, not "
                      f"{shown_law(force)}")
+
+
+def _check_nesting(name: str, value: Any) -> None:
+    """TypeError if ``value`` nests lists, tuples or mappings deeper than :data:`MAX_NESTING` (an iterative walk:
+    no recursion to exhaust)."""
+    stack = [(value, 0)]
+    while stack:
+        x, depth = stack.pop()
+        if isinstance(x, Mapping):
+            children: Any = x.values()
+        elif isinstance(x, (list, tuple)):
+            children = x
+        else:
+            continue
+        if depth >= MAX_NESTING:
+            raise TypeError(f"{name} is nested more than MAX_NESTING = {MAX_NESTING} deep (lists in lists): a law's "
+                            "fields nest at most 3 deep (tables: a list of (V, v, f) triples of lists)")
+        stack.extend((c, depth + 1) for c in children)
