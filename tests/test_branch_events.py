@@ -103,26 +103,46 @@ def branch_1e5_up():
     return exact.continue_orbit(exact.periodic_orbit(FVV_1E5, n=3), "V", stop=1.5)
 
 
+def _up_jumps(orbit, V):
+    """AB->CD jump times [s] of a one-period run (x 1.02) at velocity ``V`` from ``orbit``'s first section state."""
+    a, w = orbit.section_states[0]
+    tr = exact.simulate(orbit.params.replace(V=V), 1.02 * orbit.period, alpha0=float(a), omega0=float(w),
+                        F0=float(orbit.return_map_values[0]), branch0="CD", rtol=1e-12, save="jumps")
+    return tr.jumps.t[tr.jumps.from_branch == 0]
+
+
 def test_crest_event_ends_the_branch(branch_1e5_up):
     """Hypothesis: the period-3 branch ends where an interior crest of F (1 + sin α) on AB reaches f_max, at V =
     1.0020700 (linear extrapolation of the crest margin, which falls below 1e-6 of f_max - f_min at the last
-    point).  Checked by direct simulation from the last orbit's state for one period: 1e-5 below the event the
-    third AB->CD jump comes at the end of the period (to 1e-4 s), 1e-5 above it one oscillation earlier, at
-    the crest's time (to 1e-4 s, 3.5 ms before the end)."""
+    point).  Checked by direct simulation from the last orbit's state for one period, at dV on either side of the
+    event: below it the three AB->CD jumps close the period (the third at its end, to 1e-4 s); above it the
+    regular jump that follows the crest (3.5 ms later) comes instead at the crest's own time (to 1e-4 s), the
+    jumps before it unchanged (to 1e-4 s).
+
+    Which of the three jumps follows the crest depends on which jump the orbit's section starts from, and
+    periodic_orbit picks it by a near-recurrence that round-off decides (on one CPU the crest precedes the first
+    jump, on another the third): the test finds it (the first regular jump after the crest) instead of assuming
+    it.  dV is 20 times the distance from the last point to the event, measured from the crest margin's slope
+    over the last two points (~1.5e-5): far beyond the extrapolation's error (its curvature moves the event by
+    < 1e-8), the margin then about +-1e-5 of f_max - f_min (6 orders above the runs' rtol), while the crest time
+    drifts only ~0.1 s per unit V (2e-6 s at dV), well inside the 1e-4 s tolerance, itself 35 times below the
+    3.5 ms that tell the crest's time from the regular jump's."""
     b = branch_1e5_up
     assert b.stopped == "crest" and "crest" in b.message
     assert b.end_value == pytest.approx(1.0020700, abs=2e-7)
-    last = b.points[-1].orbit
-    c = exact.crest_margin(last)
+    last, prev = b.points[-1].orbit, b.points[-2].orbit
+    c, c_prev = exact.crest_margin(last), exact.crest_margin(prev)
     assert c.branch == "AB" and c.margin < 1e-6 and c.floor > 0.5
-    a, w = last.section_states[0]
-    for dV, t_third in ((-1e-5, last.period), (1e-5, c.t)):
-        tr = exact.simulate(last.params.replace(V=b.end_value + dV), 1.02 * last.period, alpha0=float(a),
-                            omega0=float(w), F0=float(last.return_map_values[0]), branch0="CD", rtol=1e-12,
-                            save="jumps")
-        up = tr.jumps.t[tr.jumps.from_branch == 0]
-        assert up[2] == pytest.approx(t_third, abs=1e-4)
-    assert last.period - c.t > 3e-3
+    slope = (c.margin - c_prev.margin) / (last.params.V - prev.params.V)  # per unit V, falling to 0 at the event
+    assert slope < 0
+    dV = 20 * c.margin / -slope
+    assert 1e-6 < dV < 1e-4
+    below, above = _up_jumps(last, b.end_value - dV), _up_jumps(last, b.end_value + dV)
+    assert len(below) == 3 and below[2] == pytest.approx(last.period, abs=1e-4)
+    k = int(np.searchsorted(below, c.t))  # the regular jump the crest precedes
+    assert k < 3 and below[k] - c.t > 3e-3
+    assert len(above) >= k + 1 and above[k] == pytest.approx(c.t, abs=1e-4)
+    assert above[:k] == pytest.approx(below[:k], abs=1e-4)
 
 
 def test_grazing_end_is_extrapolated_below_the_last_point():
