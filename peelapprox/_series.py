@@ -67,7 +67,7 @@ class Spectrum:
     peak : float or None
         The frequency of the largest power above the lowest non-zero bin [Hz]; None when the trace is flat
         (its power above the lowest bin, integrated, is that of fluctuations below :data:`FLAT_RTOL` times its
-        largest |F|: rounding, not a signal, whose largest bin falls at an arbitrary frequency).
+        largest ``|F|``: rounding, not a signal, whose largest bin falls at an arbitrary frequency).
     """
 
     frequency: np.ndarray
@@ -82,14 +82,14 @@ class Spectrum:
 class ForceSeries:
     """A pull-force trace F(t) [N] at times t [s], measured or sampled from a run, and its statistics.
 
-    ``ForceSeries(t, F, *, V=None, source="measured")``: t increasing and finite, F finite with |F| at most
+    ``ForceSeries(t, F, *, V=None, source="measured")``: t increasing and finite, F finite with ``|F|`` at most
     :data:`MAX_FORCE` (1e12 N), one length, at least :data:`MIN_SAMPLES` samples; V the pull speed [m/s] if known
     (it labels the observables).
 
     Raises
     ------
     ValueError
-        Naming the argument and the first offending sample: NaN or inf, |F| beyond MAX_FORCE, non-increasing
+        Naming the argument and the first offending sample: NaN or inf, ``|F|`` beyond MAX_FORCE, non-increasing
         time, different lengths, too few samples, V not positive.
     """
 
