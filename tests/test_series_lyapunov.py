@@ -32,14 +32,41 @@ def chaos_short() -> ForceSeries:
     return _series(2.5, 1e-4, 15.0)
 
 
-def test_chaotic_trace_fast(chaos_short):
-    """Hypothesis: 15 s of the chaotic trace give λ within 25 % of the exact 5.28 bits/s from the return map,
-    with a straight fit range inside the curve and the IAAFT surrogates rejected (p = 1/20)."""
-    r = chaos_short.lyapunov(surrogates=19, references=2000)
-    assert isinstance(r, SeriesLyapunov) and r.embedded == "returns" and r.status == "ok"
-    assert abs(r.lambda_bits_per_s / EXACT_BITS - 1) < 0.25, r
-    a, b = r.fit_range
-    assert 0 < a < b <= r.k[-1] and b - a >= 20
+def _windows(n: int, seconds: float = 15.0) -> list[ForceSeries]:
+    """``n`` consecutive ``seconds``-long windows of one chaotic run (V = 2.5, I = 1e-4) from T0: the first is
+    sample for sample ``chaos_short``'s trace (the t_eval output does not change the solver's steps)."""
+    whole = _series(2.5, 1e-4, n * seconds)
+    m = int(seconds * RATE)
+    return [ForceSeries(whole.t[i * m:(i + 1) * m], whole.F[i * m:(i + 1) * m], V=whole.V,
+                        source=f"{whole.source}, window {i + 1} of {n}") for i in range(n)]
+
+
+def test_chaotic_trace_fast():
+    """Hypothesis: three 15 s windows of the chaotic trace (T0 = 30, 45, 60 s of one run) give a median λ from the
+    return map within [0.8, 1.75] x the exact 5.28 bits/s, each with a straight fit range inside the curve, and
+    the IAAFT surrogates rejected on the first (p = 1/20).
+
+    Why the median of three and that band: a 15 s estimate is one realisation of a chaotic trace, and a
+    different CPU (FMA, vector width) gives a different one, so the band must cover the estimator's spread, not
+    one run's value.  Measured over 25 realisations (20 consecutive 15 s windows T0 = 30-315 s, and T0 = 30 s
+    from alpha0 = 0.1, 0.2, 0.3, 0.5, 0.7; surrogates=0, references=2000): λ = 6.38 ± 1.12 bits/s (mean ± sd),
+    3.23-8.01, i.e. 1.21 ± 0.21 x exact: 15 s read ~21 % high and spread ±21 % (one window met the old
+    ±25 % band 13 times in 25).  The median of three has sd ~0.15 x exact (bootstrap of the 25), all 2300
+    triples' medians lie in 0.99-1.50 x; the band is the mean ∓ 2.7 sd / + 3.6 sd, and an estimator off by 2x
+    (median ~2.4 x or ~0.6 x ± 0.08) falls outside it.  Surrogates: z = 58-111 over the first ten windows,
+    so z > 3 is not close."""
+    wins = _windows(3)
+    lams = []
+    for i, w in enumerate(wins):
+        r = w.lyapunov(surrogates=19 if i == 0 else 0, references=2000)
+        assert isinstance(r, SeriesLyapunov) and r.embedded == "returns" and r.status == "ok"
+        a, b = r.fit_range
+        assert 0 < a < b <= r.k[-1] and b - a >= 20, r
+        lams.append(r.lambda_bits_per_s)
+        if i == 0:
+            first = r
+    assert 0.8 < float(np.median(lams)) / EXACT_BITS < 1.75, lams
+    r = first
     assert r.surrogate is not None and r.surrogate.n == 19 and r.surrogate.rejects_noise
     assert r.surrogate.p_value == pytest.approx(0.05) and r.surrogate.z_score > 3
     d = r.as_dict()
@@ -74,10 +101,12 @@ def test_periodic_trace_gives_zero_and_no_rejection(V, I, seconds):
 
 def test_trace_embedding_runs_and_is_labelled(chaos_short):
     """Hypothesis: the continuous trace can be embedded too (one step per sample) and gives a positive λ of
-    the right order (within a factor 2: its curve bends, docs/dynamics.md)."""
+    the right order (within [0.5, 2.5] x exact: its curve bends, docs/dynamics.md).  Measured on ten 15 s
+    windows (T0 = 30-165 s of one run, references=1000): 5.80-11.33 bits/s, 1.10-2.15 x exact, so the former
+    factor 2 failed on one window in ten; this checks the order of magnitude, not a 2x error."""
     r = chaos_short.lyapunov(embed="trace", surrogates=0, references=1000)
     assert r.embedded == "trace" and r.step == pytest.approx(1 / RATE) and r.surrogate is None
-    assert 0.5 * EXACT_BITS < r.lambda_bits_per_s < 2 * EXACT_BITS
+    assert 0.5 * EXACT_BITS < r.lambda_bits_per_s < 2.5 * EXACT_BITS
     assert "one step per sample" in r.method
 
 
