@@ -43,6 +43,7 @@ SLOW = {
     "peelapprox figures": "the paper's Figs. 2-9, ~11 s",
     "peelapprox basins": "54 starts of 60 s each with their orbits, ~24 s",
     "peelapprox warmup": "compiles the first calls' kernels when not cached (--cpu generic: always in CI), ~80 s",
+    "peelapprox infer": "a least-squares fit of I and k over tens of exact runs, 1-2 min",
 }
 
 
@@ -97,11 +98,21 @@ def _env() -> dict[str, str]:
 
 
 def _write_tape(directory: Path) -> None:
-    """``my_tape.csv`` of the README's ``--force-table`` line: fvV at V = 1.2 m/s, 30 points per decade."""
-    from peelapprox import peel_force
+    """The files the README's data lines read: ``my_tape.csv`` (``--force-table``: fvV at V = 1.2 m/s, 30 points
+    per decade), ``pts.csv`` (``--smooth``: 60 points of fvV at V = 1.2 m/s over v in [1e-3, 31.6] m/s with 1 %
+    seeded noise, as measured points would be) and ``trace.csv`` (``series``/``infer``: 10 s of the pull force at
+    V = 1 m/s, I = 1e-2 kg m², k = 1000 N/m after a 10 s transient, sampled at 10 kHz with 0.5 N of noise)."""
+    import exact
+    from peelapprox import PeelParams, peel_force
 
     v = np.logspace(-6, 1.5, 226)
     np.savetxt(directory / "my_tape.csv", np.c_[v, peel_force(v, 1.2)], delimiter=",", header="v,f", comments="")
+    v = np.logspace(-3, 1.5, 60)
+    f = peel_force(v, 1.2) * (1 + 0.01 * np.random.default_rng(36).standard_normal(v.size))
+    np.savetxt(directory / "pts.csv", np.c_[v, f], delimiter=",", header="v,f", comments="")
+    grid = 10.0 + np.arange(100_000) / 1e4
+    tr = exact.simulate(PeelParams(V=1.0, I=1e-2), 20.0, t_eval=grid)
+    tr.as_series(1e4, noise=0.5, seed=7).to_csv(str(directory / "trace.csv"))
 
 
 def _collect(proc: subprocess.Popen) -> tuple[int, str, str]:
@@ -177,6 +188,7 @@ def test_cheap_command(started, command):
 @pytest.mark.parametrize("command", [c for c in COMMANDS if c not in CHEAP])
 def test_slow_command(tmp_path, command):
     """A long README command exits 0 in its own process (``SLOW`` gives each one's cost)."""
+    _write_tape(tmp_path)
     proc = subprocess.Popen([sys.executable, "-c", "import sys; from peelapprox.cli import main; sys.exit(main())",
                              *shlex.split(command)[1:]], cwd=tmp_path, env=_env(), text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
