@@ -418,7 +418,7 @@ def _marginal(f: _Found) -> bool:
 def _probe(params: PeelParams, law: Any, rtol: float, deadline: float) -> str | None:
     """Why the exact model breaks down from the solver's start where the default chain may not: the full branch
     dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
-    :data:`PROBE_RETURNS` returns; None if it does not (issue 34: of 200 random points, 3 where the exact run
+    :data:`PROBE_RETURNS` returns; None if it does not (a probe found, of 200 random points, 3 where the exact run
     breaks down got a stick-slip prediction; at V = 0.903, I = 1.08e-4 Airy1 + approxvdot's first CD stay lasts
     2.6 ms and lands at 247 N where the exact one lasts 11.2 ms and lands at 162 N, with α = 0.2, whose swing on
     AB then reaches f(0+, V): the O(α) terms of the default chain, not the physics)."""

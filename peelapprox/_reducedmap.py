@@ -5,7 +5,7 @@ reduced AB segment to the fold ``v_max``, the AB→CD jump, a reduced CD segment
 Here its state is the section of the exact model: the point on AB just before the AB→CD jump, where CONSTR,
 ``F (1 - c(α)) = f_max`` (``1 - c = 1 + sin α`` for the paper's geometry), ties F to α, so the map is a map of
 the plane ``x = (α, α̇)``.  At each fold F is put back on CONSTR (``F = f_fold/(1 - c(α))``) instead of carried
-over from the reduced segment, whose linearised constraint drifts under approxvdot (issue 35: the residual of
+over from the reduced segment, whose linearised constraint drifts under approxvdot (measured: the residual of
 ``F(1 + α) = f(v)`` changes at rate ``Ḟα``, -88…+83 N over 50 s); the map then lives on the exact section and its
 fixed points are comparable with :func:`exact.periodic_orbit`'s.
 

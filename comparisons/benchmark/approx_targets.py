@@ -1,4 +1,4 @@
-"""The targets of the stability-aware reduced map (issue 35, item 2) measured on seeded random off-grid points.
+"""The targets of the stability-aware reduced map measured on seeded random off-grid points.
 
     python -m comparisons.benchmark.approx_targets --points N --seed S [--reference-only] [--json FILE]
 

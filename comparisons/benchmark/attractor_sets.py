@@ -2,7 +2,7 @@
 
     python -m comparisons.benchmark.attractor_sets [--points 12] [--seed 35] [--workers 2] [--json FILE] [--csv FILE]
 
-Target (issue 35): ``attractor_set`` at the median point at most 10 times one ``attractor_observables`` call, on 2
+Target: ``attractor_set`` at the median point at most 10 times one ``attractor_observables`` call, on 2
 cores.  The points are drawn uniformly in V over [0.3, 4.8] m/s and log-uniformly in I over [2e-6, 8e-2] kg m^2
 (``numpy.random.default_rng(seed)``), the paper's law at the default k and R.  At each point, in one process and one
 after the other: ``attractor_observables(p)`` (its defaults: 30 s transient, 20 s window, rtol 1e-10; each point's

@@ -8,7 +8,7 @@ the jumps fall at every phase of the sampling grid, as in a measured trace), whi
 grid: samples a cycle (25, 28, 40, 60, 100), drop/noise (10, 20, 50, noiseless), slip fractions (0.01: a fall
 shorter than a sample at these rates; 0.1: 2.5-10 samples).  For each cell the table gives the mean detected drop's
 error against the true 5.6 N (``ForceSeries.slips``, defaults) and the slips found against the cycles.  The
-detector's goal (issue 36): within 2 % at >= 25 samples a cycle and drop/noise >= 10.
+detector's goal: within 2 % at >= 25 samples a cycle and drop/noise >= 10.
 """
 
 from __future__ import annotations
