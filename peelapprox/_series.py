@@ -124,6 +124,7 @@ class ForceSeries:
         self.source = str(source)
         self.t.setflags(write=False)
         self.F.setflags(write=False)
+        self._slips: dict[tuple, Slips] = {}  # slips() by its arguments: the trace is read-only
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -191,7 +192,14 @@ class ForceSeries:
         fit = integer("fit", fit, lo=3, hi=10**5)
         if method not in ("lines", "knee"):
             raise ValueError(f"method must be 'lines' or 'knee', got {method!r}")
-        return detect_slips(self.t, self.F, threshold=threshold, smooth=smooth, fit=fit, method=method)
+        key = (threshold, smooth, fit, method)
+        if key not in self._slips:  # found once per trace and arguments (observables, spectrum, lyapunov all read them)
+            found = detect_slips(self.t, self.F, threshold=threshold, smooth=smooth, fit=fit, method=method)
+            for value in vars(found).values():
+                if isinstance(value, np.ndarray):
+                    value.setflags(write=False)  # shared by every caller: read-only, as the trace is
+            self._slips[key] = found
+        return self._slips[key]
 
     def observables(self, threshold: float | None = None, *, period_rtol: float | None = None,
                     max_period: int = 32, slips: Slips | None = None) -> StickSlipObservables:

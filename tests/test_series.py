@@ -195,3 +195,20 @@ def test_from_csv_reads_units_and_names_bad_rows(tmp_path):
     (tmp_path / "d.csv").write_text("t [h],F\n0,1\n")
     with pytest.raises(ValueError, match="unknown unit"):
         ForceSeries.from_csv(str(tmp_path / "d.csv"))
+
+
+def test_slips_are_found_once_per_trace_and_arguments():
+    """Hypothesis: ``slips()`` is memoised per trace and arguments (observables, spectrum and lyapunov each read
+    it): the same call returns the very same read-only table, other arguments a new one with the values a fresh
+    trace gives (categorical; exact equality, the same computation)."""
+    t = np.arange(4000) / 1000.0
+    F = 100.0 + 10.0 * ((t * 7.0) % 1.0)
+    s = ForceSeries(t, F)
+    a = s.slips()
+    assert s.slips() is a and not a.F_before.flags.writeable
+    with pytest.raises(ValueError):
+        a.F_before[0] = 0.0
+    b = s.slips(method="knee")
+    assert b is not a and b is s.slips(method="knee")
+    fresh = ForceSeries(t, F).slips(method="knee")
+    assert np.array_equal(fresh.F_before, b.F_before) and np.array_equal(fresh.t_start, b.t_start)
