@@ -81,18 +81,18 @@ def dir_problem(st: os.stat_result) -> str | None:
         return "is a symbolic link"
     if not stat.S_ISDIR(st.st_mode):
         return "is not a directory"
-    me = _euid()
-    if me is not None and st.st_uid != me:
-        return f"is owned by another user (uid {st.st_uid})"
-    if st.st_mode & 0o022:
-        return f"is writable by {'others' if st.st_mode & 0o002 else 'its group'} ({_mode(st)})"
-    return None
+    return _owner_or_mode_problem(st)
 
 
 def file_problem(st: os.stat_result) -> str | None:
     """Why the file with ``fstat`` result ``st`` may not be read as code or a pickle (None: it may)."""
     if not stat.S_ISREG(st.st_mode):
         return "is not a regular file"
+    return _owner_or_mode_problem(st)
+
+
+def _owner_or_mode_problem(st: os.stat_result) -> str | None:
+    """Another user's, or writable by group or others (None: neither): what makes a directory or file not ours."""
     me = _euid()
     if me is not None and st.st_uid != me:
         return f"is owned by another user (uid {st.st_uid})"
