@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from ._slips_knee import slip_sticks
 from .io import fmt_number, write_rows
 
 __all__ = ["Slips", "detect_slips", "noise_level", "THRESHOLD_SIGMAS"]
@@ -370,15 +371,11 @@ def detect_slips(t: np.ndarray, F: np.ndarray, *, threshold: float | None = None
                      method=_describe(smooth, h, sigma, threshold, fit, "knee"))
     if method != "lines":
         raise ValueError(f"method must be 'lines' or 'knee', got {method!r}")
-    if peaks and peaks[0] == 0:
-        peaks, valleys = peaks[1:], valleys[1:]
-    n = len(peaks)
-    ts, te, fb, fa, rise = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     last = len(F) - 1
-    for k in range(n):
-        p, v = peaks[k], valleys[k]
-        before = valleys[k - 1] if k else 0  # the stick before runs from the previous slip's end
-        after = peaks[k + 1] if k + 1 < n else last  # the stick after runs to the next slip's start
+    spans = slip_sticks(peaks, valleys, last)
+    n = len(spans)
+    ts, te, fb, fa, rise = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for k, (p, v, before, after) in enumerate(spans):
         a = max(before + (p - before) // 2, p - half - fit, 0)
         b = min(v + (after - v) // 2, v + half + fit, last)
         ts[k], te[k], fb[k], fa[k], rise[k] = _hinge(t, F, a, b, p - half - 1.0, v + half + 1.0)

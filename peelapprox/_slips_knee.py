@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-__all__ = ["KNEE_NOISE", "knee_slips"]
+__all__ = ["KNEE_NOISE", "knee_slips", "slip_sticks"]
 
 #: The averaged noise σ/√smooth, as a fraction of a slip's mean fall per sample, above which its knee is found
 #: by segmented regression instead of the gradient alone.  At V = 3.95 m/s, I = 1.43e-5 (the ratio 0.61 with
@@ -81,21 +81,27 @@ def _split(t: np.ndarray, F: np.ndarray, lo: int, hi: int, first: int, last: int
     return lo + int(j[int(np.argmin(total))])
 
 
+def slip_sticks(peaks: list[int], valleys: list[int], last: int) -> list[tuple[int, int, int, int]]:
+    """Each slip's ``(peak, valley, before, after)``: the stick before it runs from the previous slip's end (or the
+    trace's start), the stick after it to the next slip's start (or the trace's last sample ``last``).  A slip at
+    the first sample is dropped: its stick before is not in the trace."""
+    if peaks and peaks[0] == 0:
+        peaks, valleys = peaks[1:], valleys[1:]
+    n = len(peaks)
+    return [(peaks[k], valleys[k], valleys[k - 1] if k else 0, peaks[k + 1] if k + 1 < n else last) for k in range(n)]
+
+
 def knee_slips(t: np.ndarray, F: np.ndarray, Fs: np.ndarray, peaks: list[int], valleys: list[int],
                sigma: float, smooth: int, fit: int) -> tuple[np.ndarray, ...]:
     """``(t_start, t_end, F_before, F_after, rise)`` of the confirmed extrema by the knee method (module
     docstring)."""
     half = smooth // 2
     knee_noise = sigma / math.sqrt(smooth) / KNEE_NOISE  # the smallest fall per sample the gradient is trusted on
-    if peaks and peaks[0] == 0:
-        peaks, valleys = peaks[1:], valleys[1:]
-    n = len(peaks)
-    ts, te, fb, fa, rise = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     last = len(F) - 1
-    for k in range(n):
-        p, v = peaks[k], valleys[k]
-        before = valleys[k - 1] if k else 0  # the stick before runs from the previous slip's end
-        after = peaks[k + 1] if k + 1 < n else last  # the stick after runs to the next slip's start
+    spans = slip_sticks(peaks, valleys, last)
+    n = len(spans)
+    ts, te, fb, fa, rise = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for k, (p, v, before, after) in enumerate(spans):
         # the knee: walking back from the steepest fall, the first sample at least half as steep as the slip's
         # mean fall (from the maximum forwards, noise on a flat stick could pass for it)
         mean_fall = (Fs[v] - Fs[p]) / (t[v] - t[p])
