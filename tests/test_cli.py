@@ -75,8 +75,9 @@ def test_cli_dynamics_lyapunov_methods(capsys):
 def test_cli_lyapunov_methods_are_exact_lyapunov_methods():
     """``dynamics --lyapunov-method`` takes exact.lyapunov's method names (the CLI writes them out so
     that building the parser loads no ``exact``) and maps the earlier names saltation and regularized onto
-    tangent and variational.  Hypothesis: exact set equality with ``exact.dynamics._lyapunov_options.METHODS``."""
-    from exact.dynamics._lyapunov_options import METHODS
+    tangent and variational.  Hypothesis: exact set equality with
+    ``exact.dynamics._lyapunov_options.LYAPUNOV_METHODS``."""
+    from exact.dynamics._lyapunov_options import LYAPUNOV_METHODS as METHODS
     from peelapprox.cli.dynamics import LYAPUNOV_ALIASES, LYAPUNOV_METHODS
 
     assert LYAPUNOV_METHODS == tuple(METHODS)

@@ -1,7 +1,7 @@
 """The largest Lyapunov exponent of the exact peeling dynamics: one entry point, four methods.
 
 :func:`lyapunov` measures the largest exponent, in bits/s, of the full model FLOW1, FLOW2, flow3 with CONSTR
-after a transient, by one of :data:`METHODS`:
+after a transient, by one of :data:`LYAPUNOV_METHODS`:
 
 * ``"two-trajectory"`` (default) — :func:`~exact.dynamics._benettin.benettin`'s renormalisation of two neighbouring
   hybrid orbits every ``tau`` seconds;
@@ -57,9 +57,10 @@ from ._benettin import (
     benettin,
     variant_two_trajectory,
 )
-from ._lyapunov_options import D0_RANGE, METHODS, _check, check_lyapunov_options
+from ._lyapunov_options import D0_RANGE, LYAPUNOV_METHODS, _check, check_lyapunov_options
 
-__all__ = ["METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov", "lyapunov_tangent", "lyapunov_return_map"]
+__all__ = ["LYAPUNOV_METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov", "lyapunov_tangent",
+           "lyapunov_return_map"]
 
 _AB = BRANCHES.index("AB")
 def lyapunov(
@@ -125,7 +126,7 @@ def lyapunov(
     Raises
     ------
     ValueError
-        An unknown method (the message lists :data:`METHODS`), or a bad argument (named, with its range).
+        An unknown method (the message lists :data:`LYAPUNOV_METHODS`), or a bad argument (named, with its range).
     peelapprox.ModelBreakdown, peelapprox.SolverFailure, peelapprox.SolverBudgetExceeded
         As :func:`exact.simulate`, with the time and state.
 

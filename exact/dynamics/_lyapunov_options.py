@@ -9,7 +9,7 @@ from typing import Any
 from peelapprox.validate import ArgumentTypeError, choice, duration, function, in_range, integer, optional, positive
 from peelapprox.validate import eps as _eps
 
-__all__ = ["D0_RANGE", "METHODS", "check_lyapunov_options"]
+__all__ = ["D0_RANGE", "LYAPUNOV_METHODS", "check_lyapunov_options"]
 
 #: Valid initial perturbation ``d0`` of the two-trajectory method (scaled units): below 1e-12 the perturbation
 #: of F, ``d0 f_max``, nears the rounding of F itself (``2e-16 F``) and the two orbits can start at distance 0;
@@ -18,7 +18,7 @@ D0_RANGE = (1e-12, 1.0)
 
 #: The methods of :func:`lyapunov` and the options each takes besides the common ``t_transient``, ``alpha0``,
 #: ``rtol`` and ``max_wall`` (their defaults: the table of :func:`lyapunov`).
-METHODS: dict[str, tuple[str, ...]] = {
+LYAPUNOV_METHODS: dict[str, tuple[str, ...]] = {
     "two-trajectory": ("tau", "n", "T", "n_discard", "d0", "solver"),
     "tangent": ("T", "max_steps"),
     "return-map": ("n_returns", "h"),
@@ -29,7 +29,7 @@ METHODS: dict[str, tuple[str, ...]] = {
 #: method's option ``solver``, for ``params.variant`` only).
 SOLVERS = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
 
-#: The check of each option of :data:`METHODS`, ``check(name, value) -> value``: the one the methods apply
+#: The check of each option of :data:`LYAPUNOV_METHODS`, ``check(name, value) -> value``: the one the methods apply
 #: (the variational method's, in ``exact.dynamics._variational``, are the same validators).
 _OPTION_CHECKS: dict[str, Callable[[str, Any], Any]] = {
     "tau": duration,
@@ -47,7 +47,7 @@ _OPTION_CHECKS: dict[str, Callable[[str, Any], Any]] = {
 
 
 def _check(name: str, x: Any) -> Any:
-    """Option ``name`` of :data:`METHODS` checked by its :data:`_OPTION_CHECKS` entry."""
+    """Option ``name`` of :data:`LYAPUNOV_METHODS` checked by its :data:`_OPTION_CHECKS` entry."""
     return _OPTION_CHECKS[name](name, x)
 
 
@@ -61,7 +61,7 @@ def check_lyapunov_options(method: str = "two-trajectory", **options: Any) -> st
     ----------
     method : {"two-trajectory", "tangent", "return-map", "variational"}
     **options
-        Options of ``method`` (:data:`METHODS`), each checked by the validator the method applies.
+        Options of ``method`` (:data:`LYAPUNOV_METHODS`), each checked by the validator the method applies.
 
     Returns
     -------
@@ -71,17 +71,17 @@ def check_lyapunov_options(method: str = "two-trajectory", **options: Any) -> st
     Raises
     ------
     ValueError
-        An unknown method (the message lists :data:`METHODS`), an option out of its range (named, with the
+        An unknown method (the message lists :data:`LYAPUNOV_METHODS`), an option out of its range (named, with the
         range), or both ``T`` and ``n`` for the two-trajectory method.
     peelapprox.validate.ArgumentTypeError
         (a ``TypeError`` and ``ValueError``) An option of another method, or of none (named, with the method),
         or of the wrong kind.
     """
-    method = choice("method", method, tuple(METHODS))
-    own = METHODS[method]
+    method = choice("method", method, tuple(LYAPUNOV_METHODS))
+    own = LYAPUNOV_METHODS[method]
     for name in options:
         if name not in own:
-            others = [m for m, opts in METHODS.items() if name in opts]
+            others = [m for m, opts in LYAPUNOV_METHODS.items() if name in opts]
             what = (f"an option of method {' and '.join(map(repr, others))}" if others else
                     "an option of no method")
             raise ArgumentTypeError(f"lyapunov: {name!r} is {what}, not of method={method!r} (whose options are "

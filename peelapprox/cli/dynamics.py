@@ -25,8 +25,8 @@ from ._force import law_fields
 __all__ = ["LYAPUNOV_ALIASES", "LYAPUNOV_METHODS", "add_parser", "run"]
 
 #: ``peelapprox dynamics --lyapunov-method`` choices: the methods of ``exact.lyapunov``
-#: (``exact.dynamics._lyapunov_options.METHODS``, not imported here: the parser is built without loading ``exact``;
-#: tests/test_cli.py keeps the two equal).
+#: (``exact.dynamics._lyapunov_options.LYAPUNOV_METHODS``, not imported here: the parser is built without loading
+#: ``exact``; tests/test_cli.py keeps the two equal).
 LYAPUNOV_METHODS = ("two-trajectory", "tangent", "return-map", "variational")
 #: Earlier names of two of them, still accepted: alias -> method.
 LYAPUNOV_ALIASES = {"saltation": "tangent", "regularized": "variational"}
