@@ -145,7 +145,6 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
     if not isinstance(point, StressPoint):
         raise ValueError(f"point must be a StressPoint, got {type(point).__name__}")
     import exact
-    from exact import ModelBreakdown, SolverBudgetExceeded, SolverFailure
     from peelapprox import PeelParams
 
     rec = _empty_record(point)
@@ -165,6 +164,19 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
         kw["t_eval"] = np.linspace(0.0, point.t_end, point.n_eval)
     else:
         kw["save"] = point.save
+    tr, exc = _simulate(params, point, kw, rec)
+    rec["wall"] = time.perf_counter() - t0
+    _check_end(point, rec, tr, exc, keep_jump_times)
+    return _finish(point, rec)
+
+
+def _simulate(params: Any, point: StressPoint, kw: dict, rec: dict) -> tuple[Any, Any]:
+    """Run ``exact.simulate`` and classify how it ended into ``rec`` (outcome, exception, reason, message,
+    t_reached); returns the trajectory (the partial one of an exception, None after an unexpected one) and the
+    model's or solver's exception (None when it finished or raised something else)."""
+    import exact
+    from exact import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+
     tr = None
     exc: Any = None
     try:
@@ -184,7 +196,12 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
     except Exception as e:  # noqa: BLE001 - anything else is a finding, not a crash of the suite
         rec.update(outcome=f"unexpected:{type(e).__name__}", exception=type(e).__name__, message=message(e))
         tr = None
-    rec["wall"] = time.perf_counter() - t0
+    return tr, exc
+
+
+def _check_end(point: StressPoint, rec: dict, tr: Any, exc: Any, keep_jump_times: bool) -> None:
+    """The checks of a run's end into ``rec``: the trajectory's (:func:`_inspect`), a finished run's final state
+    and end time, an exception's finite time and state with v > 0; ``nan`` as the outcome where one fails."""
     if tr is not None:
         _inspect(tr, point.t_end, rec, keep_jump_times)
         if rec["outcome"] == "ok":
@@ -199,7 +216,6 @@ def run_point(point: StressPoint, keep_jump_times: bool = False) -> dict:
             rec["outcome"] = "nan"
     if isinstance(rec["t_reached"], float) and not math.isfinite(rec["t_reached"]) and rec["outcome"] != "nan":
         rec["t_reached"] = float("nan")
-    return _finish(point, rec)
 
 
 def _finish(point: StressPoint, rec: dict) -> dict:

@@ -62,20 +62,12 @@ def _progress_line(total: int, done0: int) -> Callable[[int, int, dict], None]:
 
 
 def sweep(
-    I_values: Sequence[float] | np.ndarray,
-    V_values: Sequence[float] | np.ndarray,
-    measures: str | Sequence[str] = ("regime",),
-    *,
-    out,
-    executor: None | str | Executor = None,
-    max_workers: int | None = None,
-    options: Mapping[str, Any] | None = None,
-    progress: bool | Callable[[int, int, dict], None] | None = True,
-    resume: bool = True,
-    retry_failed: bool = False,
-    force: PeelForce | None = None,
-    coef: tuple[str, Sequence[float] | np.ndarray] | None = None,
-    max_wall: float | None = DEFAULT_MAX_WALL,
+    I_values: Sequence[float] | np.ndarray, V_values: Sequence[float] | np.ndarray,
+    measures: str | Sequence[str] = ("regime",), *, out, executor: None | str | Executor = None,
+    max_workers: int | None = None, options: Mapping[str, Any] | None = None,
+    progress: bool | Callable[[int, int, dict], None] | None = True, resume: bool = True,
+    retry_failed: bool = False, force: PeelForce | None = None,
+    coef: tuple[str, Sequence[float] | np.ndarray] | None = None, max_wall: float | None = DEFAULT_MAX_WALL,
 ) -> SweepResult:
     """Evaluate ``measures`` at every (I, V) grid point, writing each finished point to ``out`` at once.
 
@@ -121,69 +113,18 @@ def sweep(
         ``max_wall`` was spent; ``partial`` is the result so far, and the same call again computes the rest.
     """
     t0 = time.time()
-    sizes = {"I_values": grid_length(I_values), "V_values": grid_length(V_values)}
-    if isinstance(coef, (tuple, list)) and len(coef) == 2:
-        sizes["coef values"] = grid_length(coef[1])
-    check_grid_size(sizes)  # before the axes are converted: a typo's 1e8 values would take minutes
-    I_vals = check_axis("I_values", I_values, *PARAM_RANGES["I"])
-    V_vals = check_axis("V_values", V_values, *PARAM_RANGES["V"])
-    force = check_force(force)
-    coef_axis = check_coef(force, coef)
-    check_grid_size({"I_values": len(I_vals), "V_values": len(V_vals),
-                     **({"coef values": len(coef_axis[1])} if coef_axis else {})})
+    I_vals, V_vals, force, coef_axis = _check_grid(I_values, V_values, force, coef)
     max_wall = optional(positive, "max_wall", max_wall)
-    if isinstance(measures, str):
-        measures = [m.strip() for m in measures.split(",") if m.strip()]
-    if not isinstance(measures, (list, tuple)) or not all(isinstance(m, str) for m in measures):
-        raise ArgumentTypeError(f"measures must be a str or a sequence of str (names in MEASURES), got {measures!r}")
-    measures = list(measures)
-    if not measures:
-        raise ValueError(f"measures must name at least one measure; known: {sorted(MEASURES)}")
-    if len(set(measures)) != len(measures):
-        raise ValueError(f"measures must not repeat a name, got {measures}")
-    unknown = [m for m in measures if m not in MEASURES]
-    if unknown:
-        raise ValueError(f"measures: unknown measure(s) {unknown}; known: {sorted(MEASURES)}")
-    options = {} if options is None else options
-    if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
-        raise ValueError(f"options must be a mapping with str keys, got {options!r}")
-    try:
-        options = jsonable(dict(options), keep_nonfinite=True)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
-            from None
-    if "max_wall" in options:
-        raise ValueError("options: max_wall is the sweep's own argument, sweep(max_wall=...) (the engine passes "
-                         "each point's measures what is left of it), not an option")
-    _check_options(measures, options, force)
-    max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
-    local = (None, AUTO, THREADS, PROCESSES)
-    if max_workers is not None and not any(executor is x or executor == x for x in local):
-        raise ValueError("max_workers applies only to the local pools (executor None, 'threads' or 'processes'); "
-                         "size your executor instead")
-    if not (executor is None or (isinstance(executor, str) and executor in (AUTO, SERIAL, THREADS, PROCESSES))
-            or callable(getattr(executor, "submit", None))):
-        raise ValueError(f"executor must be None, 'auto', 'threads', 'processes', 'serial' or a "
-                         f"concurrent.futures.Executor, got {executor!r}")
-    if not (isinstance(progress, bool) or progress is None or callable(progress)):
-        raise ValueError("progress must be a bool, None or a callable (done, total, record)")
+    measures = _check_measures(measures)
+    options = _checked_options(options, measures, force)
+    executor, max_workers = _check_executor(executor, max_workers, progress)
     resume = flag("resume", resume)
     retry_failed = flag("retry_failed", retry_failed)
-    if max_workers == 0:
-        executor = SERIAL
-    elif executor is None or executor == AUTO:
-        executor = resolve_kind(AUTO)  # processes on more than two CPUs, threads on two (peelapprox.parallel)
     refs = {name: measure_ref(MEASURES[name]) for name in measures}
     # in this process (serial, threads) the measures are the objects themselves; elsewhere import references
     task_refs = refs if executor in (SERIAL, THREADS) else worker_refs(measures)
 
-    out = _path("out", out)
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise ValueError(f"out={out!r} exists and is not a directory")
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as exc:
-        raise ValueError(f"out={out!r}: cannot create the directory ({exc})") from None
+    out = _make_out(out)
     plan = dict(out=out, I_vals=I_vals, V_vals=V_vals, measures=measures, options=options, resume=resume,
                 retry_failed=retry_failed, force=force, coef=coef_axis)
     try:
@@ -197,6 +138,93 @@ def sweep(
         return _sweep_locked(Plan(**plan), refs, task_refs, executor, max_workers, progress, deadline, max_wall)
     finally:
         lock.close()
+
+
+def _check_grid(I_values: Any, V_values: Any, force: PeelForce | None, coef: Any
+                ) -> tuple[list[float], list[float], PeelForce, tuple[str, list[float]] | None]:
+    """The checked axes, law and coefficient axis (ValueError naming the first bad one); the grid's size is checked
+    before the axes are converted (a typo's 1e8 values would take minutes) and after."""
+    sizes = {"I_values": grid_length(I_values), "V_values": grid_length(V_values)}
+    if isinstance(coef, (tuple, list)) and len(coef) == 2:
+        sizes["coef values"] = grid_length(coef[1])
+    check_grid_size(sizes)
+    I_vals = check_axis("I_values", I_values, *PARAM_RANGES["I"])
+    V_vals = check_axis("V_values", V_values, *PARAM_RANGES["V"])
+    force = check_force(force)
+    coef_axis = check_coef(force, coef)
+    check_grid_size({"I_values": len(I_vals), "V_values": len(V_vals),
+                     **({"coef values": len(coef_axis[1])} if coef_axis else {})})
+    return I_vals, V_vals, force, coef_axis
+
+
+def _check_measures(measures: str | Sequence[str]) -> list[str]:
+    """``measures`` as a list of registered names (a str split at commas), each once; ValueError or
+    ArgumentTypeError naming it otherwise."""
+    if isinstance(measures, str):
+        measures = [m.strip() for m in measures.split(",") if m.strip()]
+    if not isinstance(measures, (list, tuple)) or not all(isinstance(m, str) for m in measures):
+        raise ArgumentTypeError(f"measures must be a str or a sequence of str (names in MEASURES), got {measures!r}")
+    measures = list(measures)
+    if not measures:
+        raise ValueError(f"measures must name at least one measure; known: {sorted(MEASURES)}")
+    if len(set(measures)) != len(measures):
+        raise ValueError(f"measures must not repeat a name, got {measures}")
+    unknown = [m for m in measures if m not in MEASURES]
+    if unknown:
+        raise ValueError(f"measures: unknown measure(s) {unknown}; known: {sorted(MEASURES)}")
+    return measures
+
+
+def _checked_options(options: Any, measures: Sequence[str], force: PeelForce) -> dict:
+    """``options`` as plain JSON data, every option the engine and ``measures`` read checked (ValueError naming
+    it)."""
+    options = {} if options is None else options
+    if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
+        raise ValueError(f"options must be a mapping with str keys, got {options!r}")
+    try:
+        options = jsonable(dict(options), keep_nonfinite=True)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"options must be JSON-serialisable (str, numbers, bools, None, lists, dicts): {exc}") \
+            from None
+    if "max_wall" in options:
+        raise ValueError("options: max_wall is the sweep's own argument, sweep(max_wall=...) (the engine passes "
+                         "each point's measures what is left of it), not an option")
+    _check_options(measures, options, force)
+    return options
+
+
+def _check_executor(executor: Any, max_workers: int | None, progress: Any) -> tuple[Any, int | None]:
+    """The executor to run on and ``max_workers`` (0: in this process), checked against each other; ``progress``
+    checked (ValueError naming the argument).  None or "auto" resolves to processes on more than two CPUs, threads
+    on two (:mod:`peelapprox.parallel`); ``max_workers=0`` to serial."""
+    max_workers = optional(integer, "max_workers", max_workers, lo=0)  # 0: in this process
+    local = (None, AUTO, THREADS, PROCESSES)
+    if max_workers is not None and not any(executor is x or executor == x for x in local):
+        raise ValueError("max_workers applies only to the local pools (executor None, 'threads' or 'processes'); "
+                         "size your executor instead")
+    if not (executor is None or (isinstance(executor, str) and executor in (AUTO, SERIAL, THREADS, PROCESSES))
+            or callable(getattr(executor, "submit", None))):
+        raise ValueError(f"executor must be None, 'auto', 'threads', 'processes', 'serial' or a "
+                         f"concurrent.futures.Executor, got {executor!r}")
+    if not (isinstance(progress, bool) or progress is None or callable(progress)):
+        raise ValueError("progress must be a bool, None or a callable (done, total, record)")
+    if max_workers == 0:
+        executor = SERIAL
+    elif executor is None or executor == AUTO:
+        executor = resolve_kind(AUTO)
+    return executor, max_workers
+
+
+def _make_out(out: Any) -> str:
+    """The checked path ``out``, created as a directory (ValueError if it cannot be)."""
+    out = _path("out", out)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise ValueError(f"out={out!r} exists and is not a directory")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"out={out!r}: cannot create the directory ({exc})") from None
+    return out
 
 
 def _check_options(measures: Sequence[str], options: Mapping, force: PeelForce | None = None) -> None:
