@@ -24,8 +24,8 @@ from ._force import add_force_options, force_from_args, law_fields
 
 __all__ = ["FORMATS", "HYBRID_ONLY", "MAX_WALL", "NEGATIVE_NUMBER", "ArgumentParser", "FromMethods", "HelpFormatter",
            "HelpFromMethods", "REDUCED_ONLY", "UNITS", "add_format", "add_max_wall_option", "add_params",
-           "add_variant_options", "methods", "params_from_args", "print_mapping", "scipy_solvers", "variant_summary",
-           "say", "subcommand", "wall_left", "wall_spent", "write_table"]
+           "add_variant_options", "add_grid_params", "methods", "params_from_args", "print_mapping", "scipy_solvers",
+           "variant_summary", "say", "subcommand", "wall_left", "wall_spent", "write_table"]
 
 #: ``--format`` of the subcommands that print one summary: ``table`` (``key: value [unit]`` lines), ``csv`` (a
 #: header and one row), ``json``.
@@ -205,6 +205,19 @@ def add_params(sp: argparse.ArgumentParser, *, geometry: bool = True, variants: 
     add_variant_options(sp.add_argument_group(title))
     sp.set_defaults(variants_refused=variants)
     add_force_options(sp)
+
+
+def add_grid_params(sp: argparse.ArgumentParser) -> None:
+    """The :class:`peelapprox.PeelParams` fields of every point of a (V, I) grid, whose axes V and I are:
+    ``--k --R --l --geometry``, each None unless given (a resumed grid's options must match what was given), its
+    default in its help (``peelapprox sweep``, ``peelapprox atlas``)."""
+    p = sp.add_argument_group("model parameters (PeelParams; V and I are the grid)")
+    p.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (default: 1000)")
+    p.add_argument("--R", type=float, default=None, help="roller radius [m] (default: 0.1)")
+    p.add_argument("--l", type=float, default=None, help="roller-motor distance [m] (read by --geometry exact; "
+                                                        "default: 1)")
+    p.add_argument("--geometry", choices=GEOMETRIES, default=None,
+                   help="the closure cos(theta): paper or exact (default: paper)")
 
 
 #: Why a subcommand refuses the model variants (``add_params(variants=...)``).

@@ -9,9 +9,9 @@ import sys
 import time
 from collections.abc import Callable
 
-from .. import GEOMETRIES, PeelForce
+from .. import PeelForce
 from ._checks import add_pool_options, check_output_path, nonnegative_int, positive_int, worker_pool
-from ._common import FORMATS, add_max_wall_option, subcommand
+from ._common import FORMATS, add_grid_params, add_max_wall_option, subcommand
 from ._force import add_force_options, force_from_args
 
 __all__ = ["add_parser", "run"]
@@ -64,13 +64,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                         "8; 0: no segment errors)")
     w.add_argument("--segment-rtol", type=float, default=None,
                    help="tolerance of the reduced solves (default: 1e-10)")
-    p = at.add_argument_group("model parameters (PeelParams; V and I are the grid)")
-    p.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (default: 1000)")
-    p.add_argument("--R", type=float, default=None, help="roller radius [m] (default: 0.1)")
-    p.add_argument("--l", type=float, default=None, help="roller-motor distance [m] (read by --geometry exact; "
-                                                        "default: 1)")
-    p.add_argument("--geometry", choices=GEOMETRIES, default=None,
-                   help="the closure cos(theta): paper or exact (default: paper)")
+    add_grid_params(at)
     add_force_options(at)
     st = at.add_argument_group("attractor sets (opt-in; comparisons.atlas.sets)")
     st.add_argument("--sets", action="store_true",

@@ -8,14 +8,20 @@ import os
 import sys
 import time
 
-from .. import GEOMETRIES
 from ._checks import (
     add_pool_options,
     check_output_path,
     check_sweep_plot_key,
     worker_pool,
 )
-from ._common import FromMethods, add_max_wall_option, add_variant_options, scipy_solvers, subcommand
+from ._common import (
+    FromMethods,
+    add_grid_params,
+    add_max_wall_option,
+    add_variant_options,
+    scipy_solvers,
+    subcommand,
+)
 from ._force import add_force_options, force_from_args
 
 __all__ = ["MEASURES_HELP", "add_parser", "run"]
@@ -72,13 +78,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     m.add_argument("--period-rtol", type=float, default=None,
                    help="relative tolerance of a repeat of the return map (period; default: 1e-6)")
     m.add_argument("--lyapunov-time", type=float, default=None, help="measured time [s] (lyapunov; default: 50)")
-    p = sw.add_argument_group("model parameters (PeelParams; V and I are the grid)")
-    p.add_argument("--k", type=float, default=None, help="tape stiffness [N/m] (default: 1000)")
-    p.add_argument("--R", type=float, default=None, help="roller radius [m] (default: 0.1)")
-    p.add_argument("--l", type=float, default=None, help="roller-motor distance [m] (read by --geometry exact; "
-                                                        "default: 1)")
-    p.add_argument("--geometry", choices=GEOMETRIES, default=None,
-                   help="the closure cos(theta): paper or exact (default: paper)")
+    add_grid_params(sw)
     v = sw.add_argument_group("model variant at every point (docs/tape-mass.md, docs/constant-load.md; the measures "
                               "jumps, period and lyapunov run it, regime refuses it; to sweep m, one sweep per "
                               "mass into its own --out)")
