@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Any, cast
 
 import numpy as np
 
@@ -48,13 +48,13 @@ STATUSES = ("stick-slip", "steady", "too few slips", "transient", "no attractor"
 #: stay; a chaotic one's rarely exceeds a few times the longest seen over a window of many slips.
 QUIET_FACTOR = 10.0
 
-#: Units of the fields (the DataFrame's ``attrs["units"]``).
-_UNITS = {"V": "m/s", "I": "kg m^2", "slip_interval": "s", "slip_interval_spread": "s", "force_drop": "N",
-          "force_drop_spread": "N", "slip_time": "s", "slip_time_spread": "s", "stick_time": "s",
-          "stick_time_spread": "s", "F_max": "N", "F_min": "N", "t_start": "s", "t_end": "s"}
 
-#: The four means and their units, in the order of the repr and the summary.
-_MEANS = (("slip_interval", "s"), ("force_drop", "N"), ("slip_time", "s"), ("stick_time", "s"))
+
+def _quantity(unit: str, role: str) -> Any:
+    """A field of :class:`StickSlipObservables` with its unit and role (``"mean"``, ``"spread"``, ``"extreme"``:
+    the observables; ``"where"``: the point and the window) in its metadata: the one schema of the observables,
+    which :attr:`StickSlipObservables.OBSERVABLES`, ``SPREADS`` and ``UNITS`` are read from."""
+    return field(metadata={"unit": unit, "role": role})
 
 
 def _mean_spread(x: np.ndarray) -> tuple[float | None, float | None]:
@@ -159,6 +159,11 @@ class StickSlipObservables:
     0 for a single value.  A quantity the window cannot define (no slip, one slip, no complete stay) is None,
     never NaN.
 
+    The fields are the one schema of the observables: each measured field carries its unit and role in its
+    metadata, and the class attributes ``OBSERVABLES`` (the four means and the force range: what a prediction is
+    compared on, :data:`comparisons.atlas.OBSERVABLES` being this very tuple), ``MEANS``, ``SPREADS`` and
+    ``UNITS`` (field -> unit) are read from them.
+
     Attributes
     ----------
     status, reason : str
@@ -188,26 +193,38 @@ class StickSlipObservables:
         trajectory does not say).
     """
 
+    # The schema read off the fields' metadata below the class (class attributes, not fields: unannotated, so
+    # that neither dataclasses.fields nor __dataclass_fields__ lists them).
+    #: The observables a prediction is compared on, in field order (the means and the force range):
+    #: ``("slip_interval", "force_drop", "slip_time", "stick_time", "F_max", "F_min")``.
+    OBSERVABLES = cast("tuple[str, ...]", ())
+    #: The four means, in field order (the repr's and the summary's).
+    MEANS = cast("tuple[str, ...]", ())
+    #: The spreads of the means, ``"<mean>_spread"``, in field order.
+    SPREADS = cast("tuple[str, ...]", ())
+    #: Field -> unit, of every field with one (the DataFrame's ``attrs["units"]``).
+    UNITS = cast("dict[str, str]", {})
+
     status: str
     reason: str
     method: str
-    V: float | None
-    I: float | None
+    V: float | None = _quantity("m/s", "where")
+    I: float | None = _quantity("kg m^2", "where")
     n_slips: int
     period: int | None
     period_label: str
-    slip_interval: float | None
-    slip_interval_spread: float | None
-    force_drop: float | None
-    force_drop_spread: float | None
-    slip_time: float | None
-    slip_time_spread: float | None
-    stick_time: float | None
-    stick_time_spread: float | None
-    F_max: float | None
-    F_min: float | None
-    t_start: float | None
-    t_end: float | None
+    slip_interval: float | None = _quantity("s", "mean")
+    slip_interval_spread: float | None = _quantity("s", "spread")
+    force_drop: float | None = _quantity("N", "mean")
+    force_drop_spread: float | None = _quantity("N", "spread")
+    slip_time: float | None = _quantity("s", "mean")
+    slip_time_spread: float | None = _quantity("s", "spread")
+    stick_time: float | None = _quantity("s", "mean")
+    stick_time_spread: float | None = _quantity("s", "spread")
+    F_max: float | None = _quantity("N", "extreme")
+    F_min: float | None = _quantity("N", "extreme")
+    t_start: float | None = _quantity("s", "where")
+    t_end: float | None = _quantity("s", "where")
 
     # ------------------------------------------------------------------------------------------ building
     @classmethod
@@ -329,7 +346,7 @@ class StickSlipObservables:
         pd = optional_import("pandas", "StickSlipObservables.to_dataframe")
         row = self.as_dict()
         df = pd.DataFrame([row], columns=list(row))
-        df.attrs["units"] = {name: _UNITS.get(name, "") for name in row}
+        df.attrs["units"] = {name: self.UNITS.get(name, "") for name in row}
         return df
 
     @property
@@ -337,13 +354,18 @@ class StickSlipObservables:
         """True if ``status == "stick-slip"``."""
         return self.status == "stick-slip"
 
+    @classmethod
+    def _means(cls) -> tuple[tuple[str, str], ...]:
+        """The four means and their units, in the order of the repr and the summary."""
+        return tuple((name, cls.UNITS[name]) for name in cls.MEANS)
+
     def _head(self) -> str:
         where = ", ".join(f"{n}={fmt_number(v, 4)}" for n, v in (("V", self.V), ("I", self.I)) if v is not None)
         per = f", {self.period_label}" if self.n_slips else ""
         return f"{self.status}{per}" + (f", {where}" if where else "")
 
     def __repr__(self) -> str:
-        means = ", ".join(f"{name}={fmt_number(getattr(self, name), 4)} {unit}" for name, unit in _MEANS
+        means = ", ".join(f"{name}={fmt_number(getattr(self, name), 4)} {unit}" for name, unit in self._means()
                           if getattr(self, name) is not None)
         if self.n_slips == 0 or not means:
             return f"StickSlipObservables({self._head()}: {'no slip' if self.n_slips == 0 else 'no complete stay'})"
@@ -354,7 +376,7 @@ class StickSlipObservables:
         """A few lines for a person: the status and its reason, each mean ± its spread, the F range, the
         method."""
         lines = [f"{self._head()}: {self.reason}"]
-        for name, unit in _MEANS:
+        for name, unit in self._means():
             value = getattr(self, name)
             if value is not None:
                 lines.append(f"  {name:<14} {fmt_number(value, 5)} ± {fmt_number(getattr(self, name + '_spread'), 2)}"
@@ -368,8 +390,18 @@ class StickSlipObservables:
         items: Sequence[tuple[str, Any]] = [("status", self.status), ("reason", self.reason),
                                             ("method", self.method), ("V [m/s]", self.V), ("I [kg m²]", self.I),
                                             ("slips", self.n_slips), ("period", self.period_label)]
-        items = [*items, *((f"{n} [{u}]", getattr(self, n)) for n, u in _MEANS),
-                 *((f"{n} spread [{u}]", getattr(self, f"{n}_spread")) for n, u in _MEANS),
+        items = [*items, *((f"{n} [{u}]", getattr(self, n)) for n, u in self._means()),
+                 *((f"{n} spread [{u}]", getattr(self, f"{n}_spread")) for n, u in self._means()),
                  ("F_max [N]", self.F_max), ("F_min [N]", self.F_min)]
         return html_table("StickSlipObservables", items)
 
+
+def _roles(*roles: str) -> tuple[str, ...]:
+    return tuple(f.name for f in dataclasses.fields(StickSlipObservables) if f.metadata.get("role") in roles)
+
+
+StickSlipObservables.OBSERVABLES = _roles("mean", "extreme")
+StickSlipObservables.MEANS = _roles("mean")
+StickSlipObservables.SPREADS = _roles("spread")
+StickSlipObservables.UNITS = {f.name: f.metadata["unit"] for f in dataclasses.fields(StickSlipObservables)
+                              if "unit" in f.metadata}

@@ -8,9 +8,12 @@ The exact windows are short (10 s of transient, 5 s measured) to keep the defaul
 own defaults (30 s + 20 s) are measured in docs/atlas.md, not here.
 """
 
+import dataclasses
 import json
 import math
 import os
+import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -31,8 +34,9 @@ from comparisons.atlas import (
     estimate_observables,
     load_atlas,
 )
+from comparisons.atlas.records import SEGMENT_STATS
 from exact import attractor_observables
-from peelapprox import ModelBreakdown, PeelParams, estimate
+from peelapprox import ModelBreakdown, PeelParams, StickSlipObservables, estimate
 from peelapprox.cli import main
 
 TESTS = str(Path(__file__).resolve().parent)
@@ -51,7 +55,7 @@ def _no_nan(text: str) -> list[dict]:
 
 @pytest.fixture(scope="module")
 def small(tmp_path_factory) -> AtlasResult:
-    """A 2 x 3 atlas in this process (estimate, and approx:default skipped until it exists)."""
+    """A 2 x 3 atlas in this process (every registered approximation)."""
     out = tmp_path_factory.mktemp("atlas") / "small"
     return atlas(I_SMALL, V_SMALL, out=out, options=OPTS, max_workers=0, progress=False)
 
@@ -163,6 +167,66 @@ def test_small_atlas_to_xarray(small):
     assert np.array_equal(err[~np.isnan(err)], ours.compressed())
 
 
+def test_observables_are_the_fields_of_stick_slip_observables():
+    """Hypothesis: the atlas's observables are ``StickSlipObservables``' own list (the very object), each a field
+    of the dataclass with its unit, the spreads the means' ``_spread`` fields; no ClassVar leaks into the fields.
+    Exact (names and units)."""
+    names = [f.name for f in dataclasses.fields(StickSlipObservables)]
+    assert OBSERVABLES is StickSlipObservables.OBSERVABLES
+    assert OBSERVABLES == ("slip_interval", "force_drop", "slip_time", "stick_time", "F_max", "F_min")
+    assert set(OBSERVABLES) <= set(names) and list(StickSlipObservables.__dataclass_fields__) == names
+    assert StickSlipObservables.SPREADS == tuple(f"{m}_spread" for m in StickSlipObservables.MEANS)
+    assert [StickSlipObservables.UNITS[o] for o in OBSERVABLES] == ["s", "N", "s", "s", "N", "N"]
+
+
+def test_small_atlas_records_hold_arrays(small):
+    """Hypothesis: a record holds each measure's values as arrays in the schema's order (options ``schema``), not
+    one key per approximation and observable: no key names an approximation, and every map's value is the
+    record's array entry (exact equality: the maps are read from them).  Categorical otherwise."""
+    assert small.options["schema"]["observables"] == list(OBSERVABLES)
+    assert small.options["schema"]["segment_stats"] == list(SEGMENT_STATS)
+    for rec in small.sweep.records:
+        assert not [k for k in rec if "estimate" in k or "approx_default" in k], rec
+        i, j = list(small.I_values).index(rec["I"]), list(small.V_values).index(rec["V"])
+        for a, name in enumerate(small.approximations):
+            assert small.prediction_status(name)[i, j] == rec["atlas_approx_prediction_status"][a]
+            for k, obs in enumerate(OBSERVABLES):
+                v, m = rec["atlas_approx_predicted"][a][k], small.prediction(name, obs)[i, j]
+                assert m is np.ma.masked if v is None else m == v
+        for k, obs in enumerate(OBSERVABLES):
+            v = rec.get("atlas_exact_observables", [None] * len(OBSERVABLES))[k]
+            assert small.exact(obs)[i, j] is np.ma.masked if v is None else small.exact(obs)[i, j] == v
+
+
+def test_first_format_atlas_reads_and_refuses_to_resume(tmp_path):
+    """Hypothesis: an atlas of the first record format (one key per number: ``atlas_approx_<name>_<observable>``,
+    3 points of the 2 x 3 grid written before the schema) loads: every map's value is its record's own key's
+    (exact equality: the conversion moves values, computes none), absent keys masked; resuming it is a
+    ValueError that says it must be regenerated.  Exact and categorical."""
+    out = tmp_path / "old"
+    shutil.copytree(Path(TESTS) / "data" / "atlas_format1", out)
+    res = load_atlas(out)
+    recs = _no_nan((out / "results.jsonl").read_text())
+    assert len(res.records) == 3 and res.approximations and res.reductions
+    for rec in recs:
+        i, j = list(res.I_values).index(rec["I"]), list(res.V_values).index(rec["V"])
+        assert res.status()[i, j] == rec["status"] and res.exact_class()[i, j] == rec["atlas_exact_class"]
+        for obs in OBSERVABLES:
+            v = rec.get(f"atlas_exact_{obs}")
+            assert res.exact(obs)[i, j] is np.ma.masked if v is None else res.exact(obs)[i, j] == v
+            for name in res.approximations:
+                v = rec.get(f"atlas_approx_{re.sub(r'[^A-Za-z0-9_]', '_', name)}_{obs}")
+                m = res.prediction(name, obs)[i, j]
+                assert m is np.ma.masked if v is None else m == v
+        for red in res.reductions:
+            for stat in SEGMENT_STATS:
+                v, m = rec.get(f"atlas_segments_{red}_{stat}"), res.segment_error(red, stat)[i, j]
+                assert m is np.ma.masked if v is None else m == v
+    assert len(res.error_rows()) == 3 * len(res.approximations) * len(OBSERVABLES)
+    with pytest.raises(ValueError, match="first record format.*new directory"):
+        atlas(res.I_values, res.V_values, out=out, options=OPTS, max_workers=0, progress=False)
+
+
 def test_predictions_checked_and_both_return_types(tmp_path, monkeypatch):
     """Hypothesis: an approximation returning a NaN observable is recorded with an ``error: ValueError`` status
     naming the field (never NaN), while one returning a ``StickSlipObservables`` is read like one returning a
@@ -172,8 +236,8 @@ def test_predictions_checked_and_both_return_types(tmp_path, monkeypatch):
     res = atlas([1e-5], [1.0], out=tmp_path / "a", approximations=["estimate", "test:nan", "test:obs"],
                 options={**OPTS, "segments_per_branch": 0}, max_workers=0, progress=False)
     rec = _no_nan((tmp_path / "a" / "results.jsonl").read_text())[0]
-    assert rec["atlas_approx_test_nan_status"].startswith("error: ValueError") and \
-        "slip_interval must be a finite number" in rec["atlas_approx_test_nan_status"]
+    nan_status = rec["atlas_approx_prediction_status"][res.approximations.index("test:nan")]
+    assert nan_status.startswith("error: ValueError") and "slip_interval must be a finite number" in nan_status
     assert res.undefined("test:nan", "slip_interval")[0, 0].startswith("predicted: error: ValueError")
     for obs in OBSERVABLES:
         assert res.prediction("test:obs", obs)[0, 0] == res.prediction("estimate", obs)[0, 0]

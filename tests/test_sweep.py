@@ -641,11 +641,13 @@ def test_malformed_manifest_gives_the_clear_error(tmp_path, damage):
     '{"I":true,"V":1.0,"status":"ok"}',
     '{"I":1e-05,"V":1.0}',
     '{"I":1e-05,"V":1.0,"status":5}',
-    '{"I":1e-05,"V":1.0,"status":"ok","slowprod_value":[1,2]}',
+    '{"I":1e-05,"V":1.0,"status":"ok","slowprod_value":[[1,[2]]]}',
+    '{"I":1e-05,"V":1.0,"status":"ok","slowprod_value":[{"a":1}]}',
     '{"I":1e-05,"V":1.0,"status":"ok","slowprod_value":1' + "0" * 400 + '}',
     '[1, 2]',
     '[' * 100000,
-], ids=["I 1e400", "V Infinity", "I a string", "I a bool", "status missing", "status a number", "a list value",
+], ids=["I 1e400", "V Infinity", "I a string", "I a bool", "status missing", "status a number", "a 3-deep list",
+        "a list of objects",
         "a 401-digit int", "not an object", "deep nesting"])
 def test_malformed_record_gives_the_clear_error(tmp_path, line):
     """Hypothesis: a crafted or corrupted complete line of results.jsonl (non-finite or non-numeric I/V,

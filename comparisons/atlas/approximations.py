@@ -6,7 +6,7 @@ never from the full DAE.  :data:`APPROXIMATIONS` maps a name to one of
 
 * a callable ``fn(params)``;
 * an import reference ``"module:attribute"`` of such a callable, resolved when an atlas starts: an entry whose
-  reference does not resolve yet (a function still to be written) is *skipped*, and the atlas says so;
+  reference does not resolve (its module or function is not installed) is *skipped*, and the atlas says so;
 * a pair ``("module:attribute", {keyword: value})``: the same, called as ``fn(params, **keywords)`` (a variant
   of one function, e.g. another alpha model).
 
@@ -31,12 +31,13 @@ from ..sweep.task import import_ref
 __all__ = ["APPROXIMATIONS", "OBSERVABLES", "UNITS", "TOLERANCE", "Entry", "register_approximation",
            "estimate_observables", "resolve", "available", "key_of", "predict"]
 
-#: The observables an atlas compares, fields of :class:`peelapprox.StickSlipObservables` (their definitions are
-#: its docstring's): the mean time between slips, the mean force drop of a slip, the mean CD and AB stays, and
-#: the force range at the jumps.  ``period`` is recorded too but compared as a class, not as a relative error.
-OBSERVABLES = ("slip_interval", "force_drop", "slip_time", "stick_time", "F_max", "F_min")
-#: The unit of each observable (times in s, forces in N).
-UNITS = {"slip_interval": "s", "force_drop": "N", "slip_time": "s", "stick_time": "s", "F_max": "N", "F_min": "N"}
+#: The observables an atlas compares: :class:`peelapprox.StickSlipObservables`' own list
+#: (``StickSlipObservables.OBSERVABLES``, the very object; their definitions are its docstring's): the mean time
+#: between slips, the mean force drop of a slip, the mean CD and AB stays, and the force range at the jumps.
+#: ``period`` is recorded too but compared as a class, not as a relative error.
+OBSERVABLES = StickSlipObservables.OBSERVABLES
+#: The unit of each observable (times in s, forces in N), from the same fields.
+UNITS = {name: StickSlipObservables.UNITS[name] for name in OBSERVABLES}
 
 #: The paper's claim for its approximations, "reasonably accurate values", read as within 10 %: the outline of
 #: the atlas's maps and the criterion of its summary.
@@ -106,7 +107,7 @@ _REF = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_][\w.]*$")
 
 
 def key_of(name: str) -> str:
-    """The record-key part of an approximation's name: every character other than a letter, digit or ``_``
+    """An approximation's name in a file name (the maps'): every character other than a letter, digit or ``_``
     becomes ``_`` (``"approx:default"`` -> ``"approx_default"``)."""
     return re.sub(r"\W", "_", name)
 
@@ -130,7 +131,7 @@ def register_approximation(name: str, entry: Entry, *, replace: bool = False) ->
     ----------
     name : str
         Letters, digits and ``_ : . + -``, starting with a letter; its :func:`key_of` must differ from every
-        other entry's (the records' keys).
+        other entry's (the maps' file names).
     entry : callable, str or (str, dict)
         ``fn(params) -> StickSlipObservables | dict``, or an import reference (module docstring).  A process
         pool's workers find an entry by name in this registry when they import this module, or else by the
@@ -149,7 +150,7 @@ def register_approximation(name: str, entry: Entry, *, replace: bool = False) ->
     _check_entry(name, entry)
     clash = [other for other in APPROXIMATIONS if other != name and key_of(other) == key_of(name)]
     if clash:
-        raise ValueError(f"approximation {name!r} has the record key {key_of(name)!r} of {clash[0]!r}: rename it")
+        raise ValueError(f"approximation {name!r} has the file-name key {key_of(name)!r} of {clash[0]!r}: rename it")
     if name in APPROXIMATIONS and APPROXIMATIONS[name] is not entry and not replace:
         raise ValueError(f"approximation {name!r} is already registered; pass replace=True to replace it")
     APPROXIMATIONS[name] = entry
@@ -221,7 +222,7 @@ def available(names: list[str] | None = None, *, serial: bool = True) -> tuple[d
             try:
                 resolve(name)
             except (ImportError, AttributeError):
-                skipped[name] = f"{ref} is not importable yet"
+                skipped[name] = f"{ref} is not importable"
                 continue
             # a reference alone travels as itself; with keywords, by name (a built-in entry, or max_workers=0)
             run[name] = entry if isinstance(entry, str) else "registry"

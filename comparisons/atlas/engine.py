@@ -18,6 +18,7 @@ from ..sweep.grid import check_grid_size, grid_length
 from ..sweep.store import check_axis, failed
 from .approximations import available
 from .measures import DEFAULTS, MEASURE_NAMES, check_options
+from .records import check_resumable, schema
 from .result import AtlasResult
 from .sets import SET_DEFAULTS, SET_MEASURE
 
@@ -50,7 +51,8 @@ def atlas_options(*, approximations: Sequence[str] | None = None, serial: bool =
     ``t_window``, ``rtol``, ``alpha0``, ``segments_per_branch``, ``segment_rtol``, ``reductions``); ``k, R, l,
     geometry`` are the :class:`peelapprox.PeelParams` fields of every point (None: its default).  The
     approximations that can run now go in ``approximations`` (name -> how a worker finds it), those whose
-    function is not importable yet in ``skipped_approximations`` (name -> why).  ``sets``: also the options of
+    function is not importable in ``skipped_approximations`` (name -> why); ``schema`` is the record schema
+    (:func:`comparisons.atlas.records.schema`).  ``sets``: also the options of
     :data:`~comparisons.atlas.sets.SET_DEFAULTS` (``set_min_share``, ``set_stability``), which ``window`` may then
     change; without it they are refused and absent (the manifest of an atlas without sets is unchanged).
 
@@ -73,7 +75,8 @@ def atlas_options(*, approximations: Sequence[str] | None = None, serial: bool =
         raise ValueError(f"approximations must be a sequence of names (None: every registered one), got "
                          f"{approximations!r}")
     run, skipped = available(None if approximations is None else list(approximations), serial=serial)
-    opts: dict[str, Any] = {**known, **window, "approximations": run, "skipped_approximations": skipped}
+    opts: dict[str, Any] = {**known, **window, "approximations": run, "skipped_approximations": skipped,
+                            "schema": schema()}
     fields: dict[str, Any] = {name: value for name, value in (("k", k), ("R", R), ("l", l), ("geometry", geometry))
               if value is not None}
     PeelParams(V=1.0, I=1e-5, **fields)  # ValueError naming a bad field and its range
@@ -83,24 +86,12 @@ def atlas_options(*, approximations: Sequence[str] | None = None, serial: bool =
 
 
 def atlas(
-    I_values: Sequence[float] | np.ndarray,
-    V_values: Sequence[float] | np.ndarray,
-    *,
-    out,
-    approximations: Sequence[str] | None = None,
-    force: PeelForce | None = None,
-    k: float | None = None,
-    R: float | None = None,
-    l: float | None = None,
-    geometry: str | None = None,
-    options: Mapping[str, Any] | None = None,
-    executor: None | str | Executor = None,
-    max_workers: int | None = None,
-    progress: bool | Callable[[int, int, dict], None] | None = True,
-    resume: bool = True,
-    retry_failed: bool = False,
-    max_wall: float | None = DEFAULT_MAX_WALL,
-    sets: bool = False,
+    I_values: Sequence[float] | np.ndarray, V_values: Sequence[float] | np.ndarray, *, out,
+    approximations: Sequence[str] | None = None, force: PeelForce | None = None, k: float | None = None,
+    R: float | None = None, l: float | None = None, geometry: str | None = None,
+    options: Mapping[str, Any] | None = None, executor: None | str | Executor = None, max_workers: int | None = None,
+    progress: bool | Callable[[int, int, dict], None] | None = True, resume: bool = True, retry_failed: bool = False,
+    max_wall: float | None = DEFAULT_MAX_WALL, sets: bool = False,
 ) -> AtlasResult:
     """Where the approximations hold: the exact attractor, every approximation's prediction and each
     reduction's exact-seeded errors at every (I, V) grid point, on the sweep engine.
@@ -116,7 +107,7 @@ def atlas(
         The atlas's directory (created; an atlas already there with the same grid and options is resumed).
     approximations : sequence of str, optional
         Names in :data:`~comparisons.atlas.approximations.APPROXIMATIONS` (default: all); an entry whose
-        function is not importable yet is skipped (:attr:`AtlasResult.skipped` says which and why).
+        function is not importable is skipped (:attr:`AtlasResult.skipped` says which and why).
     force : peelapprox.PeelForce, optional
         The peel-force law at every point (default: the paper's).
     k, R, l, geometry : optional
@@ -156,6 +147,7 @@ def atlas(
     opts = atlas_options(approximations=approximations, serial=serial, k=k, R=R, l=l, geometry=geometry, sets=sets,
                          **dict(options or {}))
     measures = (*MEASURE_NAMES, SET_MEASURE) if sets else MEASURE_NAMES
+    check_resumable(out)
     try:
         res = sweep(I_values, V_values, measures, out=out, executor=executor, max_workers=max_workers,
                     options=opts, progress=_Progress() if progress is True else progress, resume=resume,

@@ -42,7 +42,8 @@ from .._compare import DEFAULT_MODELS, compare
 from .._segments import segments
 from .._worker import error_text
 from ..sweep import register_measure
-from .approximations import APPROXIMATIONS, OBSERVABLES, key_of, predict
+from .approximations import APPROXIMATIONS, OBSERVABLES, predict
+from .records import SEGMENT_STATS, SPREADS, schema
 
 __all__ = ["MEASURE_NAMES", "DEFAULTS", "SPREADS", "SEGMENT_STATS", "reduction_key", "check_options",
            "measure_exact", "measure_segments", "measure_approx"]
@@ -69,16 +70,11 @@ DEFAULTS: dict[str, Any] = {
     "reductions": {branch: [list(m) for m in models] for branch, models in DEFAULT_MODELS.items()},
 }
 
-#: The spreads recorded with the exact means (fields of :class:`peelapprox.StickSlipObservables`).
-SPREADS = ("slip_interval_spread", "force_drop_spread", "slip_time_spread", "stick_time_spread")
-#: The per-reduction summaries of ``atlas_segments``: ``<reduction>_<stat>``.
-SEGMENT_STATS = ("dt_median", "dt_worst", "dF_median", "dF_worst", "n", "failed")
-
 _VARIANT_OPTIONS = ("tape_mass", "loading", "load_mass", "load")
 
 
 def reduction_key(branch: str, alpha_model: str, v_equation: str) -> str:
-    """The record-key part of a reduction: ``"AB_approxalpha_approxvdot"``."""
+    """The name of a reduction in an atlas: ``"AB_approxalpha_approxvdot"``."""
     return f"{branch}_{alpha_model}_{v_equation}"
 
 
@@ -132,6 +128,9 @@ def check_options(options: Mapping) -> None:
     :func:`peelapprox.estimate` are the paper's massless model's under velocity control.
     """
     _window(options)
+    if options.get("schema", schema()) != schema():
+        raise ValueError(f"schema: the atlas's record schema {options.get('schema')!r} is not this version's "
+                         f"{schema()!r}: run the atlas again into a new directory to regenerate it")
     integer("segments_per_branch", options.get("segments_per_branch", DEFAULTS["segments_per_branch"]), lo=0)
     _rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"]))
     _reductions(options)
@@ -160,7 +159,9 @@ def measure_exact(params: PeelParams, options: Mapping) -> dict:
 
     ``status`` is ``"ok"`` for stick-slip, else the observables' status (``steady``, ``transient``, ``too few
     slips``), ``breakdown:<reason>`` or ``budget:<name>``; ``class`` is the return map's label on stick-slip
-    (``period-n``, ``aperiodic``, ``too short``), else the status without its detail; ``reason`` says why.
+    (``period-n``, ``aperiodic``, ``too short``), else the status without its detail; ``reason`` says why;
+    ``observables`` and ``spreads`` the values of :data:`~comparisons.atlas.approximations.OBSERVABLES` and
+    :data:`SPREADS` (None where undefined; absent after a breakdown or a spent budget).
     """
     kw = _window(options)
     try:
@@ -172,8 +173,9 @@ def measure_exact(params: PeelParams, options: Mapping) -> dict:
         return {**_budget(exc), "class": "budget"}
     rec: dict[str, Any] = {"status": "ok" if obs.is_stick_slip else obs.status,
                            "class": obs.period_label if obs.is_stick_slip else obs.status,
-                           "reason": obs.reason, "period": obs.period, "n_slips": obs.n_slips}
-    rec.update({name: getattr(obs, name) for name in (*OBSERVABLES, *SPREADS)})
+                           "reason": obs.reason, "period": obs.period, "n_slips": obs.n_slips,
+                           "observables": [getattr(obs, name) for name in OBSERVABLES],
+                           "spreads": [getattr(obs, name) for name in SPREADS]}
     return rec
 
 
@@ -181,10 +183,11 @@ def measure_segments(params: PeelParams, options: Mapping) -> dict:
     """Sweep measure ``atlas_segments``: each reduction on the window's last ``segments_per_branch`` complete
     stays of each branch, seeded from their exact entries (:func:`comparisons.compare`).
 
-    Per reduction ``<branch>_<alpha_model>_<v_equation>``: ``_dt_median``, ``_dt_worst``, ``_dF_median``,
-    ``_dF_worst`` (of ``|approx - exact| / |exact|`` over its stays; None without a stay it solved), ``_n``
-    (stays solved) and ``_failed`` (stays whose reduced solve broke down or did not reach the fold); ``n_AB``,
-    ``n_CD`` the stays compared.  ``status`` as ``atlas_exact``'s for a breakdown or a spent budget, else ok.
+    ``stats``: per reduction (in the order of the option ``reductions``) the values of :data:`SEGMENT_STATS`:
+    ``dt_median``, ``dt_worst``, ``dF_median``, ``dF_worst`` (of ``|approx - exact| / |exact|`` over its stays;
+    None without a stay it solved), ``n`` (stays solved) and ``failed`` (stays whose reduced solve broke down or did
+    not reach the fold); ``n_AB``, ``n_CD`` the stays compared.  ``status`` as ``atlas_exact``'s for a breakdown
+    or a spent budget, else ok.
     """
     kw = _window(options)
     n = integer("segments_per_branch", options.get("segments_per_branch", DEFAULTS["segments_per_branch"]), lo=0)
@@ -200,28 +203,26 @@ def measure_segments(params: PeelParams, options: Mapping) -> dict:
     chosen = {b: [s for s in segs if s.branch == b][-n:] if n else [] for b in ("AB", "CD")}
     rows = compare(tr, models, segs=chosen["AB"] + chosen["CD"],
                    rtol=_rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"])))
-    rec: dict[str, Any] = {"status": "ok", "n_AB": len(chosen["AB"]), "n_CD": len(chosen["CD"])}
+    stats = []
     for branch, pairs in models.items():
         for am, ve in pairs:
             mine = [r for r in rows if r.branch == branch and r.alpha_model == am and r.v_equation == ve]
             ok = [r for r in mine if r.status == "ok"]
-            key = reduction_key(branch, am, ve)
-            for q, attr in (("dt", "dt_rel_error"), ("dF", "dF_rel_error")):
+            row: list[float | int | None] = []
+            for attr in ("dt_rel_error", "dF_rel_error"):
                 errs = np.array([abs(getattr(r, attr)) for r in ok if getattr(r, attr) is not None])
-                rec[f"{key}_{q}_median"] = float(np.median(errs)) if errs.size else None
-                rec[f"{key}_{q}_worst"] = float(errs.max()) if errs.size else None
-            rec[f"{key}_n"] = len(ok)
-            rec[f"{key}_failed"] = len(mine) - len(ok)
-    return rec
+                row += [float(np.median(errs)), float(errs.max())] if errs.size else [None, None]
+            stats.append([*row, len(ok), len(mine) - len(ok)])
+    return {"status": "ok", "n_AB": len(chosen["AB"]), "n_CD": len(chosen["CD"]), "stats": stats}
 
 
 def measure_approx(params: PeelParams, options: Mapping) -> dict:
     """Sweep measure ``atlas_approx``: every approximation of the option ``approximations`` at this point, and
     :func:`peelapprox.estimate`'s ``regime`` label.
 
-    Per approximation (its :func:`~comparisons.atlas.approximations.key_of` ``k``): ``k_status`` (its own,
-    ``breakdown:<reason>``, or ``error: <Type>: <message>`` when it raised), ``k_reason``, ``k_period`` and
-    ``k_<observable>`` for each of :data:`~comparisons.atlas.approximations.OBSERVABLES`.  ``status`` is ok:
+    One value per approximation (in the option's order): ``prediction_status`` (its own, ``breakdown:<reason>``,
+    or ``error: <Type>: <message>`` when it raised), ``prediction_reason``, ``prediction_period``, and
+    ``predicted``, its values of :data:`~comparisons.atlas.approximations.OBSERVABLES`.  ``status`` is ok:
     a prediction that fails is a result of the atlas, not a failure of the point.
     """
     rec: dict[str, Any] = {"status": "ok"}
@@ -229,17 +230,18 @@ def measure_approx(params: PeelParams, options: Mapping) -> dict:
         rec["regime"] = estimate(params).label
     except Exception as exc:
         rec["regime"] = error_text(exc, 200)
+    ds = []
     for name, ref in _approximations(options).items():
-        k = key_of(name)
         try:
             d = predict(name, params, ref)
         except ModelBreakdown as exc:
             d = {"status": f"breakdown:{exc.reason}", "reason": f"the reduced map breaks down ({exc.reason})"}
         except Exception as exc:
             d = {"status": error_text(exc, 300), "reason": "the approximation raised"}
-        rec[f"{k}_status"], rec[f"{k}_reason"] = d["status"], d["reason"]
-        rec[f"{k}_period"] = d.get("period")
-        rec.update({f"{k}_{field}": d.get(field) for field in OBSERVABLES})
+        ds.append(d)
+    rec.update(prediction_status=[d["status"] for d in ds], prediction_reason=[d["reason"] for d in ds],
+               prediction_period=[d.get("period") for d in ds],
+               predicted=[[d.get(field) for field in OBSERVABLES] for d in ds])
     return rec
 
 

@@ -19,8 +19,9 @@ from peelapprox.io import fmt_number, html_table, jsonable, optional_import, wri
 
 from ..sweep import SweepResult, load_sweep, record_key
 from ..sweep.store import failed
-from .approximations import OBSERVABLES, TOLERANCE, UNITS, key_of
-from .measures import MEASURE_NAMES, SEGMENT_STATS, SPREADS, reduction_key
+from .approximations import OBSERVABLES, TOLERANCE, UNITS
+from .measures import MEASURE_NAMES, reduction_key
+from .records import NOT_COMPUTED, SEGMENT_STATS, SPREADS, AtlasArrays, grid_index, is_none, upgrade
 from .sets import SET_MEASURE, set_summary
 
 __all__ = ["AtlasResult", "load_atlas", "TABLES", "SET_FIELDS"]
@@ -35,19 +36,15 @@ SET_FIELDS = ("set_status", "n_attractors", "n_stick_slip", "labels", "primary_c
               "matched_share", "default_stick_slip", "strict_match", "strict_distance", "predicted_max_multiplier",
               "exact_max_multiplier", "multiplier_error", "set_wall")
 
-_NOT_COMPUTED = "not computed"
+_NOT_COMPUTED = NOT_COMPUTED
 
 
 def _exact_key(field: str) -> str:
     return record_key("atlas_exact", field)
 
 
-def _approx_key(name: str, field: str) -> str:
-    return record_key("atlas_approx", f"{key_of(name)}_{field}")
-
-
-def _segment_key(reduction: str, stat: str) -> str:
-    return record_key("atlas_segments", f"{reduction}_{stat}")
+def _approx_key(field: str) -> str:
+    return record_key("atlas_approx", field)
 
 
 def _set_key(field: str) -> str:
@@ -56,6 +53,12 @@ def _set_key(field: str) -> str:
 
 def _number(v: Any) -> float | None:
     return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+
+
+def _slice(rec: dict, key: str, n: int) -> list:
+    """The record's list under ``key``, n Nones where it has none."""
+    vals = rec.get(key)
+    return [None] * n if vals is None else list(vals)
 
 
 class AtlasResult:
@@ -67,6 +70,12 @@ class AtlasResult:
     ----------
     sweep : comparisons.sweep.SweepResult
         The records themselves (the atlas's directory is a sweep directory).
+    records : list of dict
+        Its records in this version's format (:mod:`comparisons.atlas.records`; an atlas of the first format is
+        read through :func:`~comparisons.atlas.records.upgrade`), grid order.
+    arrays : comparisons.atlas.records.AtlasArrays
+        Every map, built once from the records: the exact observables ``[i, j, observable]``, the predictions
+        ``[approximation, i, j, observable]``, the segment statistics ``[reduction, i, j, stat]``, the statuses.
     I_values, V_values : ndarray
         The grid.
     approximations : tuple of str
@@ -100,6 +109,9 @@ class AtlasResult:
         self.force = sweep.force
         #: The atlas compares attractor sets (``atlas(..., sets=True)``; :mod:`comparisons.atlas.sets`).
         self.has_sets = SET_MEASURE in sweep.measures
+        self.records = [upgrade(rec, self.approximations, self.reductions) for rec in sweep.records]
+        self._ij = grid_index(self.records, self.I_values, self.V_values)
+        self.arrays = AtlasArrays(self.records, self._ij, self.shape, len(self.approximations), len(self.reductions))
 
     # ------------------------------------------------------------------------------------------ the grid
     @property
@@ -121,18 +133,14 @@ class AtlasResult:
         return self.sweep.failed()
 
     def _grid(self, fn) -> np.ndarray:
-        """An object array of ``fn(record or None)`` over the grid."""
-        arr = np.empty(self.shape, dtype=object)
-        for i, I in enumerate(self.I_values):
-            for j, V in enumerate(self.V_values):
-                arr[i, j] = fn(self.sweep.record(I, V))
-        return arr
+        """An object array of ``fn(record or None)`` over the grid (one pass over the records)."""
+        return self.arrays.grid(self.records, fn)
 
     def _masked(self, fn) -> np.ma.MaskedArray:
         """A masked float array of ``fn(record or None)`` (masked where it is None; 0 under the mask)."""
         vals = self._grid(fn)
-        mask = np.array([v is None for v in vals.ravel()], dtype=bool).reshape(self.shape)
-        data = np.array([0.0 if v is None else float(v) for v in vals.ravel()], dtype=float).reshape(self.shape)
+        mask = is_none(vals)
+        data = np.where(mask, 0.0, vals).astype(float)
         return np.ma.MaskedArray(data, mask=mask)
 
     # ------------------------------------------------------------------------------------------ the exact side
@@ -140,15 +148,14 @@ class AtlasResult:
         """The exact dynamics at each point (str): ``period-n``, ``aperiodic``, ``too short`` where it
         stick-slips; else ``steady``, ``transient``, ``too few slips``, ``breakdown``, ``budget``; ``failed``
         where a measure raised, ``not computed`` where the point is still to run."""
-        def cls(rec):
-            if rec is None:
-                return _NOT_COMPUTED
-            return rec.get(_exact_key("class")) or ("failed" if failed(rec) else rec["status"])
-        return self._grid(cls)
+        a = self.arrays
+        fallback = np.where(a.failed, "failed", a.status).astype(object)
+        cls = np.where(is_none(a.exact_class) | (a.exact_class == ""), fallback, a.exact_class)
+        return np.where(a.computed, cls, _NOT_COMPUTED).astype(object)
 
     def status(self) -> np.ndarray:
         """Each point's status (``ok`` where the exact attractor stick-slips; ``not computed`` if not run)."""
-        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else rec["status"])
+        return np.where(self.arrays.computed, self.arrays.status, _NOT_COMPUTED).astype(object)
 
     def stick_slip(self) -> np.ndarray:
         """Boolean map: the exact attractor stick-slips (``status == "ok"``)."""
@@ -157,20 +164,25 @@ class AtlasResult:
     def regime(self) -> np.ndarray:
         """:func:`peelapprox.estimate`'s regime label at each point (``not computed`` where the point is still
         to run, ``failed`` where its record has none)."""
-        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else
-                          rec.get(record_key("atlas_approx", "regime"), "failed"))
+        return np.where(self.arrays.computed, self.arrays.regime, _NOT_COMPUTED).astype(object)
 
     def exact(self, observable: str) -> np.ma.MaskedArray:
         """An exact observable (or its spread, ``<observable>_spread``, or ``period``), masked where the
         record has none."""
         self._check_observable(observable, (*OBSERVABLES, *SPREADS, "period", "n_slips"))
-        return self._masked(lambda rec: None if rec is None else _number(rec.get(_exact_key(observable))))
+        a = self.arrays
+        if observable in ("period", "n_slips"):
+            return getattr(a, observable).copy()
+        if observable in SPREADS:
+            return a.spreads[..., SPREADS.index(observable)].copy()
+        return a.exact[..., OBSERVABLES.index(observable)].copy()
 
     # ------------------------------------------------------------------------------------------ predictions
-    def _check_name(self, name: str) -> None:
+    def _check_name(self, name: str) -> int:
         if name not in self.approximations:
             raise ValueError(f"approximation {name!r} is not in this atlas; it has {list(self.approximations)}"
                              + (f" (skipped: {self.skipped})" if self.skipped else ""))
+        return self.approximations.index(name)
 
     @staticmethod
     def _check_observable(observable: str, known=OBSERVABLES) -> None:
@@ -179,56 +191,32 @@ class AtlasResult:
 
     def prediction(self, name: str, observable: str) -> np.ma.MaskedArray:
         """Approximation ``name``'s prediction of ``observable`` (or ``period``), masked where it has none."""
-        self._check_name(name)
+        a = self._check_name(name)
         self._check_observable(observable, (*OBSERVABLES, "period"))
-        return self._masked(lambda rec: None if rec is None else _number(rec.get(_approx_key(name, observable))))
+        if observable == "period":
+            return self.arrays.prediction_period[a].copy()
+        return self.arrays.predicted[a, ..., OBSERVABLES.index(observable)].copy()
 
     def prediction_status(self, name: str) -> np.ndarray:
         """Approximation ``name``'s status at each point (``stick-slip``, ``steady``, ``breakdown:...``,
         ``error: ...``; ``not computed``)."""
-        self._check_name(name)
-        return self._grid(lambda rec: _NOT_COMPUTED if rec is None else
-                          rec.get(_approx_key(name, "status"), "failed"))
-
-    def _why(self, rec: dict | None, name: str, observable: str) -> str:
-        """Why the relative error is undefined at ``rec`` ("" where it is defined)."""
-        if rec is None:
-            return _NOT_COMPUTED
-        if failed(rec):
-            return f"failed: {rec['status']}"
-        if rec.get(_exact_key("status")) != "ok":
-            return f"exact: {rec.get(_exact_key('class'), rec['status'])}"
-        status = rec.get(_approx_key(name, "status"))
-        if status != "stick-slip":
-            return f"predicted: {status}"
-        e, a = _number(rec.get(_exact_key(observable))), _number(rec.get(_approx_key(name, observable)))
-        if e is None:
-            return "no exact value"
-        if a is None:
-            return "not predicted"
-        return "exact value 0" if e == 0 else ""
+        st = self.arrays.prediction_status[self._check_name(name)]
+        return np.where(self.arrays.computed, np.where(is_none(st), "failed", st), _NOT_COMPUTED).astype(object)
 
     def undefined(self, name: str, observable: str) -> np.ndarray:
         """Why the relative error of ``name``'s ``observable`` is undefined at each point ("" where defined):
         ``not computed``, ``failed: ...``, ``exact: <class>`` (no stick-slip there), ``predicted: <status>``
         (the approximation predicts none, or failed), ``no exact value``, ``not predicted``."""
-        self._check_name(name)
+        a = self._check_name(name)
         self._check_observable(observable)
-        return self._grid(lambda rec: self._why(rec, name, observable))
+        return self.arrays.undefined(a, OBSERVABLES.index(observable))
 
     def relative_error(self, name: str, observable: str, *, signed: bool = False) -> np.ma.MaskedArray:
         """``|predicted - exact| / |exact|`` of ``name``'s ``observable`` (``signed``: without the outer
         absolute value), masked where undefined (:meth:`undefined` says why)."""
-        self._check_name(name)
+        a = self._check_name(name)
         self._check_observable(observable)
-
-        def err(rec):
-            if self._why(rec, name, observable):
-                return None
-            e, a = float(rec[_exact_key(observable)]), float(rec[_approx_key(name, observable)])
-            d = (a - e) / abs(e)
-            return d if signed else abs(d)
-        return self._masked(err)
+        return self.arrays.relative_error(a, OBSERVABLES.index(observable), signed)
 
     def segment_error(self, reduction: str, stat: str = "dt_median") -> np.ma.MaskedArray:
         """A reduction's per-point summary of its per-segment relative errors: ``stat`` one of ``dt_median``,
@@ -237,16 +225,26 @@ class AtlasResult:
         if reduction not in self.reductions:
             raise ValueError(f"reduction must be one of {list(self.reductions)}, got {reduction!r}")
         self._check_observable(stat, SEGMENT_STATS)
-        return self._masked(lambda rec: None if rec is None else _number(rec.get(_segment_key(reduction, stat))))
+        return self.arrays.segment_stats[self.reductions.index(reduction), ..., SEGMENT_STATS.index(stat)].copy()
 
     # ------------------------------------------------------------------------------------------ summaries
+    def _error_map(self, name: str, observable: str) -> np.ma.MaskedArray:
+        """The relative errors :meth:`within` counts: approximation ``name``'s (:meth:`relative_error`), or for
+        ``name = "segments:<reduction>"`` its :meth:`segment_error` ``observable`` at the exact stick-slip points."""
+        reduction = name[len("segments:"):] if name.startswith("segments:") else None
+        if name not in self.approximations and reduction in self.reductions:
+            m = self.segment_error(reduction, observable)
+            return np.ma.MaskedArray(m.data, mask=np.ma.getmaskarray(m) | ~self.stick_slip())
+        return self.relative_error(name, observable)
+
     def within(self, name: str, observable: str, tol: float = TOLERANCE) -> dict:
         """How often ``name`` predicts ``observable`` within ``tol``: over the exact stick-slip points, the
         number ``stick_slip``, ``compared`` (error defined), ``within`` (error <= tol), ``fraction`` (within /
-        stick_slip; None without stick-slip points), ``median_error`` and ``worst_error`` (None if none)."""
-        err = self.relative_error(name, observable)
+        stick_slip; None without stick-slip points), ``median_error`` and ``worst_error`` (None if none).
+        ``name`` is an approximation, or ``"segments:<reduction>"`` with ``observable`` a stat of
+        :meth:`segment_error` (its per-point errors at the exact stick-slip points)."""
+        vals = self._error_map(name, observable).compressed()
         n_ss = int(self.stick_slip().sum())
-        vals = err.compressed()
         n_in = int((vals <= tol).sum())
         return {"approximation": name, "observable": observable, "stick_slip": n_ss, "compared": int(vals.size),
                 "within": n_in, "fraction": n_in / n_ss if n_ss else None,
@@ -258,17 +256,8 @@ class AtlasResult:
         per-point median ``|Δt|`` and ``|ΔF|`` errors (``approximation`` = ``segments:<reduction>``,
         ``observable`` = ``dt_median`` / ``dF_median``); with sets, then the rows of :meth:`set_summary`."""
         rows = [self.within(n, o, tol) for n in self.approximations for o in OBSERVABLES]
-        n_ss = int(self.stick_slip().sum())
-        ss = self.stick_slip()
-        for red in self.reductions:
-            for stat in ("dt_median", "dF_median"):
-                m = self.segment_error(red, stat)
-                v = np.ma.MaskedArray(m.data, mask=m.mask | ~ss).compressed()
-                n_in = int((v <= tol).sum())
-                rows.append({"approximation": f"segments:{red}", "observable": stat, "stick_slip": n_ss,
-                             "compared": int(v.size), "within": n_in, "fraction": n_in / n_ss if n_ss else None,
-                             "median_error": float(np.median(v)) if v.size else None,
-                             "worst_error": float(v.max()) if v.size else None})
+        rows += [self.within(f"segments:{red}", stat, tol) for red in self.reductions
+                 for stat in ("dt_median", "dF_median")]
         if self.has_sets:
             rows += self.set_summary()
         return rows
@@ -318,7 +307,7 @@ class AtlasResult:
         absent)."""
         self._check_sets()
         return [{"I": rec["I"], "V": rec["V"], "exact_class": rec.get(_exact_key("class")),
-                 **{f: rec.get(_set_key(f)) for f in SET_FIELDS}} for rec in self.sweep.records]
+                 **{f: rec.get(_set_key(f)) for f in SET_FIELDS}} for rec in self.records]
 
     def set_summary(self) -> list[dict]:
         """:func:`comparisons.atlas.sets.set_summary` of :meth:`set_rows`: the set-match rate, the strict rate,
@@ -330,37 +319,45 @@ class AtlasResult:
         """One row per computed point: I, V, status, the exact class, reason, period and observables, the
         regime label, each approximation's status."""
         rows = []
-        for rec in self.sweep.records:
+        for rec in self.records:
             row: dict[str, Any] = {"I": rec["I"], "V": rec["V"], "status": rec["status"],
                                    "exact_class": rec.get(_exact_key("class"), "failed" if failed(rec) else ""),
                                    "exact_reason": rec.get(_exact_key("reason")),
-                                   "regime": rec.get(record_key("atlas_approx", "regime"))}
-            row.update({f"exact_{f}": rec.get(_exact_key(f)) for f in ("period", "n_slips", *OBSERVABLES)})
-            row.update({f"{name}_status": rec.get(_approx_key(name, "status")) for name in self.approximations})
+                                   "regime": rec.get(_approx_key("regime"))}
+            row.update({f"exact_{f}": rec.get(_exact_key(f)) for f in ("period", "n_slips")})
+            row.update({f"exact_{f}": v for f, v in zip(OBSERVABLES, _slice(rec, _exact_key("observables"),
+                                                                             len(OBSERVABLES)))})
+            row.update({f"{name}_status": v for name, v in zip(self.approximations, _slice(
+                rec, _approx_key("prediction_status"), len(self.approximations)))})
             rows.append(row)
         return rows
 
     def error_rows(self) -> list[dict]:
         """One row per computed point, approximation and observable: exact and predicted values, the signed
         relative error (None where undefined) and why it is undefined ("" where defined)."""
+        why = {(n, o): self.undefined(n, o) for n in self.approximations for o in OBSERVABLES}
+        err = {(n, o): self.relative_error(n, o, signed=True) for n in self.approximations for o in OBSERVABLES}
         rows = []
-        for rec in self.sweep.records:
-            for name in self.approximations:
-                for obs in OBSERVABLES:
-                    why = self._why(rec, name, obs)
-                    e, a = _number(rec.get(_exact_key(obs))), _number(rec.get(_approx_key(name, obs)))
+        for rec, ij in zip(self.records, self._ij):
+            exact = _slice(rec, _exact_key("observables"), len(OBSERVABLES))
+            predicted = _slice(rec, _approx_key("predicted"), len(self.approximations))
+            for name, values in zip(self.approximations, predicted):
+                for k, obs in enumerate(OBSERVABLES):
+                    e, a = _number(exact[k]), _number(None if values is None else values[k])
+                    w = why[name, obs][ij]
                     rows.append({"I": rec["I"], "V": rec["V"], "approximation": name, "observable": obs,
                                  "unit": UNITS[obs], "exact": e, "predicted": a,
-                                 "rel_error": None if why or e is None or a is None else (a - e) / abs(e),
-                                 "undefined": why})
+                                 "rel_error": None if w else float(err[name, obs][ij]), "undefined": w})
         return rows
 
     def segment_rows(self) -> list[dict]:
         """One row per computed point and reduction: the stays solved and failed, median and worst |Δt| and
         |ΔF| relative errors (None where the point has none)."""
         return [{"I": rec["I"], "V": rec["V"], "reduction": red, "exact_class": rec.get(_exact_key("class")),
-                 **{stat: rec.get(_segment_key(red, stat)) for stat in SEGMENT_STATS}}
-                for rec in self.sweep.records for red in self.reductions]
+                 **dict(zip(SEGMENT_STATS, stats or [None] * len(SEGMENT_STATS)))}
+                for rec in self.records
+                for red, stats in zip(self.reductions, _slice(rec, record_key("atlas_segments", "stats"),
+                                                              len(self.reductions)))]
 
     def tables(self) -> dict[str, list[dict]]:
         """Every table of the atlas by name (:data:`TABLES`): ``points``, ``errors``, ``segments``,

@@ -39,7 +39,14 @@ from typing import Any
 import numpy as np
 
 import exact
-from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, approximate_attractor, estimate
+from peelapprox import (
+    ModelBreakdown,
+    PeelParams,
+    SolverBudgetExceeded,
+    StickSlipObservables,
+    approximate_attractor,
+    estimate,
+)
 from peelapprox.io import fmt_number, write_rows
 
 from ..sweep import parse_grid
@@ -67,7 +74,7 @@ CHAINS = {
     "solver": lambda p, label: dict(start="solver"),
     "caseI": lambda p, label: _PAPER_LOW_V,
 }
-_OBS = ("slip_interval", "force_drop", "slip_time", "stick_time", "F_max", "F_min")
+_OBS = StickSlipObservables.OBSERVABLES
 
 
 def _exact_row(p: PeelParams, t_transient: float) -> dict[str, Any]:

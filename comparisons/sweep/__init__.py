@@ -7,7 +7,8 @@ dask cluster with ``executor=Client(...).get_executor()``.  Each finished point 
 ``out/results.jsonl`` and forced to disk at once, so a killed sweep loses only the points that were running,
 and the same call again finishes the rest.
 
-A measure is ``fn(params, options) -> dict`` of JSON scalars, added with :func:`register_measure` (its keys
+A measure is ``fn(params, options) -> dict`` of JSON scalars (or lists of them, one or two levels deep: the
+point's slice of an array, as an atlas's observables per approximation), added with :func:`register_measure` (its keys
 are recorded as :func:`record_key` says); the built-ins are ``regime``, ``jumps``, ``period`` and
 ``lyapunov`` (:mod:`~comparisons.sweep.measures`, which lists the options each reads).  Every option is
 checked before the first point, so a bad one is a ValueError naming it and nothing is written.  ``force=``

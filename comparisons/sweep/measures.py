@@ -1,6 +1,7 @@
 """The measures of a sweep: the registry (:data:`MEASURES`, :func:`register_measure`) and the built-ins.
 
-A measure is ``fn(params: PeelParams, options: Mapping) -> dict`` of JSON scalars, evaluated at every grid
+A measure is ``fn(params: PeelParams, options: Mapping) -> dict`` of JSON scalars (or lists of them, at most two
+levels: the point's slice of an array), evaluated at every grid
 point (see :mod:`comparisons.sweep`).  To add one, write the function and register it, with a
 ``check_options(options)`` that validates every option it reads with the validators of
 :mod:`peelapprox.validate` (raising ValueError naming the option and its range); :func:`~comparisons.sweep.sweep`

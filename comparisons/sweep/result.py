@@ -151,8 +151,11 @@ class SweepResult:
         NaN marks only the points that have no such value: not computed yet,
         the key absent from the record (e.g. ``jumps_count`` after a model
         breakdown, or a failed measure) or None (a statistic that needs more
-        jumps than the window has).  Otherwise (e.g. ``regime_label``) an
-        object array with None at those points.
+        jumps than the window has).  Otherwise (e.g. ``regime_label``, or a
+        list-valued key such as an atlas's ``atlas_exact_observables``) an
+        object array with None at those points (:meth:`to_csv` and
+        :meth:`to_xarray` write a list as its text; ``AtlasResult`` reads an
+        atlas's lists as arrays).
 
         Raises
         ------

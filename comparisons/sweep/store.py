@@ -276,9 +276,32 @@ def point_key(rec: Mapping, coef: bool = False) -> tuple[float, ...]:
     return (float(rec["I"]), float(rec["V"]), float(rec["coef"])) if coef else (float(rec["I"]), float(rec["V"]))
 
 
+def _scalar_problem(v: Any) -> bool:
+    """Whether ``v`` is not a JSON scalar a float array can hold (float, int that fits a float, str, bool, null)."""
+    if v is None or isinstance(v, (bool, str, float)):
+        return False
+    if isinstance(v, int):
+        try:
+            float(v)
+            return False
+        except OverflowError:
+            pass
+    return True
+
+
+def _value_problem(v: Any) -> bool:
+    """Whether ``v`` is neither a JSON scalar nor a list of them or of lists of them: a point's slice of an array
+    (an atlas's observables per approximation, :mod:`comparisons.atlas`), at most two levels deep."""
+    if not isinstance(v, list):
+        return _scalar_problem(v)
+    return any(any(isinstance(y, list) or _scalar_problem(y) for y in x) if isinstance(x, list) else
+               _scalar_problem(x) for x in v)
+
+
 def _record_problem(rec: Any, coef: bool = False) -> str | None:
-    """Why ``rec`` is not a record, or None.  Values must be JSON scalars that a float array can hold; with a
-    coefficient axis (``coef``) ``rec["coef"]`` must be a finite number."""
+    """Why ``rec`` is not a record, or None.  Values must be JSON scalars that a float array can hold, or lists
+    of them (one or two levels: a measure's array at this point); with a coefficient axis (``coef``)
+    ``rec["coef"]`` must be a finite number."""
     if not isinstance(rec, dict):
         return f"not a JSON object but {type(rec).__name__}"
     for key in ("I", "V", "coef") if coef else ("I", "V"):
@@ -294,15 +317,9 @@ def _record_problem(rec: Any, coef: bool = False) -> str | None:
     if not isinstance(rec.get("status"), str):
         return f"status must be a string, got {_short(rec.get('status'))}"
     for key, v in rec.items():
-        if v is None or isinstance(v, (bool, str, float)):
-            continue
-        if isinstance(v, int):
-            try:
-                float(v)
-                continue
-            except OverflowError:
-                pass
-        return f"{key} = {_short(v)} is not a JSON scalar (float, int, str, bool, null)"
+        if _value_problem(v):
+            return (f"{key} = {_short(v)} is not a JSON scalar (float, int, str, bool, null) or a list (of lists) "
+                    "of them")
     return None
 
 

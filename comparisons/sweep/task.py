@@ -72,6 +72,13 @@ def _resolve(name: str, ref: None | str | bytes) -> Measure:
                       "define it at module level in a module the workers can import")
 
 
+def _value(val: Any, depth: int = 2) -> Any:
+    """A measure's value as JSON: a scalar, or a list or tuple of them (of lists, ``depth`` levels at most)."""
+    if depth and isinstance(val, (list, tuple)):
+        return [_value(x, depth - 1) for x in val]
+    return jsonable(val, keep_nonfinite=True, scalar=True)
+
+
 def _prefixed(name: str, out: Any) -> dict:
     if not isinstance(out, Mapping):
         raise TypeError(f"measure {name!r} must return a dict, got {type(out).__name__}")
@@ -81,7 +88,7 @@ def _prefixed(name: str, out: Any) -> dict:
             raise TypeError(f"measure {name!r} returned a non-string key {key!r}")
         full = record_key(name, key)
         try:
-            rec[full] = jsonable(val, keep_nonfinite=True, scalar=True)
+            rec[full] = _value(val)
         except TypeError as exc:
             raise TypeError(f"measure {name!r}, key {key!r}: {exc}") from None
     return rec
