@@ -67,37 +67,14 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
     bs = branch_structure(params.V, force=params.force)
     if not bs.has_folds:
         raise ValueError(f"params: the law {params.force!r} has no folds at V={params.V}: no jumps to reproduce")
-    V, I, k, R, L = params.V, params.I, params.k, params.R, params.l
     inverse = _paper_inverse(params, bs) if params.force.kind == "paper" else _law_inverse(params, bs)
-
-    def v_of(y, branch):
-        c, _ = _closure_paper(y[0], R, L)
-        G = y[2] * (1.0 + c)
-        if branch == "AB":
-            return inverse(min(G, bs.f_max), "AB"), c
-        return inverse(max(G, bs.f_min), "CD"), c
-
-    def make(branch):
-        def rhs(t, y):
-            v, c = v_of(y, branch)
-            return list(_slow_rates(y[0], y[1], y[2], v, c, V, I, k, R))
-
-        level = bs.f_max if branch == "AB" else bs.f_min
-
-        def fold(t, y):
-            c, _ = _closure_paper(y[0], R, L)
-            return y[2] * (1.0 + c) - level
-
-        fold.terminal = True
-        fold.direction = 1.0 if branch == "AB" else -1.0
-        return rhs, fold
 
     t, y, br = s0.t, np.array([s0.alpha, s0.omega, s0.F]), s0.branch
     # the benchmark scenes are stick-slip orbits: the folds exist and f_max is a float (BranchStructure)
     scale = np.array([1.0, params.V / params.R, float(cast(float, bs.f_max))])
     jt, jF = [], []
     while t < t_end:
-        rhs, fold = make(br)
+        rhs, fold = _branch_system(params, bs, inverse, br)
         sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=rtol * scale, events=fold)
         if sol.status < 0:
             raise SolverFailure(f"branchwise reference failed at t={sol.t[-1]}: {sol.message}", t=float(sol.t[-1]),
@@ -110,6 +87,34 @@ def branchwise_reference(params: PeelParams, t_end: float, *, alpha0: float = 0.
         else:
             break
     return np.array(jt), np.array(jF)
+
+
+def _branch_system(params: PeelParams, bs: BranchStructure, inverse: Callable[[float, str], float], branch: str):
+    """On ``branch``: the field of ``(α, ω, F)`` (v from the branch inverse of ``G = F (1 + c(α))``, the level
+    clipped at the fold value) and its fold, the terminal event ``G = f_max`` (AB, rising) or ``G = f_min`` (CD,
+    falling)."""
+    V, I, k, R, L = params.V, params.I, params.k, params.R, params.l
+
+    def v_of(y, branch):
+        c, _ = _closure_paper(y[0], R, L)
+        G = y[2] * (1.0 + c)
+        if branch == "AB":
+            return inverse(min(G, bs.f_max), "AB"), c
+        return inverse(max(G, bs.f_min), "CD"), c
+
+    def rhs(t, y):
+        v, c = v_of(y, branch)
+        return list(_slow_rates(y[0], y[1], y[2], v, c, V, I, k, R))
+
+    level = bs.f_max if branch == "AB" else bs.f_min
+
+    def fold(t, y):
+        c, _ = _closure_paper(y[0], R, L)
+        return y[2] * (1.0 + c) - level
+
+    fold.terminal = True  # type: ignore[attr-defined]
+    fold.direction = 1.0 if branch == "AB" else -1.0  # type: ignore[attr-defined]
+    return rhs, fold
 
 
 def _paper_inverse(params: PeelParams, bs: BranchStructure) -> Callable[[float, str], float]:
