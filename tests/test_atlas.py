@@ -198,6 +198,23 @@ def test_small_atlas_records_hold_arrays(small):
             assert small.exact(obs)[i, j] is np.ma.masked if v is None else small.exact(obs)[i, j] == v
 
 
+def test_records_of_another_schema_are_relabelled():
+    """Hypothesis: a record of this format written under another schema (an observable fewer, another order, as
+    after a field is added to StickSlipObservables) is read by label: each value lands under its own observable,
+    the ones it lacks are None; a record of this schema is returned as it is.  Exact (values moved, not
+    computed)."""
+    from comparisons.atlas.records import schema, upgrade
+
+    written = {**schema(), "observables": ["F_min", "slip_interval"], "segment_stats": ["n", "dt_median"]}
+    rec = {"I": 1e-5, "V": 1.0, "status": "ok", "atlas_exact_observables": [160.5, 0.25],
+           "atlas_approx_predicted": [[161.0, 0.26], [None, 0.3]], "atlas_segments_stats": [[4, 0.01]]}
+    new = upgrade(rec, ["a", "b"], ["AB_x_y"], written)
+    assert new["atlas_exact_observables"] == [0.25, None, None, None, None, 160.5]
+    assert new["atlas_approx_predicted"] == [[0.26, None, None, None, None, 161.0], [0.3] + [None] * 5]
+    assert new["atlas_segments_stats"] == [[0.01, None, None, None, 4, None]]
+    assert upgrade(rec, ["a", "b"], ["AB_x_y"], schema()) is rec
+
+
 def test_first_format_atlas_reads_and_refuses_to_resume(tmp_path):
     """Hypothesis: an atlas of the first record format (one key per number: ``atlas_approx_<name>_<observable>``,
     3 points of the 2 x 3 grid written before the schema) loads: every map's value is its record's own key's

@@ -64,9 +64,31 @@ def _segments(field: str) -> str:
     return record_key("atlas_segments", field)
 
 
-def upgrade(rec: dict, approximations: Sequence[str], reductions: Sequence[str]) -> dict:
-    """A record of the first format (module docstring) in this format: a new dict, its keys of the first format
-    replaced by the arrays' slices (the values themselves, unchanged); a record of this format as it is."""
+def _relabel(rec: dict, written: Mapping[str, Any]) -> dict:
+    """A record of this format written under another schema (``written``: its option ``schema``, e.g. before an
+    observable was added) with its lists' last axes in this schema's order, by label (None where it had none)."""
+    new = dict(rec)
+    for key, axis, ours, nested in ((_exact("observables"), "observables", OBSERVABLES, False),
+                                    (_exact("spreads"), "spreads", SPREADS, False),
+                                    (_approx("predicted"), "observables", OBSERVABLES, True),
+                                    (_segments("stats"), "segment_stats", SEGMENT_STATS, True)):
+        labels = list(written.get(axis, ours))
+        if key not in rec or labels == list(ours):
+            continue
+        def pick(values: list, labels: list = labels, ours: tuple = ours) -> list:
+            return [values[labels.index(x)] if x in labels else None for x in ours]
+        new[key] = [pick(v) for v in rec[key]] if nested else pick(rec[key])
+    return new
+
+
+def upgrade(rec: dict, approximations: Sequence[str], reductions: Sequence[str],
+            written: Mapping[str, Any] | None = None) -> dict:
+    """A record in this format and schema: one of the first format (module docstring) as a new dict, its keys of
+    the first format replaced by the arrays' slices (the values themselves, unchanged); one of this format written
+    under another schema (``written``, the atlas's option ``schema``) with its lists relabelled to this one's; one
+    of this format and schema as it is."""
+    if written is not None and written != schema():
+        return _relabel(rec, written)
     if _exact("observables") in rec or _approx("predicted") in rec or failed(rec):
         return rec
     old: dict[str, Any] = dict(rec)

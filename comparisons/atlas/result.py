@@ -109,7 +109,8 @@ class AtlasResult:
         self.force = sweep.force
         #: The atlas compares attractor sets (``atlas(..., sets=True)``; :mod:`comparisons.atlas.sets`).
         self.has_sets = SET_MEASURE in sweep.measures
-        self.records = [upgrade(rec, self.approximations, self.reductions) for rec in sweep.records]
+        written = self.options.get("schema")
+        self.records = [upgrade(rec, self.approximations, self.reductions, written) for rec in sweep.records]
         self._ij = grid_index(self.records, self.I_values, self.V_values)
         self.arrays = AtlasArrays(self.records, self._ij, self.shape, len(self.approximations), len(self.reductions))
 
