@@ -51,13 +51,11 @@ __all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "P
            "approximate_attractor", "default_models"]
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
-#: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``; the table and its reasons are in
-#: the docstring of :func:`approximate_attractor`.
-APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
-    "low": (("airy1", "approxvdot"), ("airy1", "approxvdot")),
-    "intermediate": (("airy1", "approxvdot"), ("airy1", "approxvdot")),
-    "high": (("airy1", "approxvdot"), ("airy1", "approxvdot")),
-}
+#: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``.  The measurements (the table and its
+#: reasons are in the docstring of :func:`approximate_attractor`) chose one pair for every label, Airy1 +
+#: approxvdot on both branches; the table stays per label so that a label can be given a pair of its own.
+APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = dict.fromkeys(
+    ("low", "intermediate", "high"), (("airy1", "approxvdot"), ("airy1", "approxvdot")))
 
 #: Where the map starts (``start=``): ``"solver"``, the exact solver's default start; ``"rest"``, the foot of the
 #: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, both: the solver's attractor is the
