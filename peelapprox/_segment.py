@@ -256,7 +256,7 @@ def _checked_arguments(params, branch, F_in, alpha_in, alphadot_in, amplitude, p
                        v_equation, F_rate, rtol, atol, t_max, save, t_eval, max_steps) -> _Arguments:
     """:func:`reduced_segment`'s arguments, each checked against its type and range (in this order: the first
     bad one is named)."""
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="reduced_segment", variants=False)
     branch = choice("branch", branch, BRANCHES)
     alpha_model = choice("alpha_model", alpha_model, ALPHA_MODELS)
     v_equation = choice("v_equation", v_equation, V_EQUATIONS)
