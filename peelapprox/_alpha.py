@@ -164,7 +164,7 @@ def inertial_frequency(params: PeelParams, F):
         ``sqrt(F R / I)`` [rad/s].  Valid on AB, where ``v/R`` is small in
         FLOW1 so that ``v̇/R`` drops out of genalpha (paper Sec. V, Case I).
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="inertial_frequency", variants=False)
     Fa = states("F", F, "F")
     out = _omega(Fa, params.R, params.I)
     return float(out) if out.ndim == 0 else out
@@ -204,7 +204,7 @@ def inertial_periods(params: PeelParams, F_mean: float | None = None) -> Inertia
         If ``f(v, V)`` has no folds (no stick-slip window for this V) and no
         ``F_mean`` is given.
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="inertial_periods", variants=False)
     bs = branch_structure(params.V, force=params.force)
     F_mean = optional(state, "F_mean", F_mean, "F")
     if not bs.has_folds:
@@ -223,7 +223,7 @@ def harmonic_alpha(params: PeelParams, t, *, F: float, alpha_in: float, alphadot
     Returns ``α(t) = α_in cos Ωt + (α̇_in/Ω) sin Ωt`` and its derivative,
     ``Ω = sqrt(F R/I)``; arrays shaped like ``t`` (time since branch entry, s).
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="harmonic_alpha", variants=False)
     t = _times(t)
     return _harmonic(t, state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega"),
                      state("F", F, "F"), params.R, params.I)
@@ -266,7 +266,7 @@ def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_
     alpha, alphadot : ndarray
         Shaped like ``t``.
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="airy_alpha", variants=False)
     t = _times(t)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
     a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
@@ -305,7 +305,7 @@ def sinusoid_alpha(params: PeelParams, t, *, F_in: float, amplitude: float, phas
         ``A`` [rad] (the paper's ``α_in``) and ``φ`` [rad] at t = 0.
     Other parameters as in :func:`airy_alpha`.
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="sinusoid_alpha", variants=False)
     t = _times(t)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
     return _sinusoid(t, _finite("amplitude", amplitude), _finite("phase", phase), F_in, s, params.R, params.I)
@@ -317,7 +317,8 @@ def wkb_amplitude_phase(params: PeelParams, *, F_in: float, alpha_in: float, alp
 
     Solves ``A sin φ = α_in`` and ``A (Ω_in cos φ - s/(4 F_in) sin φ) = α̇_in``.
     """
-    F_in, s = _force_ramp(_params("params", params, variants=False), np.zeros(1), F_in, F_rate)
+    F_in, s = _force_ramp(_params("params", params, where="wkb_amplitude_phase", variants=False), np.zeros(1), F_in,
+                          F_rate)
     a_in, ad_in = state("alpha_in", alpha_in, "alpha"), state("alphadot_in", alphadot_in, "omega")
     return _wkb_match(F_in, s, a_in, ad_in, params.R, params.I)
 
@@ -357,7 +358,7 @@ def wkb_error_bound(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
     ``A(t) = A (F_in/F)^(1/4)``.  𝒱 is first order in the adiabatic
     parameter ``s/(F·sqrt(FR/I))``.
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="wkb_error_bound", variants=False)
     t = _times(t)
     F_in, s = _force_ramp(params, t, F_in, F_rate)
     A, _ = wkb_amplitude_phase(params, F_in=F_in, alpha_in=alpha_in, alphadot_in=alphadot_in, F_rate=F_rate)
@@ -386,7 +387,7 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
     ``R f'/F`` (:func:`cd_damping_time`).  The default rate is ``k (V - v)``
     when ``v`` is given, else ``k V``.
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="alpha_numerical", variants=False)
     form = choice("form", form, ALPHA_FORMS)
     t = _times(t)
     rtol = in_range("rtol", rtol, 1e-14, 1e-2)
@@ -435,7 +436,7 @@ def cd_damping_time(params: PeelParams, F, v):
     ``2π sqrt(I/(FR))`` exceeds it, the damping term of Airy1 controls α on CD
     (high inertia).  ``v`` must be on a stable branch.
     """
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="cd_damping_time", variants=False)
     Fa = states("F", F, "F")
     fp = np.asarray(law_fprime(params, states("v", v, "v")), dtype=float)
     if np.any(fp <= 0):

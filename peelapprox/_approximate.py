@@ -164,7 +164,7 @@ def approximate_attractor(
         (also a TypeError) An argument of the wrong kind.
     """
     t_wall = time.perf_counter()
-    params = _params("params", params, variants=False)
+    params = _params("params", params, where="approximate_attractor", variants=False)
     chosen = (optional(choice, "alpha_model", alpha_model, ALPHA_MODELS),
               optional(choice, "v_equation", v_equation, V_EQUATIONS),
               optional(choice, "cd_alpha_model", cd_alpha_model, ALPHA_MODELS),

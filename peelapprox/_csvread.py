@@ -200,36 +200,15 @@ def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter
     if delimiter is not None and (not isinstance(delimiter, str) or len(delimiter) != 1 or delimiter in "#\"\r\n"):
         raise ValueError(f"delimiter must be one character other than '#', a quote or a newline, got "
                          f"{shown(delimiter)}")
-    data = read_regular(path, where, max_bytes)
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise ValueError(f"{where} line {line}: not UTF-8 text ({exc.reason} at byte {exc.start}); is this a "
-                         "CSV file?") from None
-    del data  # the text alone from here on
+    lines = _data_lines(_decoded(read_regular(path, where, max_bytes), where))
     want = expected or ",".join(columns)
-    lines = _data_lines(text)
     first = next(lines, None)
     if first is None:
         raise ValueError(f"{where}: no header (expected {want})")
     delim = delimiter or ","
     raw = [h.strip() for h in _csv_row(*first, where, delim)]
-    names, units = [], []
-    for cell in raw:
-        name, unit = header_cell(cell)
-        names.append(name)
-        units.append(unit)
-    shown_header = shown(",".join(raw))
-    required = [n for n in columns if n not in optional]
-    if (len(set(names)) != len(names) or any(n not in names for n in required)
-            or (exact and any(n not in columns for n in names))):
-        raise ValueError(f"{where} line {first[0]}: header {shown_header}: expected the columns {want}")
-    col = {n: names.index(n) for n in columns if n in names}
-    factor = {}
-    for n, i in col.items():
-        unit = str(units[i] if units[i] is not None else (stated or {}).get(n, columns[n]))
-        factor[n] = convert(n, unit, columns[n], where) if columns[n] or unit else 1.0
+    col, factor = _header_columns(raw, first[0], columns, where=where, optional=optional, stated=stated, exact=exact,
+                                  want=want)
     # 8 bytes a value (array), not a Python float and a list slot (~32): memory module docstring
     out = {n: array("d") for n in col}
     line_of = array("q")
@@ -252,3 +231,36 @@ def read_columns(path: str, columns: Mapping[str, str], *, where: str, delimiter
     result = {n: np.frombuffer(x, dtype=float) for n, x in out.items()}
     result["line"] = np.frombuffer(line_of, dtype=np.int64)
     return result
+
+
+def _decoded(data: bytes, where: str) -> str:
+    """The file's bytes as text (UTF-8, a byte-order mark dropped); a ValueError naming the line of a bad byte."""
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise ValueError(f"{where} line {line}: not UTF-8 text ({exc.reason} at byte {exc.start}); is this a "
+                         "CSV file?") from None
+
+
+def _header_columns(raw: list[str], lineno: int, columns: Mapping[str, str], *, where: str,
+                    optional: Collection[str], stated: Mapping[str, str] | None, exact: bool,
+                    want: str) -> tuple[dict[str, int], dict[str, float]]:
+    """The index of each wanted column present in the header ``raw`` (line ``lineno``) and the factor converting
+    its values to the unit asked for; a ValueError for a missing, repeated or (``exact``) unexpected column."""
+    names, units = [], []
+    for cell in raw:
+        name, unit = header_cell(cell)
+        names.append(name)
+        units.append(unit)
+    shown_header = shown(",".join(raw))
+    required = [n for n in columns if n not in optional]
+    if (len(set(names)) != len(names) or any(n not in names for n in required)
+            or (exact and any(n not in columns for n in names))):
+        raise ValueError(f"{where} line {lineno}: header {shown_header}: expected the columns {want}")
+    col = {n: names.index(n) for n in columns if n in names}
+    factor = {}
+    for n, i in col.items():
+        unit = str(units[i] if units[i] is not None else (stated or {}).get(n, columns[n]))
+        factor[n] = convert(n, unit, columns[n], where) if columns[n] or unit else 1.0
+    return col, factor

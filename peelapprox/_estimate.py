@@ -41,8 +41,8 @@ __all__ = [
     "regime",
 ]
 
-def _folds(params: PeelParams) -> BranchStructure:
-    bs = _law_structure(_checked(params))
+def _folds(params: PeelParams, where: str) -> BranchStructure:
+    bs = _law_structure(_checked(params, where))
     if not bs.has_folds:
         raise ValueError(f"V={params.V} is outside the stick-slip window: f(v, V) has no folds "
                          f"(law {params.force!r})")
@@ -55,7 +55,7 @@ def crude_branch_time(params: PeelParams) -> float:
     F rises at ``k V`` (v ≪ V on AB) from ``f_min`` to ``f_max``; α and v are
     ignored.  V=1: 0.0862 s (the paper, reading 284 and 200 off a figure: 0.084).
     """
-    bs = _folds(params)
+    bs = _folds(params, "crude_branch_time")
     assert bs.f_max is not None and bs.f_min is not None  # _folds: has_folds
     return (bs.f_max - bs.f_min) / (params.k * params.V)
 
@@ -93,7 +93,7 @@ def quasi_static_branch_time(
     float
         Δt [s] (positive for a forward passage along the branch).
     """
-    bs = _folds(params)
+    bs = _folds(params, "quasi_static_branch_time")
     assert bs.v_max is not None and bs.v_min is not None and bs.v_land_cd is not None  # _folds: has_folds
     branch = choice("branch", branch, ("AB", "CD"))
     rate = choice("rate", rate, ("k(V-v)", "kV"))
@@ -132,7 +132,7 @@ def force_bounds(params: PeelParams, alpha_min: float, alpha_max: float, *, line
     folds by the peel-angle factor (paper Sec. V, Case III).  ``linear=True``
     uses the paper's ``1 + α`` (its quoted 438 N and 181 N at V=4, I=1e-2).
     """
-    bs = _folds(params)
+    bs = _folds(params, "force_bounds")
     assert bs.f_max is not None and bs.f_min is not None  # _folds: has_folds
     alpha_min, alpha_max = (in_range(name, a, -math.pi / 2, math.pi / 2, lo_open=True, hi_open=True)
                             for name, a in (("alpha_min", alpha_min), ("alpha_max", alpha_max)))
@@ -173,7 +173,7 @@ def slope_criterion(params: PeelParams, *, F_in: float, alphadot_in: float, alph
     the asymmetry from ``v/R`` in FLOW1 that the argument neglects; 0.25 puts
     the paper's two points on either side.
     """
-    params = _checked(params)  # reads I and R only: any law
+    params = _checked(params, "slope_criterion")  # reads I and R only: any law
     F_in = state("F_in", F_in, "F")
     alphadot_in = state("alphadot_in", alphadot_in, "omega")
     alpha0 = state("alpha0", alpha0, "alpha")
@@ -298,7 +298,7 @@ def estimate(params: PeelParams, *, alpha_min: float | None = None, alpha_max: f
         point outside the law's domain, or a law whose AB→CD jumps cannot
         land within its domain (a table that stops below ``f_max`` on CD).
     """
-    params = _checked(params)
+    params = _checked(params, "estimate")
     angle = dict(lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True)
     alpha_min = optional(in_range, "alpha_min", alpha_min, **angle)
     alpha_max = optional(in_range, "alpha_max", alpha_max, **angle)

@@ -7,8 +7,6 @@ estimate (which offers the approximate attractor) import it, not each other.
 
 from __future__ import annotations
 
-import sys
-
 from ._alpha import InertialPeriods, cd_damping_time, inertial_periods
 from ._params import PeelParams
 from .law import BranchStructure, FixedPoint, branch_structure, fixed_point
@@ -30,13 +28,11 @@ VELOCITY_RULE = (
 )
 
 
-def _checked(params: PeelParams) -> PeelParams:
+def _checked(params: PeelParams, where: str) -> PeelParams:
     """``params`` validated, any law (ValueError naming ``params.force`` for a law whose folds cannot be found),
-    the paper's model only (ValueError naming ``params.tape_mass`` / ``params.loading`` for a variant)."""
-    f = sys._getframe(1)
-    while f.f_back is not None and f.f_code.co_name.startswith("_"):  # the public function that was called
-        f = f.f_back
-    return _params("params", params, where=f.f_code.co_name, variants=False)
+    the paper's model only (ValueError naming ``params.tape_mass`` / ``params.loading`` for a variant, and
+    ``where``, the public function called)."""
+    return _params("params", params, where=where, variants=False)
 
 
 def _law_structure(params: PeelParams) -> BranchStructure:
@@ -70,7 +66,7 @@ def regime(params: PeelParams) -> tuple[str, str]:
     ValueError
         As :func:`estimate`, for a law whose folds or CD landing cannot be found.
     """
-    params = _checked(params)
+    params = _checked(params, "regime")
     bs = _law_structure(params)
     fp = fixed_point(params.V, params.R, force=params.force)
     if not bs.has_folds:

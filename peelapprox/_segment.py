@@ -148,81 +148,52 @@ class ReducedSegment:
         return {k: getattr(self, k) for k in keys}
 
 
-def reduced_segment(
-    params: PeelParams,
-    branch: str,
-    *,
-    F_in: float,
-    alpha_in: float | None = None,
-    alphadot_in: float | None = None,
-    amplitude: float | None = None,
-    phase: float | None = None,
-    v_in: float | None = None,
-    v_f: float | None = None,
-    alpha_model: str = "approxalpha",
-    v_equation: str = "approxvdot",
-    F_rate: float | None = None,
-    rtol: float = 1e-10,
-    atol=None,
-    t_max: float | None = None,
-    save: str = "steps",
-    t_eval=None,
-    max_steps: int = 1_000_000,
-) -> ReducedSegment:
+def reduced_segment(params: PeelParams, branch: str, *, F_in: float, alpha_in: float | None = None,
+                    alphadot_in: float | None = None, amplitude: float | None = None, phase: float | None = None,
+                    v_in: float | None = None, v_f: float | None = None, alpha_model: str = "approxalpha",
+                    v_equation: str = "approxvdot", F_rate: float | None = None, rtol: float = 1e-10, atol=None,
+                    t_max: float | None = None, save: str = "steps", t_eval=None,
+                    max_steps: int = 1_000_000) -> ReducedSegment:
     """Time and force change on one branch from the paper's reduced equations.
 
-    Integrates approxvdot or fullvdot (module docstring) coupled to an α
-    model from ``v_in`` until v reaches ``v_f`` and returns Δt, ΔF, the exit
-    state and the v(t), α(t) curves (the paper's Figs. 8 and 9).
+    Integrates approxvdot or fullvdot (module docstring) coupled to an α model from ``v_in`` until v reaches
+    ``v_f`` and returns Δt, ΔF, the exit state and the v(t), α(t) curves (the paper's Figs. 8 and 9).
 
     Parameters
     ----------
     params : PeelParams
-        V, I, k, R and the peel-force law ``params.force`` (any law with a compiled kernel,
-        :func:`peelapprox.kernels.compiled_law`: its folds, landings, ``f'(v_in)`` and its domain, which v may
-        not leave).  The reduced equations are linear in α (the paper's ``sin α ≈ α``), whatever
-        ``params.geometry``.
+        V, I, k, R and the law ``params.force`` (one with a compiled kernel, :func:`peelapprox.kernels.compiled_law`:
+        its folds, landings, ``f'(v_in)`` and the domain v may not leave).  The reduced equations are linear in α
+        (the paper's ``sin α ≈ α``), whatever ``params.geometry``.
     branch : {"AB", "CD"}
-        AB: v rises from ``v_in`` to ``v_f`` (default ``v_max``); CD: v falls
-        from ``v_in`` to ``v_f`` (default ``v_min``).
-    F_in : float
-        Pull force at entry [N].
-    alpha_in, alphadot_in : float
-        α [rad] and α̇ [rad/s] at entry.  ``"exponential"`` and ``"static"``
-        use ``alpha_in`` only; ``"sinusoid"`` accepts ``amplitude``/``phase``
-        instead.
+        AB: v rises from ``v_in`` to ``v_f`` (default ``v_max``); CD: v falls to ``v_f`` (default ``v_min``).
+    F_in, alpha_in, alphadot_in : float
+        Pull force [N], α [rad] and α̇ [rad/s] at entry.  ``"exponential"`` and ``"static"`` use ``alpha_in``
+        only; ``"sinusoid"`` accepts ``amplitude, phase`` instead.
     amplitude, phase : float, optional
         The paper's ``(α_in, φ)`` of the sinusoid (``"sinusoid"`` only).
-    v_in : float, optional
-        Entry velocity [m/s]; default the landing velocity of a jump onto the
-        branch (``branch_structure(V, force=params.force).v_land_ab`` / ``v_land_cd``).
-    v_f : float, optional
-        Exit velocity [m/s]; default the branch's fold.
-    alpha_model : str, default "approxalpha"
-        One of :data:`ALPHA_MODELS`.
-    v_equation : {"approxvdot", "fullvdot"}
+    v_in, v_f : float, optional
+        Entry and exit velocities [m/s]; default the landing velocity of a jump onto the branch
+        (``branch_structure(V, force=params.force).v_land_ab`` / ``v_land_cd``) and the branch's fold.
+    alpha_model, v_equation : str
+        One of :data:`ALPHA_MODELS` (default ``"approxalpha"``); ``"approxvdot"`` (default) or ``"fullvdot"``.
     F_rate : float, optional
-        Slope ``s`` of ``F_lin = F_in + s t`` used by ``"sinusoid"``;
-        default ``k (V - v_in)``.
+        Slope ``s`` of ``F_lin = F_in + s t`` used by ``"sinusoid"``; default ``k (V - v_in)``.
     rtol : float, default 1e-10
         In [1e-14, 1e-2] (:data:`RTOL_RANGE`).
     atol : float or array_like of 5, optional
-        Tolerances (module docstring for the semantics and the default), each in [1e-100, 1e3]
-        (:data:`ATOL_RANGE`).
+        Tolerances, each in [1e-100, 1e3] (:data:`ATOL_RANGE`; the module docstring: semantics, default).
     t_max : float, optional
         Horizon [s] in (0, 1e6]; default ``20 (f_max - f_min)/(k V) + 20 × 2π/Ω_in``.
-    save : {"steps", "none"}
-        Store the curves at accepted steps, or only entry and exit.
-        Ignored when ``t_eval`` is given.
-    t_eval : array_like, optional
-        Increasing times [s, from entry] at which to store the curves (dense
-        output); times after the exit are not filled.
+    save : {"steps", "none"}, and t_eval : array_like, optional
+        Store the curves at accepted steps, or only entry and exit; or, when ``t_eval`` is given, at those
+        increasing times [s, from entry] (dense output; times after the exit are not filled).
     max_steps : int
         Step budget, an integer in [1, 1e15] (a float such as ``1e6`` is refused: write ``10**6``).
 
-    Entry states must lie in :data:`peelapprox.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N,
-    ``alpha_in`` and ``amplitude`` in [-π, π], ``alphadot_in`` in [-1e9, 1e9] rad/s, ``v_in``, ``v_f`` in
-    (1e-150, 1e3] m/s, ``F_rate`` in [-1e12, 1e12] N/s).
+    Entry states must lie in :data:`peelapprox.STATE_RANGES` (``F_in`` in [1e-3, 1e7] N, ``alpha_in`` and
+    ``amplitude`` in [-π, π], ``alphadot_in`` in [-1e9, 1e9] rad/s, ``v_in``, ``v_f`` in (1e-150, 1e3] m/s,
+    ``F_rate`` in [-1e12, 1e12] N/s).
 
     Returns
     -------
@@ -231,8 +202,8 @@ def reduced_segment(
     Raises
     ------
     TypeError
-        (``ArgumentTypeError``, also a ValueError) For an argument of the wrong kind: a string, bool or
-        None for a number, a float for ``max_steps``, anything but a PeelParams for ``params``.
+        (``ArgumentTypeError``, also a ValueError) For an argument of the wrong kind: a string, bool or None for a
+        number, a float for ``max_steps``, anything but a PeelParams for ``params``.
     ValueError
         For an unknown model, a value out of its range, a velocity off the branch or outside the law's domain,
         missing inputs, or a law without a compiled kernel; the message names the argument.
@@ -243,7 +214,49 @@ def reduced_segment(
         If v does not reach ``v_f`` before ``t_max`` or within ``max_steps``.
     """
     t_wall = time.perf_counter()
-    params = _params("params", params, variants=False)
+    a = _checked_arguments(params, branch, F_in, alpha_in, alphadot_in, amplitude, phase, v_in, v_f, alpha_model,
+                           v_equation, F_rate, rtol, atol, t_max, save, t_eval, max_steps)
+    law = compiled_law(a.params.force, a.params.V)  # ValueError naming params.force for a law without a kernel
+    v_in, v_f = _branch_velocities(a.params, law, a.branch, a.v_in, a.v_f)
+    plan = segment_plan(a.params, law, a.branch, v_in=v_in, v_f=v_f, alpha_model=a.alpha_model,
+                        v_equation=a.v_equation, F_rate=a.F_rate, rtol=a.rtol, t_max=a.t_max, max_steps=a.max_steps)
+    _check_alpha_inputs(plan.alpha_model, a)
+    run = run_segment(plan, a.F_in, a.alpha_in, a.alphadot_in, amplitude=a.amplitude, phase=a.phase, atol=a.atol,
+                      **_save_mode(a.save, a.t_eval))
+    res = _segment_result(a, run, v_in, v_f, t_wall)
+    if run.code != DONE:
+        raise _segment_error(plan, a, run, res, law)
+    return res
+
+
+class _Arguments(NamedTuple):
+    """:func:`reduced_segment`'s arguments, checked (``atol`` of 5, ``t_eval`` an array, or None)."""
+
+    params: PeelParams
+    branch: str
+    F_in: float
+    alpha_in: float | None
+    alphadot_in: float | None
+    amplitude: float | None
+    phase: float | None
+    v_in: float | None
+    v_f: float | None
+    alpha_model: str
+    v_equation: str
+    F_rate: float | None
+    rtol: float
+    atol: np.ndarray | None
+    t_max: float | None
+    save: str
+    t_eval: np.ndarray | None
+    max_steps: int
+
+
+def _checked_arguments(params, branch, F_in, alpha_in, alphadot_in, amplitude, phase, v_in, v_f, alpha_model,
+                       v_equation, F_rate, rtol, atol, t_max, save, t_eval, max_steps) -> _Arguments:
+    """:func:`reduced_segment`'s arguments, each checked against its type and range (in this order: the first
+    bad one is named)."""
+    params = _params("params", params, where="reduced_segment", variants=False)
     branch = choice("branch", branch, BRANCHES)
     alpha_model = choice("alpha_model", alpha_model, ALPHA_MODELS)
     v_equation = choice("v_equation", v_equation, V_EQUATIONS)
@@ -266,11 +279,16 @@ def reduced_segment(
         atol_v = np.broadcast_to(atol_v, (5,)).copy()
     t_max = optional(duration, "t_max", t_max)
     te = None if t_eval is None else times("t_eval", t_eval, hi=TIME_MAX)
-    law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
+    return _Arguments(params, branch, F_in, alpha_in, alphadot_in, amplitude, phase, v_in, v_f, alpha_model,
+                      v_equation, F_rate, rtol, atol_v, t_max, save, te, max_steps)
+
+
+def _branch_velocities(params: PeelParams, law: CompiledLaw, branch: str, v_in: float | None,
+                       v_f: float | None) -> tuple[float, float]:
+    """The entry and exit velocities on ``branch`` (the defaults: the landing and the fold), checked to lie on
+    the branch and in the law's domain."""
     bs = law.structure
     d_lo, d_hi = law.domain
-
-    # ---- velocities
     if branch == "CD" and not bs.has_folds:
         raise ValueError(f"branch 'CD' does not exist for V={params.V}: f(v, V) has no folds")
     if v_in is None:
@@ -293,54 +311,63 @@ def reduced_segment(
         if not d_lo <= x <= d_hi:
             raise ValueError(f"{name} must lie in the domain [{d_lo}, {d_hi}] m/s of the peel-force law "
                              f"{params.force!r}, got {x}")
+    return v_in, v_f
 
-    # ---- α inputs
-    plan = segment_plan(params, law, branch, v_in=v_in, v_f=v_f, alpha_model=alpha_model, v_equation=v_equation,
-                        F_rate=F_rate, rtol=rtol, t_max=t_max, max_steps=max_steps)
-    am = plan.alpha_model
+
+def _check_alpha_inputs(am: int, a: _Arguments) -> None:
+    """ValueError when the α model ``am`` (its code) lacks its entry inputs."""
     if am == K.AM_SIN:
-        if amplitude is not None or phase is not None:
-            if amplitude is None or phase is None:
+        if a.amplitude is not None or a.phase is not None:
+            if a.amplitude is None or a.phase is None:
                 raise ValueError("alpha_model='sinusoid' needs both amplitude and phase (or alpha_in and alphadot_in)")
-        elif alpha_in is None or alphadot_in is None:
+        elif a.alpha_in is None or a.alphadot_in is None:
             raise ValueError("alpha_model='sinusoid' needs (amplitude, phase) or (alpha_in, alphadot_in)")
     elif am in (K.AM_EXP, K.AM_STATIC):
-        if alpha_in is None:
-            raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in")
-    elif alpha_in is None or alphadot_in is None:
-        raise ValueError(f"alpha_model={alpha_model!r} needs alpha_in and alphadot_in")
+        if a.alpha_in is None:
+            raise ValueError(f"alpha_model={a.alpha_model!r} needs alpha_in")
+    elif a.alpha_in is None or a.alphadot_in is None:
+        raise ValueError(f"alpha_model={a.alpha_model!r} needs alpha_in and alphadot_in")
 
-    if te is not None:
-        mode, cap = K.SAVE_TEVAL, te.size
-    else:
-        te = np.empty(0)
-        mode, cap = (K.SAVE_STEPS, 4096) if save == "steps" else (K.SAVE_NONE, 1)
-    run = run_segment(plan, F_in, alpha_in, alphadot_in, amplitude=amplitude, phase=phase, atol=atol_v, mode=mode,
-                      t_eval=te, cap=cap)
-    y, code, cnt = run.y, run.code, run.cnt
-    rows = run.rows
+
+def _save_mode(save: str, t_eval: np.ndarray | None) -> dict[str, Any]:
+    """The driver's storage arguments (``mode``, ``t_eval``, ``cap``) for ``save`` or ``t_eval``."""
+    if t_eval is not None:
+        return {"mode": K.SAVE_TEVAL, "t_eval": t_eval, "cap": t_eval.size}
+    mode, cap = (K.SAVE_STEPS, 4096) if save == "steps" else (K.SAVE_NONE, 1)
+    return {"mode": mode, "t_eval": np.empty(0), "cap": cap}
+
+
+def _segment_result(a: _Arguments, run: SegmentRun, v_in: float, v_f: float, t_wall: float) -> ReducedSegment:
+    """The :class:`ReducedSegment` of a run (``t_wall``: the call's start on ``time.perf_counter``)."""
+    y, cnt, rows = run.y, run.cnt, run.rows
     al_e, ad_e = K.alpha_at(y, run.q)
-    state = {"t": float(y[0]), "v": float(np.exp(y[1])), "F": float(y[2]), "alpha": al_e, "alphadot": ad_e}
-    res = ReducedSegment(
-        branch=branch, alpha_model=alpha_model, v_equation=v_equation, dt=float(y[0]), F_in=F_in,
-        F_exit=float(y[2]), dF=float(y[2] - F_in), v_in=v_in, v_f=v_f, alpha_in=float(run.alpha_in),
+    return ReducedSegment(
+        branch=a.branch, alpha_model=a.alpha_model, v_equation=a.v_equation, dt=float(y[0]), F_in=a.F_in,
+        F_exit=float(y[2]), dF=float(y[2] - a.F_in), v_in=v_in, v_f=v_f, alpha_in=float(run.alpha_in),
         alphadot_in=float(run.alphadot_in), alpha_exit=al_e, alphadot_exit=ad_e,
         t=rows[:, 0].copy(), v=rows[:, 1].copy(), F=rows[:, 2].copy(), alpha=rows[:, 3].copy(),
         alphadot=rows[:, 4].copy(), n_steps=int(cnt[K.C_STEPS]), n_rejected=int(cnt[K.C_REJ]),
         n_rhs=int(cnt[K.C_RHS]),
-        wall_time=time.perf_counter() - t_wall, rtol=rtol, atol=run.atol,
+        wall_time=time.perf_counter() - t_wall, rtol=a.rtol, atol=run.atol,
     )
-    if code == DONE:
-        return res
-    status = segment_status(plan, code)
+
+
+def _segment_error(plan: SegmentPlan, a: _Arguments, run: SegmentRun, res: ReducedSegment,
+                   law: CompiledLaw) -> Exception:
+    """The exception of a run that stopped before the exit (``res``: its partial result)."""
+    y, branch = run.y, a.branch
+    state = {"t": float(y[0]), "v": float(np.exp(y[1])), "F": float(y[2]), "alpha": res.alpha_exit,
+             "alphadot": res.alphadot_exit}
+    d_lo, d_hi = law.domain
+    status = segment_status(plan, run.code)
     what = f"v = {state['v']:.6g} m/s {'fell below the start' if branch == 'AB' else 'rose above the end'} of the law"
-    limit = {T_MAX: run.t_max, MAX_STEPS: int(max_steps)}.get(status)
-    raise status_error(status, t=state["t"], state=state, partial=res,
-                       prefix=f"{alpha_model}+{v_equation} on {branch}: ",
-                       where=f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})",
-                       limit=limit, v_f=v_f, v_floor=math.exp(plan.x_lo) if branch == "AB" else 0.0,
-                       why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * v_in, v=state["v"], lo=d_lo,
-                       hi=d_hi, law=repr(params.force), what=what)
+    limit = {T_MAX: run.t_max, MAX_STEPS: int(a.max_steps)}.get(status)
+    return status_error(status, t=state["t"], state=state, partial=res,
+                        prefix=f"{a.alpha_model}+{a.v_equation} on {branch}: ",
+                        where=f"at t={state['t']:.6g} s after entry (v={state['v']:.6g}, F={state['F']:.6g})",
+                        limit=limit, v_f=plan.v_f, v_floor=math.exp(plan.x_lo) if branch == "AB" else 0.0,
+                        why="fell by a factor e^60 below v_in: v -> 0", v_ceiling=1e3 * plan.v_in, v=state["v"],
+                        lo=d_lo, hi=d_hi, law=repr(a.params.force), what=what)
 
 
 # ---------------------------------------------------------------------------------------------- the lean path

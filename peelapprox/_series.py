@@ -12,7 +12,7 @@ The slips are found by :func:`peelapprox._slips.detect_slips` (its module docstr
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sized
+from collections.abc import Sized
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 from ._checks import shown
 from ._observables import StickSlipObservables, jump_statistics
 from ._ranges import TIME_MAX
+from ._series_lyapunov import options_signature, series_lyapunov
 from ._slips import Slips, detect_slips, noise_level
 from .io import fmt_number, jsonable
 from .validate import integer, optional, positive, reals
@@ -281,15 +282,13 @@ class ForceSeries:
         peak = None if flat else float(f[1 + int(np.argmax(p[1:]))])
         return Spectrum(frequency=f, power=p, peak=peak)
 
-    def lyapunov(self, *, embed: str = "returns", dimension: int | None = None, delay: int | None = None,
-                 theiler: int | None = None, horizon: int | None = None, neighbours: int = 1,
-                 references: int = 4000, fit: tuple[float, float] = (0.1, 0.6),
-                 fit_range: tuple[int, int] | None = None, surrogates: int = 19, alpha: float = 0.05,
-                 threshold: float | None = None, seed: int | None = 0, max_wall: float = 300.0,
-                 progress: Callable[[int, int], Any] | None = None) -> SeriesLyapunov:
+    @options_signature
+    def lyapunov(self, **options: Any) -> SeriesLyapunov:
         """The largest Lyapunov exponent from the trace, by delay embedding and the divergence of nearest
         neighbours (Rosenstein et al. 1993, Kantz 1994), with a surrogate-data test
-        (:mod:`peelapprox._series_lyapunov`).
+        (:mod:`peelapprox._series_lyapunov`).  The options are keyword-only; the signature is built from their one
+        definition, the fields of ``LyapunovOptions`` (``peelapprox/_series_lyapunov.py``), and an unknown option
+        is a ``TypeError`` naming it.
 
         Parameters
         ----------
@@ -345,12 +344,7 @@ class ForceSeries:
             Naming the argument: fewer than 3 slips, a series too short for the horizon, embedding and
             Theiler window, parameters out of range.
         """
-        from ._series_lyapunov import series_lyapunov
-
-        return series_lyapunov(self, embed=embed, dimension=dimension, delay=delay, theiler=theiler,
-                               horizon=horizon, neighbours=neighbours, references=references, fit=fit,
-                               fit_range=fit_range, surrogates=surrogates, alpha=alpha, threshold=threshold,
-                               seed=seed, max_wall=max_wall, progress=progress)
+        return series_lyapunov(self, **options)
 
     def plot(self, ax: Any = None, *, window: tuple[float, float] | None = None, threshold: float | None = None):
         """The trace F(t) with its detected slips marked (start ▼, end ▲, at the fitted corners).

@@ -40,18 +40,23 @@ off λ ≈ 0 and the return map's period (:meth:`ForceSeries.observables`), not 
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import inspect
 import math
 import textwrap
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from .io import fmt_number, jsonable
 from .validate import choice, in_range, integer, positive
 
-__all__ = ["SeriesLyapunov", "SurrogateTest", "series_lyapunov", "iaaft", "EMBEDDINGS"]
+__all__ = ["EMBEDDINGS", "LyapunovOptions", "SeriesLyapunov", "SurrogateTest", "iaaft", "options_signature",
+           "series_lyapunov"]
 
 #: What :func:`series_lyapunov` can embed (module docstring).
 EMBEDDINGS = ("returns", "trace")
@@ -311,126 +316,208 @@ def _fit_range(y: np.ndarray, y_sat: float, lo: float, hi: float) -> tuple[int, 
     return a, b
 
 
-def series_lyapunov(series: Any, *, embed: str = "returns", dimension: int | None = None, delay: int | None = None,
-                    theiler: int | None = None, horizon: int | None = None, neighbours: int = 1,
-                    references: int = 4000, fit: tuple[float, float] = (0.1, 0.6),
-                    fit_range: tuple[int, int] | None = None, surrogates: int = 19, alpha: float = 0.05,
-                    threshold: float | None = None, seed: int | None = 0, max_wall: float = 300.0,
-                    progress: Any = None) -> SeriesLyapunov:
-    """The largest Lyapunov exponent of ``series`` (:meth:`ForceSeries.lyapunov`; the module docstring)."""
-    embed = choice("embed", embed, EMBEDDINGS)
-    neighbours = integer("neighbours", neighbours, lo=1, hi=50)
-    references = integer("references", references, lo=MIN_REFERENCES, hi=10**6)
-    surrogates = integer("surrogates", surrogates, lo=0, hi=1000)
-    alpha = in_range("alpha", alpha, 0.0, 1.0, lo_open=True, hi_open=True)
-    max_wall = positive("max_wall", max_wall)
-    seed = None if seed is None else integer("seed", seed, lo=0, hi=2**63 - 1)
-    if len(fit) != 2 or not 0.0 <= float(fit[0]) < float(fit[1]) <= 1.0:
-        raise ValueError(f"fit must be two fractions 0 <= lo < hi <= 1 of the curve's rise, got {fit!r}")
-    deadline = time.perf_counter() + max_wall
+@dataclass(frozen=True, kw_only=True)
+class LyapunovOptions:
+    """The options of :meth:`peelapprox.ForceSeries.lyapunov` (their meaning: its docstring), defined once: the
+    method's signature is built from these fields (:func:`options_signature`), and :func:`series_lyapunov` checks
+    them here.  The checks of ``dimension``, ``delay``, ``theiler``, ``horizon`` and ``fit_range`` need the series
+    (their defaults and ranges depend on its slips) and are made by :func:`series_lyapunov`."""
 
-    slips = series.slips(threshold)
+    embed: str = "returns"
+    dimension: int | None = None
+    delay: int | None = None
+    theiler: int | None = None
+    horizon: int | None = None
+    neighbours: int = 1
+    references: int = 4000
+    fit: tuple[float, float] = (0.1, 0.6)
+    fit_range: tuple[int, int] | None = None
+    surrogates: int = 19
+    alpha: float = 0.05
+    threshold: float | None = None
+    seed: int | None = 0
+    max_wall: float = 300.0
+    progress: Callable[[int, int], Any] | None = None
+
+    def __post_init__(self) -> None:
+        put = functools.partial(object.__setattr__, self)
+        put("embed", choice("embed", self.embed, EMBEDDINGS))
+        put("neighbours", integer("neighbours", self.neighbours, lo=1, hi=50))
+        put("references", integer("references", self.references, lo=MIN_REFERENCES, hi=10**6))
+        put("surrogates", integer("surrogates", self.surrogates, lo=0, hi=1000))
+        put("alpha", in_range("alpha", self.alpha, 0.0, 1.0, lo_open=True, hi_open=True))
+        put("max_wall", positive("max_wall", self.max_wall))
+        put("seed", None if self.seed is None else integer("seed", self.seed, lo=0, hi=2**63 - 1))
+        fit = self.fit
+        if len(fit) != 2 or not 0.0 <= float(fit[0]) < float(fit[1]) <= 1.0:
+            raise ValueError(f"fit must be two fractions 0 <= lo < hi <= 1 of the curve's rise, got {fit!r}")
+
+
+def options_signature(fn: Callable) -> Callable:
+    """``fn(first, **options)`` with the signature ``fn(first, *, <the fields of LyapunovOptions>)`` (for
+    ``help``, Sphinx and IDEs: the options are written once, as :class:`LyapunovOptions`' fields)."""
+    first = next(iter(inspect.signature(fn).parameters.values()))
+    kw = [inspect.Parameter(f.name, inspect.Parameter.KEYWORD_ONLY, default=f.default, annotation=f.type)
+          for f in dataclasses.fields(LyapunovOptions)]
+    fn.__signature__ = inspect.Signature([first, *kw], return_annotation="SeriesLyapunov")  # type: ignore[attr-defined]
+    return fn
+
+
+class _Embedding(NamedTuple):
+    """The embedded scalar series ``x``, the time of one step [s], the steps per slip interval, the dimension
+    ``m``, the delay ``tau`` and the Theiler window ``w``."""
+
+    x: np.ndarray
+    step: float
+    per: float
+    m: int
+    tau: int
+    w: int
+
+
+@options_signature
+def series_lyapunov(series: Any, **options: Any) -> SeriesLyapunov:
+    """The largest Lyapunov exponent of ``series`` (:meth:`ForceSeries.lyapunov`, whose docstring documents the
+    options, :class:`LyapunovOptions`; the module docstring)."""
+    names = [f.name for f in dataclasses.fields(LyapunovOptions)]
+    unknown = sorted(set(options) - set(names))
+    if unknown:
+        raise TypeError(f"lyapunov() got an unknown option {unknown[0]!r}; the options are {', '.join(names)}")
+    o = LyapunovOptions(**options)
+    deadline = time.perf_counter() + o.max_wall
+    slips = series.slips(o.threshold)
     if len(slips) < 3:
         raise ValueError(f"the series has {len(slips)} slips (threshold {fmt_number(slips.threshold, 3)} N): "
                          "too few slips for a Lyapunov exponent (a trace without stick-slip has none)")
     interval = float(slips.t_start[-1] - slips.t_start[0]) / (len(slips) - 1)
-    if embed == "returns":
-        x = np.asarray(slips.F_before, float)
-        step = interval
-        m = integer("dimension", 4 if dimension is None else dimension, lo=1, hi=20)
-        tau = integer("delay", 1 if delay is None else delay, lo=1, hi=1000)
-        w = integer("theiler", m * tau if theiler is None else theiler, lo=0, hi=10**6)
-        per = 1.0
-    else:
-        n = len(series)
-        tu = np.linspace(series.t[0], series.t[-1], n)
-        x = np.interp(tu, series.t, series.F)
-        step = float(tu[1] - tu[0])
-        per = interval / step  # samples per slip interval
-        m = integer("dimension", 5 if dimension is None else dimension, lo=1, hi=20)
-        tau = integer("delay", max(1, round(per / 8)) if delay is None else delay, lo=1, hi=10**6)
-        w = integer("theiler", max(1, round(per)) if theiler is None else theiler, lo=0, hi=10**5)
+    e = _embedding(series, slips, interval, o)
+    x, m, tau = e.x, e.m, e.tau
     n_emb = x.size - (m - 1) * tau
-    kmax_default = max(MIN_FIT, min(400, (len(slips) - 1) // 4))
-    kmax = integer("horizon", round(kmax_default * per) if horizon is None else horizon, lo=MIN_FIT, hi=10**7)
-    if n_emb - kmax < 2 * w + neighbours + MIN_REFERENCES:
-        what = f"{len(slips)} slips" if embed == "returns" else f"{x.size} samples"
-        raise ValueError(f"the series is too short for horizon = {kmax}, dimension = {m}, delay = {tau} and "
-                         f"theiler = {w}: {what} give {n_emb} delay vectors, and following {MIN_REFERENCES} "
-                         f"of them for {kmax} steps needs {kmax + 2 * w + neighbours + MIN_REFERENCES}")
-    ks = np.arange(kmax + 1) if kmax <= 1000 else np.unique(np.round(np.linspace(0, kmax, 401)).astype(int))
-    if fit_range is not None:
-        if (len(fit_range) != 2 or not 0 <= int(fit_range[0]) < int(fit_range[1]) <= kmax
-                or int(fit_range[1]) - int(fit_range[0]) < 2):
-            raise ValueError(f"fit_range must be (k_start, k_end) steps with 0 <= k_start < k_end - 1 < horizon "
-                             f"= {kmax}, got {fit_range!r}")
-    rng = np.random.default_rng(seed)
-    scale = float(np.std(x)) or 1.0
-    floor = 1e-12 * scale
+    kmax, ks = _horizon(o, e, len(slips), n_emb)
+    rng = np.random.default_rng(o.seed)
+    floor = 1e-12 * (float(np.std(x)) or 1.0)
 
     def estimate(xs: np.ndarray) -> tuple[np.ndarray, int]:
-        X = _embed(xs, m, tau)
-        usable = n_emb - kmax
-        refs = np.unique(np.linspace(0, usable - 1, min(references, usable)).astype(int))
-        r, nb = _pairs(X, usable, refs, w, neighbours, deadline)
-        if r.size < MIN_REFERENCES:
-            raise ValueError(f"only {r.size} reference points have {neighbours} neighbours outside the Theiler "
-                             f"window theiler = {w}: lower theiler or horizon")
-        return _curve(X, r, nb, ks, floor), int(r.size)
+        return _estimate(xs, e, n_emb, kmax, ks, floor, o, deadline)
 
     y, n_ref = estimate(x)
     X = _embed(x, m, tau)
     i, j = rng.integers(0, n_emb, 20000), rng.integers(0, n_emb, 20000)
     y_sat = float(np.mean(np.log(np.maximum(np.linalg.norm(X[i] - X[j], axis=1), floor))))
-    if fit_range is None:
-        a, b = _fit_range(y, y_sat, float(fit[0]), float(fit[1]))
-    else:
-        a = int(np.searchsorted(ks, int(fit_range[0])))
-        b = int(np.searchsorted(ks, int(fit_range[1]), side="right")) - 1
-        if b - a + 1 < 3:
-            raise ValueError(f"fit_range = {fit_range!r} holds {max(b - a + 1, 0)} of the curve's steps (they are "
-                             f"{int(ks[1] - ks[0])} apart here): it needs at least 3")
+    a, b = _fit_indices(y, y_sat, ks, o)
     sl = slice(a, b + 1)
     slope, se, icept = _slope(ks[sl].astype(float), y[sl])
-    to_bits = 1.0 / (step * math.log(2.0))
+    to_bits = 1.0 / (e.step * math.log(2.0))
     lam = slope * to_bits
-
-    status = "ok"
-    test = None
-    if surrogates:
-        lams, curves = [], []
-        for q in range(surrogates):
-            if time.perf_counter() > deadline:
-                status = f"max_wall = {fmt_number(max_wall, 3)} s ran out after {q} of {surrogates} surrogates"
-                break
-            try:
-                ys, _ = estimate(iaaft(x, rng))
-            except TimeoutError:
-                status = f"max_wall = {fmt_number(max_wall, 3)} s ran out after {q} of {surrogates} surrogates"
-                break
-            curves.append(ys)
-            lams.append(_slope(ks[sl].astype(float), ys[sl])[0] * to_bits)
-            if progress is not None:
-                progress(q + 1, surrogates)
-        la = np.array(lams, float)
-        n_s = int(la.size)
-        p = (1.0 + float(np.sum(la >= lam))) / (n_s + 1.0)
-        sd = float(np.std(la, ddof=1)) if n_s > 1 else 0.0
-        mean = float(np.mean(la)) if n_s else lam
-        z = (lam - mean) / sd if sd > 0 else 0.0
-        test = SurrogateTest(kind="IAAFT", n=n_s, lambdas=la,
-                             curves=np.array(curves, float).reshape(n_s, ks.size), p_value=p, z_score=z,
-                             alpha=alpha, rejects_noise=bool(p <= alpha))
+    test, status = _surrogate_test(x, rng, estimate, ks, sl, to_bits, lam, o, deadline)
     what = ("the force before each slip, one step per return, λ per return / the mean time between slips "
-            f"({fmt_number(interval * 1e3, 4)} ms)" if embed == "returns" else
-            f"the trace resampled uniformly, one step per sample ({fmt_number(step * 1e3, 4)} ms)")
-    fit_how = (f"fit over k = {int(ks[a])}-{int(ks[b])}" + (" (given)" if fit_range is not None else
-               f" (the curve's rise from {fit[0]:g} to {fit[1]:g} of the way to the attractor's size)"))
-    method = (f"{'Rosenstein' if neighbours == 1 else f'Kantz ({neighbours} neighbours)'} divergence on "
-              f"scipy.spatial.cKDTree: {what}; m = {m}, delay {tau}, Theiler window {w}, {n_ref} reference "
+            f"({fmt_number(interval * 1e3, 4)} ms)" if o.embed == "returns" else
+            f"the trace resampled uniformly, one step per sample ({fmt_number(e.step * 1e3, 4)} ms)")
+    fit_how = (f"fit over k = {int(ks[a])}-{int(ks[b])}" + (" (given)" if o.fit_range is not None else
+               f" (the curve's rise from {o.fit[0]:g} to {o.fit[1]:g} of the way to the attractor's size)"))
+    method = (f"{'Rosenstein' if o.neighbours == 1 else f'Kantz ({o.neighbours} neighbours)'} divergence on "
+              f"scipy.spatial.cKDTree: {what}; m = {m}, delay {tau}, Theiler window {e.w}, {n_ref} reference "
               f"points followed {kmax} steps; {fit_how}; " + slips.method)
     return SeriesLyapunov(lambda_bits_per_s=float(lam), stderr_bits_per_s=float(se * to_bits), k=ks,
-                          ln_divergence=y, fit_range=(int(ks[a]), int(ks[b])), intercept=float(icept), step=step,
-                          embedded=embed, dimension=m, delay=tau, theiler=w, neighbours=neighbours,
+                          ln_divergence=y, fit_range=(int(ks[a]), int(ks[b])), intercept=float(icept), step=e.step,
+                          embedded=o.embed, dimension=m, delay=tau, theiler=e.w, neighbours=o.neighbours,
                           references=n_ref, surrogate=test, status=status, method=method,
                           source=str(series.source), V=series.V)
+
+
+def _embedding(series: Any, slips: Any, interval: float, o: LyapunovOptions) -> _Embedding:
+    """What is embedded (``o.embed``: the returns, or the uniformly resampled trace) and how, the defaults of
+    ``dimension``, ``delay`` and ``theiler`` filled and every one checked."""
+    if o.embed == "returns":
+        x = np.asarray(slips.F_before, float)
+        m = integer("dimension", 4 if o.dimension is None else o.dimension, lo=1, hi=20)
+        tau = integer("delay", 1 if o.delay is None else o.delay, lo=1, hi=1000)
+        w = integer("theiler", m * tau if o.theiler is None else o.theiler, lo=0, hi=10**6)
+        return _Embedding(x, interval, 1.0, m, tau, w)
+    n = len(series)
+    tu = np.linspace(series.t[0], series.t[-1], n)
+    x = np.interp(tu, series.t, series.F)
+    step = float(tu[1] - tu[0])
+    per = interval / step  # samples per slip interval
+    m = integer("dimension", 5 if o.dimension is None else o.dimension, lo=1, hi=20)
+    tau = integer("delay", max(1, round(per / 8)) if o.delay is None else o.delay, lo=1, hi=10**6)
+    w = integer("theiler", max(1, round(per)) if o.theiler is None else o.theiler, lo=0, hi=10**5)
+    return _Embedding(x, step, per, m, tau, w)
+
+
+def _horizon(o: LyapunovOptions, e: _Embedding, n_slips: int, n_emb: int) -> tuple[int, np.ndarray]:
+    """The steps each pair is followed and those the curve is evaluated at; ValueError when the series is too short
+    for them, or ``o.fit_range`` does not fit."""
+    kmax_default = max(MIN_FIT, min(400, (n_slips - 1) // 4))
+    kmax = integer("horizon", round(kmax_default * e.per) if o.horizon is None else o.horizon, lo=MIN_FIT, hi=10**7)
+    if n_emb - kmax < 2 * e.w + o.neighbours + MIN_REFERENCES:
+        what = f"{n_slips} slips" if o.embed == "returns" else f"{e.x.size} samples"
+        raise ValueError(f"the series is too short for horizon = {kmax}, dimension = {e.m}, delay = {e.tau} and "
+                         f"theiler = {e.w}: {what} give {n_emb} delay vectors, and following {MIN_REFERENCES} "
+                         f"of them for {kmax} steps needs {kmax + 2 * e.w + o.neighbours + MIN_REFERENCES}")
+    ks = np.arange(kmax + 1) if kmax <= 1000 else np.unique(np.round(np.linspace(0, kmax, 401)).astype(int))
+    fit_range = o.fit_range
+    if fit_range is not None:
+        if (len(fit_range) != 2 or not 0 <= int(fit_range[0]) < int(fit_range[1]) <= kmax
+                or int(fit_range[1]) - int(fit_range[0]) < 2):
+            raise ValueError(f"fit_range must be (k_start, k_end) steps with 0 <= k_start < k_end - 1 < horizon "
+                             f"= {kmax}, got {fit_range!r}")
+    return kmax, ks
+
+
+def _estimate(xs: np.ndarray, e: _Embedding, n_emb: int, kmax: int, ks: np.ndarray, floor: float,
+              o: LyapunovOptions, deadline: float) -> tuple[np.ndarray, int]:
+    """The divergence curve of ``xs`` (the data or a surrogate) at the steps ``ks`` and its reference points."""
+    X = _embed(xs, e.m, e.tau)
+    usable = n_emb - kmax
+    refs = np.unique(np.linspace(0, usable - 1, min(o.references, usable)).astype(int))
+    r, nb = _pairs(X, usable, refs, e.w, o.neighbours, deadline)
+    if r.size < MIN_REFERENCES:
+        raise ValueError(f"only {r.size} reference points have {o.neighbours} neighbours outside the Theiler "
+                         f"window theiler = {e.w}: lower theiler or horizon")
+    return _curve(X, r, nb, ks, floor), int(r.size)
+
+
+def _fit_indices(y: np.ndarray, y_sat: float, ks: np.ndarray, o: LyapunovOptions) -> tuple[int, int]:
+    """The first and last index into ``ks`` of the fit: ``o.fit_range``, else the rise fractions ``o.fit``."""
+    if o.fit_range is None:
+        return _fit_range(y, y_sat, float(o.fit[0]), float(o.fit[1]))
+    a = int(np.searchsorted(ks, int(o.fit_range[0])))
+    b = int(np.searchsorted(ks, int(o.fit_range[1]), side="right")) - 1
+    if b - a + 1 < 3:
+        raise ValueError(f"fit_range = {o.fit_range!r} holds {max(b - a + 1, 0)} of the curve's steps (they are "
+                         f"{int(ks[1] - ks[0])} apart here): it needs at least 3")
+    return a, b
+
+
+def _surrogate_test(x: np.ndarray, rng: np.random.Generator, estimate: Callable, ks: np.ndarray, sl: slice,
+                    to_bits: float, lam: float, o: LyapunovOptions,
+                    deadline: float) -> tuple[SurrogateTest | None, str]:
+    """The IAAFT surrogate test of ``lam`` (None without surrogates) and the status ("ok", or what the wall
+    budget left out)."""
+    if not o.surrogates:
+        return None, "ok"
+    status = "ok"
+    lams, curves = [], []
+    for q in range(o.surrogates):
+        if time.perf_counter() > deadline:
+            status = f"max_wall = {fmt_number(o.max_wall, 3)} s ran out after {q} of {o.surrogates} surrogates"
+            break
+        try:
+            ys, _ = estimate(iaaft(x, rng))
+        except TimeoutError:
+            status = f"max_wall = {fmt_number(o.max_wall, 3)} s ran out after {q} of {o.surrogates} surrogates"
+            break
+        curves.append(ys)
+        lams.append(_slope(ks[sl].astype(float), ys[sl])[0] * to_bits)
+        if o.progress is not None:
+            o.progress(q + 1, o.surrogates)
+    la = np.array(lams, float)
+    n_s = int(la.size)
+    p = (1.0 + float(np.sum(la >= lam))) / (n_s + 1.0)
+    sd = float(np.std(la, ddof=1)) if n_s > 1 else 0.0
+    mean = float(np.mean(la)) if n_s else lam
+    z = (lam - mean) / sd if sd > 0 else 0.0
+    test = SurrogateTest(kind="IAAFT", n=n_s, lambdas=la, curves=np.array(curves, float).reshape(n_s, ks.size),
+                         p_value=p, z_score=z, alpha=o.alpha, rejects_noise=bool(p <= o.alpha))
+    return test, status

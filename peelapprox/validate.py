@@ -33,7 +33,6 @@ Decisions recorded here once:
 
 from __future__ import annotations
 
-import sys
 from typing import Any
 
 import numpy as np
@@ -98,14 +97,15 @@ def params(name: str, x: Any, *, laws: tuple[str, ...] = ALL_LAWS, where: str | 
 
     A ValueError if ``x.force`` is not one of ``laws``, the laws the calling function runs (by their names:
     ``"paper"``, ``"cubic"``, ``"tabulated"``, ... as in ``peelapprox.law.law_label``; default every law);
-    the message names ``where`` (default: that function).  With ``variants=False`` (the paper's reduced
-    equations), also a ValueError for a model variant (:func:`paper_model`).
+    the message names ``where``, the calling function (every caller in the package names itself; default
+    ``"this function"``).  With ``variants=False`` (the paper's reduced equations), also a ValueError for a model
+    variant (:func:`paper_model`).
     """
     if not isinstance(x, PeelParams):
         raise ArgumentTypeError(f"{name} must be a PeelParams, got {_got(x)}")
     require_law(x, where, laws)
     if not variants:
-        paper_model(name, x, where=where or sys._getframe(1).f_code.co_name)
+        paper_model(name, x, where=where or "this function")
     return x
 
 

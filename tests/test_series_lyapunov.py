@@ -165,3 +165,23 @@ def test_too_few_slips_and_no_stick_slip_are_named():
         ForceSeries(t, saw).lyapunov(horizon=30)
     with pytest.raises(ValueError, match="window"):
         ForceSeries(t, saw).plot(window=(1.0, 0.5))
+
+
+def test_options_are_defined_once_and_an_unknown_one_is_named():
+    """``ForceSeries.lyapunov``'s signature is the fields of ``LyapunovOptions`` (names, defaults, keyword-only:
+    the options' one definition), and an unknown option is a TypeError naming it and listing the options (exact
+    comparisons: nothing is computed)."""
+    import dataclasses
+    import inspect
+
+    from peelapprox._series_lyapunov import LyapunovOptions, series_lyapunov
+
+    fields = {f.name: f.default for f in dataclasses.fields(LyapunovOptions)}
+    for fn in (ForceSeries.lyapunov, series_lyapunov):
+        params = list(inspect.signature(fn).parameters.values())[1:]
+        assert {p.name: p.default for p in params} == fields
+        assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params)
+    assert len(fields) == 15 and fields["references"] == 4000 and fields["fit"] == (0.1, 0.6)
+    s = ForceSeries(np.arange(100) / 100.0, 200.0 + np.sin(np.arange(100)), V=1.0)
+    with pytest.raises(TypeError, match="unknown option 'embedd'; the options are embed, dimension"):
+        s.lyapunov(embedd="trace")

@@ -254,22 +254,12 @@ def _budget_error(out: dict, wall: WallBudget, t_end: float) -> SolverBudgetExce
                                 state=state, partial=None)
 
 
-def attractors(
-    params: PeelParams,
-    alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3),
-    *,
-    t_transient: float = WINDOW_DEFAULTS["t_transient"],
-    window: float = WINDOW_DEFAULTS["window"],
-    rtol: float = WINDOW_DEFAULTS["rtol"],
-    period_rtol: float = 1e-6,
-    match_rtol: float = 1e-4,
-    progress: Callable[[str], None] | None = None,
-    max_wall: float | None = DEFAULT_MAX_WALL,
-    method: str | None = None,
-    solver: str | None = None,
-    executor: str | Executor | None = None,
-    max_workers: int | None = None,
-) -> list[Attractor]:
+def attractors(params: PeelParams, alpha0s: Sequence[float] = (-0.3, -0.15, 0.0, 0.15, 0.3), *,
+               t_transient: float = WINDOW_DEFAULTS["t_transient"], window: float = WINDOW_DEFAULTS["window"],
+               rtol: float = WINDOW_DEFAULTS["rtol"], period_rtol: float = 1e-6, match_rtol: float = 1e-4,
+               progress: Callable[[str], None] | None = None, max_wall: float | None = DEFAULT_MAX_WALL,
+               method: str | None = None, solver: str | None = None, executor: str | Executor | None = None,
+               max_workers: int | None = None) -> list[Attractor]:
     """Sample initial peel angles and group the attractors they reach.
 
     Each start (α0, the rest :func:`exact.initial_state`'s default) is integrated for ``t_transient`` s
@@ -334,6 +324,14 @@ def attractors(
     if not (executor is None or executor in POOL_KINDS or callable(getattr(executor, "submit", None))):
         raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
                          f"{executor!r}")
+    found = _run_starts(params, alpha0s, kw, method, solver, period_rtol, wall, say, executor, max_workers)
+    return _grouped(alpha0s, found, wall, kw["t_transient"] + kw["window"], match_rtol)
+
+
+def _run_starts(params: PeelParams, alpha0s: list[float], kw: dict, method: str | None, solver: str | None,
+                period_rtol: float, wall: WallBudget, say: Callable[[str], None], executor: str | Executor | None,
+                max_workers: int | None) -> dict[int, dict]:
+    """Each start's outcome (:func:`_start_outcome`; a start the pool lost: its budget or error), by its index."""
     deadline = None if wall.limit is None else time.time() + wall.limit - (time.perf_counter() - wall.t0)
     tasks = [(k, (params, a0, kw, method, solver, period_rtol, deadline)) for k, a0 in enumerate(alpha0s)]
     found: dict[int, dict] = {}
@@ -347,11 +345,18 @@ def attractors(
     for k, text in lost:
         found[k] = {"budget": "max_wall", "limit": wall.limit, "t": 0.0, "message": text,
                     "state": _start_state(params, alpha0s[k])} if text == DEADLINE_TEXT else {"error": text[:100]}
+    return found
+
+
+def _grouped(alpha0s: list[float], found: dict[int, dict], wall: WallBudget, t_end: float,
+             match_rtol: float) -> list[Attractor]:
+    """The starts' outcomes grouped into attractors, in the order of the starts (wherever they ran); the first
+    spent budget raised."""
     groups: list[dict] = []
-    for k, a0 in enumerate(alpha0s):  # grouped in the order of the starts, wherever they ran
+    for k, a0 in enumerate(alpha0s):
         out = found[k]
         if "budget" in out:
-            raise _budget_error(out, wall, kw["t_transient"] + kw["window"])
+            raise _budget_error(out, wall, t_end)
         if "error" in out or out["kind"] == "no stick-slip":
             groups.append(dict(label=out.get("error", "no stick-slip"), period=None, signature=(),
                                F_range=(math.nan, math.nan), starts=[a0], settle=[None]))

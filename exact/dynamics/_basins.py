@@ -20,7 +20,7 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -286,30 +286,18 @@ def _group(outcomes: list[dict], starts: list[tuple[float, float]]) -> tuple[np.
     return codes, groups
 
 
-def basins(
-    params: PeelParams,
-    *,
-    alpha0: Sequence[float] | np.ndarray,
-    F0: Sequence[float] | np.ndarray | None = None,
-    omega0: Sequence[float] | np.ndarray | None = None,
-    t_transient: float = WINDOW_DEFAULTS["t_transient"],
-    window: float = WINDOW_DEFAULTS["window"],
-    rtol: float = WINDOW_DEFAULTS["rtol"],
-    max_period: int = 32,
-    orbits: bool = False,
-    executor: str | Executor | None = None,
-    max_workers: int | None = None,
-    progress: bool | Callable[[int, int, dict], None] | None = True,
-    solver: str | None = None,
-    max_wall: float | None = DEFAULT_MAX_WALL,
-) -> BasinResult:
+def basins(params: PeelParams, *, alpha0: Sequence[float] | np.ndarray, F0: Sequence[float] | np.ndarray | None = None,
+           omega0: Sequence[float] | np.ndarray | None = None, t_transient: float = WINDOW_DEFAULTS["t_transient"],
+           window: float = WINDOW_DEFAULTS["window"], rtol: float = WINDOW_DEFAULTS["rtol"], max_period: int = 32,
+           orbits: bool = False, executor: str | Executor | None = None, max_workers: int | None = None,
+           progress: bool | Callable[[int, int, dict], None] | None = True, solver: str | None = None,
+           max_wall: float | None = DEFAULT_MAX_WALL) -> BasinResult:
     """Label every start of a grid over (α0, F0) or (α0, ω0) by the attractor it reaches.
 
     Each start runs ``exact.simulate(params, t_transient + window, alpha0=a, F0=F (or omega0=w), rtol=rtol,
-    save="jumps", t_transient=t_transient)`` (the other initial values :func:`exact.initial_state`'s
-    defaults) and its window's return map is classified by :func:`peelapprox.periodicity` (rtol 1e-6).
-    Periodic starts whose n are equal and whose sorted cycles agree to :data:`MATCH_RTOL` reach the same
-    attractor.
+    save="jumps", t_transient=t_transient)`` (the other initial values :func:`exact.initial_state`'s defaults) and
+    its window's return map is classified by :func:`peelapprox.periodicity` (rtol 1e-6).  Periodic starts whose n
+    are equal and whose sorted cycles agree to :data:`MATCH_RTOL` reach the same attractor.
 
     Parameters
     ----------
@@ -335,10 +323,10 @@ def basins(
         Also find each periodic attractor's :class:`exact.PeriodicOrbit` (:func:`exact.periodic_orbit` seeded
         by its first start's run, in this process): Floquet multipliers, stability.
     executor : {"auto", "threads", "processes", "serial"} or concurrent.futures.Executor, optional
-        A local pool of :mod:`peelapprox.parallel` (None: ``"auto"``, processes on more than two CPUs and
-        threads on one or two; a script needs no ``__main__`` guard either way), or an executor that runs the
-        starts (e.g. a dask ``Client.get_executor()``), used as is and left running; the function shipped is
-        :func:`exact.dynamics._basins_run.run_start`, its arguments plain data (PeelParams pickles with its law).
+        A local pool of :mod:`peelapprox.parallel` (None: ``"auto"``, processes on more than two CPUs and threads
+        on one or two; a script needs no ``__main__`` guard either way), or an executor that runs the starts (e.g.
+        a dask ``Client.get_executor()``), used as is and left running; the function shipped is ``run_start`` in
+        ``exact/dynamics/_basins_run.py``, its arguments plain data (PeelParams pickles with its law).
     max_workers : int, optional
         Of a local pool: 0 runs in this process; n > 0 a pool of n workers; None (default) one worker per CPU
         available, at most one per start.
@@ -346,21 +334,20 @@ def basins(
         True: a line on stderr per ~5 % of the starts (and per failed start; one updating line in Jupyter); a
         callable gets ``(done, total, outcome)`` after each.
     solver : str, optional
-        The scipy solver of a model variant's runs (:func:`exact.simulate`'s ``solver``; None: its default);
-        with the massless model's hybrid method a ValueError.
+        The scipy solver of a model variant's runs (:func:`exact.simulate`'s; None: its default); a ValueError
+        with the massless model's hybrid method.
     max_wall : float or None
         Wall-clock budget [s] of the whole call, the starts and the orbits (None: unbounded; default
-        :data:`exact.DEFAULT_MAX_WALL`, 3600 s): a start is run with what is left of it as its ``max_wall``,
-        and once it is spent the starts not run are cancelled.  A start it leaves out or cuts is a failure,
-        ``"failure:max_wall"``, and an orbit it cuts an ``orbit_error``: like every other failure of a start,
-        an outcome, not an exception, so the result holds every start that finished.  The deadline is a time of
-        the system clock, shared by the workers of a cluster to their clocks' skew.
+        :data:`exact.DEFAULT_MAX_WALL`, 3600 s): a start is run with what is left of it as its ``max_wall``, and
+        once it is spent the starts not run are cancelled.  A start it leaves out or cuts is a failure,
+        ``"failure:max_wall"``, and an orbit it cuts an ``orbit_error``: outcomes, not exceptions, so the result
+        holds every start that finished.  The deadline is a time of the system clock, shared by the workers of a
+        cluster to their clocks' skew.
 
     Returns
     -------
     BasinResult
-        The same, bit for bit, in this process or on any executor: the outcomes are put in grid order before
-        they are grouped.
+        The same, bit for bit, in this process or on any executor (the outcomes are grouped in grid order).
 
     Raises
     ------
@@ -369,6 +356,59 @@ def basins(
         start does raises: an infeasible start, a breakdown, a solver failure, a spent budget are outcomes.
     """
     wall0 = time.perf_counter()
+    a = _checked_arguments(params, alpha0, F0, omega0, t_transient, window, rtol, max_period, orbits, executor,
+                           max_workers, progress, solver, max_wall)
+    starts = [(float(x), float(v)) for x in a.alpha0 for v in a.values]
+    tasks = [(a.params, a.t_transient, a.window, a.rtol, a.max_period, x, a.axis, v, a.solver) for x, v in starts]
+    deadline = None if a.wall.limit is None else time.time() + a.wall.limit - (time.perf_counter() - a.wall.t0)
+    outcomes = run_all(tasks, a.executor, a.max_workers, reporter(a.progress, len(tasks)), deadline)
+    codes, groups = _group(outcomes, starts)
+    return _result(a, outcomes, codes, tuple(_attractor(a, g, starts) for g in groups), wall0)
+
+
+def _result(a: _Arguments, outcomes: list[dict], codes: np.ndarray, atts: tuple[BasinAttractor, ...],
+            wall0: float) -> BasinResult:
+    """The :class:`BasinResult` of the outcomes in grid order (``wall0``: the call's start)."""
+    shape = (a.alpha0.size, a.values.size)
+    return BasinResult(
+        params=a.params, alpha0=a.alpha0, axis=a.axis, values=a.values, labels=codes.reshape(shape),
+        texts=np.array([o["text"] for o in outcomes], dtype=object).reshape(shape),
+        cycles=tuple(tuple(o["cycle"]) for o in outcomes),
+        n_returns=np.array([o["n_returns"] for o in outcomes], dtype=np.int64).reshape(shape),
+        messages=tuple(o["message"] for o in outcomes), attractors=atts, t_transient=a.t_transient,
+        window=a.window, rtol=a.rtol, max_period=a.max_period, wall_time=time.perf_counter() - wall0)
+
+
+def _attractor(a: _Arguments, g: dict, starts: list[tuple[float, float]]) -> BasinAttractor:
+    """The :class:`BasinAttractor` of the group ``g`` (with its orbit, from its first start, if asked for)."""
+    orbit, err = (_orbit(a.params, starts[g["first"]], a.axis, g["n"], a.t_transient, a.window, a.rtol, a.wall)
+                  if a.orbits else (None, None))
+    return BasinAttractor(g["id"], g["n"], tuple(float(f"{c:.{CYCLE_DIGITS}g}") for c in g["cycle"]), g["count"],
+                          g["start"], orbit, err)
+
+
+class _Arguments(NamedTuple):
+    """:func:`basins`' arguments, checked: the grid's axes (``axis``: "F0" or "omega0", its ``values``)."""
+
+    params: PeelParams
+    alpha0: np.ndarray
+    axis: str
+    values: np.ndarray
+    t_transient: float
+    window: float
+    rtol: float
+    max_period: int
+    orbits: bool
+    executor: str | Executor | None
+    max_workers: int | None
+    progress: bool | Callable[[int, int, dict], None] | None
+    solver: str | None
+    wall: WallBudget
+
+
+def _checked_arguments(params, alpha0, F0, omega0, t_transient, window, rtol, max_period, orbits, executor,
+                       max_workers, progress, solver, max_wall) -> _Arguments:
+    """:func:`basins`' arguments checked, in this order (the first bad one is named)."""
     params = _params("params", params)
     if (F0 is None) == (omega0 is None):
         raise ValueError("give exactly one of F0 (an (alpha0, F0) grid) and omega0 (an (alpha0, omega0) grid)")
@@ -386,6 +426,17 @@ def basins(
     if orbits:
         paper_model_only(params, "basins(orbits=True) (exact.periodic_orbit)", "pass orbits=False")
     max_workers = optional(integer, "max_workers", max_workers, 0)
+    _check_executor(executor, max_workers)
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
+    return _Arguments(params, a_ax, axis, values, t_transient, window, rtol, max_period, orbits, executor,
+                      max_workers, progress, solver, wall)
+
+
+def _check_executor(executor: Any, max_workers: int | None) -> None:
+    """ValueError or ArgumentTypeError unless ``executor`` is None, a local pool's name or an executor (then with
+    no ``max_workers``)."""
     if isinstance(executor, str):
         if executor not in POOL_KINDS:
             raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
@@ -397,29 +448,6 @@ def basins(
         if max_workers is not None:
             raise ValueError("max_workers applies only to the local pools (executor None or a pool's name); size "
                              "your executor instead")
-    if not (progress is None or isinstance(progress, bool) or callable(progress)):
-        raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, outcome), got {progress!r}")
-    wall = WallBudget(optional(positive, "max_wall", max_wall))
-
-    starts = [(float(a), float(v)) for a in a_ax for v in values]
-    tasks = [(params, t_transient, window, rtol, max_period, a, axis, v, solver) for a, v in starts]
-    deadline = None if wall.limit is None else time.time() + wall.limit - (time.perf_counter() - wall.t0)
-    outcomes = run_all(tasks, executor, max_workers, reporter(progress, len(tasks)), deadline)
-    codes, groups = _group(outcomes, starts)
-    atts = []
-    for g in groups:
-        orbit, err = (_orbit(params, starts[g["first"]], axis, g["n"], t_transient, window, rtol, wall) if orbits
-                      else (None, None))
-        atts.append(BasinAttractor(g["id"], g["n"], tuple(float(f"{c:.{CYCLE_DIGITS}g}") for c in g["cycle"]),
-                                   g["count"], g["start"], orbit, err))
-    shape = (a_ax.size, values.size)
-    return BasinResult(
-        params=params, alpha0=a_ax, axis=axis, values=values, labels=codes.reshape(shape),
-        texts=np.array([o["text"] for o in outcomes], dtype=object).reshape(shape),
-        cycles=tuple(tuple(o["cycle"]) for o in outcomes),
-        n_returns=np.array([o["n_returns"] for o in outcomes], dtype=np.int64).reshape(shape),
-        messages=tuple(o["message"] for o in outcomes), attractors=tuple(atts), t_transient=t_transient,
-        window=window, rtol=rtol, max_period=max_period, wall_time=time.perf_counter() - wall0)
 
 
 def _check_size(axis: str, alpha0: Any, values: Any) -> None:

@@ -194,8 +194,29 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
     """
     wall0 = time.perf_counter()
     params = _params("params", params)
+    vals = _checked_values(params, parameter, values)
+    t_transient = duration("t_transient", t_transient, zero=True)
+    window = duration("window", window)
+    wall = WallBudget(optional(positive, "max_wall", max_wall))
+    max_workers = optional(integer, "max_workers", max_workers, 0)
+    _check_executor(executor)
+    report: Callable[[int, int], None] | None = None
+    line = ProgressLine(f"orbit diagram over {parameter}", vals.size) if progress is True else None
+    if line is None:
+        report = optional(function, "progress", progress or None)
+    flat = vals.ravel()
+    found = _run_values(params, parameter, flat, (t_transient, window, alpha0, rtol, method, solver, max_period),
+                        wall, line, report, executor, max_workers)
+    returns = [np.asarray(found[k][0], dtype=float) for k in range(flat.size)]
+    labels = [found[k][1] for k in range(flat.size)]
+    return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
+
+
+def _checked_values(params: PeelParams, parameter: str, values: Any) -> np.ndarray:
+    """``values`` as an array: at most :data:`MAX_DIAGRAM_VALUES` (counted before converting them: a typo's 1e9
+    values would take minutes), each a valid value of ``parameter``."""
     count = np.size(values) if isinstance(values, np.ndarray) else len(values) if hasattr(values, "__len__") else 0
-    if count > MAX_DIAGRAM_VALUES:  # before converting them: a typo's 1e9 values would take minutes
+    if count > MAX_DIAGRAM_VALUES:
         raise ValueError(f"values must hold at most MAX_DIAGRAM_VALUES = {MAX_DIAGRAM_VALUES} values (1e5 runs are "
                          f"about a day at ~1 s each: more is most likely a typo), got {count}")
     vals = reals("values", values)
@@ -206,24 +227,26 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
             with_parameter(params, parameter, x)
         except ValueError as exc:
             raise ValueError(f"values must be valid values of {parameter}, got {x!r}: {exc}") from None
-    t_transient = duration("t_transient", t_transient, zero=True)
-    window = duration("window", window)
-    wall = WallBudget(optional(positive, "max_wall", max_wall))
-    max_workers = optional(integer, "max_workers", max_workers, 0)
+    return vals
+
+
+def _check_executor(executor: Any) -> None:
+    """ValueError or TypeError unless ``executor`` is None, a local pool's name or an executor."""
     if isinstance(executor, str) and executor not in POOL_KINDS:
         raise ValueError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
                          f"{executor!r}")
     if not (executor is None or isinstance(executor, str) or callable(getattr(executor, "submit", None))):
         raise TypeError(f"executor must be None, one of {POOL_KINDS} or a concurrent.futures.Executor, got "
                         f"{executor!r}")
-    report: Callable[[int, int], None] | None = None
-    line = ProgressLine(f"orbit diagram over {parameter}", vals.size) if progress is True else None
-    if line is None:
-        report = optional(function, "progress", progress or None)
-    flat = vals.ravel()
+
+
+def _run_values(params: PeelParams, parameter: str, flat: np.ndarray, run: tuple, wall: WallBudget,
+                line: ProgressLine | None, report: Callable[[int, int], None] | None,
+                executor: str | Executor | None, max_workers: int | None) -> dict[int, tuple[np.ndarray, str]]:
+    """Each value's return map and label (:func:`_diagram_value` with the ``run`` arguments ``(t_transient,
+    window, alpha0, rtol, method, solver, max_period)``), by its index; those lost labelled."""
     deadline = None if wall.limit is None else time.time() + wall.limit - (time.perf_counter() - wall.t0)
-    tasks = [(k, (with_parameter(params, parameter, float(x)), t_transient, window, alpha0, rtol, method, solver,
-                  max_period, deadline)) for k, x in enumerate(flat)]
+    tasks = [(k, (with_parameter(params, parameter, float(x)), *run, deadline)) for k, x in enumerate(flat)]
     found: dict[int, tuple[np.ndarray, str]] = {}
 
     def put(k: int, value: tuple[np.ndarray, str]) -> None:
@@ -237,9 +260,7 @@ def orbit_diagram(params: PeelParams, parameter: str, values: Sequence[float] | 
                       max_workers=max_workers, deadline=deadline)
     for k, text in sorted(lost, key=lambda kt: kt[0]):  # not begun by the deadline, or the pool lost it
         put(k, (np.zeros(0), "budget:max_wall" if text == DEADLINE_TEXT else "solver_failure"))
-    returns = [np.asarray(found[k][0], dtype=float) for k in range(flat.size)]
-    labels = [found[k][1] for k in range(flat.size)]
-    return OrbitDiagram(parameter, vals.ravel().copy(), tuple(returns), tuple(labels), time.perf_counter() - wall0)
+    return found
 
 
 def explain(diagram: OrbitDiagram, branches: Sequence[Any], *, rtol: float = 1e-6,

@@ -63,16 +63,9 @@ __all__ = ["LYAPUNOV_METHODS", "D0_RANGE", "check_lyapunov_options", "lyapunov",
            "lyapunov_return_map"]
 
 _AB = BRANCHES.index("AB")
-def lyapunov(
-    params: PeelParams,
-    method: str = "two-trajectory",
-    *,
-    t_transient: float = T_TRANSIENT,
-    alpha0: float = 0.0,
-    rtol: float | None = None,
-    max_wall: float | None = DEFAULT_MAX_WALL,
-    **options: Any,
-) -> LyapunovResult:
+def lyapunov(params: PeelParams, method: str = "two-trajectory", *, t_transient: float = T_TRANSIENT,
+             alpha0: float = 0.0, rtol: float | None = None, max_wall: float | None = DEFAULT_MAX_WALL,
+             **options: Any) -> LyapunovResult:
     """Largest Lyapunov exponent of the exact peeling dynamics, in bits/s, by one of four methods.
 
     Parameters
@@ -148,6 +141,12 @@ def lyapunov(
     common: dict[str, Any] = dict(t_transient=t_transient, alpha0=alpha0)
     if rtol is not None:
         common["rtol"] = rtol
+    return _run_method(params, method, max_wall, common, options)
+
+
+def _run_method(params: PeelParams, method: str, max_wall: float | None, common: dict[str, Any],
+                options: dict[str, Any]) -> LyapunovResult:
+    """The exponent by ``method`` with the ``common`` arguments and the method's ``options`` (checked)."""
     if method == "two-trajectory":
         return _two_trajectory(params, max_wall=max_wall, **common, **options)
     if method == "tangent":
@@ -175,20 +174,10 @@ def _watch_wall(wall: WallBudget, progress: Callable | None) -> Callable:
     return watch
 
 
-def _two_trajectory(
-    params: PeelParams,
-    *,
-    t_transient: float = T_TRANSIENT,
-    tau: float = LYAPUNOV_TAU,
-    n: int | None = None,
-    T: float | None = None,
-    n_discard: int = 200,
-    d0: float = 1e-7,
-    alpha0: float = 0.0,
-    rtol: float = 1e-12,
-    max_wall: float | None = DEFAULT_MAX_WALL,
-    solver: str | None = None,
-) -> LyapunovResult:
+def _two_trajectory(params: PeelParams, *, t_transient: float = T_TRANSIENT, tau: float = LYAPUNOV_TAU,
+                    n: int | None = None, T: float | None = None, n_discard: int = 200, d0: float = 1e-7,
+                    alpha0: float = 0.0, rtol: float = 1e-12, max_wall: float | None = DEFAULT_MAX_WALL,
+                    solver: str | None = None) -> LyapunovResult:
     """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver, or for
     a model variant (``params.variant``) on its method with ``solver``
     (:func:`exact.dynamics._benettin.variant_two_trajectory`).
@@ -216,66 +205,77 @@ def _two_trajectory(
         raise ValueError(f"lyapunov: solver applies to a model variant's method (params.tape_mass, "
                          f"params.loading='load'), not to the hybrid method of the paper's model; got "
                          f"solver={solver!r}")
-    bs = branch_structure(params.V, force=params.force)
-    scale = natural_scales(params)
-    jumps = [0]
-    t_total = t_transient + (n + n_discard) * tau
+    pair = _TwoOrbits(params, rtol, tau, d0, wall, t_transient + (n + n_discard) * tau)
+    s0 = initial_state(params, alpha0=alpha0)
+    ref = (s0.alpha, s0.omega, s0.F, s0.branch)
+    if t_transient > 0:
+        ref, _ = pair.run(ref, t_transient)
+    # the perturbation: along F (the variable the constraint and the jumps act on), size d0
+    pert = pair.rescale(ref, (ref[0], ref[1], ref[2] + d0 * pair.scale[2], ref[3]), 1.0)
+    res = benettin(pair.advance, ref, pert, pair.distance, pair.rescale, n, n_discard=n_discard)
+    ln2 = math.log(2.0)
+    return LyapunovResult(res.exponent, res.exponent / ln2, res.stderr / ln2, res, params, tau, pair.jumps)
 
-    def run(state, dt):
-        a, w, F, br = state
+
+class _TwoOrbits:
+    """The two orbits of :func:`_two_trajectory` on the hybrid solver, states ``(α, ω, F, branch)``: ``run``
+    advances one by a hybrid run (within the call's ``wall``, ``t_total`` the simulated time of the call),
+    ``distance`` measures in the natural scales, ``rescale`` puts the perturbation back along its direction,
+    ``advance`` moves both by ``tau`` and postpones the renormalisation while they are on different branches;
+    ``jumps`` counts the reference's jumps."""
+
+    MAX_POSTPONES = 64
+
+    def __init__(self, params: PeelParams, rtol: float, tau: float, d0: float, wall: WallBudget, t_total: float):
+        self.params, self.rtol, self.tau, self.d0, self.wall, self.t_total = params, rtol, tau, d0, wall, t_total
+        self.bs = branch_structure(params.V, force=params.force)
+        self.scale = natural_scales(params)
+        self.jumps = 0
+
+    def run(self, state, dt):
+        params, (a, w, F, br) = self.params, state
         try:
-            tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=rtol, save="jumps",
-                          max_wall=wall.left(0.0, lambda: initial_state(params, alpha0=a, omega0=w, F0=F,
-                                                                        branch0=br).__dict__, t_total))
+            tr = simulate(params, dt, alpha0=a, omega0=w, F0=F, branch0=br, rtol=self.rtol, save="jumps",
+                          max_wall=self.wall.left(0.0, lambda: initial_state(params, alpha0=a, omega0=w, F0=F,
+                                                                             branch0=br).__dict__, self.t_total))
         except SolverBudgetExceeded as exc:
-            raise wall.reraise(exc) from None
+            raise self.wall.reraise(exc) from None
         s = tr.final_state
         return (s.alpha, s.omega, s.F, s.branch), len(tr.jumps)
 
-    def vec(s):
-        return np.array(s[:3]) / scale
+    def vec(self, s):
+        return np.array(s[:3]) / self.scale
 
-    def distance(a, b):
-        return float(np.linalg.norm(vec(a) - vec(b)))
+    def distance(self, a, b):
+        return float(np.linalg.norm(self.vec(a) - self.vec(b)))
 
-    def rescale(ref, pert, factor):
+    def rescale(self, ref, pert, factor):
         # a state near a fold may leave its branch's level range when moved: halve the step until it does not
         for _ in range(60):
-            x = (vec(ref) + factor * (vec(pert) - vec(ref))) * scale
-            G = x[2] * (1.0 + float(params.closure(x[0])[0]))
-            if bs.has_root(G, ref[3]):
+            x = (self.vec(ref) + factor * (self.vec(pert) - self.vec(ref))) * self.scale
+            G = x[2] * (1.0 + float(self.params.closure(x[0])[0]))
+            if self.bs.has_root(G, ref[3]):
                 return (float(x[0]), float(x[1]), float(x[2]), ref[3])
             factor *= 0.5
         return ref  # unreachable in practice: the reference itself lies on its branch
 
-    max_postpones = 64
-
-    def advance(ref, pert):
-        ref, nj = run(ref, tau)
-        pert, _ = run(pert, tau)
+    def advance(self, ref, pert):
+        tau = self.tau
+        ref, nj = self.run(ref, tau)
+        pert, _ = self.run(pert, tau)
         dt = tau
-        for _ in range(max_postpones):
+        for _ in range(self.MAX_POSTPONES):
             if ref[3] == pert[3]:
                 break
-            ref, nj2 = run(ref, tau / 8)
-            pert, _ = run(pert, tau / 8)
+            ref, nj2 = self.run(ref, tau / 8)
+            pert, _ = self.run(pert, tau / 8)
             dt += tau / 8
             nj += nj2
         else:
-            raise RuntimeError(f"lyapunov: the two orbits stayed on different branches for {max_postpones} "
-                               f"postponements of tau/8 = {tau / 8:g} s: d0 = {d0:g} is too large for this orbit")
-        jumps[0] += nj
+            raise RuntimeError(f"lyapunov: the two orbits stayed on different branches for {self.MAX_POSTPONES} "
+                               f"postponements of tau/8 = {tau / 8:g} s: d0 = {self.d0:g} is too large for this orbit")
+        self.jumps += nj
         return ref, pert, dt
-
-    s0 = initial_state(params, alpha0=alpha0)
-    ref = (s0.alpha, s0.omega, s0.F, s0.branch)
-    if t_transient > 0:
-        ref, _ = run(ref, t_transient)
-    # the perturbation: along F (the variable the constraint and the jumps act on), size d0
-    pert = rescale(ref, (ref[0], ref[1], ref[2] + d0 * scale[2], ref[3]), 1.0)
-    res = benettin(advance, ref, pert, distance, rescale, n, n_discard=n_discard)
-    ln2 = math.log(2.0)
-    return LyapunovResult(res.exponent, res.exponent / ln2, res.stderr / ln2, res, params, tau, jumps[0])
 
 
 def lyapunov_tangent(

@@ -98,17 +98,9 @@ def tangent_solve(ode, params, eps: float, atol: np.ndarray, x, d, duration: flo
     return ys[:4] * atol, ys[4:] * atol, int(ts.size - 1 - n_cross), n_cross
 
 
-def lyapunov_variational(
-    params: PeelParams,
-    *,
-    eps: float = EPS_DEFAULT,
-    t_transient: float = T_TRANSIENT,
-    T: float = 50.0,
-    tau: float = 0.5,
-    rtol: float = 1e-8,
-    alpha0: float = 0.0,
-    progress: Callable[[float, float], None] | None = None,
-) -> LyapunovResult:
+def lyapunov_variational(params: PeelParams, *, eps: float = EPS_DEFAULT, t_transient: float = T_TRANSIENT,
+                         T: float = 50.0, tau: float = 0.5, rtol: float = 1e-8, alpha0: float = 0.0,
+                         progress: Callable[[float, float], None] | None = None) -> LyapunovResult:
     """Largest Lyapunov exponent of the ε-regularised system (XDAE) from its variational equations, in bits/s.
 
     About 0.35 s of wall time per simulated second at V = 2.5, I = 1e-4, rtol 1e-8; needs pydiffsol (the
@@ -164,6 +156,30 @@ def lyapunov_variational(
     from .._shared import natural_scales
     from ._benettin import BenettinResult, LyapunovResult
 
+    T, tau, t_transient, eps, rtol, atol, alpha0, progress = _checked_arguments(params, eps, t_transient, T, tau,
+                                                                                rtol, alpha0, progress)
+    ode = _tangent_model(params, rtol)
+    scale = natural_scales(params)
+    s0 = initial_state(params, alpha0=alpha0)
+    x = np.array([s0.alpha, s0.omega, s0.F, s0.v])
+    d = _slow_tangent(params, x, np.array([0.3, 0.3, 1.0]) / math.sqrt(1.18), scale)
+    n_tr = math.ceil(t_transient / tau - 1e-9) if t_transient > 0 else 0
+    n = max(1, math.ceil(T / tau - 1e-9))
+    chunks = ([t_transient / n_tr] * n_tr if n_tr else []) + [T / n] * n
+    wall0 = time.perf_counter()
+    logs, steps, crossings, window_crossings = _intervals(ode, params, eps, atol, x, d, chunks, n_tr, scale,
+                                                          progress, t_transient + T)
+    b = BenettinResult.from_logs(logs, np.full(n, T / n), 1.0, time.perf_counter() - wall0)  # unit tangent
+    ln2 = math.log(2.0)
+    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, T / n, window_crossings,
+                          method=f"variational equations of the ε-regularised system (ε = {eps:g}, diffsol BDF)",
+                          notes=[f"steps={steps}", f"crossings={crossings}", f"solves={len(chunks)}",
+                                 f"rtol={rtol:g}"])
+
+
+def _checked_arguments(params, eps, t_transient, T, tau, rtol, alpha0, progress) -> tuple:
+    """:func:`lyapunov_variational`'s arguments checked, in this order (the first bad one is named), with the
+    atol of ``rtol``: ``(T, tau, t_transient, eps, rtol, atol, alpha0, progress)``."""
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)
     _params("params", params, laws=VARIATIONAL_LAWS, where=VARIATIONAL_LAWS_NOTE)
@@ -175,27 +191,32 @@ def lyapunov_variational(
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
     eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
-    a = default_atol("regularized", rtol)
+    atol = default_atol("regularized", rtol)
     alpha0 = state("alpha0", alpha0, "alpha")
     progress = optional(function, "progress", progress)
+    return T, tau, t_transient, eps, rtol, atol, alpha0, progress
+
+
+def _tangent_model(params: PeelParams, rtol: float):
+    """The compiled tangent DiffSL model of ``params`` (scaled atol 1, :data:`TANGENT_OPTIONS`)."""
     ode = diffsl_model(params.geometry, tangent=True, force=params.force)
     ode.rtol, ode.atol, ode.t0 = rtol, 1.0, 0.0
     for name, val in TANGENT_OPTIONS.items():
         setattr(ode.options, name, val)
+    return ode
 
-    scale = natural_scales(params)
-    s0 = initial_state(params, alpha0=alpha0)
-    x = np.array([s0.alpha, s0.omega, s0.F, s0.v])
-    d = _slow_tangent(params, x, np.array([0.3, 0.3, 1.0]) / math.sqrt(1.18), scale)
-    n_tr = math.ceil(t_transient / tau - 1e-9) if t_transient > 0 else 0
-    n = max(1, math.ceil(T / tau - 1e-9))
-    chunks = ([t_transient / n_tr] * n_tr if n_tr else []) + [T / n] * n
-    logs = np.empty(n)
+
+def _intervals(ode, params: PeelParams, eps: float, atol: np.ndarray, x: np.ndarray, d: np.ndarray,
+               chunks: list[float], n_tr: int, scale: np.ndarray,
+               progress: Callable[[float, float], None] | None, t_total: float) -> tuple[np.ndarray, int, int, int]:
+    """State and tangent solved over ``chunks`` (the first ``n_tr`` the transient), the tangent renormalised after
+    each (``progress(t_done, t_total)``): the measured intervals' log growths, the steps, the crossings and those
+    of the measured window."""
+    logs = np.empty(len(chunks) - n_tr)
     steps = crossings = window_crossings = 0
     t_done = 0.0
-    wall0 = time.perf_counter()
     for i, dt in enumerate(chunks):
-        x, d, st, nc = tangent_solve(ode, params, eps, a, x, d, dt, t_start=t_done)
+        x, d, st, nc = tangent_solve(ode, params, eps, atol, x, d, dt, t_start=t_done)
         size = float(np.linalg.norm(d[:3] / scale))
         if not (math.isfinite(size) and size > 0.0):
             raise SolverFailure(f"the tangent became {size!r} in the interval starting at t = {t_done:g} s",
@@ -208,10 +229,5 @@ def lyapunov_variational(
             window_crossings += nc
         t_done += dt
         if progress is not None:
-            progress(t_done, t_transient + T)
-    b = BenettinResult.from_logs(logs, np.full(n, T / n), 1.0, time.perf_counter() - wall0)  # unit tangent
-    ln2 = math.log(2.0)
-    return LyapunovResult(b.exponent, b.exponent / ln2, b.stderr / ln2, b, params, T / n, window_crossings,
-                          method=f"variational equations of the ε-regularised system (ε = {eps:g}, diffsol BDF)",
-                          notes=[f"steps={steps}", f"crossings={crossings}", f"solves={len(chunks)}",
-                                 f"rtol={rtol:g}"])
+            progress(t_done, t_total)
+    return logs, steps, crossings, window_crossings

@@ -53,6 +53,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -266,6 +267,42 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
         Bad arguments (named, with the valid values: ``parameter`` lists the parameters of ``orbit``'s law).
     """
     wall0 = time.perf_counter()
+    a = _checked_options(orbit, parameter, stop, step, min_step, max_step, max_points, tol, rtol, locate_tol,
+                         max_correction, graze_tol, crest_tol, progress, max_wall)
+    run = _Continuation(orbit, a, Stepper(orbit, a.parameter, a.span, a.tol, a.rtol, a.wall))
+    while len(run.points) < a.max_points and not run.step():
+        pass
+    end_value = run.points[-1].value if math.isnan(run.end_value) else run.end_value
+    return OrbitBranch(a.parameter, tuple(run.points), tuple(run.bifs), run.stopped, run.message,
+                       time.perf_counter() - wall0, end_value)
+
+
+class _Options(NamedTuple):
+    """:func:`continue_orbit`'s arguments, checked, with the start's value ``lam0``, the ``span`` to ``stop`` and
+    its ``sign``, the initial, smallest and largest steps and the wall budget."""
+
+    parameter: str
+    lam0: float
+    stop: float
+    span: float
+    sign: float
+    h: float
+    hmin: float
+    hmax: float
+    max_points: int
+    max_correction: float
+    graze_tol: float
+    crest_tol: float
+    tol: float
+    rtol: float
+    locate_tol: float
+    progress: Callable[[int, float], None] | None
+    wall: WallBudget
+
+
+def _checked_options(orbit, parameter, stop, step, min_step, max_step, max_points, tol, rtol, locate_tol,
+                     max_correction, graze_tol, crest_tol, progress, max_wall) -> _Options:
+    """:func:`continue_orbit`'s arguments checked, in this order (the first bad one is named)."""
     if not isinstance(orbit, PeriodicOrbit):
         raise TypeError(f"orbit must be an exact.PeriodicOrbit, got {type(orbit).__name__}")
     if isinstance(parameter, str) and parameter in VARIANT_PARAMETERS:
@@ -296,89 +333,111 @@ def continue_orbit(orbit: PeriodicOrbit, parameter: str = "V", *, stop: float, s
     locate_tol = in_range("locate_tol", locate_tol, 0.0, 1.0, lo_open=True, hi_open=True)
     progress = optional(function, "progress", progress)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
+    return _Options(parameter, lam0, stop, span, sign, h, hmin, hmax, max_points, max_correction, graze_tol,
+                    crest_tol, tol, rtol, locate_tol, progress, wall)
 
-    st = Stepper(orbit, parameter, span, tol, rtol, wall)
-    e_lam = np.array([0.0, 0.0, 1.0])
-    points = [BranchPoint(lam0, orbit)]
-    crests = [crest_margin(orbit) if crest_tol > 0 else NO_CREST]
-    bifs: list[Bifurcation] = []
-    stopped, message, end_value = "max_points", "", math.nan
-    lo_end, hi_end = min(lam0, stop), max(lam0, stop)
-    while len(points) < max_points:
-        if _spent(wall):
-            stopped, message = "max_wall", _wall_message(wall, points, parameter)
-            break
-        last = points[-1]
-        wl = st.w(last)
-        if len(points) == 1:  # the branch's tangent, towards stop
-            tau = branch_tangent(st.params_at, orbit, lam0, st.scale, span, rtol)
-            tau = tau if tau[2] * sign >= 0 else -tau
-        else:
-            tau = st.w(last) - st.w(points[-2])
-            tau = tau / np.linalg.norm(tau)
-        ahead = [v for e, v in events_ahead(points, crests).items() if e != "grazing"]
-        if ahead and abs(tau[2]) > 0:  # approach an extrapolated crest or breakdown geometrically, never step over
-            h = min(h, 0.5 * min(abs(v - last.value) for v in ahead) / abs(tau[2]))
-        w_pred, tau_c, final = wl + (h / span) * tau, (tau if _near_fold(last.orbit) else e_lam), False
-        if (w_pred[2] * span - stop) * sign >= 0 and tau[2] * sign > 0:  # the last step: natural, onto stop
-            w_pred = wl + tau * ((stop / span - wl[2]) / tau[2])
-            tau_c, final = e_lam, True
+
+class _Continuation:
+    """One continuation under way: the points, their crest margins, the bifurcations, the step ``h`` and, once
+    it ended, why (``stopped``, ``message``, ``end_value``; NaN: the last point's)."""
+
+    def __init__(self, orbit: PeriodicOrbit, a: _Options, st: Stepper):
+        self.orbit, self.a, self.st, self.h = orbit, a, st, a.h
+        self.points = [BranchPoint(a.lam0, orbit)]
+        self.crests = [crest_margin(orbit) if a.crest_tol > 0 else NO_CREST]
+        self.bifs: list[Bifurcation] = []
+        self.stopped, self.message, self.end_value = "max_points", "", math.nan
+
+    def end(self, stopped: str, message: str = "", end_value: float = math.nan) -> bool:
+        self.stopped, self.message, self.end_value = stopped, message, end_value
+        return True
+
+    def out_of_wall(self) -> bool:
+        return self.end("max_wall", _wall_message(self.a.wall, self.points, self.a.parameter))
+
+    def step(self) -> bool:
+        """One predictor-corrector step (the step halved on a failure); True when the branch ended."""
+        a, st = self.a, self.st
+        if _spent(a.wall):
+            return self.out_of_wall()
+        last = self.points[-1]
+        w_pred, tau_c, final = self.predict(last)
         try:
-            if h < hmin:
-                raise ValueError(f"the step fell below min_step={hmin:.3g} before an extrapolated event")
+            if self.h < a.hmin:
+                raise ValueError(f"the step fell below min_step={a.hmin:.3g} before an extrapolated event")
             pt = st.correct(w_pred, tau_c)
-            _check_correction(st, pt, w_pred, max_correction)
+            _check_correction(st, pt, w_pred, a.max_correction)
         except FAILURES as exc:
             if _out_of_wall(exc):
-                stopped, message = "max_wall", _wall_message(wall, points, parameter)
-                break
-            if h / 2 >= hmin:
-                h /= 2
-                continue
-            stopped, message, end_value = failure_end(exc, points, crests, parameter, span)
-            break
-        o = pt.orbit
-        if np.min(np.abs(o.fold_rates)) < graze_tol * o.params.k * o.params.V:
-            i = int(np.argmin(np.abs(o.fold_rates)))
-            points.append(pt)
-            crests.append(NO_CREST)
-            ev = events_ahead(points, crests).get("grazing", pt.value)
-            stopped, end_value = "grazing", near(ev, pt.value, last.value, span)
-            message = (f"the orbit meets the {'AB' if i % 2 else 'CD'} fold (fold {i + 1} of the period) almost "
-                       f"tangentially at {parameter}={pt.value:.10g}: dG/dt = {o.fold_rates[i]:.3g} N/s there "
-                       f"(below graze_tol * k V); the period-{st.n} branch ends in a grazing bifurcation, where "
-                       "its multipliers diverge")
-            break
+                return self.out_of_wall()
+            if self.h / 2 >= a.hmin:
+                self.h /= 2
+                return False
+            return self.end(*failure_end(exc, self.points, self.crests, a.parameter, a.span))
+        return self.accept(last, pt, final)
+
+    def predict(self, last: BranchPoint) -> tuple[np.ndarray, np.ndarray, bool]:
+        """The prediction from ``last``, the corrector's direction (pseudo-arclength near a fold, else λ fixed)
+        and whether it is the last step (natural, onto ``stop``); shortens ``h`` before an extrapolated event."""
+        a, st, e_lam = self.a, self.st, np.array([0.0, 0.0, 1.0])
+        wl = st.w(last)
+        if len(self.points) == 1:  # the branch's tangent, towards stop
+            tau = branch_tangent(st.params_at, self.orbit, a.lam0, st.scale, a.span, a.rtol)
+            tau = tau if tau[2] * a.sign >= 0 else -tau
+        else:
+            tau = st.w(last) - st.w(self.points[-2])
+            tau = tau / np.linalg.norm(tau)
+        ahead = [v for e, v in events_ahead(self.points, self.crests).items() if e != "grazing"]
+        if ahead and abs(tau[2]) > 0:  # approach an extrapolated crest or breakdown geometrically, never step over
+            self.h = min(self.h, 0.5 * min(abs(v - last.value) for v in ahead) / abs(tau[2]))
+        w_pred, tau_c, final = wl + (self.h / a.span) * tau, (tau if _near_fold(last.orbit) else e_lam), False
+        if (w_pred[2] * a.span - a.stop) * a.sign >= 0 and tau[2] * a.sign > 0:  # the last step: natural, onto stop
+            w_pred = wl + tau * ((a.stop / a.span - wl[2]) / tau[2])
+            tau_c, final = e_lam, True
+        return w_pred, tau_c, final
+
+    def accept(self, last: BranchPoint, pt: BranchPoint, final: bool) -> bool:
+        """Add the corrected point ``pt`` (a bifurcation since ``last`` located); True when the branch ends there."""
+        a, o = self.a, pt.orbit
+        if np.min(np.abs(o.fold_rates)) < a.graze_tol * o.params.k * o.params.V:
+            return self.grazing(last, pt)
         kind = crossing(last.orbit.multipliers, o.multipliers)
         if kind is not None:
             try:
-                bifs.append(_locate(kind, last, pt, st, locate_tol))
+                self.bifs.append(_locate(kind, last, pt, self.st, a.locate_tol))
             except SolverBudgetExceeded:  # the wall budget, mid-bisection: end before the unlocated crossing
-                stopped, message = "max_wall", _wall_message(wall, points, parameter)
-                break
-        points.append(pt)
-        crests.append(crest_margin(o) if crest_tol > 0 else NO_CREST)
-        if progress:
-            progress(len(points), pt.value)
-        c = crests[-1]
-        if min(c.margin, c.floor) < crest_tol:
+                return self.out_of_wall()
+        self.points.append(pt)
+        self.crests.append(crest_margin(o) if a.crest_tol > 0 else NO_CREST)
+        if a.progress:
+            a.progress(len(self.points), pt.value)
+        c = self.crests[-1]
+        if min(c.margin, c.floor) < a.crest_tol:
             event = "crest" if c.margin <= c.floor else "breakdown"
-            ev = events_ahead(points, crests).get(event, pt.value)
-            stopped, end_value = event, near(ev, pt.value, last.value, span)
-            message = event_message(event, c, end_value, parameter)
-            break
+            ev = events_ahead(self.points, self.crests).get(event, pt.value)
+            end_value = near(ev, pt.value, last.value, a.span)
+            return self.end(event, event_message(event, c, end_value, a.parameter), end_value)
         if final:
-            stopped = "stop"
-            break
-        if not lo_end - 0.01 * span <= pt.value <= hi_end + 0.01 * span:
-            stopped = "range"
-            message = f"the branch turned back at a fold and left [{lo_end:.10g}, {hi_end:.10g}] at {pt.value:.10g}"
-            break
-        h = min(hmax, h * 1.5) if len(o.newton) <= 3 else h
-    if math.isnan(end_value):
-        end_value = points[-1].value
-    return OrbitBranch(parameter, tuple(points), tuple(bifs), stopped, message, time.perf_counter() - wall0,
-                       end_value)
+            return self.end("stop")
+        lo_end, hi_end = min(a.lam0, a.stop), max(a.lam0, a.stop)
+        if not lo_end - 0.01 * a.span <= pt.value <= hi_end + 0.01 * a.span:
+            return self.end("range", f"the branch turned back at a fold and left [{lo_end:.10g}, {hi_end:.10g}] at "
+                                     f"{pt.value:.10g}")
+        self.h = min(a.hmax, self.h * 1.5) if len(o.newton) <= 3 else self.h
+        return False
+
+    def grazing(self, last: BranchPoint, pt: BranchPoint) -> bool:
+        """End at ``pt``, where the orbit meets a fold almost tangentially."""
+        o = pt.orbit
+        i = int(np.argmin(np.abs(o.fold_rates)))
+        self.points.append(pt)
+        self.crests.append(NO_CREST)
+        ev = events_ahead(self.points, self.crests).get("grazing", pt.value)
+        return self.end("grazing", f"the orbit meets the {'AB' if i % 2 else 'CD'} fold (fold {i + 1} of the period) "
+                                   f"almost tangentially at {self.a.parameter}={pt.value:.10g}: dG/dt = "
+                                   f"{o.fold_rates[i]:.3g} N/s there (below graze_tol * k V); the period-{self.st.n} "
+                                   "branch ends in a grazing bifurcation, where its multipliers diverge",
+                        near(ev, pt.value, last.value, self.a.span))
 
 
 def _wall_message(wall: WallBudget, points: list[BranchPoint], parameter: str) -> str:

@@ -168,9 +168,47 @@ def _continue(o, param: str, stop: float, lo: float, hi: float, max_points: int,
 
 
 def run_bifurcation(args: argparse.Namespace) -> int:
-    from exact import MAX_DIAGRAM_VALUES, explain, initial_state, orbit_diagram, periodic_orbit, with_parameter
+    from exact import orbit_diagram
 
     wall = WallBudget(args.max_wall)
+    lo, hi, n, out, plot, select, p, seeds = _bifurcation_arguments(args)
+    auto = args.seeds in (None, "auto")
+    diagram = orbit_diagram(p, args.param, np.linspace(lo, hi, n), t_transient=args.t_transient,
+                            window=args.window, alpha0=args.alpha0, progress=True, max_wall=wall_left(wall))
+    branches: list = []
+    explained: list = [None] * n
+    if auto:  # every periodic value no branch so far explains, in order
+        for j, (x, lab) in enumerate(zip(diagram.values, diagram.labels)):
+            if len(seeds) >= args.max_seeds:
+                break
+            if lab.startswith("period-") and explained[j] is None:
+                seeds.append(float(x))
+                _grow(float(x), args, p, lo, hi, diagram, branches, explained, wall)
+    else:
+        for s in seeds:
+            _grow(s, args, p, lo, hi, diagram, branches, explained, wall)
+    periodic = [j for j, lab in enumerate(diagram.labels) if lab.startswith("period-")]
+    missing = [f"{diagram.values[j]:.6g} ({diagram.labels[j]})" for j in periodic if explained[j] is None]
+    say(f"explained: {len(periodic) - len(missing)} of the {len(periodic)} periodic values of the diagram lie on a "
+        "stable continued branch of the same period (exact.explain)"
+        + (f"; not: {', '.join(missing)}" if missing else ""))
+    _print_branches(branches, args.param, args.format)
+    if out:
+        write_table(out, _bifurcation_rows(args.param, diagram, branches, explained), p.force)
+    if plot:
+        _plot_bifurcation(plot, p, diagram, branches, select, args.plot_branches)
+    if wall_spent(wall) or "budget:max_wall" in diagram.labels or any(b.stopped == "max_wall" for b in branches):
+        say(f"stopped: the --max-wall budget of {args.max_wall:g} s was spent; the output holds what was computed "
+            "(diagram values labelled budget:max_wall, branches stopped: max_wall)")
+        return 3
+    return 0
+
+
+def _bifurcation_arguments(args: argparse.Namespace) -> tuple:
+    """``bifurcation``'s range, output paths, ``--plot-select``, parameters and ``--seeds`` checked, in this order
+    (before any run): ``(lo, hi, n, out, plot, select, params, seeds)``, ``seeds`` empty for ``auto``."""
+    from exact import MAX_DIAGRAM_VALUES
+
     lo, hi, n = grid_range(args.range, "--range")
     if n > MAX_DIAGRAM_VALUES:  # before the values are made
         raise ValueError(f"--range: N must be at most {MAX_DIAGRAM_VALUES} (exact.MAX_DIAGRAM_VALUES: 1e5 runs are "
@@ -184,82 +222,68 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     except ValueError:
         raise ValueError(f"--plot-select must be branch numbers K,K,..., got {args.plot_select!r}") from None
     p = params_from_args(args)
-    auto = args.seeds in (None, "auto")
     try:
-        seeds = [] if auto else [float(x) for x in args.seeds.split(",")]
+        seeds = [] if args.seeds in (None, "auto") else [float(x) for x in args.seeds.split(",")]
     except ValueError:
         raise ValueError(f"--seeds must be numbers X,X,... or auto, got {args.seeds!r}") from None
     for s in seeds:
         if not lo <= s <= hi:
             raise ValueError(f"--seeds must lie in --range [{lo}, {hi}], got {s}")
-    diagram = orbit_diagram(p, args.param, np.linspace(lo, hi, n), t_transient=args.t_transient,
-                            window=args.window, alpha0=args.alpha0, progress=True, max_wall=wall_left(wall))
-    branches: list = []
-    explained: list = [None] * n
+    return lo, hi, n, out, plot, select, p, seeds
 
-    def grow(s: float) -> None:
-        """Branches from the orbit at ``s`` both ways; the diagram values they explain."""
-        if wall_spent(wall):
-            say(f"orbit at {args.param} = {s:g}: not looked for, --max-wall spent")
-            return
-        ps = with_parameter(p, args.param, s)
-        say(f"orbit at {args.param} = {s:g} ...")
-        start = initial_state(ps, alpha0=args.alpha0) if args.alpha0 else None
-        try:
-            o = periodic_orbit(ps, start=start, t_transient=args.t_transient, window=args.window,
-                               max_wall=wall_left(wall))
-        except (ValueError, RuntimeError) as exc:  # no periodic orbit closes there (or the run breaks down)
-            say(f"  no orbit: {exc}")
-            return
-        new = []
-        for stop in (lo, hi):
-            if stop != s:
-                new += _continue(o, args.param, stop, lo, hi, args.max_points, args.switch, "", wall)
-        for j, i in enumerate(explain(diagram, new, max_wall=wall_left(wall))):
-            if explained[j] is None and i is not None:
-                explained[j] = len(branches) + i
-        branches.extend(new)
 
-    if auto:  # every periodic value no branch so far explains, in order
-        for j, (x, lab) in enumerate(zip(diagram.values, diagram.labels)):
-            if len(seeds) >= args.max_seeds:
-                break
-            if lab.startswith("period-") and explained[j] is None:
-                seeds.append(float(x))
-                grow(float(x))
-    else:
-        for s in seeds:
-            grow(s)
-    periodic = [j for j, lab in enumerate(diagram.labels) if lab.startswith("period-")]
-    missing = [f"{diagram.values[j]:.6g} ({diagram.labels[j]})" for j in periodic if explained[j] is None]
-    say(f"explained: {len(periodic) - len(missing)} of the {len(periodic)} periodic values of the diagram lie on a "
-        "stable continued branch of the same period (exact.explain)"
-        + (f"; not: {', '.join(missing)}" if missing else ""))
-    _print_branches(branches, args.param, args.format)
-    if out:
-        rows = [dict(kind="diagram", **r) for r in diagram.rows()]
-        by_value = {float(x): (None if e is None else e + 1) for x, e in zip(diagram.values, explained)}
-        for r in rows:
-            r["explained_by_branch"] = by_value[r[args.param]]
-        for k, b in enumerate(branches):
-            rows += [dict(kind=f"branch {k + 1}", **r) for r in b.rows()]
-            rows += [dict(kind=f"branch {k + 1} {x.kind}", **{args.param: x.value}) for x in b.bifurcations]
-            rows.append(dict(kind=f"branch {k + 1} end: {b.stopped}", **{args.param: b.end_value}))
-        write_table(out, rows, p.force)
-    if plot:
-        from ..plotting import plot_bifurcation
+def _grow(s: float, args: argparse.Namespace, p, lo: float, hi: float, diagram, branches: list, explained: list,
+          wall: WallBudget) -> None:
+    """Branches from the orbit at ``s`` both ways, added to ``branches``; the diagram values they explain marked
+    in ``explained`` (the index of the first branch that does)."""
+    from exact import explain, initial_state, periodic_orbit, with_parameter
 
-        if select is not None and max(select) > len(branches):  # known only now: drawn without them
-            say(f"--plot-select: no branch {', '.join(str(k) for k in select if k > len(branches))} "
-                f"(there are {len(branches)})")
-            select = [k for k in select if k <= len(branches)]
-        plot_bifurcation(diagram, branches, plot, params=p, select=select, max_branches=args.plot_branches)
-        say(f"wrote {plot}")
-    if wall_spent(wall) or "budget:max_wall" in diagram.labels or any(b.stopped == "max_wall" for b in branches):
-        say(f"stopped: the --max-wall budget of {args.max_wall:g} s was spent; the output holds what was computed "
-            "(diagram values labelled budget:max_wall, branches stopped: max_wall)")
-        return 3
-    return 0
+    if wall_spent(wall):
+        say(f"orbit at {args.param} = {s:g}: not looked for, --max-wall spent")
+        return
+    ps = with_parameter(p, args.param, s)
+    say(f"orbit at {args.param} = {s:g} ...")
+    start = initial_state(ps, alpha0=args.alpha0) if args.alpha0 else None
+    try:
+        o = periodic_orbit(ps, start=start, t_transient=args.t_transient, window=args.window,
+                           max_wall=wall_left(wall))
+    except (ValueError, RuntimeError) as exc:  # no periodic orbit closes there (or the run breaks down)
+        say(f"  no orbit: {exc}")
+        return
+    new = []
+    for stop in (lo, hi):
+        if stop != s:
+            new += _continue(o, args.param, stop, lo, hi, args.max_points, args.switch, "", wall)
+    for j, i in enumerate(explain(diagram, new, max_wall=wall_left(wall))):
+        if explained[j] is None and i is not None:
+            explained[j] = len(branches) + i
+    branches.extend(new)
+
+
+def _bifurcation_rows(param: str, diagram, branches: list, explained: list) -> list[dict]:
+    """Every diagram point (with the branch that explains it, numbered from 1) and every branch's points,
+    bifurcations and end, as rows for ``--out``."""
+    rows = [dict(kind="diagram", **r) for r in diagram.rows()]
+    by_value = {float(x): (None if e is None else e + 1) for x, e in zip(diagram.values, explained)}
+    for r in rows:
+        r["explained_by_branch"] = by_value[r[param]]
+    for k, b in enumerate(branches):
+        rows += [dict(kind=f"branch {k + 1}", **r) for r in b.rows()]
+        rows += [dict(kind=f"branch {k + 1} {x.kind}", **{param: x.value}) for x in b.bifurcations]
+        rows.append(dict(kind=f"branch {k + 1} end: {b.stopped}", **{param: b.end_value}))
+    return rows
+
+
+def _plot_bifurcation(plot: str, p, diagram, branches: list, select: list[int] | None, max_branches: int) -> None:
+    """``--plot``: the diagram and the branches (those of ``select`` that exist)."""
+    from ..plotting import plot_bifurcation
+
+    if select is not None and max(select) > len(branches):  # known only now: drawn without them
+        say(f"--plot-select: no branch {', '.join(str(k) for k in select if k > len(branches))} "
+            f"(there are {len(branches)})")
+        select = [k for k in select if k <= len(branches)]
+    plot_bifurcation(diagram, branches, plot, params=p, select=select, max_branches=max_branches)
+    say(f"wrote {plot}")
 
 
 def _print_branches(branches: list, param: str, fmt: str) -> None:

@@ -328,71 +328,24 @@ def _jacobian(res: Callable[[np.ndarray], np.ndarray], x: np.ndarray, lo: np.nda
 def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = None, p0: Any = None,
         bounds: Any = None) -> Any:
     """The fitted law with its :class:`FitResult` (``law.fit_result``): :meth:`peelapprox.PeelForce.fit`."""
-    from scipy.optimize import least_squares
-
     model = _Model(cls, family, p0)
     fixed, free = _bounds(model, bounds)
     names = tuple(free)
     k = len(names)
     va, fa = check_points(v, f, need=k + 1, what=f"a fit of {k} coefficient(s) needs (one more than the fitted "
                                                   "coefficients, for one degree of freedom)")
-    if sigma is None:
-        w = np.ones_like(va)
-    else:
-        if not (np.ndim(sigma) in (0, 1) and np.size(sigma) in (1, va.size)):
-            raise ValueError(f"sigma must be one standard deviation [N] or one per point ({va.size}), got shape "
-                             f"{np.shape(sigma)}")
-        w = np.broadcast_to(reals("sigma", sigma), va.shape).copy()
-        bad = np.flatnonzero(~(w > 0))
-        if bad.size:
-            raise ValueError(f"sigma must be > 0 (standard deviations of f [N]): sigma[{int(bad[0])}] = "
-                             f"{float(w[bad[0]])!r}")
-    if model.depends_on_V:
-        if V is None:
-            raise ValueError(f"V: the {model.label} depends on the pull speed; give the V [m/s] the points were "
-                             "measured at")
-    Vf = 1.0 if V is None else in_range("V", V, *PARAM_RANGES["V"])
-    all_start = {**model.start, **fixed}
-
-    def theta_of(x: np.ndarray) -> tuple:
-        d = dict(all_start)
-        d.update(zip(names, map(float, x)))
-        return tuple(d[n] for n in model.names)
-
-    def res(x: np.ndarray) -> np.ndarray:
-        return (model.evaluate(theta_of(x), va, Vf, 0) - fa) / w
-
+    w = _weights(sigma, va)
+    if model.depends_on_V and V is None:
+        raise ValueError(f"V: the {model.label} depends on the pull speed; give the V [m/s] the points were "
+                         "measured at")
+    pr = _Problem(model, names, {**model.start, **fixed}, va, fa, w,
+                  1.0 if V is None else in_range("V", V, *PARAM_RANGES["V"]))
     lo = np.array([free[n][0] for n in names])
     hi = np.array([free[n][1] for n in names])
-    x0 = np.array([float(all_start[n]) for n in names])
-    span = np.where(np.isfinite(hi - lo), hi - lo, np.inf)
-    x0 = np.clip(x0, lo + 1e-12 * np.minimum(span, np.abs(x0) + 1.0), hi - 1e-12 * np.minimum(span, np.abs(x0) + 1.0))
-    r0 = res(x0)
-    if not np.all(np.isfinite(r0)):
-        i = int(np.flatnonzero(~np.isfinite(r0))[0])
-        raise ValueError(f"p0: the {model.label} at its start {dict(zip(names, x0.tolist()))} is not finite at "
-                         f"v[{i}] = {va[i]!r} m/s; give a start (p0) where it is")
-    # a coefficient bounded by (0, inf) only (a family's scale) is fitted as its logarithm: positive without the
-    # reflections of bounded trust regions, which stall on the paper family; any other finite bound is least_squares'
-    logs = (lo == 0.0) & (hi == math.inf)
-    blo, bhi = np.where(logs, -math.inf, lo), np.where(logs, math.inf, hi)
-
-    def to_x(y: np.ndarray) -> np.ndarray:
-        return np.where(logs, np.exp(np.where(logs, y, 0.0)), y)
-
-    y0 = np.where(logs, np.log(np.where(logs, x0, 1.0)), x0)
-    with np.errstate(all="ignore"):  # a trial step may overflow: least_squares rejects it and shrinks the region
-        sol = least_squares(lambda y: res(to_x(y)), y0, jac="3-point", bounds=(blo, bhi), method="trf",
-                            x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=200 * (k + 1))
-    x = to_x(np.asarray(sol.x, dtype=float))
-    if sol.status <= 0 or not np.all(np.isfinite(sol.fun)):
-        if np.all(np.isfinite(sol.fun)):
-            _covariance(_jacobian(res, x, lo, hi), names, model.label)  # not identified: say so first
-        raise ValueError(f"the {model.label} cannot be fitted to these points: least_squares stopped ({sol.message}) "
-                         f"after {sol.nfev} evaluations; give a start (p0) nearer the data, bounds, or another family")
-    values = dict(zip(model.names, theta_of(x)))
+    sol, x = _solve(pr, lo, hi, _start(pr, lo, hi))
+    values = dict(zip(model.names, pr.theta_of(x)))
     law = model.build(values)
-    J = _jacobian(res, x, lo, hi)
+    J = _jacobian(pr.res, x, lo, hi)
     cov = _covariance(J, names, model.label)
     r = sol.fun
     chi2 = float(r @ r)
@@ -401,13 +354,13 @@ def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = No
         cov = cov * (chi2 / dof)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))  # (J^T J)^-1 is positive semi-definite: clip rounding
     d = np.where(se > 0, se, 1.0)
-    folds, note = _fold_estimate(model, theta_of, x, se, cov, lo, hi, Vf, (va[0], va[-1]))
+    folds, note = _fold_estimate(model, pr.theta_of, x, se, cov, lo, hi, pr.V, (va[0], va[-1]))
     if folds is not None:
         note = _insignificant(folds, fa)
         if note:
             folds = None
-    elif _has_folds(model, theta_of(x), Vf):
-        note = (f"no significant N shape: the fitted law has folds at V={Vf!r} m/s but they vanish when a "
+    elif _has_folds(model, pr.theta_of(x), pr.V):
+        note = (f"no significant N shape: the fitted law has folds at V={pr.V!r} m/s but they vanish when a "
                 f"coefficient moves by a thousandth of its standard error ({note})")
     result = FitResult(model.label, names, values, dict(zip(names, se.tolist())), cov,
                        tuple(n for n in model.names if n not in free), r * w, chi2, dof, chi2 / dof,
@@ -418,6 +371,81 @@ def fit(cls: Any, v: Any, f: Any, family: Any, *, sigma: Any = None, V: Any = No
         object.__setattr__(law, "_no_n_shape", f"this law was fitted (PeelForce.fit) to points without a "
                                                f"significant N shape, so its folds are not the data's: {note}")
     return law
+
+
+def _weights(sigma: Any, va: np.ndarray) -> np.ndarray:
+    """The points' standard deviations [N] (ones without ``sigma``), checked: one, or one per point, each > 0."""
+    if sigma is None:
+        return np.ones_like(va)
+    if not (np.ndim(sigma) in (0, 1) and np.size(sigma) in (1, va.size)):
+        raise ValueError(f"sigma must be one standard deviation [N] or one per point ({va.size}), got shape "
+                         f"{np.shape(sigma)}")
+    w = np.broadcast_to(reals("sigma", sigma), va.shape).copy()
+    bad = np.flatnonzero(~(w > 0))
+    if bad.size:
+        raise ValueError(f"sigma must be > 0 (standard deviations of f [N]): sigma[{int(bad[0])}] = "
+                         f"{float(w[bad[0]])!r}")
+    return w
+
+
+class _Problem:
+    """The least-squares problem of a fit: the free coefficients ``names`` (the others held at ``start``), the
+    points ``va, fa`` with their standard deviations ``w``, at the pull speed ``V``."""
+
+    def __init__(self, model: _Model, names: tuple[str, ...], start: dict[str, float], va: np.ndarray,
+                 fa: np.ndarray, w: np.ndarray, V: float):
+        self.model, self.names, self.start, self.va, self.fa, self.w, self.V = model, names, start, va, fa, w, V
+
+    def theta_of(self, x: np.ndarray) -> tuple:
+        """All the law's coefficients, in its order, with the free ones at ``x``."""
+        d = dict(self.start)
+        d.update(zip(self.names, map(float, x)))
+        return tuple(d[n] for n in self.model.names)
+
+    def res(self, x: np.ndarray) -> np.ndarray:
+        """The weighted residuals at ``x``."""
+        return (self.model.evaluate(self.theta_of(x), self.va, self.V, 0) - self.fa) / self.w
+
+
+def _start(pr: _Problem, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The start of the free coefficients, moved just inside their bounds; a ValueError naming ``p0`` where the
+    law is not finite at a point there."""
+    x0 = np.array([float(pr.start[n]) for n in pr.names])
+    span = np.where(np.isfinite(hi - lo), hi - lo, np.inf)
+    x0 = np.clip(x0, lo + 1e-12 * np.minimum(span, np.abs(x0) + 1.0), hi - 1e-12 * np.minimum(span, np.abs(x0) + 1.0))
+    r0 = pr.res(x0)
+    if not np.all(np.isfinite(r0)):
+        i = int(np.flatnonzero(~np.isfinite(r0))[0])
+        raise ValueError(f"p0: the {pr.model.label} at its start {dict(zip(pr.names, x0.tolist()))} is not finite "
+                         f"at v[{i}] = {pr.va[i]!r} m/s; give a start (p0) where it is")
+    return x0
+
+
+def _solve(pr: _Problem, lo: np.ndarray, hi: np.ndarray, x0: np.ndarray) -> tuple[Any, np.ndarray]:
+    """scipy's least_squares from ``x0`` within the bounds: its result and the fitted free coefficients; a
+    ValueError when it fails (the coefficients not identified, if that is why)."""
+    from scipy.optimize import least_squares
+
+    # a coefficient bounded by (0, inf) only (a family's scale) is fitted as its logarithm: positive without the
+    # reflections of bounded trust regions, which stall on the paper family; any other finite bound is least_squares'
+    logs = (lo == 0.0) & (hi == math.inf)
+    blo, bhi = np.where(logs, -math.inf, lo), np.where(logs, math.inf, hi)
+
+    def to_x(y: np.ndarray) -> np.ndarray:
+        return np.where(logs, np.exp(np.where(logs, y, 0.0)), y)
+
+    y0 = np.where(logs, np.log(np.where(logs, x0, 1.0)), x0)
+    with np.errstate(all="ignore"):  # a trial step may overflow: least_squares rejects it and shrinks the region
+        sol = least_squares(lambda y: pr.res(to_x(y)), y0, jac="3-point", bounds=(blo, bhi), method="trf",
+                            x_scale="jac", ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=200 * (len(pr.names) + 1))
+    x = to_x(np.asarray(sol.x, dtype=float))
+    if sol.status <= 0 or not np.all(np.isfinite(sol.fun)):
+        if np.all(np.isfinite(sol.fun)):
+            _covariance(_jacobian(pr.res, x, lo, hi), pr.names, pr.model.label)  # not identified: say so first
+        raise ValueError(f"the {pr.model.label} cannot be fitted to these points: least_squares stopped "
+                         f"({sol.message}) after {sol.nfev} evaluations; give a start (p0) nearer the data, bounds, "
+                         "or another family")
+    return sol, x
 
 
 def _has_folds(model: _Model, theta: tuple, V: float) -> bool:

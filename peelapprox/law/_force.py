@@ -10,7 +10,6 @@ What a kind does is its implementation object (:mod:`peelapprox.law._kinds`, :at
 from __future__ import annotations
 
 import hashlib
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -498,14 +497,13 @@ def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = A
     """ValueError unless ``params.force`` (if any) is one of ``laws`` (:func:`law_label` names; default: every
     law): the one check, at each consumer that runs only some laws (the ε-variational Lyapunov method and the
     diffsol peer need a closed form; a driver with fvV inlined needs the paper's law).  ``where`` names the
-    consumer (default: the caller's caller, i.e. the public function that validated its ``params``)."""
+    consumer (the public function that validated its ``params``; every caller in the package names itself;
+    default ``"this function"``)."""
     force = getattr(params, "force", None)
     if force is None or force.inlined or law_label(force) in laws:
         return
-    if where is None:
-        where = sys._getframe(2).f_code.co_name
-    raise ValueError(f"params.force: {where} runs the laws {', '.join(repr(x) for x in laws)} only, not "
-                     f"{shown_law(force)}")
+    raise ValueError(f"params.force: {where or 'this function'} runs the laws {', '.join(repr(x) for x in laws)} "
+                     f"only, not {shown_law(force)}")
 
 
 def _check_nesting(name: str, value: Any) -> None:

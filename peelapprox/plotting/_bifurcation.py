@@ -78,8 +78,6 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
     matplotlib.figure.Figure
         The figure drawn into (that of ``ax`` when given).
     """
-    from matplotlib.lines import Line2D
-
     fig, axs = _canvas(ax, fig, (1, 1), (10, 5.5))
     ax = axs[0, 0]
     name = getattr(diagram, "parameter", None)
@@ -89,46 +87,16 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
     handles: dict[str, Any] = {}  # the legend: the dots, the starting orbits, the line styles, the markers
     markers: dict[str, Any] = {}
     if diagram is not None:
-        xs_d = [np.full(F.size, x) for x, F in zip(diagram.values, diagram.returns)]
-        if xs_d:
-            ax.plot(np.concatenate(xs_d), np.concatenate(list(diagram.returns)), ".", color="0.45", ms=2.5,
-                    alpha=0.8, zorder=1)
-        handles["brute-force runs: F at each AB→CD jump"] = Line2D([], [], ls="", marker=".", color="0.45", ms=6)
+        _draw_diagram(ax, diagram, handles)
     shown = _chosen(branches, select, max_branches)
     families = list(dict.fromkeys(id(b.points[0].orbit) for b in branches))  # one colour per starting orbit
     name_families = len({id(b.points[0].orbit) for b in shown}) <= _NAMED_FAMILIES
-    styles = set()
+    styles: set[str] = set()
     for br in shown:
         name = br.parameter
-        k = families.index(id(br.points[0].orbit))
-        color = f"C{k % 10}"
-        xs = np.array([p.value for p in br.points])
-        stable = np.array([p.orbit.stable for p in br.points])
-        # (points, n), each point's values sorted: the set of F at its jumps, as the diagram shows them (the
-        # cyclic order of an orbit's jumps is not kept from point to point)
-        Fs = np.sort(np.array([p.orbit.return_map_values for p in br.points]), axis=1)
-        for i in range(len(xs) - 1):  # each piece solid if both its ends are stable, else dashed
-            style = "-" if stable[i] and stable[i + 1] else "--"
-            styles.add(style)
-            ax.plot(xs[i:i + 2], Fs[i:i + 2], style, color=color, lw=0.9, zorder=2)
-        if name_families:
-            o = br.points[0].orbit
-            handles.setdefault(f"period-{o.n} orbit from {name} = {br.points[0].value:.4g}",
-                               Line2D([], [], color=color, lw=1.5))
-        for b in br.bifurcations:  # once per bifurcation: on the branch's highest line there
-            marker, c = b.marker  # from the kinds' table of exact.orbits
-            ax.plot([b.value], [float(np.max(b.orbit.return_map_values))], marker, color=c, ms=8, mec="k", zorder=3)
-            markers.setdefault(_KIND_NAMES.get(b.kind, b.kind.replace("_", " ")),
-                               Line2D([], [], ls="", marker=marker, color=c, ms=8, mec="k"))
-        if br.end_marker is not None:  # the non-smooth end, at its (extrapolated) parameter value
-            ax.plot([br.end_value], [float(Fs[-1].max())], br.end_marker, color="k", ms=7, zorder=3)
-            markers.setdefault(f"end: {br.stopped}", Line2D([], [], ls="", marker=br.end_marker, color="k", ms=7))
-    for style, what in (("-", "stable orbit"), ("--", "unstable orbit")):
-        if style in styles:
-            handles[what] = Line2D([], [], ls=style, color="0.2", lw=1.2)
-    handles.update(markers)
-    if handles:
-        ax.legend(handles.values(), handles.keys(), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+        color = f"C{families.index(id(br.points[0].orbit)) % 10}"
+        _draw_branch(ax, br, color, handles if name_families else None, markers, styles)
+    _legend(ax, handles, markers, styles)
     swept = str(name) if name else "parameter"
     ax.set(xlabel=axis_label(swept) if name else swept, ylabel="F at the AB→CD jumps [N]")
     if diagram is not None and len(diagram.values):
@@ -141,3 +109,55 @@ def plot_bifurcation(diagram: Any = None, branches: Any = (), path: str | None =
     ax.set_title(title or f"orbit diagram over {swept}" + (f" at {fixed}" if fixed else "") + which)
     _save(fig, path, dpi=130)
     return fig
+
+
+def _draw_diagram(ax: Any, diagram: Any, handles: dict[str, Any]) -> None:
+    """The diagram's grey dots, and their legend entry."""
+    from matplotlib.lines import Line2D
+
+    xs_d = [np.full(F.size, x) for x, F in zip(diagram.values, diagram.returns)]
+    if xs_d:
+        ax.plot(np.concatenate(xs_d), np.concatenate(list(diagram.returns)), ".", color="0.45", ms=2.5,
+                alpha=0.8, zorder=1)
+    handles["brute-force runs: F at each AB→CD jump"] = Line2D([], [], ls="", marker=".", color="0.45", ms=6)
+
+
+def _draw_branch(ax: Any, br: Any, color: str, handles: dict[str, Any] | None, markers: dict[str, Any],
+                 styles: set[str]) -> None:
+    """One branch's lines (solid where stable), bifurcations and end; its family's legend entry in ``handles``
+    (None: families not named), its markers' in ``markers``, its line styles added to ``styles``."""
+    from matplotlib.lines import Line2D
+
+    xs = np.array([p.value for p in br.points])
+    stable = np.array([p.orbit.stable for p in br.points])
+    # (points, n), each point's values sorted: the set of F at its jumps, as the diagram shows them (the
+    # cyclic order of an orbit's jumps is not kept from point to point)
+    Fs = np.sort(np.array([p.orbit.return_map_values for p in br.points]), axis=1)
+    for i in range(len(xs) - 1):  # each piece solid if both its ends are stable, else dashed
+        style = "-" if stable[i] and stable[i + 1] else "--"
+        styles.add(style)
+        ax.plot(xs[i:i + 2], Fs[i:i + 2], style, color=color, lw=0.9, zorder=2)
+    if handles is not None:
+        o = br.points[0].orbit
+        handles.setdefault(f"period-{o.n} orbit from {br.parameter} = {br.points[0].value:.4g}",
+                           Line2D([], [], color=color, lw=1.5))
+    for b in br.bifurcations:  # once per bifurcation: on the branch's highest line there
+        marker, c = b.marker  # from the kinds' table of exact.orbits
+        ax.plot([b.value], [float(np.max(b.orbit.return_map_values))], marker, color=c, ms=8, mec="k", zorder=3)
+        markers.setdefault(_KIND_NAMES.get(b.kind, b.kind.replace("_", " ")),
+                           Line2D([], [], ls="", marker=marker, color=c, ms=8, mec="k"))
+    if br.end_marker is not None:  # the non-smooth end, at its (extrapolated) parameter value
+        ax.plot([br.end_value], [float(Fs[-1].max())], br.end_marker, color="k", ms=7, zorder=3)
+        markers.setdefault(f"end: {br.stopped}", Line2D([], [], ls="", marker=br.end_marker, color="k", ms=7))
+
+
+def _legend(ax: Any, handles: dict[str, Any], markers: dict[str, Any], styles: set[str]) -> None:
+    """The legend beside the axes: the dots, the families, the line styles drawn, the markers."""
+    from matplotlib.lines import Line2D
+
+    for style, what in (("-", "stable orbit"), ("--", "unstable orbit")):
+        if style in styles:
+            handles[what] = Line2D([], [], ls=style, color="0.2", lw=1.2)
+    handles.update(markers)
+    if handles:
+        ax.legend(handles.values(), handles.keys(), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)

@@ -172,6 +172,23 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     Under a load (``traj.Vp`` not None: ``params.loading == "load"``), the F(t) panel also shows the pull
     speed V_p(t) on a twin axis (right, dashed), with the load's speed scale.
     """
+    cycles, panels = _checked_options(cycles, panels, dense)
+    shape, size = _panel_shape(len(panels))
+    fig, axs = _canvas(ax, fig, shape, size)
+    at = dict(zip(panels, np.ravel(axs)))
+    p = traj.params
+    w = trajectory_window(traj, cycles)
+    s = _samples(traj, dense, w.start, w.end)
+    _time_panels(at, s, w)
+    if "phase" in at:
+        _phase_panel(at["phase"], p, s["v"], s["F"])
+    fig.suptitle(title or f"{params_label(p)}, {traj.method}\n{_window_text(w)}")
+    _save(fig, path)
+    return fig
+
+
+def _checked_options(cycles: int | None, panels: Any, dense: Any) -> tuple[int | None, tuple[str, ...]]:
+    """:func:`plot_trajectory`'s ``cycles`` and ``panels`` checked (a name alone: one panel), and ``dense``."""
     from ..validate import integer
 
     if cycles is not None:
@@ -186,12 +203,12 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
     if dense is not None and not all(hasattr(dense, a) for a in ("t", "F", "alpha", "v")):
         raise TypeError(f"dense must be a Trajectory of the same run (exact.simulate(..., t_eval=...)), got "
                         f"{type(dense).__name__}")
-    shape, size = _panel_shape(len(panels))
-    fig, axs = _canvas(ax, fig, shape, size)
-    at = dict(zip(panels, np.ravel(axs)))
-    p = traj.params
-    w = trajectory_window(traj, cycles)
-    s = _samples(traj, dense, w.start, w.end)
+    return cycles, panels
+
+
+def _time_panels(at: dict[str, Any], s: dict[str, np.ndarray], w: TrajectoryWindow) -> None:
+    """The F(t), α(t) and v(t) panels among ``at`` over the window ``w``; under a load V_p(t) on a twin axis of
+    the force panel."""
     t = s["t"]
     label = {"F": ("F [N]", "pull force F(t)", "C0"), "alpha": (r"$\alpha$ [rad]", r"peel angle $\alpha(t)$", "C2"),
              "v": ("v [m/s]", "peel velocity v(t)", "C3")}
@@ -211,15 +228,13 @@ def plot_trajectory(traj: Any, path: str | None = None, *, title: str | None = N
         tw.set_ylabel("$V_p$ [m/s]", color="C4")
         at["F"].set_title("pull force F(t), pull speed $V_p(t)$ (dashed)")
         at["F"].legend(handles=at["F"].lines + tw.lines, loc="best", fontsize=8)
-    if "phase" in at:
-        _phase_panel(at["phase"], p, s["v"], s["F"])
+
+
+def _window_text(w: TrajectoryWindow) -> str:
+    """The title's line on the window: its periods of the return map, or the cycles of the run it shows."""
     if w.period is not None:
         k = w.cycles // w.period
-        span = (f"{k} period{'s' if k > 1 else ''} of the period-{w.period} return map ({w.cycles} cycles), "
+        return (f"{k} period{'s' if k > 1 else ''} of the period-{w.period} return map ({w.cycles} cycles), "
                 f"T = {(w.end - w.start) / k:.5g} s")
-    else:
-        span = f"t = {w.start:.4g}–{w.end:.4g} s" + (f", the last {w.cycles} of {w.total} cycles"
-                                                     if w.cycles < w.total else "")
-    fig.suptitle(title or f"{params_label(p)}, {traj.method}\n{span}")
-    _save(fig, path)
-    return fig
+    return f"t = {w.start:.4g}–{w.end:.4g} s" + (f", the last {w.cycles} of {w.total} cycles"
+                                                 if w.cycles < w.total else "")
