@@ -5,7 +5,7 @@ The solvers are deterministic and the records hold no timings, so what the atlas
 direct calls of the same functions for *exact* equality (JSON round-trips floats exactly); a relative error
 recomputed here from those values agrees to rounding (1e-12 relative: the same formula, evaluated again).
 The exact windows are short (10 s of transient, 5 s measured) to keep the default tier fast: the atlas's
-own defaults (30 s + 20 s) are measured in docs/atlas.md, not here.
+own defaults (100 s + 20 s) are measured in docs/atlas.md, not here.
 """
 
 import dataclasses
