@@ -66,8 +66,8 @@ def simulate(
     Parameters
     ----------
     params : PeelParams
-        Physical parameters, the ``cos θ`` closure (``geometry``) and the law ``force``: the paper's fvV, or
-        ``PeelForce.cubic(...)`` with ``method="hybrid"`` (the law driver); other laws: ValueError.
+        Physical parameters, the ``cos θ`` closure (``geometry``) and the law ``force``: any
+        :class:`peelapprox.PeelForce` (the paper's fvV, a family, an expression, a table, a smoothed law).
     t_end : float
         Final time [s], in (0, TIME_MAX] = (0, 1e6].
     alpha0, omega0, F0, branch0 : optional

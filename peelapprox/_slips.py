@@ -59,7 +59,8 @@ _GAP = 2
 
 def noise_level(F: np.ndarray) -> float:
     """The noise's standard deviation σ of a sampled force: 1.4826 · MAD(second differences) / √6 [N]
-    (module docstring, step 1); 0 for a noiseless smooth trace."""
+    (module docstring, step 1); 0 for a noiseless smooth trace.  Also the noise estimate of ``PeelForce.smoothed``
+    (its penalty search, ``peelapprox/law/_spline.py``): the package's one."""
     d2 = F[2:] - 2.0 * F[1:-1] + F[:-2]
     mad = float(np.median(np.abs(d2 - np.median(d2))))
     return 1.4826 * mad / math.sqrt(6.0)

@@ -1,9 +1,10 @@
 """The peel-force law as data: :class:`PeelForce`, one law ``f(v, V)`` [N] of the peel velocity and the pull speed.
 
-Four kinds, each plain data (strings and tuples of floats), so a law is immutable, hashable, equal by value,
-picklable and JSON-able (``dataclasses.asdict``): ``"paper"`` (the built-in fvV, evaluated bitwise by
+Five kinds (:data:`KINDS`), each plain data (strings and tuples of floats), so a law is immutable, hashable, equal
+by value, picklable and JSON-able (``dataclasses.asdict``): ``"paper"`` (the built-in fvV, evaluated bitwise by
 :func:`peelapprox.peel_force`), ``"family"`` (a formula of :mod:`peelapprox.law._families` with its coefficients
-as data), ``"expression"`` (a sympy expression kept as canonical text) and ``"tabulated"`` (measured curves).
+as data), ``"expression"`` (a sympy expression kept as canonical text), ``"tabulated"`` (measured curves) and
+``"smoothed"`` (a C⁴ spline in ln v smoothing noisy points, :mod:`peelapprox.law._spline`).
 What a kind does is its implementation object (:mod:`peelapprox.law._kinds`, :attr:`PeelForce.impl`).
 """
 
