@@ -17,6 +17,7 @@ from ._regularized import run_regularized
 if TYPE_CHECKING:
     from peelapprox import PeelParams
 
+    from ._model import Model
     from ._options import Budget, SaveAt
     from ._trajectory import State, Trajectory
 
@@ -54,22 +55,21 @@ class Hybrid(Method):
     #: The stress suite's grid needs <= ~1.5e4 steps per simulated second (I = 1e-6, rtol 1e-8; 1.3-1.8 us
     #: each): a margin of ~50x; the cap bounds a default call to ~35 s (t_end = 1e300).
     step_budget: ClassVar[tuple[float, float, float]] = (1e6, 1e6, 2e7)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("massless", "velocity")})
     rtol: float = 1e-8
     atol: float | Sequence[float] | None = None
     v_floor: float | None = None
 
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
+    def run(self, model: Model, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
-        return run_hybrid(params, t_end, s0, self, saveat, budget, progress)
+        return run_hybrid(params, t_end, s0, self, saveat, budget, progress)  # the massless model's eps -> 0 limit
 
 
 class _OnScipy(Method):
     """A method run on a scipy solver by :func:`exact._regularized.run_regularized`."""
 
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
+    def run(self, model: Model, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
-        return run_regularized(params, t_end, s0, self, saveat, budget, progress)
+        return run_regularized(model, params, t_end, s0, self, saveat, budget, progress)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -94,7 +94,6 @@ class Regularized(_OnScipy):
     atol_scale: ClassVar[tuple[float, ...]] = (1e-4, 1e-3, 1e-2, 1e-6)
     #: ~1e3 steps per simulated second needed (~150 us each); the cap bounds a default call to ~80 s.
     step_budget: ClassVar[tuple[float, float, float]] = (1e5, 1e5, 5e5)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("massless", "velocity"), ("massless", "load")})
     solvers: ClassVar[tuple[str, ...]] = ("Radau", "BDF", "LSODA")
     eps: float = EPS_DEFAULT
     solver: str = "Radau"
@@ -129,7 +128,6 @@ class Smooth(_OnScipy):
     #: ``python -m comparisons.benchmark.tape_mass``): a margin of ~8x, and the cap ~60 s of LSODA (Radau and
     #: BDF take 10-20x longer per step: give them ``max_wall``).
     step_budget: ClassVar[tuple[float, float, float]] = (1e6, 1e5, 5e6)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("tape mass", "velocity"), ("tape mass", "load")})
     solvers: ClassVar[tuple[str, ...]] = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
     solver: str = "LSODA"
     rtol: float = 1e-8
