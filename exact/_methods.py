@@ -36,8 +36,11 @@ class Hybrid(Method):
         Absolute tolerance of ``(τ, α, ω, ln v)``, each in :data:`ATOL_RANGE` = [1e-100, 1]; a scalar is
         used for every component and stored as 4 values; ``None``: ``rtol * ATOL_SCALE["hybrid"]``.
     v_floor : float, optional
-        Stop with ``ModelBreakdown(reason="v_floor")`` when v falls to this velocity [m/s], in (0, inf);
-        None: the model's own criterion only (see :func:`exact.simulate`).
+        Stop with ``ModelBreakdown(reason="v_floor")`` when v falls to this velocity [m/s], in (0, inf) (a
+        threshold of the caller's, not of the model); None: the model's own criterion only.  On AB the level
+        ``G = F(1 - cos θ)`` falling to ``f(0+, V)`` leaves CONSTR without a root (the peel front would have to
+        stop): ``ModelBreakdown(reason="no_root")`` once ``G - f(0+) <= 1e-10 max(|f(0+)|, 1 N)``, i.e. v below
+        ``BranchStructure.v_breakdown`` (~1e-67 m/s; this method integrates ln v, so it follows v that far).
 
     Raises
     ------

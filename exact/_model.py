@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -59,7 +59,7 @@ class Model:
         Its events among :data:`EVENTS`, checked in that order after every accepted step of a scipy method.
 
     The base class's methods are those of the paper's massless tape under velocity control; a subclass overrides
-    what differs (:meth:`accepts`, :meth:`field`, :meth:`initial_state`, :meth:`parameters`).
+    what differs (:meth:`accepts`, :meth:`field`, :meth:`initial_state`, :meth:`failure_hint`).
     """
 
     name: str
@@ -85,10 +85,6 @@ class Model:
     def law(self, params: PeelParams) -> CompiledLaw:
         """The compiled peel-force law of ``params`` at ``params.V`` (:func:`peelapprox.kernels.compiled_law`)."""
         return compiled_law(params.force, params.V)
-
-    def parameters(self, params: PeelParams, method: Any) -> dict[str, Any]:
-        """The model's own parameters of a run by ``method``: ``eps`` (the regularisation, or None) here."""
-        return {"eps": method.eps}
 
     def field(self, params: PeelParams, law: CompiledLaw, eps: float | None) -> tuple[Callable, Callable]:
         """The smooth field ``fun(t, y)`` and its Jacobian ``jac(t, y)`` of the state :attr:`states` (scipy's

@@ -67,7 +67,7 @@ class _ScipyRun:
         self.model, self.params, self.t_end, self.s0 = model, params, t_end, s0
         self.method, self.saveat = method, saveat
         self.solver, self.rtol, self.v_floor = cast(str, method.solver), method.rtol, method.v_floor
-        self.eps = model.parameters(params, method)["eps"]  # the regularised scheme's; None for the smooth ODE
+        self.eps = method.eps  # the regularised scheme's; None for the smooth ODE
         self.max_points, self.max_jumps, self.max_wall = budget.max_points, budget.max_jumps, budget.max_wall
         self.max_steps = int(cast(int, budget.max_steps))
         cl = model.law(params)  # the paper's law: fvV inlined in the field (the default)

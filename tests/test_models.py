@@ -140,3 +140,23 @@ def test_a_model_added_as_contributing_says_runs_through_simulate(tmp_path):
     np.testing.assert_allclose(np.array(got["omega"]) - 1.0 / PARAMS["massless"].R, a * w * np.cos(w * t), rtol=0,
                                atol=1e-7 * a * w)
     assert set(got["F"]) == {got["F0"]} and set(got["v"]) == {got["v0"]}
+
+
+@pytest.mark.parametrize("name", list(PARAMS))
+def test_each_model_field_has_its_layout(name):
+    """Hypothesis: each model's field, at seeded random states in its layout ``states``, has FLOW1's
+    ``α̇ = ω - v/R`` as its first component (to 1e-12 relative of the terms: one rounding of the subtraction, while
+    a state out of place is an O(1) error) and one rate per state, finite; its Jacobian is square in the
+    layout."""
+    model, p = exact.MODELS[name], PARAMS[name]
+    law = model.law(p)
+    fun, jac = model.field(p, law, 1e-7 if "regularized" in model.methods else None)
+    rng = np.random.default_rng(38)
+    for _ in range(5):
+        y = np.array([rng.uniform(-0.3, 0.3), rng.uniform(5.0, 20.0), rng.uniform(100.0, 300.0),
+                      10 ** rng.uniform(-3, 0.5)] + ([rng.uniform(0.5, 2.0)] if model.n_states == 5 else []))
+        rate = np.asarray(fun(0.0, y))
+        assert rate.shape == (model.n_states,) and np.all(np.isfinite(rate))
+        assert np.asarray(jac(0.0, y)).shape == (model.n_states, model.n_states)
+        expected = y[1] - y[3] / p.R
+        assert abs(rate[0] - expected) <= 1e-12 * (abs(y[1]) + abs(y[3] / p.R))
