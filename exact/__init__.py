@@ -3,7 +3,9 @@
 * **Solving** (this package's own modules): ``simulate(params, t_end, ...)`` integrates the DAE FLOW1, FLOW2,
   flow3 with the constraint CONSTR of De, Maybhate and Ananthakrishna by one of the methods in ``METHODS``:
   the ε → 0 limit ``Hybrid`` (the paper's model's default), the ε-regularised mass-matrix scheme
-  ``Regularized`` (a massless tape under a load) or the tape-mass model's smooth ODE ``Smooth``; ``SaveAt`` and
+  ``Regularized`` (a massless tape under a load) or the tape-mass model's smooth ODE ``Smooth``, each solving
+  some of the models in ``MODELS`` (``Massless``, ``MasslessLoad``, ``TapeMass``, ``TapeMassLoad``: frozen
+  dataclasses deriving from ``Model``, which carry their state layout, field, events and start); ``SaveAt`` and
   ``Budget`` say what is stored and the limits.  The saltation-tangent driver the other two rooms share is
   here too.
 * **Orbits** (:mod:`exact.orbits`): the AB→CD section map and its Jacobian, periodic orbits by Newton and their
@@ -23,6 +25,8 @@ from ._hybrid_driver import hybrid_field
 from ._initial import initial_state
 from ._method_contract import default_atol
 from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
+from ._model import MODELS, Model, register_model
+from ._models import Massless, MasslessLoad, TapeMass, TapeMassLoad
 from ._options import METHODS, Budget, SaveAt, default_max_steps
 from ._shared import DEFAULT_MAX_WALL
 from ._simulate import simulate
@@ -85,6 +89,13 @@ __all__ = [
     "Hybrid",
     "Regularized",
     "Smooth",
+    "MODELS",
+    "Model",
+    "Massless",
+    "MasslessLoad",
+    "TapeMass",
+    "TapeMassLoad",
+    "register_model",
     "SaveAt",
     "Budget",
     "initial_state",

@@ -310,11 +310,143 @@ def _advance(y, y_new, f0, K):
 
 #: The pieces :func:`_run` calls, bound per driver by :mod:`exact._hybrid_driver` (the paper's law inlined, or
 #: the law as an argument): the field ``_FIELD(y, P, out)``, the pull force ``_PULL(alpha, v, P)``,
-#: ``P = _PACK(p, law, coef)`` and ``_dop``, the DOP853 pieces of the field.  Never compiled with these placeholders.
+#: ``P = _PACK(p, law, coef)`` and ``_dop``, the DOP853 pieces of the field; and the step's pieces below that call
+#: them (:data:`BOUND_HELPERS`), each bound per driver too.  Never compiled with these placeholders.
 _FIELD: Any = None
 _PULL: Any = None
 _PACK: Any = None
 _dop: Any = None
+
+
+def _fold_event(y, y_new, K, h, P, p, Fc, tmp, cnt, br):
+    """``(ok, dense, x_fold)``: the fold inside the step ``[y, y_new]`` as a fraction of it (2: none), located on
+    the dense output (``dense``: whether it was built); ``ok`` False if that output left the domain."""
+    dense = False
+    x_fold = 2.0
+    ok = True
+    if p[P_FOLDS] != 0.0:
+        crossed, uf, gA, gB = _fold_crossing(y, y_new, p, br)
+        if crossed:
+            dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
+            ok = _finite_rows(Fc)
+            if ok:
+                x_fold = solve_theta(y, Fc, 3, uf, gA, 1.0, gB)
+    return ok, dense, x_fold
+
+
+def _end_event(y, y_new, K, h, P, Fc, tmp, cnt, dense, x_fold, tau_end):
+    """``(ok, dense, x_end, x_stop)``: t_end (τ = ``tau_end``) inside the step as a fraction of it (2: none), and
+    where the step stops, ``min(x_fold, x_end, 1)``.  τ increases up to the fold (f' > 0 on the branch) and
+    falls again beyond it, so t_end is looked for in ``[0, min(x_fold, 1)]``."""
+    x_end = 2.0
+    ok = True
+    if x_fold <= 1.0:
+        x_b = x_fold
+        tau_b = interp1(y, Fc, x_fold, 0)
+    else:
+        x_b = 1.0
+        tau_b = y_new[0]
+    if tau_b >= tau_end:
+        dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
+        ok = _finite_rows(Fc)
+        if ok:
+            x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
+    return ok, dense, x_end, min(x_fold, x_end, 1.0)
+
+
+def _teval_output(y, y_new, K, h, P, p, Fc, tmp, cnt, dense, x_stop, t_eval, t0, out, out_br, br, ye):
+    """Store the states at the times of ``t_eval`` strictly before the step's stop ``x_stop``; ``(ok, dense)``,
+    ``ok`` False if an interpolated state left the domain."""
+    if x_stop < 1.0:
+        tau_stop = interp1(y, Fc, x_stop, 0)
+    else:
+        tau_stop = y_new[0]
+    while cnt[C_TEVAL] < t_eval.shape[0] and t_eval[cnt[C_TEVAL]] - t0 <= tau_stop:
+        te = t_eval[cnt[C_TEVAL]]
+        dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
+        state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
+        if not _in_domain(ye, p):
+            return False, dense
+        ve = np.exp(ye[3])
+        _store(out, cnt[C_NOUT], te, ye, ve, _PULL(ye[1], ve, P), out_br, br)
+        cnt[C_NOUT] += 1
+        cnt[C_TEVAL] += 1
+    return True, dense
+
+
+def _reach_end(st, y, ye, h_next, P, t_end, t0, t_store, save_mode, out, out_br, cnt, br):
+    """The step reached t_end at ``ye``: store it (``save="steps"``) and stop with DONE."""
+    ye[0] = t_end - t0
+    if save_mode == SAVE_STEPS and t_end >= t_store:
+        ve = np.exp(ye[3])
+        _store(out, cnt[C_NOUT], t_end, ye, ve, _PULL(ye[1], ve, P), out_br, br)
+        cnt[C_NOUT] += 1
+    return _end(st, y, ye, h_next, DONE)
+
+
+def _jump(st, y, ye, p, P, f0, work, rtol, atol, t0, br, t_store, save_mode, out, out_br, jbuf, cnt, h):
+    """The jump at the fold reached at ``ye``: v exactly at the fold value, (α, ω, F) continuous, onto the landing
+    root of the other branch, and a fresh first step there.  Returns ``(status, br, t0, h)``: ``_GO`` and the
+    new branch, segment start and step, or NO_LANDING (a CD→AB jump without a landing root)."""
+    v_fold = p[P_VMAX] if br == 0 else p[P_VMIN]
+    ye[3] = np.log(v_fold)
+    ye[0] = max(ye[0], y[0])  # as for a plain step (_advance)
+    tj = t0 + ye[0]
+    Fj = _PULL(ye[1], v_fold, P)
+    v_after = p[P_VLCD] if br == 0 else p[P_VLAB]
+    if br == 1 and not (v_after > 0.0):
+        return _end(st, y, ye, h, NO_LANDING), br, t0, h
+    if tj >= t_store:
+        if save_mode == SAVE_STEPS:
+            _store(out, cnt[C_NOUT], tj, ye, v_fold, Fj, out_br, br)
+            cnt[C_NOUT] += 1
+        _record_jump(jbuf, cnt, tj, br, ye, Fj, v_fold, v_after)
+    cnt[C_JUMPS] += 1
+    br = 1 - br
+    _land(st, y, ye, tj, br, v_after)
+    if tj >= t_store and save_mode == SAVE_STEPS:
+        _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
+        cnt[C_NOUT] += 1
+    _FIELD(y, P, f0)
+    h = _dop.initial_step(y, f0, P, rtol, atol, work)
+    cnt[C_RHS] += 2
+    return _GO, br, tj, h
+
+
+def _plain_step(y, y_new, f0, K, P, t0, t_store, save_mode, out, out_br, cnt, br):
+    """Accept the step to ``y_new`` (:func:`_advance`) and store its end (``save="steps"``)."""
+    _advance(y, y_new, f0, K)
+    if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
+        v = np.exp(y[3])
+        _store(out, cnt[C_NOUT], t0 + y[0], y, v, _PULL(y[1], v, P), out_br, br)
+        cnt[C_NOUT] += 1
+
+
+#: The step's pieces that call the bound pieces above, bound with them per driver (names of this module).
+BOUND_HELPERS = ("_fold_event", "_end_event", "_teval_output", "_reach_end", "_jump", "_plain_step")
+
+
+@kernel(inner=True)
+def _stop_state(y, y_new, Fc, x_fold, x_end, x_stop, ye, p):
+    """The state where the step stops into ``ye`` (interpolated at an event, else its end); whether it lies in the
+    domain."""
+    if x_fold <= 1.0 or x_end <= 1.0:
+        interp(y, Fc, x_stop, ye)
+        return _in_domain(ye, p)
+    for i in range(4):
+        ye[i] = y_new[i]
+    return True
+
+
+@kernel(inner=True)
+def _left_domain(ye, p, br):
+    """The breakdown at the accepted stop ``ye`` (the peel geometry degenerating, a CD runaway), else ``_GO``."""
+    c_e, _ = _closure(ye[1], p)
+    if not (1.0 + c_e > 1e-12):
+        return GEOMETRY
+    if br == 1 and ye[3] > p[P_UCEIL]:
+        return V_CEILING
+    return _GO
 
 
 def _run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, out_br, jbuf, cnt, max_call_steps):
@@ -327,105 +459,46 @@ def _run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, o
     P = _PACK(p, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(4)
     y = np.empty(4)
-    n_teval = t_eval.shape[0]
     t0, br, h = _resume(st, y)
-    has_folds = p[P_FOLDS] != 0.0
     calls = 0
     n_bad = 0  # successive steps rejected for their dense output
-
     _FIELD(y, P, f0)
     cnt[C_RHS] += 1
     if h <= 0.0:
         h = _dop.initial_step(y, f0, P, rtol, atol, work)
         cnt[C_RHS] += 1
-
     while True:
         stop = _room_left(calls, max_call_steps, save_mode, cnt, out.shape[0], jbuf.shape[0])
         if stop != _GO:
             _save(st, y, h)
             return stop
-
-        # ---- one accepted step
         status, h, h_next, n_rej, n_rhs = _dop.step(y, f0, h, P, rtol, atol, K, y_new, tmp, sc)
         cnt[C_REJ] += n_rej
         cnt[C_RHS] += n_rhs
         if status == STEP_FAILED:
             _save(st, y, h)
             return STEP_FAIL
-        # The step's own stages and end point lie in the domain (a stage outside poisons the error
-        # estimate), but its dense output (three more stages) and the states interpolated from it
-        # need not: at loose tolerances the interpolant can leave v > 0.  Any such state rejects the
-        # step like a failed error test (``ok`` below), so no non-finite state or v <= 0 is stored,
+        # The step's own stages and end point lie in the domain (a stage outside poisons the error estimate), but
+        # its dense output (three more stages) and the states interpolated from it need not: any such state
+        # rejects the step like a failed error test (``ok``), so no non-finite state or v <= 0 is stored,
         # reported or continued from.
-        nout0 = cnt[C_NOUT]
-        nte0 = cnt[C_TEVAL]
-        ok = True
-
-        # ---- events inside [y, y_new]: the fold (x_fold), then t_end (x_end), as fractions of the step
-        dense = False
-        x_fold = 2.0
-        if has_folds:
-            crossed, uf, gA, gB = _fold_crossing(y, y_new, p, br)
-            if crossed:
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
-                ok = _finite_rows(Fc)
-                if ok:
-                    x_fold = solve_theta(y, Fc, 3, uf, gA, 1.0, gB)
+        nout0, nte0 = cnt[C_NOUT], cnt[C_TEVAL]
+        ok, dense, x_fold = _fold_event(y, y_new, K, h, P, p, Fc, tmp, cnt, br)
         # breakdown on AB: the level F(1 + c) = f(v) reached f(0+) + BREAKDOWN_LEVEL, i.e. u <= ln v_breakdown
         # (or a user's v_floor), checked at step end
         if ok and br == 0 and y_new[3] <= p[P_UFLOOR] and x_fold > 1.0:
             cnt[C_STEPS] += 1
             return _end(st, y, y_new, h_next, NO_ROOT)
-        # τ increases up to the fold (f' > 0 on the branch) and falls again beyond it, so t_end is looked for in
-        # [0, min(x_fold, 1)]
-        x_end = 2.0
-        x_stop = 1.0
+        x_end, x_stop = 2.0, 1.0
         if ok:
-            tau_end = t_end - t0
-            if x_fold <= 1.0:
-                x_b = x_fold
-                tau_b = interp1(y, Fc, x_fold, 0)
-            else:
-                x_b = 1.0
-                tau_b = y_new[0]
-            if tau_b >= tau_end:
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
-                ok = _finite_rows(Fc)
-                if ok:
-                    x_end = crossing(y, Fc, 0, tau_end, x_b, tau_b)
-            x_stop = min(x_fold, x_end, 1.0)
-
-        # ---- t_eval output strictly before the stop point of this step
+            ok, dense, x_end, x_stop = _end_event(y, y_new, K, h, P, Fc, tmp, cnt, dense, x_fold, t_end - t0)
         if ok and save_mode == SAVE_TEVAL:
-            if x_stop < 1.0:
-                tau_stop = interp1(y, Fc, x_stop, 0)
-            else:
-                tau_stop = y_new[0]
-            while cnt[C_TEVAL] < n_teval and t_eval[cnt[C_TEVAL]] - t0 <= tau_stop:
-                te = t_eval[cnt[C_TEVAL]]
-                dense = _dop.ensure_dense(dense, y, y_new, K, h, P, Fc, tmp, cnt, C_RHS)
-                state_at(y, Fc, 0, te - t0, x_stop, tau_stop, ye)
-                if not _in_domain(ye, p):
-                    ok = False
-                    break
-                ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], te, ye, ve, _PULL(ye[1], ve, P), out_br, br)
-                cnt[C_NOUT] += 1
-                cnt[C_TEVAL] += 1
-
-        # ---- the state where the step stops (ye)
+            ok, dense = _teval_output(y, y_new, K, h, P, p, Fc, tmp, cnt, dense, x_stop, t_eval, t0, out, out_br,
+                                      br, ye)
         if ok:
-            if x_fold <= 1.0 or x_end <= 1.0:
-                interp(y, Fc, x_stop, ye)
-                ok = _in_domain(ye, p)
-            else:
-                for i in range(4):
-                    ye[i] = y_new[i]
-
-        if not ok:
-            # reject the step: forget its output, retry from y with a quarter of the step
-            cnt[C_NOUT] = nout0
-            cnt[C_TEVAL] = nte0
+            ok = _stop_state(y, y_new, Fc, x_fold, x_end, x_stop, ye, p)
+        if not ok:  # reject the step: forget its output, retry from y with a quarter of the step
+            cnt[C_NOUT], cnt[C_TEVAL] = nout0, nte0
             cnt[C_REJ] += 1
             h *= 0.25
             n_bad += 1
@@ -438,53 +511,16 @@ def _run(st, p, law, coef, rtol, atol, t_end, t_store, save_mode, t_eval, out, o
             n_bad = 0
         cnt[C_STEPS] += 1
         calls += 1
-
-        c_e, _ = _closure(ye[1], p)
-        if not (1.0 + c_e > 1e-12):
-            return _end(st, y, ye, h, GEOMETRY)
-        if br == 1 and ye[3] > p[P_UCEIL]:
-            return _end(st, y, ye, h, V_CEILING)
-
-        if x_end <= 1.0 and x_end <= x_fold:
-            # reached t_end (a fold exactly at t_end is left for a later call)
-            ye[0] = t_end - t0
-            if save_mode == SAVE_STEPS and t_end >= t_store:
-                ve = np.exp(ye[3])
-                _store(out, cnt[C_NOUT], t_end, ye, ve, _PULL(ye[1], ve, P), out_br, br)
-                cnt[C_NOUT] += 1
-            return _end(st, y, ye, h_next, DONE)
-
+        stop = _left_domain(ye, p, br)
+        if stop != _GO:
+            return _end(st, y, ye, h, stop)
+        if x_end <= 1.0 and x_end <= x_fold:  # reached t_end (a fold exactly at t_end is left for a later call)
+            return _reach_end(st, y, ye, h_next, P, t_end, t0, t_store, save_mode, out, out_br, cnt, br)
         if x_fold <= 1.0:
-            # ---- jump at the fold: v exactly at the fold value, (α, ω, F) continuous
-            v_fold = p[P_VMAX] if br == 0 else p[P_VMIN]
-            ye[3] = np.log(v_fold)
-            ye[0] = max(ye[0], y[0])  # as for a plain step (_advance)
-            tj = t0 + ye[0]
-            Fj = _PULL(ye[1], v_fold, P)
-            v_after = p[P_VLCD] if br == 0 else p[P_VLAB]
-            if br == 1 and not (v_after > 0.0):  # a CD->AB jump without a landing root
-                return _end(st, y, ye, h, NO_LANDING)
-            if tj >= t_store:
-                if save_mode == SAVE_STEPS:
-                    _store(out, cnt[C_NOUT], tj, ye, v_fold, Fj, out_br, br)
-                    cnt[C_NOUT] += 1
-                _record_jump(jbuf, cnt, tj, br, ye, Fj, v_fold, v_after)
-            cnt[C_JUMPS] += 1
-            br = 1 - br
-            t0 = tj
-            _land(st, y, ye, tj, br, v_after)
-            if tj >= t_store and save_mode == SAVE_STEPS:
-                _store(out, cnt[C_NOUT], tj, y, v_after, Fj, out_br, br)
-                cnt[C_NOUT] += 1
-            _FIELD(y, P, f0)
-            h = _dop.initial_step(y, f0, P, rtol, atol, work)
-            cnt[C_RHS] += 2
+            stop, br, t0, h = _jump(st, y, ye, p, P, f0, work, rtol, atol, t0, br, t_store, save_mode, out, out_br,
+                                    jbuf, cnt, h)
+            if stop != _GO:
+                return stop
             continue
-
-        # ---- plain accepted step
-        _advance(y, y_new, f0, K)
+        _plain_step(y, y_new, f0, K, P, t0, t_store, save_mode, out, out_br, cnt, br)
         h = h_next
-        if save_mode == SAVE_STEPS and t0 + y[0] >= t_store:
-            v = np.exp(y[3])
-            _store(out, cnt[C_NOUT], t0 + y[0], y, v, _PULL(y[1], v, P), out_br, br)
-            cnt[C_NOUT] += 1

@@ -35,7 +35,6 @@ from peelapprox.kernels import (
     LAW_TYPE,
     CompiledLaw,
     compile_only,
-    compiled_law,
     kernel,
     make_dop853,
     model_block,
@@ -46,6 +45,7 @@ from peelapprox.kernels import (
 from peelapprox.kernels import status as S
 
 from . import _hybrid as H
+from ._initial import law_for
 from ._trajectory import Jumps, SolverStats, State, Trajectory
 
 if TYPE_CHECKING:
@@ -105,15 +105,19 @@ RUN_SIG = _t.int64(
 )
 
 
-def _driver_copy(field: Callable, pull: Callable, pack: Callable) -> Callable:
+def _driver_copy(field: Callable, pull: Callable, pack: Callable, tag: str) -> Callable:
     """:func:`exact._hybrid._run` reading ``field``, ``pull``, ``pack`` and the DOP853 pieces of ``field`` as its
-    globals ``_FIELD``, ``_PULL``, ``_PACK``, ``_dop`` (:func:`peelapprox.kernels.rebind`)."""
-    return rebind(H._run, _FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
+    globals ``_FIELD``, ``_PULL``, ``_PACK``, ``_dop`` (:func:`peelapprox.kernels.rebind`), and the step's pieces
+    that call them (``exact._hybrid.BOUND_HELPERS``) bound likewise, as inner kernels named after ``tag``."""
+    pieces = dict(_FIELD=field, _PULL=pull, _PACK=pack, _dop=make_dop853(field))
+    helpers = {name: kernel(rebind(getattr(H, name), **pieces), inner=True, name=f"{name.lstrip('_')}_{tag}")
+               for name in H.BOUND_HELPERS}
+    return rebind(H._run, **pieces, **helpers)
 
 
 _DRIVERS = {
-    False: kernel(_driver_copy(H._rhs, H.pull_force, pack_inlined), name="run_inlined"),
-    True: kernel(_driver_copy(_rhs_law, _pull_force_P, pack_law), name="run_law"),
+    False: kernel(_driver_copy(H._rhs, H.pull_force, pack_inlined, "inlined"), name="run_inlined"),
+    True: kernel(_driver_copy(_rhs_law, _pull_force_P, pack_law, "law"), name="run_law"),
 }
 
 
@@ -122,19 +126,6 @@ def driver(law_argument: bool) -> Any:
     from numba's cache when it is there): ``law_argument=False`` with fvV inlined (``law``, ``coef`` unused),
     True with the law ``law`` and its coefficients ``coef``."""
     return compile_only(_DRIVERS[bool(law_argument)], RUN_SIG)
-
-
-def law_for(params: PeelParams) -> CompiledLaw:
-    """The peel-force law of ``params`` as the hybrid drivers take it (:func:`peelapprox.kernels.compiled_law` at
-    ``params.V``); ValueError naming ``params.force`` if its AB→CD jumps could not land (a table that stops below
-    ``f_max`` on CD), or as ``compiled_law`` raises."""
-    law = compiled_law(params.force, params.V)
-    bs = law.structure
-    if bs.has_folds and bs.v_land_cd is None:
-        raise ValueError(f"params.force: {params.force!r} at V={params.V!r} m/s never reaches f_max={bs.f_max!r} N "
-                         f"on its fast branch within its domain up to {law.domain[1]!r} m/s: an AB->CD jump could not "
-                         "land (extend the table to higher v)")
-    return law
 
 
 def domain_status(status: int, cl: CompiledLaw, v: float, ceiling: float) -> tuple[int, str]:

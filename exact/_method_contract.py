@@ -20,6 +20,8 @@ import numpy as np
 from peelapprox.validate import choice, optional, positive, reals
 from peelapprox.validate import rtol as _rtol
 
+from ._model import Model, model_of
+from ._models import solving
 from ._options import METHODS, _refuse, method_class
 
 if TYPE_CHECKING:
@@ -28,27 +30,13 @@ if TYPE_CHECKING:
     from ._options import Budget, SaveAt
     from ._trajectory import State, Trajectory
 
-__all__ = ["Method", "ATOL_RANGE", "MODELS", "default_atol", "default_method", "model_of", "method_option"]
+__all__ = ["Method", "ATOL_RANGE", "default_atol", "default_method", "method_option"]
 
 #: Valid absolute tolerances, every component: 0 is excluded (τ starts every branch segment at 0, so pure
 #: relative control has no scale there), above 1 (1 s, 1 rad, 1 rad/s, a factor e in v (hybrid, ln v),
 #: 1 m/s or 1 N (regularised)) no error is controlled at all; below 1e-100 the scaled field overflows the
 #: error norm.
 ATOL_RANGE = (1e-100, 1.0)
-
-#: The models a method may solve, ``(tape, loading)`` as :func:`model_of` reads them from the parameters.
-MODELS = {
-    ("massless", "velocity"): "the massless tape under velocity control (the paper's model)",
-    ("massless", "load"): "the massless tape under a load (loading='load')",
-    ("tape mass", "velocity"): "the tape-mass model (params.tape_mass) under velocity control",
-    ("tape mass", "load"): "the tape-mass model (params.tape_mass) under a load",
-}
-
-
-def model_of(params: PeelParams) -> tuple[str, str]:
-    """The model of ``params`` as a key of :data:`MODELS`: ``("massless" or "tape mass", params.loading)``."""
-    return ("massless" if params.tape_mass is None else "tape mass", params.loading)
-
 
 def _atol_vector(scale: Sequence[float], rtol: float, atol: Any) -> np.ndarray:
     """``rtol * scale`` for ``atol=None``, else ``atol`` checked (:data:`ATOL_RANGE`) and broadcast to 4 values."""
@@ -80,9 +68,10 @@ class Method:
         The default absolute tolerances are ``rtol * atol_scale``, one per integrated component.
     step_budget : (rate, floor, cap)
         The default step budget, ``clip(rate * t_end, floor, cap)`` (:func:`default_max_steps`).
-    models : frozenset of (tape, loading)
-        The models it solves (keys of :data:`MODELS`); the first method of :data:`METHODS` that solves a model
-        is that model's default.
+    models : frozenset of str
+        Models (names in ``exact.MODELS``) it solves besides those that list it in their own ``methods``
+        (:class:`exact.Model`); the first method of :data:`METHODS` that solves a model is that model's
+        default.
     solvers : tuple of str
         The scipy solvers its ``solver`` field takes (empty: it has no ``solver``).
 
@@ -94,7 +83,7 @@ class Method:
     about: ClassVar[str]
     atol_scale: ClassVar[tuple[float, ...]]
     step_budget: ClassVar[tuple[float, float, float]]
-    models: ClassVar[frozenset[tuple[str, str]]]
+    models: ClassVar[frozenset[str]] = frozenset()
     solvers: ClassVar[tuple[str, ...]] = ()
     rtol: float
     atol: float | Sequence[float] | None
@@ -140,17 +129,17 @@ class Method:
         return cast(Any, cls)(rtol=rtol, atol=atol, v_floor=v_floor, **given)
 
     @classmethod
-    def check_model(cls, params: PeelParams) -> None:
-        """ValueError saying which methods solve the model of ``params`` if this one does not."""
-        model = model_of(params)
-        if model not in cls.models:
-            fits = [n for n, m in METHODS.items() if model in m.models]
-            raise ValueError(f"method={cls.name!r} is {cls.about}; it does not solve {MODELS[model]}: use "
+    def check_model(cls, model: Model) -> None:
+        """ValueError saying which methods solve ``model`` if this one does not."""
+        fits = solving(model, METHODS)
+        if cls.name not in fits:
+            raise ValueError(f"method={cls.name!r} is {cls.about}; it does not solve {model.about}: use "
                              f"method={' or '.join(map(repr, fits))} (the default there: {fits[0]!r})")
 
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
+    def run(self, model: Model, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
-        """Integrate the model of ``params`` from the consistent state ``s0`` to ``t_end``.
+        """Integrate ``model`` (:class:`exact.Model`, one that this method solves) with the parameters ``params``
+        from the consistent state ``s0`` to ``t_end``.
 
         ``saveat`` and ``budget`` are validated (``budget.max_steps`` resolved); ``progress``, if given, is called
         with ``(t, t_end)`` now and then.  Returns the :class:`Trajectory`; a stop of the model or the integrator
@@ -160,14 +149,13 @@ class Method:
         raise NotImplementedError
 
 
-def default_method(params: PeelParams | None) -> str:
-    """The method ``simulate`` uses for ``params`` when none is given: the first of :data:`METHODS` that solves
-    its model (hybrid for the paper's model, regularized for a massless tape under a load, smooth with a tape
-    mass)."""
-    if params is None:
+def default_method(params: PeelParams | None, model: Model | None = None) -> str:
+    """The method ``simulate`` uses when none is given: the first of :data:`METHODS` that solves ``model`` (default
+    the model of ``params``, :func:`exact._model.model_of`): hybrid for the paper's model, regularized for a
+    massless tape under a load, smooth with a tape mass."""
+    if params is None and model is None:
         return next(iter(METHODS))
-    model = model_of(params)
-    return next(name for name, m in METHODS.items() if model in m.models)
+    return solving(model if model is not None else model_of(cast(Any, params)), METHODS)[0]
 
 
 def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] = None) -> np.ndarray:
@@ -198,11 +186,12 @@ def default_atol(method: str, rtol: float, atol: None | float | Sequence[float] 
 
 
 def method_option(method: Any, *, solver: Any, eps: Any, rtol: Any, atol: Any, v_floor: Any,
-                  params: Any = None) -> Method:
+                  params: Any = None, model: Model | None = None) -> Method:
     """The method object of a ``simulate`` call: ``method`` itself if it is one (then the keywords it holds
     must be left at their defaults), else the :data:`exact._methods.METHODS` entry of that name built from the
-    keywords.  ``method=None`` picks the model's method (``params``: :func:`exact._methods.default_method`); a
-    method that cannot solve the model of ``params`` is refused (ValueError naming the ones that can).
+    keywords.  ``method=None`` picks the model's method (``model``, default that of ``params``:
+    :func:`default_method`); a method that cannot solve the model is refused (ValueError naming the ones that
+    can).
     """
     if isinstance(method, Method):
         _refuse("method", method, [("solver", solver), ("eps", eps), ("rtol", rtol), ("atol", atol),
@@ -211,8 +200,8 @@ def method_option(method: Any, *, solver: Any, eps: Any, rtol: Any, atol: Any, v
                 f"{type(method).__name__}(rtol=...)")
         opts = method
     else:
-        name = default_method(params) if method is None else choice("method", method, tuple(METHODS))
+        name = default_method(params, model) if method is None else choice("method", method, tuple(METHODS))
         opts = METHODS[name].from_keywords(solver=solver, eps=eps, rtol=rtol, atol=atol, v_floor=v_floor)
-    if params is not None:
-        opts.check_model(params)
+    if params is not None or model is not None:
+        opts.check_model(model if model is not None else model_of(params))
     return opts

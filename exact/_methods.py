@@ -17,6 +17,7 @@ from ._regularized import run_regularized
 if TYPE_CHECKING:
     from peelapprox import PeelParams
 
+    from ._model import Model
     from ._options import Budget, SaveAt
     from ._trajectory import State, Trajectory
 
@@ -35,8 +36,11 @@ class Hybrid(Method):
         Absolute tolerance of ``(τ, α, ω, ln v)``, each in :data:`ATOL_RANGE` = [1e-100, 1]; a scalar is
         used for every component and stored as 4 values; ``None``: ``rtol * ATOL_SCALE["hybrid"]``.
     v_floor : float, optional
-        Stop with ``ModelBreakdown(reason="v_floor")`` when v falls to this velocity [m/s], in (0, inf);
-        None: the model's own criterion only (see :func:`exact.simulate`).
+        Stop with ``ModelBreakdown(reason="v_floor")`` when v falls to this velocity [m/s], in (0, inf) (a
+        threshold of the caller's, not of the model); None: the model's own criterion only.  On AB the level
+        ``G = F(1 - cos θ)`` falling to ``f(0+, V)`` leaves CONSTR without a root (the peel front would have to
+        stop): ``ModelBreakdown(reason="no_root")`` once ``G - f(0+) <= 1e-10 max(|f(0+)|, 1 N)``, i.e. v below
+        ``BranchStructure.v_breakdown`` (~1e-67 m/s; this method integrates ln v, so it follows v that far).
 
     Raises
     ------
@@ -54,22 +58,21 @@ class Hybrid(Method):
     #: The stress suite's grid needs <= ~1.5e4 steps per simulated second (I = 1e-6, rtol 1e-8; 1.3-1.8 us
     #: each): a margin of ~50x; the cap bounds a default call to ~35 s (t_end = 1e300).
     step_budget: ClassVar[tuple[float, float, float]] = (1e6, 1e6, 2e7)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("massless", "velocity")})
     rtol: float = 1e-8
     atol: float | Sequence[float] | None = None
     v_floor: float | None = None
 
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
+    def run(self, model: Model, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
-        return run_hybrid(params, t_end, s0, self, saveat, budget, progress)
+        return run_hybrid(params, t_end, s0, self, saveat, budget, progress)  # the massless model's eps -> 0 limit
 
 
 class _OnScipy(Method):
     """A method run on a scipy solver by :func:`exact._regularized.run_regularized`."""
 
-    def run(self, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
+    def run(self, model: Model, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
-        return run_regularized(params, t_end, s0, self, saveat, budget, progress)
+        return run_regularized(model, params, t_end, s0, self, saveat, budget, progress)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -94,7 +97,6 @@ class Regularized(_OnScipy):
     atol_scale: ClassVar[tuple[float, ...]] = (1e-4, 1e-3, 1e-2, 1e-6)
     #: ~1e3 steps per simulated second needed (~150 us each); the cap bounds a default call to ~80 s.
     step_budget: ClassVar[tuple[float, float, float]] = (1e5, 1e5, 5e5)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("massless", "velocity"), ("massless", "load")})
     solvers: ClassVar[tuple[str, ...]] = ("Radau", "BDF", "LSODA")
     eps: float = EPS_DEFAULT
     solver: str = "Radau"
@@ -129,7 +131,6 @@ class Smooth(_OnScipy):
     #: ``python -m comparisons.benchmark.tape_mass``): a margin of ~8x, and the cap ~60 s of LSODA (Radau and
     #: BDF take 10-20x longer per step: give them ``max_wall``).
     step_budget: ClassVar[tuple[float, float, float]] = (1e6, 1e5, 5e6)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("tape mass", "velocity"), ("tape mass", "load")})
     solvers: ClassVar[tuple[str, ...]] = ("Radau", "BDF", "LSODA", "DOP853", "RK45")
     solver: str = "LSODA"
     rtol: float = 1e-8

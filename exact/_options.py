@@ -135,7 +135,9 @@ class Budget:
     max_points : int
         Stored points, in [1, 1e15].
     max_wall : float, optional
-        Wall-clock seconds of the integration, in (0, inf); None: bounded by ``max_steps`` only.
+        Wall-clock seconds of the integration, in (0, inf) (checked between the hybrid method's kernel calls, at
+        most 250,000 steps (~0.4 s) apart, and at every step of a scipy method); None: bounded by ``max_steps``
+        only.
 
     Raises
     ------

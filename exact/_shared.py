@@ -11,6 +11,8 @@ import numpy as np
 
 from peelapprox import PeelParams, branch_structure
 
+from ._model import model_of
+
 __all__ = ["DEFAULT_MAX_WALL", "natural_scales", "paper_model_only"]
 
 #: Default wall-clock budget [s] of the calls made of many solver runs (lyapunov, lyapunov_return_map,
@@ -20,10 +22,10 @@ DEFAULT_MAX_WALL = 3600.0
 
 
 def paper_model_only(params: PeelParams, what: str, instead: str = "") -> None:
-    """Refuse a model variant (``params.variant``: a tape mass or a constant load) for ``what``, a tool built on
+    """Refuse a model the hybrid method does not solve (a tape mass or a constant load) for ``what``, a tool built on
     the hybrid solver's jumps (its section returns, tangent dynamics and saltation matrices), with a ValueError
     naming ``params`` and the model it supports (``instead``: what to use for the variant)."""
-    if params.variant is not None:
+    if "hybrid" not in model_of(params).methods:
         raise ValueError(
             f"{what} supports the paper's massless, velocity-controlled model only (params.tape_mass=None, "
             f"params.loading='velocity': the hybrid method's jumps and saltation matrices), got params with "

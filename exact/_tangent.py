@@ -282,79 +282,111 @@ def lyapunov_saltation(params, *, t_transient: float = T_TRANSIENT, T: float = 5
     run and after every jump (the compiled loop between two jumps is bounded by ``max_steps``); exceeding it
     raises :class:`peelapprox.SolverBudgetExceeded` with ``budget="max_wall"``.
     """
-    from ._initial import initial_state
     from ._methods import ATOL_SCALE
     from ._shared import natural_scales
-    from ._simulate import simulate
 
     T = duration("T", T)
     t_transient = duration("t_transient", t_transient, zero=True)
     max_steps = optional(integer, "max_steps", max_steps)
     wall = WallBudget(optional(positive, "max_wall", max_wall))
-    # no transient: the initial state itself (simulate needs t_end > 0)
-    try:
-        s = (simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps", max_wall=wall.limit).final_state
-             if t_transient > 0 else initial_state(params, alpha0=alpha0))
-    except SolverBudgetExceeded as exc:
-        raise wall.reraise(exc) from None
+    s = _transient_state(params, t_transient, alpha0, rtol, wall)
     ts = tangent_system(params)
-    cl, law, coef, bs, p, run, field, pull = ts.law, ts.law.arg, ts.law.coef, ts.law.structure, ts.p, ts.run, \
-        ts.field, ts.pull
-    scale = natural_scales(params)
     # the tangent's own accuracy need is modest (growth rates to ~1e-6) and its difference quotient carries
     # ~1e-9 relative noise: an absolute 1e-7 on the (unit-size) tangent keeps the steps those of the state
     atol = np.concatenate([rtol * np.asarray(ATOL_SCALE["hybrid"]), np.full(4, 1e-7)])
-    br = 0 if s.branch == "AB" else 1
     if max_steps is None:
         max_steps = min(int(STEPS_PER_SECOND * (T + 1.0)), MAX_DEFAULT_STEPS)
-
-    def where(t_now):
-        v = math.exp(y[3])
-        return dict(t=t_transient + t_now, alpha=float(y[1]), omega=float(y[2]), F=float(pull(y[1], v)),
-                    v=v, branch="AB" if br == 0 else "CD")
-
-    y = np.array([0.0, s.alpha, s.omega, math.log(s.v), 0.0, 0.0, 0.0, 1.0])
-    y[4:] /= np.linalg.norm(_equal_time_vector(y, field, pull, scale))
-    t, logs, n_jumps, steps = 0.0, 0.0, 0, 0
-    seg_logs: list[float] = []  # per renormalisation: the log growth and the time since the last one
-    seg_dts: list[float] = []
-    t_last, pending = 0.0, 0.0  # growth not yet recorded (jumps at one instant make one interval)
-
-    def record(g: float) -> None:
-        nonlocal t_last, pending
-        pending += g
-        if t > t_last:
-            seg_logs.append(pending)
-            seg_dts.append(t - t_last)
-            t_last, pending = t, 0.0
-
-    while t < T:
-        status, n = run(y, p, law, coef, br, rtol, atol, T - t, max_steps - steps)
-        steps += n
+    walk = _TangentWalk(params, ts, natural_scales(params), t_transient, s)
+    while walk.t < T:
+        status, n = ts.run(walk.y, ts.p, ts.law.arg, ts.law.coef, walk.br, rtol, atol, T - walk.t,
+                           max_steps - walk.steps)
+        walk.steps += n
         if status == DONE:
-            t += y[0]
-            g = math.log(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
-            logs += g
-            record(g)
+            walk.t += walk.y[0]
+            walk.renormalise(at_jump=False)
             break
         if status != FOLD:
-            lo, hi = cl.domain
-            status, what = HD.domain_status(status, cl, math.exp(y[3]), math.inf)
-            raise status_error(status, t=t_transient + t + y[0], state=where(t + y[0]), prefix="tangent integration: ",
-                               where=f"at t = {t_transient + t + y[0]:.6g} s", limit=int(max_steps),
-                               f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]), lo=lo, hi=hi,
-                               law=repr(params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)
-        t += y[0]
-        if ts.jump(y, br) is None:
-            code, what = HD.domain_status(NO_LANDING, cl, math.exp(y[3]), math.inf)
-            raise status_error(code, t=t_transient + t, state=where(t), prefix="tangent integration: ",
-                               where=f"at t = {t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero, what=what,
-                               lo=cl.domain[0], hi=cl.domain[1], law=repr(params.force))
-        br = 1 - br
-        n_jumps += 1
-        d = float(np.linalg.norm(_equal_time_vector(y, field, pull, scale)))
-        logs += math.log(d)
-        record(math.log(d))
-        y[4:] /= d
-        wall.left(t_transient + t, lambda t=t: where(t), t_transient + T)
-    return logs / t, n_jumps, t, steps, (np.array(seg_logs), np.array(seg_dts))
+            raise walk.stop_error(status, max_steps)
+        walk.t += walk.y[0]
+        walk.jump()
+        wall.left(t_transient + walk.t, lambda t=walk.t: walk.where(t), t_transient + T)
+    return walk.logs / walk.t, walk.n_jumps, walk.t, walk.steps, (np.array(walk.seg_logs), np.array(walk.seg_dts))
+
+
+def _transient_state(params, t_transient: float, alpha0: float, rtol: float, wall: WallBudget):
+    """The state at ``t_transient`` of ``exact.simulate`` from ``alpha0`` (at 0: the initial state itself, as
+    simulate needs t_end > 0); the wall budget's error if the transient used it up."""
+    from ._initial import initial_state
+    from ._simulate import simulate
+
+    try:
+        return (simulate(params, t_transient, alpha0=alpha0, rtol=rtol, save="jumps", max_wall=wall.limit).final_state
+                if t_transient > 0 else initial_state(params, alpha0=alpha0))
+    except SolverBudgetExceeded as exc:
+        raise wall.reraise(exc) from None
+
+
+class _TangentWalk:
+    """The state and tangent ``y`` of :func:`lyapunov_saltation` on branch ``br``, the time ``t`` since the
+    transient, and the log growth recorded at each renormalisation (jumps at one instant make one interval)."""
+
+    def __init__(self, params, ts: TangentSystem, scale: np.ndarray, t_transient: float, s) -> None:
+        self.params, self.ts, self.scale, self.t_transient = params, ts, scale, t_transient
+        self.br = 0 if s.branch == "AB" else 1
+        self.y = np.array([0.0, s.alpha, s.omega, math.log(s.v), 0.0, 0.0, 0.0, 1.0])
+        self.y[4:] /= np.linalg.norm(self.size())
+        self.t, self.logs, self.n_jumps, self.steps = 0.0, 0.0, 0, 0
+        self.seg_logs: list[float] = []  # per renormalisation: the log growth and the time since the last one
+        self.seg_dts: list[float] = []
+        self.t_last, self.pending = 0.0, 0.0  # growth not yet recorded
+
+    def size(self) -> np.ndarray:
+        """The tangent's scaled (δα, δω, δF) at equal t."""
+        return _equal_time_vector(self.y, self.ts.field, self.ts.pull, self.scale)
+
+    def where(self, t_now: float) -> dict:
+        y = self.y
+        v = math.exp(y[3])
+        return dict(t=self.t_transient + t_now, alpha=float(y[1]), omega=float(y[2]), F=float(self.ts.pull(y[1], v)),
+                    v=v, branch="AB" if self.br == 0 else "CD")
+
+    def record(self, g: float) -> None:
+        self.pending += g
+        if self.t > self.t_last:
+            self.seg_logs.append(self.pending)
+            self.seg_dts.append(self.t - self.t_last)
+            self.t_last, self.pending = self.t, 0.0
+
+    def renormalise(self, at_jump: bool) -> None:
+        """Record the tangent's log growth; after a jump, rescale it to size 1 (at the end, leave it)."""
+        if not at_jump:
+            g = math.log(np.linalg.norm(self.size()))
+            self.logs += g
+            self.record(g)
+            return
+        d = float(np.linalg.norm(self.size()))
+        self.logs += math.log(d)
+        self.record(math.log(d))
+        self.y[4:] /= d
+
+    def jump(self) -> None:
+        """Jump from the fold reached at ``t`` (its saltation), or raise the stop of a jump that cannot land."""
+        cl, bs, t, params = self.ts.law, self.ts.law.structure, self.t, self.params
+        if self.ts.jump(self.y, self.br) is None:
+            code, what = HD.domain_status(NO_LANDING, cl, math.exp(self.y[3]), math.inf)
+            raise status_error(code, t=self.t_transient + t, state=self.where(t), prefix="tangent integration: ",
+                               where=f"at t = {self.t_transient + t:.6g} s", f_min=bs.f_min, f_zero=bs.f_zero,
+                               what=what, lo=cl.domain[0], hi=cl.domain[1], law=repr(params.force))
+        self.br = 1 - self.br
+        self.n_jumps += 1
+        self.renormalise(at_jump=True)
+
+    def stop_error(self, status: int, max_steps: int) -> Exception:
+        """The documented exception of the compiled loop's stop ``status`` (neither DONE nor FOLD)."""
+        cl, bs, y, t, p = self.ts.law, self.ts.law.structure, self.y, self.t, self.ts.p
+        lo, hi = cl.domain
+        status, what = HD.domain_status(status, cl, math.exp(y[3]), math.inf)
+        return status_error(status, t=self.t_transient + t + y[0], state=self.where(t + y[0]),
+                            prefix="tangent integration: ", where=f"at t = {self.t_transient + t + y[0]:.6g} s",
+                            limit=int(max_steps), f_zero=bs.f_zero, level=BREAKDOWN_LEVEL, v=math.exp(y[3]), lo=lo,
+                            hi=hi, law=repr(self.params.force), v_ceiling=math.exp(p[H.P_UCEIL]), what=what)

@@ -43,7 +43,7 @@ API = {
     },
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
-        "STEP_BUDGET",
+        "STEP_BUDGET", "MODELS", "Model", "Massless", "MasslessLoad", "TapeMass", "TapeMassLoad", "register_model",
         "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
         "WarmupReport",

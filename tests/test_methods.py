@@ -10,7 +10,8 @@ import pytest
 
 import exact
 import exact._hybrid as H
-from exact._method_contract import MODELS, Method, default_method
+from exact import MODELS
+from exact._method_contract import Method, default_method
 from exact._options import METHODS
 from exact._trajectory import Jumps, SolverStats, State, Trajectory
 from peelapprox import PeelParams
@@ -28,7 +29,7 @@ class Euler(Method):
     about: ClassVar[str] = "explicit Euler with a fixed step on the tape-mass model's field"
     atol_scale: ClassVar[tuple[float, ...]] = (1e-4, 1e-3, 1e-2, 1e-6)
     step_budget: ClassVar[tuple[float, float, float]] = (1e8, 1e3, 1e9)
-    models: ClassVar[frozenset[tuple[str, str]]] = frozenset({("tape mass", "velocity")})
+    models: ClassVar[frozenset[str]] = frozenset({"tape_mass"})
     dt: float = 1e-7
     rtol: float = 1e-8
     atol: float | None = None
@@ -38,7 +39,7 @@ class Euler(Method):
         if not self.dt > 0:
             raise ValueError(f"dt must be positive, got {self.dt!r}")
 
-    def run(self, params, t_end, s0, saveat, budget, progress):
+    def run(self, model, params, t_end, s0, saveat, budget, progress):
         cl = compiled_law(params.force, params.V)
         field, _ = bound_variant_field("tape", cl.fn)
         q = variant_parameters(params, params.tape_mass)
@@ -100,7 +101,10 @@ def test_the_table_holds_the_methods_facts():
     assert [METHODS[n] for n in METHODS] == [exact.Hybrid, exact.Regularized, exact.Smooth]
     assert exact.ATOL_SCALE == {n: m.atol_scale for n, m in METHODS.items()}
     assert exact.STEP_BUDGET == {n: m.step_budget for n, m in METHODS.items()}
-    assert all(any(model in m.models for m in METHODS.values()) for model in MODELS)
+    assert {name: model.methods for name, model in MODELS.items()} == {
+        "massless": ("hybrid", "regularized"), "massless_load": ("regularized",), "tape_mass": ("smooth",),
+        "tape_mass_load": ("smooth",)}
+    assert all(m in METHODS for model in MODELS.values() for m in model.methods)
     assert exact.Smooth.solvers == ("Radau", "BDF", "LSODA", "DOP853", "RK45") and exact.Smooth().solver == "LSODA"
     assert exact.Hybrid().solver is None and exact.Hybrid().eps is None
 

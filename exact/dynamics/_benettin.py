@@ -211,6 +211,7 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
 
     from .._initial import initial_state
     from .._method_contract import method_option
+    from .._model import model_of
     from .._options import output_options
     from .._trajectory import State
 
@@ -218,7 +219,8 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
     opts = cast("Regularized | Smooth", method_option(None, solver=solver, eps=None, rtol=rtol, atol=None,
                                                       v_floor=None, params=params))
     wall = WallBudget(max_wall)
-    under_load = params.loading == "load"
+    model = model_of(params)
+    under_load = "Vp" in model.states
     scale = np.concatenate([natural_scales(params), [params.V] * (2 if under_load else 1)])
     jumps = [0]
     t_total = t_transient + (n + n_discard) * tau
@@ -230,7 +232,7 @@ def variant_two_trajectory(params: PeelParams, *, t_transient: float, tau: float
                                   max_points=5_000_000, max_steps=int(max(1e5, 2e6 * dt)), max_jumps=20_000_000,
                                   max_wall=wall.left(0.0, s0.__dict__, t_total))
         try:
-            tr = opts.run(params, dt, s0, out, lim, None)
+            tr = opts.run(model, params, dt, s0, out, lim, None)
         except SolverBudgetExceeded as exc:
             raise wall.reraise(exc) from None
         s = tr.final_state
