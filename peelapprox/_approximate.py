@@ -185,7 +185,8 @@ def approximate_attractor(
             status="steady", method="approximate: no folds, nothing to chain", **common,
             reason=f"the law has no folds at V = {fmt_number(params.V, 4)} m/s (f increases in v): steady peeling "
                    "at the stable fixed point v = V"))
-    (ab_am, ab_ve), (cd_am, cd_ve) = default_models(params)
+    inertia, velocity = regime(params)
+    (ab_am, ab_ve), (cd_am, cd_ve) = APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
     models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
     chain = f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
     if bs.v_land_ab is None or bs.v_land_cd is None:
@@ -193,23 +194,19 @@ def approximate_attractor(
         return _promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
                                                       reason=f"a jump has no landing on {which}: no return map"))
     deadline = math.inf if max_wall is None else t_wall + max_wall
-    maps = (ReturnMap(params, law, models, rtol, deadline), ReturnMap(params, law, models, NEWTON_RTOL, deadline))
+    lo = ReturnMap(params, law, models, rtol, deadline)
+    maps = (lo, lo.at(NEWTON_RTOL))
     names = ("solver", "rest") if start == "auto" else (start,)
     found = []
     for name in names:
         s = _solver_start(params, law) if name == "solver" else _rest(law)
         found.append(_from_start(params, maps, s, name, n_transient, n_returns, rtol, chain, common))
     probe = _probe(params, law, rtol, deadline) if "solver" in names and models != FULL_CHAIN else None
-    primary = _assemble(found, _label(params), probe)
+    label = "no stick-slip (stable fixed point)" if velocity == "stable" else f"{inertia} inertia, {velocity} V"
+    primary = _assemble(found, label, probe)
     if warn:
         warn_low(primary)
     return primary
-
-
-def _label(params: PeelParams) -> str:
-    """The regime label of :attr:`peelapprox.RegimeEstimate.label` (the key of the measured validity)."""
-    inertia, velocity = regime(params)
-    return "no stick-slip (stable fixed point)" if velocity == "stable" else f"{inertia} inertia, {velocity} V"
 
 
 def _promote(o: StickSlipObservables, **extra: Any) -> ApproximateAttractor:
@@ -306,11 +303,7 @@ def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, J: np.ndarr
     and its mean force drop."""
     hi = maps[1]
     cycles = 3  # the orbit itself: one cycle gives its means, three its period label (peelapprox.periodicity)
-    recs = []
-    y = x
-    for _ in range(cycles * n):
-        y, r = hi.ret(y)
-        recs.append(r)
+    y, recs = hi.run(x, cycles * n)
     mu = tuple(complex(m) for m in np.linalg.eigvals(J))
     rho = max(abs(m) for m in mu)
     kind = "stable" if rho < 1.0 else ("neutral" if rho <= 1.0 + NEUTRAL else "unstable")
@@ -353,15 +346,13 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
     lo.returns = 0
     left: list[ApproximateAttractor] = []
     try:
-        x = lo.enter(s)
-        recs: list[tuple] = []
-        for k in range(n_transient):
-            x, r = lo.ret(x)
-            recs.append(r)
-            if k + 1 == EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends it
-                got = _settle(maps, x, recs, name, chain, common, EARLY_RTOL)
-                if got is not None and max(abs(m) for m in got[0].multipliers or (1.0,)) < 1.0 - MULTIPLIER_ERROR:
-                    return _Found(got[0], left, _alpha_max(got[1]))
+        x, recs = lo.run(lo.enter(s), min(n_transient, EARLY_RETURNS))
+        if EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends the transient
+            got = _settle(maps, x, recs, name, chain, common, EARLY_RTOL)
+            if got is not None and max(abs(m) for m in got[0].multipliers or (1.0,)) < 1.0 - MULTIPLIER_ERROR:
+                return _Found(got[0], left, _alpha_max(got[1]))
+            x, more = lo.run(x, n_transient - EARLY_RETURNS)
+            recs += more
         for _ in range(MAX_ESCAPES + 1):
             got = _settle(maps, x, recs, name, chain, common)
             if got is None:
@@ -375,14 +366,8 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
             left.append(dataclasses.replace(obs, escape_returns=k_esc))
             if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
                 x = xs + (x - xs) * (ESCAPE_PUSH * drop / dev)
-            recs = []
-            for _ in range(max(n_transient, 3 * MAX_PERIOD)):
-                x, r = lo.ret(x)
-                recs.append(r)
-        recs = []  # the sample: n_returns after the transient
-        while len(recs) < n_returns:
-            x, r = lo.ret(x)
-            recs.append(r)
+            x, recs = lo.run(x, max(n_transient, 3 * MAX_PERIOD))
+        x, recs = lo.run(x, n_returns)  # the sample: n_returns after the transient
         got = _settle(maps, x, recs, name, chain, common)  # a periodic orbit reached late, after the transient
         if got is not None and max(abs(m) for m in got[0].multipliers or (2.0,)) <= 1.0 + NEUTRAL:
             return _Found(got[0], left, _alpha_max(got[1]))
@@ -424,9 +409,7 @@ def _probe(params: PeelParams, law: Any, rtol: float, deadline: float) -> str | 
     AB then reaches f(0+, V): the O(α) terms of the default chain, not the physics)."""
     m = ReturnMap(params, law, FULL_CHAIN, rtol, deadline)
     try:
-        x = m.enter(_solver_start(params, law))
-        for _ in range(PROBE_RETURNS):
-            x = m.ret(x)[0]
+        m.run(m.enter(_solver_start(params, law)), PROBE_RETURNS)
     except MapStop as stop:
         if stop.timeout or stop.plan is None or stop.plan.branch != "AB":
             return None
