@@ -102,28 +102,18 @@ def default_models(params: PeelParams) -> tuple[tuple[str, str], tuple[str, str]
     return APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
 
 
-def approximate_attractor(
-    params: PeelParams,
-    *,
-    alpha_model: str | None = None,
-    v_equation: str | None = None,
-    cd_alpha_model: str | None = None,
-    cd_v_equation: str | None = None,
-    start: str = "auto",
-    n_transient: int = 40,
-    n_returns: int = 500,
-    rtol: float = 1e-6,
-    max_wall: float | None = 10.0,
-    warn: bool = True,
-) -> ApproximateAttractor:
+def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None, v_equation: str | None = None,
+                          cd_alpha_model: str | None = None, cd_v_equation: str | None = None, start: str = "auto",
+                          n_transient: int = 40, n_returns: int = 500, rtol: float = 1e-6,
+                          max_wall: float | None = 10.0, warn: bool = True) -> ApproximateAttractor:
     """The stick-slip attractor predicted by the paper's reduced branch-wise equations, without the DAE.
 
     Runs the reduced return map on the exact model's section (module docstring: AB segment to the fold, jump
     with F put on CONSTR, CD segment to the fold, jump) from the exact solver's start and from rest, finds its
     periodic orbits by Newton with their multipliers, leaves the unstable ones, and reads the observables of
     what it reaches with the definitions of :class:`StickSlipObservables`.  The default reductions, Airy1 +
-    approxvdot on both branches, keep FLOW1's kinematic term ``-v̇/R``, large near the folds (docs/theory.md,
-    "The approximate attractor", has the measurements of this choice and of genalpha + fullvdot).
+    approxvdot on both branches, keep FLOW1's kinematic term ``-v̇/R``, large near the folds (measurements of this
+    choice and of genalpha + fullvdot: docs/theory.md, "The approximate attractor").
 
     Parameters
     ----------
@@ -141,12 +131,11 @@ def approximate_attractor(
         Returns in the sample where no periodic orbit of period <= :data:`MAX_PERIOD` is found (chaotic,
         quasi-periodic or long-period), in [3, 10**6] (500).
     rtol : float
-        Relative tolerance of the segments while iterating (1e-6); Newton and its Jacobian run at 1e-10.
+        Relative tolerance of the segments while iterating (1e-6); Newton and its Jacobian run at 1e-9.
     max_wall : float or None
-        Wall-clock budget [s] (10; None: unbounded), checked between segments, each with a step budget.
+        Wall-clock budget [s] (10; None: unbounded), checked every 20,000 integration steps at most.
     warn : bool
-        Warn once (:class:`peelapprox.ApproximationWarning`) when the primary prediction has low confidence
-        (True).
+        Warn once (:class:`peelapprox.ApproximationWarning`) if the primary prediction has low confidence (True).
 
     Returns
     -------
@@ -167,46 +156,46 @@ def approximate_attractor(
     """
     t_wall = time.perf_counter()
     params = _params("params", params, variants=False)
-    chosen = (optional(choice, "alpha_model", alpha_model, ALPHA_MODELS),
-              optional(choice, "v_equation", v_equation, V_EQUATIONS),
-              optional(choice, "cd_alpha_model", cd_alpha_model, ALPHA_MODELS),
-              optional(choice, "cd_v_equation", cd_v_equation, V_EQUATIONS))
-    n_transient = integer("n_transient", n_transient, lo=0, hi=10**6)
-    n_returns = integer("n_returns", n_returns, lo=3, hi=10**6)
-    start = choice("start", start, STARTS)
-    rtol = _rtol("rtol", rtol)
-    max_wall = optional(positive, "max_wall", max_wall)
-    warn = flag("warn", warn)
+    chosen = [optional(choice, name, value, ALPHA_MODELS if "alpha" in name else V_EQUATIONS) for name, value in (
+        ("alpha_model", alpha_model), ("v_equation", v_equation), ("cd_alpha_model", cd_alpha_model),
+        ("cd_v_equation", cd_v_equation))]
+    n_transient, n_returns = integer("n_transient", n_transient, lo=0, hi=10**6), \
+        integer("n_returns", n_returns, lo=3, hi=10**6)
+    start, rtol, max_wall, warn = choice("start", start, STARTS), _rtol("rtol", rtol), \
+        optional(positive, "max_wall", max_wall), flag("warn", warn)
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
-    bs = law.structure
     common: dict[str, Any] = dict(V=float(params.V), I=float(params.I), t_start=None, t_end=None)
+    inertia, velocity = regime(params) if law.structure.has_folds else ("n/a", "stable")
+    (ab_am, ab_ve), (cd_am, cd_ve) = APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
+    models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
+    chain = f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
+    if (no_map := _no_map(params, law.structure, chain, common)) is not None:
+        return no_map
+    lo = ReturnMap(params, law, models, rtol, math.inf if max_wall is None else t_wall + max_wall)
+    maps, names = (lo, lo.at(NEWTON_RTOL)), ("solver", "rest") if start == "auto" else (start,)
+    found = [_from_start(params, maps, _solver_start(params, law) if name == "solver" else _rest(law), name,
+                         n_transient, n_returns, rtol, chain, common) for name in names]
+    probe = _probe(params, law, rtol, lo.deadline) if "solver" in names and models != FULL_CHAIN else None
+    primary = _assemble(found, "no stick-slip (stable fixed point)" if velocity == "stable"
+                        else f"{inertia} inertia, {velocity} V", probe)  # the regime label of estimate()
+    if warn:
+        warn_low(primary)
+    return primary
+
+
+def _no_map(params: PeelParams, bs: Any, chain: str, common: dict[str, Any]) -> ApproximateAttractor | None:
+    """The answer where there is no return map to iterate: no folds at V (steady) or a jump without a landing
+    (breakdown); None where there is one."""
     if not bs.has_folds:
         return _promote(StickSlipObservables._no_slip(
             status="steady", method="approximate: no folds, nothing to chain", **common,
             reason=f"the law has no folds at V = {fmt_number(params.V, 4)} m/s (f increases in v): steady peeling "
                    "at the stable fixed point v = V"))
-    inertia, velocity = regime(params)
-    (ab_am, ab_ve), (cd_am, cd_ve) = APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
-    models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
-    chain = f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
     if bs.v_land_ab is None or bs.v_land_cd is None:
         which = "AB (f_min <= f(0+, V))" if bs.v_land_ab is None else "CD (the law's domain ends below f_max)"
         return _promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
                                                       reason=f"a jump has no landing on {which}: no return map"))
-    deadline = math.inf if max_wall is None else t_wall + max_wall
-    lo = ReturnMap(params, law, models, rtol, deadline)
-    maps = (lo, lo.at(NEWTON_RTOL))
-    names = ("solver", "rest") if start == "auto" else (start,)
-    found = []
-    for name in names:
-        s = _solver_start(params, law) if name == "solver" else _rest(law)
-        found.append(_from_start(params, maps, s, name, n_transient, n_returns, rtol, chain, common))
-    probe = _probe(params, law, rtol, deadline) if "solver" in names and models != FULL_CHAIN else None
-    label = "no stick-slip (stable fixed point)" if velocity == "stable" else f"{inertia} inertia, {velocity} V"
-    primary = _assemble(found, label, probe)
-    if warn:
-        warn_low(primary)
-    return primary
+    return None
 
 
 def _promote(o: StickSlipObservables, **extra: Any) -> ApproximateAttractor:
