@@ -70,6 +70,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_dop853_tableau.py",  # its coefficients, frozen into the kernels
     "peelapprox/_alpha.py",
     "peelapprox/_segment_kernel.py",
+    "peelapprox/_reducedmap_kernel.py",  # the reduced return map's compiled returns
     "peelapprox/_packing.py",  # the parameter-vector layouts, frozen into the kernels
     "peelapprox/_variant_fields.py",  # the tape-mass and load fields
     "peelapprox/_model_jit.py",  # the model's inline kernels (closures, rates, XDAE)

@@ -16,6 +16,8 @@ eigenvalues of that Jacobian.
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -23,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from . import _reducedmap_kernel as RK
 from . import _segment_kernel as K
 from ._params import PeelParams
 from ._segment import SegmentPlan, SegmentRun, run_segment, segment_plan
@@ -43,6 +46,9 @@ FD_STEP = 3e-5
 NEWTON_TOL = 1e-8
 #: Newton iterations at most.
 NEWTON_MAX_IT = 8
+#: Integration steps of one compiled call of returns (:meth:`ReturnMap.run`) at most: the wall-clock deadline is
+#: checked between calls (~10-30 ms of work each).
+STEP_CAP = 20_000
 _CLOSED = {AM_SIN, AM_HARM, AM_EXP, AM_STATIC}
 _NO_T = np.empty(0)
 
@@ -60,9 +66,13 @@ class ReturnMap:
     """The reduced return map of one chain at one segment tolerance (module docstring)."""
 
     def __init__(self, params: PeelParams, law: Any, models: tuple[tuple[str, str], tuple[str, str]],
-                 rtol: float, deadline: float = math.inf) -> None:
+                 rtol: float, deadline: float = math.inf, book: dict | None = None) -> None:
         bs = law.structure
         self.params, self.law, self.models, self.rtol = params, law, models, rtol
+        #: The plans built so far by (branch, v_in), shared by the maps of one call (``book``): a plan of another
+        #: chain or tolerance is the same plan with its model fields changed, not built again (~0.5 ms each).
+        self.book: dict = {} if book is None else book
+        self.plans: tuple[SegmentPlan, ...] = ()
         self.plans = (self.plan("AB", bs.v_land_ab), self.plan("CD", bs.v_land_cd))
         R = params.R
         # the jump of ω-continuity: α̇ after = α̇ before + (v before - v after)/R
@@ -74,14 +84,39 @@ class ReturnMap:
         self.deadline = deadline
         # run_segment's default horizon, its entry-independent part: 20 quasi-static passages of the fold gap
         self.horizon = 20.0 * (self.fold[0] - self.fold[1]) / (params.k * params.V)
+        self.compiled = self.paper and not any(pl.alpha_model in _CLOSED for pl in self.plans)
+        if self.compiled:  # the branch rows of the compiled returns (peelapprox._reducedmap_kernel)
+            self.rows = np.array([[pl.v_in, pl.fp_in, pl.F_rate, pl.x_f, pl.x_lo, pl.x_hi,
+                                   -1.0 if pl.t_max is None else pl.t_max, pl.max_steps, fold, kick, up]
+                                  for pl, fold, kick, up in ((self.plans[0], self.fold[1], self.kick[1], 1.0),
+                                                             (self.plans[1], self.fold[0], self.kick[0], 0.0))])
+            self.kernel = RK.returns(not law.inlined)
+
+    def at(self, rtol: float) -> ReturnMap:
+        """This map with its segments at the tolerance ``rtol`` (the same plans otherwise, not built again)."""
+        other = copy.copy(self)
+        other.rtol, other.returns = rtol, 0
+        other.plans = tuple(dataclasses.replace(pl, rtol=rtol) for pl in self.plans)
+        return other
 
     def plan(self, branch: str, v_in: float) -> SegmentPlan:
         bs = self.law.structure
         code = 0 if branch == "AB" else 1
+        if self.plans and v_in == self.plans[code].v_in:
+            return self.plans[code]
         am, ve = self.models[code]
-        return segment_plan(self.params, self.law, branch, v_in=v_in, v_f=bs.v_max if code == 0 else bs.v_min,
-                            alpha_model=am, v_equation=ve, F_rate=None, rtol=self.rtol, t_max=None,
-                            max_steps=SEGMENT_MAX_STEPS)
+        pl = self.book.get((branch, v_in))
+        if pl is None:
+            pl = self.book[(branch, v_in)] = segment_plan(
+                self.params, self.law, branch, v_in=v_in, v_f=bs.v_max if code == 0 else bs.v_min, alpha_model=am,
+                v_equation=ve, F_rate=None, rtol=self.rtol, t_max=None, max_steps=SEGMENT_MAX_STEPS)
+            return pl
+        a, e = K.ALPHA_MODELS.index(am), K.V_EQUATIONS.index(ve)
+        if (pl.alpha_model, pl.v_equation, pl.rtol) == (a, e, self.rtol):
+            return pl
+        q = pl.q.copy()  # segment_plan's q depends on the chain through these two fields only
+        q[K.Q_AM], q[K.Q_VE] = a, e
+        return dataclasses.replace(pl, alpha_model=a, v_equation=e, q=q, rtol=self.rtol)
 
     def force(self, branch: int, a: float) -> float:
         """F on CONSTR at the fold of ``branch`` (0 AB: f_max, 1 CD: f_min) with the angle ``a``."""
@@ -123,6 +158,36 @@ class ReturnMap:
                           self.returns)
         return y
 
+    def run(self, x: np.ndarray, n: int) -> tuple[np.ndarray, list[tuple[float, ...]]]:
+        """``n`` returns from ``x``: the last section point and the returns' records (:meth:`ret`'s), compiled
+        where the chain allows (:mod:`peelapprox._reducedmap_kernel`: the same numbers), else by :meth:`ret`."""
+        if not self.compiled:
+            recs = []
+            for _ in range(n):
+                x, r = self.ret(x)
+                recs.append(r)
+            return x, recs
+        x = np.array(x, dtype=float)
+        out: list[tuple[float, ...]] = []
+        rows = np.empty((n, 6))
+        info = np.zeros(4, dtype=np.int64)
+        stop = np.empty(6)
+        pl = self.plans
+        while len(out) < n:
+            if time.perf_counter() > self.deadline:
+                raise MapStop(None, None, self.returns, timeout=True)
+            self.kernel(x, n - len(out), pl[0].q, pl[1].q, self.rows, pl[0].law_arg, pl[0].law.coef, self.rtol,
+                        self.horizon, STEP_CAP, rows, info, stop)
+            done = int(info[RK.I_DONE])
+            self.returns += done
+            out.extend(tuple(r) for r in rows[:done].tolist())
+            if info[RK.I_CODE] != DONE:
+                plan = pl[int(info[RK.I_BRANCH])]
+                raise MapStop(plan, SegmentRun(int(info[RK.I_CODE]), stop[:5].copy(), np.empty((0, 5)),
+                                               np.zeros(5, dtype=np.int64), plan.q, 0.0, 0.0, np.zeros(5),
+                                               float(stop[5])), self.returns)
+        return x, out
+
     def ret(self, x: np.ndarray | tuple[float, float]) -> tuple[np.ndarray, tuple[float, ...]]:
         """One return from the section point ``x = (α, α̇)``: the next one, and ``(F at the AB→CD jump, F at the
         CD→AB jump, the CD stay, the AB stay, α at the two jumps)``."""
@@ -135,9 +200,7 @@ class ReturnMap:
         return np.array([a1, ad]), (F, G, t_cd, t_ab, a0, a)
 
     def power(self, x: np.ndarray, n: int) -> np.ndarray:
-        for _ in range(n):
-            x = self.ret(x)[0]
-        return x
+        return self.run(x, n)[0]
 
     def enter(self, start: tuple[int, float, float, float, float]) -> np.ndarray:
         """The first section point from a start ``(branch code, F, v, α, α̇)`` anywhere on a branch."""

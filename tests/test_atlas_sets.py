@@ -188,3 +188,21 @@ def test_set_stability_compares_multipliers_and_budget_is_the_sweeps():
     assert exc.value.budget == "max_wall"
     with pytest.raises(ValueError, match="sets"):
         atlas(I_GRID, V_GRID, out="unused", sets="yes", max_workers=0, progress=False)
+
+
+def test_the_set_measure_reuses_the_default_prediction_of_its_point():
+    """Hypothesis: a point's set measure reads the ``approx:default`` prediction its atlas measure made for the same
+    ``params`` object (one ``approximate_attractor`` run per point, not two), and computes its own for another
+    object.  Identity, not a tolerance: the very object the approximation returned, or a new one with the same
+    fields (the map is deterministic); and the record of either is the same."""
+    from comparisons.atlas import approximations, sets
+
+    p, q = PeelParams(V=1.0, I=1e-2), PeelParams(V=1.0, I=1e-2)
+    rec = approximations.predict("approx:default", p)
+    made = approximations.last_output("approx:default", p, approximate_attractor)
+    assert made is not None and made.slip_interval == rec["slip_interval"]
+    got, fields = sets._predicted(p)
+    assert got is made
+    other, other_fields = sets._predicted(q)
+    assert other is not made and other.as_dict() == made.as_dict() and other_fields == fields
+    assert approximations.last_output("approx:default", p, lambda params: None) is None  # another function: none

@@ -30,7 +30,7 @@ from peelapprox.validate import flag, in_range
 
 from .._worker import error_text
 from ..sweep import register_measure
-from .approximations import TOLERANCE
+from .approximations import TOLERANCE, last_output
 from .measures import _wall, _window
 
 __all__ = ["SET_DEFAULTS", "SET_MEASURE", "MATCHED", "match_set", "measure_sets", "check_set_options",
@@ -98,9 +98,12 @@ def _max_mu(mult: Any) -> float | None:
 
 
 def _predicted(params: PeelParams) -> tuple[Any, dict]:
-    """The primary prediction (None where it raised) and its record fields."""
+    """The primary prediction (None where it raised) and its record fields: the atlas's ``approx:default``
+    prediction of this point when it ran (:func:`~comparisons.atlas.approximations.last_output`), else computed."""
     try:
-        a = approximate_attractor(params, warn=False)
+        a = last_output("approx:default", params, approximate_attractor)
+        if a is None:
+            a = approximate_attractor(params, warn=False)
     except ModelBreakdown as exc:
         return None, {"predicted_status": f"breakdown:{exc.reason}", "confidence": "low",
                       "confidence_reason": "the reduced map breaks down", "n_predicted": 0}

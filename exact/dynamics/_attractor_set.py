@@ -64,23 +64,12 @@ APERIODIC_RTOL = 0.05
 CHAOS_BITS = 1.0
 
 
-def attractor_set(
-    params: PeelParams,
-    *,
-    starts: str | Sequence[Any] = "default",
-    t_transient: float = WINDOW_DEFAULTS["t_transient"],
-    t_window: float = WINDOW_DEFAULTS["window"],
-    rtol: float = WINDOW_DEFAULTS["rtol"],
-    period_rtol: float = 1e-6,
-    max_period: int = 32,
-    stability: bool = True,
-    lyapunov_T: float = 10.0,
-    max_exponents: int = 2,
-    workers: int | None = None,
-    executor: Executor | None = None,
-    progress: bool | Callable[[int, int, str], None] | None = None,
-    max_wall: float | None = DEFAULT_MAX_WALL,
-) -> AttractorSet:
+def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default",
+                  t_transient: float = WINDOW_DEFAULTS["t_transient"], t_window: float = WINDOW_DEFAULTS["window"],
+                  rtol: float = WINDOW_DEFAULTS["rtol"], period_rtol: float = 1e-6, max_period: int = 32,
+                  stability: bool = True, lyapunov_T: float = 10.0, max_exponents: int = 2, workers: int | None = None,
+                  executor: Executor | None = None, progress: bool | Callable[[int, int, str], None] | None = None,
+                  max_wall: float | None = DEFAULT_MAX_WALL) -> AttractorSet:
     """The coexisting attractors reached from a designed set of starts, each with its observables, class, share
     of the starts and stability; runs still on an unstable orbit are transients with their predicted escape.
 
@@ -134,33 +123,33 @@ def attractor_set(
         failure, a spent budget are outcomes.
     """
     wall0 = time.perf_counter()
-    params = _params("params", params)
-    t_transient = duration("t_transient", t_transient, zero=True)
-    t_window = duration("t_window", t_window)
-    rtol = _rtol("rtol", rtol)
-    period_rtol = positive("period_rtol", period_rtol)
-    max_period = integer("max_period", max_period, 1, 1000)
-    stability = flag("stability", stability)
-    lyapunov_T = duration("lyapunov_T", lyapunov_T)
-    max_exponents = integer("max_exponents", max_exponents, 0, 1000)
-    workers = optional(integer, "workers", workers, 0)
-    if executor is not None and not callable(getattr(executor, "submit", None)):
-        raise ArgumentTypeError(f"executor must be None or a concurrent.futures.Executor, got {executor!r}")
-    say = _reporter(progress)
-    deadline = Deadline(optional(positive, "max_wall", max_wall))
+    params, t_transient, t_window = _params("params", params), duration("t_transient", t_transient, zero=True), \
+        duration("t_window", t_window)
+    rtol, period_rtol, max_period = _rtol("rtol", rtol), positive("period_rtol", period_rtol), \
+        integer("max_period", max_period, 1, 1000)
+    stability, lyapunov_T, max_exponents = flag("stability", stability), duration("lyapunov_T", lyapunov_T), \
+        integer("max_exponents", max_exponents, 0, 1000)
+    workers, executor = optional(integer, "workers", workers, 0), _executor(executor)
+    say, deadline = _reporter(progress), Deadline(optional(positive, "max_wall", max_wall))
     valid, invalid = check_starts(params, starts)
     say(0, len(valid), f"attractor_set V={params.V:g} I={params.I:g}: {len(valid)} starts")
     runs = run_all(params, valid, t_transient, t_window, rtol, deadline, workers, executor, say)
     reader = _Reader(params, t_transient, t_window, rtol, period_rtol, max_period, stability,
                      (lyapunov_T, max_exponents), deadline, say)
-    out = reader.read(valid, runs)
-    outcomes = [*out, *(SetOutcome(s, "invalid start", None, why) for s, why in invalid)]
-    counters = dict(reader.counters, runs=float(sum(1 for r in runs if r.get("trajectory") is not None)),
+    outcomes = [*reader.read(valid, runs), *(SetOutcome(s, "invalid start", None, why) for s, why in invalid)]
+    counters = dict(reader.counters, runs=float(sum(r.get("trajectory") is not None for r in runs)),
                     run_wall=float(sum(r.get("wall", 0.0) for r in runs)))
     status, message = _status(reader.attractors, outcomes)
     return AttractorSet(params=params, status=status, message=message, attractors=tuple(reader.attractors),
                         outcomes=tuple(outcomes), t_transient=t_transient, t_window=t_window, rtol=rtol,
                         counters=counters, wall_time=time.perf_counter() - wall0)
+
+
+def _executor(executor: Any) -> Executor | None:
+    """``executor`` checked: None or anything with a ``submit`` (a :class:`concurrent.futures.Executor`)."""
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise ArgumentTypeError(f"executor must be None or a concurrent.futures.Executor, got {executor!r}")
+    return executor
 
 
 def _reporter(progress: Any) -> Callable[[int, int, str], None]:
