@@ -81,6 +81,10 @@ API = {
         "write_maps", "atlas_cost", "AtlasCost", "match_set", "SET_DEFAULTS", "plot_multistability_map",
         "plot_confidence_map",
     },
+    "comparisons.front": {
+        "front_ensemble", "FrontEnsemble", "ENSEMBLE_COLUMNS", "inertia_of_ratio", "FRONT_DEFAULTS", "measure_front",
+        "check_front_options", "twin_lyapunov",
+    },
     "comparisons.sweep": {
         "MEASURES", "SweepResult", "load_sweep", "parse_grid", "register_measure", "sweep",
         "MANIFEST", "RESERVED", "RESULTS", "record_key", "MAX_SWEEP_POINTS", "check_grid_size",

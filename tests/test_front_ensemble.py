@@ -1,0 +1,78 @@
+"""The peel front's sweep measure, ensembles on the sweep engine and the reproduction report (comparisons.front)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from comparisons.front import (
+    FRONT_DEFAULTS,
+    check_front_options,
+    front_ensemble,
+    inertia_of_ratio,
+    measure_front,
+)
+from comparisons.sweep import MEASURES
+from peelapprox import PeelParams
+
+SHORT = {"front_N": 4, "front_t_transient": 0.004, "front_window": 0.006, "front_dt_save": 1e-5,
+         "front_lyap_window": 0.002, "front_lyap_tau": 0.0005}
+
+
+def test_front_measure_is_registered_and_checks_its_options():
+    """The measure is in the sweep's registry under "front"; a bad option is a ValueError naming it, before any
+    run (categorical)."""
+    assert MEASURES["front"] is measure_front
+    for key, bad in (("front_N", 0), ("front_gamma", -1.0), ("front_ends", "round"), ("front_window", 0.0),
+                     ("front_threshold", 1.5), ("front_lyap_tau", 1.0)):
+        with pytest.raises((ValueError, TypeError), match=key):
+            check_front_options({key: bad})
+    assert check_front_options({}) == FRONT_DEFAULTS
+
+
+def test_uniform_front_is_smooth_and_silent():
+    """Hypothesis: a front started uniform (δ₀ = 0) stays uniform (docs/peel-front.md, "Two limits that hold
+    exactly"), so its AE power is exactly 0: no bursts, E_AE = 0, ⟨W⟩ = 0, class smooth (exact: the deviations have
+    zero rates, bitwise), while the mean front still stick-slips (jumps > 0)."""
+    rec = measure_front(PeelParams(V=1.0, I=1e-2, tape_mass=1e-3),
+                        {**SHORT, "front_delta0": 0.0, "front_lyapunov": False})
+    assert rec["status"] == "ok"
+    assert rec["pattern"] == "smooth" and rec["roughness"] == 0.0
+    assert rec["ae_energy"] == 0.0 and rec["bursts"] == 0 and rec["burst_energies"] == ""
+    assert rec["jumps"] >= 1
+
+
+def test_ensemble_resumes_and_pools(tmp_path):
+    """An ensemble of 1 ratio x 2 V x 1 γ x 2 seeds on the sweep engine (in this process): 4 records, each run's
+    I = m R²/r_m (to rounding, 1e-15), the seed and γ as asked; the same call again computes nothing and returns
+    the same records bitwise (resumed from out); the pooled burst energies of a cell are its seeds' energies
+    concatenated (exact); every run's counters are there (steps > 0, CPU > 0)."""
+    kw = dict(gammas=(0.1,), seeds=(0, 1), out=str(tmp_path / "ens"), options={**SHORT, "front_delta0": 0.05},
+              max_workers=0, progress=False)
+    ens = front_ensemble([1e-3], [1.0, 2.0], **kw)
+    assert ens.n_runs == 4
+    for r in ens.records:
+        assert r["status"] == "ok", r["status"]
+        assert math.isclose(r["I"], inertia_of_ratio(1e-3, 1e-3, 0.1), rel_tol=1e-15)
+        assert r["gamma"] == 0.1 and r["seed"] in (0, 1) and r["front_steps"] > 0 and r["front_cpu_s"] > 0
+    again = front_ensemble([1e-3], [1.0, 2.0], **kw)
+    assert again.rows(energies=True) == ens.rows(energies=True)
+    pooled = ens.burst_energies(V=1.0)
+    parts = [np.array(r["front_burst_energies"].split(), dtype=float) for r in ens.select(V=1.0)
+             if r["front_burst_energies"]]
+    assert np.array_equal(pooled, np.concatenate(parts) if parts else np.empty(0))
+    path = ens.write(str(tmp_path / "runs.csv"))
+    assert open(path, encoding="utf-8").readline().startswith("gamma,seed,r_m,I,V,status")
+
+
+def test_ensemble_refuses_bad_axes(tmp_path):
+    """Repeated seeds, a ratio <= 0 and a bad measure option are ValueErrors naming them (categorical)."""
+    with pytest.raises(ValueError, match="repeats"):
+        front_ensemble([1e-3], [1.0], seeds=(0, 0), out=str(tmp_path / "a"), max_workers=0, progress=False)
+    with pytest.raises(ValueError, match="inertia_ratios"):
+        front_ensemble([0.0], [1.0], out=str(tmp_path / "b"), max_workers=0, progress=False)
+    with pytest.raises(ValueError, match="front_N"):
+        front_ensemble([1e-3], [1.0], out=str(tmp_path / "c"), options={"front_N": -3}, max_workers=0,
+                       progress=False)
