@@ -76,3 +76,51 @@ def test_ensemble_refuses_bad_axes(tmp_path):
     with pytest.raises(ValueError, match="front_N"):
         front_ensemble([1e-3], [1.0], out=str(tmp_path / "c"), options={"front_N": -3}, max_workers=0,
                        progress=False)
+
+
+def _record(gamma, seed, r_m, V, pattern, lam, se, status="ok"):
+    return {"gamma": gamma, "seed": seed, "r_m": r_m, "I": 1e-5 / r_m, "V": V, "status": status,
+            "front_pattern": pattern if status == "ok" else None, "front_roughness": 1.0,
+            "front_mixed_fraction": 0.2, "front_phi_mean": 0.3, "front_lyapunov": lam, "front_lyapunov_se": se,
+            "front_chaotic": status == "ok" and lam > 3 * se, "front_burst_energies": ""}
+
+
+def test_pattern_table_takes_the_seeds_majority_and_the_chaotic_window_most_seeds():
+    """On fabricated records (so the expected values are set by hand): a cell's class is the class most of its
+    seeds give, with its count; a run that broke down counts as "breakdown"; the chaotic window holds the V where
+    more than half the seeds have λ > 3 SE (exact, categorical)."""
+    from comparisons.front.ensemble import FrontEnsemble
+    from comparisons.front.report import chaotic_window, pattern_table
+
+    recs = [_record(0.1, 0, 1e-3, 1.0, "rugged", 10.0, 1.0), _record(0.1, 1, 1e-3, 1.0, "rugged", 10.0, 1.0),
+            _record(0.1, 2, 1e-3, 1.0, "smooth", 1.0, 1.0),
+            _record(0.1, 0, 1e-3, 2.0, "smooth", 10.0, 1.0), _record(0.1, 1, 1e-3, 2.0, "x", 0, 1, "breakdown:arrest"),
+            _record(0.1, 2, 1e-3, 2.0, "x", 0, 1, "breakdown:arrest")]
+    ens = FrontEnsemble(recs, np.array([1e-3]), np.array([1.0, 2.0]), np.array([0.1]), (0, 1, 2), {}, "")
+    rows = {r["V"]: r for r in pattern_table(ens)}
+    assert (rows[1.0]["pattern"], rows[1.0]["agree"], rows[1.0]["runs"]) == ("rugged", 2, 3)
+    assert (rows[2.0]["pattern"], rows[2.0]["agree"]) == ("breakdown", 2)
+    assert rows[1.0]["chaotic"] == 2 and rows[2.0]["chaotic"] == 1
+    assert chaotic_window(list(rows.values()), 1e-3, 0.1) == [1.0]
+
+
+@pytest.mark.slow
+def test_report_fits_tell_two_regimes_from_one():
+    """The report's decision rule (two regimes when the broken law's bootstrap p < 0.01, with 199 null
+    catalogues so that p can reach 0.005): 3000 draws of a broken law (1.5 below 10, 2.5 above, xmin 1) are
+    "two", with α1 and α2 within 0.1 and the break within x1.5 (3000 draws: looser than bursts.md's 20000-draw
+    targets); 3000 Pareto draws (α = 2) are "one" with the single α within 0.1 (seeded: deterministic)."""
+    from scipy import stats
+
+    from comparisons.front.report import _fits
+
+    u = np.random.default_rng(3).uniform(size=3000)
+    a1, a2, xb = 1.5, 2.5, 10.0
+    c1, c2 = (1 - xb ** (1 - a1)) / (a1 - 1), xb ** (1 - a1) / (a2 - 1)
+    z = u * (c1 + c2)
+    x = np.where(z < c1, (1 - z * (a1 - 1)) ** (1 / (1 - a1)), xb * (1 - (z - c1) / c2) ** (1 / (1 - a2)))
+    two = _fits(x)
+    assert two["regimes"] == "two" and two["p_broken"] < 0.01
+    assert abs(two["alpha1"] - a1) < 0.1 and abs(two["alpha2"] - a2) < 0.1 and 1 / 1.5 < two["x_break"] / xb < 1.5
+    one = _fits(stats.pareto(b=1.0).rvs(3000, random_state=np.random.default_rng(4)))
+    assert one["regimes"] == "one" and abs(one["alpha"] - 2.0) < 0.1
