@@ -144,3 +144,20 @@ def test_burst_exponent_is_stable_across_threshold_sampling_seed_and_heterogenei
         assert by[name]["alpha_lo"] is not None, by[name]
     bad = [r["variant"] for r in rows if r["consistent"] is False]
     assert not bad, rows
+
+
+@pytest.mark.slow
+def test_ensemble_on_a_process_pool_equals_serial(tmp_path):
+    """Hypothesis: the ensemble's sweeps, run at once from threads on one shared process pool (the report's path
+    on more than 2 CPUs), give the records of the serial run bitwise, except each run's CPU seconds (a
+    measurement): 2 ratios x 2 V x 2 γ x 2 seeds, N = 4.  (The sweep engine's own tests check its executors;
+    this checks that the measure is imported in the workers and that concurrent sweeps do not mix records.)"""
+    kw = dict(gammas=(0.1, 1.0), seeds=(0, 1), options={**SHORT, "front_delta0": 0.05}, progress=False)
+    pool = front_ensemble([1e-3, 1e-1], [1.0, 2.0], out=str(tmp_path / "p"), executor="processes", max_workers=2,
+                          **kw)
+    serial = front_ensemble([1e-3, 1e-1], [1.0, 2.0], out=str(tmp_path / "s"), max_workers=0, **kw)
+
+    def drop(rows):
+        return [{k: v for k, v in r.items() if k != "front_cpu_s"} for r in rows]
+    assert pool.n_runs == 16
+    assert drop(pool.rows(energies=True)) == drop(serial.rows(energies=True))
