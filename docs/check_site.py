@@ -41,7 +41,7 @@ from urllib.parse import urlparse
 API_MODULES = (
     "peelapprox", "exact", "comparisons", "peelapprox.plotting", "peelapprox.io", "peelapprox.parallel",
     "peelapprox.validate",
-    "peelapprox.errors", "peelapprox.kernels", "peelapprox.cli", "comparisons.atlas", "comparisons.sweep",
+    "peelapprox.errors", "peelapprox.kernels", "peelapprox.cli", "comparisons.atlas", "comparisons.front", "comparisons.sweep",
     "comparisons.stress", "comparisons.benchmark", "comparisons.benchmark.peers",
 )
 #: Pages that must hold typeset formulas (the landing page states the model's equations; the theory page maps

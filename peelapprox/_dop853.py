@@ -48,6 +48,8 @@ __all__ = [
     "combine",
     "workspace",
     "interp1",
+    "interp_mean",
+    "solve_theta_mean",
     "interp",
     "solve_theta",
     "crossing",
@@ -160,11 +162,23 @@ def interp(y_old, Fc, x, out):
 
 
 @kernel(inner=True)
-def solve_theta(y_old, Fc, i, target, g0, xb, g1):
-    """x in [0, xb] with interp1(x, i) = target.
+def interp_mean(y_old, Fc, x, i0, n):
+    """The mean of the ``n`` dense-output components ``i0 … i0 + n - 1`` at fraction x of the step (summed in
+    index order, then divided by n: for n = 1, bitwise :func:`interp1` of component ``i0``)."""
+    s = 0.0
+    for j in range(n):
+        s += interp1(y_old, Fc, x, i0 + j)
+    return s / n
+
+
+@kernel(inner=True)
+def solve_theta_mean(y_old, Fc, i0, n, target, g0, xb, g1):
+    """x in [0, xb] with :func:`interp_mean` ``(x, i0, n)`` = target: the one Illinois root-finder.
 
     ``g0``, ``g1`` are the values minus target at 0 and xb, of opposite sign
-    (or ``g1 == 0``).  Illinois-modified regula falsi, to ~1 ulp in x.
+    (or ``g1 == 0``, which returns xb).  Illinois-modified regula falsi, to ~1 ulp in x.
+    The peel front's driver finds the mean front's jump with it (the mean of the strips' velocities);
+    :func:`solve_theta` is its case n = 1.
     """
     if g1 == 0.0:
         return xb
@@ -175,7 +189,7 @@ def solve_theta(y_old, Fc, i, target, g0, xb, g1):
         x = (a * gb - b * ga) / (gb - ga)
         if not (a < x < b):
             x = 0.5 * (a + b)
-        gx = interp1(y_old, Fc, x, i) - target
+        gx = interp_mean(y_old, Fc, x, i0, n) - target
         if gx == 0.0:
             return x
         if (gx > 0.0) == (gb > 0.0):
@@ -191,6 +205,16 @@ def solve_theta(y_old, Fc, i, target, g0, xb, g1):
         if b - a <= 4e-16:
             break
     return b if abs(gb) < abs(ga) else a
+
+
+@kernel(inner=True)
+def solve_theta(y_old, Fc, i, target, g0, xb, g1):
+    """x in [0, xb] with interp1(x, i) = target.
+
+    ``g0``, ``g1`` are the values minus target at 0 and xb, of opposite sign
+    (or ``g1 == 0``).  Illinois-modified regula falsi, to ~1 ulp in x (:func:`solve_theta_mean` of one component).
+    """
+    return solve_theta_mean(y_old, Fc, i, 1, target, g0, xb, g1)
 
 
 @kernel(inner=True)

@@ -32,6 +32,7 @@ FIGURES = {
     "05_sweep_phase_diagram": "sweep_phase_diagram.png",
     "06_orbits_bifurcation": "orbits_bifurcation.png",
     "07_your_data": "your_data.png",
+    "08_peel_front": "peel_front.png",
 }
 
 
@@ -253,3 +254,24 @@ def test_07_your_data(runs):
     k = _num(r"k = ([\d.]+) \(truth", out)
     lo, hi = _num(r"95 % in \[([\d.]+),", out), _num(r"95 % in \[[\d.]+, ([\d.]+)\]", out)
     assert abs(k / 1000 - 1) < 0.05 and lo <= 1000 <= hi
+
+
+def test_08_peel_front(runs):
+    """The front of docs/peel-front.md's "Use" and the bursts of a longer run.
+
+    * N = 64 (V = 1, I = 1e-2, m = 1 g, γ = 0.05, κ = 0.1, δ₀ = 0.01, seed 0, 30 ms): stuck-peeled with ⟨W⟩ = 1.67,
+      Φ_mix = 0.35 and ⟨n_dw⟩ = 12.9, as that page reports (its printed digits: to half a unit of the last).
+    * E_AE, a state of the integration, equals the trapezoid integral of the stored AE power to 1e-3 relative
+      (docs/peel-front.md, "Energy balance": the trapezoid rule's own error through the bursts at 2 µs).
+    * N = 16 over 0.3 s: each slip of the front (an AB->CD jump of the mean front, half of its jumps) makes one
+      AE burst above 5 % of the record's largest AE power, within one (a burst cut by the record's ends).
+    """
+    out = _output(runs, "08_peel_front")
+    assert "pattern stuck-peeled" in out
+    assert _num(r"<W> = ([\d.]+)", out) == pytest.approx(1.67, abs=0.005)
+    assert _num(r"Phi_mix = ([\d.]+)", out) == pytest.approx(0.35, abs=0.005)
+    assert _num(r"<n_dw> = ([\d.]+)", out) == pytest.approx(12.9, abs=0.05)
+    e_state, e_trap = _num(r"AE energy ([\d.]+) J", out), _num(r"trapezoid integral ([\d.]+) J", out)
+    assert e_trap == pytest.approx(e_state, rel=1e-3)
+    jumps, bursts = _num(r"0.3 s: (\d+) mean-front jumps", out), _num(r"jumps, (\d+) bursts", out)
+    assert abs(bursts - jumps / 2) <= 1

@@ -9,8 +9,8 @@ the strips) and allocates nothing: the work arrays come from Python.
 Events, located on the step's 7th-order dense output:
 
 * the **mean front's jump**: v̄ = mean v_j crossing the inflection velocity v_infl of f, as the tape-mass model's
-  driver records its jumps (``exact.simulate(method="smooth")``); root of the interpolated mean by Illinois
-  regula falsi (each evaluation O(N));
+  driver records its jumps (``exact.simulate(method="smooth")``); root of the interpolated mean by the package's
+  Illinois regula falsi (``solve_theta_mean`` of :mod:`peelapprox.kernels`; each evaluation O(N));
 * a **local branch switch**: strip j's v_j crossing v_infl within a step (one per strip and step: two crossings
   of one strip inside one step are not seen, a step being far shorter than a local switch's transit).
 """
@@ -32,10 +32,10 @@ from peelapprox.kernels import (
     N_STAGES,
     STEP_FAILED,
     interp,
-    interp1,
     kernel,
     make_dop853,
     solve_theta,
+    solve_theta_mean,
 )
 from peelapprox.kernels import front_rhs as _rhs
 
@@ -62,14 +62,6 @@ def _mean_v(y, n):
     s = 0.0
     for j in range(n):
         s += y[FY_STRIPS + n + j]
-    return s / n
-
-
-@kernel(inline="always")
-def _mean_v_at(y_old, Fc, x, n):
-    s = 0.0
-    for j in range(n):
-        s += interp1(y_old, Fc, x, FY_STRIPS + n + j)
     return s / n
 
 
@@ -150,6 +142,71 @@ def _checks(y, n, opts, st):
     return DONE
 
 
+@kernel(inline="always")
+def _mean_jump(t, h_done, y, y_new, K, P, Fc, tmp, cnt, jbuf, n, v_mid, t_store, dense):
+    """The mean front's jump in the step from (t, y) to y_new, if v̄ crossed v_mid: counted, and stored in jbuf
+    from t_store on; returns whether the dense output is built."""
+    vm0, vm1 = _mean_v(y, n), _mean_v(y_new, n)
+    if (vm0 > v_mid) == (vm1 > v_mid):
+        return dense
+    dense = _dop.ensure_dense(dense, y, y_new, K, h_done, P, Fc, tmp, cnt, C_RHS)
+    x = solve_theta_mean(y, Fc, FY_STRIPS + n, n, v_mid, vm0 - v_mid, 1.0, vm1 - v_mid)
+    tj = t + x * h_done
+    cnt[C_JUMPS] += 1
+    if tj >= t_store:
+        interp(y, Fc, x, tmp)
+        k = cnt[C_NJOUT]
+        jbuf[k, 0] = tj
+        jbuf[k, 1] = 1.0 if vm0 > v_mid else 0.0
+        jbuf[k, 2] = 1.0 if vm1 > v_mid else 0.0
+        jbuf[k, 3] = tmp[FY_ALPHA]
+        jbuf[k, 4] = tmp[FY_OMEGA]
+        sF = 0.0
+        for j in range(n):
+            sF += tmp[FY_STRIPS + j]
+        jbuf[k, 5] = sF / n
+        jbuf[k, 6] = v_mid
+        jbuf[k, 7] = v_mid
+        cnt[C_NJOUT] = k + 1
+    return dense
+
+
+@kernel(inline="always")
+def _local_switches(t, h_done, y, y_new, K, P, Fc, tmp, cnt, lbuf, n, v_mid, t_store, dense):
+    """Every strip whose v_j crossed v_mid in the step: counted, and stored in lbuf from t_store on; returns
+    whether the dense output is built."""
+    for j in range(n):
+        i = FY_STRIPS + n + j
+        if (y[i] > v_mid) != (y_new[i] > v_mid):
+            dense = _dop.ensure_dense(dense, y, y_new, K, h_done, P, Fc, tmp, cnt, C_RHS)
+            x = solve_theta(y, Fc, i, v_mid, y[i] - v_mid, 1.0, y_new[i] - v_mid)
+            cnt[C_LOCAL] += 1
+            tl = t + x * h_done
+            if tl >= t_store:
+                k = cnt[C_NLOUT]
+                lbuf[k, 0] = tl
+                lbuf[k, 1] = j
+                lbuf[k, 2] = 1.0 if y_new[i] > v_mid else 0.0
+                cnt[C_NLOUT] = k + 1
+    return dense
+
+
+@kernel(inline="always")
+def _save_grid(t, t_new, h_done, y, y_new, K, P, Fc, tmp, ye, cnt, st, q, v_mid, t_store, dt_save, out_g, out_y,
+               store_front, dense):
+    """Store the grid points k dt_save in (t, t_new] (from t_store on) from the dense output; returns whether it
+    is built."""
+    while st[S_NEXT_SAVE] * dt_save <= t_new:
+        ts = st[S_NEXT_SAVE] * dt_save
+        if ts >= t_store:
+            dense = _dop.ensure_dense(dense, y, y_new, K, h_done, P, Fc, tmp, cnt, C_RHS)
+            x = (ts - t) / h_done
+            interp(y, Fc, min(max(x, 0.0), 1.0), ye)
+            _store(ts, ye, q, v_mid, out_g, out_y, cnt, store_front)
+        st[S_NEXT_SAVE] += 1.0
+    return dense
+
+
 _A1, _A2 = _t.float64[::1], _t.float64[:, ::1]
 #: The one signature of :func:`run_front` (the law a typed function argument, so the loop is compiled once per
 #: machine and runs every compiled law).
@@ -202,76 +259,12 @@ def run_front(y, st, q, law, coef, atol, opts, out_g, out_y, jbuf, lbuf, cnt, ma
         t_new = t + h_done
         if t_new > t_end or t_end - t_new < 1e-15 * t_end:
             t_new = t_end
-        dense = False
-        # the mean front's jump
-        vm0, vm1 = _mean_v(y, n), _mean_v(y_new, n)
-        if (vm0 > v_mid) != (vm1 > v_mid):
-            dense = _dop.ensure_dense(dense, y, y_new, K, h_done, P, Fc, tmp, cnt, C_RHS)
-            a, b, ga, gb = 0.0, 1.0, vm0 - v_mid, vm1 - v_mid
-            side = 0
-            for _ in range(200):
-                x = (a * gb - b * ga) / (gb - ga)
-                if not (a < x < b):
-                    x = 0.5 * (a + b)
-                gx = _mean_v_at(y, Fc, x, n) - v_mid
-                if gx == 0.0:
-                    a = b = x
-                    break
-                if (gx > 0.0) == (gb > 0.0):
-                    b, gb = x, gx
-                    if side == 1:
-                        ga *= 0.5
-                    side = 1
-                else:
-                    a, ga = x, gx
-                    if side == -1:
-                        gb *= 0.5
-                    side = -1
-                if b - a <= 4e-16:
-                    break
-            x = b if abs(gb) < abs(ga) else a
-            tj = t + x * h_done
-            cnt[C_JUMPS] += 1
-            if tj >= t_store:
-                interp(y, Fc, x, tmp)
-                k = cnt[C_NJOUT]
-                jbuf[k, 0] = tj
-                jbuf[k, 1] = 1.0 if vm0 > v_mid else 0.0
-                jbuf[k, 2] = 1.0 if vm1 > v_mid else 0.0
-                jbuf[k, 3] = tmp[FY_ALPHA]
-                jbuf[k, 4] = tmp[FY_OMEGA]
-                sF = 0.0
-                for j in range(n):
-                    sF += tmp[FY_STRIPS + j]
-                jbuf[k, 5] = sF / n
-                jbuf[k, 6] = v_mid
-                jbuf[k, 7] = v_mid
-                cnt[C_NJOUT] = k + 1
-        # local branch switches
+        dense = _mean_jump(t, h_done, y, y_new, K, P, Fc, tmp, cnt, jbuf, n, v_mid, t_store, False)
         if n > 1:
-            for j in range(n):
-                i = FY_STRIPS + n + j
-                if (y[i] > v_mid) != (y_new[i] > v_mid):
-                    dense = _dop.ensure_dense(dense, y, y_new, K, h_done, P, Fc, tmp, cnt, C_RHS)
-                    x = solve_theta(y, Fc, i, v_mid, y[i] - v_mid, 1.0, y_new[i] - v_mid)
-                    cnt[C_LOCAL] += 1
-                    tl = t + x * h_done
-                    if tl >= t_store:
-                        k = cnt[C_NLOUT]
-                        lbuf[k, 0] = tl
-                        lbuf[k, 1] = j
-                        lbuf[k, 2] = 1.0 if y_new[i] > v_mid else 0.0
-                        cnt[C_NLOUT] = k + 1
-        # output
+            dense = _local_switches(t, h_done, y, y_new, K, P, Fc, tmp, cnt, lbuf, n, v_mid, t_store, dense)
         if dt_save > 0.0:
-            while st[S_NEXT_SAVE] * dt_save <= t_new:
-                ts = st[S_NEXT_SAVE] * dt_save
-                if ts >= t_store:
-                    dense = _dop.ensure_dense(dense, y, y_new, K, h_done, P, Fc, tmp, cnt, C_RHS)
-                    x = (ts - t) / h_done
-                    interp(y, Fc, min(max(x, 0.0), 1.0), ye)
-                    _store(ts, ye, q, v_mid, out_g, out_y, cnt, store_front)
-                st[S_NEXT_SAVE] += 1.0
+            dense = _save_grid(t, t_new, h_done, y, y_new, K, P, Fc, tmp, ye, cnt, st, q, v_mid, t_store, dt_save,
+                               out_g, out_y, store_front, dense)
         elif t_new >= t_store:
             _store(t_new, y_new, q, v_mid, out_g, out_y, cnt, store_front)
         for i in range(y.shape[0]):

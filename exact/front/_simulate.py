@@ -141,8 +141,16 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
     """
     if not isinstance(params, FrontParams):
         raise TypeError(f"params must be a FrontParams, got {type(params).__name__}")
-    fp = params
-    n = fp.N
+    kw = _checked(params.N, t_end, rtol, atol, t_transient, dt_save, store_front, max_values, max_steps, max_local,
+                  max_jumps, max_wall, progress)
+    y = np.ascontiguousarray(_start(params, y0, alpha0, omega0, F0, branch0))
+    return _Run(params, **kw).go(y)
+
+
+def _checked(n: int, t_end: float, rtol: float, atol: Any, t_transient: float, dt_save: float | None,
+             store_front: bool, max_values: int, max_steps: int | None, max_local: int, max_jumps: int,
+             max_wall: float | None, progress: Any) -> dict:
+    """:func:`simulate_front`'s options checked (ValueError/TypeError naming each), as :class:`_Run`'s keywords."""
     t_end = duration("t_end", t_end)
     rt = _rtol("rtol", rtol)
     at = _atol(atol, rt, n)
@@ -166,9 +174,9 @@ def simulate_front(params: FrontParams, t_end: float, *, rtol: float = 1e-8, ato
         progress = None
     elif progress is not None and not callable(progress):
         raise TypeError(f"progress must be None, a bool or a callable (t, t_end), got {type(progress).__name__}")
-    y = np.ascontiguousarray(_start(fp, y0, alpha0, omega0, F0, branch0))
-    return _Run(fp, t_end, rt, at, t_store, dts, store_front, max_values, max_steps, max_local, max_jumps, max_wall,
-                progress).go(y)
+    return dict(t_end=t_end, rtol=rt, atol=at, t_store=t_store, dt_save=dts, store_front=store_front,
+                max_values=max_values, max_steps=max_steps, max_local=max_local, max_jumps=max_jumps,
+                max_wall=max_wall, progress=progress)
 
 
 class _Run:

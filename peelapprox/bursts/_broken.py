@@ -228,6 +228,41 @@ def _single(y: np.ndarray) -> tuple[float, float]:
     return a, y.size * math.log(a - 1.0) - a * s
 
 
+def _bootstrap(y, x0, min_regime, max_candidates, n_bootstrap, rng, deadline, tick) -> list:
+    """``(alpha1, alpha2, x_break)`` of up to ``n_bootstrap`` nonparametric replicates (a replicate without two
+    regimes of ``min_regime`` is skipped)."""
+    boot: list[tuple[float, float, float]] = []
+    for k in range(n_bootstrap):
+        if time.perf_counter() > deadline:
+            break
+        tick(k + 1)
+        yr = np.sort(rng.choice(y, y.size, replace=True))
+        try:
+            b1, b2, bb, *_ = _broken(yr, min_regime, max_candidates)
+        except ValueError:
+            continue
+        boot.append((b1, b2, bb * x0))
+    return boot
+
+
+def _null(y, a_s, lr, min_regime, max_candidates, n_null, rng, deadline, tick) -> tuple[int, int]:
+    """The parametric bootstrap of the likelihood ratio: ``(catalogues with LR* >= lr, catalogues done)``, each
+    drawn from the fitted single law (exponent ``a_s``)."""
+    worse = done = 0
+    for k in range(n_null):
+        if time.perf_counter() > deadline:
+            break
+        tick(k + 1)
+        ys = np.sort(sample_power_law(rng, y.size, a_s, 1.0))
+        try:
+            llb = _broken(ys, min_regime, max_candidates)[3]
+        except ValueError:
+            continue
+        done += 1
+        worse += 2.0 * (llb - _single(ys)[1]) >= lr
+    return worse, done
+
+
 def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: int = 50, n_null: int = 50,
                          seed: int = 0, min_regime: int = 50, max_candidates: int = 40,
                          max_wall: float = 120.0, progress: bool | Callable[[int, int], None] = False
@@ -282,31 +317,10 @@ def fit_broken_power_law(sizes: Any, *, xmin: float | None = None, n_bootstrap: 
     lr = max(2.0 * (ll - ll_s), 0.0)
     rng = np.random.default_rng(seed)
     deadline = t0 + max_wall
-    boot: list[tuple[float, float, float]] = []
-    tick = reporter(progress, "broken-law bootstrap", n_bootstrap)
-    for k in range(n_bootstrap):
-        if time.perf_counter() > deadline:
-            break
-        tick(k + 1)
-        yr = np.sort(rng.choice(y, y.size, replace=True))
-        try:
-            b1, b2, bb, *_ = _broken(yr, min_regime, max_candidates)
-        except ValueError:
-            continue
-        boot.append((b1, b2, bb * x0))
-    worse = done = 0
-    tick = reporter(progress, "broken-law null catalogues", n_null)
-    for k in range(n_null):
-        if time.perf_counter() > deadline:
-            break
-        tick(k + 1)
-        ys = np.sort(sample_power_law(rng, y.size, a_s, 1.0))
-        try:
-            llb = _broken(ys, min_regime, max_candidates)[3]
-        except ValueError:
-            continue
-        done += 1
-        worse += 2.0 * (llb - _single(ys)[1]) >= lr
+    boot = _bootstrap(y, x0, min_regime, max_candidates, n_bootstrap, rng, deadline,
+                      reporter(progress, "broken-law bootstrap", n_bootstrap))
+    worse, done = _null(y, a_s, lr, min_regime, max_candidates, n_null, rng, deadline,
+                        reporter(progress, "broken-law null catalogues", n_null))
     notes = [f"{cands} break candidates; LR p-value by parametric bootstrap ({done} single-law catalogues)"]
     status = 1 if (len(boot) < n_bootstrap or done < n_null) and time.perf_counter() > deadline else 0
     if status:

@@ -252,6 +252,48 @@ def _goodness(x, fit_xmin, alpha, ks, xmin_given, xmax, min_tail, max_candidates
     return (worse / done if done else None), done
 
 
+def _check_options(xmin, xmax, discrete, n_bootstrap, gof_bootstrap, seed, min_tail, max_candidates, max_wall
+                   ) -> tuple:
+    """:func:`fit_power_law`'s options checked (ValueError/TypeError naming the option): ``(xmin, hi,
+    n_bootstrap, gof_bootstrap, seed, min_tail, max_candidates, max_wall)``, ``hi`` the law's upper end."""
+    xmin = optional(positive, "xmin", xmin)
+    hi = math.inf if xmax is None else positive("xmax", xmax)
+    if xmin is not None and hi <= xmin:
+        raise ValueError(f"xmax must be greater than xmin = {xmin!r}, got {xmax!r}")
+    if discrete and xmin is not None and xmin != round(xmin):
+        raise ValueError(f"xmin must be an integer >= 1 with discrete=True, got {xmin!r}")
+    n_bootstrap = integer("n_bootstrap", n_bootstrap, lo=0, hi=100_000)
+    gof_bootstrap = integer("gof_bootstrap", gof_bootstrap, lo=0, hi=100_000)
+    if gof_bootstrap and discrete:
+        raise ValueError("gof_bootstrap must be 0 with discrete=True (the goodness-of-fit test samples a "
+                         "continuous law)")
+    seed = integer("seed", seed, lo=0, hi=2**63 - 1)
+    min_tail = integer("min_tail", min_tail, lo=5, hi=10**9)
+    max_candidates = integer("max_candidates", max_candidates, lo=2, hi=MAX_XMIN_CANDIDATES)
+    max_wall = in_range("max_wall", max_wall, 0.0, 1e6, lo_open=True)
+    return xmin, hi, n_bootstrap, gof_bootstrap, seed, min_tail, max_candidates, max_wall
+
+
+def _notes(x, discrete, n_tail, status, max_wall, n_done, n_bootstrap, n_gof, gof_bootstrap, min_tail, fxmin,
+           alpha) -> list[str]:
+    """The sentences of a :class:`PowerLawFit`'s ``message``."""
+    notes = [f"{'discrete' if discrete else 'continuous'} maximum likelihood on {n_tail} of {x.size} sizes"]
+    if status:
+        notes.append(f"max_wall = {max_wall:g} s reached: {n_done} of {n_bootstrap} bootstrap and {n_gof} of "
+                     f"{gof_bootstrap} goodness-of-fit replicates done")
+    if not status and n_done < n_bootstrap:
+        notes.append(f"{n_bootstrap - n_done} of {n_bootstrap} bootstrap replicates had no fit (no tail of "
+                     f"min_tail = {min_tail} sizes) and are left out")
+    if n_bootstrap and n_done < MIN_BOOTSTRAP:
+        notes.append(f"no intervals: {n_done} bootstrap replicates, fewer than {MIN_BOOTSTRAP}")
+    if not discrete and fxmin < 6 and np.all(x == np.round(x)):
+        notes.append("the sizes are all integers and xmin < 6: the continuous law misfits counts there (CSN "
+                     "Sec. 3.5); consider discrete=True")
+    if any(abs(alpha - b) < 1e-6 for b in ALPHA_BOUNDS):
+        notes.append(f"alpha on the search bound {ALPHA_BOUNDS}: the tail is not a power law in that range")
+    return notes
+
+
 def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None = None, discrete: bool = False,
                   n_bootstrap: int = 100, gof_bootstrap: int = 0, seed: int = 0, min_tail: int = 50,
                   max_candidates: int = 100, max_wall: float = 60.0,
@@ -298,21 +340,8 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
     t0 = time.perf_counter()
     discrete = flag("discrete", discrete)
     x = _sizes(sizes, discrete)
-    xmin = optional(positive, "xmin", xmin)
-    hi = math.inf if xmax is None else positive("xmax", xmax)
-    if xmin is not None and hi <= xmin:
-        raise ValueError(f"xmax must be greater than xmin = {xmin!r}, got {xmax!r}")
-    if discrete and xmin is not None and xmin != round(xmin):
-        raise ValueError(f"xmin must be an integer >= 1 with discrete=True, got {xmin!r}")
-    n_bootstrap = integer("n_bootstrap", n_bootstrap, lo=0, hi=100_000)
-    gof_bootstrap = integer("gof_bootstrap", gof_bootstrap, lo=0, hi=100_000)
-    if gof_bootstrap and discrete:
-        raise ValueError("gof_bootstrap must be 0 with discrete=True (the goodness-of-fit test samples a "
-                         "continuous law)")
-    seed = integer("seed", seed, lo=0, hi=2**63 - 1)
-    min_tail = integer("min_tail", min_tail, lo=5, hi=10**9)
-    max_candidates = integer("max_candidates", max_candidates, lo=2, hi=MAX_XMIN_CANDIDATES)
-    max_wall = in_range("max_wall", max_wall, 0.0, 1e6, lo_open=True)
+    xmin, hi, n_bootstrap, gof_bootstrap, seed, min_tail, max_candidates, max_wall = _check_options(
+        xmin, xmax, discrete, n_bootstrap, gof_bootstrap, seed, min_tail, max_candidates, max_wall)
     reporter(progress, "", 0)  # checks progress before the work
 
     fxmin, alpha, ks, n_tail, cands, nev = _estimate(x, xmin, hi, discrete, min_tail, max_candidates)
@@ -326,23 +355,11 @@ def fit_power_law(sizes: Any, *, xmin: float | None = None, xmax: float | None =
     if gof_bootstrap:
         gof_p, n_gof = _goodness(x, fxmin, alpha, ks, xmin, hi, min_tail, max_candidates, gof_bootstrap, rng,
                                  deadline, reporter(progress, "goodness of fit", gof_bootstrap))
-    notes = [f"{'discrete' if discrete else 'continuous'} maximum likelihood on {n_tail} of {x.size} sizes"]
     cut = alphas.size < n_bootstrap or n_gof < gof_bootstrap
     status = 1 if time.perf_counter() > deadline and cut else 0
-    if status:
-        notes.append(f"max_wall = {max_wall:g} s reached: {alphas.size} of {n_bootstrap} bootstrap and {n_gof} of "
-                     f"{gof_bootstrap} goodness-of-fit replicates done")
-    if not status and alphas.size < n_bootstrap:
-        notes.append(f"{n_bootstrap - alphas.size} of {n_bootstrap} bootstrap replicates had no fit (no tail of "
-                     f"min_tail = {min_tail} sizes) and are left out")
+    notes = _notes(x, discrete, n_tail, status, max_wall, alphas.size, n_bootstrap, n_gof, gof_bootstrap, min_tail,
+                   fxmin, alpha)
     enough = alphas.size >= MIN_BOOTSTRAP
-    if n_bootstrap and not enough:
-        notes.append(f"no intervals: {alphas.size} bootstrap replicates, fewer than {MIN_BOOTSTRAP}")
-    if not discrete and fxmin < 6 and np.all(x == np.round(x)):
-        notes.append("the sizes are all integers and xmin < 6: the continuous law misfits counts there (CSN "
-                     "Sec. 3.5); consider discrete=True")
-    if any(abs(alpha - b) < 1e-6 for b in ALPHA_BOUNDS):
-        notes.append(f"alpha on the search bound {ALPHA_BOUNDS}: the tail is not a power law in that range")
     pct = (2.5, 97.5)
     return PowerLawFit(
         alpha=float(alpha), xmin=float(fxmin), xmax=None if xmax is None else hi, discrete=discrete, n=int(x.size),
