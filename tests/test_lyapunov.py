@@ -18,6 +18,25 @@ from peelapprox import PeelParams
 P = PeelParams(V=1.0, I=1e-3)  # period 5-ish stick-slip, ~20 jumps/s: short runs see several jumps
 
 
+def _forbid_runs(monkeypatch) -> None:
+    """Every method's runner replaced by one that fails the test: a refusal "before any run" is then checked
+    as such, not by a wall-clock bound (which a loaded machine can break, and a short run can meet)."""
+    import exact.dynamics._lyapunov as L
+    import exact.dynamics._variational as V
+
+    def ran(*args, **kwargs):
+        raise AssertionError("a Lyapunov run started")
+
+    for module, name in ((L, "_two_trajectory"), (L, "_tangent"), (L, "_return_map"), (V, "lyapunov_variational")):
+        monkeypatch.setattr(module, name, ran)
+
+
+@pytest.fixture
+def no_run(monkeypatch):
+    """:func:`_forbid_runs` for the whole test."""
+    _forbid_runs(monkeypatch)
+
+
 def test_default_method_is_the_two_trajectory_lyapunov_that_peelapprox_offers():
     """Hypothesis: ``peelapprox.lyapunov`` is ``exact.lyapunov`` (identity), its default method is
     "two-trajectory" with today's defaults (read from the signature: t_transient 30 s, alpha0 0, max_wall
@@ -77,20 +96,18 @@ def test_unknown_method_lists_the_methods():
     ("variational", "n_returns", "return-map"),
     ("tangent", "window", None),
 ])
-def test_an_option_of_another_method_is_refused_by_name(method, option, owner):
+def test_an_option_of_another_method_is_refused_by_name(no_run, method, option, owner):
     """Hypothesis: an option the chosen method does not take raises before any run a TypeError (also a
     ValueError, peelapprox's ArgumentTypeError) naming the option, the chosen method and, when it is another
     method's option, that method (substrings; categorical).  The variational case needs no pydiffsol: the
     check comes first.  (T is now also an option of two-trajectory, so the row that refused T for
     two-trajectory asks return-map, the one method without T.)"""
-    t0 = time.perf_counter()
-    with pytest.raises(TypeError) as ei:
+    with pytest.raises(TypeError) as ei:  # refused up front: no_run fails the test if a run starts
         lyapunov(P, method, **{option: 1})
     assert isinstance(ei.value, ValueError)
     msg = str(ei.value)
     assert repr(option) in msg and f"method={method!r}" in msg
     assert (repr(owner) in msg) if owner else "no method" in msg
-    assert time.perf_counter() - t0 < 1.0  # refused up front, not after a run
 
 
 @pytest.mark.parametrize("method, kw, name", [
@@ -156,7 +173,7 @@ def test_variational_method_refuses_a_bad_eps_and_equals_lyapunov_variational():
     assert (a.per_s, a.stderr_bits, a.n_jumps, a.notes) == (b.per_s, b.stderr_bits, b.n_jumps, b.notes)
 
 
-def test_two_trajectory_T_is_round_T_over_tau_intervals_and_excludes_n():
+def test_two_trajectory_T_is_round_T_over_tau_intervals_and_excludes_n(monkeypatch):
     """``T`` (measured seconds) is common to the methods that measure a time.  Hypothesis: for
     two-trajectory ``T`` runs ``n = max(2, round(T/tau))`` intervals, bitwise the run with that ``n`` (0.1 s is
     20 intervals of 0.005 s; 0.0124 s rounds to 2); giving both ``T`` and ``n`` is a ValueError naming both,
@@ -167,20 +184,18 @@ def test_two_trajectory_T_is_round_T_over_tau_intervals_and_excludes_n():
     assert list(a.benettin.running) == list(b.benettin.running)
     c, d = lyapunov(P, T=0.0124, **kw), lyapunov(P, n=2, **kw)
     assert (c.per_s, c.n_jumps) == (d.per_s, d.n_jumps)
-    t0 = time.perf_counter()
+    _forbid_runs(monkeypatch)  # the runs above done: from here a run fails the test (refused before any run)
     with pytest.raises(ValueError, match=r"T .*n .*not both") as ei:
         lyapunov(P, T=1.0, n=200)
     assert "T=1.0" in str(ei.value) and "n=200" in str(ei.value)
-    assert time.perf_counter() - t0 < 1.0
 
 
-def test_check_lyapunov_options_checks_without_running():
+def test_check_lyapunov_options_checks_without_running(no_run):
     """Hypothesis: ``exact.check_lyapunov_options(method, **options)`` returns the method and raises the
     errors ``lyapunov`` would raise for the options (bad eps, T with n, another method's option, unknown
-    method), in well under a second and without pydiffsol (categorical; messages by substring)."""
+    method), without running (``no_run``) and without pydiffsol (categorical; messages by substring)."""
     from exact import check_lyapunov_options
 
-    t0 = time.perf_counter()
     assert check_lyapunov_options("variational", eps=1e-7, T=5.0, progress=None) == "variational"
     assert check_lyapunov_options() == "two-trajectory"
     with pytest.raises(ValueError, match=r"^eps must be finite and in \[1e-15, 0.01\], got 1e-30"):
@@ -191,7 +206,6 @@ def test_check_lyapunov_options_checks_without_running():
         check_lyapunov_options("tangent", n_returns=10)
     with pytest.raises(ValueError, match="method must be one of"):
         check_lyapunov_options("saltation")
-    assert time.perf_counter() - t0 < 1.0
 
 
 def test_return_map_takes_alpha0_like_the_dispatcher():
