@@ -48,9 +48,10 @@ def simulate(params: PeelParams, t_end: float, *, alpha0: float = 0.0, omega0: f
     Parameters
     ----------
     params : PeelParams
-        Physical parameters, the ``cos θ`` closure (``geometry``), the law ``force`` (any :class:`peelapprox.PeelForce`: the paper's fvV, a family, an expression, a table,
-        a smoothed law) and the variant fields
-        (``tape_mass``, ``loading``), which pick the model (``exact.MODELS``) unless ``model`` is given.
+        Physical parameters, the ``cos θ`` closure (``geometry``), the law ``force`` (any
+        :class:`peelapprox.PeelForce`: the paper's fvV, a family, an expression, a table, a smoothed law) and
+        the variant fields (``tape_mass``, ``loading``), which pick the model (``exact.MODELS``) unless
+        ``model`` is given.
     t_end : float
         Final time [s], in (0, TIME_MAX] = (0, 1e6].
     alpha0, omega0, F0, branch0 : optional
