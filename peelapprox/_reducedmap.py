@@ -90,7 +90,7 @@ class ReturnMap:
                                    -1.0 if pl.t_max is None else pl.t_max, pl.max_steps, fold, kick, up]
                                   for pl, fold, kick, up in ((self.plans[0], self.fold[1], self.kick[1], 1.0),
                                                              (self.plans[1], self.fold[0], self.kick[0], 0.0))])
-            self.kernel = RK.returns(not law.inlined)
+            self.loop = RK.returns(not law.inlined)
 
     def at(self, rtol: float) -> ReturnMap:
         """This map with its segments at the tolerance ``rtol`` (the same plans otherwise, not built again)."""
@@ -176,7 +176,7 @@ class ReturnMap:
         while len(out) < n:
             if time.perf_counter() > self.deadline:
                 raise MapStop(None, None, self.returns, timeout=True)
-            self.kernel(x, n - len(out), pl[0].q, pl[1].q, self.rows, pl[0].law_arg, pl[0].law.coef, self.rtol,
+            self.loop(x, n - len(out), pl[0].q, pl[1].q, self.rows, pl[0].law_arg, pl[0].law.coef, self.rtol,
                         self.horizon, STEP_CAP, rows, info, stop)
             done = int(info[RK.I_DONE])
             self.returns += done
