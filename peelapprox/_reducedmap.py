@@ -11,7 +11,8 @@ fixed points are comparable with :func:`exact.periodic_orbit`'s.
 
 A period-n orbit is a zero of ``P^n(x) - x``, found by Newton with a finite-difference Jacobian (central
 differences, step :data:`FD_STEP` of the orbit's scale, at :data:`NEWTON_RTOL`); its multipliers are the
-eigenvalues of that Jacobian.
+eigenvalues of that Jacobian.  :func:`envelope` measures a section point's deviation from an unstable orbit in that
+Jacobian's dominant eigen-coordinates (the amplitude of its escape law).
 """
 
 from __future__ import annotations
@@ -261,3 +262,23 @@ def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | Non
     except MapStop:
         return None
     return None
+
+
+def envelope(m: ReturnMap, J: np.ndarray, x: np.ndarray, xs: np.ndarray) -> float:
+    """The envelope of the AB→CD force's deviation from the orbit through ``xs`` of the section point ``x``: its
+    amplitude in the dominant eigen-coordinates of ``J = D P^n`` (a complex pair's plane, where the deviation turns
+    by arg μ per period, or a real μ's left eigenvector) times the force's gradient along them.  One return's force
+    deviation samples one phase of a turning deviation and may be far below the envelope that reaches the escape:
+    with it 3 of the escape benchmark's 10 predictions were within 20 % of the exact escape, with the envelope 6,
+    and 10 with the envelope and the exact orbit's |μ| (``python -m comparisons.benchmark.approx_targets --seed 1
+    --points 100 --escapes 10``)."""
+    mu, W = np.linalg.eig(J)
+    i = int(np.argmax(np.abs(mu)))
+    h = 1e-7
+    g = np.array([(m.force(0, float(xs[0]) + h) - m.force(0, float(xs[0]) - h)) / (2.0 * h), 0.0])
+    d = np.asarray(x, dtype=float) - xs
+    if abs(mu[i].imag) > 1e-12 * abs(mu[i]):
+        B = np.column_stack([W[:, i].real, W[:, i].imag])
+        return float(np.linalg.norm(g @ B) * np.linalg.norm(np.linalg.solve(B, d)))
+    left = np.linalg.inv(W.real)[i]
+    return float(abs(g @ W.real[:, i]) * abs(left @ d))
