@@ -35,7 +35,7 @@ from ._approx_result import ALPHA_LINEAR, MULTIPLIER_ERROR, ApproximateAttractor
 from ._observables import StickSlipObservables, jump_statistics
 from ._params import PeelParams
 from ._ranges import F0_FACTOR
-from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, newton
+from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, envelope, newton
 from ._regime import regime
 from ._segment import SegmentPlan, segment_status
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
@@ -311,26 +311,6 @@ def _deviation(recs: list[tuple], orbit: list[tuple], n: int) -> float:
     return max(abs(recs[-i][0] - orbit[(n - i) % n][0]) for i in range(1, n + 1))
 
 
-def _envelope(m: ReturnMap, J: np.ndarray, x: np.ndarray, xs: np.ndarray) -> float:
-    """The envelope of the AB→CD force's deviation from the orbit through ``xs`` of the section point ``x``: its
-    amplitude in the dominant eigen-coordinates of ``J = D P^n`` (a complex pair's plane, where the deviation turns
-    by arg μ per period, or a real μ's left eigenvector) times the force's gradient along them.  One return's force
-    deviation samples one phase of a turning deviation and may be far below the envelope that reaches the escape:
-    with it 3 of the escape benchmark's 10 predictions were within 20 % of the exact escape, with the envelope 6,
-    and 10 with the envelope and the exact orbit's |μ| (``python -m comparisons.benchmark.approx_targets --seed 1
-    --points 100 --escapes 10``)."""
-    mu, W = np.linalg.eig(J)
-    i = int(np.argmax(np.abs(mu)))
-    h = 1e-7
-    g = np.array([(m.force(0, float(xs[0]) + h) - m.force(0, float(xs[0]) - h)) / (2.0 * h), 0.0])
-    d = np.asarray(x, dtype=float) - xs
-    if abs(mu[i].imag) > 1e-12 * abs(mu[i]):
-        B = np.column_stack([W[:, i].real, W[:, i].imag])
-        return float(np.linalg.norm(g @ B) * np.linalg.norm(np.linalg.solve(B, d)))
-    left = np.linalg.inv(W.real)[i]
-    return float(abs(g @ W.real[:, i]) * abs(left @ d))
-
-
 def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: list[tuple], name: str, chain: str,
             common: dict[str, Any], rtol: float = CANDIDATE_RTOL
             ) -> tuple[ApproximateAttractor, list[tuple], float, tuple[np.ndarray, np.ndarray], int] | None:
@@ -369,7 +349,7 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
                 return _Found(obs, left, _alpha_max(orbit))
             rho, dev, thr = max(abs(m) for m in obs.multipliers or ()), _deviation(recs, orbit, n), \
                 ESCAPE_FRACTION * drop
-            amp = _envelope(lo, J, x, xs)
+            amp = envelope(lo, J, x, xs)
             k_esc = lo.returns + (n * math.log(thr / amp) / math.log(rho) if 0.0 < amp < thr else 0.0)
             left.append(dataclasses.replace(obs, escape_returns=k_esc))
             if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
