@@ -46,7 +46,7 @@ from peelapprox.parallel import map_points
 from .ensemble import FrontEnsemble, front_ensemble, inertia_of_ratio
 from .measure import FRONT_DEFAULTS, measure_front
 
-__all__ = ["SIZES", "PATTERN_COLOURS", "run_report", "burst_stability", "exponent_table", "main"]
+__all__ = ["SIZES", "PATTERN_COLOURS", "run_report", "burst_stability", "exponent_table", "cost_sample", "main"]
 
 #: The report's sizes.  ``small``: a few minutes on 2 loaded cores; ``full``: 16 cores for ~4 minutes
 #: (docs/peel-front.md, "Reproduction": the CPU seconds per run measured on the small size).
@@ -343,6 +343,23 @@ def _markdown(cfg: dict, size: str, ens: FrontEnsemble, pats: list, exps: list, 
     ])
 
 
+def cost_sample(size: str, n: int = 24, *, seed: int = 39) -> dict:
+    """The CPU seconds of ``n`` of the ensemble's runs of ``SIZES[size]`` drawn at random (``seed``), run here one
+    after the other: their mean, SD, largest, and the ensemble's total estimated as mean × runs with its SE."""
+    cfg = SIZES[size]
+    grid = [(rm, V, g, s) for rm in cfg["r_m"] for V in cfg["V"] for g in cfg["gammas"] for s in cfg["seeds"]]
+    cpu = []
+    for k in np.random.default_rng(seed).choice(len(grid), min(n, len(grid)), replace=False):
+        rm, V, g, s = grid[k]
+        rec = measure_front(PeelParams(V=V, I=inertia_of_ratio(rm, TAPE_MASS, RADIUS), tape_mass=TAPE_MASS, R=RADIUS),
+                            {**cfg["options"], "front_gamma": g, "front_seed": s})
+        cpu.append(rec["cpu_s"])
+    c = np.asarray(cpu)
+    sd = float(np.std(c, ddof=1)) if c.size > 1 else 0.0
+    return {"runs": len(grid), "sampled": int(c.size), "mean_s": float(c.mean()), "sd_s": sd, "max_s": float(c.max()),
+            "total_s": len(grid) * float(c.mean()), "total_se_s": len(grid) * sd / math.sqrt(c.size)}
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m comparisons.front``: the report (module docstring)."""
     ap = argparse.ArgumentParser(prog="python -m comparisons.front", description=__doc__.split("\n\n")[0])
@@ -351,7 +368,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--work", default=None, help="directory of the ensemble's sweeps (resumable)")
     ap.add_argument("--workers", type=int, default=None, help="local pool size (0: this process)")
     ap.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    ap.add_argument("--cost-sample", type=int, default=0, metavar="N",
+                    help="only time N randomly drawn runs of the size's ensemble here and estimate its CPU seconds")
     a = ap.parse_args(argv)
+    if a.cost_sample:
+        c = cost_sample(a.size, a.cost_sample)
+        print(f"{c['sampled']} of {c['runs']} runs: mean {c['mean_s']:.3f} CPU s (SD {c['sd_s']:.3f}, max "
+              f"{c['max_s']:.2f}); the ensemble ~{c['total_s']:.0f} +- {c['total_se_s']:.0f} CPU s")
+        return 0
     s = run_report(a.size, a.out, work=a.work, max_workers=a.workers, progress=not a.quiet)
     print(f"front report ({a.size}): {s['runs']} runs, wall {s['wall_s']:.1f} s, runs' CPU {s['cpu_s_runs']:.1f} s "
           f"({s['cpu_s_per_run']:.2f} s a run), chaotic V {s['chaotic_V']}; files in {a.out}", file=sys.stderr)
