@@ -255,6 +255,15 @@ def make_dop853(rhs) -> Dop853:
     def jit(fn):
         return kernel(fn, name=f"{fn.__name__}__{tag}", inner=True)
 
+    dense = jit(_dense_for(rhs))
+    pieces = Dop853(f"dop853__{tag}")
+    pieces.initial_step, pieces.step, pieces.dense, pieces.ensure_dense = (
+        jit(_initial_step_for(rhs)), jit(_step_for(rhs)), dense, jit(_ensure_dense_for(dense)))
+    return pieces
+
+
+# The pieces' Python functions, closed over the field (numba freezes a closure's free variables as globals).
+def _initial_step_for(rhs):
     def initial_step(y0, f0, p, rtol, atol, work):
         n = y0.shape[0]
         sc = work[0]
@@ -286,6 +295,10 @@ def make_dop853(rhs) -> Dop853:
             h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
         return min(100.0 * h0, h1)
 
+    return initial_step
+
+
+def _step_for(rhs):
     def step(y, f0, h, p, rtol, atol, K, y_new, tmp, sc):
         n = y.shape[0]
         rejected = False
@@ -335,6 +348,10 @@ def make_dop853(rhs) -> Dop853:
             if n_rej > MAX_REJECTIONS or h <= 1e-300:
                 return STEP_FAILED, h, h, n_rej, n_rhs
 
+    return step
+
+
+def _dense_for(rhs):
     def dense(y_old, y_new, K, h, p, Fc, tmp):
         n = y_old.shape[0]
         for si in range(_NX - _NS - 1):
@@ -353,18 +370,17 @@ def make_dop853(rhs) -> Dop853:
                     acc += _D[r, j] * K[j, i]
                 Fc[3 + r, i] = h * acc
 
-    dense_j = jit(dense)
+    return dense
 
+
+def _ensure_dense_for(dense_j):
     def ensure_dense(done, y_old, y_new, K, h, p, Fc, tmp, cnt, i_rhs):
         if not done:
             dense_j(y_old, y_new, K, h, p, Fc, tmp)
             cnt[i_rhs] += _NX - _NS - 1
         return True
 
-    pieces = Dop853(f"dop853__{tag}")
-    pieces.initial_step, pieces.step, pieces.dense, pieces.ensure_dense = (jit(initial_step), jit(step), dense_j,
-                                                                          jit(ensure_dense))
-    return pieces
+    return ensure_dense
 
 
 def _cache_tag(rhs) -> str:

@@ -64,10 +64,10 @@ from dataclasses import dataclass, field
 from typing import Any, NamedTuple, cast
 
 import numpy as np
-from numba.experimental.function_type import _get_wrapper_address as _wrapper_address
 
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, _wkb_match
+from ._jit import wrapper_address as _wrapper_address
 from ._packing import model_block
 from ._params import PeelParams
 from ._ranges import TIME_MAX

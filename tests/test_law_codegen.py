@@ -1,4 +1,4 @@
-"""Compiled peel-force laws generated from one symbolic source: peelapprox.law._render, _kernels and codegen.
+"""Compiled peel-force laws generated from one symbolic source: peelapprox._render, law._kernels and law.codegen.
 
 Oracles: the families' formulas written a second time here by hand (f, f', f'' in closed form, as the numpy
 evaluators of ``_law_families`` were before they were generated) and evaluated at 30 digits (mpmath); the
@@ -28,9 +28,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
+import peelapprox._render as R
+import peelapprox._symbolic as S
 import peelapprox.law._cache as LC
 import peelapprox.law._kernels as C
-import peelapprox.law._render as R
 import peelapprox.law.codegen as CG
 from peelapprox import PeelForce
 from peelapprox.errors import KernelCacheWarning
@@ -106,6 +107,22 @@ def test_generated_laws_module_is_fresh():
     """Hypothesis: peelapprox/law/_generated.py is exactly what render_module() produces now (exact string
     equality, as tests/test_symbolic.py for _generated.py): regenerate with ``python -m peelapprox.law.codegen``."""
     assert CG.render_module() == (ROOT / "peelapprox" / "law" / "_generated.py").read_text()
+
+
+def test_one_command_writes_both_generated_modules(tmp_path, monkeypatch):
+    """Hypothesis: ``write_modules`` (the command ``python -m peelapprox.law.codegen``) writes the model's kernels
+    and the families' laws, each exactly its renderer's text (string equality), through the one renderer."""
+    written = {}
+    monkeypatch.setattr(R, "write_module", lambda path, text: written.setdefault(Path(path), text))
+    CG.write_modules()
+    assert written == {Path(S.__file__).with_name("_generated.py"): S.render_module(),
+                       Path(CG.__file__).with_name("_generated.py"): CG.render_module()}
+
+
+def test_the_renderers_forms_are_the_abis():
+    """Hypothesis: the forms the renderer hard-codes (it imports nothing of the law, which sits above it) are
+    the ABI's ``LAW_LNV``, ``LAW_FP``, ``LAW_FPP`` (exact tuple equality)."""
+    assert R.FORMS == (LAW_LNV, LAW_FP, LAW_FPP)
 
 
 def test_rendering_does_not_depend_on_the_hash_seed():

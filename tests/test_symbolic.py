@@ -26,7 +26,7 @@ def test_generated_module_is_fresh():
     """Hypothesis: peelapprox/_generated.py is exactly what render_module() produces now.
 
     Tolerance: none (exact string equality).  Any edit of the sympy source that
-    is not followed by ``python -m peelapprox._symbolic`` fails here.  (The
+    is not followed by ``python -m peelapprox.law.codegen`` fails here.  (The
     rendering depends on the sympy version's printer and CSE; a sympy upgrade
     that changes the text is also reported, which is intended: regenerate and
     review the diff.)

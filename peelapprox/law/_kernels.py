@@ -1,7 +1,7 @@
 """The compiled laws of the families and of expression laws: compiled on first use, expressions cached on disk.
 
 :func:`family_kernel` compiles a family's law from :mod:`peelapprox.law._generated` (numba's on-disk cache: once
-per machine).  :func:`expression_kernel` renders an expression law (:func:`peelapprox.law._render.render_law`)
+per machine).  :func:`expression_kernel` renders an expression law (:func:`peelapprox._render.render_law`)
 into a module of the user's private cache directory (``PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``;
 :mod:`peelapprox.law._cache`), named by the SHA-256 of its canonical text and :func:`codegen_version` (a changed
 expression or renderer is a new file, never a stale kernel), written atomically, built from the text rendered
@@ -22,13 +22,14 @@ from typing import Any
 
 import numpy as np
 
+from .. import _render
 from .._checks import shown
 from .._deadline import LAW_BUILD_SECONDS, Expired, time_limit
 from .._jit import kernel
+from .._render import CODEGEN_VERSION, render_law
 from ..errors import KernelCacheWarning
 from ._abi import LAW_SIG
 from ._cache import cache_dir, law_dir, read_verified, write_atomic
-from ._render import CODEGEN_VERSION, render_law
 
 __all__ = ["cache_dir", "codegen_version", "expression_kernel", "expression_source", "family_kernel"]
 
@@ -71,11 +72,11 @@ _EXPRESSION_KERNELS: dict[str, tuple[Any, Callable]] = {}
 
 
 def codegen_version() -> str:
-    """:data:`~peelapprox.law._render.CODEGEN_VERSION` and the first 12 hex digits of the SHA-256 of the renderer,
+    """:data:`~peelapprox._render.CODEGEN_VERSION` and the first 12 hex digits of the SHA-256 of the renderer,
     this file and :mod:`peelapprox.law._symbolic` (a changed renderer gives new file names: no stale kernel)."""
     h = hashlib.sha256()
-    for f in ("_render.py", "_kernels.py", "_symbolic.py"):
-        h.update(Path(__file__).with_name(f).read_bytes())
+    for f in (Path(_render.__file__), Path(__file__), Path(__file__).with_name("_symbolic.py")):
+        h.update(f.read_bytes())
     return f"{CODEGEN_VERSION}-{h.hexdigest()[:12]}"
 
 

@@ -1,8 +1,15 @@
-"""The rendering of a peel-force law from its symbolic form into Python source of the compiled laws' ABI.
+"""The one renderer of generated code: sympy expressions into plain Python on numpy functions.
 
-:func:`render_law` turns a law ``f(v, V; c)`` (sympy, :mod:`peelapprox.law._symbolic`) into the Python source of
-a law of the ABI of :mod:`peelapprox.law._abi` — ``law(x, coef, form) -> (f8, f8, f8)`` — and of its packing
-``pack(V, c) -> coef``.  The rendering:
+Both generated modules and every expression law come from here: the model's kernels
+(:func:`render_function`, into ``peelapprox/_generated.py`` from :mod:`peelapprox._symbolic`), the families'
+laws (:func:`render_law`, into ``peelapprox/law/_generated.py``) and a user's expression law (compiled at run
+time by ``peelapprox/law/_kernels.py``); :func:`render_module` joins a header and functions into a module's
+text and :func:`write_module` writes it.  ``python -m peelapprox.law.codegen`` regenerates both modules.
+
+:func:`render_law` turns a law ``f(v, V; c)`` (sympy, in the symbols ``v``, ``V`` of
+:mod:`peelapprox.law._symbolic`) into the Python source of a law of the compiled laws' ABI
+(``peelapprox/law/_abi.py``) — ``law(x, coef, form) -> (f8, f8, f8)`` — and of its packing ``pack(V, c) -> coef``.
+The rendering:
 
 * **u = ln v.**  Every power of v with a non-integer exponent becomes ``exp(p u)`` (a half-integer one
   ``v^k s`` with ``s = sqrt v``, cheaper) and ``ln v`` becomes ``u`` (integer powers stay products).  The law
@@ -15,36 +22,38 @@ a law of the ABI of :mod:`peelapprox.law._abi` — ``law(x, coef, form) -> (f8, 
   of ``coef``, computed once by ``pack`` when a run is packed.  The kernel does no arithmetic on V or the
   coefficients alone; numbers stay literals.  The entries are numbered in sympy's canonical order, and each
   law's docstring lists them (``coef = pack(V, c) = [...]``): that is the coef layout.
-* **One code path, CSE** over f, v f', f', f'' (as :mod:`peelapprox._symbolic` does): f, then the return of
-  ``LAW_LNV`` with v f', then f' and the return of ``LAW_FP``, then f''; floats are printed exactly (``repr``).
+* **One code path, CSE** over f, v f', f', f'' (as :func:`render_function` does for the model): f, then the
+  return of ``LAW_LNV`` with v f', then f' and the return of ``LAW_FP``, then f''; floats are printed exactly
+  (``repr``).
 
-sympy is imported when a law is rendered, not with this module.
+This module imports nothing of the package (it sits below the law, which compiles expression laws with it);
+the forms it hard-codes are the ABI's (a test checks :data:`FORMS` against ``peelapprox/law/_abi.py``).
+sympy is imported when something is rendered, not with this module.
 """
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
-from ._abi import LAW_FP, LAW_FPP, LAW_LNV
-
-__all__ = ["CODEGEN_VERSION", "render_law"]
+__all__ = ["CODEGEN_VERSION", "FORMS", "render_function", "render_law", "render_module", "write_module"]
 
 #: Bump when the rendering changes what a law computes (the file's own hash is in
 #: :func:`peelapprox.law._kernels.codegen_version` too).
 CODEGEN_VERSION = "law-codegen-1"
-#: The forms hard-coded in the rendered source (0, 1, 2), checked against the ABI's.
-_FORMS = (LAW_LNV, LAW_FP, LAW_FPP)
-assert _FORMS == (0, 1, 2), _FORMS
+#: The forms hard-coded in the rendered laws: ``LAW_LNV``, ``LAW_FP``, ``LAW_FPP`` of the ABI.
+FORMS = (0, 1, 2)
 #: Names a coefficient may not take (the kernel's and pack's own).
 _RESERVED = {"x", "coef", "form", "v", "u", "s", "V", "numpy", "cs"}
 _GENERATED_NAME = re.compile(r"^[wt]\d+$")
 
 
-
 # ---------------------------------------------------------------------------------------------- rendering
-def _printer() -> Any:
+def _printer(exact: bool = True) -> Any:
+    """sympy's numpy printer; ``exact``: floats as ``repr`` and negative integer powers as ``1.0/...`` (the laws)."""
     from sympy.printing.numpy import NumPyPrinter
 
     class _Printer(NumPyPrinter):
@@ -59,9 +68,48 @@ def _printer() -> Any:
                 return f"(1.0/{self.parenthesize(base, 1000)})" if base.is_Pow else f"(1.0/{self._print(base)})"
             return super()._print_Pow(expr, rational=rational)
 
-    return _Printer({"fully_qualified_modules": True, "inline": True})
+    return (_Printer if exact else NumPyPrinter)({"fully_qualified_modules": True, "inline": True})
 
 
+# ------------------------------------------------------------------------------------------ the model's kernels
+def render_function(name: str, args: Sequence[str], exprs: Sequence[Any], doc: str,
+                    out_names: Sequence[str] | None = None, prelude: Sequence[tuple[Any, Any]] = (),
+                    extra_outs: Sequence[str] = ()) -> str:
+    """Python source of ``def name(*args)`` returning ``exprs`` after common-subexpression elimination.
+
+    ``prelude`` lines ``sym = expr`` come first (the CSE symbols are ``x0, x1, ...``); the outputs are named
+    ``out_names`` (default ``r0, r1, ...``) and returned after ``extra_outs`` (names the prelude defines).  A
+    numeric output is printed as a float (numba then types the tuple homogeneously).  sympy's numpy printer.
+    """
+    import sympy as sp
+
+    printer = _printer(exact=False)
+    repl, red = sp.cse(list(exprs), symbols=sp.numbered_symbols("x"), optimizations="basic")
+    lines = [f"def {name}({', '.join(args)}):", f'    """{doc}"""']
+    lines += [f"    {sym} = {printer.doprint(e)}" for sym, e in prelude]
+    for sym, e in repl:
+        lines.append(f"    {sym} = {printer.doprint(e)}")
+    outs = list(out_names or [f"r{i}" for i in range(len(red))])
+    for o, e in zip(outs, red):
+        e = sp.Float(e) if e.is_Number else e  # homogeneous float tuples for numba
+        lines.append(f"    {o} = {printer.doprint(e)}")
+    ret = ", ".join(list(extra_outs) + outs)
+    lines.append(f"    return {ret}" + ("," if len(outs) + len(extra_outs) == 1 else ""))
+    return "\n".join(lines) + "\n"
+
+
+def render_module(header: str, functions: Sequence[str]) -> str:
+    """A generated module's text: its ``header`` (docstring and imports) and the rendered functions."""
+    return "\n\n".join([header, *functions])
+
+
+def write_module(path: str | os.PathLike, text: str) -> str:
+    """Write a generated module's ``text`` to ``path``; return the path."""
+    Path(path).write_text(text)
+    return str(path)
+
+
+# ---------------------------------------------------------------------------------------------- the laws
 def _in_u(expr: Any, v: Any, u: Any, s: Any) -> Any:
     """``expr`` with ``ln v -> u``, ``v^(n/2) -> v^((n-1)/2) s`` (s = sqrt v, cheaper than exp) and
     ``v^p -> exp(p u)`` for other non-integer p (powers of products split first)."""
@@ -145,7 +193,8 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     name : str
         The law function's name; ``pack_name`` (default ``name + "_pack"``) is its packing.
     expr : sympy expression
-        ``f`` in the symbols ``v`` and ``V`` of :mod:`peelapprox.law._symbolic` and ``coef_symbols``.
+        ``f`` in the positive symbols ``v`` and ``V`` (those of :mod:`peelapprox.law._symbolic`) and
+        ``coef_symbols``.
     coef_symbols : sequence of sympy symbols
         The coefficients, in the order ``pack``'s ``c`` gives them.
     doc : str
@@ -165,12 +214,29 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     """
     import sympy as sp
 
-    from ._symbolic import V, v
-
+    v, V = sp.Symbol("v", positive=True), sp.Symbol("V", positive=True)
     _check_names(coef_symbols)
     unknown = sorted(s.name for s in expr.free_symbols - {v, V, *coef_symbols})
     if unknown:
         raise ValueError(f"expr has symbols {', '.join(unknown)} other than v, V and the coefficients")
+    derived, repl, red, used = _law_outputs(expr, v)
+    pack_name = pack_name or f"{name}_pack"
+    return (_law_source(name, pack_name, doc, derived, repl, red, used) + "\n\n"
+            + _pack_source(name, pack_name, [s.name for s in coef_symbols], derived))
+
+
+#: The law's outputs in the order they are computed: f, then v f' (LAW_LNV), f' (LAW_FP) and f'' (LAW_FPP).
+_OUTS = ("f", "vfp", "fp", "fpp")
+
+
+def _law_outputs(expr: Any, v: Any) -> tuple[list, list, list, set]:
+    """f, v f', f', f'' of ``expr`` in u = ln v and s = sqrt v with the V-dependence hoisted into ``coef``.
+
+    Returns the hoisted subexpressions (the coef layout, canonical order), the CSE definitions ``(w_i, rhs)``,
+    the reduced outputs (in :data:`_OUTS` order) and the symbols they use.
+    """
+    import sympy as sp
+
     u, sq = sp.Symbol("u", real=True), sp.Symbol("s", positive=True)
     F = _in_u(expr, v, u, sq)
 
@@ -186,18 +252,23 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     derived = list(sp.ordered(hoist.table))
     ks = [sp.Symbol(f"coef[{i}]", real=True) for i in range(len(derived))]  # read in place
     rename = {hoist.table[d]: ks[i] for i, d in enumerate(derived)}
-    outs = ("f", "vfp", "fp", "fpp")
-    repl, red = sp.cse([hoisted[k].xreplace(rename) for k in outs], symbols=sp.numbered_symbols("w"),
+    repl, red = sp.cse([hoisted[k].xreplace(rename) for k in _OUTS], symbols=sp.numbered_symbols("w"),
                        optimizations="basic")
     red = [sp.Float(e) if e.is_Number else e for e in red]  # homogeneous float tuples for numba
-    defs = dict(repl)
     used = set().union(*(e.free_symbols for e in red), *(e.free_symbols for _, e in repl))
+    return derived, repl, red, used
+
+
+def _law_source(name: str, pack_name: str, doc: str, derived: list, repl: list, red: list, used: set) -> str:
+    """The law function's text: each form returns as soon as its outputs are computed."""
+    import sympy as sp
 
     p = _printer()
+    defs = dict(repl)
 
     def stage(out: str, done: set, indent: str) -> list[str]:
         """The CSE lines ``out`` needs that ``done`` does not hold (in order), then ``out`` itself."""
-        e = red[outs.index(out)]
+        e = red[_OUTS.index(out)]
         need, stack = set(), list(e.free_symbols)
         while stack:
             sym = stack.pop()
@@ -208,7 +279,6 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
         return [f"{indent}{sym} = {p.doprint(rhs)}" for sym, rhs in repl if sym in need] + [
             f"{indent}{out} = {p.doprint(e)}"]
 
-    pack_name = pack_name or f"{name}_pack"
     layout = ", ".join(p.doprint(d) for d in derived)
     lines = [f"def {name}(x, coef, form):",
              f'    """{doc or "A peel-force law"} in the ABI of peelapprox.law._abi.',
@@ -216,8 +286,8 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
              f"    coef = {pack_name}(V, c) = [{layout}]",
              '    """',
              "    v = numpy.exp(x) if form == 0 else x  # LAW_LNV: x = ln v -> (v, f, v f'); else x = v"]
-    lines += ["    u = x if form == 0 else numpy.log(v)"] if u in used else []
-    lines += ["    s = numpy.sqrt(v)"] if sq in used else []
+    lines += ["    u = x if form == 0 else numpy.log(v)"] if sp.Symbol("u", real=True) in used else []
+    lines += ["    s = numpy.sqrt(v)"] if sp.Symbol("s", positive=True) in used else []
     done: set = set()
     lines += stage("f", done, "    ")
     lines.append("    if form == 0:")
@@ -228,9 +298,14 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
     lines.append("        return f, fp, numpy.nan")
     lines += stage("fpp", done, "    ")
     lines.append("    return f, fp, fpp")
-    law = "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n"
 
-    names = [s.name for s in coef_symbols]
+
+def _pack_source(name: str, pack_name: str, names: list[str], derived: list) -> str:
+    """The packing's text: ``coef`` (the hoisted subexpressions, after CSE) from V and the coefficients."""
+    import sympy as sp
+
+    p = _printer()
     plines = [f"def {pack_name}(V, cs=()):",
               f'    """coef of {name} at the pull speed V from the coefficients cs = ({", ".join(names)})."""']
     if names:
@@ -241,4 +316,4 @@ def render_law(name: str, expr: Any, coef_symbols: Sequence[Any] = (), pack_name
         plines.append(f"    return numpy.array([{', '.join(p.doprint(e) for e in red)}], dtype=numpy.float64)")
     else:
         plines.append("    return numpy.zeros(0, dtype=numpy.float64)")
-    return law + "\n\n" + "\n".join(plines) + "\n"
+    return "\n".join(plines) + "\n"
