@@ -1,15 +1,18 @@
 """The gallery docs/examples/ runs: every script exits 0, writes its figure and prints the numbers it promises.
 
-Each example runs as a user would run it, ``python docs/examples/NAME.py --out DIR`` in a fresh process (in a
-temporary working directory, so nothing lands in ./docs), and at least one printed number is checked against
+Each example runs as a user would run it, ``python docs/examples/NAME.py --out DIR`` (in a temporary working
+directory, so nothing lands in ./docs): as ``__main__`` with its own argv and a fresh namespace, several in
+one process (``_DRIVER``, :data:`BATCHES`), and at least one printed number is checked against
 an expectation that does not come from the code under test: the paper's numbers, closed forms, or the values
 docs/*.md report (measured once and written down there).  The examples of this module's run are started
-together when the first test needs one (two cores: the processes overlap their imports and computations), so
-the default tier pays ~the slowest example plus the rest's CPU time shared, not their sum.
+together when the first test needs one, in two processes (two cores), so the default tier pays the
+interpreter, the imports and the kernel loads twice, not once per example, and about half the examples' CPU
+time in wall time.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
@@ -44,40 +47,96 @@ def _env() -> dict[str, str]:
     return env
 
 
-class _Run:
-    """One example's process, started at once, collected on first use."""
+#: Runs the examples named in argv[2] (JSON: name, output directory) one after another in this process, each
+#: as ``python NAME.py --out DIR`` would (``__main__``, its own argv, the gallery's directory on the path, a
+#: fresh namespace), and writes their exit statuses, stdout and stderr as JSON to argv[1].
+_DRIVER = """
+import contextlib, io, json, os, runpy, sys, traceback
+path, jobs, examples, results = sys.argv[1], json.loads(sys.argv[2]), sys.argv[3], {}
+sys.path.insert(0, examples)
+for name, out in jobs:
+    script = os.path.join(examples, name + ".py")
+    sys.argv = [script, "--out", out]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        try:
+            runpy.run_path(script, run_name="__main__")
+            status = 0
+        except SystemExit as exc:
+            status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        except BaseException:
+            traceback.print_exc()
+            status = 1
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
+    results[name] = [status, stdout.getvalue(), stderr.getvalue()]
+with open(path, "w") as f:
+    json.dump(results, f)
+"""
 
-    def __init__(self, name: str, base: Path):
-        self.name, self.out = name, base / name
-        self.out.mkdir(parents=True)
-        self.proc = subprocess.Popen([sys.executable, str(EXAMPLES / f"{name}.py"), "--out", str(self.out)],
-                                     cwd=base, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     text=True)
-        self._result: tuple[int, str, str] | None = None
+#: The examples in two processes (two cores), balanced by CPU time; a process per example paid the
+#: interpreter, the imports and the kernel loads (~3 s of CPU) seven times.
+BATCHES = (("07_your_data", "04_your_own_tape", "01_quickstart", "02_three_regimes"),
+           ("05_sweep_phase_diagram", "06_orbits_bifurcation", "03_approx_vs_exact"))
 
-    def result(self) -> tuple[int, str, str]:
-        if self._result is None:
+
+class _Batch:
+    """One process running ``names`` in turn (output directories under ``base``), started at once, collected on
+    first use: ``result(name)`` is that example's ``(status, stdout, stderr)``, or the process's own when it
+    died."""
+
+    def __init__(self, names: list[str], base: Path):
+        self.path = base / f"results-{names[0]}.json"
+        jobs = [(name, str(base / name)) for name in names]
+        self.proc = subprocess.Popen([sys.executable, "-c", _DRIVER, str(self.path), json.dumps(jobs), str(EXAMPLES)],
+                                     cwd=base, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self._done: tuple[int, str, str] | None = None
+
+    def result(self, name: str) -> tuple[int, str, str]:
+        if self._done is None:
             try:
                 stdout, stderr = self.proc.communicate(timeout=TIMEOUT)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 stdout, stderr = self.proc.communicate()
-            self._result = (self.proc.returncode, stdout, stderr)
-        return self._result
+            self._done = (self.proc.returncode, stdout, stderr)
+        if self._done[0] != 0 or not self.path.is_file():
+            return self._done
+        status, stdout, stderr = json.loads(self.path.read_text())[name]
+        return status, stdout, stderr
+
+
+class _Run:
+    """One example: its output directory and its batch."""
+
+    def __init__(self, name: str, base: Path, batch: _Batch):
+        self.name, self.out, self.batch = name, base / name, batch
+
+    def result(self) -> tuple[int, str, str]:
+        return self.batch.result(self.name)
 
 
 @pytest.fixture(scope="module")
 def runs(request, tmp_path_factory):
-    """The examples whose tests are selected in this session, all started now, each collected when asked for."""
+    """The examples whose tests are selected in this session, all started now in the processes of
+    :data:`BATCHES`, each collected when asked for."""
     selected = [item.name for item in request.session.items if item.module is request.module]
     names = [name for name in FIGURES if any(name in test for test in selected)]
     base = tmp_path_factory.mktemp("examples")
-    started = {name: _Run(name, base) for name in names}
+    started, batches = {}, []
+    batched = {name for group in BATCHES for name in group}
+    for group in (*BATCHES, tuple(name for name in FIGURES if name not in batched)):  # a new example: a process
+        mine = [name for name in group if name in names]
+        if mine:
+            for name in mine:
+                (base / name).mkdir()
+            batches.append(_Batch(mine, base))
+            started.update({name: _Run(name, base, batches[-1]) for name in mine})
     yield started
-    for run in started.values():  # a test that failed early leaves no process behind
-        if run.proc.poll() is None:
-            run.proc.kill()
-            run.proc.communicate()
+    for batch in batches:  # a test that failed early leaves no process behind
+        if batch.proc.poll() is None:
+            batch.proc.kill()
+            batch.proc.communicate()
 
 
 def _output(runs, name: str) -> str:
