@@ -21,6 +21,7 @@ import signal
 import threading
 import time
 from collections.abc import Iterator
+from typing import Any
 from contextlib import contextmanager
 
 __all__ = ["LAW_BUILD_SECONDS", "Expired", "WallSpent", "caller_budget", "time_limit"]
@@ -82,6 +83,18 @@ class WallSpent(BaseException):
         self.seconds = seconds
 
 
+def _disarm(previous: Any, error: type[BaseException]) -> None:
+    """Stop the timer and put the previous handler back, also when the timer fires once more on the way (its
+    expiry is then raised by the caller's check of the elapsed time, after the clean-up)."""
+    while True:
+        try:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, previous)
+            return
+        except error:
+            continue
+
+
 @contextmanager
 def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator[None]:
     """Raise ``error(limit, caller)`` (:class:`Expired`) if the body runs longer than ``seconds`` or past the
@@ -107,12 +120,11 @@ def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator
     previous = signal.signal(signal.SIGALRM, _expire)
     # repeating: an exception raised where Python cannot propagate it (a weakref callback, a ctypes callback of
     # llvmlite) is printed and dropped, so the timer fires again every REPEAT seconds until one lands
-    signal.setitimer(signal.ITIMER_REAL, limit, REPEAT)
-    try:
+    try:  # armed inside the try: a timer firing at once (a limit of microseconds) still reaches the finally
+        signal.setitimer(signal.ITIMER_REAL, limit, REPEAT)
         yield
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, previous)
+        _disarm(previous, error)
     # every firing may have landed where Python drops exceptions (a __del__, a gc callback) while the body ran
     # on to its end: a body that returned late is late all the same
     if time.perf_counter() - now > limit:
