@@ -21,8 +21,8 @@ import signal
 import threading
 import time
 from collections.abc import Iterator
-from typing import Any
 from contextlib import contextmanager
+from typing import Any
 
 __all__ = ["LAW_BUILD_SECONDS", "Expired", "WallSpent", "caller_budget", "time_limit"]
 
