@@ -57,6 +57,9 @@ class Model:
         model in its own ``models`` (:class:`exact._method_contract.Method`).
     events : tuple of str
         Its events among :data:`EVENTS`, checked in that order after every accepted step of a scipy method.
+    parameters : tuple of (str, str)
+        The fields of :class:`peelapprox.PeelParams` that it reads beyond the paper's (V, I, k, R, l, geometry,
+        force), each with its unit: a trajectory shows those that are set (its repr, its DataFrame's attrs).
 
     The base class's methods are those of the paper's massless tape under velocity control; a subclass overrides
     what differs (:meth:`accepts`, :meth:`field`, :meth:`initial_state`, :meth:`failure_hint`).
@@ -67,6 +70,7 @@ class Model:
     states: tuple[str, ...] = ("alpha", "omega", "F", "v")
     methods: tuple[str, ...] = ()
     events: tuple[str, ...] = ("slack", "v_positive", "law_domain", "v_floor", "no_root", "jump")
+    parameters: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         unknown = [e for e in self.events if e not in EVENTS]
@@ -77,6 +81,17 @@ class Model:
     def n_states(self) -> int:
         """The number of integrated states (the length of :attr:`states`)."""
         return len(self.states)
+
+    @property
+    def has_hybrid(self) -> bool:
+        """Whether the hybrid method solves it: the tools built on that method's jumps (section returns, tangent
+        dynamics, saltation matrices) apply, and no scipy ``solver`` is chosen for its default run."""
+        return "hybrid" in self.methods
+
+    @property
+    def under_load(self) -> bool:
+        """Whether the pull speed ``Vp`` is a state (a constant load), not the fixed ``params.V``."""
+        return "Vp" in self.states
 
     def accepts(self, params: PeelParams) -> bool:
         """Whether ``params`` describe this model (the registry picks the first that does: :func:`model_of`)."""
@@ -93,13 +108,13 @@ class Model:
 
     def y0(self, params: PeelParams, s0: State) -> np.ndarray:
         """The integrated state at the start ``s0`` (a new array in the layout :attr:`states`)."""
-        extra = [params.V if s0.Vp is None else s0.Vp] if "Vp" in self.states else []
+        extra = [params.V if s0.Vp is None else s0.Vp] if self.under_load else []
         return np.array([s0.alpha, s0.omega, s0.F, s0.v] + extra)
 
     def atol(self, atol: np.ndarray) -> np.ndarray:
         """A method's 4 absolute tolerances ``(α, ω, F, v)`` extended to :attr:`states` (``Vp`` on the scale of
         v)."""
-        return np.append(atol, atol[3]) if "Vp" in self.states else atol
+        return np.append(atol, atol[3]) if self.under_load else atol
 
     def initial_state(self, params: PeelParams, *, alpha0: float = 0.0, omega0: float | None = None,
                       F0: float | None = None, branch0: str | None = None, Vp0: float | None = None) -> State:
