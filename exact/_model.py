@@ -16,12 +16,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from peelapprox.kernels import CompiledLaw, compiled_law
 
+from . import _registry
 from ._initial import initial_state
 
 if TYPE_CHECKING:
@@ -133,7 +134,7 @@ class Model:
 
 #: The models of :func:`exact.simulate` by name, in the order :func:`model_of` tries them (the built-in ones
 #: entered by :mod:`exact._models`).
-MODELS: dict[str, Model] = {}
+MODELS: dict[str, Model] = _registry.MODELS  # one dict: the registry's (exact/_registry.py), typed here
 
 
 def register_model(model: Model) -> Model:
@@ -149,4 +150,4 @@ def register_model(model: Model) -> Model:
 
 def model_of(params: PeelParams) -> Model:
     """The model ``params`` describe: the first of :data:`MODELS` that accepts them."""
-    return next(m for m in MODELS.values() if m.accepts(params))
+    return cast(Model, _registry.model_of(params))

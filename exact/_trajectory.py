@@ -13,6 +13,8 @@ from peelapprox import BRANCHES, ForceSeries, PeelParams
 from peelapprox.io import fmt_number, html_table, optional_import, param_attrs
 from peelapprox.validate import finite, integer, nonnegative, optional, positive
 
+from ._registry import model_of
+
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 
 #: Units of the columns of :meth:`Trajectory.to_dataframe` and :meth:`Jumps.to_dataframe` (``df.attrs["units"]``).
@@ -23,8 +25,6 @@ _UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "Vp"
 def _variant_units(params) -> dict[str, str]:
     """The fields of PeelParams that the model of ``params`` reads beyond the paper's, with their units
     (``Model.parameters``: the repr, the DataFrame's attrs): ``{}`` for the paper's model."""
-    from ._model import model_of  # here: the model module imports the start, which imports this one
-
     return dict(model_of(params).parameters)
 
 
