@@ -14,6 +14,7 @@ The built-in models (the paper's massless tape and its follow-ups: the tape mass
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
@@ -60,7 +61,12 @@ class Model:
         Its events among :data:`EVENTS`, checked in that order after every accepted step of a scipy method.
     parameters : tuple of (str, str)
         The fields of :class:`peelapprox.PeelParams` that it reads beyond the paper's (V, I, k, R, l, geometry,
-        force), each with its unit: a trajectory shows those that are set (its repr, its DataFrame's attrs).
+        force), each with its unit: a trajectory shows those that are set (its repr, its DataFrame's attrs), and
+        those not in any model's ``selected_by`` are the numeric parameters that ``exact.with_parameter`` and
+        ``exact.orbit_diagram`` take (:func:`model_parameters`).
+    selected_by : tuple of (str, object)
+        The field values that select it besides its parameters (``loading="load"``): ``exact.with_parameter`` sets
+        them with a parameter of which this is the first model in :data:`MODELS` to list it.
 
     The base class's methods are those of the paper's massless tape under velocity control; a subclass overrides
     what differs (:meth:`accepts`, :meth:`field`, :meth:`initial_state`, :meth:`failure_hint`).
@@ -72,6 +78,7 @@ class Model:
     methods: tuple[str, ...] = ()
     events: tuple[str, ...] = ("slack", "v_positive", "law_domain", "v_floor", "no_root", "jump")
     parameters: tuple[tuple[str, str], ...] = ()
+    selected_by: tuple[tuple[str, object], ...] = ()
 
     def __post_init__(self) -> None:
         unknown = [e for e in self.events if e not in EVENTS]
@@ -151,3 +158,19 @@ def register_model(model: Model) -> Model:
 def model_of(params: PeelParams) -> Model:
     """The model ``params`` describe: the first of :data:`MODELS` that accepts them."""
     return cast(Model, _registry.model_of(params))
+
+
+def model_parameters() -> dict[str, Model]:
+    """The numeric parameters of the models (their ``parameters`` that no model's ``selected_by`` names: a tape mass,
+    a load's mass and force), each with the first model of :data:`MODELS` that lists it, in the order of
+    :class:`peelapprox.PeelParams`' fields."""
+    from peelapprox import PeelParams
+
+    selectors = {n for m in MODELS.values() for n, _ in m.selected_by}
+    found: dict[str, Model] = {}
+    for m in MODELS.values():
+        for n, _ in m.parameters:
+            if n not in selectors:
+                found.setdefault(n, m)
+    order = [f.name for f in dataclasses.fields(PeelParams)]
+    return {n: found[n] for n in sorted(found, key=order.index)}

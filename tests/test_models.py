@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import exact
-from exact._model import model_of
+from exact._model import model_of, model_parameters
 from peelapprox import PeelParams
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -172,14 +172,21 @@ def test_the_questions_tools_ask_a_model():
     """Hypothesis: the properties the tools read instead of the parameters' variant fields answer, for each built-in
     model, what those fields said (exact: booleans and names): only the paper's massless tape has the hybrid method
     (so its tools and the refusal of a scipy ``solver``), the models under a load integrate the pull speed ``Vp``,
-    and a variant's trajectory shows the variant fields that are set, with their units, in its repr and its
-    DataFrame's attrs (the paper's model: none)."""
+    each model lists the fields it reads, the load's selected by ``loading="load"`` (which ``with_parameter``
+    sets with a load's parameter), and a variant's trajectory shows the variant fields that are set, with their
+    units, in its repr and its DataFrame's attrs (the paper's model: none)."""
     assert [m.has_hybrid for m in exact.MODELS.values()] == [True, False, False, False]
     assert [m.under_load for m in exact.MODELS.values()] == [False, True, False, True]
-    assert exact.MODELS["massless"].parameters == ()
-    for name in ("massless_load", "tape_mass", "tape_mass_load"):
-        assert dict(exact.MODELS[name].parameters) == {"tape_mass": "kg", "loading": "", "load_mass": "kg",
-                                                       "load": "N"}
+    assert [dict(m.parameters) for m in exact.MODELS.values()] == [
+        {}, {"loading": "", "load_mass": "kg", "load": "N"}, {"tape_mass": "kg", "loading": ""},
+        {"tape_mass": "kg", "loading": "", "load_mass": "kg", "load": "N"}]
+    assert [m.selected_by for m in exact.MODELS.values()] == [(), (("loading", "load"),), (), (("loading", "load"),)]
+    # the numeric parameters, each set with the field values that select its first model (a load's loading)
+    owners = {n: m.name for n, m in model_parameters().items()}
+    assert owners == {"tape_mass": "tape_mass", "load_mass": "massless_load", "load": "massless_load"}
+    p = PARAMS["massless"]
+    assert exact.with_parameter(p, "load_mass", 2.0) == p.replace(loading="load", load_mass=2.0)
+    assert exact.with_parameter(PARAMS["tape_mass"], "tape_mass", 0.0) == p
     assert exact.model_of(PARAMS["tape_mass"]) is exact.MODELS["tape_mass"]
     tr = exact.simulate(PARAMS["tape_mass"], 1e-3)
     assert "tape_mass=0.001 kg, loading='velocity'," in repr(tr)

@@ -11,6 +11,7 @@ computed when the sweep is resumed.  Workers get each measure by its import refe
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -35,7 +36,8 @@ NOT_RUN = "not run: max_wall"
 #: The PeelParams fields a sweep's options set (besides I, V and the law): the models' own too (``Model.parameters``
 #: of ``exact.MODELS``: a tape mass, a constant load), so a sweep of (I, V) runs for a given model; one sweep per
 #: tape mass sweeps m.
-PARAM_OPTIONS = ("k", "R", "l", "geometry") + tuple(dict.fromkeys(n for m in MODELS.values() for n, _ in m.parameters))
+PARAM_OPTIONS = ("k", "R", "l", "geometry") + tuple(
+    f.name for f in dataclasses.fields(PeelParams) if any(f.name in dict(m.parameters) for m in MODELS.values()))
 
 
 def import_ref(ref: str) -> Any:
