@@ -18,6 +18,7 @@ closing residual is halved (at most 8 times).
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable
 
@@ -87,6 +88,8 @@ def with_parameter(params: PeelParams, parameter: str, value: float) -> PeelPara
     name = _coefficient(params, parameter)
     owner = model_parameters().get(parameter)
     if owner is not None:  # a model's parameter, set with the field values that select that model (a load's)
+        if isinstance(value, numbers.Real) and not isinstance(value, bool):
+            value = float(value)  # PeelParams stores a float; a numpy 0 is then its "unset" 0 (tape_mass=None)
         return params.replace(**dict(owner.selected_by), **{parameter: value})
     if name is None:
         return params.replace(**{parameter: value})
