@@ -25,7 +25,7 @@ from ._hybrid_driver import hybrid_field
 from ._initial import initial_state
 from ._method_contract import default_atol
 from ._methods import ATOL_SCALE, STEP_BUDGET, Hybrid, Regularized, Smooth
-from ._model import MODELS, Model, register_model
+from ._model import MODELS, Model, model_of, register_model
 from ._models import Massless, MasslessLoad, TapeMass, TapeMassLoad
 from ._options import METHODS, Budget, SaveAt, default_max_steps
 from ._shared import DEFAULT_MAX_WALL
@@ -96,6 +96,7 @@ __all__ = [
     "TapeMass",
     "TapeMassLoad",
     "register_model",
+    "model_of",
     "SaveAt",
     "Budget",
     "initial_state",

@@ -14,14 +14,16 @@ The built-in models (the paper's massless tape and its follow-ups: the tape mass
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from peelapprox.kernels import CompiledLaw, compiled_law
 
+from . import _registry
 from ._initial import initial_state
 
 if TYPE_CHECKING:
@@ -57,6 +59,14 @@ class Model:
         model in its own ``models`` (:class:`exact._method_contract.Method`).
     events : tuple of str
         Its events among :data:`EVENTS`, checked in that order after every accepted step of a scipy method.
+    parameters : tuple of (str, str)
+        The fields of :class:`peelapprox.PeelParams` that it reads beyond the paper's (V, I, k, R, l, geometry,
+        force), each with its unit: a trajectory shows those that are set (its repr, its DataFrame's attrs), and
+        those not in any model's ``selected_by`` are the numeric parameters that ``exact.with_parameter`` and
+        ``exact.orbit_diagram`` take (:func:`model_parameters`).
+    selected_by : tuple of (str, object)
+        The field values that select it besides its parameters (``loading="load"``): ``exact.with_parameter`` sets
+        them with a parameter of which this is the first model in :data:`MODELS` to list it.
 
     The base class's methods are those of the paper's massless tape under velocity control; a subclass overrides
     what differs (:meth:`accepts`, :meth:`field`, :meth:`initial_state`, :meth:`failure_hint`).
@@ -67,6 +77,8 @@ class Model:
     states: tuple[str, ...] = ("alpha", "omega", "F", "v")
     methods: tuple[str, ...] = ()
     events: tuple[str, ...] = ("slack", "v_positive", "law_domain", "v_floor", "no_root", "jump")
+    parameters: tuple[tuple[str, str], ...] = ()
+    selected_by: tuple[tuple[str, object], ...] = ()
 
     def __post_init__(self) -> None:
         unknown = [e for e in self.events if e not in EVENTS]
@@ -77,6 +89,17 @@ class Model:
     def n_states(self) -> int:
         """The number of integrated states (the length of :attr:`states`)."""
         return len(self.states)
+
+    @property
+    def has_hybrid(self) -> bool:
+        """Whether the hybrid method solves it: the tools built on that method's jumps (section returns, tangent
+        dynamics, saltation matrices) apply, and no scipy ``solver`` is chosen for its default run."""
+        return "hybrid" in self.methods
+
+    @property
+    def under_load(self) -> bool:
+        """Whether the pull speed ``Vp`` is a state (a constant load), not the fixed ``params.V``."""
+        return "Vp" in self.states
 
     def accepts(self, params: PeelParams) -> bool:
         """Whether ``params`` describe this model (the registry picks the first that does: :func:`model_of`)."""
@@ -93,13 +116,13 @@ class Model:
 
     def y0(self, params: PeelParams, s0: State) -> np.ndarray:
         """The integrated state at the start ``s0`` (a new array in the layout :attr:`states`)."""
-        extra = [params.V if s0.Vp is None else s0.Vp] if "Vp" in self.states else []
+        extra = [params.V if s0.Vp is None else s0.Vp] if self.under_load else []
         return np.array([s0.alpha, s0.omega, s0.F, s0.v] + extra)
 
     def atol(self, atol: np.ndarray) -> np.ndarray:
         """A method's 4 absolute tolerances ``(α, ω, F, v)`` extended to :attr:`states` (``Vp`` on the scale of
         v)."""
-        return np.append(atol, atol[3]) if "Vp" in self.states else atol
+        return np.append(atol, atol[3]) if self.under_load else atol
 
     def initial_state(self, params: PeelParams, *, alpha0: float = 0.0, omega0: float | None = None,
                       F0: float | None = None, branch0: str | None = None, Vp0: float | None = None) -> State:
@@ -118,7 +141,7 @@ class Model:
 
 #: The models of :func:`exact.simulate` by name, in the order :func:`model_of` tries them (the built-in ones
 #: entered by :mod:`exact._models`).
-MODELS: dict[str, Model] = {}
+MODELS: dict[str, Model] = _registry.MODELS  # one dict: the registry's (exact/_registry.py), typed here
 
 
 def register_model(model: Model) -> Model:
@@ -134,4 +157,20 @@ def register_model(model: Model) -> Model:
 
 def model_of(params: PeelParams) -> Model:
     """The model ``params`` describe: the first of :data:`MODELS` that accepts them."""
-    return next(m for m in MODELS.values() if m.accepts(params))
+    return cast(Model, _registry.model_of(params))
+
+
+def model_parameters() -> dict[str, Model]:
+    """The numeric parameters of the models (their ``parameters`` that no model's ``selected_by`` names: a tape mass,
+    a load's mass and force), each with the first model of :data:`MODELS` that lists it, in the order of
+    :class:`peelapprox.PeelParams`' fields."""
+    from peelapprox import PeelParams
+
+    selectors = {n for m in MODELS.values() for n, _ in m.selected_by}
+    found: dict[str, Model] = {}
+    for m in MODELS.values():
+        for n, _ in m.parameters:
+            if n not in selectors:
+                found.setdefault(n, m)
+    order = [f.name for f in dataclasses.fields(PeelParams)]
+    return {n: found[n] for n in sorted(found, key=order.index)}

@@ -48,6 +48,9 @@ __all__ = ["Massless", "MasslessLoad", "TapeMass", "TapeMassLoad", "VP0_MAX"]
 VP0_MAX = 1e3
 
 _VARIANT_EVENTS = ("arrest", "slack", "v_positive", "law_domain", "v_floor")
+#: The variants' fields of PeelParams and their units (a trajectory shows those set): the tape mass, the loading
+#: (which selects velocity control or a load) and the load's mass and force.
+_TAPE, _LOADING, _LOAD = (("tape_mass", "kg"),), (("loading", ""),), (("load_mass", "kg"), ("load", "N"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -108,6 +111,8 @@ class MasslessLoad(_Loaded):
     states: tuple[str, ...] = ("alpha", "omega", "F", "v", "Vp")
     methods: tuple[str, ...] = ("regularized",)
     events: tuple[str, ...] = _VARIANT_EVENTS + ("no_root", "jump")
+    parameters: tuple[tuple[str, str], ...] = _LOADING + _LOAD
+    selected_by: tuple[tuple[str, object], ...] = (("loading", "load"),)
     variant: str = "eps_load"
 
 
@@ -125,6 +130,7 @@ class TapeMass(_Variant):
     about: str = "the tape-mass model (params.tape_mass) under velocity control"
     methods: tuple[str, ...] = ("smooth",)
     events: tuple[str, ...] = _VARIANT_EVENTS + ("jump",)
+    parameters: tuple[tuple[str, str], ...] = _TAPE + _LOADING
     variant: str = "tape"
 
     def failure_hint(self, params: PeelParams) -> str:
@@ -140,6 +146,8 @@ class TapeMassLoad(_Loaded):
     states: tuple[str, ...] = ("alpha", "omega", "F", "v", "Vp")
     methods: tuple[str, ...] = ("smooth",)
     events: tuple[str, ...] = _VARIANT_EVENTS + ("jump",)
+    parameters: tuple[tuple[str, str], ...] = _TAPE + _LOADING + _LOAD
+    selected_by: tuple[tuple[str, object], ...] = (("loading", "load"),)
     variant: str = "tape_load"
 
     def failure_hint(self, params: PeelParams) -> str:

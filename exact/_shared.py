@@ -25,11 +25,11 @@ def paper_model_only(params: PeelParams, what: str, instead: str = "") -> None:
     """Refuse a model the hybrid method does not solve (a tape mass or a constant load) for ``what``, a tool built on
     the hybrid solver's jumps (its section returns, tangent dynamics and saltation matrices), with a ValueError
     naming ``params`` and the model it supports (``instead``: what to use for the variant)."""
-    if "hybrid" not in model_of(params).methods:
+    model = model_of(params)
+    if not model.has_hybrid:
         raise ValueError(
-            f"{what} supports the paper's massless, velocity-controlled model only (params.tape_mass=None, "
-            f"params.loading='velocity': the hybrid method's jumps and saltation matrices), got params with "
-            f"tape_mass={params.tape_mass!r}, loading={params.loading!r} (variant {params.variant!r})"
+            f"{what} supports the paper's massless, velocity-controlled model only (the hybrid method's jumps and "
+            f"saltation matrices), got params of the model {model.name!r}, {model.about}"
             + (f"; {instead}" if instead else ""))
 
 

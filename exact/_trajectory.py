@@ -13,6 +13,8 @@ from peelapprox import BRANCHES, ForceSeries, PeelParams
 from peelapprox.io import fmt_number, html_table, optional_import, param_attrs
 from peelapprox.validate import finite, integer, nonnegative, optional, positive
 
+from ._registry import model_of
+
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 
 #: Units of the columns of :meth:`Trajectory.to_dataframe` and :meth:`Jumps.to_dataframe` (``df.attrs["units"]``).
@@ -20,15 +22,16 @@ _UNITS = {"t": "s", "alpha": "rad", "omega": "rad/s", "F": "N", "v": "m/s", "Vp"
           "from_branch": "", "to_branch": "", "v_before": "m/s", "v_after": "m/s"}
 
 
-#: The variant fields of PeelParams and their units (the repr, the DataFrame's attrs).
-_VARIANT_UNITS = {"tape_mass": "kg", "loading": "", "load_mass": "kg", "load": "N"}
+def _variant_units(params) -> dict[str, str]:
+    """The fields of PeelParams that the model of ``params`` reads beyond the paper's, with their units
+    (``Model.parameters``: the repr, the DataFrame's attrs): ``{}`` for the paper's model."""
+    return dict(model_of(params).parameters)
 
 
 def _variant_fields(params) -> dict:
-    """The variant fields of ``params`` that are set (tape mass, load): ``{}`` for the paper's model."""
-    if params.variant is None:
-        return {}
-    return {n: getattr(params, n) for n in _VARIANT_UNITS if getattr(params, n) is not None}
+    """The fields of :func:`_variant_units` that are set in ``params`` (tape mass, load): ``{}`` for the paper's
+    model."""
+    return {n: getattr(params, n) for n in _variant_units(params) if getattr(params, n) is not None}
 
 
 def _branches(pd, codes: np.ndarray):
@@ -229,7 +232,7 @@ class Trajectory:
     eps : float or None
         Regularisation parameter (``method="regularized"`` only).
     Vp : ndarray or None
-        The pull speed [m/s] at the stored points under a load (``params.loading == "load"``); None under
+        The pull speed [m/s] at the stored points under a load (a model with the state ``Vp``); None under
         velocity control (the pull speed is ``params.V``).
     initial_state, final_state : State
         Where the run started and ended (``final_state`` continues a run).
@@ -287,7 +290,8 @@ class Trajectory:
 
     def __repr__(self) -> str:
         p = self.params
-        var = "".join(f", {n}={v!r}" + (f" {_VARIANT_UNITS[n]}" if _VARIANT_UNITS[n] else "")
+        units = _variant_units(p)
+        var = "".join(f", {n}={v!r}" + (f" {units[n]}" if units[n] else "")
                       for n, v in _variant_fields(p).items())  # the model variant, if any
         return (
             f"Trajectory(V={p.V}, I={p.I}{var}, method={self.method!r}, t=[{self.initial_state.t}, {self.t_end}], "
@@ -360,9 +364,10 @@ class Trajectory:
 
     def _repr_html_(self) -> str:
         p, st = self.params, self.stats
+        units = _variant_units(p)
         return html_table("Trajectory", {
             "V [m/s]": p.V, "I [kg m²]": p.I, "k [N/m]": p.k, "force": repr(p.force),
-            **{f"{n} [{_VARIANT_UNITS[n]}]" if _VARIANT_UNITS[n] else n: v for n, v in _variant_fields(p).items()},
+            **{f"{n} [{units[n]}]" if units[n] else n: v for n, v in _variant_fields(p).items()},
             "method": self.method,
             "t [s]": f"{fmt_number(self.initial_state.t, 6)} … {fmt_number(self.t_end, 6)}",
             "points": len(self.t), "jumps": len(self.jumps), "steps": st.n_steps,
@@ -427,7 +432,7 @@ class Trajectory:
 
     def to_dataframe(self):
         """The stored points as a :class:`pandas.DataFrame`: columns ``t, alpha, omega, F, v`` (the arrays
-        themselves, float64), under a load (``params.loading == "load"``) also ``Vp`` (the pull speed [m/s]), and
+        themselves, float64), under a load (a model with the state ``Vp``) also ``Vp`` (the pull speed [m/s]), and
         ``branch`` (a categorical of the names ``"AB"``/``"CD"``), one row per stored point (a jump is two rows
         at the same ``t``).
 
@@ -451,5 +456,6 @@ class Trajectory:
                          "method": self.method, "solver": self.solver, "rtol": self.rtol, "eps": self.eps,
                          "t_transient": self.t_transient, "t_end": self.t_end})
         if var:
-            df.attrs["variant_units"] = {n: _VARIANT_UNITS[n] for n in var}
+            units = _variant_units(self.params)
+            df.attrs["variant_units"] = {n: units[n] for n in var}
         return df

@@ -44,7 +44,7 @@ API = {
     "exact": {
         "ATOL_SCALE", "Budget", "Hybrid", "Jump", "Jumps", "METHODS", "ModelBreakdown", "Regularized", "Smooth",
         "STEP_BUDGET", "MODELS", "Model", "Massless", "MasslessLoad", "TapeMass", "TapeMassLoad", "register_model",
-        "SaveAt",
+        "model_of", "SaveAt",
         "SolverBudgetExceeded", "SolverFailure", "SolverStats", "State", "Trajectory", "compile_kernels",
         "WarmupReport",
         "default_atol", "default_max_steps", "hybrid_field", "initial_state", "lyapunov_variational", "simulate",

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import exact
-from exact._model import model_of
+from exact._model import model_of, model_parameters
 from peelapprox import PeelParams
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -109,7 +109,9 @@ w = math.sqrt(p.k * p.R ** 2 / p.I)
 tr = exact.simulate(p, 0.01, model="rigid_roller", omega0=p.V / p.R + 0.01 * w, rtol=1e-10, atol=1e-14)
 print(json.dumps(dict(method=tr.method, w=w, t=tr.t.tolist(), alpha=tr.alpha.tolist(), omega=tr.omega.tolist(),
                       F=tr.F.tolist(), F0=tr.initial_state.F, v=tr.v.tolist(), v0=tr.initial_state.v,
-                      default=exact.simulate(p, 1e-3).method, type=type(toy).__name__)))
+                      default=exact.simulate(p, 1e-3).method, type=type(toy).__name__, has_hybrid=toy.has_hybrid,
+                      under_load=toy.under_load, parameters=toy.parameters, Vp=tr.Vp is None,
+                      columns=list(tr.to_dataframe().columns))))
 """
 
 
@@ -134,6 +136,10 @@ def test_a_model_added_as_contributing_says_runs_through_simulate(tmp_path):
     assert out.returncode == 0, out.stderr[-3000:]
     got = json.loads(out.stdout)
     assert got["type"] == "RigidRoller" and got["method"] == "smooth" and got["default"] == "hybrid"
+    # the questions the tools ask a model (the hybrid method's tools, a load's pull speed, the fields it reads):
+    # the base class's answers for a model that lists only "smooth" and the four states
+    assert (got["has_hybrid"], got["under_load"], got["parameters"], got["Vp"]) == (False, False, [], True)
+    assert got["columns"] == ["t", "alpha", "omega", "F", "v", "branch"]
     t, w, a = np.array(got["t"]), got["w"], 0.01
     assert t[-1] == 0.01 and t[-1] * w / (2 * math.pi) > 1.5
     np.testing.assert_allclose(got["alpha"], a * np.sin(w * t), rtol=0, atol=1e-7 * a)
@@ -160,3 +166,33 @@ def test_each_model_field_has_its_layout(name):
         assert np.asarray(jac(0.0, y)).shape == (model.n_states, model.n_states)
         expected = y[1] - y[3] / p.R
         assert abs(rate[0] - expected) <= 1e-12 * (abs(y[1]) + abs(y[3] / p.R))
+
+
+def test_the_questions_tools_ask_a_model():
+    """Hypothesis: the properties the tools read instead of the parameters' variant fields answer, for each built-in
+    model, what those fields said (exact: booleans and names): only the paper's massless tape has the hybrid method
+    (so its tools and the refusal of a scipy ``solver``), the models under a load integrate the pull speed ``Vp``,
+    each model lists the fields it reads, the load's selected by ``loading="load"`` (which ``with_parameter``
+    sets with a load's parameter), and a variant's trajectory shows the variant fields that are set, with their
+    units, in its repr and its DataFrame's attrs (the paper's model: none)."""
+    assert [m.has_hybrid for m in exact.MODELS.values()] == [True, False, False, False]
+    assert [m.under_load for m in exact.MODELS.values()] == [False, True, False, True]
+    assert [dict(m.parameters) for m in exact.MODELS.values()] == [
+        {}, {"loading": "", "load_mass": "kg", "load": "N"}, {"tape_mass": "kg", "loading": ""},
+        {"tape_mass": "kg", "loading": "", "load_mass": "kg", "load": "N"}]
+    assert [m.selected_by for m in exact.MODELS.values()] == [(), (("loading", "load"),), (), (("loading", "load"),)]
+    # the numeric parameters, each set with the field values that select its first model (a load's loading)
+    owners = {n: m.name for n, m in model_parameters().items()}
+    assert owners == {"tape_mass": "tape_mass", "load_mass": "massless_load", "load": "massless_load"}
+    p = PARAMS["massless"]
+    assert exact.with_parameter(p, "load_mass", 2.0) == p.replace(loading="load", load_mass=2.0)
+    for zero in (0, 0.0, np.int64(0), np.float32(0.0)):  # 0 of any real type: the massless model
+        assert exact.with_parameter(PARAMS["tape_mass"], "tape_mass", zero) == p
+    assert exact.model_of(PARAMS["tape_mass"]) is exact.MODELS["tape_mass"]
+    tr = exact.simulate(PARAMS["tape_mass"], 1e-3)
+    assert "tape_mass=0.001 kg, loading='velocity'," in repr(tr)
+    attrs = tr.to_dataframe().attrs
+    assert attrs["variant_units"] == {"tape_mass": "kg", "loading": ""}
+    assert (attrs["params"]["tape_mass"], attrs["params"]["loading"]) == (1e-3, "velocity")
+    tr = exact.simulate(PARAMS["massless"], 1e-3)
+    assert "tape_mass" not in repr(tr) and "variant_units" not in tr.to_dataframe().attrs

@@ -34,11 +34,14 @@ SHORT = dict(t_transient=0.05, window=0.1, rtol=1e-8)
                          ids=["tape", "load"])
 def test_hybrid_only_tools_refuse_the_variants(call, what, params):
     """The section map, saltation tangent and ε-scheme variational tools are the massless velocity-controlled
-    model's: a variant is refused before any run, naming params, the variant and the model supported."""
+    model's: a variant is refused before any run, naming params, the variant's model (``exact.MODELS``) and the
+    model supported."""
     with pytest.raises(ValueError, match="massless, velocity-controlled model only") as info:
         call(params)
     msg = str(info.value)
-    assert what in msg and f"variant {params.variant!r}" in msg and "params" in msg
+    model = exact.model_of(params)
+    assert model.name != "massless" and what in msg and f"model {model.name!r}, {model.about}" in msg
+    assert "params" in msg
 
 
 def test_continuation_refuses_a_variant_parameter():

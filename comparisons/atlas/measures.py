@@ -18,12 +18,13 @@ first point.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from exact import attractor_observables, window_run
+from exact import MODELS, attractor_observables, window_run
 from peelapprox import (
     ALPHA_MODELS,
     TIME_MAX,
@@ -70,7 +71,10 @@ DEFAULTS: dict[str, Any] = {
     "reductions": {branch: [list(m) for m in models] for branch, models in DEFAULT_MODELS.items()},
 }
 
-_VARIANT_OPTIONS = ("tape_mass", "loading", "load_mass", "load")
+#: The PeelParams fields of the models an atlas does not measure (those without the hybrid method:
+#: ``Model.parameters``) and their defaults, which leave the paper's model.
+_VARIANT_OPTIONS = {f.name: f.default for f in dataclasses.fields(PeelParams)
+                    if any(f.name in dict(m.parameters) for m in MODELS.values() if not m.has_hybrid)}
 
 
 def reduction_key(branch: str, alpha_model: str, v_equation: str) -> str:
@@ -135,7 +139,7 @@ def check_options(options: Mapping) -> None:
     _rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"]))
     _reductions(options)
     _approximations(options)
-    variant = [k for k in _VARIANT_OPTIONS if options.get(k) is not None and options.get(k) != "velocity"]
+    variant = [k for k, default in _VARIANT_OPTIONS.items() if options.get(k) not in (None, default)]
     if variant:
         raise ValueError(f"options {variant}: an atlas measures the reduced equations of the paper's massless model "
                          "under velocity control, which a model variant does not have")

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq
 
-from exact import ModelBreakdown, SolverBudgetExceeded, SolverFailure, simulate
+from exact import METHODS, ModelBreakdown, SolverBudgetExceeded, SolverFailure, model_of, simulate
 from peelapprox import PeelParams, branch_inverse, branch_structure, peel_force
 from peelapprox.io import write_rows
 from peelapprox.kernels import (
@@ -72,11 +72,12 @@ def mass_limit(V: float = 1.0, I: float = 1e-5, masses: Sequence[float] = (1e1, 
     (``method="smooth"``) at that m on both sides.
     """
     base: dict[str, Any] = dict(V=V, I=I, tape_mass=tape_mass)
-    kw: dict[str, Any] = dict(solver=solver, rtol=rtol)
-    if tape_mass is None:
-        kw.update(method="regularized", eps=EPS)
-    else:
-        kw.update(method="smooth")
+    # the model's first method on a scipy solver (regularized for the massless tape, smooth with a tape mass): it
+    # solves the model under the load too
+    method = next(n for n in model_of(PeelParams(**base)).methods if METHODS[n].solvers)
+    kw: dict[str, Any] = dict(solver=solver, rtol=rtol, method=method)
+    if method == "regularized":  # the ε-scheme at the paper's ε
+        kw.update(eps=EPS)
     case = "massless" if tape_mass is None else f"tape m={tape_mass:g} kg"
     progress(f"limit {case}: velocity-controlled reference, {t_end} s")
     ref = simulate(PeelParams(**base), t_end, **kw)

@@ -54,20 +54,22 @@ def _params(V: float, I: float, m: float) -> PeelParams:
     return PeelParams(V=V, I=I, tape_mass=m if m > 0 else None)
 
 
-def _solver(m: float) -> str | None:
-    return SOLVER if m > 0 else None
+def _solver(params: PeelParams) -> str | None:
+    """The scipy solver of the study for a model without the hybrid method (the tape mass), else None."""
+    return None if exact.model_of(params).has_hybrid else SOLVER
 
 
 def measure_point(V: float, I: float, m: float, *, t_transient: float, window: float,
                   max_wall: float = 600.0) -> dict:
     """The row of one (V, I, m): period, force drops, slip rate over the window (module docstring)."""
     p = _params(V, I, m)
-    row: dict = {"V": V, "I": I, "m": m, "method": "hybrid" if m == 0 else f"smooth {SOLVER}",
+    solver = _solver(p)
+    row: dict = {"V": V, "I": I, "m": m, "method": " ".join(filter(None, [exact.model_of(p).methods[0], solver])),
                  "t_transient": t_transient, "window": window}
     t0 = time.perf_counter()
     try:
         # simulate, not window_run: the small masses need more steps than the smooth method's default budget
-        tr = exact.simulate(p, t_transient + window, t_transient=t_transient, rtol=RTOL, solver=_solver(m),
+        tr = exact.simulate(p, t_transient + window, t_transient=t_transient, rtol=RTOL, solver=solver,
                             save="jumps", max_steps=10**7, max_wall=max_wall)
     except (ModelBreakdown, SolverFailure, SolverBudgetExceeded) as exc:
         return {**row, "status": f"{type(exc).__name__}: {str(exc)[:100]}"}
@@ -94,8 +96,9 @@ def measure_lyapunov(V: float, I: float, m: float, T: float, max_wall: float = 6
     """The two-trajectory exponent at (V, I, m) over ``T`` s (:data:`LYAPUNOV`), with its standard error."""
     t1 = time.perf_counter()
     try:
-        kw = {"solver": SOLVER} if m > 0 else {}
-        r = exact.lyapunov(_params(V, I, m), T=T, max_wall=max_wall, **LYAPUNOV, **kw)  # type: ignore[arg-type]
+        p = _params(V, I, m)
+        kw = {} if _solver(p) is None else {"solver": _solver(p)}
+        r = exact.lyapunov(p, T=T, max_wall=max_wall, **LYAPUNOV, **kw)  # type: ignore[arg-type]
         return dict(lyapunov_bits=r.bits_per_s, lyapunov_stderr=r.stderr_bits, lyapunov_T=T,
                     lyapunov_wall=time.perf_counter() - t1)
     except (ModelBreakdown, SolverFailure, SolverBudgetExceeded, RuntimeError, ValueError) as exc:

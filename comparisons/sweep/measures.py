@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from exact import METHODS, lyapunov, window_run
+from exact import METHODS, lyapunov, model_of, window_run
 from peelapprox import (
     LYAPUNOV_TAU,
     T_TRANSIENT,
@@ -191,10 +191,11 @@ def _check_solver(options: Mapping) -> str | None:
 
 
 def _solver(params: PeelParams, options: Mapping) -> dict:
-    """``{"solver": options["solver"]}`` for a model variant's runs (``params.variant``), else ``{}`` (the
-    hybrid method has its own integrator); the option checked (ValueError naming it and the solvers)."""
+    """``{"solver": options["solver"]}`` for the runs of a model without the hybrid method (``Model.has_hybrid``:
+    a tape mass, a load), else ``{}`` (the hybrid method has its own integrator); the option checked (ValueError
+    naming it and the solvers)."""
     solver = _check_solver(options)
-    return {"solver": solver} if solver is not None and params.variant is not None else {}
+    return {"solver": solver} if solver is not None and not model_of(params).has_hybrid else {}
 
 
 def _check_window_options(options: Mapping) -> None:

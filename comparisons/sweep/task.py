@@ -11,12 +11,14 @@ computed when the sweep is resumed.  Workers get each measure by its import refe
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import time
 from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType, ModuleType
 from typing import Any, cast
 
+from exact import MODELS
 from peelapprox import PeelForce, PeelParams, SolverBudgetExceeded
 from peelapprox.io import jsonable
 
@@ -31,9 +33,11 @@ __all__ = ["NOT_RUN", "PARAM_OPTIONS", "import_ref", "run_point", "make_params",
 NOT_RUN = "not run: max_wall"
 
 #: Options the engine turns into :class:`peelapprox.PeelParams` fields.
-#: The PeelParams fields a sweep's options set (besides I, V and the law): the model variant's too (a tape mass,
-#: a constant load), so a sweep of (I, V) runs for a given variant; one sweep per tape mass sweeps m.
-PARAM_OPTIONS = ("k", "R", "l", "geometry", "tape_mass", "loading", "load_mass", "load")
+#: The PeelParams fields a sweep's options set (besides I, V and the law): the models' own too (``Model.parameters``
+#: of ``exact.MODELS``: a tape mass, a constant load), so a sweep of (I, V) runs for a given model; one sweep per
+#: tape mass sweeps m.
+PARAM_OPTIONS = ("k", "R", "l", "geometry") + tuple(
+    f.name for f in dataclasses.fields(PeelParams) if any(f.name in dict(m.parameters) for m in MODELS.values()))
 
 
 def import_ref(ref: str) -> Any:

@@ -27,6 +27,7 @@ from peelapprox.parallel import AUTO, DEADLINE_TEXT, POOL_KINDS, map_points
 from peelapprox.validate import duration, function, integer, optional, positive, reals
 from peelapprox.validate import params as _params
 
+from .._model import MODELS, model_of
 from .._shared import DEFAULT_MAX_WALL
 from ..orbits import solve_orbit, with_parameter
 
@@ -85,8 +86,8 @@ class OrbitDiagram:
 
         pd = optional_import("pandas", "OrbitDiagram.to_dataframe")
         df = pd.DataFrame(self.rows(), columns=[self.parameter, "F", "label"]).astype({"F": float})
-        df.attrs.update({"units": {self.parameter: {"V": "m/s", "I": "kg m²", "k": "N/m", "tape_mass": "kg",
-                                                               "load_mass": "kg", "load": "N"}.get(self.parameter, ""),
+        units = {"V": "m/s", "I": "kg m²", "k": "N/m", **{n: u for m in MODELS.values() for n, u in m.parameters}}
+        df.attrs.update({"units": {self.parameter: units.get(self.parameter, ""),
                                    "F": "N", "label": ""},
                          "parameter": self.parameter, "wall_time": self.wall_time})
         return df
@@ -127,7 +128,7 @@ def _diagram_value(p: PeelParams, t_transient: float, window: float, alpha0: flo
         return np.zeros(0), "budget:max_wall"
     try:
         tr = simulate(p, t_transient + window, alpha0=alpha0, rtol=rtol, save="jumps", t_transient=t_transient,
-                      method=method, solver=solver if p.variant is not None else None, max_wall=left)
+                      method=method, solver=None if model_of(p).has_hybrid else solver, max_wall=left)
         F = return_map(tr)
         label = "no stick-slip" if F.size < 2 else periodicity(F, max_period=max_period).label
     except ModelBreakdown as exc:

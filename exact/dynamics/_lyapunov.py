@@ -46,6 +46,7 @@ from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
 from .._initial import initial_state
+from .._model import model_of
 from .._shared import DEFAULT_MAX_WALL, natural_scales, paper_model_only
 from .._simulate import simulate
 from ._attractors import window_run
@@ -73,8 +74,8 @@ def lyapunov(params: PeelParams, method: str = "two-trajectory", *, t_transient:
     params : PeelParams
         With any law ``params.force`` that :func:`exact.simulate` runs (its scales and branches are the law's:
         :func:`peelapprox.branch_structure` with ``force``); ``"variational"``: the paper's law only (ValueError
-        naming the method and the law otherwise).  A model variant (``params.tape_mass``,
-        ``params.loading="load"``) takes ``"two-trajectory"`` only, on its own method (``"smooth"``,
+        naming the method and the law otherwise).  A model without the hybrid method (``exact.MODELS``: a tape
+        mass, a constant load) takes ``"two-trajectory"`` only, on its own method (``"smooth"``,
         ``"regularized"``); the other methods are a ValueError naming the model they support.
     method : {"two-trajectory", "tangent", "return-map", "variational"}
         How (module docstring; costs and agreement in docs/usage.md and docs/dynamics.md).
@@ -135,7 +136,7 @@ def lyapunov(params: PeelParams, method: str = "two-trajectory", *, t_transient:
     hence d0 = 1e-7, rtol = 1e-12.  ``d0`` must lie in :data:`D0_RANGE` = [1e-12, 1].
     """
     method = check_lyapunov_options(method, **options)
-    if _params("params", params).variant is not None and method != "two-trajectory":
+    if not model_of(_params("params", params)).has_hybrid and method != "two-trajectory":
         paper_model_only(params, f"lyapunov method={method!r}",
                          "a model variant (a tape mass, a constant load) takes method='two-trajectory' only")
     common: dict[str, Any] = dict(t_transient=t_transient, alpha0=alpha0)
@@ -179,7 +180,7 @@ def _two_trajectory(params: PeelParams, *, t_transient: float = T_TRANSIENT, tau
                     alpha0: float = 0.0, rtol: float = 1e-12, max_wall: float | None = DEFAULT_MAX_WALL,
                     solver: str | None = None) -> LyapunovResult:
     """Method ``"two-trajectory"`` of :func:`lyapunov` (its Notes): :func:`benettin` on the hybrid solver, or for
-    a model variant (``params.variant``) on its method with ``solver``
+    a model without the hybrid method (``Model.has_hybrid``) on its method with ``solver``
     (:func:`exact.dynamics._benettin.variant_two_trajectory`).
 
     ``n`` renormalisation intervals are measured (10000 by default), or ``max(2, round(T/tau))`` of them when
@@ -198,12 +199,12 @@ def _two_trajectory(params: PeelParams, *, t_transient: float = T_TRANSIENT, tau
     n, n_discard = _check("n", 10000 if n is None else n), _check("n_discard", n_discard)
     alpha0 = state("alpha0", alpha0, "alpha")
     rtol = _rtol("rtol", rtol)
-    if params.variant is not None:
+    if not model_of(params).has_hybrid:
         return variant_two_trajectory(params, t_transient=t_transient, tau=tau, n=n, n_discard=n_discard, d0=d0,
                                       alpha0=alpha0, rtol=rtol, solver=solver, max_wall=wall.limit)
     if solver is not None:
-        raise ValueError(f"lyapunov: solver applies to a model variant's method (params.tape_mass, "
-                         f"params.loading='load'), not to the hybrid method of the paper's model; got "
+        raise ValueError(f"lyapunov: solver applies to a model variant's method (a model without the hybrid "
+                         f"method: a tape mass, a constant load), not to the hybrid method of the paper's model; got "
                          f"solver={solver!r}")
     pair = _TwoOrbits(params, rtol, tau, d0, wall, t_transient + (n + n_discard) * tau)
     s0 = initial_state(params, alpha0=alpha0)

@@ -183,11 +183,9 @@ def _checked_arguments(params, eps, t_transient, T, tau, rtol, alpha0, progress)
     T, tau = duration("T", T), duration("tau", tau)
     t_transient = duration("t_transient", t_transient, zero=True)
     _params("params", params, laws=VARIATIONAL_LAWS, where=VARIATIONAL_LAWS_NOTE)
-    if params.variant is not None:
-        from .._shared import paper_model_only
+    from .._shared import paper_model_only
 
-        paper_model_only(params, "lyapunov method 'variational' (the paper's eps-scheme)",
-                         "use method='two-trajectory'")
+    paper_model_only(params, "lyapunov method 'variational' (the paper's eps-scheme)", "use method='two-trajectory'")
     duration("t_end", t_transient + T)  # the checks of the regularised runs (comparisons' run_peer)
     eps = _eps("eps", eps)
     rtol = in_range("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)

@@ -18,6 +18,7 @@ closing residual is halved (at most 8 times).
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable
 
@@ -27,6 +28,8 @@ from peelapprox import PeelForce, PeelParams
 from peelapprox.errors import WallBudget
 from peelapprox.validate import ArgumentTypeError
 
+from .. import _models  # noqa: F401  (the built-in models registered before VARIANT_PARAMETERS is read)
+from .._model import model_parameters
 from ._periodic import PeriodicOrbit, check_wall, make_orbit
 from ._section import compose, section_return_n, system_of
 
@@ -35,11 +38,12 @@ __all__ = ["PARAMETERS", "VARIANT_PARAMETERS", "bordered_newton", "branch_tangen
 
 #: The parameters of :func:`exact.continue_orbit` besides a family law's coefficients (``"force.<name>"``).
 PARAMETERS = ("V", "I", "k")
-#: The model variants' parameters (``PeelParams`` fields, with their ranges): :func:`with_parameter` and
+#: The model variants' parameters (``PeelParams`` fields, with their ranges; the numeric ``parameters`` of the
+#: models in ``exact.MODELS``: ``exact._model.model_parameters``): :func:`with_parameter` and
 #: :func:`exact.orbit_diagram` take them (a brute-force diagram over the tape mass or the load), the
 #: continuation does not (its section map is the massless model's).  ``"load_mass"`` and ``"load"`` set
-#: ``loading="load"``; ``"tape_mass"`` 0 is the massless model (``tape_mass=None``).
-VARIANT_PARAMETERS = ("tape_mass", "load_mass", "load")
+#: ``loading="load"`` (their model's ``selected_by``); ``"tape_mass"`` 0 is the massless model (``tape_mass=None``).
+VARIANT_PARAMETERS = tuple(model_parameters())
 #: Relative forward-difference step of ``∂P^n/∂λ``.
 FD_STEP = 1e-7
 
@@ -82,10 +86,11 @@ def with_parameter(params: PeelParams, parameter: str, value: float) -> PeelPara
     ``loading="load"``.  The value is checked by :class:`peelapprox.PeelParams` (ValueError naming the field
     and its range)."""
     name = _coefficient(params, parameter)
-    if parameter == "tape_mass":
-        return params.replace(tape_mass=None if value == 0 else value)
-    if parameter in ("load_mass", "load"):
-        return params.replace(loading="load", **{parameter: value})
+    owner = model_parameters().get(parameter)
+    if owner is not None:  # a model's parameter, set with the field values that select that model (a load's)
+        if isinstance(value, numbers.Real) and not isinstance(value, bool):
+            value = float(value)  # PeelParams stores a float; a numpy 0 is then its "unset" 0 (tape_mass=None)
+        return params.replace(**dict(owner.selected_by), **{parameter: value})
     if name is None:
         return params.replace(**{parameter: value})
     law = params.force

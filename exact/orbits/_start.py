@@ -18,6 +18,7 @@ import numpy as np
 from peelapprox import BRANCHES, PeelParams, periodicity
 from peelapprox.validate import choice, duration, state
 
+from .._model import model_of
 from .._simulate import simulate
 from .._trajectory import State, Trajectory
 
@@ -57,9 +58,10 @@ def check_start(params: PeelParams, start: Any) -> None:
     for name in ("alpha", "omega", "F", "v"):
         state(f"start.{name}", getattr(start, name), name)
     choice("start.branch", start.branch, BRANCHES)
-    if start.Vp is not None and params.loading == "velocity":
-        raise ValueError(f"start.Vp must be None under velocity control (params.loading='velocity': the pull speed "
-                         f"is params.V = {params.V!r} m/s), got {start.Vp!r}")
+    model = model_of(params)
+    if start.Vp is not None and not model.under_load:
+        raise ValueError(f"start.Vp must be None for {model.about} (the pull speed is params.V = {params.V!r} m/s), "
+                         f"got {start.Vp!r}")
 
 
 def seed(params: PeelParams, start: Any, n: int | None, t_transient: float, window: float, max_period: int,
