@@ -35,6 +35,7 @@ from peelapprox.validate import ArgumentTypeError, duration, flag, integer, opti
 from peelapprox.validate import params as _params
 from peelapprox.validate import rtol as _rtol
 
+from .._model import model_of
 from .._shared import DEFAULT_MAX_WALL
 from .._trajectory import Trajectory
 from ..orbits._periodic import minimal_period, solve_orbit
@@ -253,7 +254,7 @@ class _Reader:
                 return SetOutcome(s, "attractor", g, f"{self.groups[g]['label']} (the orbit Newton closed from an "
                                   "earlier start)", obs, wall_time=wall)
         if n is not None:
-            orbit, note = self._orbit(tr, n) if self.stability and self.params.variant is None else (None, "")
+            orbit, note = self._orbit(tr, n) if self.stability and model_of(self.params).has_hybrid else (None, "")
             if orbit is not None and not orbit.stable:
                 esc = self._escape(tr, orbit)
                 sitting = escape_index(x, orbit.return_map_values) is None  # every return within 1 % of the orbit's
@@ -365,7 +366,7 @@ class _Reader:
         from ._lyapunov import lyapunov
 
         alpha = [starts[i] for i in g["members"] if starts[i].alpha_only]
-        if not self.stability or self.params.variant is not None:
+        if not self.stability or not model_of(self.params).has_hybrid:
             g["note"] = "no exponent: stability=False" if not self.stability else "no exponent for a model variant"
             return
         if not alpha:

@@ -16,6 +16,7 @@ from peelapprox.errors import WallBudget
 from peelapprox.parallel import AUTO, worker_pool
 
 from .._initial import initial_state
+from .._model import model_of
 from .._simulate import simulate
 from .._trajectory import State
 from ._attractor_set_result import SetStart
@@ -54,7 +55,7 @@ def default_starts(params: PeelParams) -> tuple[SetStart, ...]:
     folds at V (8 starts then, else 5)."""
     out = [SetStart("solver")]
     try:
-        bs = params.force.folds(params.V) if params.variant is None else None
+        bs = params.force.folds(params.V) if model_of(params).has_hybrid else None
     except ValueError:
         bs = None
     folds = bs is not None and bs.has_folds and None not in (bs.v_land_ab, bs.f_min, bs.f_max, bs.v_max)
