@@ -132,3 +132,22 @@ def test_stacked_roots_equal_numpy_roots_per_interval():
     assert len(cross) == 1 and abs(cross[0] - (np.sqrt(3.0) - 1.0)) <= 4.5e-16
     ext = _extrema(t, a, d)
     assert len(ext) == 2 and ext[0] == 2.5 and 3.0 < ext[1] < 4.0
+
+
+def test_compare_without_periods_gives_the_same_rows(low):
+    """``compare(..., periods=False)`` (the atlas's call: the reduced solves store no steps) gives every row's
+    status, Δt and ΔF exactly as with periods (the driver's steps do not depend on what it stores: no
+    tolerance), and None for the approximate period columns; a non-bool ``periods`` is refused by name."""
+    from comparisons import compare
+
+    segs = segments(low, last=4)
+    full, lean = compare(low, segs=segs), compare(low, segs=segs, periods=False)
+    assert len(full) == len(lean) >= 16
+    for a, b in zip(full, lean):
+        da, db = a.as_dict(), b.as_dict()
+        assert db.pop("period_approx") is None and db.pop("period_rel_error") is None
+        da.pop("period_approx"), da.pop("period_rel_error")
+        assert da == db
+    assert any(r.period_approx is not None for r in full)
+    with pytest.raises(TypeError, match="periods"):
+        compare(low, segs=segs, periods="no")

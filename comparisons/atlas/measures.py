@@ -201,7 +201,7 @@ def measure_segments(params: PeelParams, options: Mapping) -> dict:
     segs = segments(tr, last=2 * n) if n else []  # the last n of each branch: the branches alternate
     chosen = {b: [s for s in segs if s.branch == b][-n:] if n else [] for b in ("AB", "CD")}
     rows = compare(tr, models, segs=chosen["AB"] + chosen["CD"],
-                   rtol=_rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"])))
+                   rtol=_rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"])), periods=False)
     stats = []
     for branch, pairs in models.items():
         for am, ve in pairs:
