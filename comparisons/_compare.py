@@ -143,7 +143,7 @@ def _err(a: float | None, e: float | None):
 
 
 def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None = None, *,
-            segs: list[Segment] | None = None, rtol: float = 1e-10) -> RowTable:
+            segs: list[Segment] | None = None, rtol: float = 1e-10, periods: bool = True) -> RowTable:
     """Every reduction on every segment of an exact trajectory, seeded from exact entry states.
 
     Parameters
@@ -158,6 +158,10 @@ def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None =
         A subset of ``segments(trajectory)`` to compare (default: all).
     rtol : float
         Tolerance of the reduced solves.
+    periods : bool
+        False: leave ``period_approx`` and ``period_rel_error`` None and let the reduced solves store no steps
+        (``save="none"``; Δt and ΔF are the same numbers, the steps taken being the same): for a caller that
+        compares Δt and ΔF only (an atlas), whose Python per row it saves.
 
     Returns
     -------
@@ -175,15 +179,19 @@ def compare(trajectory, models: Mapping[str, Sequence[tuple[str, str]]] | None =
     models = DEFAULT_MODELS if models is None else models
     # the reductions are the paper's massless constant-V equations: a variant's trajectory is refused here
     params = _params("trajectory.params", trajectory.params, where="compare", variants=False)
+    if not isinstance(periods, bool):
+        raise TypeError(f"periods must be True or False, got {periods!r}")
+    save = "steps" if periods else "none"
     rows = RowTable()
     for s in (segments(trajectory) if segs is None else segs):
         p_ex = s.local_period()
         for am, ve in models.get(s.branch, ()):
             dt_a = dF_a = p_a = None
-            r, status = run_reduction(params, s.branch, am, ve, rtol=rtol, **s.entry())
+            r, status = run_reduction(params, s.branch, am, ve, rtol=rtol, save=save, **s.entry())
             if r is not None:
                 dt_a, dF_a = r.dt, r.dF
-                p_a = local_period(_crossings(r.t, r.alpha, r.alphadot), _extrema(r.t, r.alpha, r.alphadot))
+                if periods:
+                    p_a = local_period(_crossings(r.t, r.alpha, r.alphadot), _extrema(r.t, r.alpha, r.alphadot))
             dt_abs, dt_rel = _err(dt_a, s.dt)
             dF_abs, dF_rel = _err(dF_a, s.dF)
             _, p_rel = _err(p_a, p_ex)

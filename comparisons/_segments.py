@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import trapezoid
 
+from peelapprox.validate import integer
+
 __all__ = ["Segment", "segments"]
 
 
@@ -112,14 +114,36 @@ def _hermite_roots(t0, t1, a0, a1, d0, d1):
     return sorted(out)
 
 
+def _companion_roots(p: np.ndarray) -> np.ndarray:
+    """The roots of each row of ``p`` (polynomial coefficients, highest power first, the first and last of every
+    row nonzero) as ``numpy.roots`` finds them, one row each: the eigenvalues of the same companion matrices, by
+    one stacked ``numpy.linalg.eigvals`` call (LAPACK's geev on each matrix, as ``numpy.roots`` calls it: the
+    same numbers bitwise) instead of a Python call per interval.  Complex, shape ``p.shape[0] x (degree)``."""
+    n, k = p.shape
+    A = np.zeros((n, k - 1, k - 1))
+    A[:, np.arange(1, k - 1), np.arange(k - 2)] = 1.0
+    A[:, 0, :] = -p[:, 1:] / p[:, :1]
+    return np.linalg.eigvals(A).astype(complex, copy=False) if n else np.empty((0, k - 1), complex)
+
+
 def _crossings(t, a, d):
-    """Upward zero crossings of α from samples (t, α, α̇), Hermite-refined."""
-    out = []
+    """Upward zero crossings of α from samples (t, α, α̇), Hermite-refined (:func:`_hermite_roots` on every
+    interval where α turns from negative to non-negative; the cubics with a zero end coefficient, which
+    ``numpy.roots`` reduces, one by one, the others in one stacked eigenvalue call)."""
     idx = np.nonzero((a[:-1] < 0) & (a[1:] >= 0))[0]
-    for i in idx:
-        if t[i + 1] <= t[i]:
-            continue
-        out.extend(_hermite_roots(t[i], t[i + 1], a[i], a[i + 1], d[i], d[i + 1]))
+    idx = idx[t[idx + 1] > t[idx]]
+    t0, t1 = t[idx], t[idx + 1]
+    h = t1 - t0
+    c0, c1, c2, c3 = _hermite_coefficients(h, a[idx], a[idx + 1], d[idx], d[idx + 1])
+    plain = (np.abs(c3) > 0) & (c0 != 0)
+    out = [] if plain.all() else [r for i in idx[~plain] for r in
+                                  _hermite_roots(t[i], t[i + 1], a[i], a[i + 1], d[i], d[i + 1])]
+    c0, c1, c2, c3, t0, h = (x[plain, None] for x in (c0, c1, c2, c3, t0, h))
+    r = _companion_roots(np.hstack((c3, c2, c1, c0)))
+    s = r.real
+    ok = (np.abs(r.imag) < 1e-12) & (0.0 < s) & (s <= 1.0)
+    ok &= c1 + 2 * c2 * s + 3 * c3 * s * s > 0
+    out.extend((t0 + s * h)[ok].tolist())
     return np.array(sorted(set(out)))
 
 
@@ -132,20 +156,40 @@ def local_period(crossings, extrema) -> float | None:
     return None
 
 
+def _extremum(t0, h, a0, a1, d0, d1):
+    """The stationary point of the Hermite cubic on one interval where α̇ changes sign (numpy.roots)."""
+    _, c1, c2, c3 = _hermite_coefficients(h, a0, a1, d0, d1)
+    roots = np.roots([3 * c3, 2 * c2, c1]) if abs(c3) > 0 else np.roots([2 * c2, c1])
+    inside = [r.real for r in roots if abs(r.imag) < 1e-12 and 0.0 <= r.real <= 1.0]
+    # a sign change of d guarantees a root in [0, 1]; take the one nearest the linear estimate
+    s_lin = d0 / (d0 - d1)
+    return t0 + h * (min(inside, key=lambda r: abs(r - s_lin)) if inside else s_lin)
+
+
 def _extrema(t, a, d):
-    """Times where α̇ changes sign between samples, refined as the stationary point of the Hermite cubic."""
-    out = []
-    for i in np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]:
-        h = t[i + 1] - t[i]
-        if h <= 0:
-            continue
-        _, c1, c2, c3 = _hermite_coefficients(h, a[i], a[i + 1], d[i], d[i + 1])
-        roots = np.roots([3 * c3, 2 * c2, c1]) if abs(c3) > 0 else np.roots([2 * c2, c1])
-        inside = [r.real for r in roots if abs(r.imag) < 1e-12 and 0.0 <= r.real <= 1.0]
-        # a sign change of d guarantees a root in [0, 1]; take the one nearest the linear estimate
-        s_lin = d[i] / (d[i] - d[i + 1])
-        out.append(t[i] + h * (min(inside, key=lambda r: abs(r - s_lin)) if inside else s_lin))
-    return np.array(out)
+    """Times where α̇ changes sign between samples, refined as the stationary point of the Hermite cubic
+    (:func:`_extremum`: the quadratics with a zero end coefficient one by one, the others in one stacked
+    eigenvalue call; of two roots in [0, 1] the first nearest the linear estimate, as ``min`` picks)."""
+    idx = np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]
+    h = t[idx + 1] - t[idx]
+    idx, h = idx[h > 0], h[h > 0]
+    t0, d0, d1 = t[idx], d[idx], d[idx + 1]
+    _, c1, c2, c3 = _hermite_coefficients(h, a[idx], a[idx + 1], d0, d1)
+    p = np.stack((3 * c3, 2 * c2, c1), axis=1)
+    plain = (np.abs(c3) > 0) & (c1 != 0)
+    out = np.empty(len(idx))
+    for j in np.flatnonzero(~plain):
+        out[j] = _extremum(t0[j], h[j], a[idx[j]], a[idx[j] + 1], d0[j], d1[j])
+    r = _companion_roots(p[plain])
+    s_lin = (d0 / (d0 - d1))[plain, None]
+    s = r.real
+    inside = (np.abs(r.imag) < 1e-12) & (0.0 <= s) & (s <= 1.0)
+    dist = np.where(inside, np.abs(s - s_lin), np.inf)
+    best = np.argmin(dist, axis=1)
+    rows = np.arange(len(best))
+    s_best = np.where(inside.any(axis=1), s[rows, best], s_lin[:, 0])
+    out[plain] = t0[plain] + h[plain] * s_best
+    return out
 
 
 def time_mean(t: np.ndarray, x: np.ndarray, t0: float, t1: float) -> float:
@@ -161,7 +205,7 @@ def time_mean(t: np.ndarray, x: np.ndarray, t0: float, t1: float) -> float:
     return float(trapezoid(xx, tt) / (t1 - t0))
 
 
-def segments(trajectory) -> list[Segment]:
+def segments(trajectory, *, last: int | None = None) -> list[Segment]:
     """Complete branch segments of an exact trajectory, in time order.
 
     Parameters
@@ -170,6 +214,10 @@ def segments(trajectory) -> list[Segment]:
         From :func:`exact.simulate`.  Entry/exit states and Δt, ΔF need only
         the jumps (``save="jumps"`` suffices); the α periods need stored points
         (``save="steps"`` or ``t_eval``), else they are empty.
+    last : int, optional
+        Only the last ``last`` complete segments (each as in the whole list, its :attr:`Segment.index` too;
+        the branches alternate, so the last ``2 n`` hold the last ``n`` of each branch): what a caller that
+        compares the end of a window needs, without the α crossings of every earlier stay.  None: all.
 
     Returns
     -------
@@ -179,13 +227,14 @@ def segments(trajectory) -> list[Segment]:
         out).
     """
     J = trajectory.jumps
+    first = 0 if last is None else max(len(J) - 1 - integer("last", last, lo=0), 0)
     R = trajectory.params.R
     t = np.asarray(trajectory.t)
     al = np.asarray(trajectory.alpha)
     ad = np.asarray(trajectory.omega) - np.asarray(trajectory.v) / R
     F = np.asarray(trajectory.F)
     out: list[Segment] = []
-    for i in range(len(J) - 1):
+    for i in range(first, len(J) - 1):
         a, b = J[i], J[i + 1]
         if a.to_branch != b.from_branch:  # pragma: no cover - the solver guarantees alternation
             raise ValueError(f"jumps {i} and {i + 1} do not share a branch: {a.to_branch} vs {b.from_branch}")
@@ -210,7 +259,7 @@ def segments(trajectory) -> list[Segment]:
                 if len(per):
                     Fp = np.array([time_mean(tt, FF, c0, c1) for c0, c1 in zip(cross[:-1], cross[1:])])
         out.append(Segment(
-            index=len(out), branch=a.to_branch, t_in=a.t, alpha_in=a.alpha, alphadot_in=a.omega - a.v_after / R,
+            index=i, branch=a.to_branch, t_in=a.t, alpha_in=a.alpha, alphadot_in=a.omega - a.v_after / R,
             omega_in=a.omega, F_in=a.F, v_in=a.v_after, t_out=b.t, alpha_out=b.alpha,
             alphadot_out=b.omega - b.v_before / R, omega_out=b.omega, F_out=b.F, v_out=b.v_before,
             crossings=cross, periods=per, F_at_periods=Fp, extrema=ext,

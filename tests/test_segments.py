@@ -78,3 +78,76 @@ def test_compare_rows(low):
         assert r.dt_abs_error == pytest.approx(r.dt_approx - r.dt_exact, abs=0)
         if r.branch == "AB":
             assert abs(r.period_rel_error) <= 1e-3
+
+
+def test_last_segments_are_the_tail_of_all(low):
+    """``segments(tr, last=k)`` is the last k of ``segments(tr)``, each the same segment (index, entry, exit,
+    crossings, periods, extrema equal exactly: each stay is computed from its own two jumps), k beyond the
+    count gives all, 0 none; a negative or non-integer ``last`` is refused by name."""
+    full = segments(low)
+    for k in (0, 1, 4, len(full), len(full) + 7):
+        tail = segments(low, last=k)
+        assert len(tail) == min(k, len(full))
+        for s, r in zip(tail, full[len(full) - len(tail):]):
+            assert s.index == r.index and s.dt == r.dt and s.dF == r.dF and s.v_in == r.v_in
+            for f in ("crossings", "periods", "F_at_periods", "extrema"):
+                assert np.array_equal(getattr(s, f), getattr(r, f))
+    for bad in (-1, 1.5, "2"):
+        with pytest.raises((ValueError, TypeError), match="last"):
+            segments(low, last=bad)
+
+
+def test_stacked_roots_equal_numpy_roots_per_interval():
+    """The crossings and extrema found with one stacked eigenvalue call equal, bitwise, those of the
+    per-interval ``numpy.roots`` path (``_hermite_roots``, ``_extremum``: the code before the stacking, kept for
+    the cubics with a zero end coefficient) on 200 seeded random sample sets with repeated times and exact
+    zeros of α and α̇: the same companion matrices go to the same LAPACK routine, so no tolerance."""
+    from comparisons._segments import _crossings, _extrema, _extremum, _hermite_roots
+
+    rng = np.random.default_rng(37)
+    found = 0
+    for _ in range(200):
+        m = int(rng.integers(2, 60))
+        t = np.cumsum(rng.random(m) * rng.choice([0, 1, 1, 1], m))
+        a = np.sin(rng.random() * 20 * t + rng.random()) + rng.normal(0, 0.1, m)
+        d = np.cos(rng.random() * 20 * t) * rng.choice([1, 0, -1], m, p=[.45, .1, .45])
+        a[rng.random(m) < 0.05] = 0.0
+        ref = []
+        for i in np.nonzero((a[:-1] < 0) & (a[1:] >= 0))[0]:
+            if t[i + 1] > t[i]:
+                ref.extend(_hermite_roots(t[i], t[i + 1], a[i], a[i + 1], d[i], d[i + 1]))
+        got = _crossings(t, a, d)
+        assert got.tobytes() == np.array(sorted(set(ref))).tobytes()
+        ext = [_extremum(t[i], t[i + 1] - t[i], a[i], a[i + 1], d[i], d[i + 1])
+               for i in np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0] if t[i + 1] > t[i]]
+        assert _extrema(t, a, d).tobytes() == np.array(ext, dtype=float).tobytes()
+        found += len(got) + len(ext)
+    assert found > 1000
+    # intervals whose cubic term is exactly zero (the numpy.roots fallback) beside ordinary ones
+    t = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    a, d = np.array([-1.0, 0.5, 0.0, 0.0, -0.3]), np.array([1.0, 2.0, 1.0, -1.0, 0.7])
+    # on [0, 1] a(s) = -1 + s + s^2/2: the root sqrt(3) - 1 (to rounding: 2 ulp); on [2, 3] a(s) = s - s^2, the
+    # stationary point 1/2 exactly (a linear root), and the ordinary interval [3, 4] on the stacked path
+    cross = _crossings(t, a, d)
+    assert len(cross) == 1 and abs(cross[0] - (np.sqrt(3.0) - 1.0)) <= 4.5e-16
+    ext = _extrema(t, a, d)
+    assert len(ext) == 2 and ext[0] == 2.5 and 3.0 < ext[1] < 4.0
+
+
+def test_compare_without_periods_gives_the_same_rows(low):
+    """``compare(..., periods=False)`` (the atlas's call: the reduced solves store no steps) gives every row's
+    status, Δt and ΔF exactly as with periods (the driver's steps do not depend on what it stores: no
+    tolerance), and None for the approximate period columns; a non-bool ``periods`` is refused by name."""
+    from comparisons import compare
+
+    segs = segments(low, last=4)
+    full, lean = compare(low, segs=segs), compare(low, segs=segs, periods=False)
+    assert len(full) == len(lean) >= 16
+    for a, b in zip(full, lean):
+        da, db = a.as_dict(), b.as_dict()
+        assert db.pop("period_approx") is None and db.pop("period_rel_error") is None
+        da.pop("period_approx"), da.pop("period_rel_error")
+        assert da == db
+    assert any(r.period_approx is not None for r in full)
+    with pytest.raises(TypeError, match="periods"):
+        compare(low, segs=segs, periods="no")

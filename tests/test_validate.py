@@ -348,3 +348,15 @@ def test_fuzz_reduced_segment(arg, value, branch, model):
     res = _ok_or_named(lambda: pa.reduced_segment(P, branch, **kw), (arg, "v_in", "v_f", "F = F_in"))
     if res is not None:
         assert math.isfinite(res.dt) and res.dt >= 0 and math.isfinite(res.F_exit)
+
+
+def test_interval_text_is_remembered_per_sign_and_type():
+    """The range text of the validators' messages is cached (peelapprox/_checks.py): a cached ``0.0`` must not
+    serve ``-0.0``, nor an int bound a float one, and an open/closed end must stay as asked (exact strings)."""
+    from peelapprox._checks import interval
+
+    assert interval(0.0, 1.0) == "[0, 1]" and interval(0.0, 1.0) == "[0, 1]"
+    assert interval(-0.0, 1.0) == "[-0, 1]"
+    assert interval(0.0, 1.0, lo_open=True) == "(0, 1]"
+    assert interval(1, 2) == "[1, 2]" and interval(1.5, 2) == "[1.5, 2]"
+    assert interval(0.0, math.inf) == "[0, inf)"

@@ -73,7 +73,7 @@ def estimate_observables(params: PeelParams) -> dict:
     ValueError
         As :func:`peelapprox.estimate` (a model variant, a law whose folds cannot be found).
     """
-    e = estimate(params)
+    e = _estimate_of(params)
     method = "estimate: quasi-static cycle (alpha = 0, approxvdot between the folds)"
     if e.velocity == "stable" or not e.has_folds:
         why = (f"the law has no folds at V = {fmt_number(e.V, 4)} m/s" if not e.has_folds else
@@ -87,6 +87,19 @@ def estimate_observables(params: PeelParams) -> dict:
     return {"status": "stick-slip", "reason": f"{e.label}: the quasi-static cycle between the folds",
             "method": method, "period": 1, "slip_interval": t_ab + t_cd, "force_drop": e.f_max - e.f_min,
             "slip_time": t_cd, "stick_time": t_ab, "F_max": e.f_max, "F_min": e.f_min}
+
+
+_LAST = threading.local()
+
+
+def _estimate_of(params: PeelParams) -> Any:
+    """:func:`peelapprox.estimate` of ``params``, this thread's last one reused for the very same object: an atlas
+    point asks for it twice (the ``regime`` label and the ``"estimate"`` approximation), and its quadratures call
+    Python functions (under the GIL) ~10 ms a time.  The object is held, so its ``id`` is not reused."""
+    last = getattr(_LAST, "pair", None)
+    if last is None or last[0] is not params:
+        last = _LAST.pair = (params, estimate(params))
+    return last[1]
 
 
 #: name -> approximation (module docstring).  One line adds one; an entry whose import reference does not

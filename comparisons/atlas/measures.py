@@ -33,7 +33,6 @@ from peelapprox import (
     ModelBreakdown,
     PeelParams,
     SolverBudgetExceeded,
-    estimate,
 )
 from peelapprox.io import fmt_number
 from peelapprox.validate import duration, integer, state
@@ -43,7 +42,7 @@ from .._compare import DEFAULT_MODELS, compare
 from .._segments import segments
 from .._worker import error_text
 from ..sweep import register_measure
-from .approximations import APPROXIMATIONS, OBSERVABLES, predict
+from .approximations import APPROXIMATIONS, OBSERVABLES, _estimate_of, predict
 from .records import SEGMENT_STATS, SPREADS, schema
 
 __all__ = ["MEASURE_NAMES", "DEFAULTS", "SPREADS", "SEGMENT_STATS", "reduction_key", "check_options",
@@ -203,10 +202,10 @@ def measure_segments(params: PeelParams, options: Mapping) -> dict:
         return {"status": f"breakdown:{exc.reason}"}
     except SolverBudgetExceeded as exc:
         return {"status": _budget(exc)["status"]}
-    segs = segments(tr) if n else []
+    segs = segments(tr, last=2 * n) if n else []  # the last n of each branch: the branches alternate
     chosen = {b: [s for s in segs if s.branch == b][-n:] if n else [] for b in ("AB", "CD")}
     rows = compare(tr, models, segs=chosen["AB"] + chosen["CD"],
-                   rtol=_rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"])))
+                   rtol=_rtol("segment_rtol", options.get("segment_rtol", DEFAULTS["segment_rtol"])), periods=False)
     stats = []
     for branch, pairs in models.items():
         for am, ve in pairs:
@@ -231,7 +230,7 @@ def measure_approx(params: PeelParams, options: Mapping) -> dict:
     """
     rec: dict[str, Any] = {"status": "ok"}
     try:
-        rec["regime"] = estimate(params).label
+        rec["regime"] = _estimate_of(params).label
     except Exception as exc:
         rec["regime"] = error_text(exc, 200)
     ds = []
