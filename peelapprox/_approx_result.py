@@ -71,7 +71,7 @@ class ApproximateAttractor(StickSlipObservables):
         ``A_k = A_k0 |μ|^((k - k0)/n)`` reaches :data:`ESCAPE_FRACTION` of its force drop, counted from the start
         (``A`` the envelope of the AB→CD force's deviation from the orbit: the section point's deviation in the
         dominant eigen-coordinates of ``D P^n`` times the force's gradient); None otherwise.  Measured against the
-        exact runs: within 20 % where the map's |μ| - 1 is within 20 % of the exact orbit's (docs/theory.md).
+        exact runs: within 20 % where the map's ``|μ| - 1`` is within 20 % of the exact orbit's (docs/theory.md).
     confidence : {"high", "low"}
         ``"low"`` where a rule of the module docstring applies; ``confidence_reason`` says which.
     confidence_reason : str
