@@ -47,7 +47,7 @@ from .validate import choice, flag, integer, optional, positive
 from .validate import params as _params
 from .validate import rtol as _rtol
 
-__all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "PERIOD_RTOL", "STARTS",
+__all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "PERIOD_RTOL", "START_NAMES",
            "approximate_attractor", "default_models"]
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
@@ -60,7 +60,7 @@ APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = dict.fromk
 #: Where the map starts (``start=``): ``"solver"``, the exact solver's default start; ``"rest"``, the foot of the
 #: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, both: the solver's attractor is the
 #: primary prediction, the rest start's an alternative (the primary where the solver's start finds none).
-STARTS = ("auto", "solver", "rest")
+START_NAMES = ("auto", "solver", "rest")
 
 #: A periodic orbit is looked for with periods up to this (Newton on ``P^n``); longer ones are sampled.
 MAX_PERIOD = 12
@@ -122,7 +122,7 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         AB's and CD's α model (:data:`peelapprox.ALPHA_MODELS`) and v equation (:data:`peelapprox.V_EQUATIONS`),
         any combination; each None is the default (:data:`APPROX_DEFAULTS`).
     start : {"auto", "solver", "rest"}
-        Where the map starts (:data:`STARTS`): ``"auto"`` both, the solver's attractor first.
+        Where the map starts (:data:`START_NAMES`): ``"auto"`` both, the solver's attractor first.
     n_transient : int
         Returns discarded before a period is looked for, an integer in [0, 10**6] (40).
     n_returns : int
@@ -159,7 +159,7 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         ("cd_v_equation", cd_v_equation))]
     n_transient, n_returns = integer("n_transient", n_transient, lo=0, hi=10**6), \
         integer("n_returns", n_returns, lo=3, hi=10**6)
-    start, rtol, max_wall, warn = choice("start", start, STARTS), _rtol("rtol", rtol), \
+    start, rtol, max_wall, warn = choice("start", start, START_NAMES), _rtol("rtol", rtol), \
         optional(positive, "max_wall", max_wall), flag("warn", warn)
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
     common: dict[str, Any] = dict(V=float(params.V), I=float(params.I), t_start=None, t_end=None)
