@@ -6,6 +6,8 @@ The oracle is the truth the synthetic trace was made with: the exact model at kn
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -56,7 +58,7 @@ def test_a_start_a_third_of_the_truth_extends_the_box():
 def test_the_box_stops_at_the_parameter_range():
     """The extension stays within PARAM_RANGES: a side at the range's limit does not move, an interior side
     moves out by the initial half-width at the node spacing (a closed-form check of the helper)."""
-    from exact.dynamics._infer import _extend
+    from exact.dynamics._infer_search import extend as _extend
     from peelapprox import PARAM_RANGES
 
     lo = np.array([np.log(PARAM_RANGES["I"][0])])
@@ -79,7 +81,8 @@ def test_the_closest_attractor_of_the_set_is_read():
     p = PeelParams(V=1.0, I=1e-5)
     tr = exact.simulate(p, 35.0, alpha0=-0.3, t_eval=30.0 + np.arange(50000) / 1e4)
     s = tr.as_series(1e4, noise=0.5, drift=5.0, seed=1)
-    vals, sig, threshold, noise, used = data_statistics(s)
+    d = data_statistics(s)
+    vals, sig, threshold, noise, used = d.values, d.sigma, d.threshold, d.noise, d.used
     r = set_statistics(p, s, threshold, noise, 30.0, 1e-10, 120.0, (vals, sig, used), 3)
     assert r.start == "alpha0=-0.3" and r.label == "period-1" and r.n_runs == 3
     assert r.values is not None and np.all(np.abs((r.values - vals) / sig)[used] <= 3.0)
@@ -102,7 +105,8 @@ def test_the_replicate_spread_of_a_chaotic_trace():
     s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
     o = s.observables()
     assert o.period is None
-    vals, sig, threshold, noise, used = data_statistics(s)
+    d = data_statistics(s)
+    threshold, noise = d.threshold, d.noise
     sd, stable, n = replicate_spread(p, s, threshold, noise, 30.0, 1e-10, 120.0, 3)
     assert sd is not None and n == 3 and not stable
     for j, name in enumerate(OBSERVABLES[:4]):
@@ -186,15 +190,18 @@ def test_an_aperiodic_fit_needs_a_probable_chi2():
     above POOR_FIT (1e-3) and below GOOD_FIT (0.05).  With a tight interval inside the box the parameter is
     identified for a periodic series (threshold POOR_FIT) and not for an aperiodic one (threshold GOOD_FIT: its
     sigma rests on a few model replicates), and the verdict quotes the probability."""
-    from exact.dynamics._infer import GOOD_FIT, POOR_FIT, _result
+    from exact.dynamics._infer import GOOD_FIT, POOR_FIT
+    from exact.dynamics._infer_result import Outcome, assemble
+    from exact.dynamics._infer_search import Point, Problem, SeriesFit
+    from exact.dynamics._infer_stats import SeriesData
 
     x = np.log(1000.0)
     model = np.ones(7)
-    evaluated = [(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
-    data = [(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool))]
+    evaluated = [Point(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
+    fits = [SeriesFit(None, 1.0, SeriesData(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool)))]
     box = (np.array([x - 1.0]), np.array([x + 1.0]))
-    args = (PeelParams(V=1.0, I=1e-2), ["k"], np.arange(7), None, evaluated, box, data, [1.0], "converged", "", 1.0,
-            6, ())
-    assert _result(*args, POOR_FIT).identified["k"]
-    strict = _result(*args, GOOD_FIT)
+    problem = Problem(PeelParams(V=1.0, I=1e-2), ("k",), np.arange(7), 30.0, 1e-10, 1)
+    outcome = Outcome(evaluated, None, box, 6, "converged", "", 1.0)
+    assert outcome.poor_fit == POOR_FIT and assemble(problem, fits, outcome).identified["k"]
+    strict = assemble(problem, fits, dataclasses.replace(outcome, poor_fit=GOOD_FIT))
     assert not strict.identified["k"] and "probability 0.023" in strict.verdicts["k"]

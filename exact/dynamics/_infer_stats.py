@@ -33,8 +33,8 @@ from peelapprox.io import fmt_number
 from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
-__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SetReading", "data_statistics",
-           "model_statistics", "replicate_spread", "set_statistics", "trace_statistics"]
+__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SeriesData", "SetReading",
+           "data_statistics", "model_statistics", "replicate_spread", "set_statistics", "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -114,7 +114,48 @@ def _cycle_frequency(series: ForceSeries, f_slip: float) -> tuple[float, bool]:
     return line, True
 
 
-def data_statistics(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
+@dataclass(frozen=True)
+class SeriesData:
+    """One measured series' statistics as :func:`infer` fits them (:func:`data_statistics`).
+
+    Attributes
+    ----------
+    values, sigma : ndarray
+        The statistics of :data:`OBSERVABLES` and their σ (module docstring: residuals).
+    threshold, noise : float
+        The detector's threshold and the series' noise level, with which every model trace is read.
+    used : ndarray of bool
+        Which statistics the series carries (not the cycle frequency where no line stands out of its
+        periodogram, nor where it is not stable across the model's replicates).
+    """
+
+    values: np.ndarray
+    sigma: np.ndarray
+    threshold: float
+    noise: float
+    used: np.ndarray
+
+    def fitted(self, sel: np.ndarray) -> np.ndarray:
+        """The indices into :data:`OBSERVABLES` fitted: those of ``sel`` (the ``statistics`` asked for) the
+        series carries, in ``sel``'s order."""
+        return sel[self.used[sel]]
+
+    def target(self, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(values, σ, mask)`` of :func:`set_statistics`: the mask over :data:`OBSERVABLES` of the fitted
+        statistics."""
+        mask = np.zeros(len(OBSERVABLES), dtype=bool)
+        mask[self.fitted(sel)] = True
+        return self.values, self.sigma, mask
+
+    def residuals(self, model: np.ndarray | None, sel: np.ndarray, penalty: float) -> np.ndarray:
+        """``(model - data) / σ`` over the fitted statistics; ``penalty`` for each where the model does not
+        stick-slip (``model`` None)."""
+        if model is None:
+            return np.full(int(np.count_nonzero(self.used[sel])), penalty)
+        return ((model - self.values) / self.sigma)[self.fitted(sel)]
+
+
+def data_statistics(series: ForceSeries) -> SeriesData:
     """The series' statistics, their σ (module docstring: residuals), the detector's threshold, the noise
     level and which statistics it carries: not the cycle frequency where no line stands out of the periodogram
     below half the slip frequency (a period-1 trace: only drift and noise there)."""
@@ -132,7 +173,7 @@ def data_statistics(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float,
             sig[j] = math.hypot(sig[j], spread / math.sqrt(max(o.n_slips - 1, 1)))
     used = np.ones(len(OBSERVABLES), dtype=bool)
     used[OBSERVABLES.index("f_cycle")] = line
-    return vals, sig, threshold, series.noise, used
+    return SeriesData(vals, sig, threshold, series.noise, used)
 
 
 def model_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
