@@ -166,6 +166,8 @@ def test_bad_input_is_named(high_inertia):
         (dict(series=high_inertia, params0=p0, free=("k",), max_wall=0.0), ValueError, "max_wall"),
         (dict(series=high_inertia, params0=p0, free=("k",), attractors=0), ValueError, "attractors"),
         (dict(series=high_inertia, params0=p0, free=("k",), attractors=9), ValueError, "attractors"),
+        (dict(series=high_inertia, params0=p0, free=("k",), replicates=0), ValueError, "replicates"),
+        (dict(series=high_inertia, params0=p0, free=("k",), replicates=2.0), ValueError, "replicates"),
     ]
     for kwargs, error, match in cases:
         with pytest.raises(error, match=match):
@@ -205,3 +207,26 @@ def test_an_aperiodic_fit_needs_a_probable_chi2():
     assert outcome.poor_fit == POOR_FIT and assemble(problem, fits, outcome).identified["k"]
     strict = assemble(problem, fits, dataclasses.replace(outcome, poor_fit=GOOD_FIT))
     assert not strict.identified["k"] and "probability 0.023" in strict.verdicts["k"]
+
+
+def test_the_replicate_mean_of_a_chaotic_trace():
+    """Hypothesis (synthetic likelihood's mean, Wood 2010): at the chaotic point V = 2.5, I = 1e-4 the model's
+    statistics over two replicates (the attractor set's first two starts) are the mean of the two starts' own
+    readings (model_statistics from each start: the same runs, so equal to round-off, 1e-12 relative), and that
+    mean lies strictly between them wherever they differ."""
+    from exact.dynamics._attractor_set_runs import default_starts
+    from exact.dynamics._infer_stats import data_statistics, model_statistics, replicate_mean
+
+    p = PeelParams(V=2.5, I=1e-4)
+    s = exact.simulate(p, 33.0, t_eval=30.0 + np.arange(30000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    d = data_statistics(s)
+    r = replicate_mean(p, s, d.threshold, d.noise, 30.0, 1e-10, 120.0, (d.values, d.sigma, d.used), 2)
+    each = [model_statistics(p, s, d.threshold, d.noise, 30.0, 1e-10, 120.0, **st.kwargs())
+            for st in default_starts(p)[:2]]
+    assert all(e is not None for e in each) and r.values is not None
+    assert r.start == "mean of 2 aperiodic replicates" and r.label == "aperiodic" and r.n_runs == 2
+    np.testing.assert_allclose(r.values, (each[0] + each[1]) / 2, rtol=1e-12)
+    differ = each[0] != each[1]
+    assert differ.any()
+    assert np.all(np.minimum(each[0], each[1])[differ] < r.values[differ])
+    assert np.all(r.values[differ] < np.maximum(each[0], each[1])[differ])

@@ -6,12 +6,18 @@ and read by the same slip detector with the same threshold, gives the same stati
 several (one series per V).
 
 * **Statistics and residuals** (``exact/dynamics/_infer_stats.py``): seven statistics of the trace, the model's
-  read off an exact run sampled, noised and detected as the data were; residuals ``(model - data) / σ``.
+  read off an exact run sampled, noised and detected as the data were; residuals ``(model - data) / σ``.  The
+  search's pieces (the grid, its extension, the residuals at a trial point, the replicate spread) are in
+  ``exact/dynamics/_infer_search.py``, the result and its verdicts in ``exact/dynamics/_infer_result.py``; they
+  pass named records (a series' ``SeriesData``, ``SeriesFit``, ``Problem``, an evaluated ``Point``, ``Outcome``).
 * **The attractor set.**  At each trial point the statistics are those of the attractor closest to the data
   among those reached from the first ``attractors`` starts of :func:`exact.attractor_set`'s design
   (:func:`set_statistics`); at the best point the whole design runs once to name that attractor and its share
   (:attr:`Inference.attractors`).  For an aperiodic series the model's spread over replicates at the best grid
-  point joins each σ and the cycle line is kept only where it is stable across them (:func:`replicate_spread`).
+  point joins each σ and the cycle line is kept only where it is stable across them (:func:`replicate_spread`);
+  with ``replicates`` > 1 the model's statistics at every trial point are the mean over that many replicates
+  (:func:`replicate_mean`: a synthetic likelihood's mean, Wood 2010) and the spread's share of σ shrinks by
+  √replicates.
 * **Search, then fit.**  An attractor's statistics are not smooth in the parameters (periodic windows,
   coexisting attractors), so a local fit alone finds a nearby minimum with an overconfident interval.  First
   a grid over ``params0 / search`` to ``params0 · search`` (ln θ for I, k, R; ±30 % for coefficients; at most
@@ -92,6 +98,7 @@ _F_CYCLE = OBSERVABLES.index("f_cycle")
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
           more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
           t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0, attractors: int = 1,
+          replicates: int = 1,
           progress: Callable[[str], None] | bool | None = True, executor: str | Executor | None = None,
           max_workers: int | None = None) -> Inference:
     """The model's parameters whose force traces read like the measured ones (module docstring).
@@ -126,6 +133,11 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         alone; 3 is the opt-in for multistable traces (docs/your-data.md; measured not yet to rescue the needle
         basin at V = 1, I = 1e-5).
         At the best point every start of the design runs once, to name the attractor and its share.
+    replicates : int
+        For an aperiodic (chaotic or quasi-periodic) series, the model's statistics at each trial point are the
+        mean over the aperiodic traces of the first ``replicates`` starts of the design (a synthetic likelihood's
+        mean, Wood 2010; the replicate spread's share of σ shrinks by √replicates), in [1, 8]; 1 (the default):
+        one reading, as for a periodic series.  Costs ``replicates`` runs per trial point and aperiodic series.
     progress : callable, bool or None
         Called with a line of text after each model run; True (default): those lines on stderr (a fit takes
         tens of seconds to minutes); False or None: silent.
@@ -150,7 +162,7 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     say = _progress(progress)
     problem, fits, notes, n_obs, x0, limits = _prepare(
         series, params0, free, more, statistics, search=search, t_transient=t_transient, rtol=rtol,
-        max_wall=max_wall, attractors=attractors, executor=executor, max_workers=max_workers)
+        max_wall=max_wall, attractors=attractors, replicates=replicates, executor=executor, max_workers=max_workers)
     run = _Search(problem, fits, t_wall, positive("max_wall", max_wall), say, executor,
                   optional(integer, "max_workers", max_workers, 0))
     outcome = run.run(x0, limits, float(search), n_obs, notes)
@@ -177,7 +189,7 @@ def _progress(progress: Callable[[str], None] | bool | None) -> Callable[[str], 
 
 def _prepare(series: ForceSeries, params0: PeelParams, free: Sequence[str], more: Sequence[ForceSeries],
              statistics: Sequence[str], *, search: float, t_transient: float, rtol: float, max_wall: float,
-             attractors: int, executor: Any, max_workers: int | None
+             attractors: int, replicates: int, executor: Any, max_workers: int | None
              ) -> tuple[Problem, list[SeriesFit], tuple[str, ...], int, np.ndarray, tuple[np.ndarray, np.ndarray]]:
     """``infer``'s arguments checked (each error names its argument) and the data read: the problem, the
     series with their statistics, the notes, the number of fitted statistics, the start in fitted coordinates
@@ -205,12 +217,15 @@ def _prepare(series: ForceSeries, params0: PeelParams, free: Sequence[str], more
                          f"{executor!r}")
     if isinstance(attractors, bool) or not isinstance(attractors, (int, np.integer)) or not 1 <= attractors <= 8:
         raise ValueError(f"attractors must be an integer in [1, 8], got {attractors!r}")
+    if isinstance(replicates, bool) or not isinstance(replicates, (int, np.integer)) or not 1 <= replicates <= 8:
+        raise ValueError(f"replicates must be an integer in [1, 8], got {replicates!r}")
     data = [data_statistics(s) for s in all_series]
     notes = tuple(f"f_cycle is not fitted at V = {fmt_number(float(s.V), 4)} m/s: no line of a period-n cycle "
                   "stands out of its periodogram (a period-1 trace)"
                   for s, d in zip(all_series, data) if s.V is not None and not d.used[_F_CYCLE] and _F_CYCLE in sel)
-    problem = Problem(params0, tuple(names), sel, t_transient, rtol, int(attractors))
-    fits = [SeriesFit(s, float(s.V), d) for s, d in zip(all_series, data) if s.V is not None]  # all have V
+    problem = Problem(params0, tuple(names), sel, t_transient, rtol, int(attractors), int(replicates))
+    fits = [SeriesFit(s, float(s.V), d, s.observables().period is None)  # all have V (data_statistics)
+            for s, d in zip(all_series, data) if s.V is not None]
     n_obs = n_fitted(problem, fits)
     if n_obs < len(names):
         raise ValueError(f"statistics: {n_obs} fitted statistic(s) for {len(names)} free parameter(s) "
@@ -295,14 +310,13 @@ class _Search:
         names = self.problem.names
         axes, box_lo, box_hi = grid(names, x0, limits[0], limits[1], search, len(self.fits))
         status, message, jac, n_extended = "converged", "", None, 0
-        aperiodic = [f.series.observables().period is None for f in self.fits]
+        aperiodic = [f.aperiodic for f in self.fits]
         try:
             while True:
                 self.run_nodes([x for x in nodes(axes)
                                 if not any(np.allclose(x, e.x, rtol=0.0, atol=1e-9) for e in self.evaluated)])
                 if n_extended == 0 and any(aperiodic):
-                    self.fits, n_obs, extra = replicated(self.problem, self.evaluated, self.fits, aperiodic,
-                                                         self.left())
+                    self.fits, n_obs, extra = replicated(self.problem, self.evaluated, self.fits, self.left())
                     notes += extra
                 top = self.fit(box_lo, box_hi, n_obs)
                 jac, status, message = top.jac, "converged" if top.success else "failed", str(top.message)

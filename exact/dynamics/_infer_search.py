@@ -20,7 +20,15 @@ import numpy as np
 from peelapprox import ForceSeries, PeelParams
 from peelapprox.io import fmt_number
 
-from ._infer_stats import OBSERVABLES, REPEATABILITY, SeriesData, SetReading, replicate_spread, set_statistics
+from ._infer_stats import (
+    OBSERVABLES,
+    REPEATABILITY,
+    SeriesData,
+    SetReading,
+    replicate_mean,
+    replicate_spread,
+    set_statistics,
+)
 
 __all__ = ["GRID_RUNS", "LOG", "PENALTY", "Point", "Problem", "SeriesFit", "apply", "attractor_lines",
            "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "replicated", "residuals",
@@ -38,11 +46,13 @@ _F_CYCLE = OBSERVABLES.index("f_cycle")
 
 @dataclass(frozen=True)
 class SeriesFit:
-    """One series of a fit: the trace, its pull speed and its statistics (:class:`SeriesData`)."""
+    """One series of a fit: the trace, its pull speed, its statistics (:class:`SeriesData`) and whether the trace
+    is aperiodic (its return map has no period: chaotic or quasi-periodic)."""
 
     series: ForceSeries
     V: float
     data: SeriesData
+    aperiodic: bool = False
 
 
 @dataclass(frozen=True)
@@ -61,6 +71,9 @@ class Problem:
         Of every model run.
     attractors : int
         Starts of the attractor set's design tried at each trial point (:func:`set_statistics`).
+    replicates : int
+        For an aperiodic series, the model's statistics at a trial point are the mean over this many replicates
+        (:func:`replicate_mean`) where more than 1; 1: one reading (:func:`set_statistics`).
     """
 
     params0: PeelParams
@@ -69,6 +82,7 @@ class Problem:
     t_transient: float
     rtol: float
     attractors: int
+    replicates: int = 1
 
 
 @dataclass(frozen=True)
@@ -209,9 +223,13 @@ def residuals(problem: Problem, fits: Sequence[SeriesFit], x: np.ndarray, left: 
     readings: list[SetReading] = []
     for f in fits:
         d = f.data
-        r = set_statistics(apply(problem.params0, problem.names, x, f.V), f.series, d.threshold, d.noise,
-                           problem.t_transient, problem.rtol, max(1.0, left), d.target(problem.sel),
-                           problem.attractors)
+        p = apply(problem.params0, problem.names, x, f.V)
+        if f.aperiodic and problem.replicates > 1:
+            r = replicate_mean(p, f.series, d.threshold, d.noise, problem.t_transient, problem.rtol, max(1.0, left),
+                               d.target(problem.sel), problem.replicates)
+        else:
+            r = set_statistics(p, f.series, d.threshold, d.noise, problem.t_transient, problem.rtol, max(1.0, left),
+                               d.target(problem.sel), problem.attractors)
         out.append(d.residuals(r.values, problem.sel, PENALTY))
         models.append(r.values)
         readings.append(r)
@@ -233,18 +251,19 @@ def n_fitted(problem: Problem, fits: Sequence[SeriesFit]) -> int:
     return sum(int(np.count_nonzero(f.data.used[problem.sel])) for f in fits)
 
 
-def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], aperiodic: list[bool],
-               left: float) -> tuple[list[SeriesFit], int, tuple[str, ...]]:
+def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], left: float
+               ) -> tuple[list[SeriesFit], int, tuple[str, ...]]:
     """For each aperiodic series, the model's replicate spread at the best grid point (:func:`replicate_spread`)
-    added in quadrature to the statistics' σ (a diagonal synthetic likelihood, Wood 2010), and the cycle line
+    added in quadrature to the statistics' σ (a diagonal synthetic likelihood, Wood 2010; divided by √m where the
+    model's statistics are a mean over m = ``problem.replicates`` replicates), and the cycle line
     dropped where it is not stable across the replicates; the χ² of every point evaluated so far (``evaluated``,
     updated in place) recomputed with the new σ.  Returns the series, the number of fitted statistics and the
     notes."""
     x = best(evaluated).x
     out, notes, t0 = [], [], time.perf_counter()
-    for k, f in enumerate(fits):
+    for f in fits:
         d = f.data
-        if not aperiodic[k] or left - (time.perf_counter() - t0) <= 1.0:
+        if not f.aperiodic or left - (time.perf_counter() - t0) <= 1.0:
             out.append(f)
             continue
         sd, stable, n = replicate_spread(apply(problem.params0, problem.names, x, f.V), f.series, d.threshold,
@@ -252,7 +271,7 @@ def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], 
         if sd is None:
             out.append(f)
             continue
-        sig, used = np.hypot(d.sigma, sd), d.used.copy()
+        sig, used = np.hypot(d.sigma, sd / math.sqrt(problem.replicates)), d.used.copy()
         notes.append(f"V = {fmt_number(f.V, 4)} m/s: an aperiodic trace; the model's spread over {n} replicates "
                      "added to each statistic's sigma")
         if used[_F_CYCLE] and not stable:

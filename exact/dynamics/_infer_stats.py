@@ -34,7 +34,8 @@ from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
 __all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SeriesData", "SetReading",
-           "data_statistics", "model_statistics", "replicate_spread", "set_statistics", "trace_statistics"]
+           "data_statistics", "model_statistics", "replicate_mean", "replicate_spread", "set_statistics",
+           "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -269,3 +270,28 @@ def replicate_spread(p: PeelParams, series: ForceSeries, threshold: float, noise
     j = OBSERVABLES.index("f_cycle")
     stable = all(r[1] for r in reads) and sd[j] <= REPEATABILITY["f_cycle"] * abs(float(arr[:, j].mean()))
     return sd, bool(stable), len(reads)
+
+
+def replicate_mean(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                   rtol: float, max_wall: float, target: tuple[np.ndarray, np.ndarray, np.ndarray], n: int
+                   ) -> SetReading:
+    """The model's statistics at ``p`` for an aperiodic series as a synthetic likelihood's mean (Wood 2010): the
+    mean over the aperiodic traces reached from the first ``n`` starts of :func:`exact.attractor_set`'s design
+    (each a replicate: another phase of a chaotic or quasi-periodic attractor), read as :func:`model_statistics`.
+    A single chaotic window's means move erratically with the parameters (another phase at every point); their
+    mean over replicates moves less.  Where no start reaches an aperiodic trace, the reading of those starts
+    closest to the data (:func:`set_statistics`' rule); ``n_runs`` is ``n``."""
+    vals, sig, used = target
+    reads, periodic = [], []
+    for st in default_starts(p)[: max(1, n)]:
+        m, period, _ = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
+        if m is not None and period is None:
+            reads.append(m)
+        else:
+            cost = math.inf if m is None else float(np.sum((((m - vals) / sig)[used]) ** 2))
+            periodic.append((cost, st.name, m, period))
+    if reads:
+        return SetReading(np.mean(np.array(reads), axis=0), f"mean of {len(reads)} aperiodic replicates", None,
+                          max(1, n))
+    best = min(periodic, key=lambda r: r[0])
+    return SetReading(best[2], best[1], best[3], max(1, n))
