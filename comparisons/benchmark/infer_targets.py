@@ -1,7 +1,7 @@
 """How often :func:`exact.infer` recovers I and k from synthetic measured traces at seeded random points.
 
     python -m comparisons.benchmark.infer_targets --traces N --seed S [--seconds 20] [--max-wall 900]
-        [--attractors 1] [--jobs 1] [--json FILE] [--csv FILE]
+        [--attractors 1] [--replicates 1] [--jobs 1] [--json FILE] [--csv FILE]
 
 The target (the goal for ``infer``): I and k within 10 % (k within 5 % at a periodic low-inertia point), reported
 identified, on multistable, quasi-periodic and chaotic traces drawn over the plane, not at chosen points.
@@ -19,8 +19,8 @@ identified, on multistable, quasi-periodic and chaotic traces drawn over the pla
   reaches: ``periodic-low`` (periodic, I <= 1e-4), ``periodic`` (periodic, higher inertia), ``quasi-periodic``,
   ``chaotic``, ``aperiodic`` (no exponent); a point whose trace does not stick-slip is skipped (``no-stick-slip``).
 * **Start**: I times a factor log-uniform in [1/2, 2], k times one in [1/1.25, 1.25] (seeded), both free;
-  ``infer(series, start, ("I", "k"), max_wall=..., attractors=...)`` with its other defaults, its grid serial in
-  the trace's own process.
+  ``infer(series, start, ("I", "k"), max_wall=..., attractors=..., replicates=...)`` with its other defaults,
+  its grid serial in the trace's own process.
 * **Measures** per class and overall: *recovered* (both within the tolerances above), *identified* (both verdicts),
   *hit* (both: the target), and the verdict's calibration: the share of identified fits that are recovered (an
   identified verdict should be right) and of recovered fits that are identified.
@@ -80,8 +80,8 @@ def classify(aset: Any, I: float) -> str:
     return str(solver.kind)
 
 
-def run_trace(i: int, truth: dict[str, float], seed: int, seconds: float, max_wall: float, attractors: int
-              ) -> dict[str, Any]:
+def run_trace(i: int, truth: dict[str, float], seed: int, seconds: float, max_wall: float, attractors: int,
+              replicates: int = 1) -> dict[str, Any]:
     """One trace's row: its truth, start, class, the fit's values and verdicts, and the measures."""
     import exact
     from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, infer
@@ -101,7 +101,7 @@ def run_trace(i: int, truth: dict[str, float], seed: int, seconds: float, max_wa
         series = tr.as_series(1e4, noise=0.5, drift=5.0, seed=seed * 1000 + i)
         t0 = time.perf_counter()
         res = infer(series, PeelParams(V=V, I=truth["I0"], k=truth["k0"]), ("I", "k"), max_wall=max_wall,
-                    attractors=attractors, progress=False, executor="serial")
+                    attractors=attractors, replicates=replicates, progress=False, executor="serial")
     except (ModelBreakdown, SolverBudgetExceeded, ValueError) as exc:  # a trace infer refuses: recorded
         row.update({"status": f"refused: {type(exc).__name__}: {exc}"[:300], "recovered": False, "identified": False,
                     "hit": False})
@@ -167,14 +167,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seconds", type=float, default=20.0, help="each trace's duration at 10 kHz (20)")
     ap.add_argument("--max-wall", type=float, default=900.0, help="each infer call's budget [s] (900)")
     ap.add_argument("--attractors", type=int, default=1, help="infer's attractors= (1)")
+    ap.add_argument("--replicates", type=int, default=1, help="infer's replicates= (1)")
     ap.add_argument("--jobs", type=int, default=1, help="traces at once, in processes (1)")
     ap.add_argument("--json", help="write the rows as JSON (a path ending in .json)")
     ap.add_argument("--csv", help="write the rows as CSV (a path ending in .csv)")
     a = ap.parse_args(argv)
-    if a.traces < 1 or a.jobs < 1 or not 1 <= a.attractors <= 8 or not 0.5 <= a.seconds <= 200 or a.max_wall <= 0:
-        ap.error("--traces and --jobs must be >= 1, --attractors in [1, 8], --seconds in [0.5, 200], --max-wall > 0")
+    if (a.traces < 1 or a.jobs < 1 or not 1 <= a.attractors <= 8 or not 1 <= a.replicates <= 8
+            or not 0.5 <= a.seconds <= 200 or a.max_wall <= 0):
+        ap.error("--traces and --jobs must be >= 1, --attractors and --replicates in [1, 8], --seconds in "
+                 "[0.5, 200], --max-wall > 0")
     truths = draw(a.traces, a.seed)
-    args = [(i, t, a.seed, a.seconds, a.max_wall, a.attractors) for i, t in enumerate(truths)]
+    args = [(i, t, a.seed, a.seconds, a.max_wall, a.attractors, a.replicates) for i, t in enumerate(truths)]
     rows: list[dict[str, Any]] = []
     t0 = time.perf_counter()
     if a.jobs == 1:
@@ -188,6 +191,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(_line(rows[-1]), file=sys.stderr, flush=True)
     rows.sort(key=lambda r: r["trace"])
     print(f"infer_targets: {a.traces} traces (seed {a.seed}), {a.seconds:g} s each, attractors={a.attractors}, "
+          f"replicates={a.replicates}, "
           f"max_wall {a.max_wall:g} s; {fmt_number(time.perf_counter() - t0, 3)} s in all")
     print(summarise(rows))
     for path in (a.json, a.csv):
