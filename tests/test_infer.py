@@ -230,3 +230,29 @@ def test_the_replicate_mean_of_a_chaotic_trace():
     assert differ.any()
     assert np.all(np.minimum(each[0], each[1])[differ] < r.values[differ])
     assert np.all(r.values[differ] < np.maximum(each[0], each[1])[differ])
+
+
+@pytest.mark.slow
+def test_the_statistics_along_k_at_a_chaotic_point():
+    """Hypothesis (why ``replicates`` stays 1, docs/your-data.md): at the chaotic point V = 2.5, I = 1e-4 (5 s
+    windows, k over 9 steps spanning ±10 %) the model's statistics (slip interval, drop, stick, slip time, rise,
+    F_start) deviate from a line in ln k by less than one data sigma (rms), with one reading and with the mean of
+    3 replicates alike (measured 0.05-0.81 and 0.06-0.90); and the mean of 3 does not smooth them by the sqrt(3)
+    independent replicates would give (its rms over the six statistics is above 1/sqrt(3) = 0.58 of one
+    reading's; measured 1.08): the roughness is not replicate noise.  36 runs, about 5 min under load."""
+    from exact.dynamics._infer_stats import data_statistics, replicate_mean, set_statistics
+
+    p = PeelParams(V=2.5, I=1e-4)
+    s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    d = data_statistics(s)
+    tgt = (d.values, d.sigma, d.used)
+    ks = 1000.0 * np.exp(np.linspace(-0.1, 0.1, 9))
+    x = np.log(ks)
+    rough = []
+    for read in (lambda q: set_statistics(q, s, d.threshold, d.noise, 30.0, 1e-10, 300.0, tgt, 1),
+                 lambda q: replicate_mean(q, s, d.threshold, d.noise, 30.0, 1e-10, 300.0, tgt, 3)):
+        y = np.array([read(p.replace(k=float(k))).values for k in ks])[:, :6]
+        fit = np.array([np.polyval(np.polyfit(x, y[:, j], 1), x) for j in range(6)]).T
+        rough.append(np.sqrt(np.mean((y - fit) ** 2, axis=0)) / d.sigma[:6])
+    assert np.all(rough[0] < 1.0) and np.all(rough[1] < 1.0), rough
+    assert np.sqrt(np.mean(rough[1] ** 2)) > np.sqrt(np.mean(rough[0] ** 2)) / np.sqrt(3.0), rough
