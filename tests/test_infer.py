@@ -239,7 +239,7 @@ def test_the_statistics_along_k_at_a_chaotic_point():
     F_start) deviate from a line in ln k by less than one data sigma (rms), with one reading and with the mean of
     3 replicates alike (measured 0.05-0.81 and 0.06-0.90); and the mean of 3 does not smooth them by the sqrt(3)
     independent replicates would give (its rms over the six statistics is above 1/sqrt(3) = 0.58 of one
-    reading's; measured 1.08): the roughness is not replicate noise.  36 runs, about 5 min under load."""
+    reading's; measured 1.08): the roughness is not replicate noise.  36 runs, 1.5-5 min."""
     from exact.dynamics._infer_stats import data_statistics, replicate_mean, set_statistics
 
     p = PeelParams(V=2.5, I=1e-4)
