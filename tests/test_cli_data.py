@@ -85,3 +85,13 @@ def test_cli_infer_reports_progress(tmp_path, capsys):
     res = json.loads(cap.out)
     assert res["status"] in ("budget", "converged") and "k" in res["values"]
     assert "infer: " in cap.err
+
+
+def test_cli_infer_refuses_attractors_and_replicates_out_of_range(tmp_path, capsys):
+    """``--attractors`` and ``--replicates`` take 1-8 (exact.infer's range): 0 and 9 exit 2 naming the option,
+    before the trace is read."""
+    for opt in ("--attractors", "--replicates"):
+        for bad in ("0", "9"):
+            with pytest.raises(SystemExit) as e:
+                main(["infer", str(tmp_path / "none.csv"), "--V", "1", opt, bad])
+            assert e.value.code == 2 and opt in capsys.readouterr().err

@@ -6,6 +6,8 @@ The oracle is the truth the synthetic trace was made with: the exact model at kn
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -56,7 +58,7 @@ def test_a_start_a_third_of_the_truth_extends_the_box():
 def test_the_box_stops_at_the_parameter_range():
     """The extension stays within PARAM_RANGES: a side at the range's limit does not move, an interior side
     moves out by the initial half-width at the node spacing (a closed-form check of the helper)."""
-    from exact.dynamics._infer import _extend
+    from exact.dynamics._infer_search import extend as _extend
     from peelapprox import PARAM_RANGES
 
     lo = np.array([np.log(PARAM_RANGES["I"][0])])
@@ -79,7 +81,8 @@ def test_the_closest_attractor_of_the_set_is_read():
     p = PeelParams(V=1.0, I=1e-5)
     tr = exact.simulate(p, 35.0, alpha0=-0.3, t_eval=30.0 + np.arange(50000) / 1e4)
     s = tr.as_series(1e4, noise=0.5, drift=5.0, seed=1)
-    vals, sig, threshold, noise, used = data_statistics(s)
+    d = data_statistics(s)
+    vals, sig, threshold, noise, used = d.values, d.sigma, d.threshold, d.noise, d.used
     r = set_statistics(p, s, threshold, noise, 30.0, 1e-10, 120.0, (vals, sig, used), 3)
     assert r.start == "alpha0=-0.3" and r.label == "period-1" and r.n_runs == 3
     assert r.values is not None and np.all(np.abs((r.values - vals) / sig)[used] <= 3.0)
@@ -102,7 +105,8 @@ def test_the_replicate_spread_of_a_chaotic_trace():
     s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
     o = s.observables()
     assert o.period is None
-    vals, sig, threshold, noise, used = data_statistics(s)
+    d = data_statistics(s)
+    threshold, noise = d.threshold, d.noise
     sd, stable, n = replicate_spread(p, s, threshold, noise, 30.0, 1e-10, 120.0, 3)
     assert sd is not None and n == 3 and not stable
     for j, name in enumerate(OBSERVABLES[:4]):
@@ -162,6 +166,8 @@ def test_bad_input_is_named(high_inertia):
         (dict(series=high_inertia, params0=p0, free=("k",), max_wall=0.0), ValueError, "max_wall"),
         (dict(series=high_inertia, params0=p0, free=("k",), attractors=0), ValueError, "attractors"),
         (dict(series=high_inertia, params0=p0, free=("k",), attractors=9), ValueError, "attractors"),
+        (dict(series=high_inertia, params0=p0, free=("k",), replicates=0), ValueError, "replicates"),
+        (dict(series=high_inertia, params0=p0, free=("k",), replicates=2.0), ValueError, "replicates"),
     ]
     for kwargs, error, match in cases:
         with pytest.raises(error, match=match):
@@ -186,15 +192,67 @@ def test_an_aperiodic_fit_needs_a_probable_chi2():
     above POOR_FIT (1e-3) and below GOOD_FIT (0.05).  With a tight interval inside the box the parameter is
     identified for a periodic series (threshold POOR_FIT) and not for an aperiodic one (threshold GOOD_FIT: its
     sigma rests on a few model replicates), and the verdict quotes the probability."""
-    from exact.dynamics._infer import GOOD_FIT, POOR_FIT, _result
+    from exact.dynamics._infer import GOOD_FIT, POOR_FIT
+    from exact.dynamics._infer_result import Outcome, assemble
+    from exact.dynamics._infer_search import Point, Problem, SeriesFit
+    from exact.dynamics._infer_stats import SeriesData
 
     x = np.log(1000.0)
     model = np.ones(7)
-    evaluated = [(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
-    data = [(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool))]
+    evaluated = [Point(np.array([x + d]), c, [model], []) for d, c in ((0.0, 13.0), (0.01, 20.0), (-0.01, 20.0))]
+    fits = [SeriesFit(None, 1.0, SeriesData(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool)))]
     box = (np.array([x - 1.0]), np.array([x + 1.0]))
-    args = (PeelParams(V=1.0, I=1e-2), ["k"], np.arange(7), None, evaluated, box, data, [1.0], "converged", "", 1.0,
-            6, ())
-    assert _result(*args, POOR_FIT).identified["k"]
-    strict = _result(*args, GOOD_FIT)
+    problem = Problem(PeelParams(V=1.0, I=1e-2), ("k",), np.arange(7), 30.0, 1e-10, 1)
+    outcome = Outcome(evaluated, None, box, 6, "converged", "", 1.0)
+    assert outcome.poor_fit == POOR_FIT and assemble(problem, fits, outcome).identified["k"]
+    strict = assemble(problem, fits, dataclasses.replace(outcome, poor_fit=GOOD_FIT))
     assert not strict.identified["k"] and "probability 0.023" in strict.verdicts["k"]
+
+
+def test_the_replicate_mean_of_a_chaotic_trace():
+    """Hypothesis (synthetic likelihood's mean, Wood 2010): at the chaotic point V = 2.5, I = 1e-4 the model's
+    statistics over two replicates (the attractor set's first two starts) are the mean of the two starts' own
+    readings (model_statistics from each start: the same runs, so equal to round-off, 1e-12 relative), and that
+    mean lies strictly between them wherever they differ."""
+    from exact.dynamics._attractor_set_runs import default_starts
+    from exact.dynamics._infer_stats import data_statistics, model_statistics, replicate_mean
+
+    p = PeelParams(V=2.5, I=1e-4)
+    s = exact.simulate(p, 33.0, t_eval=30.0 + np.arange(30000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    d = data_statistics(s)
+    r = replicate_mean(p, s, d.threshold, d.noise, 30.0, 1e-10, 120.0, (d.values, d.sigma, d.used), 2)
+    each = [model_statistics(p, s, d.threshold, d.noise, 30.0, 1e-10, 120.0, **st.kwargs())
+            for st in default_starts(p)[:2]]
+    assert all(e is not None for e in each) and r.values is not None
+    assert r.start == "mean of 2 aperiodic replicates" and r.label == "aperiodic" and r.n_runs == 2
+    np.testing.assert_allclose(r.values, (each[0] + each[1]) / 2, rtol=1e-12)
+    differ = each[0] != each[1]
+    assert differ.any()
+    assert np.all(np.minimum(each[0], each[1])[differ] < r.values[differ])
+    assert np.all(r.values[differ] < np.maximum(each[0], each[1])[differ])
+
+
+@pytest.mark.slow
+def test_the_statistics_along_k_at_a_chaotic_point():
+    """Hypothesis (why ``replicates`` stays 1, docs/your-data.md): at the chaotic point V = 2.5, I = 1e-4 (5 s
+    windows, k over 9 steps spanning ±10 %) the model's statistics (slip interval, drop, stick, slip time, rise,
+    F_start) deviate from a line in ln k by less than one data sigma (rms), with one reading and with the mean of
+    3 replicates alike (measured 0.05-0.81 and 0.06-0.90); and the mean of 3 does not smooth them by the sqrt(3)
+    independent replicates would give (its rms over the six statistics is above 1/sqrt(3) = 0.58 of one
+    reading's; measured 1.08): the roughness is not replicate noise.  36 runs, 1.5-5 min."""
+    from exact.dynamics._infer_stats import data_statistics, replicate_mean, set_statistics
+
+    p = PeelParams(V=2.5, I=1e-4)
+    s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
+    d = data_statistics(s)
+    tgt = (d.values, d.sigma, d.used)
+    ks = 1000.0 * np.exp(np.linspace(-0.1, 0.1, 9))
+    x = np.log(ks)
+    rough = []
+    for read in (lambda q: set_statistics(q, s, d.threshold, d.noise, 30.0, 1e-10, 300.0, tgt, 1),
+                 lambda q: replicate_mean(q, s, d.threshold, d.noise, 30.0, 1e-10, 300.0, tgt, 3)):
+        y = np.array([read(p.replace(k=float(k))).values for k in ks])[:, :6]
+        fit = np.array([np.polyval(np.polyfit(x, y[:, j], 1), x) for j in range(6)]).T
+        rough.append(np.sqrt(np.mean((y - fit) ** 2, axis=0)) / d.sigma[:6])
+    assert np.all(rough[0] < 1.0) and np.all(rough[1] < 1.0), rough
+    assert np.sqrt(np.mean(rough[1] ** 2)) > np.sqrt(np.mean(rough[0] ** 2)) / np.sqrt(3.0), rough

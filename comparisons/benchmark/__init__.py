@@ -28,7 +28,9 @@ The tape-mass model (docs/tape-mass.md): ``python -m comparisons.benchmark.tape_
 across the mass range, :mod:`.tape_mass`) and ``python -m comparisons.benchmark.tape_mass_limit`` (the low-mass
 limit and the ε of a tape mass, :mod:`.tape_mass_limit`).  ``python -m comparisons.benchmark.attractor_sets`` times
 :func:`exact.attractor_set` against one :func:`exact.attractor_observables` call on seeded random points
-(:mod:`.attractor_sets`).
+(:mod:`.attractor_sets`).  ``python -m comparisons.benchmark.infer_targets`` measures how often
+:func:`exact.infer` recovers I and k from synthetic measured traces at seeded random points, per class of trace
+(:mod:`.infer_targets`).
 """
 
 from .eps import EpsRow, eps_study, fit_power_law, small_eps_check

@@ -33,8 +33,9 @@ from peelapprox.io import fmt_number
 from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
-__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SetReading", "data_statistics",
-           "model_statistics", "replicate_spread", "set_statistics", "trace_statistics"]
+__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SeriesData", "SetReading",
+           "data_statistics", "model_statistics", "replicate_mean", "replicate_spread", "set_statistics",
+           "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -114,7 +115,48 @@ def _cycle_frequency(series: ForceSeries, f_slip: float) -> tuple[float, bool]:
     return line, True
 
 
-def data_statistics(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
+@dataclass(frozen=True)
+class SeriesData:
+    """One measured series' statistics as :func:`infer` fits them (:func:`data_statistics`).
+
+    Attributes
+    ----------
+    values, sigma : ndarray
+        The statistics of :data:`OBSERVABLES` and their σ (module docstring: residuals).
+    threshold, noise : float
+        The detector's threshold and the series' noise level, with which every model trace is read.
+    used : ndarray of bool
+        Which statistics the series carries (not the cycle frequency where no line stands out of its
+        periodogram, nor where it is not stable across the model's replicates).
+    """
+
+    values: np.ndarray
+    sigma: np.ndarray
+    threshold: float
+    noise: float
+    used: np.ndarray
+
+    def fitted(self, sel: np.ndarray) -> np.ndarray:
+        """The indices into :data:`OBSERVABLES` fitted: those of ``sel`` (the ``statistics`` asked for) the
+        series carries, in ``sel``'s order."""
+        return sel[self.used[sel]]
+
+    def target(self, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(values, σ, mask)`` of :func:`set_statistics`: the mask over :data:`OBSERVABLES` of the fitted
+        statistics."""
+        mask = np.zeros(len(OBSERVABLES), dtype=bool)
+        mask[self.fitted(sel)] = True
+        return self.values, self.sigma, mask
+
+    def residuals(self, model: np.ndarray | None, sel: np.ndarray, penalty: float) -> np.ndarray:
+        """``(model - data) / σ`` over the fitted statistics; ``penalty`` for each where the model does not
+        stick-slip (``model`` None)."""
+        if model is None:
+            return np.full(int(np.count_nonzero(self.used[sel])), penalty)
+        return ((model - self.values) / self.sigma)[self.fitted(sel)]
+
+
+def data_statistics(series: ForceSeries) -> SeriesData:
     """The series' statistics, their σ (module docstring: residuals), the detector's threshold, the noise
     level and which statistics it carries: not the cycle frequency where no line stands out of the periodogram
     below half the slip frequency (a period-1 trace: only drift and noise there)."""
@@ -132,7 +174,7 @@ def data_statistics(series: ForceSeries) -> tuple[np.ndarray, np.ndarray, float,
             sig[j] = math.hypot(sig[j], spread / math.sqrt(max(o.n_slips - 1, 1)))
     used = np.ones(len(OBSERVABLES), dtype=bool)
     used[OBSERVABLES.index("f_cycle")] = line
-    return vals, sig, threshold, series.noise, used
+    return SeriesData(vals, sig, threshold, series.noise, used)
 
 
 def model_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
@@ -228,3 +270,28 @@ def replicate_spread(p: PeelParams, series: ForceSeries, threshold: float, noise
     j = OBSERVABLES.index("f_cycle")
     stable = all(r[1] for r in reads) and sd[j] <= REPEATABILITY["f_cycle"] * abs(float(arr[:, j].mean()))
     return sd, bool(stable), len(reads)
+
+
+def replicate_mean(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                   rtol: float, max_wall: float, target: tuple[np.ndarray, np.ndarray, np.ndarray], n: int
+                   ) -> SetReading:
+    """The model's statistics at ``p`` for an aperiodic series as a synthetic likelihood's mean (Wood 2010): the
+    mean over the aperiodic traces reached from the first ``n`` starts of :func:`exact.attractor_set`'s design
+    (each a replicate: another phase of a chaotic or quasi-periodic attractor), read as :func:`model_statistics`.
+    A single chaotic window's means move erratically with the parameters (another phase at every point); their
+    mean over replicates moves less.  Where no start reaches an aperiodic trace, the reading of those starts
+    closest to the data (:func:`set_statistics`' rule); ``n_runs`` is ``n``."""
+    vals, sig, used = target
+    reads, periodic = [], []
+    for st in default_starts(p)[: max(1, n)]:
+        m, period, _ = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
+        if m is not None and period is None:
+            reads.append(m)
+        else:
+            cost = math.inf if m is None else float(np.sum((((m - vals) / sig)[used]) ** 2))
+            periodic.append((cost, st.name, m, period))
+    if reads:
+        return SetReading(np.mean(np.array(reads), axis=0), f"mean of {len(reads)} aperiodic replicates", None,
+                          max(1, n))
+    best = min(periodic, key=lambda r: r[0])
+    return SetReading(best[2], best[1], best[3], max(1, n))

@@ -108,6 +108,12 @@ def add_infer_parser(sub: Any) -> argparse.ArgumentParser:
                                                                              "sampled window [s] (default 30)")
     ip.add_argument("--max-wall", type=positive_float, default=600.0, metavar="S",
                     help="wall-clock budget [s] (default 600): then the best point so far, status budget")
+    ip.add_argument("--attractors", type=int, default=1, choices=range(1, 9), metavar="N",
+                    help="at each trial point, the attractor closest to the data among those reached from the first "
+                         "N starts of exact.attractor_set's design, 1-8 (default 1: the solver's start)")
+    ip.add_argument("--replicates", type=int, default=1, choices=range(1, 9), metavar="N",
+                    help="for a chaotic or quasi-periodic trace, the model's statistics at each trial point are the "
+                         "mean over N replicates, 1-8 (default 1)")
     ip.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     ip.add_argument("--out", metavar="FILE", help="also write the result to this .json (or its residuals to .csv)")
     add_format(ip, "the result")
@@ -123,7 +129,7 @@ def run_infer(args: argparse.Namespace) -> int:
     series = _read(args, params0.V)
     progress = None if args.quiet else say  # its lines begin with "infer: "
     res = infer(series, params0, free, search=args.search, t_transient=args.t_transient, max_wall=args.max_wall,
-                progress=progress)
+                attractors=args.attractors, replicates=args.replicates, progress=progress)
     if args.format == "table":
         print(res.report())
     else:

@@ -1,0 +1,325 @@
+"""The search of :func:`exact.infer`: the fitted coordinates, the grid and its extension, the model's residuals at a
+trial point, the replicate spread of aperiodic series and the attractor lines of the verdict.
+
+The records: :class:`Problem` (what is fitted, fixed for a call), :class:`SeriesFit` (one series, its pull speed
+and its statistics) and :class:`Point` (one evaluated trial point).  The search loop is in
+``exact/dynamics/_infer.py``, the result's assembly in ``exact/dynamics/_infer_result.py``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from peelapprox import ForceSeries, PeelParams
+from peelapprox.io import fmt_number
+
+from ._infer_stats import (
+    OBSERVABLES,
+    REPEATABILITY,
+    SeriesData,
+    SetReading,
+    replicate_mean,
+    replicate_spread,
+    set_statistics,
+)
+
+__all__ = ["GRID_RUNS", "LOG", "PENALTY", "Point", "Problem", "SeriesFit", "apply", "attractor_lines",
+           "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "replicated", "residuals",
+           "shares", "spans", "values_of"]
+
+#: The most grid points of the search per series (an odd number per axis, params0 at the centre: 9 x 9 for two
+#: parameters).
+GRID_RUNS = 81
+#: The parameters fitted in ln θ (positive, spanning decades); the others, a law's coefficients, in θ.
+LOG = ("I", "k", "R")
+#: A residual for a model run that does not stick-slip or breaks down: far outside any σ.
+PENALTY = 1e3
+_F_CYCLE = OBSERVABLES.index("f_cycle")
+
+
+@dataclass(frozen=True)
+class SeriesFit:
+    """One series of a fit: the trace, its pull speed, its statistics (:class:`SeriesData`) and whether the trace
+    is aperiodic (its return map has no period: chaotic or quasi-periodic)."""
+
+    series: ForceSeries
+    V: float
+    data: SeriesData
+    aperiodic: bool = False
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What one :func:`exact.infer` call fits, fixed for the call (picklable: a pool's task carries it).
+
+    Attributes
+    ----------
+    params0 : PeelParams
+        The model and the centre of the search.
+    names : tuple of str
+        The free parameters (:func:`free_names`).
+    sel : ndarray of int
+        The indices into :data:`OBSERVABLES` of the ``statistics`` asked for.
+    t_transient, rtol : float
+        Of every model run.
+    attractors : int
+        Starts of the attractor set's design tried at each trial point (:func:`set_statistics`).
+    replicates : int
+        For an aperiodic series, the model's statistics at a trial point are the mean over this many replicates
+        (:func:`replicate_mean`) where more than 1; 1: one reading (:func:`set_statistics`).
+    """
+
+    params0: PeelParams
+    names: tuple[str, ...]
+    sel: np.ndarray
+    t_transient: float
+    rtol: float
+    attractors: int
+    replicates: int = 1
+
+
+@dataclass(frozen=True)
+class Point:
+    """One evaluated trial point: its fitted coordinates, χ², the model's statistics per series (None: no
+    stick-slip) and their readings (the attractor each was read from)."""
+
+    x: np.ndarray
+    chi2: float
+    models: list[np.ndarray | None]
+    readings: list[SetReading]
+
+
+def best(evaluated: Sequence[Point]) -> Point:
+    """The evaluated point of the smallest χ² (the first of ties)."""
+    return min(evaluated, key=lambda e: e.chi2)
+
+
+def free_names(params0: PeelParams, free: Sequence[str]) -> list[str]:
+    """The free parameters, checked: I, k, R, or ``force.<coefficient>`` of a family law."""
+    if isinstance(free, str) or not isinstance(free, Sequence) or not free:
+        raise TypeError(f"free must be a non-empty sequence of parameter names, got {free!r}")
+    coefs = dict(params0.force.coefficients) if params0.force.kind == "family" else {}
+    out = []
+    for name in free:
+        if not isinstance(name, str):
+            raise TypeError(f"free: each name must be a string, got {name!r}")
+        if name.startswith("force."):
+            if name[6:] not in coefs:
+                have = ", ".join(f"force.{c}" for c in coefs) or "none (params0.force is not a family law)"
+                raise ValueError(f"free: {name!r} is not a coefficient of params0.force; its coefficients: {have}")
+        elif name not in LOG:
+            raise ValueError(f"free: {name!r} is not a fitted parameter; choose from I, k, R, force.<coefficient>")
+        if name in out:
+            raise ValueError(f"free: {name!r} is given twice")
+        out.append(name)
+    return out
+
+
+def apply(params0: PeelParams, names: Sequence[str], x: np.ndarray, V: float) -> PeelParams:
+    """``params0`` at pull speed V with the free parameters at ``x`` (ln θ for I, k, R)."""
+    changes: dict[str, Any] = {"V": V}
+    coefs = dict(params0.force.coefficients) if params0.force.kind == "family" else {}
+    for name, xi in zip(names, x):
+        if name in LOG:
+            changes[name] = math.exp(float(xi))
+        else:
+            coefs[name[6:]] = float(xi)
+    if any(n.startswith("force.") for n in names):
+        changes["force"] = type(params0.force).family(str(params0.force.name), **coefs)
+    return params0.replace(**changes)
+
+
+def values_of(names: Sequence[str], x: np.ndarray) -> list[float]:
+    """The parameters' values at fitted coordinates ``x``."""
+    return [math.exp(float(xi)) if n in LOG else float(xi) for n, xi in zip(names, x)]
+
+
+def grid(names: Sequence[str], x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, search: float, n_series: int
+         ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The search grid's nodes per axis (``exact/dynamics/_infer.py``'s docstring) and its box ``(low, high)``
+    per parameter, in fitted coordinates."""
+    half = np.array([math.log(search) if n in LOG else 0.3 * max(abs(x), 1e-12) for n, x in zip(names, x0)])
+    box_lo, box_hi = np.maximum(x0 - half, lo), np.minimum(x0 + half, hi)
+    per = max(3, int(math.floor((GRID_RUNS / max(n_series, 1)) ** (1.0 / len(names)) + 1e-9)))
+    per = min(per - (per % 2 == 0), 9)  # odd: params0 is a node
+    return [np.linspace(a, b, per) for a, b in zip(box_lo, box_hi)], box_lo, box_hi
+
+
+def nodes(axes: list[np.ndarray]) -> np.ndarray:
+    """Every point of the grid whose nodes per axis are ``axes``."""
+    return np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
+
+
+def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | None, n_obs: int
+          ) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The best evaluated point, its χ², the scale s, the 95 % interval ``(low, high)`` per parameter in fitted
+    coordinates (the union of the profile and the Jacobian's) and the covariance (or None)."""
+    dof = n_obs - len(names)
+    top = best(evaluated)
+    x, chi2 = top.x, top.chi2
+    s = max(1.0, chi2 / dof) if dof > 0 else 1.0
+    accept = np.array([e.x for e in evaluated if e.chi2 <= chi2 + 3.84 * s])
+    lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
+    cov = None if jac is None else np.linalg.pinv(jac.T @ jac) * s
+    if cov is not None:
+        for i in range(len(names)):
+            if math.isfinite(float(cov[i, i])) and cov[i, i] > 0:
+                se = math.sqrt(float(cov[i, i]))
+                lo_[i], hi_[i] = min(lo_[i], x[i] - 1.96 * se), max(hi_[i], x[i] + 1.96 * se)
+    return np.asarray(x), float(chi2), s, lo_, hi_, cov
+
+
+def edge_sides(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | None, n_obs: int, box: tuple,
+               limits: tuple) -> list[tuple[int, int]]:
+    """The box's sides ``(parameter index, -1 low / +1 high)`` that the 95 % interval reaches and that can still
+    move outwards within :data:`peelapprox.PARAM_RANGES`."""
+    _, _, _, lo_, hi_, _ = spans(names, evaluated, jac, n_obs)
+    out = []
+    for i in range(len(names)):
+        if lo_[i] <= box[0][i] + 1e-12 and box[0][i] > limits[0][i] + 1e-12:
+            out.append((i, -1))
+        if hi_[i] >= box[1][i] - 1e-12 and box[1][i] < limits[1][i] - 1e-12:
+            out.append((i, 1))
+    return out
+
+
+def extend(names: Sequence[str], axes: list[np.ndarray], box_lo: np.ndarray, box_hi: np.ndarray,
+           sides: list[tuple[int, int]], limits: tuple, search: float
+           ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The grid with each side in ``sides`` moved outwards by the initial half-width (a factor ``search`` for
+    I, k, R; 30 % of the value for a coefficient), within the limits, at the axis' node spacing: the new nodes
+    with the other axes' nodes are the points evaluated next."""
+    axes, box_lo, box_hi = [a.copy() for a in axes], box_lo.copy(), box_hi.copy()
+    for i, side in sides:
+        a = axes[i]
+        step = float(a[1] - a[0]) if a.size > 1 else 0.1
+        width = math.log(search) if names[i] in LOG else 0.3 * max(abs(float(a[a.size // 2])), 1e-12)
+        n = max(1, int(math.ceil(width / step - 1e-9)))
+        if side < 0:
+            new = np.maximum(a[0] - step * np.arange(n, 0, -1), limits[0][i])
+            axes[i] = np.unique(np.concatenate([new, a]))
+            box_lo[i] = axes[i][0]
+        else:
+            new = np.minimum(a[-1] + step * np.arange(1, n + 1), limits[1][i])
+            axes[i] = np.unique(np.concatenate([a, new]))
+            box_hi[i] = axes[i][-1]
+    return axes, box_lo, box_hi
+
+
+def residuals(problem: Problem, fits: Sequence[SeriesFit], x: np.ndarray, left: float
+              ) -> tuple[np.ndarray, list[np.ndarray | None], list[SetReading]]:
+    """The weighted residuals of the model at ``x`` against every series' statistics, the model's statistics
+    per series (None: no stick-slip) and their readings (:func:`set_statistics`: the attractor closest to the
+    data among the first ``problem.attractors`` starts), each run bounded by ``left`` seconds (at least 1)."""
+    out: list[np.ndarray] = []
+    models: list[np.ndarray | None] = []
+    readings: list[SetReading] = []
+    for f in fits:
+        d = f.data
+        p = apply(problem.params0, problem.names, x, f.V)
+        if f.aperiodic and problem.replicates > 1:
+            r = replicate_mean(p, f.series, d.threshold, d.noise, problem.t_transient, problem.rtol, max(1.0, left),
+                               d.target(problem.sel), problem.replicates)
+        else:
+            r = set_statistics(p, f.series, d.threshold, d.noise, problem.t_transient, problem.rtol, max(1.0, left),
+                               d.target(problem.sel), problem.attractors)
+        out.append(d.residuals(r.values, problem.sel, PENALTY))
+        models.append(r.values)
+        readings.append(r)
+    return np.concatenate(out), models, readings
+
+
+def grid_point(problem: Problem, fits: Sequence[SeriesFit], x: np.ndarray, deadline: float
+               ) -> tuple[np.ndarray, list[np.ndarray | None], list[SetReading]] | None:
+    """:func:`residuals` at a grid point as a pool's task; None when the call's ``deadline`` (a ``time.time()``)
+    passed before it began."""
+    left = deadline - time.time()
+    if left <= 0:
+        return None
+    return residuals(problem, fits, x, left)
+
+
+def n_fitted(problem: Problem, fits: Sequence[SeriesFit]) -> int:
+    """The number of statistics fitted over all series."""
+    return sum(int(np.count_nonzero(f.data.used[problem.sel])) for f in fits)
+
+
+def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], left: float
+               ) -> tuple[list[SeriesFit], int, tuple[str, ...]]:
+    """For each aperiodic series, the model's replicate spread at the best grid point (:func:`replicate_spread`)
+    added in quadrature to the statistics' σ (a diagonal synthetic likelihood, Wood 2010; divided by √m where the
+    model's statistics are a mean over m = ``problem.replicates`` replicates), and the cycle line
+    dropped where it is not stable across the replicates; the χ² of every point evaluated so far (``evaluated``,
+    updated in place) recomputed with the new σ.  Returns the series, the number of fitted statistics and the
+    notes."""
+    x = best(evaluated).x
+    out, notes, t0 = [], [], time.perf_counter()
+    for f in fits:
+        d = f.data
+        if not f.aperiodic or left - (time.perf_counter() - t0) <= 1.0:
+            out.append(f)
+            continue
+        sd, stable, n = replicate_spread(apply(problem.params0, problem.names, x, f.V), f.series, d.threshold,
+                                         d.noise, problem.t_transient, problem.rtol, left - (time.perf_counter() - t0))
+        if sd is None:
+            out.append(f)
+            continue
+        sig, used = np.hypot(d.sigma, sd / math.sqrt(problem.replicates)), d.used.copy()
+        notes.append(f"V = {fmt_number(f.V, 4)} m/s: an aperiodic trace; the model's spread over {n} replicates "
+                     "added to each statistic's sigma")
+        if used[_F_CYCLE] and not stable:
+            used[_F_CYCLE] = False
+            notes.append(f"f_cycle is not fitted at V = {fmt_number(f.V, 4)} m/s: the model's cycle line is not "
+                         f"stable across its replicates (absent in one, or spread over "
+                         f"{fmt_number(100 * REPEATABILITY['f_cycle'], 2)} %)")
+        out.append(dataclasses.replace(f, data=dataclasses.replace(d, sigma=sig, used=used)))
+    n_obs = n_fitted(problem, out)
+    if n_obs < len(problem.names):  # dropping the line would leave too few statistics: keep the former reading
+        return fits, n_fitted(problem, fits), ()
+    for i, e in enumerate(evaluated):
+        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(e.models, out)])
+        evaluated[i] = dataclasses.replace(e, chi2=float(res @ res))
+    return out, n_obs, tuple(notes)
+
+
+def shares(problem: Problem, evaluated: Sequence[Point], fits: Sequence[SeriesFit], left: float
+           ) -> list[SetReading | None]:
+    """At the best point, per series, the whole design of starts (:func:`set_statistics` with ``share``); None
+    where the budget is spent."""
+    if not evaluated:
+        return []
+    x = best(evaluated).x
+    t0, out = time.perf_counter(), list[SetReading | None]()
+    for f in fits:
+        d = f.data
+        spent = time.perf_counter() - t0
+        if left - spent <= 1.0:
+            out.append(None)
+            continue
+        out.append(set_statistics(apply(problem.params0, problem.names, x, f.V), f.series, d.threshold, d.noise,
+                                  problem.t_transient, problem.rtol, left - spent, d.target(problem.sel), 8,
+                                  share=True))
+    return out
+
+
+def attractor_lines(evaluated: Sequence[Point], full: Sequence[SetReading | None], Vs: Sequence[float]
+                    ) -> tuple[str, ...]:
+    """Per series, the attractor the best point's statistics are read from, the start reaching it and its
+    share of the set's starts."""
+    if not evaluated:
+        return ()
+    top = best(evaluated).readings
+    out = []
+    padded: list[SetReading | None] = [*full, *([None] * (len(top) - len(full)))]
+    for V, r, whole in zip(Vs, top, padded):
+        share = ("its share of the set's starts not measured (max_wall spent)" if whole is None or whole.share is None
+                 else f"share {fmt_number(100 * whole.share, 3)} % of the set's {whole.n_runs} starts")
+        out.append(f"at V = {fmt_number(V, 4)} m/s on the {r.label} attractor (from the start {r.start!r}; {share})")
+    return tuple(out)
