@@ -99,7 +99,7 @@ def test_the_replicate_spread_of_a_chaotic_trace():
     lies within [0.16, 1.92] of its true value at 95 % (chi-squared, 2 dof) and the slips' correlation makes the
     standard error itself approximate (measured ratios 0.5-1.3).  The cycle line of a chaotic trace is not
     stable across the replicates."""
-    from exact.dynamics._infer_stats import OBSERVABLES, data_statistics, replicate_spread
+    from exact.dynamics._infer_stats import STATISTICS, data_statistics, replicate_spread
 
     p = PeelParams(V=2.5, I=1e-4)
     s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
@@ -109,7 +109,7 @@ def test_the_replicate_spread_of_a_chaotic_trace():
     threshold, noise = d.threshold, d.noise
     sd, stable, n = replicate_spread(p, s, threshold, noise, 30.0, 1e-10, 120.0, 3)
     assert sd is not None and n == 3 and not stable
-    for j, name in enumerate(OBSERVABLES[:4]):
+    for j, name in enumerate(STATISTICS[:4]):
         sem = getattr(o, f"{name}_spread") / np.sqrt(o.n_slips - 1)
         assert 0.25 <= sd[j] / sem <= 4.0, (name, sd[j], sem)
 

@@ -22,7 +22,7 @@ several (one series per V).
   coexisting attractors), so a local fit alone finds a nearby minimum with an overconfident interval.  First
   a grid over ``params0 / search`` to ``params0 · search`` (ln θ for I, k, R; ±30 % for coefficients; at most
   :data:`GRID_RUNS` points per series), then :func:`scipy.optimize.least_squares` from the grid's best point,
-  and from the next best ones (:data:`STARTS` in all) while the fit's χ² is improbable (:data:`GOOD_FIT`).
+  and from the next best ones (:data:`N_STARTS` in all) while the fit's χ² is improbable (:data:`GOOD_FIT`).
   Where the 95 % interval (below) reaches a side of the box, that side moves out by the initial half-width (at
   the grid's node spacing, within :data:`peelapprox.PARAM_RANGES`), the new nodes are evaluated and the fit
   repeated, at most :data:`MAX_EXTEND` times: a verdict "the edge of the search" then means the data, not the
@@ -73,9 +73,9 @@ from ._infer_search import (
     shares,
     values_of,
 )
-from ._infer_stats import OBSERVABLES, data_statistics
+from ._infer_stats import STATISTICS, data_statistics
 
-__all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "MAX_EXTEND", "POOR_FIT", "STARTS", "infer"]
+__all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "MAX_EXTEND", "POOR_FIT", "N_STARTS", "infer"]
 
 #: Relative step of the forward-difference Jacobian.
 DIFF_STEP = 1e-3
@@ -83,20 +83,20 @@ DIFF_STEP = 1e-3
 #: in all) while its χ² is improbable at :data:`GOOD_FIT`: on a comb of periodic windows a local fit from the
 #: best node can end in a neighbouring window (V = 1, I = 1e-2: χ² = 18.8 on 5 dof at I -3 %, k -2 %, where the
 #: truth gives 0.01).
-STARTS = 3
+N_STARTS = 3
 #: The most times the search box is extended (each side the 95 % interval reaches moved out by the initial
 #: half-width, within :data:`peelapprox.PARAM_RANGES`) before a verdict: a start a factor 3 off puts the truth
 #: on the initial box's edge, and "not identified: the edge of the search" would then describe the box, not the
 #: data.
 MAX_EXTEND = 3
-#: The χ² probability from which a fit needs no further start (:data:`STARTS`), and below which a fit to an
+#: The χ² probability from which a fit needs no further start (:data:`N_STARTS`), and below which a fit to an
 #: aperiodic series identifies nothing (:data:`POOR_FIT`).
 GOOD_FIT = 0.05
-_F_CYCLE = OBSERVABLES.index("f_cycle")
+_F_CYCLE = STATISTICS.index("f_cycle")
 
 
 def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", "k"), *,
-          more: Sequence[ForceSeries] = (), statistics: Sequence[str] = OBSERVABLES, search: float = 3.0,
+          more: Sequence[ForceSeries] = (), statistics: Sequence[str] = STATISTICS, search: float = 3.0,
           t_transient: float = 30.0, rtol: float = 1e-10, max_wall: float = 600.0, attractors: int = 1,
           replicates: int = 1,
           progress: Callable[[str], None] | bool | None = True, executor: str | Executor | None = None,
@@ -114,7 +114,7 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     more : sequence of ForceSeries
         Traces at other pull speeds, fitted together with ``series``.
     statistics : sequence of str
-        The statistics fitted, a subset of :data:`OBSERVABLES` (all).  Where coexisting attractors make the
+        The statistics fitted, a subset of :data:`STATISTICS` (all).  Where coexisting attractors make the
         period, and with it the cycle frequency and the means over a cycle, jump between neighbouring parameter
         values (low inertia), the per-stick statistics ``("rise", "F_start", "force_drop")`` vary smoothly.
     search : float
@@ -203,8 +203,8 @@ def _prepare(series: ForceSeries, params0: PeelParams, free: Sequence[str], more
             raise TypeError(f"series and more must be ForceSeries, got {type(s).__name__}")
     names = free_names(params0, free)
     if isinstance(statistics, str) or not isinstance(statistics, Sequence) or not statistics:
-        raise TypeError(f"statistics must be a non-empty sequence of names from {OBSERVABLES}, got {statistics!r}")
-    sel = np.array([OBSERVABLES.index(choice("statistics", n, OBSERVABLES)) for n in statistics])
+        raise TypeError(f"statistics must be a non-empty sequence of names from {STATISTICS}, got {statistics!r}")
+    sel = np.array([STATISTICS.index(choice("statistics", n, STATISTICS)) for n in statistics])
     if len(set(sel.tolist())) != sel.size:
         raise ValueError(f"statistics: a name is given twice in {tuple(statistics)!r}")
     positive("max_wall", max_wall)
@@ -290,12 +290,12 @@ class _Search:
                 self.residuals(x)
 
     def fit(self, box_lo: np.ndarray, box_hi: np.ndarray, n_obs: int) -> Any:
-        """The least-squares fit from the best evaluated points (at most :data:`STARTS`) in the box: the best."""
+        """The least-squares fit from the best evaluated points (at most :data:`N_STARTS`) in the box: the best."""
         from scipy.optimize import least_squares
         from scipy.stats import chi2 as chi2_dist
 
         top = None
-        for e in sorted(self.evaluated, key=lambda e: e.chi2)[:STARTS]:
+        for e in sorted(self.evaluated, key=lambda e: e.chi2)[:N_STARTS]:
             sol = least_squares(self.residuals, np.clip(e.x, box_lo, box_hi), bounds=(box_lo, box_hi),
                                 diff_step=DIFF_STEP, max_nfev=100)
             if top is None or sol.cost < top.cost:

@@ -14,7 +14,7 @@ from peelapprox import PeelParams
 from peelapprox.io import fmt_number, jsonable
 
 from ._infer_search import LOG, Point, Problem, SeriesFit, apply, best, spans, values_of
-from ._infer_stats import OBSERVABLES
+from ._infer_stats import STATISTICS
 
 __all__ = ["POOR_FIT", "Inference", "Outcome", "assemble"]
 
@@ -203,7 +203,7 @@ def _residual_rows(problem: Problem, fits: Sequence[SeriesFit], model: list | No
         d = f.data
         for j in d.fitted(problem.sel).tolist():
             mv = None if m is None else float(m[j])
-            rows.append({"V": f.V, "observable": OBSERVABLES[j], "data": float(d.values[j]),
+            rows.append({"V": f.V, "observable": STATISTICS[j], "data": float(d.values[j]),
                          "sigma": float(d.sigma[j]), "model": mv,
                          "residual": None if mv is None else (mv - float(d.values[j])) / float(d.sigma[j])})
     return rows

@@ -21,8 +21,8 @@ from peelapprox import ForceSeries, PeelParams
 from peelapprox.io import fmt_number
 
 from ._infer_stats import (
-    OBSERVABLES,
     REPEATABILITY,
+    STATISTICS,
     SeriesData,
     SetReading,
     replicate_mean,
@@ -41,7 +41,7 @@ GRID_RUNS = 81
 LOG = ("I", "k", "R")
 #: A residual for a model run that does not stick-slip or breaks down: far outside any σ.
 PENALTY = 1e3
-_F_CYCLE = OBSERVABLES.index("f_cycle")
+_F_CYCLE = STATISTICS.index("f_cycle")
 
 
 @dataclass(frozen=True)
@@ -66,7 +66,7 @@ class Problem:
     names : tuple of str
         The free parameters (:func:`free_names`).
     sel : ndarray of int
-        The indices into :data:`OBSERVABLES` of the ``statistics`` asked for.
+        The indices into :data:`STATISTICS` of the ``statistics`` asked for.
     t_transient, rtol : float
         Of every model run.
     attractors : int

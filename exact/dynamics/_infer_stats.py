@@ -1,6 +1,6 @@
 """The statistics :func:`exact.infer` fits: a force trace's, measured or the model's, read the same way.
 
-* **Statistics** (:data:`OBSERVABLES`): the slip interval, force drop, stick and slip times of
+* **Statistics** (:data:`STATISTICS`): the slip interval, force drop, stick and slip times of
   :meth:`ForceSeries.observables`, the mean slope of the sticks (``k (V - v)``: mostly k), the mean force at
   a slip's start (set by the law and the α oscillation: mostly I; the trace's linear trend removed, so a
   machine's slow drift does not read as force) and the cycle frequency (left out where no line stands out of the
@@ -33,12 +33,12 @@ from peelapprox.io import fmt_number
 from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
-__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "OBSERVABLES", "REPEATABILITY", "SeriesData", "SetReading",
+__all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "STATISTICS", "REPEATABILITY", "SeriesData", "SetReading",
            "data_statistics", "model_statistics", "replicate_mean", "replicate_spread", "set_statistics",
            "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
-OBSERVABLES = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
+STATISTICS = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
 #: The σ of each statistic, relative: not the detector's repeatability under noise (a 20 s, 10 kHz model trace
 #: read with 0.5 N of white noise and without differs by 2e-6 in the slip interval, 0.2 % in the drop, 4.5 % in
 #: the slip time) but the model's own roughness: from one periodic window to the next (I varied by 5 % steps
@@ -62,7 +62,7 @@ NOISE_SEED = 20041
 
 def trace_statistics(series: ForceSeries, threshold: float | None
                      ) -> tuple[np.ndarray | None, Any, bool, float]:
-    """The statistics of :data:`OBSERVABLES` of a series (None if it does not stick-slip), its observables,
+    """The statistics of :data:`STATISTICS` of a series (None if it does not stick-slip), its observables,
     whether its periodogram holds a cycle line (:func:`_cycle_frequency`) and the detector's threshold."""
     slips = series.slips(threshold, method="knee")  # the detector the statistics were calibrated with
     o = series.observables(slips=slips)  # read off these slips, not detected a second time
@@ -70,7 +70,7 @@ def trace_statistics(series: ForceSeries, threshold: float | None
         return None, o, False, slips.threshold
     assert o.slip_interval is not None  # stick-slip with two slips or more
     f_cycle, line = _cycle_frequency(series, 1.0 / o.slip_interval)
-    vals = [getattr(o, n) for n in OBSERVABLES[:4]] + [float(np.mean(slips.rise)), _start_force(slips), f_cycle]
+    vals = [getattr(o, n) for n in STATISTICS[:4]] + [float(np.mean(slips.rise)), _start_force(slips), f_cycle]
     return np.asarray(vals, dtype=float), o, line, slips.threshold
 
 
@@ -122,7 +122,7 @@ class SeriesData:
     Attributes
     ----------
     values, sigma : ndarray
-        The statistics of :data:`OBSERVABLES` and their σ (module docstring: residuals).
+        The statistics of :data:`STATISTICS` and their σ (module docstring: residuals).
     threshold, noise : float
         The detector's threshold and the series' noise level, with which every model trace is read.
     used : ndarray of bool
@@ -137,14 +137,14 @@ class SeriesData:
     used: np.ndarray
 
     def fitted(self, sel: np.ndarray) -> np.ndarray:
-        """The indices into :data:`OBSERVABLES` fitted: those of ``sel`` (the ``statistics`` asked for) the
+        """The indices into :data:`STATISTICS` fitted: those of ``sel`` (the ``statistics`` asked for) the
         series carries, in ``sel``'s order."""
         return sel[self.used[sel]]
 
     def target(self, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(values, σ, mask)`` of :func:`set_statistics`: the mask over :data:`OBSERVABLES` of the fitted
+        """``(values, σ, mask)`` of :func:`set_statistics`: the mask over :data:`STATISTICS` of the fitted
         statistics."""
-        mask = np.zeros(len(OBSERVABLES), dtype=bool)
+        mask = np.zeros(len(STATISTICS), dtype=bool)
         mask[self.fitted(sel)] = True
         return self.values, self.sigma, mask
 
@@ -166,14 +166,14 @@ def data_statistics(series: ForceSeries) -> SeriesData:
     if vals is None:
         raise ValueError(f"the series at V = {fmt_number(series.V, 4)} m/s does not stick-slip ({o.status}: "
                          f"{o.reason}): there is nothing to fit")
-    sig = np.array([REPEATABILITY[n] * abs(v) for n, v in zip(OBSERVABLES, vals)])
+    sig = np.array([REPEATABILITY[n] * abs(v) for n, v in zip(STATISTICS, vals)])
     sig[-1] = max(sig[-1], 0.5 / series.duration)  # at least half a periodogram bin
     if o.period is None:  # an aperiodic trace: its means scatter
-        for j, n in enumerate(OBSERVABLES[:4]):
+        for j, n in enumerate(STATISTICS[:4]):
             spread = getattr(o, f"{n}_spread") or 0.0
             sig[j] = math.hypot(sig[j], spread / math.sqrt(max(o.n_slips - 1, 1)))
-    used = np.ones(len(OBSERVABLES), dtype=bool)
-    used[OBSERVABLES.index("f_cycle")] = line
+    used = np.ones(len(STATISTICS), dtype=bool)
+    used[STATISTICS.index("f_cycle")] = line
     return SeriesData(vals, sig, threshold, series.noise, used)
 
 
@@ -267,7 +267,7 @@ def replicate_spread(p: PeelParams, series: ForceSeries, threshold: float, noise
         return None, False, len(reads)
     arr = np.array([r[0] for r in reads])
     sd = arr.std(axis=0, ddof=1)
-    j = OBSERVABLES.index("f_cycle")
+    j = STATISTICS.index("f_cycle")
     stable = all(r[1] for r in reads) and sd[j] <= REPEATABILITY["f_cycle"] * abs(float(arr[:, j].mean()))
     return sd, bool(stable), len(reads)
 
