@@ -67,7 +67,7 @@ I = 10^-3.25, α0 = 0.25, where stored time went back by 8.5e-13 s.
 
 Integrator
 ----------
-The one compiled integrator of the package, :mod:`peelapprox._dop853`
+The one compiled integrator of the package, :mod:`peelapprox._compiled._dop853`
 (Dormand–Prince 8(5,3), scipy's coefficients and controller, scipy's
 tolerance semantics), on the state ``y = (τ, α, ω, ln v)`` where ``τ = t - t_seg``
 is the time since the segment started (so the error control of the time is

@@ -19,7 +19,7 @@ are compared at equal t at the measurement points: the (α, ω) part of ``δy �
 ``ẏ = (dy/ds)/(dt/ds)``, and the F part from CONSTR, ``δF = (∂F/∂α) δα + (∂F/∂u) δu``.
 
 This module owns only its small driver (integrate to the fold, no output); the step is the package's one
-DOP853 (:mod:`peelapprox._dop853`).
+DOP853 (:mod:`peelapprox._compiled._dop853`).
 """
 
 from __future__ import annotations

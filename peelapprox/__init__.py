@@ -20,35 +20,8 @@ observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObs
 object (``peelapprox.periodic_orbit is exact.periodic_orbit``), documented once, on its home's API page.
 """
 
-from ._alpha import (
-    ALPHA_FORMS,
-    InertialPeriods,
-    airy_alpha,
-    alpha_numerical,
-    cd_damping_time,
-    cd_decay_alpha,
-    harmonic_alpha,
-    inertial_frequency,
-    inertial_period,
-    inertial_periods,
-    sinusoid_alpha,
-    wkb_alpha,
-    wkb_amplitude_phase,
-    wkb_error_bound,
-)
-from ._approx_result import ApproximateAttractor, ApproximationWarning
-from ._approximate import approximate_attractor
-from ._estimate import (
-    INERTIA_RULE,
-    VELOCITY_RULE,
-    RegimeEstimate,
-    SlopeCriterion,
-    crude_branch_time,
-    estimate,
-    force_bounds,
-    quasi_static_branch_time,
-    slope_criterion,
-)
+from ._measured._series import ForceSeries, Spectrum
+from ._measured._series_lyapunov import SeriesLyapunov, SurrogateTest
 from ._observables import StickSlipObservables
 from ._params import PeelParams
 from ._ranges import (
@@ -69,10 +42,37 @@ from ._ranges import (
     TIME_MAX,
     WINDOW_DEFAULTS,
 )
+from ._reduced._alpha import (
+    ALPHA_FORMS,
+    InertialPeriods,
+    airy_alpha,
+    alpha_numerical,
+    cd_damping_time,
+    cd_decay_alpha,
+    harmonic_alpha,
+    inertial_frequency,
+    inertial_period,
+    inertial_periods,
+    sinusoid_alpha,
+    wkb_alpha,
+    wkb_amplitude_phase,
+    wkb_error_bound,
+)
+from ._reduced._approx_result import ApproximateAttractor, ApproximationWarning
+from ._reduced._approximate import approximate_attractor
+from ._reduced._estimate import (
+    INERTIA_RULE,
+    VELOCITY_RULE,
+    RegimeEstimate,
+    SlopeCriterion,
+    crude_branch_time,
+    estimate,
+    force_bounds,
+    quasi_static_branch_time,
+    slope_criterion,
+)
+from ._reduced._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
-from ._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
-from ._series import ForceSeries, Spectrum
-from ._series_lyapunov import SeriesLyapunov, SurrogateTest
 from ._slips import Slips
 from ._version import __version__ as __version__
 from .bursts import (

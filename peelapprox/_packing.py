@@ -15,8 +15,8 @@ A numba kernel takes the model as one float64 vector.  Every driver's vector sta
 
 and a driver appends its own fields after it, numbering them from :data:`N_M` (the hybrid solver's fold and
 landing velocities in ``exact._hybrid``, the reduced segment's α model and entry state in
-:mod:`peelapprox._segment_kernel`).  The kernels read every entry by its named constant.  The constants are
-frozen into the compiled kernels, so this file is one of :data:`peelapprox._jit.KERNEL_SOURCES`.
+:mod:`peelapprox._reduced._segment_kernel`).  The kernels read every entry by its named constant.  The constants are
+frozen into the compiled kernels, so this file is one of :data:`peelapprox._compiled._jit.KERNEL_SOURCES`.
 """
 
 from __future__ import annotations

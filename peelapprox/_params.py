@@ -154,7 +154,7 @@ class PeelParams:
 
     def closure(self, alpha):
         """``(c, dc/dα)`` with ``c = -cos θ`` for this geometry; scalar or array ``alpha``."""
-        from . import _generated
+        from ._compiled import _generated
 
         fun = _generated.closure_paper if self.geometry == "paper" else _generated.closure_exact
         return fun(alpha, self.R, self.l)

@@ -1,6 +1,6 @@
 """One table of the compiled drivers' status codes: code, reason, exception, message.
 
-The hybrid DAE driver (``exact._hybrid``), the reduced-segment driver (``peelapprox._segment_kernel``) and the
+The hybrid DAE driver (``exact._hybrid``), the reduced-segment driver (``peelapprox._reduced._segment_kernel``) and the
 saltation-tangent driver (``exact._tangent``) return one of these integer codes (plain module constants:
 numba freezes them into the kernels); :func:`status_error` turns a code into the documented exception, in
 the style of scipy's ``MESSAGES`` and diffrax's ``RESULTS``.  Codes below 10 are not errors (the run ended

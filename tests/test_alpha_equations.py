@@ -1,6 +1,6 @@
 """Each fact in one place: the reduced α equations and the parameter packings.
 
-The reduced α equations used to be written in ``peelapprox/_alpha.py`` (the public closed forms and
+The reduced α equations used to be written in ``peelapprox/_reduced/_alpha.py`` (the public closed forms and
 ``alpha_numerical``) and again inside the reduced-segment kernel; the kernels' parameter vectors each had their
 own index constants for the same model parameters.  These tests would catch the two copies drifting apart
 again: the segment kernel's α must be the public formula's, and every driver's vector must start with the one
@@ -135,7 +135,7 @@ def test_every_driver_vector_starts_with_the_model_block():
     indices and values)."""
     from exact import _hybrid as H
     from exact._hybrid_driver import param_vector as _param_vector
-    from peelapprox import _segment_kernel as K
+    from peelapprox._reduced import _segment_kernel as K
 
     p = PeelParams(V=1.0, I=1e-5, geometry="exact")
     pv = _param_vector(p, 1e-9)
@@ -153,8 +153,8 @@ def test_every_driver_vector_starts_with_the_model_block():
 
 def test_jitable_refuses_a_function_outside_the_kernel_sources():
     """A formula shared with kernels must live in a hashed kernel source (else a change to it would not
-    invalidate the cached kernels that inline it): :func:`peelapprox._jit.jitable` refuses this test's own."""
-    from peelapprox._jit import jitable
+    invalidate the cached kernels that inline it): :func:`peelapprox._compiled._jit.jitable` refuses this test's own."""
+    from peelapprox._compiled._jit import jitable
 
     def f(x):
         return 2.0 * x

@@ -229,9 +229,9 @@ def _atlas_rows() -> dict:
 
 def test_validity_table_is_the_measurement():
     """Hypothesis: the validity estimate() reports is the atlas's measurement, not a second copy that drifted:
-    every regime of the approx:default rows of docs/atlas/atlas_regimes.csv is in peelapprox._validity.VALIDITY
+    every regime of the approx:default rows of docs/atlas/atlas_regimes.csv is in peelapprox._reduced._validity.VALIDITY
     with the same point count and fractions (exact: the same decimal text parsed to the same floats)."""
-    from peelapprox._validity import VALIDITY
+    from peelapprox._reduced._validity import VALIDITY
 
     rows = _atlas_rows()
     assert set(rows) == set(VALIDITY)

@@ -23,7 +23,7 @@ from peelapprox import (
     StickSlipObservables,
     approximate_attractor,
 )
-from peelapprox._reducedmap import newton
+from peelapprox._reduced._reducedmap import newton
 
 
 class Henon:
@@ -90,9 +90,9 @@ def test_multipliers_agree_with_the_exact_periodic_orbit():
     """Independent oracle: :func:`exact.periodic_orbit`, Newton on the full DAE's section with its own monodromy,
     at V = 2, I = 1e-3 where both find a stable period-7 orbit (the issue's example: the old map called it
     aperiodic).  The reduced map's period label is the exact one, and its largest |μ| is within the reduction's
-    measured multiplier error, :data:`peelapprox._approx_result.MULTIPLIER_ERROR` = 0.07, of the exact one
+    measured multiplier error, :data:`peelapprox._reduced._approx_result.MULTIPLIER_ERROR` = 0.07, of the exact one
     (measured: 0.847 against 0.899)."""
-    from peelapprox._approx_result import MULTIPLIER_ERROR
+    from peelapprox._reduced._approx_result import MULTIPLIER_ERROR
 
     p = PeelParams(V=2.0, I=1e-3)
     o = approximate_attractor(p, warn=False)

@@ -1,4 +1,5 @@
-"""The validity table's generator (``python -m comparisons.atlas.validity``): the table of peelapprox/_validity.py is
+"""The validity table's generator (``python -m comparisons.atlas.validity``): the table of
+peelapprox/_reduced/_validity.py is
 what the generator writes from docs/atlas/atlas_regimes.csv, and a new atlas's rows go into it unchanged."""
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_the_committed_table_is_the_generators_output():
-    """Hypothesis: regenerating peelapprox/_validity.py from docs/atlas/atlas_regimes.csv changes nothing (the table
+    """Hypothesis: regenerating peelapprox/_reduced/_validity.py from docs/atlas/atlas_regimes.csv changes nothing (the
+    table
     was generated, not edited).  Exact text equality: the generator writes ``repr`` of the CSV's floats."""
     assert validity.regenerate(ROOT / "docs" / "atlas" / "atlas_regimes.csv") == validity.TARGET.read_text()
     assert validity.main(["--from", str(ROOT / "docs" / "atlas"), "--check"]) == 0

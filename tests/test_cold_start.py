@@ -27,7 +27,7 @@ rec = event.RecordingListener()
 event.register("numba:compile", rec)
 import peelapprox, exact
 at_import = sum(1 for _, e in rec.buffer if e.is_start)
-import peelapprox.law._abi as A, peelapprox.law._table_jit as T, peelapprox._segment_kernel as SK
+import peelapprox.law._abi as A, peelapprox.law._table_jit as T, peelapprox._reduced._segment_kernel as SK
 import peelapprox.kernels as K
 import exact._hybrid_driver as HL, exact._tangent as TG
 {job}

@@ -177,8 +177,8 @@ def test_every_chapter_is_in_the_site():
 def _private_citations(line: str) -> list[str]:
     """The code spans of a markdown line that cite a private dotted name (``exact._hybrid._rhs``,
     ``_generated.slow_rates(...)``): a dotted name (before any call parentheses) with a part that starts with
-    one underscore.  A file (``peelapprox/_symbolic.py``), a dunder (``__main__``) or a command (``python -m
-    peelapprox._symbolic``) is not one."""
+    one underscore.  A file (``peelapprox/_compiled/_symbolic.py``), a dunder (``__main__``) or a command (``python -m
+    peelapprox._compiled._symbolic``) is not one."""
     found = []
     for span in re.findall(r"`([^`]+)`", line):
         name = re.match(r"[\w.]+", span)
@@ -197,7 +197,7 @@ def test_chapters_cite_no_private_dotted_name():
     the count of such citations is 0."""
     assert _private_citations("`exact._hybrid._rhs` and `_generated.slow_rates(x)`") == \
         ["exact._hybrid._rhs", "_generated.slow_rates(x)"]
-    assert _private_citations("`peelapprox/_symbolic.py`, `_generated.py`, `python -m peelapprox._symbolic`, "
+    assert _private_citations("`peelapprox/_compiled/_symbolic.py`, `_generated.py`, `python -m peelapprox._compiled._symbolic`, "  # noqa: E501
                               "`__main__`, `peelapprox.kernels.diffsl_code(tangent=True)`") == []
     found = []
     for path in [DOCS.parent / "README.md", *sorted(DOCS.rglob("*.md"))]:

@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit
 from numba.core import event
 
-from peelapprox import _dop853 as D
+from peelapprox._compiled import _dop853 as D
 
 
 def test_inner_helper_is_a_plain_function_that_compiled_callers_compile_once():
@@ -38,7 +38,8 @@ def test_inner_helper_is_a_plain_function_that_compiled_callers_compile_once():
 
 
 def test_dop853_pieces_are_a_module_of_plain_functions():
-    """Hypothesis: ``make_dop853`` returns a :class:`~peelapprox._dop853.Dop853` module whose four pieces are plain
+    """Hypothesis: ``make_dop853`` returns a :class:`~peelapprox._compiled._dop853.Dop853` module whose four pieces are
+    plain
     functions named after the field (the names a cold run's compile listing shows)."""
     from exact._hybrid import _rhs
 

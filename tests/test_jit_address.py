@@ -1,6 +1,6 @@
 """The one private numba name the package uses: the compiled wrapper's address of a dispatcher.
 
-``peelapprox._jit.wrapper_address`` reaches ``numba.experimental.function_type._get_wrapper_address`` (its
+``peelapprox._compiled._jit.wrapper_address`` reaches ``numba.experimental.function_type._get_wrapper_address`` (its
 docstring says why no public route serves: ``cfunc`` compiles a second time, a dispatcher argument costs ~35 µs
 a call).  These tests fail first, and say so, if a numba release drops or changes it.
 """
@@ -13,12 +13,12 @@ import numpy as np
 from numba import njit, types
 from numba.experimental import function_type
 
-from peelapprox._jit import wrapper_address
+from peelapprox._compiled._jit import wrapper_address
 
 
 def test_numba_still_has_the_private_wrapper_address():
     """Hypothesis: this numba keeps ``_get_wrapper_address`` (a callable); if it fails, numba dropped it:
-    change ``peelapprox._jit.wrapper_address`` to a public route (``numba.cfunc(sig)(fn).address``)."""
+    change ``peelapprox._compiled._jit.wrapper_address`` to a public route (``numba.cfunc(sig)(fn).address``)."""
     assert callable(getattr(function_type, "_get_wrapper_address", None))
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-import peelapprox._jit as J
+import peelapprox._compiled._jit as J
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -77,7 +77,7 @@ def test_every_kernel_source_is_hashed():
             if re.search(r"(?<![.\w])(?<!def )kernel\(|@kernel\b|\bnjit\b", text) and f.name != "_jit.py":
                 users.add(f.relative_to(ROOT).as_posix())
     assert users <= set(J.KERNEL_SOURCES), users - set(J.KERNEL_SOURCES)
-    assert {"peelapprox/_generated.py", "peelapprox/_alpha.py"} <= set(J.KERNEL_SOURCES)
+    assert {"peelapprox/_compiled/_generated.py", "peelapprox/_reduced/_alpha.py"} <= set(J.KERNEL_SOURCES)
 
 
 def test_source_tag_changes_with_any_kernel_source(tmp_path):
@@ -114,7 +114,7 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path):
     again = _probe(tmp_path)
     assert (again["run_hits"], again["run_misses"], again["n_run"]) == (1, 0, 1)
     assert again["kern_law"] == before["kern_law"]
-    gen = tmp_path / "peelapprox" / "_generated.py"
+    gen = tmp_path / "peelapprox" / "_compiled" / "_generated.py"
     src = gen.read_text()
     assert src.count("400*x2") == 3  # f in peel_force_fp, peel_force_fpp, peel_force_lnv
     gen.write_text(src.replace("400*x2", "401*x2"))

@@ -1,8 +1,10 @@
-"""Compiled peel-force laws generated from one symbolic source: peelapprox._render, law._kernels and law.codegen.
+"""Compiled peel-force laws generated from one symbolic source: peelapprox._compiled._render, law._kernels and
+law.codegen.
 
 Oracles: the families' formulas written a second time here by hand (f, f', f'' in closed form, as the numpy
 evaluators of ``_law_families`` were before they were generated) and evaluated at 30 digits (mpmath); the
-built-in paper law (``paper_law``, generated independently in ``w = ln v`` by ``peelapprox._symbolic``); sympy's
+built-in paper law (``paper_law``, generated independently in ``w = ln v`` by ``peelapprox._compiled._symbolic``);
+sympy's
 own lambdified derivatives of an expression law (``PeelForce.f/df/d2f``).
 
 The tolerance of most comparisons, ``1e-13 * scale``, with ``scale`` the sum of the magnitudes of the terms of
@@ -28,8 +30,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-import peelapprox._render as R
-import peelapprox._symbolic as S
+import peelapprox._compiled._render as R
+import peelapprox._compiled._symbolic as S
 import peelapprox.law._cache as LC
 import peelapprox.law._kernels as C
 import peelapprox.law.codegen as CG
@@ -241,7 +243,7 @@ def test_law_expression_of_each_kind():
     _symbolic.peel_force_expr symbolically), the paper family at defaults equal to it at 30 digits to 1e-15
     relative (floats 0.35, ... vs rationals 7/20, ...: < 1e-17 relative in the exponents), a family with its
     coefficients, an expression rebuilt from its text (exactly equal), and ValueError for a table."""
-    from peelapprox import _symbolic as S
+    from peelapprox._compiled import _symbolic as S
 
     paper = law_expression(PeelForce.paper())
     assert sp.simplify(paper - S.peel_force_expr(v, V)) == 0

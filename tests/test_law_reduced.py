@@ -163,7 +163,7 @@ def test_the_law_driver_with_the_papers_kernel_reproduces_the_inlined_driver():
     inlined driver's segment: Δt, ΔF to 1e-12 relative and the same number of steps (the two differ only in how
     v = e^u enters f: roundings), and the default params still take the inlined copy (0.2.0's numbers, oracle
     IDENTICAL)."""
-    from peelapprox import _segment_kernel as K
+    from peelapprox._reduced import _segment_kernel as K
     from peelapprox.kernels import paper_coefficients, paper_law
 
     p = PeelParams(V=1.0, I=1e-2)

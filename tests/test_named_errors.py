@@ -394,7 +394,7 @@ def test_force_series_refuses_more_samples_than_its_limit():
     """A trace of more than MAX_SAMPLES samples (1e8 took 11 GB in infer) is refused before any copy, naming the
     limit (categorical); checked on a read-only broadcast view, which costs no memory."""
     from peelapprox import ForceSeries
-    from peelapprox._series import MAX_SAMPLES
+    from peelapprox._measured._series import MAX_SAMPLES
 
     big = np.broadcast_to(np.float64(200.0), (MAX_SAMPLES + 1,))
     with pytest.raises(ValueError, match=rf"more than the {MAX_SAMPLES} a force series may have"):

@@ -65,8 +65,8 @@ def test_dop853_tableau_equals_scipys_bitwise():
     """Hypothesis: the package's copy of the tableau is scipy's, bit for bit (``tobytes`` equality, dtype and shape),
     wherever the installed scipy still has the private module it was copied from; the integrator uses the copy."""
     ref = pytest.importorskip("scipy.integrate._ivp.dop853_coefficients")
-    from peelapprox import _dop853
-    from peelapprox import _dop853_tableau as ours
+    from peelapprox._compiled import _dop853
+    from peelapprox._compiled import _dop853_tableau as ours
 
     for name in ("N_STAGES", "N_STAGES_EXTENDED", "INTERPOLATOR_POWER"):
         assert getattr(ours, name) == getattr(ref, name)

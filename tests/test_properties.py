@@ -142,7 +142,7 @@ def test_fold_location_is_invariant_to_the_bracket(V, lo, hi):
     search measured at most 5.0e-15 (v_max) and 3.2e-15 (v_min).  Same for v_min."""
     from scipy.optimize import brentq
 
-    from peelapprox._generated import peel_force_coefficients
+    from peelapprox._compiled._generated import peel_force_coefficients
     from peelapprox.law._paper import _V_HI, _V_LO, _fp
 
     bs = branch_structure(V)

@@ -1,4 +1,5 @@
-"""The reduced return map's compiled returns (peelapprox/_reducedmap_kernel.py) against the Python map they replace
+"""The reduced return map's compiled returns (peelapprox/_reduced/_reducedmap_kernel.py) against the Python map they
+replace
 (:meth:`ReturnMap.ret`, one segment driver call per stay): the same numbers bitwise, the same stops."""
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ import numpy as np
 import pytest
 
 from peelapprox import PeelForce, PeelParams
-from peelapprox import _reducedmap as RM
-from peelapprox._approximate import APPROX_DEFAULTS, FULL_CHAIN, _rest, _solver_start
+from peelapprox._reduced import _reducedmap as RM
+from peelapprox._reduced._approximate import APPROX_DEFAULTS, FULL_CHAIN, _rest, _solver_start
 from peelapprox.law._compiled import compiled_law
 
 RNG = np.random.default_rng(2035)

@@ -391,7 +391,7 @@ def test_a_numba_cache_dir_others_can_write_is_not_used(tmp_path, monkeypatch):
     exactly) and nothing is read from or written to that directory."""
     import numba
 
-    from peelapprox import _jit as J
+    from peelapprox._compiled import _jit as J
 
     d = tmp_path / "nbc"
     d.mkdir()
@@ -427,7 +427,7 @@ def test_a_truncated_numba_index_is_a_cache_miss(tmp_path, monkeypatch):
     and returns its value (x + 1 = 3.5 exactly), instead of an UnpicklingError out of the call."""
     import numba
 
-    from peelapprox._jit import kernel
+    from peelapprox._compiled._jit import kernel
 
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "nb"))
 
@@ -485,7 +485,7 @@ def _mul_three(x):
 
 def _compile_mul_three() -> object:
     """A new dispatcher of the same function (what a new process makes): its cache is looked up on disk."""
-    from peelapprox._jit import kernel
+    from peelapprox._compiled._jit import kernel
 
     return kernel(outside=True)(_mul_three)
 

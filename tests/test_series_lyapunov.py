@@ -174,7 +174,7 @@ def test_options_are_defined_once_and_an_unknown_one_is_named():
     import dataclasses
     import inspect
 
-    from peelapprox._series_lyapunov import LyapunovOptions, series_lyapunov
+    from peelapprox._measured._series_lyapunov import LyapunovOptions, series_lyapunov
 
     fields = {f.name: f.default for f in dataclasses.fields(LyapunovOptions)}
     for fn in (ForceSeries.lyapunov, series_lyapunov):

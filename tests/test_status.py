@@ -13,7 +13,7 @@ def test_drivers_use_the_table_codes():
     values each driver module imported; two numberings existed before)."""
     import exact._hybrid as H
     import exact._tangent as T
-    import peelapprox._segment_kernel as G
+    import peelapprox._reduced._segment_kernel as G
 
     for mod, names in ((H, ("DONE", "OUT_FULL", "JUMPS_FULL", "PAUSE", "NO_ROOT", "NO_LANDING", "GEOMETRY",
                             "V_CEILING", "STEP_FAIL")),

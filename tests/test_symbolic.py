@@ -1,4 +1,4 @@
-"""The symbolic model source (peelapprox._symbolic) and the code generated from it.
+"""The symbolic model source (peelapprox._compiled._symbolic) and the code generated from it.
 
 Checks that (a) the committed generated module is a fresh rendering, (b) the
 Lagrangian derivation (LAGRAN, DISSPN, MOTION1, MOTION2) reproduces FLOW2,
@@ -15,15 +15,15 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from peelapprox import _generated as g
-from peelapprox import _symbolic as S
 from peelapprox import branch_structure
+from peelapprox._compiled import _generated as g
+from peelapprox._compiled import _symbolic as S
 
 # ---------------------------------------------------------------- (a)
 
 
 def test_generated_module_is_fresh():
-    """Hypothesis: peelapprox/_generated.py is exactly what render_module() produces now.
+    """Hypothesis: peelapprox/_compiled/_generated.py is exactly what render_module() produces now.
 
     Tolerance: none (exact string equality).  Any edit of the sympy source that
     is not followed by ``python -m peelapprox.law.codegen`` fails here.  (The

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-import peelapprox._symbolic as S
+import peelapprox._compiled._symbolic as S
 from peelapprox import PeelParams
 from peelapprox.kernels import compiled_law, variant_field, variant_parameters
 

@@ -9,7 +9,7 @@ import os
 import pytest
 
 import peelapprox.kernels as K
-from peelapprox._jit import SOURCE_TAG
+from peelapprox._compiled._jit import SOURCE_TAG
 
 
 @pytest.fixture

@@ -1,11 +1,12 @@
-"""Regenerate the measured validity :func:`peelapprox.estimate` reports (``peelapprox/_validity.py``) from an atlas.
+"""Regenerate the measured validity :func:`peelapprox.estimate` reports (``peelapprox/_reduced/_validity.py``) from an
+atlas.
 
     python -m comparisons.atlas.validity --from DIR_OR_CSV [--source TEXT] [--target FILE] [--check]
 
 ``DIR_OR_CSV`` is an atlas directory (its ``atlas_regimes.csv``, written by ``peelapprox atlas --out DIR``) or
 that file.  Its ``approx:default`` rows (per regime label of :func:`peelapprox.estimate`: the exact stick-slip
 points, the fractions predicted within 10 % for the slip interval, the force drop and both) become the table
-``VALIDITY`` of the target (default: ``peelapprox/_validity.py`` of this checkout), rewritten between its
+``VALIDITY`` of the target (default: ``peelapprox/_reduced/_validity.py`` of this checkout), rewritten between its
 ``VALIDITY: dict[str, Validity] = {`` line and the closing brace, floats as ``repr`` (the CSV's text parsed to
 the same floats, which ``tests/test_approx_attractor.py::test_validity_table_is_the_measurement`` checks against
 ``docs/atlas/atlas_regimes.csv``); ``--source`` replaces the one-line ``SOURCE`` string (where the numbers come
@@ -24,7 +25,7 @@ from pathlib import Path
 __all__ = ["TARGET", "read_validity", "render", "regenerate", "main"]
 
 #: The file the table is written into.
-TARGET = Path(__file__).resolve().parents[2] / "peelapprox" / "_validity.py"
+TARGET = Path(__file__).resolve().parents[2] / "peelapprox" / "_reduced" / "_validity.py"
 _HEAD = "VALIDITY: dict[str, Validity] = {\n"
 _SOURCE = re.compile(r'^SOURCE = \(.*?\)\n', re.S | re.M)
 
@@ -76,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m comparisons.atlas.validity", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--from", dest="source_file", required=True, help="an atlas directory or its atlas_regimes.csv")
-    ap.add_argument("--target", default=str(TARGET), help="the module to rewrite (default peelapprox/_validity.py)")
+    ap.add_argument("--target", default=str(TARGET), help="the module to rewrite (default peelapprox/_reduced/_validity.py)")  # noqa: E501
     ap.add_argument("--source", help="the new SOURCE sentence (where the numbers come from)")
     ap.add_argument("--check", action="store_true", help="write nothing; exit 1 if the target is not up to date")
     args = ap.parse_args(argv)

@@ -60,7 +60,7 @@ ALPHA0S = (0.0, 0.15, -0.15, 0.3, -0.3)
 #: Where the cached references live.
 DATA = Path(__file__).parent / "data"
 #: The deviation, in force drops of the orbit, at which a run has left an unstable orbit: the map's own
-#: ``ESCAPE_FRACTION`` (peelapprox/_approximate.py).
+#: ``ESCAPE_FRACTION`` (peelapprox/_reduced/_approximate.py).
 ESCAPE_FRACTION = 1.0
 _OBS = ("slip_interval", "force_drop", "F_max", "F_min", "period")
 

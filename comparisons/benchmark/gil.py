@@ -2,7 +2,8 @@
 
     python -m comparisons.benchmark.gil [--I 1e-6:1e-1:4:log] [--V 0.2:5:4] [--t-transient 30] [--window 10]
 
-Every compiled kernel is compiled with ``nogil=True`` (``peelapprox/_jit.py``), so a thread running one does not
+Every compiled kernel is compiled with ``nogil=True`` (``peelapprox/_compiled/_jit.py``), so a thread running one does
+not
 hold the GIL; whatever else a point does (the Python around the kernels, numpy and scipy calls, the store's
 write) does.  This runs an atlas (:func:`comparisons.atlas.atlas`, every measure) serially in this thread after
 one untimed point (kernels loaded), and measures with the thread's CPU time (``time.thread_time``: the CPU this

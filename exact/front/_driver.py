@@ -2,7 +2,8 @@
 output and breakdown checks, all inside one numba function (:func:`run_front`), entered from Python only when a
 buffer fills, a step budget of the call is spent or the run ends (:mod:`exact.front._run`).
 
-Integrator: :mod:`peelapprox._dop853` (the package's one compiled integrator, scipy's tolerance semantics) on the
+Integrator: :mod:`peelapprox._compiled._dop853` (the package's one compiled integrator, scipy's tolerance semantics) on
+the
 state of :func:`peelapprox.kernels.front_rhs`.  Every step costs O(N) (13 field evaluations, each two passes over
 the strips) and allocates nothing: the work arrays come from Python.
 

@@ -416,8 +416,8 @@ def exit_status(exc: BaseException) -> int | None:
     """:data:`EXIT_USAGE` (2) for a bad argument, output path or missing optional package; :data:`EXIT_STOP` (3)
     when the model or solver stopped; :data:`EXIT_WRITE` (1) when writing failed after the checks (disk full, a
     path changed meanwhile); None for anything else (an internal error, :data:`EXIT_INTERNAL`)."""
-    from .._diffsl import PeerUnavailableError
     from ..errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
+    from ..kernels._diffsl import PeerUnavailableError
 
     if isinstance(exc, (ValueError, PeerUnavailableError)):
         return EXIT_USAGE

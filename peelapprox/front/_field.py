@@ -4,8 +4,8 @@ State ``y = (α, ω, E_AE, F_0 … F_{N-1}, v_0 … v_{N-1}, W_in, W_peel)`` wit
 whole tape would carry at strip j's stretch; the pull force is ``F = mean F_j = k ū``), ``v_j`` the local peel
 velocity, ``E_AE`` the integrated acoustic emission, ``W_in = ∫ F̄ V dt`` the work of the pull and
 ``W_peel = ∫ N⁻¹ Σ f(v_j) v_j dt`` the energy dissipated at the peel front (the energy balance's integrals).
-The mean ``(α̇, ω̇, F̄̇, v̄̇)`` is the tape-mass model's field (``tape_rhs`` of :mod:`peelapprox._generated`,
-generated from :mod:`peelapprox._symbolic`) evaluated with the mean peel force ``f̄ = mean f(v_j)``: the same
+The mean ``(α̇, ω̇, F̄̇, v̄̇)`` is the tape-mass model's field (``tape_rhs`` of :mod:`peelapprox._compiled._generated`,
+generated from :mod:`peelapprox._compiled._symbolic`) evaluated with the mean peel force ``f̄ = mean f(v_j)``: the same
 code as the tape-mass model's, so N = 1 is that model.  Each strip adds its deviation from the mean::
 
     Ḟ_j = k (V + c (R ω - v̄) - v_j)
@@ -17,7 +17,7 @@ from the front's Lagrangian and Rayleigh function is :mod:`peelapprox.front._sym
 Cost: one pass over the strips for the means, one for the rates -- O(N), no N × N array.
 
 A strip with ``v_j <= 0`` (a trial stage outside the law's domain) makes the whole field NaN: the DOP853 step
-is then rejected and retried smaller (:mod:`peelapprox._dop853`).
+is then rejected and retried smaller (:mod:`peelapprox._compiled._dop853`).
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ from typing import Any
 import numpy as np
 from numba import types as _nb
 
-from .. import _generated as _g
-from .._jit import compile_only, kernel
-from .._model_jit import closure_d2
+from .._compiled import _generated as _g
+from .._compiled._jit import compile_only, kernel
+from .._compiled._model_jit import closure_d2
 from .._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
 from ..law import ALL_LAWS
 from ..law._abi import LAW_FP, LAW_TYPE

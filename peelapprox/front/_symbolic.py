@@ -8,7 +8,7 @@ Coordinates: the roller angle α and the N local stretches u_j.  Kinematics (the
     R = N⁻¹ Σ_j Φ(v_j) + Γ/2 Σ_bonds (u̇_{j+1} - u̇_j)²,   Φ' = f
 
 and Lagrange's equations ``d/dt ∂L/∂q̇ - ∂L/∂q + ∂R/∂q̇ = 0``.  N = 1 is the tape-mass model's Lagrangian
-(``tape_mass_lagrange_equations`` in ``peelapprox/_symbolic.py``).  Only f's values enter (not its slope), so
+(``tape_mass_lagrange_equations`` in ``peelapprox/_compiled/_symbolic.py``).  Only f's values enter (not its slope), so
 here f(v_j) are symbols ``f_j`` and ``c, c'`` are symbols of the closure at α.
 """
 

@@ -16,9 +16,9 @@ form           ``x``        returns
 ``LAW_FPP``    ``v``         ``(f, f', f'')``: the saltation tangent and the fold finders
 =============  ===========  ==================================================================================
 
-A law is any function compiled by :func:`peelapprox._jit.kernel` with ``signature=LAW_SIG`` (cached on disk: a
+A law is any function compiled by :func:`peelapprox._compiled._jit.kernel` with ``signature=LAW_SIG`` (cached on disk: a
 compiled law costs one compilation per machine).  :func:`paper_law` (:data:`LAWS`) is fvV of De, Maybhate &
-Ananthakrishna (2004) through exactly the generated code the drivers inline (:mod:`peelapprox._generated`:
+Ananthakrishna (2004) through exactly the generated code the drivers inline (:mod:`peelapprox._compiled._generated`:
 ``peel_force_lnv``, ``peel_force_fp``, ``peel_force_fpp``), so a driver taking it as an argument gives bitwise
 the numbers of the inlined law.  The other laws are generated from their sympy form
 (:mod:`peelapprox.law._kernels`: the families from :mod:`peelapprox.law._generated`, an expression in the user
@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import types
 
-from .._jit import kernel
+from .._compiled._jit import kernel
 from ._paper import (
     peel_force_coefficients,
     peel_force_fp_jit,
@@ -73,7 +73,7 @@ def unused_law(x, coef, form):
 @kernel(inline="always")
 def pack_inlined(p, law, coef):
     """What a field with the paper's law inlined receives from a driver copy: its parameter vector ``p`` (fvV
-    reads ``p[M_B], p[M_A]``); ``law`` and ``coef`` unused (:func:`peelapprox._jit.rebind`)."""
+    reads ``p[M_B], p[M_A]``); ``law`` and ``coef`` unused (:func:`peelapprox._compiled._jit.rebind`)."""
     return p
 
 

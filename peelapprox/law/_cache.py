@@ -1,7 +1,8 @@
 """The on-disk cache of the compiled expression laws: where it is, and the checks that keep it from being planted.
 
 :func:`law_dir` is the verified directory (``$PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``; it and its
-parents must pass :func:`peelapprox._jit.unsafe_dir`; numba's cache of the laws is in the kernels' private root),
+parents must pass :func:`peelapprox._compiled._jit.unsafe_dir`; numba's cache of the laws is in the kernels' private
+root),
 else a private temporary
 one with a :class:`~peelapprox.errors.KernelCacheWarning`; :func:`read_verified` reads a law module without
 following links and only from a regular file of this user's; :func:`write_atomic` replaces it.  What runs is
@@ -18,8 +19,8 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from .._jit import unsafe_dir
-from .._private import cache_home
+from .._compiled._jit import unsafe_dir
+from .._compiled._private import cache_home
 from ..errors import KernelCacheWarning
 
 __all__ = ["MAX_MODULE_BYTES", "cache_dir", "law_dir", "read_verified", "write_atomic"]
@@ -39,10 +40,11 @@ _FALLBACK: dict[str, Path] = {}
 
 
 def law_dir() -> Path:
-    """The verified cache directory (:func:`cache_dir`, which must pass :func:`peelapprox._jit.unsafe_dir`: its
+    """The verified cache directory (:func:`cache_dir`, which must pass :func:`peelapprox._compiled._jit.unsafe_dir`:
+    its
     parents too; the default one, the package's own, is replaced when it fails), else a private temporary one for
     this process, with one :class:`~peelapprox.errors.KernelCacheWarning` naming why.  numba's cache of the laws
-    is not here but in the kernels' private root (:mod:`peelapprox._kcache`)."""
+    is not here but in the kernels' private root (:mod:`peelapprox._compiled._kcache`)."""
     d = cache_dir()
     why = unsafe_dir(d, replace="PEELAPPROX_CACHE_DIR" not in os.environ)
     if why is None:

@@ -1,7 +1,7 @@
 """The compiled laws of the families and of expression laws: compiled on first use, expressions cached on disk.
 
 :func:`family_kernel` compiles a family's law from :mod:`peelapprox.law._generated` (numba's on-disk cache: once
-per machine).  :func:`expression_kernel` renders an expression law (:func:`peelapprox._render.render_law`)
+per machine).  :func:`expression_kernel` renders an expression law (:func:`peelapprox._compiled._render.render_law`)
 into a module of the user's private cache directory (``PEELAPPROX_CACHE_DIR``, else ``~/.cache/peelapprox/laws``;
 :mod:`peelapprox.law._cache`), named by the SHA-256 of its canonical text and :func:`codegen_version` (a changed
 expression or renderer is a new file, never a stale kernel), written atomically, built from the text rendered
@@ -22,11 +22,11 @@ from typing import Any
 
 import numpy as np
 
-from .. import _render
 from .._checks import shown
+from .._compiled import _render
+from .._compiled._jit import kernel
+from .._compiled._render import CODEGEN_VERSION, render_law
 from .._deadline import LAW_BUILD_SECONDS, Expired, time_limit
-from .._jit import kernel
-from .._render import CODEGEN_VERSION, render_law
 from ..errors import KernelCacheWarning
 from ._abi import LAW_SIG
 from ._cache import cache_dir, law_dir, read_verified, write_atomic
@@ -39,7 +39,7 @@ _FAMILY_KERNELS: dict[str, tuple[Callable, Callable]] = {}
 def family_kernel(name: str) -> tuple[Any, Callable[..., np.ndarray]]:
     """The compiled law of the family ``name`` and its packing: ``(law, pack)``.
 
-    ``law`` is compiled for :data:`peelapprox.law._abi.LAW_SIG` by :func:`peelapprox._jit.kernel` (cached on
+    ``law`` is compiled for :data:`peelapprox.law._abi.LAW_SIG` by :func:`peelapprox._compiled._jit.kernel` (cached on
     disk); ``pack(V, c)`` gives its ``coef`` (float64 array) from the pull speed V and the coefficients ``c``
     in the family's order (``tuple(x for _, x in force.coefficients)``).  Memoised per process.
 
@@ -72,7 +72,7 @@ _EXPRESSION_KERNELS: dict[str, tuple[Any, Callable]] = {}
 
 
 def codegen_version() -> str:
-    """:data:`~peelapprox._render.CODEGEN_VERSION` and the first 12 hex digits of the SHA-256 of the renderer,
+    """:data:`~peelapprox._compiled._render.CODEGEN_VERSION` and the first 12 hex digits of the SHA-256 of the renderer,
     this file and :mod:`peelapprox.law._symbolic` (a changed renderer gives new file names: no stale kernel)."""
     h = hashlib.sha256()
     for f in (Path(_render.__file__), Path(__file__), Path(__file__).with_name("_symbolic.py")):
@@ -108,7 +108,8 @@ def expression_kernel(source: str) -> tuple[Any, Callable[..., np.ndarray]]:
     exactly that text, else it is written anew, atomically (a planted, replaced or truncated file, or a link,
     is replaced with a :class:`~peelapprox.errors.KernelCacheWarning`).  The module is built from the rendered
     text, not from the file, which names it for numba's on-disk cache (in the kernels' private root,
-    :mod:`peelapprox._kcache`, its files checked before numba reads them): a second process renders again (tens
+    :mod:`peelapprox._compiled._kcache`, its files checked before numba reads them): a second process renders again
+    (tens
     of ms), loads the compiled law and compiles nothing.  The cache directory and its parents must be real
     directories that no one else can write (the directory this user's, the parents this user's or root's);
     otherwise (a link, another owner, group- or world-writable, unwritable) a private temporary directory is used

@@ -194,7 +194,7 @@ class PaperKind(LawKind):
         return paper_structure(V)
 
     def expression(self, force: Any) -> Any:
-        from .. import _symbolic as S
+        from .._compiled import _symbolic as S
         from ._symbolic import V, v
 
         return S.peel_force_expr(v, V)

@@ -1,7 +1,7 @@
 """The paper's law fvV (Eq. fvV): its evaluation, branch structure and branch inverses, bitwise the 0.2 numbers.
 
-The formulas are generated from the sympy source (:mod:`peelapprox._symbolic`) into
-:mod:`peelapprox._generated`; here they are wrapped as vectorised numpy functions with argument checks
+The formulas are generated from the sympy source (:mod:`peelapprox._compiled._symbolic`) into
+:mod:`peelapprox._compiled._generated`; here they are wrapped as vectorised numpy functions with argument checks
 (:func:`peel_force`, :func:`peel_force_derivative`), numba kernels for the solvers (``peel_force_*_jit``),
 the branch structure of ``f(·, V)`` (:func:`paper_structure`: folds by Brent's method either side of the
 minimiser of f', cached per V) and the inverse of f on each stable branch (:func:`branch_inverse`, in
@@ -18,9 +18,9 @@ from typing import Any, cast
 import numpy as np
 from scipy.optimize import brentq
 
-from .. import _generated as _g
 from .._checks import choice, in_range, reals
-from .._jit import kernel
+from .._compiled import _generated as _g
+from .._compiled._jit import kernel
 from .._ranges import PARAM_RANGES, STATE_RANGES
 from ._folds import BRANCHES, BREAKDOWN_LEVEL, BranchStructure
 

@@ -40,7 +40,7 @@ def family_expression(name: str) -> tuple[sp.Expr, tuple[sp.Symbol, ...]]:
 def law_expression(force: Any) -> sp.Expr:
     """The law ``f(v, V)`` of a :class:`peelapprox.PeelForce` as a sympy expression in :data:`v`, :data:`V`.
 
-    fvV exactly (rationals, :func:`peelapprox._symbolic.peel_force_expr`); a family with its coefficients as
+    fvV exactly (rationals, :func:`peelapprox._compiled._symbolic.peel_force_expr`); a family with its coefficients as
     sympy Floats; an expression rebuilt from its canonical text.
 
     Raises

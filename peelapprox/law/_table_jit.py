@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import kernel
+from .._compiled._jit import kernel
 from ._abi import LAW_FP, LAW_LNV, LAW_SIG
 from ._table import TableLaw, check_tables
 

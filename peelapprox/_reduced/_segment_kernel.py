@@ -1,8 +1,8 @@
 """The compiled reduced-segment integrator: its parameter layout, vector field and event driver.
 
-The equations and their desingularised form are described in :mod:`peelapprox._segment` (the public
+The equations and their desingularised form are described in :mod:`peelapprox._reduced._segment` (the public
 :func:`~peelapprox.reduced_segment`, which validates the arguments, packs :func:`segment_parameters` and calls
-:func:`run`).  The α equations come from :mod:`peelapprox._alpha`, where each is written once: the closed forms
+:func:`run`).  The α equations come from :mod:`peelapprox._reduced._alpha`, where each is written once: the closed forms
 (``"sinusoid"``, ``"harmonic"``, ``"exponential"``) are evaluated at the state's t by the same functions the
 public ``sinusoid_alpha``, ``harmonic_alpha``, ``cd_decay_alpha`` call, and the restoring term ``-F R α/I`` of
 approxalpha/Airy is the one :func:`~peelapprox.alpha_numerical` integrates.  The damping terms of Airy1/Airy2
@@ -13,7 +13,7 @@ Parameter vector ``q``: the model block of :mod:`peelapprox._packing` (``M_V``, 
 ``M_B``, ``M_A``; the reduced equations are linear in α and read neither ``M_L`` nor ``M_GEOM``), then this
 driver's fields ``Q_*`` from index ``N_M``.
 
-The peel-force law: the driver body :func:`_run` is compiled twice (:func:`peelapprox._jit.rebind`),
+The peel-force law: the driver body :func:`_run` is compiled twice (:func:`peelapprox._compiled._jit.rebind`),
 as the hybrid solver's (``exact._hybrid_driver``):
 
 * ``run(False)`` -- the paper's law fvV **inlined** (:func:`field`, ``q`` carrying ``b, A``): the default path,
@@ -35,18 +35,18 @@ from typing import Any
 import numpy as np
 from numba import types as _t
 
+from .._compiled._dop853 import N_STAGES as _NS
+from .._compiled._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
+from .._compiled._jit import compile_only, kernel, rebind
+from .._packing import M_A, M_B, M_I, M_K, M_R, M_V, N_M
+from .._status import DONE, F_NONPOSITIVE, MAX_STEPS, NONFINITE, OUT_FULL, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
+from ..law._abi import LAW_LNV, LAW_TYPE, pack_inlined, pack_law
+from ..law._paper import peel_force_fp_jit
 from ._alpha import _decay, _harmonic, _restoring, _sinusoid
-from ._dop853 import N_STAGES as _NS
-from ._dop853 import STEP_FAILED, crossing, interp, interp1, make_dop853, solve_theta, state_at, workspace
-from ._jit import compile_only, kernel, rebind
-from ._packing import M_A, M_B, M_I, M_K, M_R, M_V, N_M
-from ._status import DONE, F_NONPOSITIVE, MAX_STEPS, NONFINITE, OUT_FULL, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
-from .law._abi import LAW_LNV, LAW_TYPE, pack_inlined, pack_law
-from .law._paper import peel_force_fp_jit
 
 __all__ = ["ALPHA_MODELS", "RUN_SIG", "V_EQUATIONS", "alpha_of", "field", "field_law", "run", "segment_parameters"]
 
-#: α models accepted by :func:`peelapprox.reduced_segment` (:mod:`peelapprox._segment`); the code of each is
+#: α models accepted by :func:`peelapprox.reduced_segment` (:mod:`peelapprox._reduced._segment`); the code of each is
 #: its index (``AM_*``)
 ALPHA_MODELS = (
     "sinusoid", "harmonic", "approxalpha", "airy2", "airy2_frozen", "airy1", "genalpha", "exponential", "static",

@@ -19,13 +19,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._checks import shown
-from ._observables import StickSlipObservables, jump_statistics
-from ._ranges import TIME_MAX
+from .._checks import shown
+from .._observables import StickSlipObservables, jump_statistics
+from .._ranges import TIME_MAX
+from .._slips import Slips, detect_slips, noise_level
+from ..io import fmt_number, jsonable
+from ..validate import integer, optional, positive, reals
 from ._series_lyapunov import options_signature, series_lyapunov
-from ._slips import Slips, detect_slips, noise_level
-from .io import fmt_number, jsonable
-from .validate import integer, optional, positive, reals
 
 if TYPE_CHECKING:
     from ._series_lyapunov import SeriesLyapunov
@@ -152,7 +152,7 @@ class ForceSeries:
             Naming the file and, for a cell, its line and column (a missing column, an unknown unit, a cell
             that is not a number); or the trace's own checks with the file line of the offending sample.
         """
-        from ._csvread import read_columns
+        from .._csvread import read_columns
 
         if not (isinstance(columns, tuple) and len(columns) == 2 and all(isinstance(c, str) for c in columns)):
             raise TypeError(f"columns must be a pair of column names (time, force), got {columns!r}")
@@ -286,8 +286,10 @@ class ForceSeries:
     def lyapunov(self, **options: Any) -> SeriesLyapunov:
         """The largest Lyapunov exponent from the trace, by delay embedding and the divergence of nearest
         neighbours (Rosenstein et al. 1993, Kantz 1994), with a surrogate-data test
-        (:mod:`peelapprox._series_lyapunov`).  The options are keyword-only; the signature is built from their one
-        definition, the fields of ``LyapunovOptions`` (``peelapprox/_series_lyapunov.py``), and an unknown option
+        (:mod:`peelapprox._measured._series_lyapunov`).  The options are keyword-only; the signature is built from their
+        one
+        definition, the fields of ``LyapunovOptions`` (``peelapprox/_measured/_series_lyapunov.py``), and an unknown
+        option
         is a ``TypeError`` naming it.
 
         Parameters
@@ -366,7 +368,7 @@ class ForceSeries:
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
             raise ValueError(f"window must be (t_start, t_end) with t_start < t_end, got {window!r}")
         if ax is None:
-            from .plotting import pyplot
+            from ..plotting import pyplot
 
             _, ax = pyplot().subplots(figsize=(9, 4))
         s = self.slips(threshold)
@@ -396,7 +398,7 @@ class ForceSeries:
         matplotlib axes
         """
         if ax is None:
-            from .plotting import pyplot
+            from ..plotting import pyplot
 
             _, ax = pyplot().subplots(figsize=(5, 5))
         x, y = self.return_map(threshold)
@@ -441,7 +443,7 @@ class ForceSeries:
         ImportError
             If pandas is not installed (``pip install 'peelapprox[data]'``).
         """
-        from .io import optional_import
+        from ..io import optional_import
 
         pd = optional_import("pandas", "ForceSeries.to_dataframe")
         df = pd.DataFrame({"t": np.array(self.t), "F": np.array(self.F)})

@@ -1,4 +1,5 @@
-"""The Dormand–Prince 8(5,3) tableau with its 7th-order dense output, owned by the package (:mod:`peelapprox._dop853`).
+"""The Dormand–Prince 8(5,3) tableau with its 7th-order dense output, owned by the package
+(:mod:`peelapprox._compiled._dop853`).
 
 Provenance: copied verbatim (the same literals and the same numpy expressions, so the same float64 values bit for
 bit) from scipy 1.17.1, ``scipy/integrate/_ivp/dop853_coefficients.py``, a private module of scipy that the

@@ -1,8 +1,8 @@
 """The stick-slip attractor predicted from the paper's reduced branch-wise equations alone (no DAE solve).
 
-:func:`approximate_attractor` chains the reduced segments of :mod:`peelapprox._segment` (Sec. V of the paper:
+:func:`approximate_attractor` chains the reduced segments of :mod:`peelapprox._reduced._segment` (Sec. V of the paper:
 an α model coupled to the velocity equation approxvdot or fullvdot) into a return map on the exact model's
-section (:mod:`peelapprox._reducedmap`) and finds its attractors:
+section (:mod:`peelapprox._reduced._reducedmap`) and finds its attractors:
 
 1. **AB**: from the landing velocity ``v_land_ab`` the α model and the v equation are integrated until v reaches
    the fold ``v_max`` (the transversal event ``ln v = ln v_max`` of the desingularised field).
@@ -31,21 +31,21 @@ from typing import Any
 
 import numpy as np
 
+from .._observables import StickSlipObservables, jump_statistics
+from .._params import PeelParams
+from .._ranges import F0_FACTOR
+from .._status import F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
+from ..io import fmt_number
+from ..law import fixed_point
+from ..law._compiled import compiled_law
+from ..validate import choice, flag, integer, optional, positive
+from ..validate import params as _params
+from ..validate import rtol as _rtol
 from ._approx_result import ALPHA_LINEAR, MULTIPLIER_ERROR, ApproximateAttractor, confidence, warn_low
-from ._observables import StickSlipObservables, jump_statistics
-from ._params import PeelParams
-from ._ranges import F0_FACTOR
 from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, envelope, newton
 from ._regime import regime
 from ._segment import SegmentPlan, segment_status
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
-from ._status import F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
-from .io import fmt_number
-from .law import fixed_point
-from .law._compiled import compiled_law
-from .validate import choice, flag, integer, optional, positive
-from .validate import params as _params
-from .validate import rtol as _rtol
 
 __all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "PERIOD_RTOL", "START_NAMES",
            "approximate_attractor", "default_models"]

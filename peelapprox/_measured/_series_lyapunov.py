@@ -52,8 +52,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .io import fmt_number, jsonable
-from .validate import choice, in_range, integer, positive
+from ..io import fmt_number, jsonable
+from ..validate import choice, in_range, integer, positive
 
 __all__ = ["EMBEDDINGS", "LyapunovOptions", "SeriesLyapunov", "SurrogateTest", "iaaft", "options_signature",
            "series_lyapunov"]
@@ -200,7 +200,7 @@ class SeriesLyapunov:
         matplotlib axes
         """
         if ax is None:
-            from .plotting import pyplot
+            from ..plotting import pyplot
 
             _, ax = pyplot().subplots(figsize=(7, 4.5))
         tk = self.k * self.step

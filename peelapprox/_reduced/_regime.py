@@ -1,16 +1,16 @@
 """The regime labels of :func:`peelapprox.estimate`: the rules, and the labels of a point without the branch
 quadratures (:func:`regime`, which the reduced return map reads to pick its default reductions).
 
-Kept apart from :mod:`peelapprox._estimate` so that the approximate attractor (which reads the labels) and the
+Kept apart from :mod:`peelapprox._reduced._estimate` so that the approximate attractor (which reads the labels) and the
 estimate (which offers the approximate attractor) import it, not each other.
 """
 
 from __future__ import annotations
 
+from .._params import PeelParams
+from ..law import BranchStructure, FixedPoint, branch_structure, fixed_point
+from ..validate import params as _params
 from ._alpha import InertialPeriods, cd_damping_time, inertial_periods
-from ._params import PeelParams
-from .law import BranchStructure, FixedPoint, branch_structure, fixed_point
-from .validate import params as _params
 
 __all__ = ["INERTIA_RULE", "VELOCITY_RULE", "regime"]
 

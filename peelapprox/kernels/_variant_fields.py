@@ -1,12 +1,14 @@
 """The model variants' compiled fields (the follow-ups of the paper's model): the tape-mass model and the constant load.
 
 Three smooth ODE systems in the state ``y = (α, ω, F, v)`` or ``(α, ω, F, v, V_p)``, each with its analytic
-Jacobian, rendered from :func:`peelapprox._symbolic.variant_system` into :mod:`peelapprox._generated`:
+Jacobian, rendered from :func:`peelapprox._compiled._symbolic.variant_system` into
+:mod:`peelapprox._compiled._generated`:
 
 =============  ======  ===================================================================================
 model          states  equations
 =============  ======  ===================================================================================
-``"tape"``     4       FLOW1, flow3, the tape-mass model's ω̇ and v̇ (:func:`peelapprox._symbolic.tape_mass_rates`)
+``"tape"``     4       FLOW1, flow3, the tape-mass model's ω̇ and v̇
+(:func:`peelapprox._compiled._symbolic.tape_mass_rates`)
 ``"tape_load"`` 5      the same with ``V → V_p`` and ``M V̇_p = F_L - F``
 ``"eps_load"`` 5       the massless tape under a load: XDAE (``ε v̇ = F(1 - cos θ) - f``) with ``V → V_p``
 =============  ======  ===================================================================================
@@ -26,12 +28,12 @@ import numpy as np
 from numba import njit
 from numba import types as _nb
 
-from . import _generated as _g
-from ._jit import compile_only, kernel, rebind
-from ._model_jit import closure_d2, regularized_rhs
-from ._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
-from .law import ALL_LAWS
-from .law._abi import LAW_FP, LAW_TYPE, paper_law
+from .._compiled import _generated as _g
+from .._compiled._jit import compile_only, kernel, rebind
+from .._compiled._model_jit import closure_d2, regularized_rhs
+from .._packing import M_GEOM, M_I, M_K, M_L, M_R, M_V, N_M, model_block
+from ..law import ALL_LAWS
+from ..law._abi import LAW_FP, LAW_TYPE, paper_law
 
 __all__ = ["VARIANT_MODELS", "Q_MASS", "Q_LOAD_MASS", "Q_LOAD", "variant_parameters", "variant_field",
            "bound_variant_field"]

@@ -2,7 +2,8 @@
 warm-up records that say so (``exact.compile_kernels``, ``peelapprox warmup``).
 
 A warm-up record is a small JSON file, ``<kernel root>/warmup-<cpu>.json``, written by the process that ran the
-warm-up (0600, by a new file renamed over the old): the kernel sources' tag (:data:`peelapprox._jit.SOURCE_TAG`), the
+warm-up (0600, by a new file renamed over the old): the kernel sources' tag
+(:data:`peelapprox._compiled._jit.SOURCE_TAG`), the
 numba and Python versions, the CPU name numba compiled for and what the warm-up compiled and loaded.  It is data,
 read as JSON and only from a private file; numba's own files are never read here.  A record whose tag or versions
 differ from this process's is *stale*: numba discards those kernels on load (their stamps differ) and compiles them
@@ -22,9 +23,9 @@ from typing import Any
 import numba
 from numba.core import config as numba_config
 
-from ._jit import SOURCE_TAG, caching_enabled
-from ._kcache import kernel_root, root_problem
-from ._private import dir_problem, file_problem, open_private
+from .._compiled._jit import SOURCE_TAG, caching_enabled
+from .._compiled._kcache import kernel_root, root_problem
+from .._compiled._private import dir_problem, file_problem, open_private
 
 __all__ = ["cache_status", "cpu_name", "record_warmup"]
 
@@ -101,7 +102,7 @@ def cache_status() -> dict[str, Any]:
     was refused), the law directory, the folders with their numbers of kernels and files (and files that would
     be refused), this process's CPU, tag and versions, the warm-up records with whether each is fresh and for
     this CPU, and a one-line ``verdict``."""
-    from .law._cache import cache_dir, law_dir
+    from ..law._cache import cache_dir, law_dir
 
     root = kernel_root()
     env = getattr(numba_config, "CACHE_DIR", "") or ""

@@ -1,7 +1,8 @@
 """The one renderer of generated code: sympy expressions into plain Python on numpy functions.
 
 Both generated modules and every expression law come from here: the model's kernels
-(:func:`render_function`, into ``peelapprox/_generated.py`` from :mod:`peelapprox._symbolic`), the families'
+(:func:`render_function`, into ``peelapprox/_compiled/_generated.py`` from :mod:`peelapprox._compiled._symbolic`), the
+families'
 laws (:func:`render_law`, into ``peelapprox/law/_generated.py``) and a user's expression law (compiled at run
 time by ``peelapprox/law/_kernels.py``); :func:`render_module` joins a header and functions into a module's
 text and :func:`write_module` writes it.  ``python -m peelapprox.law.codegen`` regenerates both modules.

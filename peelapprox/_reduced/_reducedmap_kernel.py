@@ -1,7 +1,7 @@
 """The reduced return map's returns in compiled code: many returns per call of Python.
 
-:meth:`peelapprox._reducedmap.ReturnMap.ret` runs one return as two calls of the segment driver
-(:func:`peelapprox._segment_kernel.run`) from Python, each with its parameter vector, tolerances and horizon
+:meth:`peelapprox._reduced._reducedmap.ReturnMap.ret` runs one return as two calls of the segment driver
+(:func:`peelapprox._reduced._segment_kernel.run`) from Python, each with its parameter vector, tolerances and horizon
 built in Python: ~25 µs of set-up and dispatch per segment, more than a short segment's integration.
 :func:`returns` runs the same arithmetic, in the same order, for many returns in one call (the same numbers
 bitwise, the default chain's integrated α models with the paper's geometry ``1 - c(α) = 1 + sin α``):
@@ -9,7 +9,7 @@ bitwise, the default chain's integrated α models with the paper's geometry ``1 
 * the AB→CD jump: ``F = f_max/(1 + sin α)``, ``α̇ += kick_ab``; a CD stay to ``v_min``;
 * the CD→AB jump: ``G = f_min/(1 + sin α)``, ``α̇ += kick_cd``; an AB stay to ``v_max``;
 
-each stay with the parameter vector, ``atol`` and horizon of :meth:`peelapprox._reducedmap.ReturnMap.lean`.  A
+each stay with the parameter vector, ``atol`` and horizon of :meth:`peelapprox._reduced._reducedmap.ReturnMap.lean`.  A
 call stops after ``n`` returns, at a segment that does not reach its fold (its status, branch and final state
 returned), or once ``step_cap`` integration steps are spent (the caller checks its wall-clock deadline between
 calls, so a call's length is bounded whatever the returns cost).
@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 from numba import types as _t
 
+from .._compiled._jit import compile_only, kernel, rebind
+from .._packing import M_I, M_R
+from .._status import DONE
+from ..law._abi import LAW_TYPE
 from . import _segment_kernel as K
-from ._jit import compile_only, kernel, rebind
-from ._packing import M_I, M_R
-from ._status import DONE
-from .law._abi import LAW_TYPE
 
 __all__ = ["B_FOLD", "B_KICK", "N_B", "returns", "RETURNS_SIG"]
 
@@ -44,7 +44,8 @@ _RUN: Any = None
 
 
 def _stay(y, q0, b, row, law, coef, rtol, horizon, F, a, ad, atol, cnt, stop, dummy_t, dummy_out):
-    """One stay on branch ``row`` from ``(F, α, α̇)`` (:meth:`peelapprox._reducedmap.ReturnMap.lean`'s arithmetic);
+    """One stay on branch ``row`` from ``(F, α, α̇)`` (:meth:`peelapprox._reduced._reducedmap.ReturnMap.lean`'s
+    arithmetic);
     y holds the final state; the driver's status."""
     q = q0.copy()
     R, I = q[M_R], q[M_I]
@@ -135,7 +136,8 @@ _COPIES = {False: _copy(False), True: _copy(True)}
 
 
 def returns(law_argument: bool) -> Any:
-    """:func:`_returns` calling the segment driver copy ``law_argument`` (:func:`peelapprox._segment_kernel.run`),
+    """:func:`_returns` calling the segment driver copy ``law_argument``
+    (:func:`peelapprox._reduced._segment_kernel.run`),
     compiled for :data:`RETURNS_SIG` on first use (from numba's cache when it is there)."""
     K.run(law_argument)  # the driver it calls, compiled (or loaded) and frozen first
     return compile_only(_COPIES[law_argument], RETURNS_SIG)

@@ -3,7 +3,7 @@
 numba's own locators put a function's cache files (an index ``*.nbi`` and data files ``*.nbc``, both *pickles*
 that numba loads) in ``NUMBA_CACHE_DIR``, the package's ``__pycache__`` or ``~/.cache/numba``, in per-module folders
 made with the umask's mode and never checked: under ``umask 000`` another user could replace an index and run
-code as the next user of the cache.  Every kernel of the package (:func:`peelapprox._jit.kernel`) is cached
+code as the next user of the cache.  Every kernel of the package (:func:`peelapprox._compiled._jit.kernel`) is cached
 instead by :class:`PrivateCache`:
 
 * the **root** is ``NUMBA_CACHE_DIR`` when it is set and private, else ``~/.cache/peelapprox/numba``
@@ -12,7 +12,8 @@ instead by :class:`PrivateCache`:
   private root at all the kernels are compiled without caching (one warning).  A read-only install works: nothing
   is written beside the package;
 * each module's folder ``<root>/<package>_<sha1 of its directory>`` (numba's naming) is made 0700 whatever the umask,
-  and one that is a link, another user's or writable by others is replaced (:func:`peelapprox._private.private_dir`);
+  and one that is a link, another user's or writable by others is replaced
+  (:func:`peelapprox._compiled._private.private_dir`);
 * before numba unpickles an index or data file, the file is checked: a regular file of this user's that no one
   else can write, not a link; another is not read, is removed, and the kernel is compiled (a warning says so);
   files are written 0600; a truncated or garbled file is a cache miss, as a missing one is.
@@ -36,13 +37,14 @@ from typing import Any
 from numba.core import caching as _caching
 from numba.core import config as numba_config
 
+from ..errors import KernelCacheWarning
 from ._private import cache_home, open_private, private_dir
-from .errors import KernelCacheWarning
 
 __all__ = ["SUPPORTED", "PrivateCache", "default_root", "kernel_root", "root_problem"]
 
 #: Whether this numba's cache classes have the methods the classes below override (numba 0.58-0.68 have them);
-#: without them the kernels are compiled uncached (:mod:`peelapprox._jit`), never cached where the checks do not
+#: without them the kernels are compiled uncached (:mod:`peelapprox._compiled._jit`), never cached where the checks do
+# not
 #: reach (the classes themselves are in every numba since 0.49).
 _BASES = ("_CacheLocator", "_SourceFileBackedLocatorMixin", "CompileResultCacheImpl", "IndexDataCacheFile",
           "FunctionCache", "Cache")
@@ -98,7 +100,7 @@ def kernel_root() -> Path | None:
         _ROOTS[key] = root
         if notes:
             _NOTES[key] = "; ".join(notes)
-        if notes and root is not None:  # with no root at all, peelapprox._jit warns once (caching off)
+        if notes and root is not None:  # with no root at all, peelapprox._compiled._jit warns once (caching off)
             warnings.warn(f"peelapprox: {_NOTES[key]}; numba loads the pickled files it finds there, so peelapprox's "
                           f"kernels are cached in {str(root)!r} instead (point NUMBA_CACHE_DIR to a directory of yours "
                           "that only you can write)", KernelCacheWarning, stacklevel=5)
@@ -112,7 +114,7 @@ def root_problem() -> str | None:
 
 class PrivateLocator(_caching._SourceFileBackedLocatorMixin, _caching._CacheLocator):
     """numba's cache locator for a function of ``py_file``: its module's folder under :func:`kernel_root`, made and
-    checked by :func:`peelapprox._private.private_dir` (replaced when not private)."""
+    checked by :func:`peelapprox._compiled._private.private_dir` (replaced when not private)."""
 
     def __init__(self, py_func: Any, py_file: str, root: Path):
         self._py_file = py_file
@@ -159,7 +161,7 @@ class _PrivateImpl(_caching.CompileResultCacheImpl):
 
 
 class _PrivateIndexFile(_caching.IndexDataCacheFile):
-    """numba's index and data files, read only after :func:`peelapprox._private.open_private` accepted them (a
+    """numba's index and data files, read only after :func:`peelapprox._compiled._private.open_private` accepted them (a
     corrupt one is a miss), written 0600 by a new file renamed over the old."""
 
     def _accepted(self, path: str) -> bool:

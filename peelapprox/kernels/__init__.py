@@ -1,7 +1,8 @@
 """The one door through which the solvers of ``exact`` get the model's compiled pieces.
 
-Everything here is compiled by :func:`peelapprox._jit.kernel` from the one generated source
-(:mod:`peelapprox._generated`, written by :mod:`peelapprox._symbolic`), compiled once, and shared by every
+Everything here is compiled by :func:`peelapprox._compiled._jit.kernel` from the one generated source
+(:mod:`peelapprox._compiled._generated`, written by :mod:`peelapprox._compiled._symbolic`), compiled once, and shared by
+every
 driver: the peel force (fvV) in the velocity and in the ln v form, the law ABI by which a driver takes the
 peel-force law as a function argument with its coefficients as data (:mod:`peelapprox.law._abi`: ``LAW_SIG``,
 ``LAW_TYPE``, the forms ``LAW_*``, the compiled laws ``LAWS``; the tabulated law ``table_law`` and its packing
@@ -10,11 +11,11 @@ peel-force law as a function argument with its coefficients as data (:mod:`peela
 geometry switch, the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot), the regularised
 system XDAE and its Jacobian (also as whole fields of the state and a packed parameter vector, the form the
 stiff solvers call), and the model variants' fields (the tape mass, the constant load:
-:mod:`peelapprox._variant_fields`).  The model block every driver's parameter vector starts with
+:mod:`peelapprox.kernels._variant_fields`).  The model block every driver's parameter vector starts with
 (:mod:`peelapprox._packing`: the index constants ``M_*``, its length ``N_M``, :func:`model_block`), the DOP853 pieces
-(:mod:`peelapprox._dop853`), the kernel compiler and the status codes (:mod:`peelapprox._status`) are offered
+(:mod:`peelapprox._compiled._dop853`), the kernel compiler and the status codes (:mod:`peelapprox._status`) are offered
 here too, so ``exact`` needs no private module of ``peelapprox`` for its kernels.  The same system written in
-DiffSL and JIT-compiled by pydiffsol (optional, the ``bench`` extra; :mod:`peelapprox._diffsl`) is offered here
+DiffSL and JIT-compiled by pydiffsol (optional, the ``bench`` extra; :mod:`peelapprox.kernels._diffsl`) is offered here
 for the ε-variational Lyapunov exponent of ``exact`` and the peers of ``comparisons``.
 
 The model functions are ``inline="always"``: numba inlines them into the fields at the IR level (as separate
@@ -28,21 +29,8 @@ from typing import Any
 import numpy as np
 from numba import types as _nb
 
-from . import _status as status
-from ._cachestatus import cache_status, cpu_name, record_warmup
-from ._deadline import Expired as BuildExpired
-from ._deadline import caller_budget
-from ._diffsl import (
-    DIFFSL_INPUTS,
-    DIFFSL_TANGENT_INPUTS,
-    DIFFSOL_OPTIONS,
-    PeerUnavailableError,
-    diffsl_code,
-    diffsl_inputs,
-    diffsl_model,
-    import_optional,
-)
-from ._dop853 import (
+from .. import _status as status
+from .._compiled._dop853 import (
     MAX_REJECTIONS,
     N_STAGES,
     STEP_FAILED,
@@ -56,8 +44,8 @@ from ._dop853 import (
     state_at,
     workspace,
 )
-from ._jit import compile_only, kernel, rebind
-from ._model_jit import (
+from .._compiled._jit import compile_only, kernel, rebind
+from .._compiled._model_jit import (
     closure,
     closure_d2,
     closure_exact,
@@ -69,9 +57,10 @@ from ._model_jit import (
     regularized_rhs,
     slow_rates,
 )
-from ._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
-from ._variant_fields import VARIANT_MODELS, bound_variant_field, variant_field, variant_parameters
-from .front._field import (
+from .._deadline import Expired as BuildExpired
+from .._deadline import caller_budget
+from .._packing import M_A, M_B, M_GEOM, M_I, M_K, M_L, M_R, M_V, MODEL_FIELDS, N_M, model_block
+from ..front._field import (
     FQ_GAMMA,
     FQ_N,
     FQ_PERIODIC,
@@ -86,8 +75,8 @@ from .front._field import (
     front_rhs,
     front_state_size,
 )
-from .law import ALL_LAWS
-from .law._abi import (
+from ..law import ALL_LAWS
+from ..law._abi import (
     LAW_FP,
     LAW_FPP,
     LAW_LNV,
@@ -99,11 +88,23 @@ from .law._abi import (
     paper_coefficients,
     paper_law,
 )
-from .law._compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
-from .law._kernels import expression_kernel, family_kernel
-from .law._paper import _invert as branch_inverse_at
-from .law._paper import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
-from .law._table_jit import table_coefficients, table_law
+from ..law._compiled import U_ZERO, CompiledLaw, compiled_law, law_domain
+from ..law._kernels import expression_kernel, family_kernel
+from ..law._paper import _invert as branch_inverse_at
+from ..law._paper import peel_force_coefficients, peel_force_fp_jit, peel_force_fpp_jit, peel_force_lnv_jit
+from ..law._table_jit import table_coefficients, table_law
+from ._cachestatus import cache_status, cpu_name, record_warmup
+from ._diffsl import (
+    DIFFSL_INPUTS,
+    DIFFSL_TANGENT_INPUTS,
+    DIFFSOL_OPTIONS,
+    PeerUnavailableError,
+    diffsl_code,
+    diffsl_inputs,
+    diffsl_model,
+    import_optional,
+)
+from ._variant_fields import VARIANT_MODELS, bound_variant_field, variant_field, variant_parameters
 
 #: Index of ε in the regularised system's parameter vector, after the model block.
 Q_EPS = N_M

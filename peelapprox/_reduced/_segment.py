@@ -48,8 +48,8 @@ with ``N`` the numerator of the v equation; every ``1/f'`` cancels, so the
 field is smooth through the fold and the exit is the transversal event
 ``ln v = ln v_f``.  Closed-form α models are evaluated at the current t.
 
-The integrator is the package's one compiled DOP853 (:mod:`peelapprox._dop853`),
-driven by :mod:`peelapprox._segment_kernel` (the field, its parameter layout and
+The integrator is the package's one compiled DOP853 (:mod:`peelapprox._compiled._dop853`),
+driven by :mod:`peelapprox._reduced._segment_kernel` (the field, its parameter layout and
 the exit event), with scipy's tolerance semantics: a step is accepted when the RMS of
 ``err_i / (atol_i + rtol·|y_i|)`` is below 1 over ``y = (t, ln v, F, α, α̇)``.
 The default ``atol = rtol × (1 ms, 1, F_in, α_scale, Ω_in α_scale)`` with
@@ -65,21 +65,21 @@ from typing import Any, NamedTuple, cast
 
 import numpy as np
 
+from .._compiled._jit import wrapper_address as _wrapper_address
+from .._packing import model_block
+from .._params import PeelParams
+from .._ranges import TIME_MAX
+from .._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V_FLOOR, status_error
+from ..law import ALL_LAWS, BRANCHES, peel_force_derivative
+from ..law._abi import LAW_SIG, LAW_TYPE
+from ..law._compiled import CompiledLaw, compiled_law
+from ..validate import choice, duration, integer, optional, optional_finite, reals, times
+from ..validate import params as _params
+from ..validate import rtol as _rtol
+from ..validate import state as _state
 from . import _segment_kernel as K
 from ._alpha import _damping_time, _decay, _frozen_rate, _omega, _sinusoid, _wkb_match
-from ._jit import wrapper_address as _wrapper_address
-from ._packing import model_block
-from ._params import PeelParams
-from ._ranges import TIME_MAX
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
-from ._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V_FLOOR, status_error
-from .law import ALL_LAWS, BRANCHES, peel_force_derivative
-from .law._abi import LAW_SIG, LAW_TYPE
-from .law._compiled import CompiledLaw, compiled_law
-from .validate import choice, duration, integer, optional, optional_finite, reals, times
-from .validate import params as _params
-from .validate import rtol as _rtol
-from .validate import state as _state
 
 __all__ = ["ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "SegmentPlan", "SegmentRun", "reduced_segment",
            "run_segment", "segment_plan", "segment_status"]
@@ -432,7 +432,8 @@ class SegmentPlan:
 
 class SegmentRun(NamedTuple):
     """One run of the compiled driver (:func:`run_segment`): its status code, the final state
-    ``y = (t, ln v, F, α, α̇)`` (α, α̇ the state's: a closed form's are :func:`peelapprox._segment_kernel.alpha_at`
+    ``y = (t, ln v, F, α, α̇)`` (α, α̇ the state's: a closed form's are
+    :func:`peelapprox._reduced._segment_kernel.alpha_at`
     of ``y, q``), the stored rows and counters, the parameter vector and the entry α, α̇, atol, t_max used."""
 
     code: int

@@ -16,11 +16,13 @@ CD limit of Airy2      ``α̇ = -F α/(R f'(v))``, frozen f', F            :func
 =====================  =============================================  =========================
 
 The force on the branch is the paper's ``F = F_in + k(V - v) t`` with v frozen (``s = F_rate``, default ``k V``:
-the paper drops v on AB); the coupling to the peel velocity (approxvdot, fullvdot) is in :mod:`peelapprox._segment`.
+the paper drops v on AB); the coupling to the peel velocity (approxvdot, fullvdot) is in
+:mod:`peelapprox._reduced._segment`.
 Units: t [s], α [rad], α̇ [rad/s], F [N], R [m], I [kg m²], k [N/m], v, V [m/s].
 
 Each formula is written once, below, as a function of scalars that works on numpy arrays and inside numba
-(:func:`peelapprox._jit.jitable`), called by the public functions here and by the compiled segment solver alike.
+(:func:`peelapprox._compiled._jit.jitable`), called by the public functions here and by the compiled segment solver
+alike.
 Two caveats, measured: numpy's vectorised ``exp`` and the compiled libm ``exp`` differ in the last bit for ~5 %
 of arguments (``_decay`` agrees to 1 ulp, not bitwise); and the segment solver multiplies Airy1/Airy2's damping
 ``(Ḟ + F α̇)/(R f')`` by ``dt/ds = v f'`` with ``f'`` cancelled (it integrates through the fold, ``f' = 0``): the
@@ -35,14 +37,14 @@ from typing import NamedTuple
 import numpy as np
 from scipy import integrate, special
 
-from ._jit import jitable
-from ._params import PeelParams
-from ._ranges import TIME_MAX
-from .errors import SolverFailure
-from .law import branch_structure
-from .validate import choice, in_range, optional, state, states, times
-from .validate import finite as _finite
-from .validate import params as _params
+from .._compiled._jit import jitable
+from .._params import PeelParams
+from .._ranges import TIME_MAX
+from ..errors import SolverFailure
+from ..law import branch_structure
+from ..validate import choice, in_range, optional, state, states, times
+from ..validate import finite as _finite
+from ..validate import params as _params
 
 __all__ = [
     "inertial_frequency",

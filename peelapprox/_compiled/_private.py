@@ -26,7 +26,7 @@ import uuid
 import warnings
 from pathlib import Path
 
-from .errors import KernelCacheWarning
+from ..errors import KernelCacheWarning
 
 __all__ = ["cache_home", "chain_problem", "dir_problem", "file_problem", "open_private", "private_dir"]
 

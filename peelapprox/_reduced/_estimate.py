@@ -20,13 +20,13 @@ from typing import Any
 import numpy as np
 from scipy import integrate
 
+from .._observables import StickSlipObservables
+from .._params import PeelParams
+from ..law import BranchStructure, FixedPoint, fixed_point
+from ..validate import choice, flag, function, in_range, nonnegative, optional, state
 from ._alpha import inertial_frequency, law_fprime
-from ._observables import StickSlipObservables
-from ._params import PeelParams
 from ._regime import INERTIA_RULE, VELOCITY_RULE, _checked, _labels, _law_structure, regime
 from ._validity import validity_text
-from .law import BranchStructure, FixedPoint, fixed_point
-from .validate import choice, flag, function, in_range, nonnegative, optional, state
 
 __all__ = [
     "crude_branch_time",
@@ -234,7 +234,8 @@ class RegimeEstimate:
     def validity(self) -> dict[str, str]:
         """``{"slip_interval": ..., "force_drop": ...}``: how often :meth:`attractor`'s prediction of each was
         within 10 % of the exact attractor's, measured over the stick-slip points of this regime label
-        (:mod:`peelapprox._validity`: the 40 x 40 benchmark of ``comparisons.benchmark.approx_attractor``), e.g.
+        (:mod:`peelapprox._reduced._validity`: the 40 x 40 benchmark of ``comparisons.benchmark.approx_attractor``),
+        e.g.
         "within 10 % of the exact attractor on 77 % of the 283 'low inertia, low V' points measured (...)"."""
         return validity_text(self.label)
 

@@ -1,6 +1,6 @@
 """The reduced return map on the exact model's section, its periodic orbits by Newton and their multipliers.
 
-The map (:func:`peelapprox.approximate_attractor`, module docstring of :mod:`peelapprox._approximate`) chains a
+The map (:func:`peelapprox.approximate_attractor`, module docstring of :mod:`peelapprox._reduced._approximate`) chains a
 reduced AB segment to the fold ``v_max``, the AB→CD jump, a reduced CD segment to ``v_min`` and the CD→AB jump.
 Here its state is the section of the exact model: the point on AB just before the AB→CD jump, where CONSTR,
 ``F (1 - c(α)) = f_max`` (``1 - c = 1 + sin α`` for the paper's geometry), ties F to α, so the map is a map of
@@ -26,12 +26,12 @@ from typing import Any
 
 import numpy as np
 
+from .._params import PeelParams
+from .._status import DONE
 from . import _reducedmap_kernel as RK
 from . import _segment_kernel as K
-from ._params import PeelParams
 from ._segment import SegmentPlan, SegmentRun, run_segment, segment_plan
 from ._segment_kernel import AM_EXP, AM_HARM, AM_SIN, AM_STATIC, alpha_at
-from ._status import DONE
 
 __all__: list[str] = []
 
@@ -86,7 +86,7 @@ class ReturnMap:
         # run_segment's default horizon, its entry-independent part: 20 quasi-static passages of the fold gap
         self.horizon = 20.0 * (self.fold[0] - self.fold[1]) / (params.k * params.V)
         self.compiled = self.paper and not any(pl.alpha_model in _CLOSED for pl in self.plans)
-        if self.compiled:  # the branch rows of the compiled returns (peelapprox._reducedmap_kernel)
+        if self.compiled:  # the branch rows of the compiled returns (peelapprox._reduced._reducedmap_kernel)
             self.rows = np.array([[pl.v_in, pl.fp_in, pl.F_rate, pl.x_f, pl.x_lo, pl.x_hi,
                                    -1.0 if pl.t_max is None else pl.t_max, pl.max_steps, fold, kick, up]
                                   for pl, fold, kick, up in ((self.plans[0], self.fold[1], self.kick[1], 1.0),
@@ -138,7 +138,8 @@ class ReturnMap:
         return float(y[0]), float(y[3]), float(y[4])
 
     def lean(self, plan: SegmentPlan, F: float, a: float, ad: float) -> np.ndarray:
-        """:func:`peelapprox._segment.run_segment`'s arithmetic for an integrated α model (no closed form), without
+        """:func:`peelapprox._reduced._segment.run_segment`'s arithmetic for an integrated α model (no closed form),
+        without
         its per-call set-up: the same parameter vector, atol, horizon and driver call, so the same numbers bitwise;
         the final state ``(t, ln v, F, α, α̇)``."""
         p = self.params
@@ -161,7 +162,8 @@ class ReturnMap:
 
     def run(self, x: np.ndarray, n: int) -> tuple[np.ndarray, list[tuple[float, ...]]]:
         """``n`` returns from ``x``: the last section point and the returns' records (:meth:`ret`'s), compiled
-        where the chain allows (:mod:`peelapprox._reducedmap_kernel`: the same numbers), else by :meth:`ret`."""
+        where the chain allows (:mod:`peelapprox._reduced._reducedmap_kernel`: the same numbers), else by
+        :meth:`ret`."""
         if not self.compiled:
             recs = []
             for _ in range(n):

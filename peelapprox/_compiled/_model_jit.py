@@ -1,9 +1,9 @@
 """The model's compiled pieces, inlined into every field that uses them: the ``cos θ`` closures (with the
 geometry switch and the second derivative), the slow rates (FLOW1, FLOW2, flow3), the constraint rate (Eq. vdot)
-and the regularised system XDAE with its Jacobian, each compiled from :mod:`peelapprox._generated`.
+and the regularised system XDAE with its Jacobian, each compiled from :mod:`peelapprox._compiled._generated`.
 
 One place for them: :mod:`peelapprox.kernels` offers them to ``exact``, and the model variants' fields
-(:mod:`peelapprox._variant_fields`) inline the same kernels.
+(:mod:`peelapprox.kernels._variant_fields`) inline the same kernels.
 """
 
 from __future__ import annotations

@@ -15,8 +15,8 @@ The confidence rules (:func:`confidence`), each measured (docs/theory.md, "The a
   explain);
 * the exact model breaks down where the default chain does not: the full branch dynamics linearised in α
   (genalpha + fullvdot on both branches) run from the solver's start reaches ``F (1 + sin α) = f(0+, V)`` on AB
-  (v → 0, CONSTR without a root) within :data:`peelapprox._approximate.PROBE_RETURNS` returns;
-* its regime's measured validity (:data:`peelapprox._validity.VALIDITY`) below :data:`VALIDITY_FLOOR`.
+  (v → 0, CONSTR without a root) within :data:`peelapprox._reduced._approximate.PROBE_RETURNS` returns;
+* its regime's measured validity (:data:`peelapprox._reduced._validity.VALIDITY`) below :data:`VALIDITY_FLOOR`.
 """
 
 from __future__ import annotations
@@ -26,9 +26,9 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from ._observables import StickSlipObservables
+from .._observables import StickSlipObservables
+from ..io import fmt_number, jsonable
 from ._validity import VALIDITY
-from .io import fmt_number, jsonable
 
 __all__ = ["ALPHA_LINEAR", "ApproximateAttractor", "ApproximationWarning", "CONFIDENCES",
            "MULTIPLIER_ERROR", "VALIDITY_FLOOR"]
@@ -47,7 +47,7 @@ MULTIPLIER_ERROR = 0.07
 #: where the exact attractor stays in 228-356 N (V = 3.1-3.4 m/s, I = 0.04-0.06), reach 0.85-1.0 rad.
 ALPHA_LINEAR = 0.6
 #: A regime whose measured share of predictions within 10 % is below this is low confidence (of
-#: :data:`peelapprox._validity.VALIDITY`, only 'high inertia, high V', 47 %).
+#: :data:`peelapprox._reduced._validity.VALIDITY`, only 'high inertia, high V', 47 %).
 VALIDITY_FLOOR = 0.5
 
 

@@ -2,14 +2,14 @@
 
 Both compiled solvers of the package use this module: the hybrid (ε → 0) DAE
 solver (``exact._hybrid``) and the reduced branch-wise equations
-(``peelapprox._segment_kernel``).  Each of them owns its *driver* (what happens at
+(``peelapprox._reduced._segment_kernel``).  Each of them owns its *driver* (what happens at
 events, jumps and output), never the step itself.
 
 Method
 ------
 Dormand–Prince 8(5,3) with its 7th-order dense output (Hairer, Nørsett &
 Wanner, *Solving ODEs I*, II.10), using the package's copy of scipy's coefficient
-tables (:mod:`peelapprox._dop853_tableau`, with its provenance and licence) and scipy's step-size
+tables (:mod:`peelapprox._compiled._dop853_tableau`, with its provenance and licence) and scipy's step-size
 controller (safety 0.9, factors in [0.2, 10], error exponent -1/8, no growth
 right after a rejection).  Tolerance semantics are scipy's: a step is accepted
 when the RMS over components of ``err_i / (atol_i + rtol·max(|y_i|, |y_new_i|))``
@@ -23,7 +23,7 @@ returns them as a :class:`Dop853` module object.  The field is bound as a
 closure variable, not passed as an argument, so that it is inlined into the
 stages (through a first-class function argument it is an indirect call LLVM
 cannot inline: ``docs/performance.md``).  Every piece here, bound or not, is
-a ``kernel(inner=True)`` helper (:func:`peelapprox._jit.kernel`): compiled
+a ``kernel(inner=True)`` helper (:func:`peelapprox._compiled._jit.kernel`): compiled
 into the driver that calls it, without Python wrappers or cache files of its
 own, and cached inside that driver, whose cache index carries a hash of all
 kernel sources, so a changed field, tableau or ``_generated.py`` is always

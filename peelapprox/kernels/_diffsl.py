@@ -1,5 +1,5 @@
 """The ε-regularised system (XDAE) written in DiffSL, the model language of diffsol, printed from the symbolic
-source :mod:`peelapprox._symbolic` (no second copy of the formulas), and JIT-compiled by pydiffsol.
+source :mod:`peelapprox._compiled._symbolic` (no second copy of the formulas), and JIT-compiled by pydiffsol.
 
 The state is ``X = (α, ω, F, v)`` of ``M Ẋ = φ(X)``, ``M = diag(1, 1, 1, ε)``, with φ = (FLOW1, FLOW2,
 flow3, ``F (1 - cos θ) - f(v, V)``) and the peel force f of Eq. (fvV); ``tangent=True`` adds the
@@ -20,12 +20,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._ranges import GEOMETRIES
-from .io import optional_import
-from .law import PeelForce, branch_structure
+from .._ranges import GEOMETRIES
+from ..io import optional_import
+from ..law import PeelForce, branch_structure
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ._params import PeelParams
+    from .._params import PeelParams
 
 __all__ = ["DIFFSL_INPUTS", "DIFFSL_TANGENT_INPUTS", "DIFFSOL_OPTIONS", "PeerUnavailableError", "diffsl_code",
            "diffsl_inputs", "diffsl_model", "import_optional"]
@@ -62,15 +62,15 @@ DIFFSL_TANGENT_INPUTS = ("d0a", "d0w", "d0F", "d0v", "ta", "tw", "tF", "tv")
 
 
 def _law_expression(force):
-    """f(v, V) of the law ``force`` (None or the paper's: fvV) in the symbols of :mod:`peelapprox._symbolic`.
+    """f(v, V) of the law ``force`` (None or the paper's: fvV) in the symbols of :mod:`peelapprox._compiled._symbolic`.
 
     Raises
     ------
     ValueError
         For a tabulated law (no closed form to write in DiffSL), naming ``params.force``.
     """
-    from . import _symbolic as S
-    from .law import _symbolic as L
+    from .._compiled import _symbolic as S
+    from ..law import _symbolic as L
 
     try:
         e = L.law_expression(force or PeelForce.paper())
@@ -83,13 +83,13 @@ def _law_expression(force):
 
 def _diffsl_expressions(geometry: str, force=None) -> dict:
     """DiffSL (C-syntax) expressions of c(α), φ_α, φ_ω, φ_F and φ_v, printed from the one symbolic source
-    :mod:`peelapprox._symbolic` (``cos_theta_expr``, ``equations_of_motion``; fvV inside CONSTR, or the law
+    :mod:`peelapprox._compiled._symbolic` (``cos_theta_expr``, ``equations_of_motion``; fvV inside CONSTR, or the law
     ``force`` in its place, :mod:`peelapprox.law._symbolic`), so the peer integrates the same model as every other
     solver without a second copy of the formulas.  The pull force is named ``Fp`` in DiffSL (``F_i`` is
     DiffSL's right-hand side)."""
     import sympy as sp
 
-    from . import _symbolic as S
+    from .._compiled import _symbolic as S
 
     Fp = sp.Symbol("Fp", real=True)
     alpha_dot, omega_dot, F_dot, constraint = S.equations_of_motion(S.c_)
@@ -124,7 +124,7 @@ def diffsl_code(geometry: str = "paper", *, tangent: bool = False, force=None) -
     ``M δẊ = (∂φ/∂X)(X) δX``, in four more states ``z = δX / t`` with scales
     ``t = (ta, tw, tF, tv)`` and initial value ``(d0a, d0w, d0F, d0v)``
     (inputs :data:`DIFFSL_TANGENT_INPUTS`, after :data:`DIFFSL_INPUTS`).  ∂φ/∂X is
-    the Jacobian of :func:`peelapprox._symbolic.regularized_system`, printed with the
+    the Jacobian of :func:`peelapprox._compiled._symbolic.regularized_system`, printed with the
     closure's ``dc/dα`` and ``f' = ∂f/∂v`` of fvV.
 
     Parameters
