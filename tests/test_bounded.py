@@ -91,7 +91,7 @@ _S0 = State(t=0.0, alpha=0.0, omega=0.0, F=250.0, v=1.0, branch="AB")
     (dict(t=math.nan), r"start\.t must be finite and in \[0, 1e6\], got nan"),
     (dict(v=math.nan), r"start\.v must be finite and in \(1e-150, 1000\], got nan"),
     (dict(v=-1.0), r"start\.v must be finite and in \(1e-150, 1000\], got -1.0"),
-    (dict(Vp=1.0), r"start\.Vp must be None under velocity control"),
+    (dict(Vp=1.0), r"start\.Vp must be None for the massless tape under velocity control"),
     (dict(alpha=4.0), r"start\.alpha must be finite and in \[-3\.14159, 3\.14159\], got 4.0"),
     (dict(branch="XY"), r"start\.branch must be one of \('AB', 'CD'\)"),
 ])

@@ -105,7 +105,7 @@ def test_help_lists_what_a_subcommand_can_do():
     --help every Lyapunov method of exact.lyapunov; segment and compare --help every alpha model and v equation;
     bifurcation --help the parameters it continues in (exact string checks)."""
     from comparisons.sweep import MEASURES
-    from exact.dynamics._lyapunov_options import METHODS as LYAPUNOV_METHODS
+    from exact.dynamics._lyapunov_options import LYAPUNOV_METHODS
     from peelapprox import ALPHA_MODELS, V_EQUATIONS
 
     text = " ".join(SUB["sweep"].format_help().split())
