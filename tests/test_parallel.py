@@ -191,10 +191,28 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _lines(proc, expected, timeout):
+    """Read ``proc``'s stdout lines until ``expected`` were all seen, within ``timeout`` s (a failure, not a hang,
+    if they never come)."""
+    import selectors
+
+    sel = selectors.DefaultSelector()
+    sel.register(proc.stdout, selectors.EVENT_READ)
+    left, t0 = list(expected), time.monotonic()
+    while left:
+        assert time.monotonic() - t0 < timeout, f"still waiting for {left} from the script"
+        if sel.select(timeout=1.0):
+            line = proc.stdout.readline().strip()
+            assert line, "the script closed its stdout"
+            if line in left:
+                left.remove(line)
+
+
 def test_keyboard_interrupt_stops_workers(tmp_path):
     """Hypothesis: Ctrl-C (SIGINT to the process) during a process-pool map ends the script with
     KeyboardInterrupt and kills its workers, which were running 60 s tasks.  Bound: 60 s for the script to exit
-    and its workers to go (a hang, or workers finishing their tasks, would take longer)."""
+    and its workers to go (a hang, or workers finishing their tasks, would take longer).  The interrupt is sent
+    once both workers print that their task began (a fixed 1 s wait let a loaded machine send it earlier)."""
     if not os.path.exists(f"/proc/{os.getpid()}/task/{os.getpid()}/children"):
         pytest.skip("needs Linux's /proc/<pid>/task/<pid>/children")
     script = tmp_path / "interrupt.py"
@@ -203,6 +221,7 @@ def test_keyboard_interrupt_stops_workers(tmp_path):
         sys.path.insert(0, {ROOT!r})
         from peelapprox.parallel import map_points
         def nap(x):
+            print("napping", flush=True)
             time.sleep(60)
             return x
         def started(x):
@@ -215,7 +234,7 @@ def test_keyboard_interrupt_stops_workers(tmp_path):
                             text=True, start_new_session=True)
     try:
         assert proc.stdout.readline().strip() == "ready"
-        time.sleep(1.0)
+        _lines(proc, ["napping", "napping"], 60.0)  # both workers inside a task: the interrupt meets a running map
         workers = _children(proc.pid)
         assert workers
         proc.send_signal(signal.SIGINT)
