@@ -213,10 +213,9 @@ def test_keyboard_interrupt_stops_workers(tmp_path):
     KeyboardInterrupt and kills its workers, which were running 60 s tasks.  Bound: 60 s for the script to exit
     and its workers to go (a hang, or workers finishing their tasks, would take longer).  The interrupt is sent
     once both workers print that their task began (a fixed 1 s wait let a loaded machine send it earlier).  The
-    script puts Python's own SIGINT handler back first: a process started from one that ignores SIGINT inherits
-    the ignoring, and in the full default tier something before this test leaves the test process so (the test
-    timed out twice there with the workers' third task started, and fails the same way alone under a parent
-    that ignores SIGINT)."""
+    script puts Python's own SIGINT handler back first: a process inherits an ignored SIGINT, and bash ignores
+    it in every command it runs in the background without job control (`bash -c 'cmd &'`): a test suite run
+    so timed out here twice, the workers' third task started, and fails the same way alone under such a parent."""
     if not os.path.exists(f"/proc/{os.getpid()}/task/{os.getpid()}/children"):
         pytest.skip("needs Linux's /proc/<pid>/task/<pid>/children")
     script = tmp_path / "interrupt.py"
