@@ -51,25 +51,15 @@ def _env() -> dict[str, str]:
 #: as ``python NAME.py --out DIR`` would (``__main__``, its own argv, the gallery's directory on the path, a
 #: fresh namespace), and writes their exit statuses, stdout and stderr as JSON to argv[1].
 _DRIVER = """
-import contextlib, io, json, os, runpy, sys, traceback
+import json, os, sys
+sys.path.insert(0, os.path.join(os.environ["PYTHONPATH"].split(os.pathsep)[0], "tests"))
+from _run_script import run_script
 path, jobs, examples, results = sys.argv[1], json.loads(sys.argv[2]), sys.argv[3], {}
 sys.path.insert(0, examples)
 for name, out in jobs:
-    script = os.path.join(examples, name + ".py")
-    sys.argv = [script, "--out", out]
-    stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-        try:
-            runpy.run_path(script, run_name="__main__")
-            status = 0
-        except SystemExit as exc:
-            status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-        except BaseException:
-            traceback.print_exc()
-            status = 1
+    results[name] = list(run_script(os.path.join(examples, name + ".py"), ["--out", out]))
     if "matplotlib.pyplot" in sys.modules:
         sys.modules["matplotlib.pyplot"].close("all")
-    results[name] = [status, stdout.getvalue(), stderr.getvalue()]
 with open(path, "w") as f:
     json.dump(results, f)
 """

@@ -96,22 +96,14 @@ with open(sys.argv[1], "w") as f:
 # this process, each as ``python FILE`` would (``__main__``, a fresh namespace, in its own directory), and
 # writes their exit statuses and stderr's tail as JSON to argv[1].
 _BLOCKS = """
-import contextlib, io, json, os, runpy, sys, traceback
+import json, os, sys
+sys.path.insert(0, os.path.join(os.environ["PYTHONPATH"].split(os.pathsep)[0], "tests"))
+from _run_script import run_script
 results, path, jobs = {}, sys.argv[1], json.loads(sys.argv[2])
 for script, cwd in jobs:
     os.chdir(cwd)
-    sys.argv = [script]
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            runpy.run_path(script, run_name="__main__")
-            status = 0
-        except SystemExit as exc:
-            status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-        except BaseException:
-            traceback.print_exc()
-            status = 1
-    results[script] = [status, err.getvalue()[-3000:]]
+    status, _, err = run_script(script, [])
+    results[script] = [status, err[-3000:]]
 with open(path, "w") as f:
     json.dump(results, f)
 """
