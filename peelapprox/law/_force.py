@@ -19,37 +19,16 @@ from .._checks import in_range, shown
 from .._ranges import PARAM_RANGES
 from . import _expression, _families
 from ._folds import BranchStructure
+from ._force_checks import _check_field_types, _check_nesting
 from ._kinds import FOLD_GRID_DENSITY, KIND_IMPLS, LawKind, shown_law
 
 __all__ = ["ALL_LAWS", "FOLD_GRID_DENSITY", "KINDS", "PeelForce", "law_label", "require_law", "shown_law"]
-
-#: The deepest nesting of lists (or tuples, mappings) in a field of :meth:`PeelForce.from_dict`'s mapping: a law's
-#: fields nest at most 3 deep (tables: a list of (V, v, f) triples of lists).
-MAX_NESTING = 8
 
 #: The kinds of law.
 KINDS = tuple(KIND_IMPLS)
 #: Every law by its :func:`law_label`: what a consumer that honours any law passes as ``laws``.
 ALL_LAWS = ("paper", *(f.constructor for f in _families.FAMILIES.values()), "expression", "tabulated",
             "smoothed")
-
-
-def _check_field_types(force: Any) -> None:
-    """TypeError naming the field whose type is wrong (a list as a family's name, coefficients as a flat list),
-    before any kind uses it; coefficients given as a mapping or as JSON's ``[name, value]`` lists become pairs."""
-    for field in ("kind", "name", "source"):
-        value = getattr(force, field)
-        if not (isinstance(value, str) or (value is None and field != "kind")):
-            raise TypeError(f"{field} must be a string{'' if field == 'kind' else ' or None'}, got "
-                            f"{type(value).__name__} {shown(value)}")
-    coefs = force.coefficients
-    if isinstance(coefs, Mapping):
-        coefs = tuple(coefs.items())
-    if (isinstance(coefs, (str, bytes)) or not isinstance(coefs, (tuple, list))
-            or not all(isinstance(p, (tuple, list)) and len(p) == 2 and isinstance(p[0], str) for p in coefs)):
-        raise TypeError(f"coefficients must be (name, value) pairs or a mapping of name to value, got "
-                        f"{shown(force.coefficients)}")
-    object.__setattr__(force, "coefficients", tuple(tuple(p) for p in coefs))
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -352,8 +331,8 @@ class PeelForce:
     def from_dict(cls, d: Mapping[str, Any]) -> PeelForce:
         """The law ``dataclasses.asdict(law)`` (or its JSON) describes; validated.
 
-        A field nested deeper than :data:`MAX_NESTING` (lists in lists) is a TypeError naming it (a coefficient
-        list nested 100,000 deep raised RecursionError)."""
+        A field nested deeper than :data:`~peelapprox.law._force_checks.MAX_NESTING` (lists in lists) is a
+        TypeError naming it (a coefficient list nested 100,000 deep raised RecursionError)."""
         if not isinstance(d, Mapping):
             raise TypeError(f"d must be a mapping of the law's fields (dataclasses.asdict(law) or its JSON), got "
                             f"{type(d).__name__}")
@@ -505,21 +484,3 @@ def require_law(params: Any, where: str | None = None, laws: tuple[str, ...] = A
         return
     raise ValueError(f"params.force: {where or 'this function'} runs the laws {', '.join(repr(x) for x in laws)} "
                      f"only, not {shown_law(force)}")
-
-
-def _check_nesting(name: str, value: Any) -> None:
-    """TypeError if ``value`` nests lists, tuples or mappings deeper than :data:`MAX_NESTING` (an iterative walk:
-    no recursion to exhaust)."""
-    stack = [(value, 0)]
-    while stack:
-        x, depth = stack.pop()
-        if isinstance(x, Mapping):
-            children: Any = x.values()
-        elif isinstance(x, (list, tuple)):
-            children = x
-        else:
-            continue
-        if depth >= MAX_NESTING:
-            raise TypeError(f"{name} is nested more than MAX_NESTING = {MAX_NESTING} deep (lists in lists): a law's "
-                            "fields nest at most 3 deep (tables: a list of (V, v, f) triples of lists)")
-        stack.extend((c, depth + 1) for c in children)
