@@ -108,10 +108,18 @@ def simulate(params: PeelParams, t_end: float, *, alpha0: float = 0.0, omega0: f
     out, lim = output_options(opts, t_end, saveat, budget, save=save, t_eval=t_eval, t_transient=t_transient,
                               max_points=max_points, max_steps=max_steps, max_jumps=max_jumps, max_wall=max_wall)
     report = _progress_option(progress, f"simulate V={params.V} I={params.I}")
+    start = dict(alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0, Vp0=Vp0)
+    return _start_and_run(mod, opts, params, t_end, start, out, lim, report)
+
+
+def _start_and_run(mod: Model, opts: Method, params: PeelParams, t_end: float, start: dict[str, Any], out: SaveAt,
+                   lim: Budget, report: Callable[[float, float], None] | None) -> Trajectory:
+    """``simulate``'s consistent start (``start``: its initial-state keywords) and the run of ``opts`` from it, both
+    within ``max_wall``; a peel-force law whose compile outlasts it is :func:`_compile_expired`'s budget error."""
     st0 = None
     try:
         with caller_budget(lim.max_wall):  # an expression law compiled for this run is bounded by max_wall too
-            st0 = mod.initial_state(params, alpha0=alpha0, omega0=omega0, F0=F0, branch0=branch0, Vp0=Vp0)
+            st0 = mod.initial_state(params, **start)
             return opts.run(mod, params, t_end, st0, out, lim, report)
     except BuildExpired:
         raise _compile_expired(params, lim, st0) from None
