@@ -87,32 +87,25 @@ from typing import Any
 import numpy as np
 
 from peelapprox.kernels import (
-    M_A,
-    M_B,
-    M_GEOM,
-    M_I,
-    M_K,
-    M_L,
-    M_R,
-    M_V,
     MAX_REJECTIONS,
     N_M,
     STEP_FAILED,
-    closure,
-    constraint_rate,
     crossing,
     interp,
     interp1,
     kernel,
-    peel_force_fp_jit,
-    peel_force_lnv_jit,
-    slow_rates,
     solve_theta,
     state_at,
     workspace,
 )
 from peelapprox.kernels import N_STAGES as _NS
 from peelapprox.kernels import status as _st
+
+# the field, in its own module, is read through this one too (exact._hybrid_driver, exact._tangent, tests)
+from ._hybrid_field import _closure
+from ._hybrid_field import _field as _field
+from ._hybrid_field import _rhs as _rhs
+from ._hybrid_field import pull_force as pull_force
 
 DONE, OUT_FULL, JUMPS_FULL, PAUSE, STEP_FAIL = _st.DONE, _st.OUT_FULL, _st.JUMPS_FULL, _st.PAUSE, _st.STEP_FAIL
 NO_ROOT, NO_LANDING, GEOMETRY, V_CEILING = _st.NO_ROOT, _st.NO_LANDING, _st.GEOMETRY, _st.V_CEILING
@@ -139,48 +132,6 @@ N_J = 8
 FOLD_REL = 1e-9
 # save modes
 SAVE_STEPS, SAVE_TEVAL, SAVE_NONE = 0, 1, 2
-
-
-@kernel(inline="always")
-def _closure(alpha, p):
-    return closure(alpha, p[M_GEOM], p[M_R], p[M_L])
-
-
-@kernel
-def pull_force(alpha, v, p):
-    """F = f(v, V) / (1 + c(α))  (CONSTR solved for F), the paper's law inlined (fvV, ``p[M_B], p[M_A]``)."""
-    f, _ = peel_force_fp_jit(v, p[M_B], p[M_A])
-    c, _ = _closure(alpha, p)
-    return f / (1.0 + c)
-
-
-@kernel(inline="always")
-def _field(y, p, v, f, g, out):
-    """The field at ``y`` given ``v = e^u``, ``f(v)`` and ``g = v f'(v)`` (whichever law gave them)."""
-    if not (v > 0.0):  # trial stage left the model's domain (v underflowed): poison the step
-        for i in range(4):
-            out[i] = np.nan
-        return
-    c, dc = _closure(y[1], p)
-    if not (1.0 + c > 0.0):  # the peel geometry degenerates (alpha -> -pi/2): outside the domain as well
-        for i in range(4):
-            out[i] = np.nan
-        return
-    F = f / (1.0 + c)
-    ad, wd, Fd = slow_rates(y[1], y[2], F, v, c, p[M_V], p[M_I], p[M_K], p[M_R])
-    (Gd,) = constraint_rate(F, Fd, c, dc, ad)
-    out[0] = g
-    out[1] = g * ad
-    out[2] = g * wd
-    out[3] = Gd  # d(ln v)/ds = (dv/ds)/v = Ġ
-
-
-@kernel
-def _rhs(y, p, out):
-    """Desingularised vector field d(τ, α, ω, u)/ds, u = ln v, dt/ds = v f'(v) (module docstring), the paper's law
-    inlined: the field of the saltation tangent (``exact._tangent``) and of ``exact.hybrid_field``."""
-    v, f, g = peel_force_lnv_jit(y[3], p[M_B], p[M_A])  # g = v f'(v) = df/d(ln v) = dt/ds
-    _field(y, p, v, f, g, out)
 
 
 @kernel(inner=True)

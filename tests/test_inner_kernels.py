@@ -41,11 +41,11 @@ def test_dop853_pieces_are_a_module_of_plain_functions():
     """Hypothesis: ``make_dop853`` returns a :class:`~peelapprox._compiled._dop853.Dop853` module whose four pieces are
     plain
     functions named after the field (the names a cold run's compile listing shows)."""
-    from exact._hybrid import _rhs
+    from exact._hybrid_field import _rhs
 
     d = D.make_dop853(_rhs)
     assert isinstance(d, D.Dop853)
     for piece in ("initial_step", "step", "dense", "ensure_dense"):
         fn = getattr(d, piece)
         assert not hasattr(fn, "signatures")
-        assert fn.__name__ == f"{piece}__exact__hybrid__rhs"
+        assert fn.__name__ == f"{piece}__exact__hybrid_field__rhs"

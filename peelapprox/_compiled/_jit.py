@@ -79,6 +79,7 @@ KERNEL_SOURCES: tuple[str, ...] = (
     "peelapprox/_status.py",  # the status codes, frozen into the kernels
     "peelapprox/kernels/__init__.py",
     "exact/_hybrid.py",
+    "exact/_hybrid_field.py",  # its field and pull force
     "exact/_hybrid_driver.py",
     "exact/_jacobian.py",
     "exact/_regularized.py",
