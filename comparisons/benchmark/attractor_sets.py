@@ -24,7 +24,9 @@ import numpy as np
 
 import exact
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded
-from peelapprox.io import fmt_number, write_rows
+from peelapprox.io import fmt_number
+
+from ._rows import add_row_files, write_row_files
 
 __all__ = ["points", "measure", "main"]
 
@@ -63,8 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--points", type=int, default=12, help="random points (12)")
     ap.add_argument("--seed", type=int, default=35, help="the points' seed (35)")
     ap.add_argument("--workers", type=int, default=2, help="attractor_set's threads (2)")
-    ap.add_argument("--json", help="write the rows as JSON (a path ending in .json)")
-    ap.add_argument("--csv", help="write the rows as CSV (a path ending in .csv)")
+    add_row_files(ap)
     a = ap.parse_args(argv)
     if a.points < 1 or a.workers < 0:
         ap.error("--points must be >= 1 and --workers >= 0")
@@ -83,9 +84,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{fmt_number(statistics.median(ratios), 3)}"
           f" (max {fmt_number(max(ratios), 3)}); median times: attractor_observables {fmt_number(med_obs, 3)} s, "
           f"attractor_set {fmt_number(med_set, 3)} s, their ratio {fmt_number(med_set / med_obs, 3)}")
-    for path in (a.json, a.csv):
-        if path:
-            write_rows(path, rows)
+    write_row_files(a, rows)
     return 0
 
 

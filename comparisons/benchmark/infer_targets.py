@@ -41,7 +41,9 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox.io import fmt_number, write_rows
+from peelapprox.io import fmt_number
+
+from ._rows import add_row_files, write_row_files
 
 __all__ = ["CLASSES", "LOW_INERTIA", "classify", "draw", "main", "run_trace", "summarise"]
 
@@ -169,8 +171,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--attractors", type=int, default=1, help="infer's attractors= (1)")
     ap.add_argument("--replicates", type=int, default=1, help="infer's replicates= (1)")
     ap.add_argument("--jobs", type=int, default=1, help="traces at once, in processes (1)")
-    ap.add_argument("--json", help="write the rows as JSON (a path ending in .json)")
-    ap.add_argument("--csv", help="write the rows as CSV (a path ending in .csv)")
+    add_row_files(ap)
     a = ap.parse_args(argv)
     if (a.traces < 1 or a.jobs < 1 or not 1 <= a.attractors <= 8 or not 1 <= a.replicates <= 8
             or not 0.5 <= a.seconds <= 200 or a.max_wall <= 0):
@@ -194,9 +195,7 @@ def main(argv: list[str] | None = None) -> int:
           f"replicates={a.replicates}, "
           f"max_wall {a.max_wall:g} s; {fmt_number(time.perf_counter() - t0, 3)} s in all")
     print(summarise(rows))
-    for path in (a.json, a.csv):
-        if path:
-            write_rows(path, rows)
+    write_row_files(a, rows)
     return 0
 
 
