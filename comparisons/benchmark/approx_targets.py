@@ -29,8 +29,12 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
   escape, at most 300 s) and the exact orbit of that period (:func:`exact.periodic_orbit` seeded by the run): the
   exact escape return is the first AB→CD jump after the run's closest approach to the orbit's return-map values
   whose force deviates from them by more than the orbit's force drop (``ESCAPE_FRACTION``, as the map's), the
-  predicted one the map's ``escape_returns``; beside it the same law with the exact orbit's |μ| (what is left of
-  a miss with the exact multiplier).
+  predicted one the map's ``escape_returns``; beside it the map's own |μ|, the escape law's (the full chain's
+  where the map's is within 0.02 of 1, ``escape_multiplier``), the exact orbit's, and the same law with the exact
+  orbit's |μ| (what is left of a miss with the exact multiplier).  The points are those where the map's own |μ| - 1
+  is in [1e-4, 1e-2] (the exact orbits' are there too at every point measured).  ``--escape-cache FILE`` keeps the
+  exact side (escape return, |μ|, returns run, the run's length) per point and period in a JSON file, read where it
+  holds the point (run again where it found no escape in a shorter run than now asked), written after each new one.
 """
 
 from __future__ import annotations
@@ -192,9 +196,11 @@ def multiplier_errors(ref: list[dict[str, Any]], k: int) -> list[dict[str, Any]]
     return rows
 
 
-def escapes(ref: list[dict[str, Any]], k: int) -> list[dict[str, Any]]:
-    """The predicted against the exact escape return from the solver's start (module docstring)."""
+def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> list[dict[str, Any]]:
+    """The predicted against the exact escape return from the solver's start (module docstring); the exact side
+    read from ``cache`` where it holds the point (:func:`_exact_escape`)."""
     rows: list[dict[str, Any]] = []
+    done: dict[str, Any] = json.loads(cache.read_text()) if cache is not None and cache.exists() else {}
     for r, o in _cpu_rows(ref, start="solver"):
         if len(rows) >= k:
             break
@@ -203,30 +209,46 @@ def escapes(ref: list[dict[str, Any]], k: int) -> list[dict[str, Any]]:
         if not left:
             continue
         a = left[0]
-        p = PeelParams(V=r["V"], I=r["I"])
         assert a.escape_returns is not None and a.slip_interval is not None and a.force_drop is not None
         t_end = min(300.0, 1.5 * a.escape_returns * a.slip_interval + 1.0)
+        mu_map = max(abs(m) for m in a.multipliers or ())
         row: dict[str, Any] = {"V": r["V"], "I": r["I"], "n": a.period, "predicted": a.escape_returns,
-                               "mu": max(abs(m) for m in a.multipliers or ())}
-        try:
-            tr = exact.simulate(p, t_end, rtol=1e-10, save="jumps", max_wall=300.0)
-            orbit = exact.periodic_orbit(p, start=tr, n=a.period, max_wall=120.0)
-        except Exception as exc:  # recorded, not fatal
-            rows.append({**row, "error": f"{type(exc).__name__}: {exc}"[:200]})
+                               "mu_map": mu_map, "mu": mu_map if a.escape_multiplier is None
+                               else abs(a.escape_multiplier)}
+        key = f"{r['V']!r} {r['I']!r} {a.period}"
+        got = done.get(key)
+        if got is None or (got.get("exact") is None and got["t_end"] < t_end):
+            got = done[key] = _exact_escape(PeelParams(V=r["V"], I=r["I"]), a.period, ESCAPE_FRACTION * a.force_drop,
+                                            t_end)
+            if cache is not None:
+                cache.parent.mkdir(parents=True, exist_ok=True)
+                cache.write_text(json.dumps(done, indent=1))
+        row.update({k_: v for k_, v in got.items() if k_ != "t_end"})
+        if "error" in got:
+            rows.append(row)
             continue
-        F = np.asarray(tr.jumps.F)[np.asarray(tr.jumps.from_branch) == 0]
-        dev = np.min(np.abs(F[:, None] - np.asarray(orbit.return_map_values)[None, :]), axis=1)
-        thr = ESCAPE_FRACTION * a.force_drop
-        closest = int(np.argmin(dev))
-        out = np.flatnonzero((dev > thr) & (np.arange(dev.size) > closest)) if dev[closest] < thr else np.array([])
-        row.update(exact=int(out[0]) + 1 if out.size else None, exact_mu=float(max(abs(m) for m in orbit.multipliers)),
-                   returns_run=int(F.size))
         row.update(_decomposed(a, row["mu"], row["exact_mu"]))
         rows.append(row)
         print(f"  escape V={r['V']:.4g} I={r['I']:.3g}: predicted {a.escape_returns:.0f}, exact {row['exact']} "
-              f"(|mu| {row['mu']:.5f} approx, {row['exact_mu']:.5f} exact; with the exact |mu| "
-              f"{_f0(row.get('with_exact_mu'))})", file=sys.stderr)
+              f"(|mu| {row['mu_map']:.5f} map, {row['mu']:.5f} escape law, {row['exact_mu']:.5f} exact; with the "
+              f"exact |mu| {_f0(row.get('with_exact_mu'))})", file=sys.stderr)
     return rows
+
+
+def _exact_escape(p: PeelParams, n: int, thr: float, t_end: float) -> dict[str, Any]:
+    """The exact escape return from the solver's default start (module docstring) in a run of ``t_end`` s, the
+    exact orbit's largest |μ| and the returns run (an error recorded, not fatal)."""
+    try:
+        tr = exact.simulate(p, t_end, rtol=1e-10, save="jumps", max_wall=300.0)
+        orbit = exact.periodic_orbit(p, start=tr, n=n, max_wall=120.0)
+    except Exception as exc:  # recorded, not fatal
+        return {"error": f"{type(exc).__name__}: {exc}"[:200], "t_end": t_end}
+    F = np.asarray(tr.jumps.F)[np.asarray(tr.jumps.from_branch) == 0]
+    dev = np.min(np.abs(F[:, None] - np.asarray(orbit.return_map_values)[None, :]), axis=1)
+    closest = int(np.argmin(dev))
+    out = np.flatnonzero((dev > thr) & (np.arange(dev.size) > closest)) if dev[closest] < thr else np.array([])
+    return {"exact": int(out[0]) + 1 if out.size else None, "exact_mu": float(max(abs(m) for m in orbit.multipliers)),
+            "returns_run": int(F.size), "t_end": t_end}
 
 
 def _f0(x: float | None) -> str:
@@ -260,6 +282,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--multipliers", type=int, default=0, help="compare multipliers with exact.periodic_orbit at K "
                     "points (module docstring)")
     ap.add_argument("--escapes", type=int, default=0, help="compare escape returns with the exact run at K points")
+    ap.add_argument("--escape-cache", help="a JSON file of the exact escape runs: read where it holds a point, "
+                    "written after each new one (the exact runs take up to 300 s simulated each)")
     args = ap.parse_args(argv)
     if args.points < 1 or args.repeats < 1:
         ap.error("--points and --repeats must be >= 1")
@@ -269,7 +293,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.multipliers or args.escapes:
         extra = {"multipliers": multiplier_errors(ref, args.multipliers) if args.multipliers else [],
-                 "escapes": escapes(ref, args.escapes) if args.escapes else []}
+                 "escapes": escapes(ref, args.escapes, Path(args.escape_cache) if args.escape_cache else None)
+                 if args.escapes else []}
         d = [abs(x["diff"]) for x in extra["multipliers"] if x.get("same_orbit")]
         if d:
             print(f"multipliers: {len(d)} orbits (of {len(extra['multipliers'])} tried) the same on both sides, "

@@ -42,7 +42,8 @@ from ..validate import choice, flag, integer, optional, positive
 from ..validate import params as _params
 from ..validate import rtol as _rtol
 from ._approx_result import ALPHA_LINEAR, MULTIPLIER_ERROR, ApproximateAttractor, confidence, warn_low
-from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, envelope, newton
+from ._escape import escape_return
+from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, newton
 from ._regime import regime
 from ._segment import SegmentPlan, segment_status
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
@@ -349,9 +350,8 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
                 return _Found(obs, left, _alpha_max(orbit))
             rho, dev, thr = max(abs(m) for m in obs.multipliers or ()), _deviation(recs, orbit, n), \
                 ESCAPE_FRACTION * drop
-            amp = envelope(lo, J, x, xs)
-            k_esc = lo.returns + (n * math.log(thr / amp) / math.log(rho) if 0.0 < amp < thr else 0.0)
-            left.append(dataclasses.replace(obs, escape_returns=k_esc))
+            k_esc, mu_esc = escape_return(lo, J, x, xs, n, rho, thr, FULL_CHAIN)
+            left.append(dataclasses.replace(obs, escape_returns=k_esc, escape_multiplier=mu_esc))
             if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
                 x = xs + (x - xs) * (ESCAPE_PUSH * drop / dev)
             x, recs = lo.run(x, max(n_transient, 3 * MAX_PERIOD))
