@@ -31,8 +31,9 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
   whose force deviates from them by more than the orbit's force drop (``ESCAPE_FRACTION``, as the map's), the
   predicted one the map's ``escape_returns``; beside it the map's own |μ|, the escape law's (the full chain's
   where the map's is within 0.02 of 1, ``escape_multiplier``), the exact orbit's, and the same law with the exact
-  orbit's |μ| (what is left of a miss with the exact multiplier).  The points are those where the map's own |μ| - 1
-  is in [1e-4, 1e-2] (the exact orbits' are there too at every point measured).  ``--escape-cache FILE`` keeps the
+  orbit's |μ| (what is left of a miss with the exact multiplier).  The points are those where the escape law's
+  |μ| - 1 is in [1e-4, 1e-2], an orbit the map leaves (first) or the weakly stable one it stays on where the full
+  chain's is unstable (``kind`` "left", "stays").  ``--escape-cache FILE`` keeps the
   exact side (escape return, |μ|, returns run, the run's length) per point and period in a JSON file, read where it
   holds the point (run again where it found no escape in a shorter run than now asked), written after each new one.
 """
@@ -204,8 +205,8 @@ def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> lis
     for r, o in _cpu_rows(ref, start="solver"):
         if len(rows) >= k:
             break
-        left = [a for a in o.alternatives if a.escape_returns is not None and a.multipliers is not None
-                and 1e-4 <= max(abs(m) for m in a.multipliers) - 1.0 <= 1e-2]
+        left = [a for a in (*o.alternatives, o) if a.escape_returns is not None and a.multipliers is not None
+                and 1e-4 <= _law_mu(a) - 1.0 <= 1e-2]
         if not left:
             continue
         a = left[0]
@@ -213,8 +214,7 @@ def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> lis
         t_end = min(300.0, 1.5 * a.escape_returns * a.slip_interval + 1.0)
         mu_map = max(abs(m) for m in a.multipliers or ())
         row: dict[str, Any] = {"V": r["V"], "I": r["I"], "n": a.period, "predicted": a.escape_returns,
-                               "mu_map": mu_map, "mu": mu_map if a.escape_multiplier is None
-                               else abs(a.escape_multiplier)}
+                               "mu_map": mu_map, "mu": _law_mu(a), "kind": "stays" if a is o else "left"}
         key = f"{r['V']!r} {r['I']!r} {a.period}"
         got = done.get(key)
         if got is None or (got.get("exact") is None and got["t_end"] < t_end):
@@ -229,10 +229,16 @@ def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> lis
             continue
         row.update(_decomposed(a, row["mu"], row["exact_mu"]))
         rows.append(row)
-        print(f"  escape V={r['V']:.4g} I={r['I']:.3g}: predicted {a.escape_returns:.0f}, exact {row['exact']} "
+        print(f"  escape ({row['kind']}) V={r['V']:.4g} I={r['I']:.3g}: predicted {a.escape_returns:.0f}, "
+              f"exact {row['exact']} "
               f"(|mu| {row['mu_map']:.5f} map, {row['mu']:.5f} escape law, {row['exact_mu']:.5f} exact; with the "
               f"exact |mu| {_f0(row.get('with_exact_mu'))})", file=sys.stderr)
     return rows
+
+
+def _law_mu(a: Any) -> float:
+    """The |μ| that sets the escape law's rate: ``escape_multiplier``'s where there is one, else the map's own."""
+    return abs(a.escape_multiplier) if a.escape_multiplier is not None else max(abs(m) for m in a.multipliers)
 
 
 def _exact_escape(p: PeelParams, n: int, thr: float, t_end: float) -> dict[str, Any]:
@@ -300,10 +306,14 @@ def main(argv: list[str] | None = None) -> int:
             print(f"multipliers: {len(d)} orbits (of {len(extra['multipliers'])} tried) the same on both sides, "
                   f"|d|mu|| median {np.median(d):.4f}, 90th percentile {np.percentile(d, 90):.4f}, max {max(d):.4f}")
         e = [x for x in extra["escapes"] if x.get("exact")]
-        if e:
+        for kind in ("left", "stays", None):
+            ek = [x for x in e if kind is None or x["kind"] == kind]
+            where = {"left": " (orbits the map leaves)", "stays": " (orbits the map stays on)", None: ", all"}[kind]
             for key, what in (("predicted", "predicted"), ("with_exact_mu", "with the exact orbit's |mu|")):
-                within = sum(x.get(key) is not None and abs(x[key] / x["exact"] - 1.0) <= 0.2 for x in e)
-                print(f"escapes: {within} of {len(e)} {what} within 20 % of the exact escape return")
+                within = sum(x.get(key) is not None and abs(x[key] / x["exact"] - 1.0) <= 0.2 for x in ek)
+                print(f"escapes{where}: {within} of {len(ek)} {what} within 20 % of the exact escape return")
+        if len(e) < len(extra["escapes"]):
+            print(f"escapes: {len(extra['escapes']) - len(e)} exact runs without an escape or with an error")
         if args.json:
             Path(args.json).write_text(json.dumps(extra, indent=1, default=str))
         return 0
