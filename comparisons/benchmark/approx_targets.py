@@ -24,18 +24,18 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
 * ``--multipliers K``: at the first K points whose primary prediction is a periodic orbit (n <= 12),
   :func:`exact.periodic_orbit` with the same n, and the difference of the largest |μ| (the reduction's multiplier
   error the confidence rule uses);
-* ``--escapes K``: at the first K points where the solver's start left an unstable orbit with |μ| - 1 in
-  [1e-4, 1e-2], the exact run from the solver's default start (``save="jumps"``, up to 1.5 times the predicted
-  escape, at most 300 s) and the exact orbit of that period (:func:`exact.periodic_orbit` seeded by the run): the
-  exact escape return is the first AB→CD jump after the run's closest approach to the orbit's return-map values
-  whose force deviates from them by more than the orbit's force drop (``ESCAPE_FRACTION``, as the map's), the
-  predicted one the map's ``escape_returns``; beside it the map's own |μ|, the escape law's (the full chain's
-  where the map's is within 0.02 of 1, ``escape_multiplier``), the exact orbit's, and the same law with the exact
-  orbit's |μ| (what is left of a miss with the exact multiplier).  The points are those where the escape law's
-  |μ| - 1 is in [1e-4, 1e-2], an orbit the map leaves (first) or the weakly stable one it stays on where the full
-  chain's is unstable (``kind`` "left", "stays").  ``--escape-cache FILE`` keeps the
-  exact side (escape return, |μ|, returns run, the run's length) per point and period in a JSON file, read where it
-  holds the point (run again where it found no escape in a shorter run than now asked), written after each new one.
+* ``--escapes K``: at the first K points where the solver's start either left an unstable orbit or settled on
+  one the map finds weakly stable and the full chain unstable (``kind`` "left", "stays"; a left orbit first), with
+  the escape law's |μ| - 1 in [1e-4, 1e-2]: the exact run from the solver's default start (``save="jumps"``, up to
+  1.5 times the predicted escape, at most 300 s) and the exact orbit of that period (:func:`exact.periodic_orbit`
+  seeded by the run).  The exact escape return is the first AB→CD jump after the run's closest approach to the
+  orbit's return-map values whose force deviates from them by more than the orbit's force drop
+  (``ESCAPE_FRACTION``, as the map's), the predicted one the map's ``escape_returns``; beside it the map's own |μ|,
+  the escape law's (``escape_multiplier``, the full chain's, where the map's is in [0.99, 1.02]), the exact
+  orbit's, and the same law with the exact orbit's |μ| (what is left of a miss with the exact multiplier).
+  ``--escape-cache FILE`` keeps the exact side (escape return, |μ|, returns run, the run's length) per point and
+  period in a JSON file, read where it holds the point (run again where it found no escape in a shorter run than
+  now asked), written after each new one.
 """
 
 from __future__ import annotations
