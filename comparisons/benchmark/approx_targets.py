@@ -33,9 +33,9 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
   (``ESCAPE_FRACTION``, as the map's), the predicted one the map's ``escape_returns``; beside it the map's own |μ|,
   the escape law's (``escape_multiplier``, the full chain's, where the map's is in [0.99, 1.02]), the exact
   orbit's, and the same law with the exact orbit's |μ| (what is left of a miss with the exact multiplier).
-  ``--escape-cache FILE`` keeps the exact side (escape return, |μ|, returns run, the run's length) per point and
-  period in a JSON file, read where it holds the point (run again where it found no escape in a shorter run than
-  now asked), written after each new one.
+  The exact side (escape return, |μ|, returns run, the run's length) is kept per point and period in
+  ``comparisons/benchmark/data/approx_escapes_seed<S>_n<N>.json`` (or ``--escape-cache FILE``), read where it holds
+  the point (run again where it found no escape in a shorter run than now asked), written after each new one.
 """
 
 from __future__ import annotations
@@ -288,8 +288,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--multipliers", type=int, default=0, help="compare multipliers with exact.periodic_orbit at K "
                     "points (module docstring)")
     ap.add_argument("--escapes", type=int, default=0, help="compare escape returns with the exact run at K points")
-    ap.add_argument("--escape-cache", help="a JSON file of the exact escape runs: read where it holds a point, "
-                    "written after each new one (the exact runs take up to 300 s simulated each)")
+    ap.add_argument("--escape-cache", help="the JSON file of the exact escape runs, read where it holds a point, "
+                    "written after each new one (the exact runs take up to 300 s simulated each); default "
+                    "data/approx_escapes_seed<S>_n<N>.json beside the reference")
     args = ap.parse_args(argv)
     if args.points < 1 or args.repeats < 1:
         ap.error("--points and --repeats must be >= 1")
@@ -299,7 +300,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.multipliers or args.escapes:
         extra = {"multipliers": multiplier_errors(ref, args.multipliers) if args.multipliers else [],
-                 "escapes": escapes(ref, args.escapes, Path(args.escape_cache) if args.escape_cache else None)
+                 "escapes": escapes(ref, args.escapes, Path(args.escape_cache) if args.escape_cache
+                                     else DATA / f"approx_escapes_seed{args.seed}_n{args.points}.json")
                  if args.escapes else []}
         d = [abs(x["diff"]) for x in extra["multipliers"] if x.get("same_orbit")]
         if d:
