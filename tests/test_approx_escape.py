@@ -73,6 +73,21 @@ def test_an_orbit_the_map_stays_on_gets_the_exact_runs_escape():
     assert abs(o.escape_returns / k_exact - 1.0) < 0.2
 
 
+def test_no_escape_return_where_the_map_settles_from_a_deviation_as_large_as_the_orbit():
+    """Stored exact oracle (the same benchmark): at this seed-1 point the map settles on a period-1 orbit it finds
+    weakly stable, from a deviation that, at the full chain's rate, is already as large as the orbit's force drop;
+    the exact run leaves the orbit at return 172 (the exact |μ| 1.00307).  The linear law has no e-fold to run
+    there (it would say 40, the map's settling return: -77 %; 3 of 3 such escapes were 73-77 % off), so the
+    prediction carries the full chain's multiplier, within 2 % of the exact one in |μ| - 1 (measured 1.5 %), and no
+    escape return rather than a wrong one."""
+    p = PeelParams(V=1.7032415340471847, I=0.010714235142583683)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        o = approximate_attractor(p, start="solver", warn=False)
+    assert o.period == 1 and o.stable and o.escape_returns is None and o.escape_multiplier is not None
+    assert abs((abs(o.escape_multiplier) - 1.0) / (1.003074497139905 - 1.0) - 1.0) < 0.02
+
+
 def test_the_full_chain_keeps_its_own_rate():
     """Stored exact oracle.  Run with the full chain itself (genalpha + fullvdot on both branches), the map's own
     multiplier sets the rate (``escape_multiplier`` None, nothing to refine), and its |μ| - 1 is the exact orbit's

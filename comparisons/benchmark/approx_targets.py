@@ -205,13 +205,13 @@ def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> lis
     for r, o in _cpu_rows(ref, start="solver"):
         if len(rows) >= k:
             break
-        left = [a for a in (*o.alternatives, o) if a.escape_returns is not None and a.multipliers is not None
-                and 1e-4 <= _law_mu(a) - 1.0 <= 1e-2]
+        left = [a for a in (*o.alternatives, o) if (a.escape_returns is not None or a.escape_multiplier is not None)
+                and a.multipliers is not None and 1e-4 <= _law_mu(a) - 1.0 <= 1e-2]
         if not left:
             continue
-        a = left[0]
-        assert a.escape_returns is not None and a.slip_interval is not None and a.force_drop is not None
-        t_end = min(300.0, 1.5 * a.escape_returns * a.slip_interval + 1.0)
+        a = left[0]  # escape_returns None: an unstable rate without a predicted return, counted as a miss
+        assert a.slip_interval is not None and a.force_drop is not None
+        t_end = min(300.0, 1.5 * (a.escape_returns or 200.0) * a.slip_interval + 1.0)
         mu_map = max(abs(m) for m in a.multipliers or ())
         row: dict[str, Any] = {"V": r["V"], "I": r["I"], "n": a.period, "predicted": a.escape_returns,
                                "mu_map": mu_map, "mu": _law_mu(a), "kind": "stays" if a is o else "left"}
@@ -229,7 +229,7 @@ def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> lis
             continue
         row.update(_decomposed(a, row["mu"], row["exact_mu"]))
         rows.append(row)
-        print(f"  escape ({row['kind']}) V={r['V']:.4g} I={r['I']:.3g}: predicted {a.escape_returns:.0f}, "
+        print(f"  escape ({row['kind']}) V={r['V']:.4g} I={r['I']:.3g}: predicted {_f0(a.escape_returns)}, "
               f"exact {row['exact']} "
               f"(|mu| {row['mu_map']:.5f} map, {row['mu']:.5f} escape law, {row['exact_mu']:.5f} exact; with the "
               f"exact |mu| {_f0(row.get('with_exact_mu'))})", file=sys.stderr)
@@ -266,7 +266,7 @@ def _decomposed(a: Any, mu: float, mu_exact: float) -> dict[str, Any]:
     ``method``; ``A`` its amplitude) redone with the exact orbit's |mu|: what is left of a miss when the multiplier
     is the exact one."""
     m = re.search(r"after (\d+) returns", a.method)
-    if m is None or not mu > 1.0 or not mu_exact > 1.0:
+    if m is None or not mu > 1.0 or not mu_exact > 1.0 or a.escape_returns is None:
         return {}
     k0 = int(m.group(1))
     return {"k0": k0, "with_exact_mu": k0 + (a.escape_returns - k0) * math.log(mu) / math.log(mu_exact)}
@@ -313,7 +313,9 @@ def main(argv: list[str] | None = None) -> int:
             where = {"left": " (orbits the map leaves)", "stays": " (orbits the map stays on)", None: ", all"}[kind]
             for key, what in (("predicted", "predicted"), ("with_exact_mu", "with the exact orbit's |mu|")):
                 within = sum(x.get(key) is not None and abs(x[key] / x["exact"] - 1.0) <= 0.2 for x in ek)
-                print(f"escapes{where}: {within} of {len(ek)} {what} within 20 % of the exact escape return")
+                made = sum(x.get(key) is not None for x in ek)
+                print(f"escapes{where}: {within} of {len(ek)} {what} within 20 % of the exact escape return "
+                      f"({within} of the {made} with a return predicted)")
         if len(e) < len(extra["escapes"]):
             print(f"escapes: {len(extra['escapes']) - len(e)} exact runs without an escape or with an error")
         if args.json:
