@@ -24,13 +24,18 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
 * ``--multipliers K``: at the first K points whose primary prediction is a periodic orbit (n <= 12),
   :func:`exact.periodic_orbit` with the same n, and the difference of the largest |μ| (the reduction's multiplier
   error the confidence rule uses);
-* ``--escapes K``: at the first K points where the solver's start left an unstable orbit with |μ| - 1 in
-  [1e-4, 1e-2], the exact run from the solver's default start (``save="jumps"``, up to 1.5 times the predicted
-  escape, at most 300 s) and the exact orbit of that period (:func:`exact.periodic_orbit` seeded by the run): the
-  exact escape return is the first AB→CD jump after the run's closest approach to the orbit's return-map values
-  whose force deviates from them by more than the orbit's force drop (``ESCAPE_FRACTION``, as the map's), the
-  predicted one the map's ``escape_returns``; beside it the same law with the exact orbit's |μ| (what is left of
-  a miss with the exact multiplier).
+* ``--escapes K``: at the first K points where the solver's start either left an unstable orbit or settled on
+  one the map finds weakly stable and the full chain unstable (``kind`` "left", "stays"; a left orbit first), with
+  the escape law's |μ| - 1 in [1e-4, 1e-2]: the exact run from the solver's default start (``save="jumps"``, up to
+  1.5 times the predicted escape, at most 300 s) and the exact orbit of that period (:func:`exact.periodic_orbit`
+  seeded by the run).  The exact escape return is the first AB→CD jump after the run's closest approach to the
+  orbit's return-map values whose force deviates from them by more than the orbit's force drop
+  (``ESCAPE_FRACTION``, as the map's), the predicted one the map's ``escape_returns``; beside it the map's own |μ|,
+  the escape law's (``escape_multiplier``, the full chain's, where the map's is in [0.99, 1.02]), the exact
+  orbit's, and the same law with the exact orbit's |μ| (what is left of a miss with the exact multiplier).
+  The exact side (escape return, |μ|, returns run, the run's length) is kept per point and period in
+  ``comparisons/benchmark/data/approx_escapes_seed<S>_n<N>.json`` (or ``--escape-cache FILE``), read where it holds
+  the point (run again where it found no escape in a shorter run than now asked), written after each new one.
 """
 
 from __future__ import annotations
@@ -192,41 +197,64 @@ def multiplier_errors(ref: list[dict[str, Any]], k: int) -> list[dict[str, Any]]
     return rows
 
 
-def escapes(ref: list[dict[str, Any]], k: int) -> list[dict[str, Any]]:
-    """The predicted against the exact escape return from the solver's start (module docstring)."""
+def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> list[dict[str, Any]]:
+    """The predicted against the exact escape return from the solver's start (module docstring); the exact side
+    read from ``cache`` where it holds the point (:func:`_exact_escape`)."""
     rows: list[dict[str, Any]] = []
+    done: dict[str, Any] = json.loads(cache.read_text()) if cache is not None and cache.exists() else {}
     for r, o in _cpu_rows(ref, start="solver"):
         if len(rows) >= k:
             break
-        left = [a for a in o.alternatives if a.escape_returns is not None and a.multipliers is not None
-                and 1e-4 <= max(abs(m) for m in a.multipliers) - 1.0 <= 1e-2]
+        left = [a for a in (*o.alternatives, o) if (a.escape_returns is not None or a.escape_multiplier is not None)
+                and a.multipliers is not None and 1e-4 <= _law_mu(a) - 1.0 <= 1e-2]
         if not left:
             continue
-        a = left[0]
-        p = PeelParams(V=r["V"], I=r["I"])
-        assert a.escape_returns is not None and a.slip_interval is not None and a.force_drop is not None
-        t_end = min(300.0, 1.5 * a.escape_returns * a.slip_interval + 1.0)
+        a = left[0]  # escape_returns None: an unstable rate without a predicted return, counted as a miss
+        assert a.slip_interval is not None and a.force_drop is not None
+        t_end = min(300.0, 1.5 * (a.escape_returns or 200.0) * a.slip_interval + 1.0)
+        mu_map = max(abs(m) for m in a.multipliers or ())
         row: dict[str, Any] = {"V": r["V"], "I": r["I"], "n": a.period, "predicted": a.escape_returns,
-                               "mu": max(abs(m) for m in a.multipliers or ())}
-        try:
-            tr = exact.simulate(p, t_end, rtol=1e-10, save="jumps", max_wall=300.0)
-            orbit = exact.periodic_orbit(p, start=tr, n=a.period, max_wall=120.0)
-        except Exception as exc:  # recorded, not fatal
-            rows.append({**row, "error": f"{type(exc).__name__}: {exc}"[:200]})
+                               "mu_map": mu_map, "mu": _law_mu(a), "kind": "stays" if a is o else "left"}
+        key = f"{r['V']!r} {r['I']!r} {a.period}"
+        got = done.get(key)
+        if got is None or (got.get("exact") is None and got["t_end"] < t_end):
+            got = done[key] = _exact_escape(PeelParams(V=r["V"], I=r["I"]), a.period, ESCAPE_FRACTION * a.force_drop,
+                                            t_end)
+            if cache is not None:
+                cache.parent.mkdir(parents=True, exist_ok=True)
+                cache.write_text(json.dumps(done, indent=1))
+        row.update({k_: v for k_, v in got.items() if k_ != "t_end"})
+        if "error" in got:
+            rows.append(row)
             continue
-        F = np.asarray(tr.jumps.F)[np.asarray(tr.jumps.from_branch) == 0]
-        dev = np.min(np.abs(F[:, None] - np.asarray(orbit.return_map_values)[None, :]), axis=1)
-        thr = ESCAPE_FRACTION * a.force_drop
-        closest = int(np.argmin(dev))
-        out = np.flatnonzero((dev > thr) & (np.arange(dev.size) > closest)) if dev[closest] < thr else np.array([])
-        row.update(exact=int(out[0]) + 1 if out.size else None, exact_mu=float(max(abs(m) for m in orbit.multipliers)),
-                   returns_run=int(F.size))
         row.update(_decomposed(a, row["mu"], row["exact_mu"]))
         rows.append(row)
-        print(f"  escape V={r['V']:.4g} I={r['I']:.3g}: predicted {a.escape_returns:.0f}, exact {row['exact']} "
-              f"(|mu| {row['mu']:.5f} approx, {row['exact_mu']:.5f} exact; with the exact |mu| "
-              f"{_f0(row.get('with_exact_mu'))})", file=sys.stderr)
+        print(f"  escape ({row['kind']}) V={r['V']:.4g} I={r['I']:.3g}: predicted {_f0(a.escape_returns)}, "
+              f"exact {row['exact']} "
+              f"(|mu| {row['mu_map']:.5f} map, {row['mu']:.5f} escape law, {row['exact_mu']:.5f} exact; with the "
+              f"exact |mu| {_f0(row.get('with_exact_mu'))})", file=sys.stderr)
     return rows
+
+
+def _law_mu(a: Any) -> float:
+    """The |μ| that sets the escape law's rate: ``escape_multiplier``'s where there is one, else the map's own."""
+    return abs(a.escape_multiplier) if a.escape_multiplier is not None else max(abs(m) for m in a.multipliers)
+
+
+def _exact_escape(p: PeelParams, n: int, thr: float, t_end: float) -> dict[str, Any]:
+    """The exact escape return from the solver's default start (module docstring) in a run of ``t_end`` s, the
+    exact orbit's largest |μ| and the returns run (an error recorded, not fatal)."""
+    try:
+        tr = exact.simulate(p, t_end, rtol=1e-10, save="jumps", max_wall=300.0)
+        orbit = exact.periodic_orbit(p, start=tr, n=n, max_wall=120.0)
+    except Exception as exc:  # recorded, not fatal
+        return {"error": f"{type(exc).__name__}: {exc}"[:200], "t_end": t_end}
+    F = np.asarray(tr.jumps.F)[np.asarray(tr.jumps.from_branch) == 0]
+    dev = np.min(np.abs(F[:, None] - np.asarray(orbit.return_map_values)[None, :]), axis=1)
+    closest = int(np.argmin(dev))
+    out = np.flatnonzero((dev > thr) & (np.arange(dev.size) > closest)) if dev[closest] < thr else np.array([])
+    return {"exact": int(out[0]) + 1 if out.size else None, "exact_mu": float(max(abs(m) for m in orbit.multipliers)),
+            "returns_run": int(F.size), "t_end": t_end}
 
 
 def _f0(x: float | None) -> str:
@@ -238,7 +266,7 @@ def _decomposed(a: Any, mu: float, mu_exact: float) -> dict[str, Any]:
     ``method``; ``A`` its amplitude) redone with the exact orbit's |mu|: what is left of a miss when the multiplier
     is the exact one."""
     m = re.search(r"after (\d+) returns", a.method)
-    if m is None or not mu > 1.0 or not mu_exact > 1.0:
+    if m is None or not mu > 1.0 or not mu_exact > 1.0 or a.escape_returns is None:
         return {}
     k0 = int(m.group(1))
     return {"k0": k0, "with_exact_mu": k0 + (a.escape_returns - k0) * math.log(mu) / math.log(mu_exact)}
@@ -260,6 +288,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--multipliers", type=int, default=0, help="compare multipliers with exact.periodic_orbit at K "
                     "points (module docstring)")
     ap.add_argument("--escapes", type=int, default=0, help="compare escape returns with the exact run at K points")
+    ap.add_argument("--escape-cache", help="the JSON file of the exact escape runs, read where it holds a point, "
+                    "written after each new one (the exact runs take up to 300 s simulated each); default "
+                    "data/approx_escapes_seed<S>_n<N>.json beside the reference")
     args = ap.parse_args(argv)
     if args.points < 1 or args.repeats < 1:
         ap.error("--points and --repeats must be >= 1")
@@ -269,16 +300,24 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.multipliers or args.escapes:
         extra = {"multipliers": multiplier_errors(ref, args.multipliers) if args.multipliers else [],
-                 "escapes": escapes(ref, args.escapes) if args.escapes else []}
+                 "escapes": escapes(ref, args.escapes, Path(args.escape_cache) if args.escape_cache
+                                     else DATA / f"approx_escapes_seed{args.seed}_n{args.points}.json")
+                 if args.escapes else []}
         d = [abs(x["diff"]) for x in extra["multipliers"] if x.get("same_orbit")]
         if d:
             print(f"multipliers: {len(d)} orbits (of {len(extra['multipliers'])} tried) the same on both sides, "
                   f"|d|mu|| median {np.median(d):.4f}, 90th percentile {np.percentile(d, 90):.4f}, max {max(d):.4f}")
         e = [x for x in extra["escapes"] if x.get("exact")]
-        if e:
+        for kind in ("left", "stays", None):
+            ek = [x for x in e if kind is None or x["kind"] == kind]
+            where = {"left": " (orbits the map leaves)", "stays": " (orbits the map stays on)", None: ", all"}[kind]
             for key, what in (("predicted", "predicted"), ("with_exact_mu", "with the exact orbit's |mu|")):
-                within = sum(x.get(key) is not None and abs(x[key] / x["exact"] - 1.0) <= 0.2 for x in e)
-                print(f"escapes: {within} of {len(e)} {what} within 20 % of the exact escape return")
+                within = sum(x.get(key) is not None and abs(x[key] / x["exact"] - 1.0) <= 0.2 for x in ek)
+                made = sum(x.get(key) is not None for x in ek)
+                print(f"escapes{where}: {within} of {len(ek)} {what} within 20 % of the exact escape return "
+                      f"({within} of the {made} with a return predicted)")
+        if len(e) < len(extra["escapes"]):
+            print(f"escapes: {len(extra['escapes']) - len(e)} exact runs without an escape or with an error")
         if args.json:
             Path(args.json).write_text(json.dumps(extra, indent=1, default=str))
         return 0

@@ -42,7 +42,8 @@ from ..validate import choice, flag, integer, optional, positive
 from ..validate import params as _params
 from ..validate import rtol as _rtol
 from ._approx_result import ALPHA_LINEAR, MULTIPLIER_ERROR, ApproximateAttractor, confidence, warn_low
-from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, envelope, newton
+from ._escape import escape_return
+from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, newton
 from ._regime import regime
 from ._segment import SegmentPlan, segment_status
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
@@ -332,6 +333,7 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
     lo, hi = maps
     lo.returns = 0
     left: list[ApproximateAttractor] = []
+    k_in = 0  # the return at which the map set out towards the orbit it reaches next (the start, or the last push)
     try:
         x, recs = lo.run(lo.enter(s), min(n_transient, EARLY_RETURNS))
         if EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends the transient
@@ -345,15 +347,18 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
             if got is None:
                 break  # no period found: a sample
             obs, orbit, drop, (xs, J), n = got
-            if obs.stable or max(abs(m) for m in obs.multipliers or ()) <= 1.0 + NEUTRAL:
-                return _Found(obs, left, _alpha_max(orbit))
-            rho, dev, thr = max(abs(m) for m in obs.multipliers or ()), _deviation(recs, orbit, n), \
-                ESCAPE_FRACTION * drop
-            amp = envelope(lo, J, x, xs)
-            k_esc = lo.returns + (n * math.log(thr / amp) / math.log(rho) if 0.0 < amp < thr else 0.0)
-            left.append(dataclasses.replace(obs, escape_returns=k_esc))
+            rho, thr = max(abs(m) for m in obs.multipliers or ()), ESCAPE_FRACTION * drop
+            if obs.stable or rho <= 1.0 + NEUTRAL:  # the escape of an orbit the full chain finds weakly unstable
+                k_esc, mu_esc = escape_return(lo, J, x, xs, n, rho, thr, FULL_CHAIN, lo.returns - k_in) \
+                    if rho < 1.0 - NEUTRAL else (None, None)
+                return _Found(dataclasses.replace(obs, escape_returns=k_esc, escape_multiplier=mu_esc), left,
+                              _alpha_max(orbit))
+            dev = _deviation(recs, orbit, n)
+            k_esc, mu_esc = escape_return(lo, J, x, xs, n, rho, thr, FULL_CHAIN, lo.returns - k_in)
+            left.append(dataclasses.replace(obs, escape_returns=k_esc, escape_multiplier=mu_esc))
             if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
                 x = xs + (x - xs) * (ESCAPE_PUSH * drop / dev)
+            k_in = lo.returns
             x, recs = lo.run(x, max(n_transient, 3 * MAX_PERIOD))
         x, recs = lo.run(x, n_returns)  # the sample: n_returns after the transient
         got = _settle(maps, x, recs, name, chain, common)  # a periodic orbit reached late, after the transient
