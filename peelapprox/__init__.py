@@ -18,7 +18,11 @@ dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lya
 observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObservables.from_trajectory``;
 ``attractor_observables`` runs the exact solver for them).  Each re-exported name is its home module's very
 object (``peelapprox.periodic_orbit is exact.periodic_orbit``), documented once, on its home's API page.
+The burst statistics (``burst_catalogue``, ``fit_power_law``, ...) are this package's own, imported on first use
+too: ``import peelapprox`` imports none of scipy's optimize, integrate or special (docs/performance.md).
 """
+
+from typing import TYPE_CHECKING
 
 from ._measured._series import ForceSeries, Spectrum
 from ._measured._series_lyapunov import SeriesLyapunov, SurrogateTest
@@ -75,19 +79,6 @@ from ._reduced._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduce
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._slips import Slips
 from ._version import __version__ as __version__
-from .bursts import (
-    ALTERNATIVES,
-    BURST_COLUMNS,
-    MAX_XMIN_CANDIDATES,
-    BrokenPowerLawFit,
-    BurstCatalogue,
-    LikelihoodRatio,
-    PowerLawFit,
-    burst_catalogue,
-    compare_power_law,
-    fit_broken_power_law,
-    fit_power_law,
-)
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from .front import FrontParams, FrontPattern, TransverseModes, front_pattern, transverse_growth_rates
 from .law import (
@@ -105,6 +96,21 @@ from .law import (
     peel_force,
     peel_force_derivative,
 )
+
+if TYPE_CHECKING:  # imported on first access (``_LAZY`` below); here for the type checkers
+    from .bursts import (
+        ALTERNATIVES,
+        BURST_COLUMNS,
+        MAX_XMIN_CANDIDATES,
+        BrokenPowerLawFit,
+        BurstCatalogue,
+        LikelihoodRatio,
+        PowerLawFit,
+        burst_catalogue,
+        compare_power_law,
+        fit_broken_power_law,
+        fit_power_law,
+    )
 
 __all__ = [
     "PeelParams",
@@ -242,10 +248,17 @@ _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "attractor_o
                                          "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult", "benettin",
                                          "periodic_orbit", "PeriodicOrbit", "continue_orbit", "OrbitBranch",
                                          "switch_branch", "basins", "BasinResult", "infer", "Inference")})
+#: This package's own names whose modules import scipy's optimize/integrate/special (the burst statistics), imported
+#: on first access the same way (documented on this package's page, their home), so that ``import peelapprox`` and a
+#: first ``exact.simulate`` import none of them (docs/performance.md, "After `peelapprox warmup`";
+#: tests/test_cold_start.py).
+_OWN_LAZY = {name: "peelapprox.bursts" for name in (
+    "ALTERNATIVES", "BURST_COLUMNS", "MAX_XMIN_CANDIDATES", "BrokenPowerLawFit", "BurstCatalogue", "LikelihoodRatio",
+    "PowerLawFit", "burst_catalogue", "compare_power_law", "fit_broken_power_law", "fit_power_law")}
 
 
 def __getattr__(name: str):
-    module = _LAZY.get(name)
+    module = _LAZY.get(name) or _OWN_LAZY.get(name)
     if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     import importlib
@@ -254,4 +267,4 @@ def __getattr__(name: str):
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(globals()) | set(_LAZY) | set(_OWN_LAZY))
