@@ -18,14 +18,14 @@ dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lya
 observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObservables.from_trajectory``;
 ``attractor_observables`` runs the exact solver for them).  Each re-exported name is its home module's very
 object (``peelapprox.periodic_orbit is exact.periodic_orbit``), documented once, on its home's API page.
-The burst statistics (``burst_catalogue``, ``fit_power_law``, ...) are this package's own, imported on first use
-too: ``import peelapprox`` imports none of scipy's optimize, integrate or special (docs/performance.md).
+The burst statistics (``burst_catalogue``, ``fit_power_law``, ...), the reduced equations and the approximate
+attractor (``reduced_segment``, ``approximate_attractor``, ``estimate``, the α forms) and a measured force trace
+(``ForceSeries``, ``SeriesLyapunov``) are this package's own, imported on first use too: ``import peelapprox`` and a
+first ``exact.simulate`` import none of them, nor scipy's optimize, integrate or special (docs/performance.md).
 """
 
 from typing import TYPE_CHECKING
 
-from ._measured._series import ForceSeries, Spectrum
-from ._measured._series_lyapunov import SeriesLyapunov, SurrogateTest
 from ._observables import StickSlipObservables
 from ._params import PeelParams
 from ._ranges import (
@@ -46,36 +46,6 @@ from ._ranges import (
     TIME_MAX,
     WINDOW_DEFAULTS,
 )
-from ._reduced._alpha import (
-    ALPHA_FORMS,
-    InertialPeriods,
-    airy_alpha,
-    alpha_numerical,
-    cd_damping_time,
-    cd_decay_alpha,
-    harmonic_alpha,
-    inertial_frequency,
-    inertial_period,
-    inertial_periods,
-    sinusoid_alpha,
-    wkb_alpha,
-    wkb_amplitude_phase,
-    wkb_error_bound,
-)
-from ._reduced._approx_result import ApproximateAttractor, ApproximationWarning
-from ._reduced._approximate import approximate_attractor
-from ._reduced._estimate import (
-    INERTIA_RULE,
-    VELOCITY_RULE,
-    RegimeEstimate,
-    SlopeCriterion,
-    crude_branch_time,
-    estimate,
-    force_bounds,
-    quasi_static_branch_time,
-    slope_criterion,
-)
-from ._reduced._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._slips import Slips
 from ._version import __version__ as __version__
@@ -98,6 +68,38 @@ from .law import (
 )
 
 if TYPE_CHECKING:  # imported on first access (``_LAZY`` below); here for the type checkers
+    from ._measured._series import ForceSeries, Spectrum
+    from ._measured._series_lyapunov import SeriesLyapunov, SurrogateTest
+    from ._reduced._alpha import (
+        ALPHA_FORMS,
+        InertialPeriods,
+        airy_alpha,
+        alpha_numerical,
+        cd_damping_time,
+        cd_decay_alpha,
+        harmonic_alpha,
+        inertial_frequency,
+        inertial_period,
+        inertial_periods,
+        sinusoid_alpha,
+        wkb_alpha,
+        wkb_amplitude_phase,
+        wkb_error_bound,
+    )
+    from ._reduced._approx_result import ApproximateAttractor, ApproximationWarning
+    from ._reduced._approximate import approximate_attractor
+    from ._reduced._estimate import (
+        INERTIA_RULE,
+        VELOCITY_RULE,
+        RegimeEstimate,
+        SlopeCriterion,
+        crude_branch_time,
+        estimate,
+        force_bounds,
+        quasi_static_branch_time,
+        slope_criterion,
+    )
+    from ._reduced._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
     from .bursts import (
         ALTERNATIVES,
         BURST_COLUMNS,
@@ -255,6 +257,32 @@ _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "attractor_o
 _OWN_LAZY = {name: "peelapprox.bursts" for name in (
     "ALTERNATIVES", "BURST_COLUMNS", "MAX_XMIN_CANDIDATES", "BrokenPowerLawFit", "BurstCatalogue", "LikelihoodRatio",
     "PowerLawFit", "burst_catalogue", "compare_power_law", "fit_broken_power_law", "fit_power_law")}
+# the reduced equations, the approximate attractor, the estimates and a measured force trace: the reduced-map
+# kernels' modules, scipy's integrate/special on use, none needed by exact.simulate
+_OWN_LAZY.update(dict.fromkeys((
+    "ForceSeries", "Spectrum",
+), "peelapprox._measured._series"))
+_OWN_LAZY.update(dict.fromkeys((
+    "SeriesLyapunov", "SurrogateTest",
+), "peelapprox._measured._series_lyapunov"))
+_OWN_LAZY.update(dict.fromkeys((
+    "ALPHA_FORMS", "InertialPeriods", "airy_alpha", "alpha_numerical", "cd_damping_time", "cd_decay_alpha",
+    "harmonic_alpha", "inertial_frequency", "inertial_period", "inertial_periods", "sinusoid_alpha", "wkb_alpha",
+    "wkb_amplitude_phase", "wkb_error_bound",
+), "peelapprox._reduced._alpha"))
+_OWN_LAZY.update(dict.fromkeys((
+    "ApproximateAttractor", "ApproximationWarning",
+), "peelapprox._reduced._approx_result"))
+_OWN_LAZY.update(dict.fromkeys((
+    "approximate_attractor",
+), "peelapprox._reduced._approximate"))
+_OWN_LAZY.update(dict.fromkeys((
+    "INERTIA_RULE", "VELOCITY_RULE", "RegimeEstimate", "SlopeCriterion", "crude_branch_time", "estimate",
+    "force_bounds", "quasi_static_branch_time", "slope_criterion",
+), "peelapprox._reduced._estimate"))
+_OWN_LAZY.update(dict.fromkeys((
+    "ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment",
+), "peelapprox._reduced._segment"))
 
 
 def __getattr__(name: str):
