@@ -19,6 +19,8 @@ Every public name is importable from ``exact`` itself; the return-map analysis o
 (``return_map``, ``periodicity``) is the core package's, :mod:`peelapprox`.
 """
 
+from typing import TYPE_CHECKING
+
 from peelapprox.errors import ModelBreakdown, SolverBudgetExceeded, SolverFailure
 
 from ._hybrid_driver import hybrid_field
@@ -32,55 +34,57 @@ from ._shared import DEFAULT_MAX_WALL
 from ._simulate import simulate
 from ._trajectory import Jump, Jumps, SolverStats, State, Trajectory
 from ._warmup import WarmupReport, compile_kernels
-from .dynamics import (
-    MAX_BASIN_STARTS,
-    MAX_DIAGRAM_VALUES,
-    VARIATIONAL_LAWS,
-    Attractor,
-    AttractorSet,
-    BasinAttractor,
-    BasinResult,
-    BenettinResult,
-    EscapePrediction,
-    Inference,
-    LyapunovResult,
-    OrbitDiagram,
-    SetAttractor,
-    SetOutcome,
-    SetStart,
-    attractor_observables,
-    attractor_set,
-    attractors,
-    basins,
-    benettin,
-    check_lyapunov_options,
-    explain,
-    infer,
-    lyapunov,
-    lyapunov_return_map,
-    lyapunov_tangent,
-    lyapunov_variational,
-    orbit_diagram,
-    window_run,
-)
-from .front import FrontTrajectory, simulate_front
-from .orbits import (
-    Bifurcation,
-    BranchPoint,
-    Crest,
-    OrbitBranch,
-    PeriodicOrbit,
-    SectionReturn,
-    continue_orbit,
-    crest_margin,
-    monodromy_fd,
-    parameter_value,
-    periodic_orbit,
-    section_return,
-    solve_orbit,
-    switch_branch,
-    with_parameter,
-)
+
+if TYPE_CHECKING:  # the orbits, dynamics and front rooms: imported on first access (``_LAZY`` below)
+    from .dynamics import (
+        MAX_BASIN_STARTS,
+        MAX_DIAGRAM_VALUES,
+        VARIATIONAL_LAWS,
+        Attractor,
+        AttractorSet,
+        BasinAttractor,
+        BasinResult,
+        BenettinResult,
+        EscapePrediction,
+        Inference,
+        LyapunovResult,
+        OrbitDiagram,
+        SetAttractor,
+        SetOutcome,
+        SetStart,
+        attractor_observables,
+        attractor_set,
+        attractors,
+        basins,
+        benettin,
+        check_lyapunov_options,
+        explain,
+        infer,
+        lyapunov,
+        lyapunov_return_map,
+        lyapunov_tangent,
+        lyapunov_variational,
+        orbit_diagram,
+        window_run,
+    )
+    from .front import FrontTrajectory, simulate_front
+    from .orbits import (
+        Bifurcation,
+        BranchPoint,
+        Crest,
+        OrbitBranch,
+        PeriodicOrbit,
+        SectionReturn,
+        continue_orbit,
+        crest_margin,
+        monodromy_fd,
+        parameter_value,
+        periodic_orbit,
+        section_return,
+        solve_orbit,
+        switch_branch,
+        with_parameter,
+    )
 
 __all__ = [
     "simulate",
@@ -163,3 +167,39 @@ __all__ = [
     "infer",
     "Inference",
 ]
+
+
+#: The names of the orbits, dynamics and front rooms: name -> module, imported on first access (a module
+#: ``__getattr__``), so that ``import exact`` and a first ``simulate`` import only the solving room
+#: (docs/performance.md, "After `peelapprox warmup`"; tests/test_cold_start.py).  Each is the module's own object.
+_LAZY: dict[str, str] = {}
+_LAZY.update(dict.fromkeys((
+    "MAX_BASIN_STARTS", "MAX_DIAGRAM_VALUES", "VARIATIONAL_LAWS", "Attractor", "AttractorSet", "BasinAttractor",
+    "BasinResult", "BenettinResult", "EscapePrediction", "Inference", "LyapunovResult", "OrbitDiagram",
+    "SetAttractor", "SetOutcome", "SetStart", "attractor_observables", "attractor_set", "attractors", "basins",
+    "benettin", "check_lyapunov_options", "explain", "infer", "lyapunov", "lyapunov_return_map",
+    "lyapunov_tangent", "lyapunov_variational", "orbit_diagram", "window_run"
+), "exact.dynamics"))
+_LAZY.update(dict.fromkeys((
+    "FrontTrajectory", "simulate_front"
+), "exact.front"))
+_LAZY.update(dict.fromkeys((
+    "Bifurcation", "BranchPoint", "Crest", "OrbitBranch", "PeriodicOrbit", "SectionReturn", "continue_orbit",
+    "crest_margin", "monodromy_fd", "parameter_value", "periodic_orbit", "section_return", "solve_orbit",
+    "switch_branch", "with_parameter"
+), "exact.orbits"))
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # once: later lookups are plain module attributes
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

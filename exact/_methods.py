@@ -12,7 +12,6 @@ from peelapprox.validate import eps as _eps
 
 from ._hybrid_driver import run_hybrid
 from ._method_contract import METHODS, Method
-from ._regularized import run_regularized
 
 if TYPE_CHECKING:
     from peelapprox import PeelParams
@@ -72,6 +71,9 @@ class _OnScipy(Method):
 
     def run(self, model: Model, params: PeelParams, t_end: float, s0: State, saveat: SaveAt, budget: Budget,
             progress: Callable[[float, float], None] | None) -> Trajectory:
+        # imported on first use: scipy's solvers are not on the hybrid method's path (docs/performance.md)
+        from ._regularized import run_regularized
+
         return run_regularized(model, params, t_end, s0, self, saveat, budget, progress)
 
 

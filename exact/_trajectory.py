@@ -5,15 +5,18 @@ from __future__ import annotations
 import dataclasses
 import json
 from dataclasses import dataclass
-from typing import overload
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
-from peelapprox import BRANCHES, ForceSeries, PeelParams
+from peelapprox import BRANCHES, PeelParams
 from peelapprox.io import fmt_number, html_table, optional_import, param_attrs
 from peelapprox.validate import finite, integer, nonnegative, optional, positive
 
 from ._registry import model_of
+
+if TYPE_CHECKING:
+    from peelapprox import ForceSeries
 
 __all__ = ["Trajectory", "Jumps", "Jump", "State", "SolverStats"]
 
@@ -428,6 +431,8 @@ class Trajectory:
         p = self.params
         source = (f"exact.simulate(V = {fmt_number(p.V, 6)} m/s, I = {fmt_number(p.I, 4)} kg m^2) sampled at "
                   f"{fmt_number(rate, 6)} Hz ({how}), noise {fmt_number(noise, 3)} N, drift {fmt_number(drift, 3)} N")
+        from peelapprox import ForceSeries  # on first use: a first simulate needs no force-trace analysis
+
         return ForceSeries(grid, Fs, V=float(p.V), source=source)
 
     def to_dataframe(self):

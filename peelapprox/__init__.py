@@ -18,10 +18,14 @@ dynamics that run the exact solver, from :mod:`exact`: ``lyapunov`` (``exact.lya
 observables, ``StickSlipObservables`` (read off any trajectory by ``StickSlipObservables.from_trajectory``;
 ``attractor_observables`` runs the exact solver for them).  Each re-exported name is its home module's very
 object (``peelapprox.periodic_orbit is exact.periodic_orbit``), documented once, on its home's API page.
+The burst statistics (``burst_catalogue``, ``fit_power_law``, ...), the reduced equations and the approximate
+attractor (``reduced_segment``, ``approximate_attractor``, ``estimate``, the α forms) and a measured force trace
+(``ForceSeries``, ``SeriesLyapunov``) are this package's own, imported on first use too: ``import peelapprox`` and a
+first ``exact.simulate`` import none of them, nor scipy's optimize, integrate or special (docs/performance.md).
 """
 
-from ._measured._series import ForceSeries, Spectrum
-from ._measured._series_lyapunov import SeriesLyapunov, SurrogateTest
+from typing import TYPE_CHECKING
+
 from ._observables import StickSlipObservables
 from ._params import PeelParams
 from ._ranges import (
@@ -42,52 +46,9 @@ from ._ranges import (
     TIME_MAX,
     WINDOW_DEFAULTS,
 )
-from ._reduced._alpha import (
-    ALPHA_FORMS,
-    InertialPeriods,
-    airy_alpha,
-    alpha_numerical,
-    cd_damping_time,
-    cd_decay_alpha,
-    harmonic_alpha,
-    inertial_frequency,
-    inertial_period,
-    inertial_periods,
-    sinusoid_alpha,
-    wkb_alpha,
-    wkb_amplitude_phase,
-    wkb_error_bound,
-)
-from ._reduced._approx_result import ApproximateAttractor, ApproximationWarning
-from ._reduced._approximate import approximate_attractor
-from ._reduced._estimate import (
-    INERTIA_RULE,
-    VELOCITY_RULE,
-    RegimeEstimate,
-    SlopeCriterion,
-    crude_branch_time,
-    estimate,
-    force_bounds,
-    quasi_static_branch_time,
-    slope_criterion,
-)
-from ._reduced._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
 from ._returnmap import Periodicity, classify, force_drops, periodicity, return_map, settle_time
 from ._slips import Slips
 from ._version import __version__ as __version__
-from .bursts import (
-    ALTERNATIVES,
-    BURST_COLUMNS,
-    MAX_XMIN_CANDIDATES,
-    BrokenPowerLawFit,
-    BurstCatalogue,
-    LikelihoodRatio,
-    PowerLawFit,
-    burst_catalogue,
-    compare_power_law,
-    fit_broken_power_law,
-    fit_power_law,
-)
 from .errors import KernelCacheWarning, ModelBreakdown, SolverBudgetExceeded, SolverFailure
 from .front import FrontParams, FrontPattern, TransverseModes, front_pattern, transverse_growth_rates
 from .law import (
@@ -105,6 +66,53 @@ from .law import (
     peel_force,
     peel_force_derivative,
 )
+
+if TYPE_CHECKING:  # imported on first access (``_LAZY`` below); here for the type checkers
+    from ._measured._series import ForceSeries, Spectrum
+    from ._measured._series_lyapunov import SeriesLyapunov, SurrogateTest
+    from ._reduced._alpha import (
+        ALPHA_FORMS,
+        InertialPeriods,
+        airy_alpha,
+        alpha_numerical,
+        cd_damping_time,
+        cd_decay_alpha,
+        harmonic_alpha,
+        inertial_frequency,
+        inertial_period,
+        inertial_periods,
+        sinusoid_alpha,
+        wkb_alpha,
+        wkb_amplitude_phase,
+        wkb_error_bound,
+    )
+    from ._reduced._approx_result import ApproximateAttractor, ApproximationWarning
+    from ._reduced._approximate import approximate_attractor
+    from ._reduced._estimate import (
+        INERTIA_RULE,
+        VELOCITY_RULE,
+        RegimeEstimate,
+        SlopeCriterion,
+        crude_branch_time,
+        estimate,
+        force_bounds,
+        quasi_static_branch_time,
+        slope_criterion,
+    )
+    from ._reduced._segment import ALPHA_MODELS, V_EQUATIONS, ReducedSegment, reduced_segment
+    from .bursts import (
+        ALTERNATIVES,
+        BURST_COLUMNS,
+        MAX_XMIN_CANDIDATES,
+        BrokenPowerLawFit,
+        BurstCatalogue,
+        LikelihoodRatio,
+        PowerLawFit,
+        burst_catalogue,
+        compare_power_law,
+        fit_broken_power_law,
+        fit_power_law,
+    )
 
 __all__ = [
     "PeelParams",
@@ -242,10 +250,43 @@ _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "attractor_o
                                          "lyapunov_tangent", "lyapunov_return_map", "LyapunovResult", "benettin",
                                          "periodic_orbit", "PeriodicOrbit", "continue_orbit", "OrbitBranch",
                                          "switch_branch", "basins", "BasinResult", "infer", "Inference")})
+#: This package's own names whose modules import scipy's optimize/integrate/special (the burst statistics), imported
+#: on first access the same way (documented on this package's page, their home), so that ``import peelapprox`` and a
+#: first ``exact.simulate`` import none of them (docs/performance.md, "After `peelapprox warmup`";
+#: tests/test_cold_start.py).
+_OWN_LAZY = {name: "peelapprox.bursts" for name in (
+    "ALTERNATIVES", "BURST_COLUMNS", "MAX_XMIN_CANDIDATES", "BrokenPowerLawFit", "BurstCatalogue", "LikelihoodRatio",
+    "PowerLawFit", "burst_catalogue", "compare_power_law", "fit_broken_power_law", "fit_power_law")}
+# the reduced equations, the approximate attractor, the estimates and a measured force trace: the reduced-map
+# kernels' modules, scipy's integrate/special on use, none needed by exact.simulate
+_OWN_LAZY.update(dict.fromkeys((
+    "ForceSeries", "Spectrum",
+), "peelapprox._measured._series"))
+_OWN_LAZY.update(dict.fromkeys((
+    "SeriesLyapunov", "SurrogateTest",
+), "peelapprox._measured._series_lyapunov"))
+_OWN_LAZY.update(dict.fromkeys((
+    "ALPHA_FORMS", "InertialPeriods", "airy_alpha", "alpha_numerical", "cd_damping_time", "cd_decay_alpha",
+    "harmonic_alpha", "inertial_frequency", "inertial_period", "inertial_periods", "sinusoid_alpha", "wkb_alpha",
+    "wkb_amplitude_phase", "wkb_error_bound",
+), "peelapprox._reduced._alpha"))
+_OWN_LAZY.update(dict.fromkeys((
+    "ApproximateAttractor", "ApproximationWarning",
+), "peelapprox._reduced._approx_result"))
+_OWN_LAZY.update(dict.fromkeys((
+    "approximate_attractor",
+), "peelapprox._reduced._approximate"))
+_OWN_LAZY.update(dict.fromkeys((
+    "INERTIA_RULE", "VELOCITY_RULE", "RegimeEstimate", "SlopeCriterion", "crude_branch_time", "estimate",
+    "force_bounds", "quasi_static_branch_time", "slope_criterion",
+), "peelapprox._reduced._estimate"))
+_OWN_LAZY.update(dict.fromkeys((
+    "ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment",
+), "peelapprox._reduced._segment"))
 
 
 def __getattr__(name: str):
-    module = _LAZY.get(name)
+    module = _LAZY.get(name) or _OWN_LAZY.get(name)
     if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     import importlib
@@ -254,4 +295,4 @@ def __getattr__(name: str):
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(globals()) | set(_LAZY) | set(_OWN_LAZY))

@@ -87,6 +87,48 @@ def test_plain_hybrid_simulate_compiles_only_the_hybrid_driver(probes):
     assert second["compiled"] == first["compiled"]
 
 
+#: Modules a first hybrid ``simulate`` does not need, imported lazily by the code that does need them
+#: (docs/performance.md, "After `peelapprox warmup`"): scipy's optimize (the folds' Brent search is
+#: ``peelapprox/_brentq.py``), integrate and special, the rooms of ``exact`` other than solving, the burst statistics,
+#: the reduced equations and a measured force trace, the regularised scheme, the pools, sympy, matplotlib and the
+#: optional packages.  (``scipy.linalg`` is not listed: numba's own first cache load imports it, the BLAS check of
+#: ``numba/np/arraymath.py``.)
+LAZY_MODULES = ("scipy.optimize", "scipy.integrate", "scipy.special", "scipy.interpolate", "scipy.stats",
+                "scipy.signal", "sympy", "matplotlib", "pandas", "loky", "hypothesis", "cloudpickle", "threadpoolctl",
+                "exact.dynamics", "exact.orbits", "exact.front", "exact._regularized", "peelapprox.bursts",
+                "peelapprox._reduced._approximate", "peelapprox._reduced._alpha", "peelapprox._measured._series",
+                "peelapprox.parallel", "peelapprox.plotting", "comparisons")
+
+IMPORTED = """
+import json, sys
+lazy = {lazy!r}
+import peelapprox
+after_peelapprox = sorted(m for m in lazy if m in sys.modules)
+import exact
+after_exact = sorted(m for m in lazy if m in sys.modules)
+tr = exact.simulate(peelapprox.PeelParams(V=1.0, I=1e-2), 0.5)
+after_simulate = sorted(m for m in lazy if m in sys.modules)
+names = (exact.periodic_orbit, peelapprox.burst_catalogue, peelapprox.attractors,  # the lazy names still resolve
+         peelapprox.approximate_attractor)
+print(json.dumps(dict(after_peelapprox=after_peelapprox, after_exact=after_exact, after_simulate=after_simulate,
+                      n_jumps=int(tr.stats.n_jumps), lazy_now=sorted(m for m in lazy if m in sys.modules))))
+"""
+
+
+def test_first_simulate_imports_only_what_it_needs(probes, shared):
+    """Hypothesis: ``import peelapprox``, ``import exact`` and a first plain hybrid ``simulate`` (the run of the
+    probes above, its driver loaded from their cache) import none of :data:`LAZY_MODULES`; reading a lazy public
+    name (``exact.periodic_orbit``, ``peelapprox.burst_catalogue``, ``peelapprox.attractors``,
+    ``peelapprox.approximate_attractor``) then imports its module.  Structural, exact (the names in
+    ``sys.modules``); the time this saves is measured, not tested (docs/performance.md)."""
+    out = _run(shared, ["-c", IMPORTED.format(lazy=LAZY_MODULES)])
+    got = json.loads(out.strip().splitlines()[-1])
+    assert got["after_peelapprox"] == got["after_exact"] == got["after_simulate"] == [], got
+    assert got["n_jumps"] >= 1
+    assert {"exact.orbits", "exact.dynamics", "peelapprox.bursts", "scipy.optimize",
+            "peelapprox._reduced._approximate"} <= set(got["lazy_now"]), got
+
+
 #: A user's first calls after the README's set-up, other parameters than the warm-up's own: what they compiled.
 FIRST_CALLS = """
 import json

@@ -17,6 +17,10 @@ first call in a new process for a **fresh install without warm-up** (empty cache
 caches, ``exact.compile_kernels()`` -- what ``peelapprox warmup`` runs -- in one process, then the entry point in a
 new one) and **warm** (a second process after the first), with cold/warm and after-warm-up/warm ratios.
 
+The children use Python's bytecode cache (``__pycache__``, written by the first process that imports a module, as
+in a user's installation) even where this process runs with ``PYTHONDONTWRITEBYTECODE``; ``--no-bytecode`` runs them
+without it.
+
 With ``--detail NAME`` the cold run of one entry point prints which functions compiled and their exclusive
 compile time (its own time, the nested compilations of its callees excluded), largest first.
 """
@@ -107,8 +111,18 @@ def _run_child(code: str, env: dict[str, str]) -> dict:
     return out
 
 
+#: Whether the children may read and write Python's bytecode cache (``__pycache__`` beside the sources), as a user's
+#: installation does; ``--no-bytecode`` sets ``PYTHONDONTWRITEBYTECODE=1`` instead, so that every process compiles the
+#: sources of the modules it imports that have no bytecode yet (~0.35 s CPU for peelapprox's and exact's, measured
+#: with ``python -X importtime``/``cProfile``: docs/performance.md, "After `peelapprox warmup`").
+BYTECODE = True
+
+
 def _env(tmp: Path) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    if not BYTECODE:
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
     root = str(Path(__file__).resolve().parents[2])
     env.update(NUMBA_CACHE_DIR=str(tmp / "numba"), PEELAPPROX_CACHE_DIR=str(tmp / "laws"), MPLBACKEND="Agg",
                PYTHONPATH=os.pathsep.join([root] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]),
@@ -146,11 +160,12 @@ def first_call(name: str = "simulate hybrid") -> dict:
         _run_child(_WARMUP, env)
         warmup = dict(wall=time.perf_counter() - t)
         after = _run_child(code, env)
-    return dict(name=name, fresh=fresh, after_warmup=after, warm=warm, warmup=warmup)
+    return dict(name=name, fresh=fresh, after_warmup=after, warm=warm, warmup=warmup, bytecode=BYTECODE)
 
 
 def _first_call_table(r: dict) -> str:
-    lines = [f"first call of `{r['name']}` in a new process (warm-up itself: {r['warmup']['wall']:.1f} s wall)", "",
+    lines = [f"first call of `{r['name']}` in a new process (warm-up itself: {r['warmup']['wall']:.1f} s wall; "
+             f"bytecode cache {'on' if r.get('bytecode', True) else 'off'})", "",
              "| state | wall [s] | call [s] | CPU [s] | compiled | loaded | wall / warm wall |", "|" + "---|" * 7]
     for key, label in (("fresh", "fresh install, no warm-up"), ("after_warmup", "after `peelapprox warmup`"),
                        ("warm", "warm (second process)")):
@@ -194,7 +209,11 @@ def main(argv: list[str] | None = None) -> int:
                          "(default: simulate hybrid) and exit")
     ap.add_argument("--detail", choices=list(ENTRY_POINTS), help="print what a cold run of this entry point "
                     "compiles, with exclusive compile times, and exit")
+    ap.add_argument("--no-bytecode", action="store_true", help="run the children with PYTHONDONTWRITEBYTECODE=1 "
+                    "(each compiles the sources it imports); default: Python's bytecode cache, as installed")
     args = ap.parse_args(argv)
+    global BYTECODE
+    BYTECODE = not args.no_bytecode
     if args.detail:
         print(detail(args.detail))
         return 0

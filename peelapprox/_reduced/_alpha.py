@@ -35,7 +35,6 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from scipy import integrate, special
 
 from .._compiled._jit import jitable
 from .._params import PeelParams
@@ -283,6 +282,8 @@ def airy_alpha(params: PeelParams, t, *, F_in: float, alpha_in: float, alphadot_
             f"x = -cbrt(R s/I) (t + F_in/s) at |x| = {x_far:.3g}, beyond {AIRY_X_MAX:g} where scipy's Ai/Bi are "
             f"NaN (|F_rate| too small or t too large): use wkb_alpha there (its error, wkb_error_bound, is "
             f"~|x|^-1.5)")
+    from scipy import special  # on first use: importing this module imports no scipy (docs/performance.md)
+
     ai0, aip0, bi0, bip0 = special.airy(x0)
     c1 = np.pi * (a_in * bip0 + ad_in / a * bi0)
     c2 = -np.pi * (a_in * aip0 + ad_in / a * ai0)
@@ -419,6 +420,8 @@ def alpha_numerical(params: PeelParams, t, *, F_in: float, alpha_in: float, alph
     tv = t.ravel()[order]
     if tv[-1] == 0.0:  # every time is the entry: nothing to integrate (solve_ivp needs a non-empty span)
         return np.full(t.shape, a_in), np.full(t.shape, ad_in)
+    from scipy import integrate  # on first use
+
     sol = integrate.solve_ivp(rhs, (0.0, float(tv[-1])), [a_in, ad_in], method="DOP853", t_eval=tv,
                               rtol=rtol, atol=atol)
     if sol.status != 0:

@@ -18,7 +18,6 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
-from scipy import integrate
 
 from .._observables import StickSlipObservables
 from .._params import PeelParams
@@ -119,6 +118,8 @@ def quasi_static_branch_time(
     # data inside the interval are break points of the quadrature (each piece is smooth)
     lo, hi = sorted((math.log(v_in), math.log(v_f)))
     knots = sorted({math.log(x) for t in params.force.tables for x in t[1] if lo < math.log(x) < hi})
+    from scipy import integrate  # on first use: importing this module imports no scipy (docs/performance.md)
+
     val, _ = integrate.quad(lambda w: integrand(math.exp(w)) * math.exp(w), math.log(v_in), math.log(v_f),
                             epsabs=0.0, epsrel=1e-11, limit=max(200, 4 * len(knots)), points=knots or None)
     return val

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 from typing import Any, cast
 
 import numpy as np
-from scipy.optimize import brentq
 
+from .._brentq import brentq
 from ._abi import LAW_FP, LAW_FPP, unused_law
 from ._folds import BREAKDOWN_LEVEL, BranchStructure
 

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
-from scipy.optimize import brentq
+
+from .._brentq import brentq
 
 __all__ = ["BRANCHES", "BREAKDOWN_LEVEL", "BranchStructure", "Folds", "find_folds"]
 

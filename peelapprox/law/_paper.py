@@ -16,8 +16,8 @@ import math
 from typing import Any, cast
 
 import numpy as np
-from scipy.optimize import brentq
 
+from .._brentq import brentq
 from .._checks import choice, in_range, reals
 from .._compiled import _generated as _g
 from .._compiled._jit import kernel
@@ -136,7 +136,7 @@ def _folds_and_landings(V: float) -> BranchStructure:
     f_zero = float(130.0 + b)
     if _fp(v_inf, b, A) >= 0:
         return BranchStructure(V, False, v_inflection=v_inf, f_zero=f_zero)
-    kw = dict(args=(b, A), xtol=1e-300, rtol=4 * np.finfo(float).eps)
+    kw: dict[str, Any] = dict(args=(b, A), xtol=1e-300, rtol=4 * np.finfo(float).eps)
     v_max = brentq(_fp, _V_LO, v_inf, **kw)
     v_min = brentq(_fp, v_inf, _V_HI, **kw)
     f_max = float(_g.peel_force_fp(v_max, b, A)[0])
