@@ -171,9 +171,11 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         return no_map
     lo = ReturnMap(params, law, models, rtol, math.inf if max_wall is None else t_wall + max_wall)
     maps, names = (lo, lo.at(NEWTON_RTOL)), ("solver", "rest") if start == "auto" else (start,)
-    found = [_from_start(params, maps, _solver_start(params, law) if name == "solver" else _rest(law), name,
+    solver = _solver_start(params, law) if "solver" in names else None
+    found = [_from_start(params, maps, solver if name == "solver" and solver is not None else _rest(law), name,
                          n_transient, n_returns, rtol, chain, common) for name in names]
-    probe = _probe(params, law, rtol, lo.deadline, lo.book) if "solver" in names and models != FULL_CHAIN else None
+    probe = _probe(params, law, solver, rtol, lo.deadline, lo.book) if solver is not None and models != FULL_CHAIN \
+        else None
     primary = _assemble(found, "no stick-slip (stable fixed point)" if velocity == "stable"
                         else f"{inertia} inertia, {velocity} V", probe)  # the regime label of estimate()
     if warn:
@@ -408,16 +410,17 @@ def _marginal(f: _Found) -> bool:
     return undecided(f.obs) or any(undecided(o) for o in f.left)
 
 
-def _probe(params: PeelParams, law: Any, rtol: float, deadline: float, book: dict | None = None) -> str | None:
-    """Why the exact model breaks down from the solver's start where the default chain may not: the full branch
-    dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
+def _probe(params: PeelParams, law: Any, start: Start, rtol: float, deadline: float,
+           book: dict | None = None) -> str | None:
+    """Why the exact model breaks down from the solver's start (``start``) where the default chain may not: the full
+    branch dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
     :data:`PROBE_RETURNS` returns; None if it does not (a probe found, of 200 random points, 3 where the exact run
     breaks down got a stick-slip prediction; at V = 0.903, I = 1.08e-4 Airy1 + approxvdot's first CD stay lasts
     2.6 ms and lands at 247 N where the exact one lasts 11.2 ms and lands at 162 N, with α = 0.2, whose swing on
     AB then reaches f(0+, V): the O(α) terms of the default chain, not the physics)."""
     m = ReturnMap(params, law, FULL_CHAIN, rtol, deadline, book)
     try:
-        m.run(m.enter(_solver_start(params, law)), PROBE_RETURNS)
+        m.run(m.enter(start), PROBE_RETURNS)
     except MapStop as stop:
         if stop.timeout or stop.plan is None or stop.plan.branch != "AB":
             return None

@@ -253,6 +253,12 @@ def jacobian(power: Callable[[np.ndarray, int], np.ndarray], x: np.ndarray, n: i
     return J
 
 
+def _scaled(d: np.ndarray, s: np.ndarray) -> float:
+    """``max |d / s|`` of finite vectors, in Python floats (numpy's quotients and maximum, without its per-call
+    cost)."""
+    return max(abs(a / b) for a, b in zip(d.tolist(), s.tolist()))
+
+
 def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | None:
     """The period-n orbit's point near ``x`` and ``D P^n`` there (multipliers: its eigenvalues), or None when the
     chord iteration (a forward-difference Jacobian at ``x``, renewed once after three steps) does not converge to
@@ -267,16 +273,16 @@ def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | Non
         J = jacobian(m.power, x, n, s, fx)
         for it in range(NEWTON_MAX_IT):
             r = fx - x
-            if np.max(np.abs(r / s)) < NEWTON_TOL:  # on the orbit already (a neutral direction need not be solved)
+            if _scaled(r, s) < NEWTON_TOL:  # on the orbit already (a neutral direction need not be solved)
                 return x, jacobian(m.power, x, n, s)
             try:
                 dx = np.linalg.solve(J - eye, -r)
             except np.linalg.LinAlgError:
                 return None
-            if not np.all(np.isfinite(dx)) or np.max(np.abs(dx / s)) > 0.5:
+            if not all(math.isfinite(d) for d in dx.tolist()) or (step := _scaled(dx, s)) > 0.5:
                 return None
             x = x + dx
-            if np.max(np.abs(dx / s)) < NEWTON_TOL:
+            if step < NEWTON_TOL:
                 return x, jacobian(m.power, x, n, s)
             fx = m.power(x, n)
             if it == 2:
