@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import operator
 import time
 from typing import Any
 
@@ -277,7 +278,7 @@ def _candidates(F: np.ndarray, scale: float, rtol: float = CANDIDATE_RTOL) -> li
         m = max(2 * n, 6)
         if size < m + n:
             break
-        mismatch[n] = max(abs(a - b) for a, b in zip(x[k - m:], x[k - m - n:k - n])) / scale
+        mismatch[n] = max(map(abs, map(operator.sub, x[k - m:], x[k - m - n:k - n]))) / scale
     out: list[int] = []
     for n, r in sorted(mismatch.items(), key=lambda item: item[1]):
         if r >= rtol:
