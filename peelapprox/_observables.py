@@ -25,13 +25,15 @@ On a periodic attractor (period n) each mean is taken over the last whole cycles
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, cast
 
 import numpy as np
 
-from ._returnmap import HasJumps, _trajectory, periodicity
+from ._checks import MAX_COUNT
+from ._returnmap import HasJumps, _periodicity, _trajectory, periodicity
 from .io import fmt_number, html_table, jsonable, optional_import
 from .law import BRANCHES, fixed_point
 from .validate import duration, integer, positive
@@ -58,10 +60,20 @@ def _quantity(unit: str, role: str) -> Any:
 
 
 def _mean_spread(x: np.ndarray) -> tuple[float | None, float | None]:
-    """The mean and the sample standard deviation (ddof 1; 0 for one value) of ``x``, (None, None) if empty."""
-    if x.size == 0:
+    """The mean and the sample standard deviation (ddof 1; 0 for one value) of ``x``, (None, None) if empty.
+
+    numpy's ``mean`` and ``std`` arithmetic without their per-call cost (a reduced map reads the observables of
+    every orbit it finds): the sum by ``np.add.reduce`` divided by the size, the squared deviations from that mean
+    summed the same way, divided by ``size - 1``, and the square root (bitwise ``float(np.mean(x))`` and
+    ``float(np.std(x, ddof=1))`` of a float array)."""
+    n = x.size
+    if n == 0:
         return None, None
-    return float(np.mean(x)), float(np.std(x, ddof=1)) if x.size > 1 else 0.0
+    mean = np.add.reduce(x) / n
+    if n == 1:
+        return float(mean), 0.0
+    d = x - mean
+    return float(mean), math.sqrt(float(np.add.reduce(d * d) / (n - 1)))
 
 
 def _whole_cycles(x: np.ndarray, n: int | None) -> np.ndarray:
@@ -100,7 +112,11 @@ def jump_statistics(t: np.ndarray, F: np.ndarray, fb: np.ndarray, *, period_rtol
     samples = {"slip_interval": np.diff(t[slips]), "force_drop": F[to_cd] - F[to_cd + 1],
                "slip_time": t[to_cd + 1] - t[to_cd], "stick_time": t[to_ab + 1] - t[to_ab]}
     if slips.size >= 2:
-        per = periodicity(F[slips], rtol=period_rtol, max_period=max_period)
+        x = F[slips]
+        plain = (x.dtype == np.float64 and type(period_rtol) is float and 0.0 < period_rtol < math.inf
+                 and type(max_period) is int and 1 <= max_period <= MAX_COUNT and bool(np.isfinite(x).all()))
+        per = _periodicity(x, period_rtol, max_period) if plain else periodicity(x, rtol=period_rtol,
+                                                                                  max_period=max_period)
         period, label = per.period, per.label
     else:
         period, label = None, "too short" if slips.size else "no stick-slip"

@@ -149,6 +149,13 @@ def periodicity(
     max_period, min_repeats = integer("max_period", max_period), integer("min_repeats", min_repeats)
     if x.ndim != 1 or x.size < 2:
         raise ValueError(f"x must be a 1-D finite sequence of at least 2 returns, got shape {x.shape}")
+    return _periodicity(x, rtol, int(max_period), int(min_repeats))
+
+
+def _periodicity(x: np.ndarray, rtol: float, max_period: int, min_repeats: int = 2) -> Periodicity:
+    """:func:`periodicity` of arguments it has checked: ``x`` a 1-D finite float array of at least 2 returns,
+    ``rtol`` a finite positive float, ``max_period`` and ``min_repeats`` positive ints (the observables of a reduced
+    map read a period for every orbit it finds, and these checks cost more than the search)."""
     scale = float(np.max(np.abs(x)))
     # differences of x / max|x| (in [-1, 1]): no overflow for |x| near the float maximum, and all-zero
     # returns (scale 0) are the constant sequence, mismatch 0

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import operator
 import time
 from typing import Any
 
@@ -172,9 +173,11 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         return no_map
     lo = ReturnMap(params, law, models, rtol, math.inf if max_wall is None else t_wall + max_wall)
     maps, names = (lo, lo.at(NEWTON_RTOL)), ("solver", "rest") if start == "auto" else (start,)
-    found = [_from_start(params, maps, _solver_start(params, law) if name == "solver" else _rest(law), name,
+    solver = _solver_start(params, law) if "solver" in names else None
+    found = [_from_start(params, maps, solver if name == "solver" and solver is not None else _rest(law), name,
                          n_transient, n_returns, rtol, chain, common) for name in names]
-    probe = _probe(params, law, rtol, lo.deadline, lo.book) if "solver" in names and models != FULL_CHAIN else None
+    probe = _probe(params, law, solver, rtol, lo.deadline, lo.book) if solver is not None and models != FULL_CHAIN \
+        else None
     primary = _assemble(found, "no stick-slip (stable fixed point)" if velocity == "stable"
                         else f"{inertia} inertia, {velocity} V", probe)  # the regime label of estimate()
     if warn:
@@ -243,20 +246,18 @@ class _Found:
         self.obs, self.left, self.alpha_max = obs, left, alpha_max
 
 
-def _observe(recs: list[tuple], F_next: float, *, period_rtol: float, max_period: int, how: str, chain: str,
+def _observe(recs: np.ndarray, F_next: float, *, period_rtol: float, max_period: int, how: str, chain: str,
              common: dict[str, Any], t0: float, **extra: Any) -> ApproximateAttractor:
-    """The observables of the returns ``recs`` (:meth:`ReturnMap.ret`'s records) and the next AB→CD force."""
+    """The observables of the returns ``recs`` (:meth:`ReturnMap.run`'s records) and the next AB→CD force; the
+    jump times are the stays summed in order from ``t0`` (``np.cumsum`` adds one after the other)."""
     m = len(recs)
     t = np.empty(2 * m + 1)
+    t[0], t[1::2], t[2::2] = t0, recs[:, 2], recs[:, 3]
+    t = np.cumsum(t)
     F = np.empty(2 * m + 1)
+    F[0:-1:2], F[1::2], F[-1] = recs[:, 0], recs[:, 1], F_next
     fb = np.zeros(2 * m + 1, dtype=int)
-    clock = t0
-    for i, r in enumerate(recs):
-        t[2 * i], F[2 * i] = clock, r[0]
-        clock += r[2]
-        t[2 * i + 1], F[2 * i + 1], fb[2 * i + 1] = clock, r[1], 1
-        clock += r[3]
-    t[-1], F[-1] = clock, F_next
+    fb[1::2] = 1
     stats, cycles = jump_statistics(t, F, fb, period_rtol=period_rtol, max_period=max_period)
     reason = (f"{stats['n_slips']} slips of the reduced return map ({how}), return map {stats['period_label']}"
               + (f"; means over the last {cycles} whole cycles" if cycles is not None else ""))
@@ -264,17 +265,21 @@ def _observe(recs: list[tuple], F_next: float, *, period_rtol: float, max_period
                                 **{**common, "t_start": float(t[0]), "t_end": float(t[-1])}, **extra)
 
 
-def _candidates(F: list[float], scale: float, rtol: float = CANDIDATE_RTOL) -> list[int]:
+def _candidates(F: np.ndarray, scale: float, rtol: float = CANDIDATE_RTOL) -> list[int]:
     """Periods n <= :data:`MAX_PERIOD` after which the last returns repeat to :data:`CANDIDATE_RTOL` of
     ``scale``, best repeating first, at most :data:`MAX_CANDIDATES`; a divisor of n that repeats nearly as well
-    (within 4 times n's mismatch, or 1e-3) stands for n (a period-2 orbit also repeats after 4)."""
-    x = np.asarray(F)
+    (within 4 times n's mismatch, or 1e-3) stands for n (a period-2 orbit also repeats after 4).  The largest
+    ``|F_k - F_(k-n)|`` over the last ``max(2n, 6)`` returns, in Python floats on the last 3 :data:`MAX_PERIOD`
+    returns (the same differences as numpy's, and the same maximum, without numpy's per-call cost)."""
+    size = len(F)
+    x = F[-3 * MAX_PERIOD:].tolist()
+    k = len(x)
     mismatch: dict[int, float] = {}
     for n in range(1, MAX_PERIOD + 1):
         m = max(2 * n, 6)
-        if x.size < m + n:
+        if size < m + n:
             break
-        mismatch[n] = float(np.max(np.abs(x[-m:] - x[-m - n:-n]))) / scale
+        mismatch[n] = max(map(abs, map(operator.sub, x[k - m:], x[k - m - n:k - n]))) / scale
     out: list[int] = []
     for n, r in sorted(mismatch.items(), key=lambda item: item[1]):
         if r >= rtol:
@@ -285,46 +290,62 @@ def _candidates(F: list[float], scale: float, rtol: float = CANDIDATE_RTOL) -> l
     return out[:MAX_CANDIDATES]
 
 
-def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, J: np.ndarray, returns: int, name: str,
-           chain: str, common: dict[str, Any]) -> tuple[ApproximateAttractor, list[tuple], float]:
+def _multipliers(J: np.ndarray) -> tuple[complex, ...]:
+    """The eigenvalues of ``J = D P^n``: the orbit's multipliers."""
+    return tuple(complex(m) for m in np.linalg.eigvals(J))
+
+
+def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, mu: tuple[complex, ...], returns: int,
+           name: str, chain: str, common: dict[str, Any]) -> tuple[ApproximateAttractor, np.ndarray, float]:
     """A periodic orbit's observables over whole cycles of the orbit itself (at Newton's tolerance), its records
-    and its mean force drop."""
+    and its mean force drop.  The first cycle is Newton's last ``P^n(x)`` where it ran it (the map's memo)."""
     hi = maps[1]
     cycles = 3  # the orbit itself: one cycle gives its means, three its period label (peelapprox.periodicity)
-    y, recs = hi.run(x, cycles * n)
-    mu = tuple(complex(m) for m in np.linalg.eigvals(J))
+    y, first = hi.run(x, n)
+    y, rest = hi.run(y, (cycles - 1) * n)
+    recs = np.concatenate((first, rest))
     rho = max(abs(m) for m in mu)
     kind = "stable" if rho < 1.0 else ("neutral" if rho <= 1.0 + NEUTRAL else "unstable")
     how = (f"{name} start, Newton on P^{n} after {returns} returns, {kind} "
            f"(|mu| {'/'.join(fmt_number(abs(m), 6) for m in mu)})")
     obs = _observe(recs, hi.force(0, float(y[0])), period_rtol=1e-6, max_period=n, how=how, chain=chain,
                    common=common, t0=0.0, multipliers=mu, start=name)
-    return obs, recs, float(np.mean([r[0] - r[1] for r in recs]))
+    return obs, recs, float(np.mean(recs[:, 0] - recs[:, 1]))
 
 
-def _alpha_max(recs: list[tuple]) -> float:
+def _alpha_max(recs: np.ndarray) -> float:
     """The largest |α| at a jump of the returns ``recs``."""
-    return max(max(abs(r[4]), abs(r[5])) for r in recs)
+    return float(np.max(np.abs(recs[:, 4:6])))
 
 
-def _deviation(recs: list[tuple], orbit: list[tuple], n: int) -> float:
+def _deviation(recs: np.ndarray, orbit: np.ndarray, n: int) -> float:
     """The largest deviation of the last n returns' AB→CD forces from the orbit's at the same phase."""
-    return max(abs(recs[-i][0] - orbit[(n - i) % n][0]) for i in range(1, n + 1))
+    return float(max(abs(recs[-i, 0] - orbit[(n - i) % n, 0]) for i in range(1, n + 1)))
 
 
-def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: list[tuple], name: str, chain: str,
-            common: dict[str, Any], rtol: float = CANDIDATE_RTOL
-            ) -> tuple[ApproximateAttractor, list[tuple], float, tuple[np.ndarray, np.ndarray], int] | None:
+def _periodic(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: np.ndarray, rtol: float
+              ) -> tuple[np.ndarray, np.ndarray, int] | None:
     """The periodic orbit Newton finds from ``x`` for a period n the returns ``recs`` propose (best first, those
-    repeating to ``rtol``): its observables, records, mean force drop, section point and n; None if none
-    converges."""
+    repeating to ``rtol``): its section point, ``D P^n`` there and n; None if none converges."""
     bs = maps[0].law.structure
-    for n in _candidates([r[0] for r in recs], float(bs.f_max - bs.f_min), rtol):
+    for n in _candidates(recs[:, 0], float(bs.f_max - bs.f_min), rtol):
         res = newton(maps[1], x.copy(), n)
         if res is not None:
-            obs, orbit, drop = _orbit(maps, res[0], n, res[1], maps[0].returns, name, chain, common)
-            return obs, orbit, drop, res, n
+            return res[0], res[1], n
     return None
+
+
+def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: np.ndarray, name: str, chain: str,
+            common: dict[str, Any], rtol: float = CANDIDATE_RTOL
+            ) -> tuple[ApproximateAttractor, np.ndarray, float, tuple[np.ndarray, np.ndarray], int] | None:
+    """The periodic orbit of :func:`_periodic`: its observables, records, mean force drop, section point and
+    ``D P^n`` there, and n; None if none converges."""
+    got = _periodic(maps, x, recs, rtol)
+    if got is None:
+        return None
+    xs, J, n = got
+    obs, orbit, drop = _orbit(maps, xs, n, _multipliers(J), maps[0].returns, name, chain, common)
+    return obs, orbit, drop, (xs, J), n
 
 
 def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start, name: str, n_transient: int,
@@ -337,11 +358,13 @@ def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start,
     try:
         x, recs = lo.run(lo.enter(s), min(n_transient, EARLY_RETURNS))
         if EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends the transient
-            got = _settle(maps, x, recs, name, chain, common, EARLY_RTOL)
-            if got is not None and max(abs(m) for m in got[0].multipliers or (1.0,)) < 1.0 - MULTIPLIER_ERROR:
-                return _Found(got[0], left, _alpha_max(got[1]))
+            early = _periodic(maps, x, recs, EARLY_RTOL)
+            mu = _multipliers(early[1]) if early is not None else (1.0,)
+            if early is not None and max(abs(m) for m in mu) < 1.0 - MULTIPLIER_ERROR:  # its observables only now
+                obs, orbit, _ = _orbit(maps, early[0], early[2], mu, lo.returns, name, chain, common)
+                return _Found(obs, left, _alpha_max(orbit))
             x, more = lo.run(x, n_transient - EARLY_RETURNS)
-            recs += more
+            recs = np.concatenate((recs, more))
         for _ in range(MAX_ESCAPES + 1):
             got = _settle(maps, x, recs, name, chain, common)
             if got is None:
@@ -393,16 +416,17 @@ def _marginal(f: _Found) -> bool:
     return undecided(f.obs) or any(undecided(o) for o in f.left)
 
 
-def _probe(params: PeelParams, law: Any, rtol: float, deadline: float, book: dict | None = None) -> str | None:
-    """Why the exact model breaks down from the solver's start where the default chain may not: the full branch
-    dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
+def _probe(params: PeelParams, law: Any, start: Start, rtol: float, deadline: float,
+           book: dict | None = None) -> str | None:
+    """Why the exact model breaks down from the solver's start (``start``) where the default chain may not: the full
+    branch dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
     :data:`PROBE_RETURNS` returns; None if it does not (a probe found, of 200 random points, 3 where the exact run
     breaks down got a stick-slip prediction; at V = 0.903, I = 1.08e-4 Airy1 + approxvdot's first CD stay lasts
     2.6 ms and lands at 247 N where the exact one lasts 11.2 ms and lands at 162 N, with α = 0.2, whose swing on
     AB then reaches f(0+, V): the O(α) terms of the default chain, not the physics)."""
     m = ReturnMap(params, law, FULL_CHAIN, rtol, deadline, book)
     try:
-        m.run(m.enter(_solver_start(params, law)), PROBE_RETURNS)
+        m.run(m.enter(start), PROBE_RETURNS)
     except MapStop as stop:
         if stop.timeout or stop.plan is None or stop.plan.branch != "AB":
             return None

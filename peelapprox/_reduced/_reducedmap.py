@@ -50,6 +50,8 @@ NEWTON_MAX_IT = 8
 #: Integration steps of one compiled call of returns (:meth:`ReturnMap.run`) at most: the wall-clock deadline is
 #: checked between calls (~10-30 ms of work each).
 STEP_CAP = 20_000
+#: Runs a map keeps (:attr:`ReturnMap.memo`) before it forgets them all: Newton's evaluations of one orbit.
+MEMO_SIZE = 32
 _CLOSED = {AM_SIN, AM_HARM, AM_EXP, AM_STATIC}
 _NO_T = np.empty(0)
 
@@ -83,6 +85,8 @@ class ReturnMap:
         self.omega = math.sqrt(self.fold[0] * R / params.I)
         self.returns = 0
         self.deadline = deadline
+        #: Runs kept by their section point's bytes and count (:meth:`run`), None: none kept.
+        self.memo: dict | None = None
         # run_segment's default horizon, its entry-independent part: 20 quasi-static passages of the fold gap
         self.horizon = 20.0 * (self.fold[0] - self.fold[1]) / (params.k * params.V)
         self.compiled = self.paper and not any(pl.alpha_model in _CLOSED for pl in self.plans)
@@ -96,7 +100,7 @@ class ReturnMap:
     def at(self, rtol: float) -> ReturnMap:
         """This map with its segments at the tolerance ``rtol`` (the same plans otherwise, not built again)."""
         other = copy.copy(self)
-        other.rtol, other.returns = rtol, 0
+        other.rtol, other.returns, other.memo = rtol, 0, {}
         other.plans = tuple(dataclasses.replace(pl, rtol=rtol) for pl in self.plans)
         return other
 
@@ -160,36 +164,52 @@ class ReturnMap:
                           self.returns)
         return y
 
-    def run(self, x: np.ndarray, n: int) -> tuple[np.ndarray, list[tuple[float, ...]]]:
-        """``n`` returns from ``x``: the last section point and the returns' records (:meth:`ret`'s), compiled
-        where the chain allows (:mod:`peelapprox._reduced._reducedmap_kernel`: the same numbers), else by
-        :meth:`ret`."""
+    def run(self, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` returns from ``x``: the last section point and the returns' records (:meth:`ret`'s, one row each,
+        shape ``(n, 6)``), compiled where the chain allows (:mod:`peelapprox._reduced._reducedmap_kernel`: the
+        same numbers), else by :meth:`ret`.  With :attr:`memo` set, the returns from a section point and count
+        already run are not run again (the same numbers: a return depends on its section point alone)."""
+        memo = self.memo
+        if memo is None:
+            return self._run(x, n)
+        key = (np.asarray(x, dtype=float).tobytes(), n)
+        if key in memo:
+            y, recs = memo[key]
+            self.returns += n
+            return y.copy(), recs
+        y, recs = self._run(x, n)
+        if len(memo) >= MEMO_SIZE:
+            memo.clear()
+        memo[key] = (y.copy(), recs)
+        return y, recs
+
+    def _run(self, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         if not self.compiled:
             recs = []
             for _ in range(n):
                 x, r = self.ret(x)
                 recs.append(r)
-            return x, recs
+            return x, np.array(recs, dtype=float).reshape(n, 6)
         x = np.array(x, dtype=float)
-        out: list[tuple[float, ...]] = []
         rows = np.empty((n, 6))
         info = np.zeros(4, dtype=np.int64)
         stop = np.empty(6)
         pl = self.plans
-        while len(out) < n:
+        got = 0
+        while got < n:
             if time.perf_counter() > self.deadline:
                 raise MapStop(None, None, self.returns, timeout=True)
-            self.loop(x, n - len(out), pl[0].q, pl[1].q, self.rows, pl[0].law_arg, pl[0].law.coef, self.rtol,
-                        self.horizon, STEP_CAP, rows, info, stop)
+            self.loop(x, n - got, pl[0].q, pl[1].q, self.rows, pl[0].law_arg, pl[0].law.coef, self.rtol,
+                      self.horizon, STEP_CAP, rows[got:], info, stop)
             done = int(info[RK.I_DONE])
             self.returns += done
-            out.extend(tuple(r) for r in rows[:done].tolist())
+            got += done
             if info[RK.I_CODE] != DONE:
                 plan = pl[int(info[RK.I_BRANCH])]
                 raise MapStop(plan, SegmentRun(int(info[RK.I_CODE]), stop[:5].copy(), np.empty((0, 5)),
                                                np.zeros(5, dtype=np.int64), plan.q, 0.0, 0.0, np.zeros(5),
                                                float(stop[5])), self.returns)
-        return x, out
+        return x, rows
 
     def ret(self, x: np.ndarray | tuple[float, float]) -> tuple[np.ndarray, tuple[float, ...]]:
         """One return from the section point ``x = (α, α̇)``: the next one, and ``(F at the AB→CD jump, F at the
@@ -233,6 +253,12 @@ def jacobian(power: Callable[[np.ndarray, int], np.ndarray], x: np.ndarray, n: i
     return J
 
 
+def _scaled(d: np.ndarray, s: np.ndarray) -> float:
+    """``max |d / s|`` of finite vectors, in Python floats (numpy's quotients and maximum, without its per-call
+    cost)."""
+    return max(abs(a / b) for a, b in zip(d.tolist(), s.tolist()))
+
+
 def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | None:
     """The period-n orbit's point near ``x`` and ``D P^n`` there (multipliers: its eigenvalues), or None when the
     chord iteration (a forward-difference Jacobian at ``x``, renewed once after three steps) does not converge to
@@ -247,16 +273,16 @@ def newton(m: Any, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray] | Non
         J = jacobian(m.power, x, n, s, fx)
         for it in range(NEWTON_MAX_IT):
             r = fx - x
-            if np.max(np.abs(r / s)) < NEWTON_TOL:  # on the orbit already (a neutral direction need not be solved)
+            if _scaled(r, s) < NEWTON_TOL:  # on the orbit already (a neutral direction need not be solved)
                 return x, jacobian(m.power, x, n, s)
             try:
                 dx = np.linalg.solve(J - eye, -r)
             except np.linalg.LinAlgError:
                 return None
-            if not np.all(np.isfinite(dx)) or np.max(np.abs(dx / s)) > 0.5:
+            if not all(math.isfinite(d) for d in dx.tolist()) or (step := _scaled(dx, s)) > 0.5:
                 return None
             x = x + dx
-            if np.max(np.abs(dx / s)) < NEWTON_TOL:
+            if step < NEWTON_TOL:
                 return x, jacobian(m.power, x, n, s)
             fx = m.power(x, n)
             if it == 2:

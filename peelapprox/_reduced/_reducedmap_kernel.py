@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numba import types as _t
 
+from .._compiled._dop853 import workspace
 from .._compiled._jit import compile_only, kernel, rebind
 from .._packing import M_I, M_R
 from .._status import DONE
@@ -39,15 +40,15 @@ N_B = 11
 # the outputs' layout: info = (returns done, status, branch of the stop, steps), stop = final state and t_max
 I_DONE, I_CODE, I_BRANCH, I_STEPS = range(4)
 
-#: The segment driver copy :func:`_returns` calls (bound per copy, :data:`_COPIES`); never compiled unbound.
-_RUN: Any = None
+#: The segment driver body copy :func:`_returns` calls (:data:`peelapprox._reduced._segment_kernel._DRIVES`, bound
+#: per copy, :data:`_COPIES`); never compiled unbound.
+_DRIVE: Any = None
 
 
-def _stay(y, q0, b, row, law, coef, rtol, horizon, F, a, ad, atol, cnt, stop, dummy_t, dummy_out):
+def _stay(y, q, b, row, law, coef, rtol, horizon, F, a, ad, atol, cnt, stop, dummy_t, dummy_out, ws):
     """One stay on branch ``row`` from ``(F, α, α̇)`` (:meth:`peelapprox._reduced._reducedmap.ReturnMap.lean`'s
-    arithmetic);
-    y holds the final state; the driver's status."""
-    q = q0.copy()
+    arithmetic) in the call's workspace ``ws``; ``q`` is the branch's parameter vector, whose entry fields are
+    written here (the rest as the plan's); y holds the final state; the driver's status."""
     R, I = q[M_R], q[M_I]
     q[K.Q_FIN] = F
     q[K.Q_VIN] = b[row, B_VIN]
@@ -74,8 +75,10 @@ def _stay(y, q0, b, row, law, coef, rtol, horizon, F, a, ad, atol, cnt, stop, du
     for i in range(5):
         cnt[i] = 0
     stop[5] = t_max
-    return _RUN(y, q, law, coef, rtol, atol, b[row, B_XF], b[row, B_XLO], b[row, B_XHI], b[row, B_UP] > 0.5, t_max,
-                np.int64(b[row, B_STEPS]), np.int64(K.SAVE_NONE), dummy_t, dummy_out, cnt)
+    K_, y_new, f0, tmp, sc, work, Fc, ye = ws
+    return _DRIVE(y, q, law, coef, rtol, atol, b[row, B_XF], b[row, B_XLO], b[row, B_XHI], b[row, B_UP] > 0.5,
+                  t_max, np.int64(b[row, B_STEPS]), np.int64(K.SAVE_NONE), dummy_t, dummy_out, cnt, K_, y_new, f0, tmp,
+                  sc, work, Fc, ye)
 
 
 def _returns(x, n, q_ab, q_cd, b, law, coef, rtol, horizon, step_cap, recs, info, stop):
@@ -85,6 +88,9 @@ def _returns(x, n, q_ab, q_cd, b, law, coef, rtol, horizon, step_cap, recs, info
     the stopping segment's final state and horizon."""
     y = np.empty(5)
     atol = np.empty(5)
+    ws = workspace(5)  # one workspace and one parameter vector per branch for all the stays of the call
+    qa = q_ab.copy()
+    qc = q_cd.copy()
     cnt = np.zeros(5, dtype=np.int64)
     dummy_t = np.empty(0)
     dummy_out = np.empty((1, 5))
@@ -95,16 +101,16 @@ def _returns(x, n, q_ab, q_cd, b, law, coef, rtol, horizon, step_cap, recs, info
     while done < n and steps < step_cap:
         a0, ad = x[0], x[1]
         F = b[1, B_FOLD] / (1.0 + np.sin(a0))
-        code = _stay(y, q_cd, b, 1, law, coef, rtol, horizon, F, a0, ad + b[1, B_KICK], atol, cnt, stop, dummy_t,
-                     dummy_out)
+        code = _stay(y, qc, b, 1, law, coef, rtol, horizon, F, a0, ad + b[1, B_KICK], atol, cnt, stop, dummy_t,
+                     dummy_out, ws)
         steps += cnt[K.C_STEPS]
         if code != DONE:
             info[I_CODE], info[I_BRANCH] = code, 1
             break
         t_cd, a, ad = y[0], y[3], y[4]
         G = b[0, B_FOLD] / (1.0 + np.sin(a))
-        code = _stay(y, q_ab, b, 0, law, coef, rtol, horizon, G, a, ad + b[0, B_KICK], atol, cnt, stop, dummy_t,
-                     dummy_out)
+        code = _stay(y, qa, b, 0, law, coef, rtol, horizon, G, a, ad + b[0, B_KICK], atol, cnt, stop, dummy_t,
+                     dummy_out, ws)
         steps += cnt[K.C_STEPS]
         if code != DONE:
             info[I_CODE], info[I_BRANCH] = code, 0
@@ -126,7 +132,7 @@ RETURNS_SIG = _t.void(_A1, _t.int64, _A1, _A1, _t.float64[:, ::1], LAW_TYPE, _A1
 
 
 def _copy(law_argument: bool) -> Any:
-    stay = kernel(rebind(_stay, _RUN=K._RUNS[law_argument]), inline="always",
+    stay = kernel(rebind(_stay, _DRIVE=K._DRIVES[law_argument]), inline="always",
                   name=f"reduced_stay_{'law' if law_argument else 'inlined'}")
     return kernel(rebind(_returns, _stay=stay), name=f"reduced_returns_{'law' if law_argument else 'inlined'}")
 

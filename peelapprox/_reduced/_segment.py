@@ -60,17 +60,19 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple, cast
 
 import numpy as np
 
+from .._compiled import _generated as _g
 from .._compiled._jit import wrapper_address as _wrapper_address
 from .._packing import model_block
 from .._params import PeelParams
 from .._ranges import TIME_MAX
 from .._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V_FLOOR, status_error
-from ..law import ALL_LAWS, BRANCHES, peel_force_derivative
+from ..law import ALL_LAWS, BRANCHES
 from ..law._abi import LAW_SIG, LAW_TYPE
 from ..law._compiled import CompiledLaw, compiled_law
 from ..validate import choice, duration, integer, optional, optional_finite, reals, times
@@ -376,6 +378,12 @@ def _segment_error(plan: SegmentPlan, a: _Arguments, run: SegmentRun, res: Reduc
 # and field of the public function, without its per-call checks.
 
 
+#: The compiled laws' addresses, looked up once per law while it lives: the lookup (~0.25 ms: numba's compile
+#: result and LLVM's function table) is the same for every plan of the law, and a reduced map builds three plans
+#: per call.
+_ADDRESSES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 class _LawAddress:
     """A compiled law passed to the driver by its cached address (numba's wrapper-address protocol).
 
@@ -391,7 +399,10 @@ class _LawAddress:
 
     def __init__(self, fn: Any) -> None:
         self.fn = fn  # keeps the compiled law, and so its address, alive
-        self.address = _wrapper_address(fn, LAW_SIG)
+        address = _ADDRESSES.get(fn)
+        if address is None:
+            address = _ADDRESSES[fn] = _wrapper_address(fn, LAW_SIG)
+        self.address = address
 
     def __wrapper_address__(self) -> int:
         return self.address
@@ -447,6 +458,13 @@ class SegmentRun(NamedTuple):
     t_max: float
 
 
+def _paper_fp(v: float, V: float) -> float:
+    """fvV's ``f'(v, V)`` at a velocity and pull speed already checked: :func:`peelapprox.peel_force_derivative`'s
+    arithmetic (the generated kernel on a 0-d float array) without its argument checks (bitwise its value)."""
+    b, A = _g.peel_force_coefficients(float(V))
+    return float(_g.peel_force_fpp(np.asarray(float(v)), b, A)[1])
+
+
 def segment_plan(params: PeelParams, law: CompiledLaw, branch: str, *, v_in: float, v_f: float, alpha_model: str,
                  v_equation: str, F_rate: float | None, rtol: float, t_max: float | None,
                  max_steps: int) -> SegmentPlan:
@@ -454,7 +472,7 @@ def segment_plan(params: PeelParams, law: CompiledLaw, branch: str, *, v_in: flo
     :func:`reduced_segment` checks them: velocities on the branch and in the law's domain, known models)."""
     am = ALPHA_MODELS.index(alpha_model)
     s = _frozen_rate(params, v_in) if F_rate is None else F_rate
-    fp_in = float(peel_force_derivative(v_in, params.V)) if law.inlined else law.df(v_in)
+    fp_in = _paper_fp(v_in, params.V) if law.inlined else law.df(v_in)
     q = model_block(params, K.N_Q, ALL_LAWS)
     q[K.Q_AM] = am
     q[K.Q_VE] = V_EQUATIONS.index(v_equation)

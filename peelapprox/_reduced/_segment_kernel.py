@@ -184,13 +184,24 @@ def alpha_at(y: np.ndarray, q: np.ndarray) -> tuple[float, float]:
 _FIELD: Any = None
 _PACK: Any = None
 _dop: Any = None
+#: The body :func:`_drive` of the copy a driver :func:`_run` calls (bound per copy, :data:`_DRIVES`).
+_DRIVE: Any = None
 
 
 def _run(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt):
     """Integrate from y until ln v crosses x_f (upward or downward); y holds the final state.  The peel force is
-    ``law`` with ``coef``, or the paper's law inlined (:func:`run`)."""
-    P = _PACK(q, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
+    ``law`` with ``coef``, or the paper's law inlined (:func:`run`).  :func:`_drive` with a workspace of its own."""
     K, y_new, f0, tmp, sc, work, Fc, ye = workspace(5)
+    return _DRIVE(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out,
+                  cnt, K, y_new, f0, tmp, sc, work, Fc, ye)
+
+
+def _drive(y, q, law, coef, rtol, atol, x_f, x_lo, x_hi, upward, t_max, max_steps, save_mode, t_eval, out, cnt, K,
+           y_new, f0, tmp, sc, work, Fc, ye):
+    """:func:`_run` in the workspace ``K, y_new, f0, tmp, sc, work, Fc, ye``
+    (:func:`peelapprox._compiled._dop853.workspace` of 5; every entry written before it is read, so a caller running
+    many segments allocates it once: :mod:`peelapprox._reduced._reducedmap_kernel`)."""
+    P = _PACK(q, law, coef)  # what the field receives through the DOP853 pieces (placeholders above)
     cap = out.shape[0]
     n_te = t_eval.shape[0]
 
@@ -270,12 +281,18 @@ _A1 = _t.float64[::1]
 RUN_SIG = _t.int64(_A1, _A1, LAW_TYPE, _A1, _t.float64, _A1, _t.float64, _t.float64, _t.float64, _t.boolean,
                    _t.float64, _t.int64, _t.int64, _A1, _t.float64[:, ::1], _t.int64[::1])
 
-#: The two copies of :func:`_run`: the paper's law inlined (False) and the law as an argument (True).
-_RUNS = {
-    False: kernel(rebind(_run, _FIELD=field, _PACK=pack_inlined, _dop=make_dop853(field)), name="segment_run_inlined"),
-    True: kernel(rebind(_run, _FIELD=field_law, _PACK=pack_law, _dop=make_dop853(field_law)),
-                 name="segment_run_law"),
+#: The two copies of :func:`_drive` (compiled into their callers): the paper's law inlined (False) and the law as
+#: an argument (True).
+_DRIVES = {
+    False: kernel(rebind(_drive, _FIELD=field, _PACK=pack_inlined, _dop=make_dop853(field)),
+                  name="segment_drive_inlined", inner=True),
+    True: kernel(rebind(_drive, _FIELD=field_law, _PACK=pack_law, _dop=make_dop853(field_law)),
+                 name="segment_drive_law", inner=True),
 }
+#: The two copies of :func:`_run`: the paper's law inlined (False) and the law as an argument (True).
+_RUNS = {law_argument: kernel(rebind(_run, _DRIVE=_DRIVES[law_argument]),
+                              name=f"segment_run_{'law' if law_argument else 'inlined'}")
+         for law_argument in (False, True)}
 
 
 def run(law_argument: bool) -> Any:
