@@ -366,14 +366,22 @@ def test_kill_and_resume(tmp_path, monkeypatch):
     assert load_atlas(out).sweep.records == fresh.sweep.records
 
 
-def test_cli_atlas(tmp_path, capsys):
+@pytest.mark.parametrize("approximations", [
+    ["--approximations", "estimate"],
+    pytest.param([], marks=pytest.mark.slow, id="every-approximation"),
+], ids=lambda a: "-".join(a[1:]) or "every-approximation")
+def test_cli_atlas(tmp_path, capsys, approximations):
     """Hypothesis: ``peelapprox atlas`` on a 1 x 2 grid exits 0, writes the records, the four tables as CSV and
     JSON and (``--plot``) the maps as PNG, and prints the summary, equal to ``load_atlas(DIR).summary()``
     (exact equality through JSON); the same command again resumes (computes nothing: the records unchanged); a
-    bad ``--V`` is exit status 2 naming it.  Categorical and exact."""
+    bad ``--V`` is exit status 2 naming it.  Categorical and exact.
+
+    The default tier runs one approximation (``--approximations estimate``: 9 maps, each error map drawn by the
+    same ``plot_error_map``); every registered approximation (33 maps, ~45 s CPU of matplotlib) is the slow
+    case, covered in the default tier by the ``estimate`` case (the same command, map writer and checks)."""
     out = tmp_path / "at"
     argv = ["atlas", "--V", "0.5,1", "--I", "1e-5", "--out", str(out), "--workers", "0", "--t-transient", "10",
-            "--window", "5", "--segments", "2", "--format", "json", "--quiet"]
+            "--window", "5", "--segments", "2", *approximations, "--format", "json", "--quiet"]
     assert main(argv + ["--plot"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary == json.loads(json.dumps(load_atlas(out).summary()))
