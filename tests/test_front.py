@@ -250,28 +250,25 @@ def test_pattern_rules():
 def test_cli_front(tmp_path, capsys):
     """``peelapprox front`` runs a small front, prints its summary as JSON (the counters equal the library's for
     the same call: the CLI adds nothing of its own), writes the series and the space-time image; a missing ``--N`` is
-    exit status 2 naming it (checked in this process: the parser is the same, a second interpreter adds only its
-    start-up)."""
+    exit status 2 naming it.  Run in this process through ``peelapprox.cli.main`` (the command ``python -m
+    peelapprox`` calls; that entry itself is tests/test_cli_conventions.py's): a second interpreter would add only
+    its start-up, ~3 s CPU."""
     import json
-    import subprocess
-    import sys
+
+    from peelapprox.cli import main
 
     out, png = tmp_path / "s.csv", tmp_path / "f.png"
-    cmd = [sys.executable, "-m", "peelapprox", "front", "--V", "1", "--I", "1e-2", "--tape-mass", "1e-3", "--N", "4",
-           "--gamma", "0.05", "--delta0", "0.01", "--t-end", "0.004", "--format", "json", "--out", str(out),
-           "--plot", str(png)]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-    assert r.returncode == 0, r.stderr
-    row = json.loads(r.stdout)
+    argv = ["front", "--V", "1", "--I", "1e-2", "--tape-mass", "1e-3", "--N", "4", "--gamma", "0.05", "--delta0",
+            "0.01", "--t-end", "0.004", "--format", "json", "--out", str(out), "--plot", str(png)]
+    capsys.readouterr()
+    assert main(argv) == 0
+    row = json.loads(capsys.readouterr().out)
     fp = FrontParams(base=BASE, N=4, gamma=0.05, delta0=0.01)
     tr = exact.simulate_front(fp, 0.004, store_front=False)
     assert row["steps"] == tr.stats.n_steps and row["jumps"] == len(tr.jumps)
     assert out.read_text().count("\n") == len(tr.t) + 1 and png.stat().st_size > 1000
-    from peelapprox.cli import main
-
-    capsys.readouterr()
     with pytest.raises(SystemExit) as bad:
-        main(cmd[3:9] + ["0", "--t-end", "0.004"])
+        main(argv[:6] + ["0", "--t-end", "0.004"])
     assert bad.value.code == 2 and "--N" in capsys.readouterr().err
 
 
