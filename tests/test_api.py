@@ -217,32 +217,48 @@ def test_version_single_sourced():
     assert version("peelapprox") == peelapprox.__version__
 
 
-def test_import_peelapprox_does_not_import_exact():
+#: One fresh interpreter for the three import checks below (each reads its own lines): the steps run in the
+#: order that keeps each check valid (``import peelapprox`` alone first, then the lazy names, then every
+#: package, then drawing); one interpreter start-up instead of three.
+FRESH_CODE = (
+    "import sys, peelapprox\n"
+    "print(sorted(m for m in sys.modules if m.split('.')[0] in ('exact', 'comparisons')))\n"
+    "print({'lyapunov', 'attractors', 'LyapunovResult', 'sweep'} <= set(dir(peelapprox)))\n"
+    "f = peelapprox.lyapunov; import exact; from peelapprox import Attractor\n"
+    "print(f is exact.lyapunov, Attractor is exact.Attractor)\n"
+    "print('comparisons.sweep' in sys.modules, end=' '); peelapprox.MEASURES\n"
+    "print('comparisons.sweep' in sys.modules)\n"
+    "import peelapprox.cli, peelapprox.plotting, comparisons, comparisons.benchmark\n"
+    "print('matplotlib' in sys.modules)\n"
+    "peelapprox.plotting.pyplot()\n"
+    "print('matplotlib.pyplot' in sys.modules)\n"
+)
+
+
+@pytest.fixture(scope="module")
+def fresh() -> list[str]:
+    """The lines :data:`FRESH_CODE` prints in a fresh interpreter (this one has imported everything already)."""
+    proc = subprocess.run([sys.executable, "-c", FRESH_CODE], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout.splitlines()
+
+
+def test_import_peelapprox_does_not_import_exact(fresh):
     """The rooms: the core imports no sibling package; the names it offers that live in ``exact``
     (the Lyapunov family, attractors) are imported on first access.  Hypothesis, in a fresh interpreter:
     after ``import peelapprox`` ``exact`` is not in ``sys.modules``; ``dir(peelapprox)`` lists the lazy names;
     accessing ``peelapprox.lyapunov`` imports ``exact`` and gives the very object ``exact.lyapunov``
     (identity, categorical)."""
-    code = ("import sys, peelapprox; assert 'exact' not in sys.modules, 'exact imported'; "
-            "assert {'lyapunov', 'attractors', 'LyapunovResult'} <= set(dir(peelapprox)); "
-            "f = peelapprox.lyapunov; import exact; assert f is exact.lyapunov; "
-            "from peelapprox import Attractor; assert Attractor is exact.Attractor; print('ok')")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+    assert fresh[0] == "[]", "exact imported"
+    assert fresh[1] == "True" and fresh[2] == "True True", fresh
 
 
-def test_import_peelapprox_imports_no_sibling_package():
+def test_import_peelapprox_imports_no_sibling_package(fresh):
     """Hypothesis: ``import peelapprox`` loads neither ``exact`` nor ``comparisons`` (the rooms' one-way
-    doors); the sweep names it offers are imported from ``comparisons.sweep`` on first access only.  A fresh
-    interpreter, since this one has imported everything already."""
-    code = ("import sys, peelapprox\n"
-            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('exact', 'comparisons')))\n"
-            "assert 'sweep' in dir(peelapprox)\n"
-            "peelapprox.MEASURES\n"
-            "print('comparisons.sweep' in sys.modules)\n")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.split() == ["[]", "True"], proc.stdout
+    doors); the sweep names it offers are imported from ``comparisons.sweep`` on first access only (not before
+    it, not by ``exact``).  A fresh interpreter, since this one has imported everything already."""
+    assert fresh[0] == "[]", fresh
+    assert fresh[1] == "True" and fresh[3] == "False True", fresh
 
 
 def test_sweep_names_are_the_same_objects_both_ways():
@@ -259,13 +275,7 @@ def test_sweep_names_are_the_same_objects_both_ways():
         peelapprox.nosuch  # noqa: B018 - the lazy __getattr__ still refuses unknown names
 
 
-def test_matplotlib_is_imported_by_plotting_only():
+def test_matplotlib_is_imported_by_plotting_only(fresh):
     """One matplotlib set-up (:func:`peelapprox.plotting.pyplot`): importing the packages, the CLI and
     the plotting module itself loads no matplotlib; drawing does.  Fresh interpreter (categorical: module set)."""
-    code = ("import sys, peelapprox, peelapprox.cli, peelapprox.plotting, exact, comparisons, comparisons.benchmark\n"
-            "print('matplotlib' in sys.modules)\n"
-            "peelapprox.plotting.pyplot()\n"
-            "print('matplotlib.pyplot' in sys.modules)\n")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.split() == ["False", "True"], proc.stdout
+    assert fresh[4:] == ["False", "True"], fresh

@@ -366,23 +366,37 @@ def test_kill_and_resume(tmp_path, monkeypatch):
     assert load_atlas(out).sweep.records == fresh.sweep.records
 
 
-def test_cli_atlas(tmp_path, capsys):
+@pytest.mark.parametrize("approximations", [
+    ["--approximations", "estimate"],
+    pytest.param([], marks=pytest.mark.slow, id="every-approximation"),
+], ids=lambda a: "-".join(a[1:]) or "every-approximation")
+def test_cli_atlas(tmp_path, capsys, approximations):
     """Hypothesis: ``peelapprox atlas`` on a 1 x 2 grid exits 0, writes the records, the four tables as CSV and
     JSON and (``--plot``) the maps as PNG, and prints the summary, equal to ``load_atlas(DIR).summary()``
     (exact equality through JSON); the same command again resumes (computes nothing: the records unchanged); a
-    bad ``--V`` is exit status 2 naming it.  Categorical and exact."""
+    bad ``--V`` is exit status 2 naming it.  Categorical and exact.
+
+    The default tier runs one approximation (``--approximations estimate``) and draws no maps: ``--plot`` and
+    every kind of map (dynamics, errors, segments, sets) are drawn in the default tier by
+    tests/test_atlas_sets.py's ``test_cli_sets_tables_and_maps`` (~1 s CPU of matplotlib per map).  Every
+    registered approximation with ``--plot`` (33 maps, ~45 s CPU) is the slow case, covered in the default tier
+    by the ``estimate`` case and that test (the same command, map writer and checks)."""
     out = tmp_path / "at"
     argv = ["atlas", "--V", "0.5,1", "--I", "1e-5", "--out", str(out), "--workers", "0", "--t-transient", "10",
-            "--window", "5", "--segments", "2", "--format", "json", "--quiet"]
-    assert main(argv + ["--plot"]) == 0
+            "--window", "5", "--segments", "2", *approximations, "--format", "json", "--quiet"]
+    plot = not approximations
+    assert main(argv + ["--plot"] * plot) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary == json.loads(json.dumps(load_atlas(out).summary()))
     for table in ("points", "errors", "segments", "summary"):
         assert (out / f"atlas_{table}.csv").is_file() and (out / f"atlas_{table}.json").is_file()
-    maps = sorted(p.name for p in (out / "maps").iterdir())
-    assert "dynamics.png" in maps and "error_estimate_slip_interval.png" in maps
-    assert len(maps) == 1 + 6 * len(load_atlas(out).approximations) + 2
-    assert all((out / "maps" / m).stat().st_size > 10_000 for m in maps)
+    if plot:
+        maps = sorted(p.name for p in (out / "maps").iterdir())
+        assert "dynamics.png" in maps and "error_estimate_slip_interval.png" in maps
+        assert len(maps) == 1 + 6 * len(load_atlas(out).approximations) + 2
+        assert all((out / "maps" / m).stat().st_size > 10_000 for m in maps)
+    else:
+        assert not (out / "maps").exists()
     before = (out / "results.jsonl").read_text()
     assert main(argv) == 0
     assert (out / "results.jsonl").read_text() == before

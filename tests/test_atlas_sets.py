@@ -142,12 +142,14 @@ def test_set_records_against_direct_calls(both):
 
 def test_cli_sets_tables_and_maps(tmp_path, capsys):
     """Hypothesis: ``peelapprox atlas --sets`` on a 1 x 2 grid exits 0, writes the ``sets`` and ``set_summary``
-    tables (CSV and JSON) and, with ``--plot``, the multistability and confidence maps (PNG, > 10 kB); its printed
-    summary is ``load_atlas(DIR).summary()`` (exact, through JSON) and ends with the four set rows.  Without
-    ``--sets`` neither table is written."""
+    tables (CSV and JSON) and, with ``--plot``, every map of the atlas (PNG, > 10 kB): the dynamics map, the
+    approximation's six error maps, the two segment maps (``--segments 2``) and the multistability and confidence
+    maps; its printed summary is ``load_atlas(DIR).summary()`` (exact, through JSON) and ends with the four set
+    rows.  Without ``--sets`` neither table is written.  (The default tier's one ``--plot`` of an atlas: every
+    kind of map once.)"""
     out = tmp_path / "at"
     argv = ["atlas", "--V", "0.5,2", "--I", "1e-5", "--out", str(out), "--workers", "0", "--t-transient", "5",
-            "--window", "3", "--segments", "0", "--approximations", "estimate", "--format", "json", "--quiet"]
+            "--window", "3", "--segments", "2", "--approximations", "estimate", "--format", "json", "--quiet"]
     assert main(argv + ["--sets", "--plot"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary == json.loads(json.dumps(load_atlas(out).summary()))
@@ -155,8 +157,11 @@ def test_cli_sets_tables_and_maps(tmp_path, capsys):
                                                       "unflagged_share"]
     for table in ("sets", "set_summary"):
         assert (out / f"atlas_{table}.csv").is_file() and (out / f"atlas_{table}.json").is_file()
-    for m in ("multistability.png", "confidence.png"):
-        assert (out / "maps" / m).stat().st_size > 10_000
+    maps = sorted(p.name for p in (out / "maps").iterdir())
+    assert {"dynamics.png", "error_estimate_slip_interval.png", "segments_dt_median.png", "segments_dF_median.png",
+            "multistability.png", "confidence.png"} <= set(maps)
+    assert len(maps) == 1 + 6 + 2 + 2
+    assert all((out / "maps" / m).stat().st_size > 10_000 for m in maps)
     plain = tmp_path / "plain"
     assert main([*argv[:6], str(plain), *argv[7:]]) == 0
     assert not (plain / "atlas_sets.csv").exists()

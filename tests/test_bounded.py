@@ -215,13 +215,18 @@ def test_sweep_refuses_a_grid_too_large_at_once(tmp_path):
     assert not (tmp_path / "s").exists()
 
 
-@pytest.mark.parametrize("workers", [0, 2], ids=["serial", "pool"])
+@pytest.mark.parametrize("workers", [pytest.param(0, marks=pytest.mark.slow), 2], ids=["serial", "pool"])
 def test_sweep_writes_its_manifest_first_and_stops_at_max_wall(tmp_path, workers):
     """20 points of the period measure (a 50 s run each, ~0.2 s) under a 0.5 s budget, in this process and on a
     pool of 2 spawned workers: the manifest exists before the first point is reported; the call raises
     ``SolverBudgetExceeded`` naming max_wall within :data:`BOUND`, with the points done recorded (fewer than 20:
     0.5 s cannot run them) and none of the points it cut; the same call without a budget then completes the
-    sweep, recording each point once (categorical counts)."""
+    sweep, recording each point once (categorical counts).
+
+    The serial case is slow (its 20-point completion, ~5 s CPU, is the pool case's); covered in the default tier
+    by the pool case (the same checks, the budget cut across processes) and by
+    ``test_cli_max_wall_bounds_each_command``'s sweep case (a serial sweep stopped by a 0.5 s budget, leaving
+    its manifest)."""
     from comparisons.sweep import sweep
 
     out = tmp_path / "s"

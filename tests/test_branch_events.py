@@ -145,11 +145,30 @@ def test_crest_event_ends_the_branch(branch_1e5_up):
     assert above[:k] == pytest.approx(below[:k], abs=1e-4)
 
 
+def test_grazing_end_is_extrapolated_beyond_the_last_point(branch_1e3):
+    """Hypothesis: the period-5 branch at I = 1e-3, which after its fold runs up in V, ends in a grazing: its
+    largest multiplier grows at each of the last 5 points and exceeds 30 at the last (it diverges there: 11 five
+    points before, 35 at the last); the grazing's parameter, extrapolated from the squared fold rate, lies
+    beyond the last point in the direction of travel (above it) by less than 1e-5 of V (the rate falls like the
+    square root of the distance).  The default tier's grazing end (the module's branch, computed once); the
+    same end of a branch running down in V is the slow test below."""
+    b = branch_1e3
+    assert b.stopped == "grazing" and "grazing" in b.message
+    growth = [float(np.max(np.abs(p.orbit.multipliers))) for p in b.points[-5:]]
+    assert all(x < y for x, y in zip(growth, growth[1:])) and growth[-1] > 30, growth
+    assert b.points[-1].value > b.points[-2].value  # running up in V, past the fold
+    assert 0 <= b.end_value - b.points[-1].value < 1e-5
+
+
+@pytest.mark.slow
 def test_grazing_end_is_extrapolated_below_the_last_point():
     """Hypothesis: fvV's period-3 orbit at I = 1e-5 continued down in V passes a period doubling at V =
     0.998547 and ends in a grazing (its slowest fold rate falls towards 0 and its multiplier diverges, beyond
     -100); the grazing's parameter, extrapolated from the squared fold rate, lies below the last point by less
-    than 1e-5 of V (the rate falls like the square root of the distance)."""
+    than 1e-5 of V (the rate falls like the square root of the distance).  Slow (~20 s CPU: 24 points, most
+    within 1e-4 of the grazing); covered in the default tier by
+    ``test_grazing_end_is_extrapolated_beyond_the_last_point`` (the same end on the module's I = 1e-3 branch)
+    and ``test_period_doubling_and_the_doubled_branch`` (a period doubling located to 1e-6)."""
     b = exact.continue_orbit(exact.periodic_orbit(FVV_1E5, n=3), "V", stop=0.5)
     assert [x.kind for x in b.bifurcations] == ["period_doubling"]
     assert b.bifurcations[0].value == pytest.approx(0.998547, abs=1e-6)

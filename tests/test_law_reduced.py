@@ -269,12 +269,15 @@ def test_periods_of_the_reductions_on_a_cubic_run():
     assert len(pe) >= 8 and max(pe) <= 0.01
 
 
-@pytest.mark.parametrize("force", ["cubic", "table"])
+@pytest.mark.parametrize("force", [pytest.param("cubic", marks=pytest.mark.slow), "table"])
 def test_branchwise_reference_runs_the_law(force):
     """Hypothesis: the branch-wise reference, which evaluates the law with ``PeelForce.f`` (numpy / scipy's
     PCHIP, not the compiled kernels) and inverts it by Brent's method, gives the hybrid solver's jumps of the same
     law (rtol 1e-13): times to 1e-9 s and F to 1e-8 N (measured 1.7e-11 s, 5.0e-10 N for the cubic; 5.5e-11 s,
-    1.3e-9 N for the table -- the reference loses digits at the folds' square-root singularity)."""
+    1.3e-9 N for the table -- the reference loses digits at the folds' square-root singularity).
+
+    The reference is slow (~10 s CPU per law): the cubic case is slow, covered in the default tier by the table
+    case (the same reference code, ``PeelForce.f`` of a non-paper law, with the harder fold singularity)."""
     law = PeelForce.cubic(*CUBIC) if force == "cubic" else _table()
     p = PeelParams(V=1.2, I=1e-5, force=law)
     ref = exact.simulate(p, 0.1, rtol=1e-13, save="jumps").jumps

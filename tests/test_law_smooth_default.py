@@ -33,12 +33,13 @@ def test_truth_is_the_closed_form():
 
 
 def test_default_penalty_works_on_noisy_cubic_many_seeds():
-    """30 seeds at 1 % noise: the default (``lam="gcv"``, shape-constrained) always gives an N-shaped law, with
+    """10 seeds at 1 % noise: the default (``lam="gcv"``, shape-constrained) always gives an N-shaped law, with
     |f_min - 184.55| <= 5 N (2.7 %) and |f_max - 240.45| <= 6 N.  Why: over 100 seeds the largest errors measured
     4.31 N and 4.95 N (sd 1.4 N: each datum is off by ~1.8 N at the fold); the issue's failing default raised on
-    4 of the first 10 seeds, and lam = 1e-2 biased f_min to 137 N."""
+    4 of the first 10 seeds, and lam = 1e-2 biased f_min to 137 N.  Ten seeds (were 30) still meet that failing
+    default four times; all 100 at 1 % are ``test_default_penalty_over_noise_levels`` (slow)."""
     errs = []
-    for seed in range(30):
+    for seed in range(10):
         bs = PeelForce.smoothed(V40, _noisy(seed, 0.01)).folds(1.0)
         errs.append((bs.f_min - F_MIN, bs.f_max - F_MAX))
     e = np.abs(np.array(errs))

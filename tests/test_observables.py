@@ -181,8 +181,32 @@ def test_steady_peeling_is_a_status_not_an_error():
     assert "the law has no folds at V = 1 m/s" in o.reason
 
 
+def test_tape_mass_variant_observables_are_its_window_run():
+    """The tape-mass model through ``attractor_observables`` on a cheap window (m = 1e-3 kg, V = 1, I = 1e-2:
+    0.5 s transient, 1 s window, LSODA rtol 1e-8; ~1.5 s CPU): stick-slip, the variant's own method named, the
+    mean drop equal to the mean of :func:`peelapprox.force_drops` of the same window's run (1e-12: the same
+    differences, summed in another order; no period on this short window, so every drop counts), F_max and F_min
+    the extremes of F at its slips (exact: the same values), every mean finite and positive.  The default
+    tier's tape-mass observables; the documented window's digits are the slow test below."""
+    p = PeelParams(V=1.0, I=1e-2, tape_mass=1e-3)
+    o = exact.attractor_observables(p, t_transient=0.5, t_window=1.0, rtol=1e-8, period_rtol=1e-5)
+    assert o.status == "stick-slip" and o.n_slips >= 20
+    assert o.method.startswith("exact: smooth (LSODA), rtol 1e-08")
+    tr = exact.window_run(p, t_transient=0.5, window=1.0, rtol=1e-8)
+    drops = force_drops(tr)
+    k = drops.size if o.period is None else drops.size - drops.size % o.period
+    assert o.force_drop == pytest.approx(np.mean(drops[drops.size - k:]), rel=1e-12)
+    assert (o.F_max, o.F_min) == (tr.jumps.F.max(), tr.jumps.F.min())
+    for name in MEANS:
+        assert np.isfinite(getattr(o, name)) and getattr(o, name) > 0
+
+
+@pytest.mark.slow
 def test_tape_mass_variant_matches_its_documented_window():
-    """The tape-mass model (m = 1e-4 kg, V = 1, I = 1e-5; its jumps are the crossings of the inflection
+    """Slow (one LSODA run of 6 s at I = 1e-5: ~20 s CPU); covered in the default tier by
+    ``test_tape_mass_variant_observables_are_its_window_run`` (the same variant and path on a cheaper window).
+
+    The tape-mass model (m = 1e-4 kg, V = 1, I = 1e-5; its jumps are the crossings of the inflection
     velocity), over docs/tape-mass-dynamics.md's window (2 s transient, 4 s, rtol 1e-8, period_rtol 1e-5).
     That page's table gives period-5, 13.2 slips/s and F at slips 268.9–276.8 N (all slips of the window),
     which the observables must reproduce to their printed digits (half a unit of the last: 0.05 N, 0.05 /s,

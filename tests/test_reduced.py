@@ -383,12 +383,15 @@ def test_estimate_fields_are_consistent():
     json.dumps(e.as_dict())
 
 
-def test_cli_estimate_and_segment(tmp_path):
-    """`peelapprox estimate --format json` prints valid JSON with the label; `segment` writes its curves."""
+def test_cli_estimate_and_segment(tmp_path, capsys):
+    """`peelapprox estimate --format json` prints valid JSON with the label; `segment` writes its curves.  In this
+    process through ``peelapprox.cli.main`` (``python -m peelapprox.cli`` itself runs in tests/test_cli_errors.py;
+    a second interpreter here would add only its start-up)."""
     from peelapprox.cli import main
 
-    out = subprocess.run([sys.executable, "-m", "peelapprox.cli", "estimate", "--V", "1", "--I", "1e-2",
-                          "--format", "json"], capture_output=True, text=True, check=True).stdout
+    capsys.readouterr()
+    assert main(["estimate", "--V", "1", "--I", "1e-2", "--format", "json"]) == 0
+    out = capsys.readouterr().out
     assert json.loads(out)["label"] == "high inertia, low V"
     csv = tmp_path / "c.csv"
     rc = main(["segment", "--V", "1", "--I", "1e-2", "--branch", "AB", "--F-in", "186.95", "--alpha-in", "0.0599",
