@@ -8,10 +8,10 @@
   ``pip install ...`` and ``python -m pytest`` are not run (installing is the environment's business; the
   tests do not run themselves).  The cheap commands (under ~5 s each) run in the default tier, one after
   another in one process (the Python blocks' own, after them) through ``peelapprox.cli.main``, the console
-  script's own entry point (the import is paid once, not ten times); each is a test of its own.  The long ones are marked slow, each in
-  its own process, with their measured cost in ``SLOW``.  The README's ``my_tape.csv`` (your own tape) is
-  written first: the paper's f(v, 1.2) at 30 points per decade of v in [1e-6, 31.6] m/s, a curve the
-  example command can run on.
+  script's own entry point (the import is paid once, not ten times); each is a test of its own.  The long
+  ones are marked slow, each in its own process, with their measured cost in ``SLOW``.  The README's
+  ``my_tape.csv`` (your own tape) is written first: the paper's f(v, 1.2) at 30 points per decade of v in
+  [1e-6, 31.6] m/s, a curve the example command can run on.
 * Nothing is written outside the temporary directory (relative outputs such as ``--out sweep/`` land there).
 
 The default tier runs one process: the Python blocks, then the cheap commands.
