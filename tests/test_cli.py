@@ -137,7 +137,7 @@ def test_cli_bad_lyapunov_option_is_refused_before_the_window_run(monkeypatch, c
     assert exc.value.code == 2 and "eps must be finite and in [1e-15, 0.01]" in capsys.readouterr().err
 
 
-def test_cli_figures_list_and_bad_name(capsys):
+def test_cli_figures_list_and_bad_name(capsys, tmp_path):
     """``figures --list`` names fig2 … fig9; an unknown ``--only`` is a clean usage error (exit 2)."""
     from peelapprox.cli import main
 
@@ -145,7 +145,7 @@ def test_cli_figures_list_and_bad_name(capsys):
     out = capsys.readouterr().out
     assert all(f"fig{n}:" in out for n in range(2, 10))
     with pytest.raises(SystemExit) as exc:
-        main(["figures", "--only", "fig1", "--out", "/tmp/unused-figs"])
+        main(["figures", "--only", "fig1", "--out", str(tmp_path / "unused-figs")])  # a path of this test's own
     assert exc.value.code == 2
 
 

@@ -5,9 +5,10 @@ directory, so nothing lands in ./docs): as ``__main__`` with its own argv and a 
 one process (``_DRIVER``, :data:`BATCHES`), and at least one printed number is checked against
 an expectation that does not come from the code under test: the paper's numbers, closed forms, or the values
 docs/*.md report (measured once and written down there).  The examples of this module's run are started
-together when the first test needs one, in two processes (two cores), so the default tier pays the
-interpreter, the imports and the kernel loads twice, not once per example, and about half the examples' CPU
-time in wall time.
+together when the first test needs one, batched in processes (:data:`BATCHES`), so a run pays the interpreter,
+the imports and the kernel loads once per batch, not once per example.  The default tier runs the four cheap
+examples (01-04) in one process; the four costly ones (05-08, 12-30 s of CPU each) are slow, each covered in the
+default tier by the tests of the functions it shows (named in its test).
 """
 
 from __future__ import annotations
@@ -64,10 +65,13 @@ with open(path, "w") as f:
     json.dump(results, f)
 """
 
-#: The examples in two processes (two cores), balanced by CPU time; a process per example paid the
-#: interpreter, the imports and the kernel loads (~3 s of CPU) seven times.
-BATCHES = (("07_your_data", "04_your_own_tape", "01_quickstart", "02_three_regimes"),
-           ("05_sweep_phase_diagram", "06_orbits_bifurcation", "03_approx_vs_exact"))
+#: The examples' processes.  The default tier runs the first group only, the four cheap examples (~20 s of CPU
+#: together, warm, measured one by one: 01 4.6 s, 02 5.5 s, 03 4.5 s, 04 6.0 s, each with ~2.5 s of interpreter
+#: and imports), in one process: under pytest-xdist the other worker has other tests to run, and a second process
+#: would pay the imports again.  The slow ones (05 13 s, 06 12 s, 07 30 s, 08 12.5 s) run in two more processes,
+#: balanced by CPU time, when ``-m slow`` selects them.
+BATCHES = (("04_your_own_tape", "01_quickstart", "02_three_regimes", "03_approx_vs_exact"),
+           ("07_your_data", "08_peel_front"), ("05_sweep_phase_diagram", "06_orbits_bifurcation"))
 
 
 class _Batch:
@@ -254,12 +258,16 @@ def test_04_why_the_expression_and_the_table_differ_in_period(runs):
     assert _num(r"\(it differs by up to ([\d.]+) N\)", out) < 0.02
 
 
+@pytest.mark.slow
 def test_05_sweep_phase_diagram(runs):
     """The 4 x 4 sweep: the paper's period 8 at (I, V) = (1e-2, 1) and the chaos of docs/dynamics.md.
 
     Exact labels: period-8 at I = 1e-2, V = 1 (the paper's Fig. 4); aperiodic at I = 1e-4, V = 1 and 2, where
     docs/dynamics.md reports chaos (λ = 3.1 and 4.7 bits/s) on the same window (t = 30-50 s, rtol 1e-10); and
     the row I = 1e-5 as that page's sweep table has it (P3, P7, P5, P1: periodic everywhere at low inertia).
+
+    Slow (16 exact runs of 50 s, 13 s of CPU): covered in the default tier by tests/test_sweep.py (the sweep,
+    its measures and records) and tests/test_parallel.py::test_sweep_records_identical_on_every_pool_kind.
     """
     out = _output(runs, "05_sweep_phase_diagram")
     rows = {m.group(1): m.group(2).split() for m in re.finditer(r"^(1e-05|0\.0001|0\.001|0\.01) +(\S.*)$", out, re.M)
@@ -270,6 +278,7 @@ def test_05_sweep_phase_diagram(runs):
     assert "16 points, 4 aperiodic, statuses: ['ok']" in out
 
 
+@pytest.mark.slow
 def test_06_orbits_bifurcation(runs):
     """The period-8 orbit at V = 1, I = 1e-2 and its branch in V, against docs/orbits.md.
 
@@ -277,6 +286,10 @@ def test_06_orbits_bifurcation(runs):
     branch's stable range there is 0.977-1.103 m/s, from a Neimark-Sacker bifurcation to the crest event that
     ends it: both ends to 2e-3 m/s (the page's 3 digits, plus the crest's linear extrapolation).  The long run
     at V = 1 lies on it: period-8.
+
+    Slow (Newton on the period-8 orbit, its continuation and an 11-point diagram, 12 s of CPU): covered
+    in the default tier by tests/test_orbits.py and tests/test_branch_events.py (the period-8 orbit, its
+    multipliers, its branch and the bifurcations that end it).
     """
     out = _output(runs, "06_orbits_bifurcation")
     assert _num(r"period n = (\d+) slips", out) == 8
@@ -286,12 +299,18 @@ def test_06_orbits_bifurcation(runs):
     assert "long run at V = 1.000: period-8" in out
 
 
+@pytest.mark.slow
 def test_07_your_data(runs):
     """A synthetic experiment (V = 1, I = 1e-2, k = 1000 N/m, 20 s at 10 kHz, 0.5 N noise, 5 N drift) written in
     ms and kN and read back: every slip of the run found (the run's own count: exact), the slip interval to 1 %
     and the drop to 2 % of the run's (the detector's stated goals), period 8 (the paper's); λ within 0.1
     bits/s of 0 (a periodic orbit; the tolerance of tests/test_series_lyapunov.py); k within 5 % of the truth
-    with its interval covering it (the inference's goal)."""
+    with its interval covering it (the inference's goal).
+
+    Slow (50 s of a run sampled at 10 kHz and a 27-run inference, 30 s of CPU): covered in the default
+    tier by tests/test_series.py, tests/test_series_lyapunov.py and tests/test_infer.py (slips, λ and k from
+    a trace).
+    """
     out = _output(runs, "07_your_data")
     found, made = _num(r"(\d+) slips found", out), _num(r"the run has (\d+)", out)
     assert found == made
@@ -305,6 +324,7 @@ def test_07_your_data(runs):
     assert abs(k / 1000 - 1) < 0.05 and lo <= 1000 <= hi
 
 
+@pytest.mark.slow
 def test_08_peel_front(runs):
     """The front of docs/peel-front.md's "Use" and the bursts of a longer run.
 
@@ -314,6 +334,9 @@ def test_08_peel_front(runs):
       (docs/peel-front.md, "Energy balance": the trapezoid rule's own error through the bursts at 2 µs).
     * N = 16 over 0.3 s: each slip of the front (an AB->CD jump of the mean front, half of its jumps) makes one
       AE burst above 5 % of the record's largest AE power, within one (a burst cut by the record's ends).
+
+    Slow (a 64-strip front over 30 ms and a 16-strip one over 0.32 s, 12.5 s of CPU): covered in the
+    default tier by tests/test_front.py and tests/test_bursts.py (the front, its patterns and its bursts).
     """
     out = _output(runs, "08_peel_front")
     assert "pattern stuck-peeled" in out

@@ -99,8 +99,13 @@ def _contributing_block() -> tuple[str, str]:
     return module, line
 
 
+#: The run of the toy model in the copy; with ``{run_default}`` the paper's parameters' default is *run*
+#: (``simulate(p, 1e-3).method``: the hybrid driver compiled in the copy's empty cache, ~20 s of CPU), else read
+#: where ``simulate`` reads it (``model_of`` and ``default_method``, which pick the model and the method of a
+#: call without ``model=`` or ``method=``).
 _RUN = """
 import json, math, exact
+from exact._method_contract import default_method
 from peelapprox import PeelParams
 assert exact.__file__.startswith({root!r}), exact.__file__
 p = PeelParams(V=1.0, I=1e-5)
@@ -109,20 +114,29 @@ w = math.sqrt(p.k * p.R ** 2 / p.I)
 tr = exact.simulate(p, 0.01, model="rigid_roller", omega0=p.V / p.R + 0.01 * w, rtol=1e-10, atol=1e-14)
 print(json.dumps(dict(method=tr.method, w=w, t=tr.t.tolist(), alpha=tr.alpha.tolist(), omega=tr.omega.tolist(),
                       F=tr.F.tolist(), F0=tr.initial_state.F, v=tr.v.tolist(), v0=tr.initial_state.v,
-                      default=exact.simulate(p, 1e-3).method, type=type(toy).__name__, has_hybrid=toy.has_hybrid,
+                      default=exact.simulate(p, 1e-3).method if {run_default} else default_method(p),
+                      default_model=exact.model_of(p).name, type=type(toy).__name__, has_hybrid=toy.has_hybrid,
                       under_load=toy.under_load, parameters=toy.parameters, Vp=tr.Vp is None,
                       columns=list(tr.to_dataframe().columns))))
 """
 
 
-def test_a_model_added_as_contributing_says_runs_through_simulate(tmp_path):
+@pytest.mark.parametrize("run_default", [False, pytest.param(True, marks=pytest.mark.slow)],
+                         ids=["default_read", "default_run"])
+def test_a_model_added_as_contributing_says_runs_through_simulate(tmp_path, run_default):
     """Hypothesis: the section's module, written into a copy of the packages with its registration line, is a
     model of ``simulate(model=...)``: its default method (smooth, the one it lists) integrates its field, the
     linear roller ``α'' = -Ω² α`` (Ω² = k R² / I) with F and v held, from the consistent start with
     ``ω0 = V/R + A Ω``, A = 0.01 rad; the orbit is ``α = A sin(Ω t)``, ``ω = V/R + A Ω cos(Ω t)`` to 1e-7 of A
     and A Ω (LSODA at rtol 1e-10 over ~1.6 periods: a global error of ~1e-9 relative, while a wrong sign or
     frequency is O(1)), F and v stay at the start's values exactly (their rates are 0), and the paper's
-    parameters still run the paper's model by default."""
+    parameters still run the paper's model by default.
+
+    The default tier reads that default where ``simulate`` picks it (``exact.model_of``, ``default_method``: the
+    massless model, hybrid); running it (``run_default``, the hybrid driver compiled in the copy's own empty
+    cache, ~20 s of CPU) is slow: covered in the default tier by the ``default_read`` case and by
+    test_a_named_model_runs_as_the_one_params_describe (``simulate(params)`` is the run of ``model_of(params)``
+    with its first method)."""
     pkg = tmp_path / "pkg"
     for name in ("peelapprox", "exact"):
         shutil.copytree(ROOT / name, pkg / name, ignore=shutil.ignore_patterns("__pycache__"))
@@ -131,11 +145,12 @@ def test_a_model_added_as_contributing_says_runs_through_simulate(tmp_path):
     models = pkg / "exact" / "_models.py"
     models.write_text(models.read_text() + "\n" + line)
     env = dict(os.environ, PYTHONPATH=str(pkg), NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
-    out = subprocess.run([sys.executable, "-c", _RUN.format(root=str(pkg))], cwd=pkg, env=env, capture_output=True,
-                         text=True, timeout=600)
+    code = _RUN.format(root=str(pkg), run_default=run_default)
+    out = subprocess.run([sys.executable, "-c", code], cwd=pkg, env=env, capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     got = json.loads(out.stdout)
     assert got["type"] == "RigidRoller" and got["method"] == "smooth" and got["default"] == "hybrid"
+    assert got["default_model"] == "massless"
     # the questions the tools ask a model (the hybrid method's tools, a load's pull speed, the fields it reads):
     # the base class's answers for a model that lists only "smooth" and the four states
     assert (got["has_hybrid"], got["under_load"], got["parameters"], got["Vp"]) == (False, False, [], True)

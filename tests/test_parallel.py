@@ -9,7 +9,6 @@ import os
 import signal
 import subprocess
 import sys
-import textwrap
 import time
 from pathlib import Path
 
@@ -62,28 +61,6 @@ def test_sweep_records_identical_on_every_pool_kind(tmp_path):
     assert len(recs["serial"]) == 4 and all(r["status"] == "ok" or r["status"].startswith("breakdown")
                                             for r in recs["serial"])
     assert any(np.isfinite(r.get("jumps_mean_interval") or np.nan) for r in recs["serial"])
-
-
-def test_script_without_main_guard_runs_on_processes(tmp_path):
-    """Hypothesis: a script with no ``if __name__ == "__main__":`` guard maps a function it defines itself on
-    the process pool: the values are right (x*x + 1 for x < 6: exact integers) and no worker re-runs the
-    script (its top-level line is printed once)."""
-    script = tmp_path / "noguard.py"
-    script.write_text(textwrap.dedent(f"""
-        import sys
-        sys.path.insert(0, {ROOT!r})
-        from peelapprox.parallel import map_points
-        print("top level")
-        def f(x):
-            return x * x + 1
-        out = {{}}
-        lost = map_points(f, [(i, (i,)) for i in range(6)], out.__setitem__, pool="processes", max_workers=2)
-        print(sorted(out.items()), lost)
-    """))
-    res = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=180, cwd=tmp_path)
-    assert res.returncode == 0, res.stderr
-    assert res.stdout.count("top level") == 1
-    assert "[(0, 1), (1, 2), (2, 5), (3, 10), (4, 17), (5, 26)] []" in res.stdout
 
 
 def test_worker_death_is_a_named_loss_not_a_hang():
@@ -191,68 +168,98 @@ def _alive(pid: int) -> bool:
         return False
 
 
-def _lines(proc, expected, timeout):
-    """Read ``proc``'s stdout lines until ``expected`` were all seen, within ``timeout`` s (a failure, not a hang,
-    if they never come)."""
+#: A script with no ``if __name__ == "__main__":`` guard: it maps a function it defines itself on the process pool
+#: and prints the values (test_script_without_main_guard_runs_on_processes), then maps 60 s naps on the same pool,
+#: to be interrupted (test_keyboard_interrupt_stops_workers).  Python's own SIGINT handler is put back first: a
+#: process inherits an ignored SIGINT, and bash ignores it in every command it runs in the background without job
+#: control (`bash -c 'cmd &'`): a test suite run so timed out here twice, the workers' third task started, and
+#: fails the same way alone under such a parent.
+_NO_GUARD = """
+import signal, sys, time
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal gives it (see above)
+sys.path.insert(0, {root!r})
+from peelapprox.parallel import map_points
+print("top level", flush=True)
+def f(x):
+    return x * x + 1
+out = {{}}
+lost = map_points(f, [(i, (i,)) for i in range(6)], out.__setitem__, pool="processes", max_workers=2)
+print(sorted(out.items()), lost, flush=True)
+def nap(x):
+    print("napping", flush=True)
+    time.sleep(60)
+    return x
+print("ready", flush=True)
+map_points(nap, [(i, (i,)) for i in range(4)], lambda k, v: None, pool="processes", max_workers=2)
+"""
+
+
+@pytest.fixture(scope="module")
+def no_guard_script(tmp_path_factory):
+    """:data:`_NO_GUARD` run as ``python SCRIPT`` and interrupted (SIGINT) once both workers print that their nap
+    began (a fixed 1 s wait let a loaded machine send it earlier), one process for the two tests that read it (an
+    interpreter, its imports and its two workers paid once).  Returns its stdout (every line), stderr, the
+    workers' pids when ``/proc`` lists a process's children (else None), and whether each worker is gone within
+    60 s of the interrupt.  Bounds: 180 s for the first map, 60 s for both naps to start, 60 s for the script to
+    exit after the interrupt (a hang, or workers finishing their 60 s naps, would take longer)."""
     import selectors
 
-    sel = selectors.DefaultSelector()
-    sel.register(proc.stdout, selectors.EVENT_READ)
-    left, t0 = list(expected), time.monotonic()
-    while left:
-        assert time.monotonic() - t0 < timeout, f"still waiting for {left} from the script"
-        if sel.select(timeout=1.0):
-            line = proc.stdout.readline().strip()
-            assert line, "the script closed its stdout"
-            if line in left:
-                left.remove(line)
-
-
-def test_keyboard_interrupt_stops_workers(tmp_path):
-    """Hypothesis: Ctrl-C (SIGINT to the process) during a process-pool map ends the script with
-    KeyboardInterrupt and kills its workers, which were running 60 s tasks.  Bound: 60 s for the script to exit
-    and its workers to go (a hang, or workers finishing their tasks, would take longer).  The interrupt is sent
-    once both workers print that their task began (a fixed 1 s wait let a loaded machine send it earlier).  The
-    script puts Python's own SIGINT handler back first: a process inherits an ignored SIGINT, and bash ignores
-    it in every command it runs in the background without job control (`bash -c 'cmd &'`): a test suite run
-    so timed out here twice, the workers' third task started, and fails the same way alone under such a parent."""
-    if not os.path.exists(f"/proc/{os.getpid()}/task/{os.getpid()}/children"):
-        pytest.skip("needs Linux's /proc/<pid>/task/<pid>/children")
-    script = tmp_path / "interrupt.py"
-    script.write_text(textwrap.dedent(f"""
-        import signal, sys, time
-        signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal gives it (see the docstring)
-        sys.path.insert(0, {ROOT!r})
-        from peelapprox.parallel import map_points
-        def nap(x):
-            print("napping", flush=True)
-            time.sleep(60)
-            return x
-        def started(x):
-            return x
-        map_points(started, [(0, (0,)), (1, (1,))], lambda k, v: None, pool="processes", max_workers=2)
-        print("ready", flush=True)
-        map_points(nap, [(i, (i,)) for i in range(4)], lambda k, v: None, pool="processes", max_workers=2)
-    """))
+    script = tmp_path_factory.mktemp("noguard") / "noguard.py"
+    script.write_text(_NO_GUARD.format(root=ROOT))
+    can_list = os.path.exists(f"/proc/{os.getpid()}/task/{os.getpid()}/children")
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True, cwd=script.parent)
+    lines: list[str] = []
     try:
-        assert proc.stdout.readline().strip() == "ready"
-        _lines(proc, ["napping", "napping"], 60.0)  # both workers inside a task: the interrupt meets a running map
-        workers = _children(proc.pid)
-        assert workers
+        sel = selectors.DefaultSelector()
+        sel.register(proc.stdout, selectors.EVENT_READ)
+        for expected, timeout in ((["ready"], 180.0), (["napping", "napping"], 60.0)):
+            left, t0 = list(expected), time.monotonic()
+            while left:
+                assert time.monotonic() - t0 < timeout, f"still waiting for {left} from the script: {lines}"
+                if sel.select(timeout=1.0):
+                    line = proc.stdout.readline().strip()
+                    assert line, f"the script closed its stdout: {lines}\n{proc.stderr.read()[-3000:]}"
+                    lines.append(line)
+                    if line in left:
+                        left.remove(line)
+        workers = _children(proc.pid) if can_list else None
         proc.send_signal(signal.SIGINT)
         t0 = time.monotonic()
-        _, err = proc.communicate(timeout=60)
-        assert "KeyboardInterrupt" in err
-        while any(_alive(w) for w in workers):
-            assert time.monotonic() - t0 < 60, f"workers still running: {[w for w in workers if _alive(w)]}"
-            time.sleep(0.2)
+        rest, err = proc.communicate(timeout=60)
+        lines += rest.splitlines()
+        gone = None
+        if workers is not None:
+            while any(_alive(w) for w in workers) and time.monotonic() - t0 < 60:
+                time.sleep(0.2)
+            gone = [not _alive(w) for w in workers]
+        return dict(stdout="\n".join(lines), stderr=err, workers=workers, gone=gone)
     finally:
         try:
             os.killpg(proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
+
+
+def test_script_without_main_guard_runs_on_processes(no_guard_script):
+    """Hypothesis: a script with no ``if __name__ == "__main__":`` guard maps a function it defines itself on
+    the process pool: the values are right (x*x + 1 for x < 6: exact integers) and no worker re-runs the
+    script (its top-level line is printed once)."""
+    out = no_guard_script["stdout"]
+    assert out.count("top level") == 1, out
+    assert "[(0, 1), (1, 2), (2, 5), (3, 10), (4, 17), (5, 26)] []" in out
+
+
+def test_keyboard_interrupt_stops_workers(no_guard_script):
+    """Hypothesis: Ctrl-C (SIGINT to the process) during a process-pool map ends the script with
+    KeyboardInterrupt and kills its workers, which were running 60 s tasks.  Bound: 60 s for the script to exit
+    and its workers to go (a hang, or workers finishing their tasks, would take longer); the interrupt is sent
+    once both workers are inside a task, and the script restores Python's SIGINT handler (:data:`_NO_GUARD`)."""
+    if no_guard_script["workers"] is None:
+        pytest.skip("needs Linux's /proc/<pid>/task/<pid>/children")
+    assert no_guard_script["workers"]
+    assert "KeyboardInterrupt" in no_guard_script["stderr"]
+    assert all(no_guard_script["gone"]), f"workers still running: {no_guard_script}"
 
 
 def test_diagram_and_attractors_identical_on_every_pool_kind():

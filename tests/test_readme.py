@@ -7,15 +7,14 @@
   command that starts with ``peelapprox`` (or ``python -m peelapprox``, run as the same) must exit 0;
   ``pip install ...`` and ``python -m pytest`` are not run (installing is the environment's business; the
   tests do not run themselves).  The cheap commands (under ~5 s each) run in the default tier, one after
-  another in one fresh process through ``peelapprox.cli.main``, the console script's own entry point (the
-  import is paid once, not ten times); each is a test of its own.  The long ones are marked slow, each in
-  its own process, with their measured cost in ``SLOW``.  The README's ``my_tape.csv`` (your own tape) is
-  written first: the paper's f(v, 1.2) at 30 points per decade of v in [1e-6, 31.6] m/s, a curve the
-  example command can run on.
+  another in one process (the Python blocks' own, after them) through ``peelapprox.cli.main``, the console
+  script's own entry point (the import is paid once, not ten times); each is a test of its own.  The long
+  ones are marked slow, each in its own process, with their measured cost in ``SLOW``.  The README's
+  ``my_tape.csv`` (your own tape) is written first: the paper's f(v, 1.2) at 30 points per decade of v in
+  [1e-6, 31.6] m/s, a curve the example command can run on.
 * Nothing is written outside the temporary directory (relative outputs such as ``--out sweep/`` land there).
 
-The default tier runs two processes, started together: one for the Python blocks, one for the cheap
-commands.
+The default tier runs one process: the Python blocks, then the cheap commands.
 """
 
 from __future__ import annotations
@@ -73,37 +72,34 @@ PYTHON_BLOCKS = _blocks(("python",))
 COMMANDS = _commands()
 CHEAP = [c for c in COMMANDS if not any(c.startswith(prefix) for prefix in SLOW)]
 
-# Runs the cheap commands one by one through the console script's entry point, each with its own stdout and
-# stderr, and writes their exit statuses (and stderr's tail) as JSON to argv[1].
+# Runs, in this one process, the Python blocks given as JSON pairs (script file, working directory) in argv[2],
+# one after another, each as ``python FILE`` would (``__main__``, a fresh namespace, in its own directory), then,
+# in the directory argv[4], the cheap commands of argv[3] one by one through the console script's entry point,
+# each with its own stdout and stderr; writes ``{"blocks": {script: [status, stderr tail]}, "commands": {command:
+# [status, stderr tail]}}`` as JSON to argv[1].
 _DRIVER = """
-import contextlib, io, json, shlex, sys
-from peelapprox.cli import main
-results = {}
-for command in json.loads(sys.argv[2]):
+import contextlib, io, json, os, shlex, sys
+sys.path.insert(0, os.path.join(os.environ["PYTHONPATH"].split(os.pathsep)[0], "tests"))
+from _run_script import run_script
+path, jobs, commands, cwd = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), sys.argv[4]
+results = {"blocks": {}, "commands": {}}
+for script, block_cwd in jobs:
+    os.chdir(block_cwd)
+    status, _, err = run_script(script, [])
+    results["blocks"][script] = [status, err[-3000:]]
+if "matplotlib.pyplot" in sys.modules:
+    sys.modules["matplotlib.pyplot"].close("all")
+if commands:
+    os.chdir(cwd)
+    from peelapprox.cli import main
+for command in commands:
     err = io.StringIO()
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
         try:
             status = main(shlex.split(command)[1:])
         except SystemExit as exc:
             status = exc.code
-    results[command] = [status, err.getvalue()[-2000:]]
-with open(sys.argv[1], "w") as f:
-    json.dump(results, f)
-"""
-
-
-# Runs the Python blocks given as JSON pairs (script file, working directory) in argv[2], one after another in
-# this process, each as ``python FILE`` would (``__main__``, a fresh namespace, in its own directory), and
-# writes their exit statuses and stderr's tail as JSON to argv[1].
-_BLOCKS = """
-import json, os, sys
-sys.path.insert(0, os.path.join(os.environ["PYTHONPATH"].split(os.pathsep)[0], "tests"))
-from _run_script import run_script
-results, path, jobs = {}, sys.argv[1], json.loads(sys.argv[2])
-for script, cwd in jobs:
-    os.chdir(cwd)
-    status, _, err = run_script(script, [])
-    results[script] = [status, err[-3000:]]
+    results["commands"][command] = [status, err.getvalue()[-2000:]]
 with open(path, "w") as f:
     json.dump(results, f)
 """
@@ -144,45 +140,41 @@ def _collect(proc: subprocess.Popen) -> tuple[int, str, str]:
 
 @pytest.fixture(scope="module")
 def started(request, tmp_path_factory):
-    """The selected default-tier work of this module, all started at once in two processes: the Python blocks
-    (each in its own directory, one after another) and the cheap commands.  ``started(key)`` waits for one of
-    them: ``"blocks"`` gives ``(status, stdout, stderr)`` with the driver's results ``{script: [status, stderr
-    tail]}`` in place of stdout, ``"commands"`` the same with ``{command: [status, stderr tail]}``."""
+    """The selected default-tier work of this module, all started at once in one process (:data:`_DRIVER`): the
+    Python blocks (each in its own directory, one after another), then the cheap commands (in a directory of
+    their own, with the README's data files).  ``started(key)`` waits for the process and gives ``(status,
+    results, stderr)``: for ``"blocks"`` the results are ``{script: [status, stderr tail]}``, for ``"commands"``
+    ``{command: [status, stderr tail]}``; the process's stdout in their place when it failed.  One process, not
+    two: the interpreter and the imports are paid once (under pytest-xdist the other core runs other tests)."""
     selected = [item.name for item in request.session.items if item.module is request.module]
-    procs: dict[str, tuple[subprocess.Popen, Path | None]] = {}
     blocks = []
     for i, block in enumerate(PYTHON_BLOCKS):
         if f"test_python_block[{i}]" in selected:
             d = tmp_path_factory.mktemp(f"block{i}")
             (d / f"block{i}.py").write_text(block)
             blocks.append((str(d / f"block{i}.py"), str(d)))
-    if blocks:
-        d = tmp_path_factory.mktemp("blocks")
-        procs["blocks"] = (subprocess.Popen([sys.executable, "-c", _BLOCKS, str(d / "results.json"),
-                                             json.dumps(blocks)], cwd=d, env=_env(), text=True,
-                                            stdout=subprocess.PIPE, stderr=subprocess.PIPE), d / "results.json")
-    if any(name.startswith("test_cheap_command") for name in selected):
-        d = tmp_path_factory.mktemp("commands")
+    commands = CHEAP if any(name.startswith("test_cheap_command") for name in selected) else []
+    d = tmp_path_factory.mktemp("commands")
+    if commands:
         _write_tape(d)
-        procs["commands"] = (subprocess.Popen([sys.executable, "-c", _DRIVER, str(d / "results.json"),
-                                               json.dumps(CHEAP)], cwd=d, env=_env(), text=True,
-                                              stdout=subprocess.PIPE, stderr=subprocess.PIPE), d / "results.json")
-    done: dict[str, tuple] = {}
+    proc = None
+    if blocks or commands:
+        proc = subprocess.Popen([sys.executable, "-c", _DRIVER, str(d / "results.json"), json.dumps(blocks),
+                                 json.dumps(commands), str(d)], cwd=d, env=_env(), text=True,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    done: list[tuple] = []
 
     def get(key: str) -> tuple:
-        if key not in done:
-            proc, results = procs[key]
+        if not done:
             status, stdout, stderr = _collect(proc)
-            if results is not None and status == 0:
-                stdout = json.loads(results.read_text())
-            done[key] = (status, stdout, stderr)
-        return done[key]
+            done.append((status, json.loads((d / "results.json").read_text()) if status == 0 else stdout, stderr))
+        status, results, stderr = done[0]
+        return status, results[key] if status == 0 else results, stderr
 
     yield get
-    for proc, _ in procs.values():
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+    if proc is not None and proc.poll() is None:
+        proc.kill()
+        proc.communicate()
 
 
 def test_readme_has_code():
