@@ -67,22 +67,22 @@ class ApproximateAttractor(StickSlipObservables):
         The map's periodic orbit's multipliers (eigenvalues of ``D P^n`` on the section, Newton's finite-difference
         Jacobian); None for an aperiodic or long-period sample and without stick-slip.
     escape_returns : float or None
-        For an unstable periodic orbit (the map's orbit being left), or an orbit the map finds weakly stable (|μ| in
-        [0.99, 1)) whose full-chain orbit (:attr:`escape_multiplier`) is unstable (the map stays on it, the exact
-        run leaves it): the return at which the amplitude law
+        For an unstable periodic orbit (the map's orbit being left), or an orbit the map finds weakly stable
+        (``|μ|`` in [0.99, 1)) whose full-chain orbit (:attr:`escape_multiplier`) is unstable (the map stays on
+        it, the exact run leaves it): the return at which the amplitude law
         ``A_k = A_k0 |μ|^((k - k0)/n)`` reaches :data:`ESCAPE_FRACTION` of its force drop, counted from the start
         (``A`` the envelope of the AB→CD force's deviation from the orbit: the section point's deviation in the
         dominant eigen-coordinates of ``D P^n`` times the force's gradient); None otherwise.  Where the map's leading
-        |μ| is in [0.99, 1.02] the law's rate is :attr:`escape_multiplier`'s (and ``A`` is corrected for the
-        returns it grew at the map's rate instead).  Measured against the exact runs where |μ| - 1 is in
+        ``|μ|`` is in [0.99, 1.02] the law's rate is :attr:`escape_multiplier`'s (and ``A`` is corrected for the
+        returns it grew at the map's rate instead).  Measured against the exact runs where ``|μ|`` - 1 is in
         [1e-4, 1e-2] (docs/theory.md, "Escape returns"): within 20 % at the 14 and 12 orbits the map leaves (two
         seeds, 7.9 % at most), at 10 of the 11 it stays on and gives a return for.  None for an orbit the map
         stays on whose deviation there is already as large as the orbit (the law has no e-fold to run; the exact
         runs left such orbits within ~200 returns): :attr:`escape_multiplier` still says it is unstable.
     escape_multiplier : complex or None
-        The multiplier whose |μ| sets the escape law's rate where it is not the map's own: the leading multiplier
-        of the same orbit of the full branch dynamics linearised in α (genalpha + fullvdot, Newton from this
-        orbit's section point), used where this orbit's leading |μ| is in [0.99, 1.02] (there the default chain's
+        The multiplier whose ``|μ|`` sets the escape law's rate where it is not the map's own: the leading
+        multiplier of the same orbit of the full branch dynamics linearised in α (genalpha + fullvdot, Newton from this
+        orbit's section point), used where this orbit's leading ``|μ|`` is in [0.99, 1.02] (there the default chain's
         ``|μ| - 1`` is 0.6-74 % below the exact orbit's, or of the wrong sign, the full chain's within 0.32 % at the
         orbits the map leaves and 7 % at those it finds weakly stable: docs/theory.md, "Escape returns"); None where
         the rate is ``max |multipliers|`` (farther from 1, or that Newton did not converge to an unstable orbit).
