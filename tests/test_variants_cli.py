@@ -200,13 +200,15 @@ def test_plot_trajectory_shows_the_pull_speed_under_a_load(tmp_path, load_run):
 
 def test_sweep_runs_the_tape_mass_at_every_point(tmp_path):
     """``peelapprox sweep --tape-mass`` passes the variant to the measures: its ``jumps`` record's slip count equals
-    that of a direct window run of the tape-mass model with the same settings (exactly: the same run; 9 slips in
-    1 s, the massless model has 12.5 per second here), and the manifest records the option."""
+    that of a direct window run of the tape-mass model with the same settings (exactly: the same run), and the
+    manifest records the option.  Half a second of window after a quarter of transient (the tape-mass model's
+    LSODA run is the test's cost): it holds 4 slips (measured), where the massless model's same window holds 7, so a
+    sweep that ran the massless model instead, or nothing, would differ."""
     out = tmp_path / "sw"
-    assert main(["sweep", "--I", "1e-5", "--V", "1", "--measure", "jumps", "--t-transient", "0.5", "--window", "1",
+    assert main(["sweep", "--I", "1e-5", "--V", "1", "--measure", "jumps", "--t-transient", "0.25", "--window", "0.5",
                  "--tape-mass", "1e-3", "--out", str(out), "--workers", "0", "--quiet", "--format", "json"]) == 0
     rec = json.loads((out / "results.jsonl").read_text().splitlines()[0])
-    tr = exact.window_run(pa.PeelParams(V=1.0, I=1e-5, tape_mass=1e-3), t_transient=0.5, window=1.0)
+    tr = exact.window_run(pa.PeelParams(V=1.0, I=1e-5, tape_mass=1e-3), t_transient=0.25, window=0.5)
     slips = int(np.sum(tr.jumps.from_branch == 0))
-    assert rec["jumps_n_slips"] == slips == 9
+    assert rec["jumps_n_slips"] == slips >= 3
     assert json.loads((out / "sweep.json").read_text())["options"]["tape_mass"] == 1e-3
