@@ -166,14 +166,10 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         optional(positive, "max_wall", max_wall), flag("warn", warn)
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
     common: dict[str, Any] = dict(V=float(params.V), I=float(params.I), t_start=None, t_end=None)
-    inertia, velocity = regime(params) if law.structure.has_folds else ("n/a", "stable")
-    (ab_am, ab_ve), (cd_am, cd_ve) = APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
-    models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
-    chain = f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
+    inertia, velocity, models, chain = _chain(params, law, chosen)
     if (no_map := _no_map(params, law.structure, chain, common)) is not None:
         return no_map
-    lo = ReturnMap(params, law, models, rtol)  # its kernels compiled (once per machine) or loaded here
-    # the budget counts from here: a first call that compiles gives the answer a later one does
+    lo = ReturnMap(params, law, models, rtol)  # kernels compiled or loaded: max_wall counts from here (docstring)
     lo.deadline = math.inf if max_wall is None else time.perf_counter() + max_wall
     maps, names = (lo, lo.at(NEWTON_RTOL)), ("solver", "rest") if start == "auto" else (start,)
     solver = _solver_start(params, law) if "solver" in names else None
@@ -186,6 +182,16 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     if warn:
         warn_low(primary)
     return primary
+
+
+def _chain(params: PeelParams, law: Any, chosen: list[str | None]
+           ) -> tuple[str, str, tuple[tuple[str, str], tuple[str, str]], str]:
+    """``estimate()``'s inertia and velocity labels of ``params`` and the chain: the models ``chosen`` (AB α, AB v,
+    CD α, CD v), :data:`APPROX_DEFAULTS`' for the regime where None, and the chain's name."""
+    inertia, velocity = regime(params) if law.structure.has_folds else ("n/a", "stable")
+    (ab_am, ab_ve), (cd_am, cd_ve) = APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
+    models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
+    return inertia, velocity, models, f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
 
 
 def _no_map(params: PeelParams, bs: Any, chain: str, common: dict[str, Any]) -> ApproximateAttractor | None:
