@@ -32,8 +32,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ._checks import MAX_COUNT
-from ._returnmap import HasJumps, _periodicity, _trajectory, periodicity
+from ._returnmap import HasJumps, _trajectory, periodicity
 from .io import fmt_number, html_table, jsonable, optional_import
 from .law import BRANCHES, fixed_point
 from .validate import duration, integer, positive
@@ -112,11 +111,7 @@ def jump_statistics(t: np.ndarray, F: np.ndarray, fb: np.ndarray, *, period_rtol
     samples = {"slip_interval": np.diff(t[slips]), "force_drop": F[to_cd] - F[to_cd + 1],
                "slip_time": t[to_cd + 1] - t[to_cd], "stick_time": t[to_ab + 1] - t[to_ab]}
     if slips.size >= 2:
-        x = F[slips]
-        plain = (x.dtype == np.float64 and type(period_rtol) is float and 0.0 < period_rtol < math.inf
-                 and type(max_period) is int and 1 <= max_period <= MAX_COUNT and bool(np.isfinite(x).all()))
-        per = _periodicity(x, period_rtol, max_period) if plain else periodicity(x, rtol=period_rtol,
-                                                                                  max_period=max_period)
+        per = periodicity(F[slips], rtol=period_rtol, max_period=max_period)
         period, label = per.period, per.label
     else:
         period, label = None, "too short" if slips.size else "no stick-slip"

@@ -27,6 +27,7 @@ from typing import Literal, Protocol, cast, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._checks import MAX_COUNT
 from .law import BRANCHES
 from .validate import ArgumentTypeError, integer, positive, reals
 
@@ -142,6 +143,10 @@ def periodicity(
     -------
     Periodicity
     """
+    if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1 and x.size >= 2 and type(rtol) is float
+            and 0.0 < rtol < math.inf and type(max_period) is int and type(min_repeats) is int
+            and 1 <= max_period <= MAX_COUNT and 1 <= min_repeats <= MAX_COUNT and bool(np.isfinite(x).all())):
+        return _periodicity(x, rtol, max_period, min_repeats)  # what the checks below pass, without their cost
     if hasattr(x, "jumps"):
         x = return_map(cast(HasJumps, x))
     x = reals("x", x)

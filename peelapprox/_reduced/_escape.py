@@ -50,7 +50,7 @@ def refined_multipliers(lo: ReturnMap, xs: np.ndarray, n: int, full: Chain) -> t
     res = newton(m, np.array(xs, dtype=float), n)
     if res is None:
         return None
-    return tuple(complex(m) for m in np.linalg.eigvals(res[1]))
+    return tuple(complex(mu) for mu in np.linalg.eigvals(res[1]))
 
 
 def escape_return(lo: ReturnMap, J: np.ndarray, x: np.ndarray, xs: np.ndarray, n: int, rho: float,

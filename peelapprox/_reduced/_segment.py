@@ -66,7 +66,6 @@ from typing import Any, NamedTuple, cast
 
 import numpy as np
 
-from .._compiled import _generated as _g
 from .._compiled._jit import wrapper_address as _wrapper_address
 from .._packing import model_block
 from .._params import PeelParams
@@ -75,6 +74,7 @@ from .._status import DONE, LAW_DOMAIN, MAX_STEPS, OUT_FULL, T_MAX, V_CEILING, V
 from ..law import ALL_LAWS, BRANCHES
 from ..law._abi import LAW_SIG, LAW_TYPE
 from ..law._compiled import CompiledLaw, compiled_law
+from ..law._paper import paper_fp
 from ..validate import choice, duration, integer, optional, optional_finite, reals, times
 from ..validate import params as _params
 from ..validate import rtol as _rtol
@@ -458,13 +458,6 @@ class SegmentRun(NamedTuple):
     t_max: float
 
 
-def _paper_fp(v: float, V: float) -> float:
-    """fvV's ``f'(v, V)`` at a velocity and pull speed already checked: :func:`peelapprox.peel_force_derivative`'s
-    arithmetic (the generated kernel on a 0-d float array) without its argument checks (bitwise its value)."""
-    b, A = _g.peel_force_coefficients(float(V))
-    return float(_g.peel_force_fpp(np.asarray(float(v)), b, A)[1])
-
-
 def segment_plan(params: PeelParams, law: CompiledLaw, branch: str, *, v_in: float, v_f: float, alpha_model: str,
                  v_equation: str, F_rate: float | None, rtol: float, t_max: float | None,
                  max_steps: int) -> SegmentPlan:
@@ -472,7 +465,7 @@ def segment_plan(params: PeelParams, law: CompiledLaw, branch: str, *, v_in: flo
     :func:`reduced_segment` checks them: velocities on the branch and in the law's domain, known models)."""
     am = ALPHA_MODELS.index(alpha_model)
     s = _frozen_rate(params, v_in) if F_rate is None else F_rate
-    fp_in = _paper_fp(v_in, params.V) if law.inlined else law.df(v_in)
+    fp_in = paper_fp(v_in, params.V) if law.inlined else law.df(v_in)
     q = model_block(params, K.N_Q, ALL_LAWS)
     q[K.Q_AM] = am
     q[K.Q_VE] = V_EQUATIONS.index(v_equation)

@@ -93,6 +93,14 @@ def peel_force_derivative(v: Any, V: float, order: int = 1) -> Any:
     return out[()] if np.ndim(out) == 0 else out
 
 
+def paper_fp(v: float, V: float) -> float:
+    """``f'(v, V)`` at a velocity and pull speed already checked: :func:`peel_force_derivative`'s arithmetic (the
+    generated kernel on a 0-d float array) without its argument checks (bitwise its value), for callers that
+    check once and evaluate per segment plan."""
+    b, A = _g.peel_force_coefficients(float(V))
+    return float(_g.peel_force_fpp(np.asarray(float(v)), b, A)[1])
+
+
 def _fp(v, b, A):
     return _g.peel_force_fp(v, b, A)[1]
 
