@@ -26,31 +26,38 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import operator
 import time
 from typing import Any
 
-import numpy as np
-
-from .._observables import StickSlipObservables, jump_statistics
+from .._observables import StickSlipObservables
 from .._params import PeelParams
 from .._ranges import F0_FACTOR
-from .._status import F_NONPOSITIVE, LAW_DOMAIN, MAX_STEPS, NONFINITE, STATUS, STEP_FAIL, T_MAX, V_CEILING, V_FLOOR
+from .._status import LAW_DOMAIN, V_FLOOR
 from ..io import fmt_number
-from ..law import fixed_point
 from ..law._compiled import compiled_law
 from ..validate import choice, flag, integer, optional, positive
 from ..validate import params as _params
 from ..validate import rtol as _rtol
 from ._approx_result import ALPHA_LINEAR, MULTIPLIER_ERROR, ApproximateAttractor, confidence, warn_low
-from ._escape import escape_return
-from ._reducedmap import NEWTON_RTOL, SEGMENT_MAX_STEPS, MapStop, ReturnMap, newton
+from ._approx_start import (
+    ESCAPE_FRACTION,
+    FULL_CHAIN,
+    MAX_ESCAPES,
+    MAX_PERIOD,
+    PERIOD_RTOL,
+    Found,
+    Start,
+    from_start,
+    promote,
+)
+from ._reducedmap import NEWTON_RTOL, MapStop, ReturnMap
 from ._regime import regime
-from ._segment import SegmentPlan, segment_status
 from ._segment_kernel import ALPHA_MODELS, V_EQUATIONS
+from ._segment_plan import segment_status
 
 __all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "PERIOD_RTOL", "START_NAMES",
            "approximate_attractor", "default_models"]
+
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
 #: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``.  The measurements (the table and its
@@ -63,36 +70,8 @@ APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = dict.fromk
 #: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, both: the solver's attractor is the
 #: primary prediction, the rest start's an alternative (the primary where the solver's start finds none).
 START_NAMES = ("auto", "solver", "rest")
-
-#: A periodic orbit is looked for with periods up to this (Newton on ``P^n``); longer ones are sampled.
-MAX_PERIOD = 12
-#: The returns' period tolerance of an aperiodic sample, ``max(PERIOD_RTOL, 100 rtol)`` relative to the largest
-#: return (long periods of a sample: :func:`peelapprox.periodicity`).
-PERIOD_RTOL = 1e-4
-#: A period n is tried by Newton when the last returns repeat after n to this fraction of ``f_max - f_min``.
-CANDIDATE_RTOL = 0.2
-#: After this many transient returns, periods that repeat to :data:`EARLY_RTOL` are tried at once, and a clearly
-#: stable orbit (every multiplier inside 1 - the multiplier error) ends the transient.
-EARLY_RETURNS = 18
-EARLY_RTOL = 0.01
-#: Periods tried by Newton at most, best repeating first.
-MAX_CANDIDATES = 2
-#: An unstable orbit is left (:attr:`ApproximateAttractor.escape_returns`) when the deviation of the force at
-#: the AB→CD jumps from the orbit's reaches this fraction of the orbit's force drop: the deviation is then as
-#: large as the orbit itself, and the run goes over to another attractor.
-ESCAPE_FRACTION = 1.0
-#: The map leaves an unstable orbit from a force deviation of this fraction of its force drop (along its own
-#: deviation), where the orbit's linearisation no longer holds the map near it.
-ESCAPE_PUSH = 1.0
-#: The full branch dynamics linearised in α: the chain whose breakdown the default chain is checked against.
-FULL_CHAIN = (("genalpha", "fullvdot"), ("genalpha", "fullvdot"))
 #: Returns of :data:`FULL_CHAIN` from the solver's start in which a breakdown is looked for.
 PROBE_RETURNS = 5
-#: A multiplier within this of the unit circle is neutral (a family of orbits, as with α held fixed by the
-#: ``"static"`` model): the orbit is the answer, not left.
-NEUTRAL = 1e-7
-#: Unstable orbits left in turn from one start before the map samples what it reaches.
-MAX_ESCAPES = 3
 
 
 def default_models(params: PeelParams) -> tuple[tuple[str, str], tuple[str, str]]:
@@ -173,7 +152,7 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     lo.deadline = math.inf if max_wall is None else time.perf_counter() + max_wall
     maps, names = (lo, lo.at(NEWTON_RTOL)), ("solver", "rest") if start == "auto" else (start,)
     solver = _solver_start(params, law) if "solver" in names else None
-    found = [_from_start(params, maps, solver if name == "solver" and solver is not None else _rest(law), name,
+    found = [from_start(params, maps, solver if name == "solver" and solver is not None else _rest(law), name,
                          n_transient, n_returns, rtol, chain, common) for name in names]
     probe = _probe(params, law, solver, rtol, lo.deadline, lo.book) if solver is not None and models != FULL_CHAIN \
         else None
@@ -198,25 +177,15 @@ def _no_map(params: PeelParams, bs: Any, chain: str, common: dict[str, Any]) -> 
     """The answer where there is no return map to iterate: no folds at V (steady) or a jump without a landing
     (breakdown); None where there is one."""
     if not bs.has_folds:
-        return _promote(StickSlipObservables._no_slip(
+        return promote(StickSlipObservables._no_slip(
             status="steady", method="approximate: no folds, nothing to chain", **common,
             reason=f"the law has no folds at V = {fmt_number(params.V, 4)} m/s (f increases in v): steady peeling "
                    "at the stable fixed point v = V"))
     if bs.v_land_ab is None or bs.v_land_cd is None:
         which = "AB (f_min <= f(0+, V))" if bs.v_land_ab is None else "CD (the law's domain ends below f_max)"
-        return _promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
+        return promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
                                                       reason=f"a jump has no landing on {which}: no return map"))
     return None
-
-
-def _promote(o: StickSlipObservables, **extra: Any) -> ApproximateAttractor:
-    """``o`` as an :class:`ApproximateAttractor` with ``extra`` fields."""
-    fields = {f: getattr(o, f) for f in StickSlipObservables.__dataclass_fields__}
-    return ApproximateAttractor(**{**fields, **extra})
-
-
-#: A start of the map: ``(branch code (0 AB, 1 CD), F, v, α, α̇)``.
-Start = tuple[int, float, float, float, float]
 
 
 def _rest(law: Any) -> Start:
@@ -247,176 +216,7 @@ def _solver_start(params: PeelParams, law: Any) -> Start:
     return 0, float(bs.f_min), float(bs.v_land_ab), 0.0, kick(float(bs.v_land_ab))
 
 
-class _Found:
-    """What one start reached: the attractor's observables, the unstable orbits left on the way, and the
-    sample's largest |α| at a jump (the confidence rules' inputs)."""
-
-    def __init__(self, obs: ApproximateAttractor, left: list[ApproximateAttractor], alpha_max: float | None) -> None:
-        self.obs, self.left, self.alpha_max = obs, left, alpha_max
-
-
-def _observe(recs: np.ndarray, F_next: float, *, period_rtol: float, max_period: int, how: str, chain: str,
-             common: dict[str, Any], t0: float, **extra: Any) -> ApproximateAttractor:
-    """The observables of the returns ``recs`` (:meth:`ReturnMap.run`'s records) and the next AB→CD force; the
-    jump times are the stays summed in order from ``t0`` (``np.cumsum`` adds one after the other)."""
-    m = len(recs)
-    t = np.empty(2 * m + 1)
-    t[0], t[1::2], t[2::2] = t0, recs[:, 2], recs[:, 3]
-    t = np.cumsum(t)
-    F = np.empty(2 * m + 1)
-    F[0:-1:2], F[1::2], F[-1] = recs[:, 0], recs[:, 1], F_next
-    fb = np.zeros(2 * m + 1, dtype=int)
-    fb[1::2] = 1
-    stats, cycles = jump_statistics(t, F, fb, period_rtol=period_rtol, max_period=max_period)
-    reason = (f"{stats['n_slips']} slips of the reduced return map ({how}), return map {stats['period_label']}"
-              + (f"; means over the last {cycles} whole cycles" if cycles is not None else ""))
-    return ApproximateAttractor(status="stick-slip", reason=reason, method=f"{chain}, {how}", **stats,
-                                **{**common, "t_start": float(t[0]), "t_end": float(t[-1])}, **extra)
-
-
-def _candidates(F: np.ndarray, scale: float, rtol: float = CANDIDATE_RTOL) -> list[int]:
-    """Periods n <= :data:`MAX_PERIOD` after which the last returns repeat to :data:`CANDIDATE_RTOL` of
-    ``scale``, best repeating first, at most :data:`MAX_CANDIDATES`; a divisor of n that repeats nearly as well
-    (within 4 times n's mismatch, or 1e-3) stands for n (a period-2 orbit also repeats after 4).  The largest
-    ``|F_k - F_(k-n)|`` over the last ``max(2n, 6)`` returns, in Python floats on the last 3 :data:`MAX_PERIOD`
-    returns (the same differences as numpy's, and the same maximum, without numpy's per-call cost)."""
-    size = len(F)
-    x = F[-3 * MAX_PERIOD:].tolist()
-    k = len(x)
-    mismatch: dict[int, float] = {}
-    for n in range(1, MAX_PERIOD + 1):
-        m = max(2 * n, 6)
-        if size < m + n:
-            break
-        mismatch[n] = max(map(abs, map(operator.sub, x[k - m:], x[k - m - n:k - n]))) / scale
-    out: list[int] = []
-    for n, r in sorted(mismatch.items(), key=lambda item: item[1]):
-        if r >= rtol:
-            break
-        n = min(d for d in mismatch if n % d == 0 and mismatch[d] <= max(4.0 * r, 1e-3))
-        if n not in out:
-            out.append(n)
-    return out[:MAX_CANDIDATES]
-
-
-def _multipliers(J: np.ndarray) -> tuple[complex, ...]:
-    """The eigenvalues of ``J = D P^n``: the orbit's multipliers."""
-    return tuple(complex(m) for m in np.linalg.eigvals(J))
-
-
-def _orbit(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, n: int, mu: tuple[complex, ...], returns: int,
-           name: str, chain: str, common: dict[str, Any]) -> tuple[ApproximateAttractor, np.ndarray, float]:
-    """A periodic orbit's observables over whole cycles of the orbit itself (at Newton's tolerance), its records
-    and its mean force drop.  The first cycle is Newton's last ``P^n(x)`` where it ran it (the map's memo)."""
-    hi = maps[1]
-    cycles = 3  # the orbit itself: one cycle gives its means, three its period label (peelapprox.periodicity)
-    y, first = hi.run(x, n)
-    y, rest = hi.run(y, (cycles - 1) * n)
-    recs = np.concatenate((first, rest))
-    rho = max(abs(m) for m in mu)
-    kind = "stable" if rho < 1.0 else ("neutral" if rho <= 1.0 + NEUTRAL else "unstable")
-    how = (f"{name} start, Newton on P^{n} after {returns} returns, {kind} "
-           f"(|mu| {'/'.join(fmt_number(abs(m), 6) for m in mu)})")
-    obs = _observe(recs, hi.force(0, float(y[0])), period_rtol=1e-6, max_period=n, how=how, chain=chain,
-                   common=common, t0=0.0, multipliers=mu, start=name)
-    return obs, recs, float(np.mean(recs[:, 0] - recs[:, 1]))
-
-
-def _alpha_max(recs: np.ndarray) -> float:
-    """The largest |α| at a jump of the returns ``recs``."""
-    return float(np.max(np.abs(recs[:, 4:6])))
-
-
-def _deviation(recs: np.ndarray, orbit: np.ndarray, n: int) -> float:
-    """The largest deviation of the last n returns' AB→CD forces from the orbit's at the same phase."""
-    return float(max(abs(recs[-i, 0] - orbit[(n - i) % n, 0]) for i in range(1, n + 1)))
-
-
-def _periodic(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: np.ndarray, rtol: float
-              ) -> tuple[np.ndarray, np.ndarray, int] | None:
-    """The periodic orbit Newton finds from ``x`` for a period n the returns ``recs`` propose (best first, those
-    repeating to ``rtol``): its section point, ``D P^n`` there and n; None if none converges."""
-    bs = maps[0].law.structure
-    for n in _candidates(recs[:, 0], float(bs.f_max - bs.f_min), rtol):
-        res = newton(maps[1], x.copy(), n)
-        if res is not None:
-            return res[0], res[1], n
-    return None
-
-
-def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: np.ndarray, name: str, chain: str,
-            common: dict[str, Any], rtol: float = CANDIDATE_RTOL
-            ) -> tuple[ApproximateAttractor, np.ndarray, float, tuple[np.ndarray, np.ndarray], int] | None:
-    """The periodic orbit of :func:`_periodic`: its observables, records, mean force drop, section point and
-    ``D P^n`` there, and n; None if none converges."""
-    got = _periodic(maps, x, recs, rtol)
-    if got is None:
-        return None
-    xs, J, n = got
-    obs, orbit, drop = _orbit(maps, xs, n, _multipliers(J), maps[0].returns, name, chain, common)
-    return obs, orbit, drop, (xs, J), n
-
-
-def _from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start, name: str, n_transient: int,
-                n_returns: int, rtol: float, chain: str, common: dict[str, Any]) -> _Found:
-    """The attractor the map reaches from ``s`` (module docstring), with the unstable orbits it left."""
-    lo, hi = maps
-    lo.returns = 0
-    left: list[ApproximateAttractor] = []
-    k_in = 0  # the return at which the map set out towards the orbit it reaches next (the start, or the last push)
-    try:
-        x, recs = lo.run(lo.enter(s), min(n_transient, EARLY_RETURNS))
-        if EARLY_RETURNS < n_transient:  # nearly repeating already: a clearly stable orbit ends the transient
-            early = _periodic(maps, x, recs, EARLY_RTOL)
-            mu = _multipliers(early[1]) if early is not None else (1.0,)
-            if early is not None and max(abs(m) for m in mu) < 1.0 - MULTIPLIER_ERROR:  # its observables only now
-                obs, orbit, _ = _orbit(maps, early[0], early[2], mu, lo.returns, name, chain, common)
-                return _Found(obs, left, _alpha_max(orbit))
-            x, more = lo.run(x, n_transient - EARLY_RETURNS)
-            recs = np.concatenate((recs, more))
-        for _ in range(MAX_ESCAPES + 1):
-            got = _settle(maps, x, recs, name, chain, common)
-            if got is None:
-                break  # no period found: a sample
-            obs, orbit, drop, (xs, J), n = got
-            rho, thr = max(abs(m) for m in obs.multipliers or ()), ESCAPE_FRACTION * drop
-            if obs.stable or rho <= 1.0 + NEUTRAL:  # the escape of an orbit the full chain finds weakly unstable
-                k_esc, mu_esc = escape_return(lo, J, x, xs, n, rho, thr, FULL_CHAIN, lo.returns - k_in) \
-                    if rho < 1.0 - NEUTRAL else (None, None)
-                return _Found(dataclasses.replace(obs, escape_returns=k_esc, escape_multiplier=mu_esc), left,
-                              _alpha_max(orbit))
-            dev = _deviation(recs, orbit, n)
-            k_esc, mu_esc = escape_return(lo, J, x, xs, n, rho, thr, FULL_CHAIN, lo.returns - k_in)
-            left.append(dataclasses.replace(obs, escape_returns=k_esc, escape_multiplier=mu_esc))
-            if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
-                x = xs + (x - xs) * (ESCAPE_PUSH * drop / dev)
-            k_in = lo.returns
-            x, recs = lo.run(x, max(n_transient, 3 * MAX_PERIOD))
-        x, recs = lo.run(x, n_returns)  # the sample: n_returns after the transient
-        got = _settle(maps, x, recs, name, chain, common)  # a periodic orbit reached late, after the transient
-        if got is not None and max(abs(m) for m in got[0].multipliers or (2.0,)) <= 1.0 + NEUTRAL:
-            return _Found(got[0], left, _alpha_max(got[1]))
-        sample = recs[-n_returns:]
-        how = f"{name} start, {n_returns} returns sampled after {lo.returns - n_returns}, rtol {fmt_number(rtol, 3)}"
-        obs = _observe(sample, lo.force(0, float(x[0])), period_rtol=max(PERIOD_RTOL, 100.0 * rtol), max_period=32,
-                       how=how, chain=chain, common=common, t0=0.0, start=name)
-        return _Found(obs, left, _alpha_max(sample))
-    except MapStop as stop:
-        if stop.timeout or stop.plan is None:
-            return _Found(_promote(StickSlipObservables._no_slip(
-                status="no attractor", method=f"{chain}, {name} start", **common,
-                reason=f"max_wall spent after {lo.returns + hi.returns} returns"), start=name), left, None)
-        return _Found(_promote(_failed(params, stop.plan, stop.run, stop.returns, f"{chain}, {name} start", common),
-                               start=name), left, None)
-
-
-def _near(a: ApproximateAttractor, b: ApproximateAttractor, tol: float) -> bool:
-    """Slip interval and force drop of ``a`` within ``tol`` (relative) of ``b``'s."""
-    return all(x is not None and y is not None and abs(x - y) <= tol * abs(y)
-               for x, y in ((a.slip_interval, b.slip_interval), (a.force_drop, b.force_drop)))
-
-
-def _marginal(f: _Found) -> bool:
+def _marginal(f: Found) -> bool:
     """The start reached an orbit whose stability the map cannot decide (a multiplier within the reduction's
     multiplier error of 1), or left such an orbit on its way (the escape's amplitude is the map's guess, and what
     follows it may still be the transient)."""
@@ -455,10 +255,10 @@ def _same(a: ApproximateAttractor, b: ApproximateAttractor) -> bool:
                for x, y in ((a.slip_interval, b.slip_interval), (a.force_drop, b.force_drop)))
 
 
-def _assemble(found: list[_Found], label: str, breakdown: str | None) -> ApproximateAttractor:
+def _assemble(found: list[Found], label: str, breakdown: str | None) -> ApproximateAttractor:
     """The primary prediction (the first start's stick-slip attractor, the map's orbits of undecided stability
     (:func:`_marginal`) last) with its confidence, and the others as its alternatives."""
-    def rated(o: ApproximateAttractor, f: _Found | None) -> ApproximateAttractor:
+    def rated(o: ApproximateAttractor, f: Found | None) -> ApproximateAttractor:
         if o.status == "stick-slip":
             c, why = confidence(o, label, f.alpha_max if f else None, tuple(f.left) if f else (), breakdown)
         elif o.status == "steady":
@@ -481,43 +281,3 @@ def _assemble(found: list[_Found], label: str, breakdown: str | None) -> Approxi
             if not any(_same(o, x) for x in others):
                 others.append(rated(o, None))
     return dataclasses.replace(primary, alternatives=tuple(others))
-
-
-def _failed(params: PeelParams, plan: SegmentPlan, run: Any, n_returns: int, chain: str,
-            common: dict[str, Any]) -> StickSlipObservables:
-    """The observables of a map stopped by a segment that did not reach its fold: steady, no attractor or
-    breakdown (:func:`approximate_attractor`'s statuses)."""
-    code = segment_status(plan, run.code)
-    y = run.y
-    v, F = math.exp(float(y[1])), float(y[2])
-    where = (f"the {plan.branch} segment entered after {n_returns} returns stopped at v = {fmt_number(v, 4)} m/s, "
-             f"F = {fmt_number(F, 5)} N, {fmt_number(float(y[0]), 4)} s after its entry")
-    if code == T_MAX:
-        fp = fixed_point(params.V, params.R, force=params.force)
-        if fp.stable:
-            return StickSlipObservables._no_slip(
-                status="steady", method=chain, **common,
-                reason=f"{where}: it did not reach its fold within its horizon ({fmt_number(run.t_max, 3)} s) and "
-                       f"the fixed point v = V is stable (f'(V, V) = {fmt_number(fp.fprime, 4)} N s/m): steady "
-                       "peeling")
-        return StickSlipObservables._no_slip(
-            status="no attractor", method=chain, **common,
-            reason=f"{where}: it did not reach its fold within its horizon ({fmt_number(run.t_max, 3)} s), "
-                   "though the fixed point is unstable")
-    if code == MAX_STEPS:
-        return StickSlipObservables._no_slip(status="no attractor", method=chain, **common,
-                                             reason=f"{where}: its step budget ({SEGMENT_MAX_STEPS}) was spent")
-    why = _BREAKDOWNS.get(code, "the segment's solver stopped")
-    return StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
-                                         reason=f"{where}: {why} (status {STATUS[code].reason})")
-
-
-#: Why a segment that broke down stopped (the reduced segment's statuses, :mod:`peelapprox._status`).
-_BREAKDOWNS = {
-    V_FLOOR: "v fell by a factor e^60 below its entry on AB: v -> 0",
-    V_CEILING: "v ran away on CD (above 1000 times its entry)",
-    F_NONPOSITIVE: "the pull force reached 0",
-    NONFINITE: "the state became non-finite",
-    LAW_DOMAIN: "v left the peel-force law's domain",
-    STEP_FAIL: "the step size collapsed",
-}

@@ -30,8 +30,8 @@ from .._params import PeelParams
 from .._status import DONE
 from . import _reducedmap_kernel as RK
 from . import _segment_kernel as K
-from ._segment import SegmentPlan, SegmentRun, run_segment, segment_plan
 from ._segment_kernel import AM_EXP, AM_HARM, AM_SIN, AM_STATIC, alpha_at
+from ._segment_plan import SegmentPlan, SegmentRun, run_segment, segment_plan
 
 __all__: list[str] = []
 
