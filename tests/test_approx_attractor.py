@@ -40,7 +40,8 @@ def test_quasi_static_limit_is_the_quadrature(p_low):
     0 (α̇ is dropped).  The orbit's observables are read at Newton's rtol 1e-9; every observable agrees to 5e-8
     (the integration's error with a margin: 6.8e-9 measured at rtol 1e-8, 4.5e-7 at 1e-6)."""
     e = estimate(p_low)
-    o = approximate_attractor(p_low, alpha_model="static", cd_alpha_model="static", rtol=1e-8, warn=False)
+    o = approximate_attractor(p_low, alpha_model="static", cd_alpha_model="static", v_equation="approxvdot",
+                              cd_v_equation="approxvdot", rtol=1e-8, warn=False)
     assert (o.status, o.period, o.period_label) == ("stick-slip", 1, "period-1")
     assert o.method.startswith("approximate: AB static/approxvdot, CD static/approxvdot, solver start, Newton on P^1 "
                                "after 40 returns, neutral (|mu| 1/0)")
@@ -123,14 +124,19 @@ def test_breakdown_and_budget_are_statuses():
 
 
 def test_defaults_follow_the_regime(p_low, p_high):
-    """The defaults of :data:`APPROX_DEFAULTS`, read off ``method``: airy1 + approxvdot on both branches at low
-    inertia (estimate's r < 1) and at high inertia (chosen by measurement, the same for every label); each slot
-    given replaces that slot only."""
-    assert estimate(p_low).inertia == "low" and estimate(p_high).inertia == "high"
-    assert approximate_attractor(p_low).method.startswith("approximate: AB airy1/approxvdot, CD airy1/approxvdot, ")
+    """The defaults of :data:`APPROX_DEFAULTS`, read off ``method``: genalpha + fullvdot on both branches at low
+    (estimate's r < 1) and intermediate inertia, airy1 + approxvdot at high inertia (chosen by measurement:
+    docs/theory.md, "The approximate attractor"); each slot given replaces that slot only."""
+    p_mid = PeelParams(V=2.0, I=2e-4)
+    assert [estimate(p).inertia for p in (p_low, p_mid, p_high)] == ["low", "intermediate", "high"]
+    full = "approximate: AB genalpha/fullvdot, CD genalpha/fullvdot, "
+    assert approximate_attractor(p_low).method.startswith(full)
+    assert approximate_attractor(p_mid, warn=False).method.startswith(full)
     assert approximate_attractor(p_high).method.startswith("approximate: AB airy1/approxvdot, CD airy1/approxvdot, ")
     o = approximate_attractor(p_high, cd_alpha_model="exponential", n_transient=5, n_returns=10)
     assert o.method.startswith("approximate: AB airy1/approxvdot, CD exponential/approxvdot")
+    o = approximate_attractor(p_low, v_equation="approxvdot", n_transient=5, n_returns=10, warn=False)
+    assert o.method.startswith("approximate: AB genalpha/approxvdot, CD genalpha/fullvdot")
     assert isinstance(o, StickSlipObservables)
 
 

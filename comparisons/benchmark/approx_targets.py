@@ -18,8 +18,13 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
 * ``strict``: it matches the α0 = 0 start's;
 * ``calibration``: of the predictions with ``confidence == "high"``, the fraction that match the set, and the
   fraction of all points that are high;
-* ``labels``: where the primary prediction and the α0 = 0 start are both periodic, whether their periods are equal;
+* ``labels``: where the primary prediction and the α0 = 0 start are both periodic, whether their periods are equal
+  (strict); ``labels_matched``: the same against the exact attractor the prediction matches (of the starts within
+  10 %, the closest: the largest of the two relative differences smallest), or the α0 = 0 start's where it matches
+  none, where both are periodic;
 * the median wall time of a call (one untimed call first, then ``--repeats``);
+* ``--chain full``: the same measures for the full branch dynamics linearised in α (genalpha + fullvdot on both
+  branches, :data:`CHAINS`) instead of the default reductions;
 * the points where every start of the exact run breaks down and the prediction's status and confidence there;
 * ``--multipliers K``: at the first K points whose primary prediction is a periodic orbit (n <= 12),
   :func:`exact.periodic_orbit` with the same n, and the difference of the largest |μ| (the reduction's multiplier
@@ -58,7 +63,8 @@ import exact
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, approximate_attractor, estimate
 from peelapprox.io import fmt_number
 
-__all__ = ["ALPHA0S", "DATA", "escapes", "main", "multiplier_errors", "points", "reference", "score"]
+__all__ = ["ALPHA0S", "CHAINS", "DATA", "escapes", "main", "matched_start", "multiplier_errors", "points", "reference",
+           "score"]
 
 #: The exact run's starts: α0 of :func:`exact.attractor_observables` (0 first: the strict reference).
 ALPHA0S = (0.0, 0.15, -0.15, 0.3, -0.3)
@@ -68,6 +74,12 @@ DATA = Path(__file__).parent / "data"
 #: ``ESCAPE_FRACTION`` (peelapprox/_reduced/_approximate.py).
 ESCAPE_FRACTION = 1.0
 _OBS = ("slip_interval", "force_drop", "F_max", "F_min", "period")
+#: The chains ``--chain`` selects: the options of :func:`peelapprox.approximate_attractor` (``default``: none).
+CHAINS: dict[str, dict[str, str]] = {
+    "default": {},
+    "full": {"alpha_model": "genalpha", "v_equation": "fullvdot", "cd_alpha_model": "genalpha",
+             "cd_v_equation": "fullvdot"},
+}
 
 
 def points(n: int, seed: int) -> list[tuple[float, float]]:
@@ -117,6 +129,25 @@ def _match(pred: Any, e: dict[str, Any]) -> bool:
     return all(abs(getattr(pred, k) / e[k] - 1.0) < 0.1 for k in ("slip_interval", "force_drop"))
 
 
+def _distance(pred: Any, e: dict[str, Any]) -> float:
+    """The larger relative difference of the slip interval and the force drop (:func:`_match`: below 0.1)."""
+    return max(abs(getattr(pred, k) / e[k] - 1.0) for k in ("slip_interval", "force_drop"))
+
+
+def matched_start(pred: Any, starts: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The exact start whose stick-slip attractor ``pred`` matches (:func:`_match`), the closest of those (the
+    larger of the two relative differences smallest, the first of equals); None where it matches none."""
+    near = [s for s in starts if _match(pred, s)]
+    return min(near, key=lambda s: _distance(pred, s)) if near else None
+
+
+def _labels(o: Any, e: dict[str, Any]) -> bool | None:
+    """Whether the prediction's period equals the exact start's, None unless both are periodic."""
+    if o.status != "stick-slip" or o.period is None or e["period"] is None:
+        return None
+    return bool(o.period == e["period"])
+
+
 def score(ref: list[dict[str, Any]], repeats: int = 1, **options: Any) -> dict[str, Any]:
     """Every point's prediction and the measures of the module docstring."""
     with warnings.catch_warnings():  # the kernels compiled or loaded first, not inside a point's max_wall
@@ -141,14 +172,17 @@ def score(ref: list[dict[str, Any]], repeats: int = 1, **options: Any) -> dict[s
                      "any_ss": any(s["status"] == "stick-slip" for s in starts),
                      "all_break": all(s["status"].startswith("exact") for s in starts),
                      "set": any(_match(o, s) for s in starts), "strict": _match(o, starts[0]),
-                     "labels": None if o.period is None or starts[0]["period"] is None or o.status != "stick-slip"
-                     else o.period == starts[0]["period"],
+                     "labels": _labels(o, starts[0]),
+                     "labels_matched": _labels(o, matched_start(o, starts) or starts[0]),
                      "high": getattr(o, "confidence", "high") == "high"})
     sel = [r for r in rows if r["strict_ss"]]
     high = [r for r in sel if r["high"]]
     both = [r for r in sel if r["labels"] is not None]
+    both_m = [r for r in sel if r["labels_matched"] is not None]
     return {"rows": rows, "n": len(sel), "set": sum(r["set"] for r in sel) / max(1, len(sel)),
             "labels_equal": sum(r["labels"] for r in both), "labels_both_periodic": len(both),
+            "labels_matched_equal": sum(r["labels_matched"] for r in both_m),
+            "labels_matched_both_periodic": len(both_m),
             "strict": sum(r["strict"] for r in sel) / max(1, len(sel)),
             "high_share": len(high) / max(1, len(sel)),
             "high_match": sum(r["set"] for r in high) / max(1, len(high)),
@@ -284,6 +318,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=1, help="timed calls per point after one untimed (default 1)")
     ap.add_argument("--reference-only", action="store_true", help="compute (or load) the exact reference, no more")
     ap.add_argument("--cached", action="store_true", help="score only the points already in the cache")
+    ap.add_argument("--chain", choices=sorted(CHAINS), default="default", help="the reductions: the default ones, "
+                    "or the full branch dynamics linearised in alpha (genalpha + fullvdot on both branches)")
+    ap.add_argument("--labels", action="store_true", help="list the points whose period label differs from the "
+                    "default start's, with the five starts' periods")
     ap.add_argument("--json", help="write the rows and the measures as JSON")
     ap.add_argument("--multipliers", type=int, default=0, help="compare multipliers with exact.periodic_orbit at K "
                     "points (module docstring)")
@@ -321,20 +359,30 @@ def main(argv: list[str] | None = None) -> int:
         if args.json:
             Path(args.json).write_text(json.dumps(extra, indent=1, default=str))
         return 0
-    s = score(ref, repeats=args.repeats)
-    print(f"seed {args.seed}, {args.points} points, {s['n']} stick-slip from the default start: set "
+    s = score(ref, repeats=args.repeats, **CHAINS[args.chain])
+    print(f"seed {args.seed}, {args.points} points, {args.chain} chain, {s['n']} stick-slip from the default start: "
+          f"set "
           f"{_pct(s['set'])} %, strict {_pct(s['strict'])} %, unflagged {_pct(s['high_share'])} % of which match "
           f"{_pct(s['high_match'])} %, median call {fmt_number(s['ms_median'], 3)} ms wall, "
           f"{fmt_number(s['cpu_ms_median'], 3)} ms CPU (periodic predictions "
           f"{fmt_number(s['cpu_ms_median_periodic'], 3)}, "
           f"aperiodic {fmt_number(s['cpu_ms_median_aperiodic'], 3)}); period labels equal to the default start's "
-          f"where both are periodic: {s['labels_equal']} of {s['labels_both_periodic']}")
+          f"where both are periodic: {s['labels_equal']} of {s['labels_both_periodic']}, to the matched attractor's: "
+          f"{s['labels_matched_equal']} of {s['labels_matched_both_periodic']}")
     for r in s["rows"]:
         o = r["pred"]
         if (r["strict_ss"] and not r["set"]) or r["all_break"]:
             ex = r["all_break"] and "all starts break down" or "miss"
             print(f"  {ex}: V={r['V']:.4g} I={r['I']:.3g} [{r['regime']}] pred {o.status} {o.period_label} "
                   f"{getattr(o, 'confidence', '-')}: {getattr(o, 'confidence_reason', '')}")
+    if args.labels:
+        for r, p in zip(s["rows"], ref):
+            if r["strict_ss"] and r["labels"] is False:
+                o = r["pred"]
+                print(f"  label: V={r['V']:.4g} I={r['I']:.3g} [{r['regime']}] pred {o.period_label} ({o.start} start, "
+                      f"{getattr(o, 'confidence', '-')}), starts {[e['period'] for e in p['starts']]}, "
+                      f"{'matches' if r['set'] else 'misses'} the set, matched attractor's label "
+                      f"{'equal' if r['labels_matched'] else 'different'}")
     if args.json:
         out = {k: v for k, v in s.items() if k != "rows"}
         out["rows"] = [{**{k: v for k, v in r.items() if k != "pred"}, "pred": r["pred"].as_dict()} for r in s["rows"]]

@@ -60,12 +60,16 @@ __all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "P
 
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
-#: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``.  The measurements (the table and its
-#: reasons are in the docstring of :func:`approximate_attractor`) chose one pair for every label, Airy1 +
-#: approxvdot on both branches; the table stays per label so that a label can be given a pair of its own.
-APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = dict.fromkeys(
-    ("low", "intermediate", "high"), (("airy1", "approxvdot"), ("airy1", "approxvdot")))
-
+#: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``.  At low and intermediate inertia the
+#: full branch dynamics linearised in α, genalpha + fullvdot on both branches (:data:`FULL_CHAIN`); at high inertia
+#: Airy1 + approxvdot (FLOW1's kinematic term kept, the O(α) terms dropped).  Measured on the benchmark's 200 random
+#: points (docs/theory.md, "The approximate attractor"): the full chain gives the exact run's period label where
+#: Airy1 + approxvdot gives a neighbouring one (10 → 9 slips per cycle, 6 → 3), matches the exact set at least as
+#: often in both regimes, and costs no more CPU time there (median 15.5 and 19.1 ms against 16.9 and 21.3 on seed
+#: 1); at high inertia it costs 3-12 ms more a call (it leaves the weakly unstable small modes and samples what
+#: follows), so the default stays Airy1 + approxvdot there.
+APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
+    "low": FULL_CHAIN, "intermediate": FULL_CHAIN, "high": (("airy1", "approxvdot"), ("airy1", "approxvdot"))}
 #: Where the map starts (``start=``): ``"solver"``, the exact solver's default start; ``"rest"``, the foot of the
 #: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, both: the solver's attractor is the
 #: primary prediction, the rest start's an alternative (the primary where the solver's start finds none).
@@ -90,9 +94,11 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     Runs the reduced return map on the exact model's section (module docstring: AB segment to the fold, jump
     with F put on CONSTR, CD segment to the fold, jump) from the exact solver's start and from rest, finds its
     periodic orbits by Newton with their multipliers, leaves the unstable ones, and reads the observables of
-    what it reaches with the definitions of :class:`StickSlipObservables`.  The default reductions, Airy1 +
-    approxvdot on both branches, keep FLOW1's kinematic term ``-v̇/R``, large near the folds (measurements of this
-    choice and of genalpha + fullvdot: docs/theory.md, "The approximate attractor").
+    what it reaches with the definitions of :class:`StickSlipObservables`.  The default reductions
+    (:data:`APPROX_DEFAULTS`): the full branch dynamics linearised in α (genalpha + fullvdot on both branches) at
+    low and intermediate inertia, Airy1 + approxvdot at high inertia, which keeps FLOW1's kinematic term ``-v̇/R``,
+    large near the folds, and drops the O(α) terms (measurements of both: docs/theory.md, "The approximate
+    attractor").
 
     Parameters
     ----------
@@ -227,7 +233,7 @@ def _marginal(f: Found) -> bool:
 
 def _probe(params: PeelParams, law: Any, start: Start, rtol: float, deadline: float,
            book: dict | None = None) -> str | None:
-    """Why the exact model breaks down from the solver's start (``start``) where the default chain may not: the full
+    """Why the exact model breaks down from the solver's start (``start``) where Airy1 + approxvdot may not: the full
     branch dynamics linearised in α (:data:`FULL_CHAIN`) reaches ``F(1 + sin α) = f(0+, V)`` on AB (v -> 0) within
     :data:`PROBE_RETURNS` returns; None if it does not (a probe found, of 200 random points, 3 where the exact run
     breaks down got a stick-slip prediction; at V = 0.903, I = 1.08e-4 Airy1 + approxvdot's first CD stay lasts
