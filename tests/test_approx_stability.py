@@ -243,3 +243,23 @@ def test_label_measure_against_the_matched_attractor():
     assert bench.matched_start(SimpleNamespace(**{**vars(pred), "slip_interval": 2.0}), starts) is None
     assert bench._labels(SimpleNamespace(**{**vars(pred), "period": None}), starts[2]) is None
     assert bench._labels(pred, start(1.0, 10.0, None)) is None
+
+
+@pytest.mark.slow
+def test_period_labels_at_low_and_intermediate_inertia():
+    """Issue 35's label target where the default chain is the full branch dynamics linearised in α (low and
+    intermediate inertia): on both seeds' cached references, wherever the primary prediction matches an exact
+    attractor of the set and both are periodic, its period equals that attractor's (the measure the issue's
+    sentence asks for: docs/theory.md, "Period labels") at >= 95 % of the points (measured 36 of 37 and 43 of 44; the
+    exception, V = 1.533, I = 1.25e-4, the rest start's period-3 where the exact orbit is period-28, is a miss).
+    With Airy1 + approxvdot there the same measure was 33 of 37 and 34 of 42.  At high inertia the default stays
+    Airy1 + approxvdot and the target is not met (docs/theory.md).  The default tier's cover: the label is the map's
+    own long-run period (``test_period_label_is_the_maps_own_long_run_period``) and the measure's definition
+    (``test_label_measure_against_the_matched_attractor``)."""
+    from comparisons.benchmark import approx_targets as bench
+
+    for seed in (1, 2):
+        rows = [r for r in bench.score(bench.reference(100, seed))["rows"]
+                if r["strict_ss"] and r["labels_matched"] is not None
+                and r["regime"].split(" inertia")[0] in ("low", "intermediate")]
+        assert len(rows) >= 30 and sum(r["labels_matched"] for r in rows) >= 0.95 * len(rows), seed
