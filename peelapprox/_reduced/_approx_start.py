@@ -72,10 +72,12 @@ Start = tuple[int, float, float, float, float]
 
 
 class Found:
-    """What one start reached: the attractor's observables, the unstable orbits left on the way, and the
-    sample's largest |α| at a jump (the confidence rules' inputs)."""
+    """What one start reached: the attractor's observables (None where the start was not followed past an orbit
+    it left: :func:`from_start`'s ``outranked``), the unstable orbits left on the way, and the sample's largest
+    |α| at a jump (the confidence rules' inputs)."""
 
-    def __init__(self, obs: ApproximateAttractor, left: list[ApproximateAttractor], alpha_max: float | None) -> None:
+    def __init__(self, obs: ApproximateAttractor | None, left: list[ApproximateAttractor],
+                 alpha_max: float | None) -> None:
         self.obs, self.left, self.alpha_max = obs, left, alpha_max
 
 
@@ -182,8 +184,12 @@ def _settle(maps: tuple[ReturnMap, ReturnMap], x: np.ndarray, recs: np.ndarray, 
 
 
 def from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start, name: str, n_transient: int,
-                n_returns: int, rtol: float, chain: str, common: dict[str, Any]) -> Found:
-    """The attractor the map reaches from ``s`` (module docstring), with the unstable orbits it left."""
+                n_returns: int, rtol: float, chain: str, common: dict[str, Any], outranked: bool = False) -> Found:
+    """The attractor the map reaches from ``s`` (module docstring), with the unstable orbits it left.
+
+    With ``outranked`` (another start's answer ranks first whatever this start reaches once
+    it has left an orbit of undecided stability: :func:`peelapprox._reduced._approximate._assemble`) the start is
+    not followed past such an orbit: its answer is then None, with the orbits it left."""
     lo, hi = maps
     lo.returns = 0
     left: list[ApproximateAttractor] = []
@@ -212,6 +218,8 @@ def from_start(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], s: Start, 
             dev = _deviation(recs, orbit, n)
             k_esc, mu_esc = escape_return(lo, J, x, xs, n, rho, thr, FULL_CHAIN, lo.returns - k_in)
             left.append(dataclasses.replace(obs, escape_returns=k_esc, escape_multiplier=mu_esc))
+            if outranked and abs(rho - 1.0) < MULTIPLIER_ERROR:  # ranked after the other start's whatever follows
+                return Found(None, left, None)
             if 0.0 < dev < ESCAPE_PUSH * drop:  # past the escape along the map's own deviation, on from there
                 x = xs + (x - xs) * (ESCAPE_PUSH * drop / dev)
             k_in = lo.returns
