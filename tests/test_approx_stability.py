@@ -117,10 +117,14 @@ def test_the_result_is_still_stick_slip_observables():
 
 def test_low_confidence_warns_once_and_high_does_not():
     """V = 4.5, I = 0.1 (the issue's example, where the old map put F in 570-622 N against the exact 306-308 N):
-    the map's period-1 orbit has |μ| within 1e-3 of 1, inside the reduction's multiplier error, so the answer is
-    low confidence and says why, with exactly one ApproximationWarning; its forces are the exact attractor's
-    (within 1 %: measured 306.3-308.1 N).  ``warn=False`` is silent.  V = 1, I = 1e-5 (a stable period-3 orbit,
-    |μ| 0.23 and 0.28, low inertia) is high confidence and silent."""
+    the map's period-1 orbit has |μ| within 1e-3 of 1 (1.00001 with the default chain, which leaves it and samples
+    500 returns around it), inside the reduction's multiplier error, so the answer is low confidence and says why,
+    with exactly one ApproximationWarning.  Stored oracle: ``exact.attractor_observables(PeelParams(V=4.5, I=0.1))``
+    (slip interval 1.25517e-3 s, force drop 1.76414 N, F 305.9-308.4 N); the prediction's means within 1 %
+    (measured -0.31 % and -0.59 %) and its forces within 5 % of that range (measured 294.5-320.0 N: the sample
+    wanders around the weakly unstable orbit, where Airy1 + approxvdot's weakly stable one had 306.3-308.0 N).
+    ``warn=False`` is silent.  V = 1, I = 1e-5 (a stable period-3 orbit, |μ| 0.23 and 0.28, low inertia) is high
+    confidence and silent."""
     p = PeelParams(V=4.5, I=0.1)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -128,7 +132,9 @@ def test_low_confidence_warns_once_and_high_does_not():
     flagged = [w for w in caught if issubclass(w.category, ApproximationWarning)]
     assert len(flagged) == 1 and "low confidence" in str(flagged[0].message)
     assert o.confidence == "low" and "multiplier" in o.confidence_reason
-    assert o.F_min == pytest.approx(306.3, rel=0.01) and o.F_max == pytest.approx(308.1, rel=0.01)
+    assert o.slip_interval == pytest.approx(1.2551746602333178e-3, rel=0.01)
+    assert o.force_drop == pytest.approx(1.764138221973517, rel=0.01)
+    assert o.F_min >= 0.95 * 305.9449825738739 and o.F_max <= 1.05 * 308.3878124009863
     with warnings.catch_warnings():
         warnings.simplefilter("error", ApproximationWarning)
         approximate_attractor(p, warn=False)
@@ -140,8 +146,8 @@ def test_breakdown_of_the_exact_run_is_flagged():
     """Issue 34: at V = 0.903, I = 1.08e-4 the exact run breaks down from the solver's start (F(1 + sin α) falls to
     f(0+, V) on AB at t = 0.021 s: :class:`peelapprox.ModelBreakdown`), and so does the full branch dynamics
     linearised in α (genalpha + fullvdot) from the same start, the default chain at this intermediate inertia: the
-    default answer is that breakdown (low confidence).  Airy1 + approxvdot (the default at high inertia) predicts
-    stick-slip: an artefact of its O(α) terms (its first CD stay lasts 2.6 ms against the exact 11.2 ms), which
+    default answer is that breakdown (low confidence).  Airy1 + approxvdot (the default at high inertia before)
+    predicts stick-slip: an artefact of its O(α) terms (its first CD stay lasts 2.6 ms against the exact 11.2 ms), which
     the answer flags: low confidence, the reason naming the full chain's breakdown."""
     p = PeelParams(V=0.903, I=1.08e-4)
     with pytest.raises(exact.ModelBreakdown):
@@ -175,8 +181,8 @@ def test_validation_seed_meets_the_accuracy_targets():
     """The issue's targets on the validation points (seed 2, never used to choose a confidence rule or constant;
     the chain per inertia label was chosen on both seeds), against their cached exact multi-start reference: the
     primary prediction matches an exact attractor of the set at >= 90 % of the stick-slip points (measured 97.9 %;
-    92.8 % with Airy1 + approxvdot everywhere), the default start's at >= 85 % (95.9 %); of the predictions not
-    flagged low >= 95 % match (100 %), and at least half are unflagged (63.9 %).  Deterministic: the same numbers
+    92.8 % with Airy1 + approxvdot everywhere), the default start's at >= 85 % (96.9 %); of the predictions not
+    flagged low >= 95 % match (100 %), and at least half are unflagged (62.9 %).  Deterministic: the same numbers
     on every run (the map has no randomness), so the margins are the measured ones."""
     from comparisons.benchmark import approx_targets as bench
 
@@ -246,20 +252,21 @@ def test_label_measure_against_the_matched_attractor():
 
 
 @pytest.mark.slow
-def test_period_labels_at_low_and_intermediate_inertia():
-    """Issue 35's label target where the default chain is the full branch dynamics linearised in α (low and
-    intermediate inertia): on both seeds' cached references, wherever the primary prediction matches an exact
-    attractor of the set and both are periodic, its period equals that attractor's (the measure the issue's
-    sentence asks for: docs/theory.md, "Period labels") at >= 95 % of the points (measured 36 of 37 and 43 of 44; the
-    exception, V = 1.533, I = 1.25e-4, the rest start's period-3 where the exact orbit is period-28, is a miss).
-    With Airy1 + approxvdot there the same measure was 33 of 37 and 34 of 42.  At high inertia the default stays
-    Airy1 + approxvdot and the target is not met (docs/theory.md).  The default tier's cover: the label is the map's
-    own long-run period (``test_period_label_is_the_maps_own_long_run_period``) and the measure's definition
+def test_period_labels_at_every_inertia():
+    """Issue 35's label target, the full branch dynamics linearised in α being the default at every inertia: on
+    both seeds' cached references, wherever the primary prediction matches an exact attractor of the set and both
+    are periodic, its period equals that attractor's (the measure the issue's sentence asks for: docs/theory.md,
+    "Period labels") at >= 95 % of the points (measured 49 of 51 and 57 of 58; the exceptions: V = 1.533, I =
+    1.25e-4, the rest start's period-3 where the exact orbit is period-28, a miss; V = 0.667, I = 4.8e-3, period-5
+    as the default start but nearest another start's attractor; V = 2.97, I = 1.5e-5 on seed 2).  With Airy1 +
+    approxvdot at high inertia (the default before) the same measure was 43 of 51 and 50 of 58, with it everywhere
+    40 of 51 and 41 of 56; at low and intermediate inertia alone the full chain gives 36 of 37 and 43 of 44.  The
+    default tier's cover: the label is the map's own long-run period
+    (``test_period_label_is_the_maps_own_long_run_period``) and the measure's definition
     (``test_label_measure_against_the_matched_attractor``)."""
     from comparisons.benchmark import approx_targets as bench
 
     for seed in (1, 2):
         rows = [r for r in bench.score(bench.reference(100, seed))["rows"]
-                if r["strict_ss"] and r["labels_matched"] is not None
-                and r["regime"].split(" inertia")[0] in ("low", "intermediate")]
-        assert len(rows) >= 30 and sum(r["labels_matched"] for r in rows) >= 0.95 * len(rows), seed
+                if r["strict_ss"] and r["labels_matched"] is not None]
+        assert len(rows) >= 50 and sum(r["labels_matched"] for r in rows) >= 0.95 * len(rows), seed

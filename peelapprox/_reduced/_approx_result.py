@@ -13,9 +13,9 @@ The confidence rules (:func:`confidence`), each measured (docs/theory.md, "The a
 * the orbit outside the physical range: an angle ``|α|`` at a jump above :data:`ALPHA_LINEAR` (F at the jumps,
   ``f_fold/(1 + sin α)``, then lies outside the law's fold band by more than the exact attractors' oscillations
   explain);
-* the exact model breaks down where the default chain does not: the full branch dynamics linearised in α
-  (genalpha + fullvdot on both branches) run from the solver's start reaches ``F (1 + sin α) = f(0+, V)`` on AB
-  (v → 0, CONSTR without a root) within :data:`peelapprox._reduced._approximate.PROBE_RETURNS` returns;
+* the exact model breaks down where the chain (one other than the full chain, the default) does not: the full branch
+  dynamics linearised in α (genalpha + fullvdot on both branches) run from the solver's start reaches ``F (1 + sin α) =
+  f(0+, V)`` on AB (v → 0, CONSTR without a root) within :data:`peelapprox._reduced._approximate.PROBE_RETURNS` returns;
 * its regime's measured validity (:data:`peelapprox._reduced._validity.VALIDITY`) below :data:`VALIDITY_FLOOR`.
 """
 
@@ -82,10 +82,11 @@ class ApproximateAttractor(StickSlipObservables):
     escape_multiplier : complex or None
         The multiplier whose ``|μ|`` sets the escape law's rate where it is not the map's own: the leading
         multiplier of the same orbit of the full branch dynamics linearised in α (genalpha + fullvdot, Newton from this
-        orbit's section point), used where this orbit's leading ``|μ|`` is in [0.99, 1.02] (there the default chain's
+        orbit's section point), used where this orbit's leading ``|μ|`` is in [0.99, 1.02] (there Airy1 + approxvdot's
         ``|μ| - 1`` is 0.6-74 % below the exact orbit's, or of the wrong sign, the full chain's within 0.32 % at the
         orbits the map leaves and 7 % at those it finds weakly stable: docs/theory.md, "Escape returns"); None where
-        the rate is ``max |multipliers|`` (farther from 1, or that Newton did not converge to an unstable orbit).
+        the rate is ``max |multipliers|`` (the chain is the full one, the default; farther from 1; or that Newton did
+        not converge to an unstable orbit).
     confidence : {"high", "low"}
         ``"low"`` where a rule of the module docstring applies; ``confidence_reason`` says which.
     confidence_reason : str

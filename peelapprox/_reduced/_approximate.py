@@ -60,16 +60,15 @@ __all__ = ["APPROX_DEFAULTS", "ESCAPE_FRACTION", "MAX_ESCAPES", "MAX_PERIOD", "P
 
 
 #: The default reductions per inertia label of :func:`peelapprox.estimate` (:data:`peelapprox.INERTIA_RULE`):
-#: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``.  At low and intermediate inertia the
-#: full branch dynamics linearised in α, genalpha + fullvdot on both branches (:data:`FULL_CHAIN`); at high inertia
-#: Airy1 + approxvdot (FLOW1's kinematic term kept, the O(α) terms dropped).  Measured on the benchmark's 200 random
-#: points (docs/theory.md, "The approximate attractor"): the full chain gives the exact run's period label where
-#: Airy1 + approxvdot gives a neighbouring one (10 → 9 slips per cycle, 6 → 3), matches the exact set at least as
-#: often in both regimes, and costs no more CPU time there (median 15.5 and 19.1 ms against 16.9 and 21.3 on seed
-#: 1); at high inertia it costs 3-12 ms more a call (it leaves the weakly unstable small modes and samples what
-#: follows), so the default stays Airy1 + approxvdot there.
+#: ``{inertia: ((AB α model, AB v equation), (CD α model, CD v equation))}``: the full branch dynamics linearised in
+#: α, genalpha + fullvdot on both branches (:data:`FULL_CHAIN`), at every label.  Measured on the benchmark's 200
+#: random points (docs/theory.md, "Which chain where"): the full chain gives the exact run's period label where
+#: Airy1 + approxvdot (FLOW1's kinematic term kept, the O(α) terms dropped) gives a neighbouring one (10 → 9 slips
+#: per cycle, 6 → 3), matches the exact set about as often, and, since the solver's start is not followed past a
+#: weakly unstable small mode where the rest start's answer ranks first (:func:`_starts`), runs fewer returns a call
+#: at high inertia (709 against 737) than Airy1 + approxvdot did as the default there.
 APPROX_DEFAULTS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
-    "low": FULL_CHAIN, "intermediate": FULL_CHAIN, "high": (("airy1", "approxvdot"), ("airy1", "approxvdot"))}
+    "low": FULL_CHAIN, "intermediate": FULL_CHAIN, "high": FULL_CHAIN}
 #: Where the map starts (``start=``): ``"solver"``, the exact solver's default start; ``"rest"``, the foot of the
 #: relaxation cycle at rest (AB landing, F = f_min, α = α̇ = 0); ``"auto"``, both: the solver's attractor is the
 #: primary prediction, the rest start's an alternative (the primary where the solver's start finds none).
@@ -96,8 +95,8 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     periodic orbits by Newton with their multipliers, leaves the unstable ones, and reads the observables of
     what it reaches with the definitions of :class:`StickSlipObservables`.  The default reductions
     (:data:`APPROX_DEFAULTS`): the full branch dynamics linearised in α (genalpha + fullvdot on both branches) at
-    low and intermediate inertia, Airy1 + approxvdot at high inertia, which keeps FLOW1's kinematic term ``-v̇/R``,
-    large near the folds, and drops the O(α) terms (measurements of both: docs/theory.md, "The approximate
+    every inertia; Airy1 + approxvdot, which keeps FLOW1's kinematic term ``-v̇/R``, large near the folds, and drops
+    the O(α) terms, is one choice of the four slots (measurements of both: docs/theory.md, "The approximate
     attractor").
 
     Parameters
@@ -222,7 +221,7 @@ def _solver_start(params: PeelParams, law: Any) -> Start:
 
 
 def _starts(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], solver: Start | None, rest: Start,
-            names: tuple[str, ...], run: tuple[Any, ...]) -> list[Found]:
+            names: tuple[str, ...], run: tuple[int, int, float, str, dict[str, Any]]) -> list[Found]:
     """What each start of ``names`` reaches (:func:`from_start` with the options ``run``), in their order.
 
     With both starts the rest start runs first.  Where its answer ranks first whatever the solver's start reaches
@@ -257,7 +256,8 @@ def _probe(params: PeelParams, law: Any, start: Start, rtol: float, deadline: fl
     :data:`PROBE_RETURNS` returns; None if it does not (a probe found, of 200 random points, 3 where the exact run
     breaks down got a stick-slip prediction; at V = 0.903, I = 1.08e-4 Airy1 + approxvdot's first CD stay lasts
     2.6 ms and lands at 247 N where the exact one lasts 11.2 ms and lands at 162 N, with α = 0.2, whose swing on
-    AB then reaches f(0+, V): the O(α) terms of the default chain, not the physics)."""
+    AB then reaches f(0+, V): the O(α) terms of that chain, not the physics).  Run where the chain is not the full
+    one (the default), i.e. where the caller chose another."""
     m = ReturnMap(params, law, FULL_CHAIN, rtol, deadline, book)
     try:
         m.run(m.enter(start), PROBE_RETURNS)

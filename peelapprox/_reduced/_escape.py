@@ -3,9 +3,10 @@
 An unstable periodic orbit of the reduced map (:func:`peelapprox.approximate_attractor`) is left at the return where
 the amplitude law ``A_k = A_k0 |μ|^((k - k0)/n)`` brings the envelope of the AB→CD force's deviation from the orbit
 to the orbit's force drop (:data:`peelapprox._reduced._approx_start.ESCAPE_FRACTION`): ``k = k0 + n ln(thr/A_k0) /
-ln|μ|``, so a relative error ε in ``|μ| - 1`` is a relative error ε in ``k - k0``.  The default chain (Airy1 +
-approxvdot) drops the O(α) terms: at the weakly unstable small modes of the escape benchmark its ``|μ| - 1`` is
-0.6–74 % below :func:`exact.periodic_orbit`'s (5.6e-4 against 2.13e-3 at V = 2.48 m/s, I = 4.4e-3).  The full
+ln|μ|``, so a relative error ε in ``|μ| - 1`` is a relative error ε in ``k - k0``. Airy1 + approxvdot (the default at
+high inertia until the full chain became the default everywhere) drops the O(α) terms: at the weakly unstable small
+modes of the escape benchmark its ``|μ| - 1`` is 0.6–74 % below :func:`exact.periodic_orbit`'s (5.6e-4 against 2.13e-3
+at V = 2.48 m/s, I = 4.4e-3).  The full
 branch dynamics linearised in α (genalpha + fullvdot, the chain ``FULL_CHAIN`` of
 :mod:`peelapprox._reduced._approx_start`), Newton on its own map from the default orbit's section point, gives
 ``|μ| - 1`` within 0.32 % of the exact one at the benchmark's ten points of seed 1 and 0.22 % at seed 2's
