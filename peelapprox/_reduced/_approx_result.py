@@ -95,7 +95,8 @@ class ApproximateAttractor(StickSlipObservables):
         The start the map reached this attractor from (``"solver"``, ``"rest"``).
     alternatives : tuple of ApproximateAttractor
         The other attractors reached from the other starts, and the unstable orbits met on the way (each with
-        its multipliers and escape return): the set is :attr:`set`.
+        its multipliers and escape return): the set is :attr:`set`.  A start not followed past a weakly unstable
+        orbit, because another start's answer ranks first whatever it reaches next, adds only the orbits it left.
     """
 
     multipliers: tuple[complex, ...] | None = None

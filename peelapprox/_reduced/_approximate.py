@@ -127,11 +127,12 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     -------
     ApproximateAttractor
         A :class:`StickSlipObservables` (``method`` names the chain, the start and how the attractor was found;
-        ``t_start``/``t_end`` on the map's own clock) with ``multipliers``, ``escape_returns``, ``confidence``
-        and ``confidence_reason``, and ``alternatives``: the attractors of the other start and the unstable orbits
-        left on the way.  ``status``: ``"stick-slip"``; ``"steady"`` (no folds at V, or a segment settles on the
-        stable fixed point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment),
-        with the reason.  Every mean is None for the last three, never NaN.
+        ``t_start``/``t_end`` on the map's own clock) with ``multipliers``, ``escape_returns``, ``confidence`` and
+        ``confidence_reason``, and ``alternatives``: the attractors of the other start and the unstable orbits left on
+        the way (the solver start's attractor not where that start was not followed past a weakly unstable orbit because
+        the rest start's answer ranks first: :func:`_starts`). ``status``: ``"stick-slip"``; ``"steady"`` (no folds at
+        V, or a segment settles on the stable fixed point); ``"no attractor"`` (a budget spent first) or ``"breakdown"``
+        (of a reduced segment), with the reason. Every mean is None for the last three, never NaN.
 
     Raises
     ------
