@@ -24,7 +24,8 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
   none, where both are periodic;
 * the median wall time of a call (one untimed call first, then ``--repeats``);
 * ``--chain full``: the same measures for the full branch dynamics linearised in α (genalpha + fullvdot on both
-  branches, :data:`CHAINS`) instead of the default reductions;
+  branches, :data:`CHAINS`; the default at every inertia since 29 Nov) instead of the default reductions, ``--chain
+  airy1`` for Airy1 + approxvdot on both branches (the default at high inertia before);
 * the points where every start of the exact run breaks down and the prediction's status and confidence there;
 * ``--multipliers K``: at the first K points whose primary prediction is a periodic orbit (n <= 12),
   :func:`exact.periodic_orbit` with the same n, and the difference of the largest |μ| (the reduction's multiplier
@@ -79,6 +80,8 @@ CHAINS: dict[str, dict[str, str]] = {
     "default": {},
     "full": {"alpha_model": "genalpha", "v_equation": "fullvdot", "cd_alpha_model": "genalpha",
              "cd_v_equation": "fullvdot"},
+    "airy1": {"alpha_model": "airy1", "v_equation": "approxvdot", "cd_alpha_model": "airy1",
+              "cd_v_equation": "approxvdot"},
 }
 
 
@@ -319,7 +322,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--reference-only", action="store_true", help="compute (or load) the exact reference, no more")
     ap.add_argument("--cached", action="store_true", help="score only the points already in the cache")
     ap.add_argument("--chain", choices=sorted(CHAINS), default="default", help="the reductions: the default ones, "
-                    "or the full branch dynamics linearised in alpha (genalpha + fullvdot on both branches)")
+                    "the full branch dynamics linearised in alpha (genalpha + fullvdot on both branches, the default "
+                    "everywhere) or Airy1 + approxvdot on both branches")
     ap.add_argument("--labels", action="store_true", help="list the points whose period label differs from the "
                     "default start's, with the five starts' periods")
     ap.add_argument("--json", help="write the rows and the measures as JSON")
