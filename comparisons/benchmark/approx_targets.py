@@ -38,7 +38,8 @@ run resumes.  The strict reference is the α0 = 0 start (the solver's default st
   orbit's return-map values whose force deviates from them by more than the orbit's force drop
   (``ESCAPE_FRACTION``, as the map's), the predicted one the map's ``escape_returns``; beside it the map's own |μ|,
   the escape law's (``escape_multiplier``, the full chain's, where the map's is in [0.99, 1.02]), the exact
-  orbit's, and the same law with the exact orbit's |μ| (what is left of a miss with the exact multiplier).
+  orbit's, and the same law with the exact orbit's |μ| (what is left of a miss with the exact multiplier).  An
+  orbit with no predicted return (the map's deviation already one force drop at its Newton) counts as a miss.
   The exact side (escape return, |μ|, returns run, the run's length) is kept per point and period in
   ``comparisons/benchmark/data/approx_escapes_seed<S>_n<N>.json`` (or ``--escape-cache FILE``), read where it holds
   the point (run again where it found no escape in a shorter run than now asked), written after each new one.
@@ -242,11 +243,14 @@ def escapes(ref: list[dict[str, Any]], k: int, cache: Path | None = None) -> lis
     for r, o in _cpu_rows(ref, start="solver"):
         if len(rows) >= k:
             break
-        left = [a for a in (*o.alternatives, o) if (a.escape_returns is not None or a.escape_multiplier is not None)
+        # an orbit left (an alternative with |mu| > 1) whether or not it got a return; the primary where it has an
+        # unstable full-chain rate (escape_multiplier) or a return
+        left = [a for a in (*o.alternatives, o) if (a is not o or a.escape_returns is not None
+                                                    or a.escape_multiplier is not None)
                 and a.multipliers is not None and 1e-4 <= _law_mu(a) - 1.0 <= 1e-2]
         if not left:
             continue
-        a = left[0]  # escape_returns None: an unstable rate without a predicted return, counted as a miss
+        a = left[0]  # escape_returns None: an unstable orbit without a predicted return, counted as a miss
         assert a.slip_interval is not None and a.force_drop is not None
         t_end = min(300.0, 1.5 * (a.escape_returns or 200.0) * a.slip_interval + 1.0)
         mu_map = max(abs(m) for m in a.multipliers or ())
