@@ -116,8 +116,8 @@ def test_no_escape_return_where_the_map_leaves_an_orbit_from_a_deviation_as_larg
     against the exact run's ``k_exact`` (172, 31, 147: 73-77 % off both ways).  So the orbit left is reported
     unstable (its own multipliers, ``escape_multiplier`` None: the rate would be the map's own) with no escape
     return rather than a wrong one.  Its |μ| - 1 within 10 % of the exact orbit's (measured -1.5 %, -2.1 %, -8.6 %:
-    the full chain's O(α²) error at these low-V points is larger than at the small modes above).  Fails if the law
-    answers (any number) for such an orbit."""
+    the 2 % of the small modes above does not hold at these low-V orbits, so the bound is these three's, not the
+    class's).  Fails if the law answers (any number) for such an orbit (it answered 40 before)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         o = approximate_attractor(PeelParams(V=V, I=I), start="solver", warn=False)

@@ -75,10 +75,11 @@ class ApproximateAttractor(StickSlipObservables):
         dominant eigen-coordinates of ``D P^n`` times the force's gradient); None otherwise.  Where the map's leading
         ``|μ|`` is in [0.99, 1.02] the law's rate is :attr:`escape_multiplier`'s (and ``A`` is corrected for the
         returns it grew at the map's rate instead).  Measured against the exact runs where ``|μ|`` - 1 is in
-        [1e-4, 1e-2] (docs/theory.md, "Escape returns"): within 20 % at the 14 and 12 orbits the map leaves (two
-        seeds, 7.9 % at most), at 10 of the 11 it stays on and gives a return for.  None for an orbit the map
-        stays on whose deviation there is already as large as the orbit (the law has no e-fold to run; the exact
-        runs left such orbits within ~200 returns): :attr:`escape_multiplier` still says it is unstable.
+        [1e-4, 1e-2] (docs/theory.md, "Escape returns"): with the default chain at 17 of 17 and 18 of the 19 orbits
+        given a return (two seeds).  None for an orbit, stayed on or left, whose deviation at the map's Newton is
+        already as large as the orbit (the law has no e-fold to run and would say the map's own return, 40, where
+        the exact runs left such orbits at 31-172): its multipliers (or :attr:`escape_multiplier`) still say it is
+        unstable.
     escape_multiplier : complex or None
         The multiplier whose ``|μ|`` sets the escape law's rate where it is not the map's own: the leading
         multiplier of the same orbit of the full branch dynamics linearised in α (genalpha + fullvdot, Newton from this
