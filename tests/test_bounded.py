@@ -701,3 +701,36 @@ def test_a_timer_that_fires_at_once_is_always_disarmed():
     assert expired == 3000
     assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
     assert signal.getsignal(signal.SIGALRM) == before
+
+
+def test_an_import_the_limit_interrupts_can_be_imported_again(tmp_path, monkeypatch):
+    """A limit that lands inside an import leaves the process able to import that package again: a package
+    whose ``__init__`` imports a submodule, then sleeps past the 0.2 s limit, is interrupted (``Expired``); the
+    next import (no sleep) gives a package whose submodule sees the new package (exact: the name it reads).
+    Before, the submodule stayed in ``sys.modules`` bound to the interrupted package, and the next import failed
+    with an ``AttributeError`` (in-process CLI calls: ``peelapprox figures --max-wall 0.01`` broke the next
+    ``import matplotlib`` of the process)."""
+    import sys
+
+    from peelapprox._deadline import Expired, time_limit
+
+    pkg = tmp_path / "interrupted_pkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("import os, time\nfrom . import sub\n"
+                                     "time.sleep(float(os.environ.get('INTERRUPTED_PKG_SLEEP', '0')))\n"
+                                     "NAME = 'whole'\n")
+    (pkg / "sub.py").write_text("import interrupted_pkg\n\ndef name():\n    return interrupted_pkg.NAME\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv("INTERRUPTED_PKG_SLEEP", "5")
+    with pytest.raises(Expired):
+        with time_limit(0.2):
+            import interrupted_pkg  # noqa: F401
+    assert "interrupted_pkg" not in sys.modules and "interrupted_pkg.sub" not in sys.modules
+    monkeypatch.setenv("INTERRUPTED_PKG_SLEEP", "0")
+    try:
+        import interrupted_pkg
+
+        assert interrupted_pkg.sub.name() == "whole"
+    finally:
+        for name in ("interrupted_pkg", "interrupted_pkg.sub"):
+            sys.modules.pop(name, None)
