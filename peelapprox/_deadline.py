@@ -7,7 +7,9 @@ running code (sympy and numba's front end are Python, so the exception lands wit
 LLVM optimisation pass is not interrupted but is itself bounded by the size limits of the expression grammar and
 of a law's derivatives, ``MAX_DERIVATIVE_NODES`` of ``peelapprox/law/_expression.py``, checked before rendering).
 Elsewhere (another thread, Windows, a caller's own timer already armed) it cannot interrupt and checks the
-clock when the call returns instead.  The previous signal handler and timer are restored on exit.
+clock when the call returns instead.  The previous signal handler and timer are restored on exit, and the
+submodules of an import the limit interrupted are forgotten (:func:`_drop_orphans`), so that the same process
+can import that package again (the CLI's ``main`` is called in-process too).
 
 :func:`caller_budget` hands a public call's ``max_wall`` (e.g. :func:`exact.simulate`'s) down to the law
 compilation it triggers without threading it through every signature: the nearer of the two deadlines
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import contextvars
 import signal
+import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -95,6 +98,18 @@ def _disarm(previous: Any, error: type[BaseException]) -> None:
             continue
 
 
+def _drop_orphans(before: set[str]) -> None:
+    """Forget the modules imported since ``before`` (a set of ``sys.modules``' names) whose package is no longer
+    in ``sys.modules``: what an import interrupted by the limit leaves.  Python drops the module whose code was
+    interrupted, but keeps its submodules imported so far, and those refer to the dropped module: importing the
+    package again would run its code with them and fail (``import matplotlib`` interrupted, the next one raised
+    ``AttributeError: module 'matplotlib' has no attribute 'get_data_path'`` from ``matplotlib.cbook``)."""
+    orphans = [name for name in list(sys.modules) if name not in before and "." in name
+               and any(name.rsplit(".", k)[0] not in sys.modules for k in range(1, name.count(".") + 1))]
+    for name in orphans:
+        sys.modules.pop(name, None)
+
+
 @contextmanager
 def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator[None]:
     """Raise ``error(limit, caller)`` (:class:`Expired`) if the body runs longer than ``seconds`` or past the
@@ -118,11 +133,16 @@ def time_limit(seconds: float, error: type[BaseException] = Expired) -> Iterator
         raise error(limit, caller)
 
     previous = signal.signal(signal.SIGALRM, _expire)
+    before = set(sys.modules)
     # repeating: an exception raised where Python cannot propagate it (a weakref callback, a ctypes callback of
     # llvmlite) is printed and dropped, so the timer fires again every REPEAT seconds until one lands
     try:  # armed inside the try: a timer firing at once (a limit of microseconds) still reaches the finally
         signal.setitimer(signal.ITIMER_REAL, limit, REPEAT)
         yield
+    except BaseException:  # the limit (or a Ctrl-C) may have landed inside an import
+        _disarm(previous, error)  # first: a repeated firing cannot interrupt the clean-up
+        _drop_orphans(before)
+        raise
     finally:
         _disarm(previous, error)
     # every firing may have landed where Python drops exceptions (a __del__, a gc callback) while the body ran

@@ -56,9 +56,11 @@ def new_figure(*, figsize: tuple[float, float] | None = None, layout: Any = "con
 
 def save_figure(fig: Any, path: str | os.PathLike, *, dpi: float = 120, **kwargs: Any) -> None:
     """Write ``fig`` to ``path`` (format from the extension), byte-reproducibly: the same figure gives the
-    same bytes on every write, on any machine with the same matplotlib and fonts.  (One figure object saved
-    twice as SVG may differ in the 6th decimal of a position: the constrained layout refines itself on every
-    draw; the same figure drawn afresh, as in each run of a script, gives the same SVG bytes.)
+    same bytes on every write, on any machine with the same matplotlib and fonts: saved twice, after a
+    ``show()``, or drawn afresh as in each run of a script.  (The constrained layout refines the positions it
+    finds on every draw; the save starts it from the grid cells, as a new figure's first draw does, and puts
+    the axes back afterwards.  A colorbar's axes start where the last draw left them: a figure with a colorbar
+    is byte-identical from save to save, and to a fresh figure's save when not drawn in between.)
 
     The file gets fixed metadata (no software version, no creation date: PNG ``Software``, PDF ``Creator``,
     ``Producer`` and ``CreationDate``, SVG ``Creator`` and ``Date``, PS ``Creator``; the PS ``CreationDate``
@@ -72,14 +74,50 @@ def save_figure(fig: Any, path: str | os.PathLike, *, dpi: float = 120, **kwargs
         matplotlib.rcParams["savefig.format"]
     metadata = {**_METADATA.get(fmt, {}), **(kwargs.pop("metadata", None) or {})}
     epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    positions = _positions(fig)
     try:
         if fmt in ("ps", "eps") and epoch is None:  # the one date the PostScript writer takes from outside
             os.environ["SOURCE_DATE_EPOCH"] = "0"
+        _start_layout(fig)
         with matplotlib.rc_context({"svg.hashsalt": _SVG_HASHSALT}):
             fig.savefig(path, dpi=dpi, format=fmt, metadata=metadata or None, **kwargs)
     finally:
         if fmt in ("ps", "eps") and epoch is None:
             os.environ.pop("SOURCE_DATE_EPOCH", None)
+        _restore(positions)
+
+
+def _positions(fig: Any) -> list[tuple[Any, Any, Any, bool]]:
+    """Every axes of ``fig`` (its subfigures' too) with its original and active positions and whether it is in
+    the layout: what a draw under a layout engine changes, for :func:`_restore`."""
+    return [(ax, ax.get_position(original=True).frozen(), ax.get_position(original=False).frozen(),
+             ax.get_in_layout()) for ax in getattr(fig, "axes", ())]
+
+
+def _restore(positions: list[tuple[Any, Any, Any, bool]]) -> None:
+    """Put the axes back where :func:`_positions` found them: a save leaves the figure's layout as it was."""
+    for ax, original, active, in_layout in positions:
+        ax.set_position(original, which="original")
+        ax.set_position(active, which="active")
+        ax.set_in_layout(in_layout)
+
+
+def _start_layout(fig: Any) -> None:
+    """Under the constrained layout, every grid axes in the layout back at its grid cell (where a new figure
+    has it), so that the layout the save runs starts where a fresh figure's first draw does.
+
+    The constrained layout refines the positions it finds (two passes from the current positions, whose tick
+    labels' sizes it measures): drawn again, a figure's axes move by ~1e-6 of the figure, and some figures
+    cycle between a few layouts, so without this start a PDF or SVG saved twice (or after a ``show()``) was
+    not byte-identical.  Axes placed by hand (out of the layout) and axes without a grid cell (a colorbar's)
+    are left where they are; :func:`_restore` puts them all back after the save."""
+    engine = fig.get_layout_engine() if hasattr(fig, "get_layout_engine") else None
+    if engine is None or type(engine).__name__ != "ConstrainedLayoutEngine":
+        return
+    for ax in fig.axes:
+        spec = ax.get_subplotspec() if hasattr(ax, "get_subplotspec") else None
+        if spec is not None and ax.get_in_layout():
+            ax.set_subplotspec(spec)
 
 
 def _save(fig: Any, path: str | None, dpi: int = 120) -> None:
