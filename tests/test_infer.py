@@ -371,3 +371,23 @@ def test_the_default_rtol_moves_the_statistics_by_far_less_than_sigma():
         m8, m10 = (model_statistics(q, series, d.threshold, d.noise, 30.0, rtol, 60.0) for rtol in (1e-8, 1e-10))
         assert m8 is not None and m10 is not None
         assert np.max((np.abs(m8 - m10) / d.sigma)[d.used]) < 0.1, (t, (m8 - m10) / d.sigma)
+
+
+@pytest.mark.slow
+def test_an_island_in_a_chaotic_band_is_not_called_identified():
+    """Hypothesis (calibration: never a confident wrong number): on the chaotic trace of
+    ``comparisons.benchmark.infer_targets``' seed 3, trace 1 (V = 2.249 m/s, I = 3.204e-4, k = 701.8; 10 s,
+    started at I x 1.38, k x 0.84) the search's best point is I 39 % low at χ² 2.55 on 4 dof, an island whose
+    neighbours 0.3 % away do not fit (χ² 87 on 24): I is not called identified, and its 95 % interval covers the
+    truth.  Measured 147 runs, 92-151 s on 2 loaded cores."""
+    from comparisons.benchmark.infer_targets import draw
+
+    t = draw(2, 3)[1]
+    tr = exact.simulate(PeelParams(V=t["V"], I=t["I"], k=t["k"]), 40.0, t_eval=30.0 + np.arange(100000) / 1e4)
+    series = tr.as_series(1e4, noise=0.5, drift=5.0, seed=3 * 1000 + 1)
+    res = infer(series, PeelParams(V=t["V"], I=t["I0"], k=t["k0"]), ("I", "k"), max_wall=600, progress=False,
+                executor="serial")
+    assert not res.identified["I"], res.verdicts["I"]
+    lo, hi = res.intervals["I"]
+    assert lo <= t["I"] <= hi
+    assert any("neighbours" in n for n in res.notes)
