@@ -34,7 +34,10 @@ several (one series per V).
   factor 2 (log-fitted) or its value (coefficients), or reaches the edge of the search: the data do not
   determine it, and the report says so instead of quoting a number.  None is identified when the best fit is
   poor (χ² improbable at :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes
-  the data nowhere in the search.
+  the data nowhere in the search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each
+  parameter) are read too: each trial point's statistics are one window's, a draw, and the best of many draws
+  is biased low, so where the neighbours' χ² (summed) is improbable at :data:`GOOD_FIT` nothing is identified,
+  and their χ² spread widens the profile's threshold (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
 """
 
 from __future__ import annotations
