@@ -378,8 +378,9 @@ def test_an_island_in_a_chaotic_band_is_not_called_identified():
     """Hypothesis (calibration: never a confident wrong number): on the chaotic trace of
     ``comparisons.benchmark.infer_targets``' seed 3, trace 1 (V = 2.249 m/s, I = 3.204e-4, k = 701.8; 10 s,
     started at I x 1.38, k x 0.84) the search's best point is I 39 % low at χ² 2.55 on 4 dof, an island whose
-    neighbours 0.3 % away do not fit (χ² 87 on 24): I is not called identified, and its 95 % interval covers the
-    truth.  Measured 147 runs, 92-151 s on 2 loaded cores."""
+    neighbours 0.3 % away do not fit with the statistics' σ (χ² 87 on 24); with σ from the neighbours' spread the
+    points as good as the best reach the box's edge.  I is not called identified, and its 95 % interval covers
+    the truth.  Measured 147 runs, 92-212 s on 2 loaded cores."""
     from comparisons.benchmark.infer_targets import draw
 
     t = draw(2, 3)[1]
@@ -391,3 +392,31 @@ def test_an_island_in_a_chaotic_band_is_not_called_identified():
     lo, hi = res.intervals["I"]
     assert lo <= t["I"] <= hi
     assert any("neighbours" in n for n in res.notes)
+
+
+def test_the_neighbours_set_an_aperiodic_sigma(monkeypatch):
+    """For an aperiodic series, σ of each statistic is joined by its spread over the best point and its 2 x (free
+    parameters) neighbours ±JITTER away (a diagonal synthetic likelihood's covariance at the best point), every
+    evaluated χ² recomputed with it.  Closed form with the model runs replaced: one free parameter, the best
+    point's statistics all 1.0, its two neighbours' 1.0 ± 0.3 (sample sd over the three draws 0.3), σ 0.4: the
+    new σ is hypot(0.4, 0.3) = 0.5, the best point's χ² 0, each neighbour's 7 · (0.3/0.5)² = 2.52."""
+    import exact.dynamics._infer_search as search
+    from exact.dynamics._infer_search import Point, Problem, SeriesFit, replicate_check
+    from exact.dynamics._infer_stats import SeriesData, SetReading
+
+    data = SeriesData(np.ones(7), np.full(7, 0.4), 1.0, 0.5, np.ones(7, dtype=bool))
+    fits = [SeriesFit(None, 1.0, data, True)]
+    problem = Problem(PeelParams(V=1.0, I=1e-2), ("k",), np.arange(7), 30.0, 1e-8, 1)
+    x = np.array([np.log(1000.0)])
+    evaluated = [Point(x, 0.0, [np.ones(7)], [SetReading(np.ones(7), "solver", None, 1)]),
+                 Point(x + 0.1, 7 * (0.6 / 0.4) ** 2, [np.full(7, 1.6)], [SetReading(np.ones(7), "solver", None, 1)])]
+
+    def fake(problem, fits, xn, left):
+        m = np.full(7, 1.0 + (0.3 if xn[0] > x[0] else -0.3))
+        return (m - 1.0) / fits[0].data.sigma, [m], [SetReading(m, "solver", None, 1)]
+
+    monkeypatch.setattr(search, "residuals", fake)
+    total, dof, runs, spread, new = replicate_check(problem, evaluated, fits, 100.0)
+    assert np.allclose(new[0].data.sigma, 0.5) and dof == 14 and runs == 2
+    assert np.isclose(total, 2 * 2.52) and np.isclose(spread, 0.0)
+    assert evaluated[0].chi2 == 0.0 and np.isclose(evaluated[1].chi2, 7 * (0.6 / 0.5) ** 2)

@@ -36,8 +36,10 @@ several (one series per V).
   poor (χ² improbable at :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes
   the data nowhere in the search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each
   parameter) are read too: each trial point's statistics are one window's, a draw, and the best of many draws
-  is biased low, so where the neighbours' χ² (summed) is improbable at :data:`GOOD_FIT` nothing is identified,
-  and their χ² spread widens the profile's threshold (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
+  is biased low.  Each statistic's σ is joined by its spread over the best point and its neighbours (every χ²
+  recomputed with it); where the neighbours' χ² (summed) is still improbable at :data:`GOOD_FIT` nothing is
+  identified, and their χ² spread widens the profile's threshold (``replicate_check`` in
+  ``exact/dynamics/_infer_search.py``).
 """
 
 from __future__ import annotations
@@ -192,8 +194,10 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     outcome = run.run(x0, limits, float(search), n_obs, notes)
     check = replicate_check(problem, run.evaluated, run.fits, run.left())
     if check is not None:
+        run.fits = check[4]
         outcome = dataclasses.replace(outcome, replicate=check[:2], chi2_noise=check[3], notes=outcome.notes + (
-            f"an aperiodic fit: chi2 at the best point's {2 * len(problem.names)} neighbours "
+            f"an aperiodic fit: each statistic's sigma joined by its spread over the best point and its "
+            f"{2 * len(problem.names)} neighbours; chi2 at those neighbours "
             f"{fmt_number(100 * JITTER, 2)} % away = {fmt_number(check[0], 4)} on {check[1]} statistics, from "
             f"neighbour to neighbour ± {fmt_number(check[3], 3)} (the profile's threshold widened by twice that)",))
     full = shares(problem, run.evaluated, run.fits, run.left())

@@ -320,21 +320,26 @@ def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], 
 JITTER = 3e-3
 
 
-def replicate_check(problem: Problem, evaluated: Sequence[Point], fits: Sequence[SeriesFit], left: float
-                    ) -> tuple[float, int, int, float] | None:
-    """The χ² at the neighbours of the best point, for a fit with an aperiodic series: the residuals (all
-    series) at the best point moved by ±:data:`JITTER` along each parameter, their χ² summed, the degrees of
-    freedom of that sum (neighbours x fitted statistics), the runs made and the standard deviation of χ² over
-    the neighbours.  Each trial point of an aperiodic series is read from one window of its attractor, a draw,
-    and the best of many draws is biased low; where the best is an island (a lucky window, a narrow periodic
-    window in the chaotic band) its neighbours, fresh draws that the statistics cannot tell from it, do not fit.
-    At V = 2.249 m/s, I = 3.2e-4 (chaotic) a fit with I 39 % low had χ² 2.55 on 4 dof, its neighbours 0.1-0.7 %
-    away 8-43, while 4 later windows of its own run fitted (21 on 24).  None without an aperiodic series or
-    where the budget is spent."""
+def replicate_check(problem: Problem, evaluated: list[Point], fits: Sequence[SeriesFit], left: float
+                    ) -> tuple[float, int, int, float, list[SeriesFit]] | None:
+    """The neighbours of the best point, for a fit with an aperiodic series: σ re-estimated there, and their χ².
+
+    The model's statistics at the best point moved by ±:data:`JITTER` along each parameter (all series): for each
+    aperiodic series the variance of each statistic over those neighbours and the best point (draws the
+    statistics cannot tell apart) joins σ² (a diagonal synthetic likelihood's covariance at the best point, Wood
+    2010); the χ² of every evaluated point is recomputed with it (``evaluated`` updated in place).  Returns the
+    neighbours' χ² (with the new σ) summed, the degrees of freedom of that sum (neighbours x fitted statistics),
+    the runs made, the standard deviation of χ² over the neighbours and the series with their new σ.  Each trial
+    point of an aperiodic series is read from one window of its attractor, a draw, and the best of many draws is
+    biased low; where the best is an island (a lucky window, a narrow periodic window in the chaotic band) its
+    neighbours do not fit.  At V = 2.249 m/s, I = 3.2e-4 (chaotic) a fit with I 39 % low had χ² 2.55 on 4 dof,
+    its neighbours 0.1-0.7 % away 8-43, while 4 later windows of its own run fitted (21 on 24).  None without an
+    aperiodic series or where the budget is spent."""
     if not evaluated or not any(f.aperiodic for f in fits):
         return None
-    x = best(evaluated).x
-    t0, chi2s = time.perf_counter(), []
+    top = best(evaluated)
+    x = top.x
+    t0, draws = time.perf_counter(), []
     for i in range(len(problem.names)):
         step = JITTER if problem.names[i] in LOG else JITTER * max(abs(float(x[i])), 1e-12)
         for sign in (-1.0, 1.0):
@@ -343,11 +348,27 @@ def replicate_check(problem: Problem, evaluated: Sequence[Point], fits: Sequence
                 return None
             xn = x.copy()
             xn[i] += sign * step
-            res, _, readings = residuals(problem, fits, xn, left_now)
-            chi2s.append((float(res @ res), res.size, sum(r.n_runs for r in readings)))
-    c = np.array([v[0] for v in chi2s])
-    return (float(c.sum()), sum(v[1] for v in chi2s), sum(v[2] for v in chi2s),
-            float(c.std(ddof=1)) if c.size > 1 else 0.0)
+            _, models, readings = residuals(problem, fits, xn, left_now)
+            draws.append((models, sum(r.n_runs for r in readings)))
+    new_fits = []
+    for j, f in enumerate(fits):
+        reads = [m[j] for m, _ in draws] + [top.models[j]]
+        if not f.aperiodic or any(m is None for m in reads):
+            new_fits.append(f)
+            continue
+        sd = np.array(reads).std(axis=0, ddof=1)
+        new_fits.append(dataclasses.replace(f, data=dataclasses.replace(f.data, sigma=np.hypot(f.data.sigma, sd))))
+    for i, e in enumerate(evaluated):
+        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(e.models, new_fits)])
+        evaluated[i] = dataclasses.replace(e, chi2=float(res @ res))
+    c, n_stat = [], 0
+    for models, _ in draws:
+        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(models, new_fits)])
+        c.append(float(res @ res))
+        n_stat += res.size
+    chi2 = np.array(c)
+    return (float(chi2.sum()), n_stat, sum(v[1] for v in draws), float(chi2.std(ddof=1)) if chi2.size > 1 else 0.0,
+            new_fits)
 
 
 def shares(problem: Problem, evaluated: Sequence[Point], fits: Sequence[SeriesFit], left: float
