@@ -34,8 +34,8 @@ from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
 __all__ = ["CLOSE", "LINE_RATIO", "NOISE_SEED", "STATISTICS", "REPEATABILITY", "SeriesData", "SetReading",
-           "data_statistics", "model_statistics", "replicate_mean", "replicate_spread",
-           "set_statistics", "trace_statistics"]
+           "data_statistics", "model_statistics", "replicate_mean", "replicate_spread", "set_statistics",
+           "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 STATISTICS = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
