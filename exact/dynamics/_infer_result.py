@@ -162,6 +162,13 @@ class Outcome:
     poor_fit : float
         The χ² probability below which no parameter is identified (:data:`POOR_FIT`, or ``GOOD_FIT`` where a
         series is aperiodic).
+    replicate : tuple of (float, int) or None
+        For a fit with an aperiodic series, the χ² summed over the best point's neighbours and its degrees of
+        freedom (``replicate_check`` in ``exact/dynamics/_infer_search.py``): improbable at ``poor_fit``, no
+        parameter is identified (the best point was a lucky draw).
+    chi2_noise : float
+        The standard deviation of χ² over those neighbours (0: periodic series): twice it widens the profile's
+        threshold (``spans``).
     """
 
     evaluated: Sequence[Point]
@@ -173,6 +180,8 @@ class Outcome:
     wall: float
     notes: tuple[str, ...] = ()
     poor_fit: float = POOR_FIT
+    replicate: tuple[float, int] | None = None
+    chi2_noise: float = 0.0
 
 
 def _verdict(name: str, i: int, x: np.ndarray, lo_i: float, hi_i: float, box: tuple, fit: tuple[float, int, float],
@@ -218,10 +227,14 @@ def assemble(problem: Problem, fits: Sequence[SeriesFit], outcome: Outcome) -> I
     dof = outcome.n_obs - len(names)
     if not outcome.evaluated:
         raise ValueError("max_wall was spent before the first model run: give a larger max_wall")
-    x, chi2, s, lo_all, hi_all, cov = spans(names, outcome.evaluated, outcome.jac, outcome.n_obs)
+    x, chi2, s, lo_all, hi_all, cov = spans(names, outcome.evaluated, outcome.jac, outcome.n_obs, outcome.chi2_noise)
     # as many statistics as parameters (dof 0) should fit exactly: judge its χ² as on one degree of freedom
     p_fit = float(chi2_dist.sf(chi2, max(dof, 1)))
     poor = p_fit < outcome.poor_fit
+    if outcome.replicate is not None and not poor:
+        p_rep = float(chi2_dist.sf(outcome.replicate[0], max(outcome.replicate[1], 1)))
+        if p_rep < outcome.poor_fit:
+            poor, chi2_rep = True, outcome.replicate
     stderr: dict[str, float | None] = dict.fromkeys(names)
     intervals: dict[str, tuple[float, float] | None] = {}
     identified = dict.fromkeys(names, False)
@@ -236,6 +249,10 @@ def assemble(problem: Problem, fits: Sequence[SeriesFit], outcome: Outcome) -> I
         narrow = (hi_i - lo_i <= math.log(2.0)) if log else (hi_i - lo_i <= abs(float(x[i])))
         identified[name] = narrow and not edge and not poor
         verdicts[name] = _verdict(name, i, x, lo_i, hi_i, box, (chi2, dof, p_fit), poor, identified[name])
+        if poor and outcome.replicate is not None and p_fit >= outcome.poor_fit:
+            verdicts[name] = (f"not identified: the best point fits (chi2 = {fmt_number(chi2, 4)} on {dof} dof) "
+                              f"but its neighbours do not (chi2 = {fmt_number(chi2_rep[0], 4)} on {chi2_rep[1]}, "
+                              f"probability {fmt_number(p_rep, 2)}): the best of many windows was a lucky draw")
     return Inference(params=apply(problem.params0, names, x, fits[0].V), values=dict(zip(names, values_of(names, x))),
                      stderr=stderr, intervals=intervals, identified=identified, verdicts=verdicts,
                      residuals=_residual_rows(problem, fits, best(outcome.evaluated).models), chi2=chi2, dof=dof,

@@ -30,9 +30,9 @@ from ._infer_stats import (
     set_statistics,
 )
 
-__all__ = ["GRID_RUNS", "LOG", "PENALTY", "Point", "Problem", "SeriesFit", "apply", "attractor_lines",
-           "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "replicated", "residuals",
-           "shares", "spans", "values_of"]
+__all__ = ["GRID_RUNS", "JITTER", "LOG", "PENALTY", "Point", "Problem", "SeriesFit", "apply", "attractor_lines",
+           "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "refine", "replicate_check",
+           "replicated", "residuals", "shares", "spans", "values_of"]
 
 #: The most grid points of the search per series (an odd number per axis, params0 at the centre: 9 x 9 for two
 #: parameters).
@@ -157,15 +157,18 @@ def nodes(axes: list[np.ndarray]) -> np.ndarray:
     return np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
 
 
-def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | None, n_obs: int
-          ) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
+def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | None, n_obs: int,
+          chi2_noise: float = 0.0) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
     """The best evaluated point, its χ², the scale s, the 95 % interval ``(low, high)`` per parameter in fitted
-    coordinates (the union of the profile and the Jacobian's) and the covariance (or None)."""
+    coordinates (the union of the profile and the Jacobian's) and the covariance (or None).  ``chi2_noise``: the
+    standard deviation of χ² over the best point's neighbours (:func:`replicate_check`; 0 without an aperiodic
+    series), twice which widens the profile's threshold: a point whose χ² is a draw is as good as the best where
+    it lies within the draws' scatter."""
     dof = n_obs - len(names)
     top = best(evaluated)
     x, chi2 = top.x, top.chi2
     s = max(1.0, chi2 / dof) if dof > 0 else 1.0
-    accept = np.array([e.x for e in evaluated if e.chi2 <= chi2 + 3.84 * s])
+    accept = np.array([e.x for e in evaluated if e.chi2 <= chi2 + 3.84 * s + 2.0 * chi2_noise])
     lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
     cov = None if jac is None else np.linalg.pinv(jac.T @ jac) * s
     if cov is not None:
@@ -246,6 +249,28 @@ def grid_point(problem: Problem, fits: Sequence[SeriesFit], x: np.ndarray, deadl
     return residuals(problem, fits, x, left)
 
 
+def refine(axes: list[np.ndarray], evaluated: Sequence[Point], box: tuple[np.ndarray, np.ndarray], top: int
+           ) -> list[np.ndarray]:
+    """The points of a finer grid around each of the ``top`` best evaluated points: per axis offsets
+    ``{-2, -1, 0, 1, 2}`` quarters of the grid's node spacing (``{-1, 0, 1}`` halves with three parameters or
+    more), so that each best node's cell is covered at a quarter of its spacing; inside ``box``, each point once,
+    in a fixed order (the best node's first), the evaluated ones left out by the caller."""
+    steps = np.array([float(a[1] - a[0]) if a.size > 1 else 0.0 for a in axes])
+    frac = np.array([-0.5, -0.25, 0.0, 0.25, 0.5]) if len(axes) <= 2 else np.array([-0.5, 0.0, 0.5])
+    offsets = nodes([frac * st for st in steps])
+    out: list[np.ndarray] = []
+    seen: set[tuple[float, ...]] = set()
+    for e in sorted(evaluated, key=lambda e: e.chi2)[:top]:
+        for off in offsets:
+            x = e.x + off
+            key = tuple(np.round(x, 9).tolist())
+            if key in seen or np.any(x < box[0] - 1e-12) or np.any(x > box[1] + 1e-12):
+                continue
+            seen.add(key)
+            out.append(x)
+    return out
+
+
 def n_fitted(problem: Problem, fits: Sequence[SeriesFit]) -> int:
     """The number of statistics fitted over all series."""
     return sum(int(np.count_nonzero(f.data.used[problem.sel])) for f in fits)
@@ -287,6 +312,63 @@ def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], 
         res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(e.models, out)])
         evaluated[i] = dataclasses.replace(e, chi2=float(res @ res))
     return out, n_obs, tuple(notes)
+
+
+#: The relative step (in ln θ for I, k, R; of the value for a coefficient) of the neighbours at which
+#: :func:`replicate_check` re-reads an aperiodic fit's best point: far below the statistics' resolution (their
+#: σ of 2 % moves by ~0.3 σ), far above what separates two windows of a chaotic run.
+JITTER = 3e-3
+
+
+def replicate_check(problem: Problem, evaluated: list[Point], fits: Sequence[SeriesFit], left: float
+                    ) -> tuple[float, int, int, float, list[SeriesFit]] | None:
+    """The neighbours of the best point, for a fit with an aperiodic series: σ re-estimated there, and their χ².
+
+    The model's statistics at the best point moved by ±:data:`JITTER` along each parameter (all series): for each
+    aperiodic series the variance of each statistic over those neighbours and the best point (draws the
+    statistics cannot tell apart) joins σ² (a diagonal synthetic likelihood's covariance at the best point, Wood
+    2010); the χ² of every evaluated point is recomputed with it (``evaluated`` updated in place).  Returns the
+    neighbours' χ² (with the new σ) summed, the degrees of freedom of that sum (neighbours x fitted statistics),
+    the runs made, the standard deviation of χ² over the neighbours and the series with their new σ.  Each trial
+    point of an aperiodic series is read from one window of its attractor, a draw, and the best of many draws is
+    biased low; where the best is an island (a lucky window, a narrow periodic window in the chaotic band) its
+    neighbours do not fit.  At V = 2.249 m/s, I = 3.2e-4 (chaotic) a fit with I 39 % low had χ² 2.55 on 4 dof,
+    its neighbours 0.1-0.7 % away 8-43, while 4 later windows of its own run fitted (21 on 24).  None without an
+    aperiodic series or where the budget is spent."""
+    if not evaluated or not any(f.aperiodic for f in fits):
+        return None
+    top = best(evaluated)
+    x = top.x
+    t0, draws = time.perf_counter(), []
+    for i in range(len(problem.names)):
+        step = JITTER if problem.names[i] in LOG else JITTER * max(abs(float(x[i])), 1e-12)
+        for sign in (-1.0, 1.0):
+            left_now = left - (time.perf_counter() - t0)
+            if left_now <= 1.0:
+                return None
+            xn = x.copy()
+            xn[i] += sign * step
+            _, models, readings = residuals(problem, fits, xn, left_now)
+            draws.append((models, sum(r.n_runs for r in readings)))
+    new_fits = []
+    for j, f in enumerate(fits):
+        reads = [m[j] for m, _ in draws] + [top.models[j]]
+        if not f.aperiodic or any(m is None for m in reads):
+            new_fits.append(f)
+            continue
+        sd = np.array(reads).std(axis=0, ddof=1)
+        new_fits.append(dataclasses.replace(f, data=dataclasses.replace(f.data, sigma=np.hypot(f.data.sigma, sd))))
+    for i, e in enumerate(evaluated):
+        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(e.models, new_fits)])
+        evaluated[i] = dataclasses.replace(e, chi2=float(res @ res))
+    c, n_stat = [], 0
+    for models, _ in draws:
+        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(models, new_fits)])
+        c.append(float(res @ res))
+        n_stat += res.size
+    chi2 = np.array(c)
+    return (float(chi2.sum()), n_stat, sum(v[1] for v in draws), float(chi2.std(ddof=1)) if chi2.size > 1 else 0.0,
+            new_fits)
 
 
 def shares(problem: Problem, evaluated: Sequence[Point], fits: Sequence[SeriesFit], left: float
