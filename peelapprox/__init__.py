@@ -254,36 +254,27 @@ _LAZY.update({name: "exact" for name in ("attractors", "Attractor", "attractor_o
 #: on first access the same way (documented on this package's page, their home), so that ``import peelapprox`` and a
 #: first ``exact.simulate`` import none of them (docs/performance.md, "After `peelapprox warmup`";
 #: tests/test_cold_start.py).
-_OWN_LAZY = {name: "peelapprox.bursts" for name in (
-    "ALTERNATIVES", "BURST_COLUMNS", "MAX_XMIN_CANDIDATES", "BrokenPowerLawFit", "BurstCatalogue", "LikelihoodRatio",
-    "PowerLawFit", "burst_catalogue", "compare_power_law", "fit_broken_power_law", "fit_power_law")}
-# the reduced equations, the approximate attractor, the estimates and a measured force trace: the reduced-map
-# kernels' modules, scipy's integrate/special on use, none needed by exact.simulate
-_OWN_LAZY.update(dict.fromkeys((
-    "ForceSeries", "Spectrum",
-), "peelapprox._measured._series"))
-_OWN_LAZY.update(dict.fromkeys((
-    "SeriesLyapunov", "SurrogateTest",
-), "peelapprox._measured._series_lyapunov"))
-_OWN_LAZY.update(dict.fromkeys((
-    "ALPHA_FORMS", "InertialPeriods", "airy_alpha", "alpha_numerical", "cd_damping_time", "cd_decay_alpha",
-    "harmonic_alpha", "inertial_frequency", "inertial_period", "inertial_periods", "sinusoid_alpha", "wkb_alpha",
-    "wkb_amplitude_phase", "wkb_error_bound",
-), "peelapprox._reduced._alpha"))
-_OWN_LAZY.update(dict.fromkeys((
-    "ApproximateAttractor", "ApproximationWarning",
-), "peelapprox._reduced._approx_result"))
-_OWN_LAZY.update(dict.fromkeys((
-    "approximate_attractor",
-), "peelapprox._reduced._approximate"))
-_OWN_LAZY.update(dict.fromkeys((
-    "INERTIA_RULE", "VELOCITY_RULE", "RegimeEstimate", "SlopeCriterion", "crude_branch_time", "estimate",
-    "force_bounds", "quasi_static_branch_time", "slope_criterion",
-), "peelapprox._reduced._estimate"))
-_OWN_LAZY.update(dict.fromkeys((
-    "ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment",
-), "peelapprox._reduced._segment"))
-
+_OWN_HOMES: dict[str, tuple[str, ...]] = {
+    "peelapprox.bursts": (
+        "ALTERNATIVES", "BURST_COLUMNS", "MAX_XMIN_CANDIDATES", "BrokenPowerLawFit", "BurstCatalogue",
+        "LikelihoodRatio", "PowerLawFit", "burst_catalogue", "compare_power_law", "fit_broken_power_law",
+        "fit_power_law"),
+    # the reduced equations, the approximate attractor, the estimates and a measured force trace: the reduced-map
+    # kernels' modules, scipy's integrate/special on use, none needed by exact.simulate
+    "peelapprox._measured._series": ("ForceSeries", "Spectrum"),
+    "peelapprox._measured._series_lyapunov": ("SeriesLyapunov", "SurrogateTest"),
+    "peelapprox._reduced._alpha": (
+        "ALPHA_FORMS", "InertialPeriods", "airy_alpha", "alpha_numerical", "cd_damping_time", "cd_decay_alpha",
+        "harmonic_alpha", "inertial_frequency", "inertial_period", "inertial_periods", "sinusoid_alpha", "wkb_alpha",
+        "wkb_amplitude_phase", "wkb_error_bound"),
+    "peelapprox._reduced._approx_result": ("ApproximateAttractor", "ApproximationWarning"),
+    "peelapprox._reduced._approximate": ("approximate_attractor",),
+    "peelapprox._reduced._estimate": (
+        "INERTIA_RULE", "VELOCITY_RULE", "RegimeEstimate", "SlopeCriterion", "crude_branch_time", "estimate",
+        "force_bounds", "quasi_static_branch_time", "slope_criterion"),
+    "peelapprox._reduced._segment": ("ALPHA_MODELS", "V_EQUATIONS", "ReducedSegment", "reduced_segment"),
+}
+_OWN_LAZY = {name: module for module, names in _OWN_HOMES.items() for name in names}
 
 def __getattr__(name: str):
     module = _LAZY.get(name) or _OWN_LAZY.get(name)

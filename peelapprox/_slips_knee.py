@@ -36,7 +36,7 @@ def _line(t: np.ndarray, F: np.ndarray, lo: int, hi: int, min_n: int) -> tuple[f
         return None
     t0 = float(t[lo])
     # least squares in closed form about the segment's means (np.polyfit's SVD costs ~10x more and agrees to
-    # rounding: the slips of 8 noisy and noiseless model traces within 1e-12 relative)
+    # rounding: the slips of 8 noisy and noiseless model traces within 1e-10 relative)
     x = t[lo:hi] - t0
     y = F[lo:hi]
     n = hi - lo

@@ -194,16 +194,17 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     outcome = run.run(x0, limits, float(search), n_obs, notes)
     check = replicate_check(problem, run.evaluated, run.fits, run.left())
     if check is not None:
-        run.fits = check[4]
-        outcome = dataclasses.replace(outcome, replicate=check[:2], chi2_noise=check[3], notes=outcome.notes + (
-            f"an aperiodic fit: each statistic's sigma joined by its spread over the best point and its "
-            f"{2 * len(problem.names)} neighbours; chi2 at those neighbours "
-            f"{fmt_number(100 * JITTER, 2)} % away = {fmt_number(check[0], 4)} on {check[1]} statistics, from "
-            f"neighbour to neighbour ± {fmt_number(check[3], 3)} (the profile's threshold widened by twice that)",))
+        run.fits = check.fits
+        note = (f"an aperiodic fit: each statistic's sigma joined by its spread over the best point and its "
+                f"{2 * len(problem.names)} neighbours; chi2 at those neighbours {fmt_number(100 * JITTER, 2)} % away "
+                f"= {fmt_number(check.chi2, 4)} on {check.n_stat} statistics, from neighbour to neighbour "
+                f"± {fmt_number(check.chi2_sd, 3)} (the profile's threshold widened by twice that)")
+        outcome = dataclasses.replace(outcome, replicate=(check.chi2, check.n_stat), chi2_noise=check.chi2_sd,
+                                      notes=outcome.notes + (note,))
     full = shares(problem, run.evaluated, run.fits, run.left())
     res = assemble(problem, run.fits, dataclasses.replace(outcome, wall=time.perf_counter() - t_wall))
     n_runs = (sum(r.n_runs for e in run.evaluated for r in e.readings) + sum(r.n_runs for r in full if r is not None)
-              + (check[2] if check is not None else 0))
+              + (check.n_runs if check is not None else 0))
     lines = attractor_lines(run.evaluated, full, [f.V for f in run.fits])
     return dataclasses.replace(res, n_evaluations=n_runs, attractors=lines,
                                verdicts={k: f"{v}; {'; '.join(lines)}" for k, v in res.verdicts.items()})

@@ -13,7 +13,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -30,9 +30,9 @@ from ._infer_stats import (
     set_statistics,
 )
 
-__all__ = ["GRID_RUNS", "JITTER", "LOG", "PENALTY", "Point", "Problem", "SeriesFit", "apply", "attractor_lines",
-           "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "refine", "replicate_check",
-           "replicated", "residuals", "shares", "spans", "values_of"]
+__all__ = ["GRID_RUNS", "JITTER", "LOG", "PENALTY", "Point", "Problem", "ReplicateCheck", "SeriesFit", "apply",
+           "attractor_lines", "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "refine",
+           "replicate_check", "replicated", "residuals", "shares", "spans", "values_of"]
 
 #: The most grid points of the search per series (an odd number per axis, params0 at the centre: 9 x 9 for two
 #: parameters).
@@ -320,16 +320,30 @@ def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], 
 JITTER = 3e-3
 
 
+class ReplicateCheck(NamedTuple):
+    """What :func:`replicate_check` found at an aperiodic fit's best point."""
+
+    chi2: float                 #: the neighbours' χ² (with the new σ), summed
+    n_stat: int                 #: its degrees of freedom (neighbours x fitted statistics)
+    n_runs: int                 #: the model runs made for the neighbours
+    chi2_sd: float              #: the standard deviation of χ² from neighbour to neighbour
+    fits: list[SeriesFit]       #: the series with their new σ
+
+
+def _chi2(models: Sequence[np.ndarray | None], fits: Sequence[SeriesFit], sel: np.ndarray) -> tuple[float, int]:
+    """χ² of the model statistics ``models`` (one per series) against ``fits``, and the number of residuals."""
+    res = np.concatenate([f.data.residuals(m, sel, PENALTY) for m, f in zip(models, fits)])
+    return float(res @ res), res.size
+
+
 def replicate_check(problem: Problem, evaluated: list[Point], fits: Sequence[SeriesFit], left: float
-                    ) -> tuple[float, int, int, float, list[SeriesFit]] | None:
+                    ) -> ReplicateCheck | None:
     """The neighbours of the best point, for a fit with an aperiodic series: σ re-estimated there, and their χ².
 
     The model's statistics at the best point moved by ±:data:`JITTER` along each parameter (all series): for each
     aperiodic series the variance of each statistic over those neighbours and the best point (draws the
     statistics cannot tell apart) joins σ² (a diagonal synthetic likelihood's covariance at the best point, Wood
-    2010); the χ² of every evaluated point is recomputed with it (``evaluated`` updated in place).  Returns the
-    neighbours' χ² (with the new σ) summed, the degrees of freedom of that sum (neighbours x fitted statistics),
-    the runs made, the standard deviation of χ² over the neighbours and the series with their new σ.  Each trial
+    2010); the χ² of every evaluated point is recomputed with it (``evaluated`` updated in place).  Each trial
     point of an aperiodic series is read from one window of its attractor, a draw, and the best of many draws is
     biased low; where the best is an island (a lucky window, a narrow periodic window in the chaotic band) its
     neighbours do not fit.  At V = 2.249 m/s, I = 3.2e-4 (chaotic) a fit with I 39 % low had χ² 2.55 on 4 dof,
@@ -359,16 +373,11 @@ def replicate_check(problem: Problem, evaluated: list[Point], fits: Sequence[Ser
         sd = np.array(reads).std(axis=0, ddof=1)
         new_fits.append(dataclasses.replace(f, data=dataclasses.replace(f.data, sigma=np.hypot(f.data.sigma, sd))))
     for i, e in enumerate(evaluated):
-        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(e.models, new_fits)])
-        evaluated[i] = dataclasses.replace(e, chi2=float(res @ res))
-    c, n_stat = [], 0
-    for models, _ in draws:
-        res = np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(models, new_fits)])
-        c.append(float(res @ res))
-        n_stat += res.size
+        evaluated[i] = dataclasses.replace(e, chi2=_chi2(e.models, new_fits, problem.sel)[0])
+    c, sizes = zip(*(_chi2(models, new_fits, problem.sel) for models, _ in draws))
     chi2 = np.array(c)
-    return (float(chi2.sum()), n_stat, sum(v[1] for v in draws), float(chi2.std(ddof=1)) if chi2.size > 1 else 0.0,
-            new_fits)
+    return ReplicateCheck(float(chi2.sum()), sum(sizes), sum(v[1] for v in draws),
+                          float(chi2.std(ddof=1)) if chi2.size > 1 else 0.0, new_fits)
 
 
 def shares(problem: Problem, evaluated: Sequence[Point], fits: Sequence[SeriesFit], left: float

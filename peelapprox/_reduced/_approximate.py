@@ -235,9 +235,14 @@ def _starts(params: PeelParams, maps: tuple[ReturnMap, ReturnMap], solver: Start
         return [from_start(params, maps, solver if name == "solver" and solver is not None else rest, name, *run)
                 for name in names]
     r = from_start(params, maps, rest, "rest", *run)
-    first = r.obs is not None and r.obs.status == "stick-slip" and (r.alpha_max or 0.0) <= ALPHA_LINEAR \
-        and not _marginal(r)
+    first = r.obs is not None and not any(_rank(r.obs, r))
     return [from_start(params, maps, solver, "solver", *run, outranked=first), r]
+
+
+def _rank(o: ApproximateAttractor, f: Found) -> tuple[bool, bool, bool]:
+    """A start's answer's place in :func:`_assemble`'s ranking (False first): not stick-slip, beyond the
+    linearised reductions' range of α, of undecided stability (:func:`_marginal`); all False ranks first."""
+    return o.status != "stick-slip", (f.alpha_max or 0.0) > ALPHA_LINEAR, _marginal(f)
 
 
 def _marginal(f: Found) -> bool:
@@ -295,8 +300,7 @@ def _assemble(found: list[Found], label: str, breakdown: str | None) -> Approxim
 
     # stick-slip first, inside the linearised reductions' range of α before outside it, an attractor whose
     # stability the map decides before one it does not, then the starts' order (a start not followed: none)
-    order = sorted(((f.obs, f) for f in found if f.obs is not None), key=lambda p: (
-        p[0].status != "stick-slip", (p[1].alpha_max or 0.0) > ALPHA_LINEAR, _marginal(p[1])))
+    order = sorted(((f.obs, f) for f in found if f.obs is not None), key=lambda p: _rank(*p))
     primary = rated(*order[0])
     others: list[ApproximateAttractor] = []
     for o, f in order[1:]:

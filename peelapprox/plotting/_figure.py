@@ -111,8 +111,10 @@ def _start_layout(fig: Any) -> None:
     cycle between a few layouts, so without this start a PDF or SVG saved twice (or after a ``show()``) was
     not byte-identical.  Axes placed by hand (out of the layout) and axes without a grid cell (a colorbar's)
     are left where they are; :func:`_restore` puts them all back after the save."""
+    from matplotlib.layout_engine import ConstrainedLayoutEngine  # matplotlib is loaded: fig is its figure
+
     engine = fig.get_layout_engine() if hasattr(fig, "get_layout_engine") else None
-    if engine is None or type(engine).__name__ != "ConstrainedLayoutEngine":
+    if not isinstance(engine, ConstrainedLayoutEngine):
         return
     for ax in fig.axes:
         spec = ax.get_subplotspec() if hasattr(ax, "get_subplotspec") else None
