@@ -21,8 +21,9 @@ prediction misses where an earlier one matched gets its four starts run then.  T
 
 **Outputs**: the measures of ``approx_targets.score``; per regime label of :func:`peelapprox.estimate`, the
 stick-slip points and the fractions within 10 % of the α0 = 0 start (slip interval, force drop, both) and of the set
-(both): the table ``estimate().validity`` reads (``--tables DIR``: ``approx_grid_regimes.csv``/``.json``); a map of
-where the prediction matches (``--plot``).
+(both), as the rows of an atlas's ``atlas_regimes.csv`` (:func:`regime_table`; ``--tables DIR`` writes
+``approx_grid_regimes.csv``/``.json``), from which ``python -m comparisons.atlas.validity --from FILE`` writes the
+table ``estimate().validity`` reads; a map of where the prediction matches (``--plot``).
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from peelapprox import PeelParams, approximate_attractor, estimate
+from peelapprox import PeelParams, approximate_attractor
 from peelapprox.io import fmt_number
 
 from .approx_targets import ALPHA0S, DATA, _exact, _match, score
@@ -100,28 +101,27 @@ def reference(n: int, workers: int = 2, path: Path | None = None) -> list[dict[s
 
 
 def regime_table(ref: list[dict[str, Any]], rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per regime label of :func:`peelapprox.estimate`: the points whose α0 = 0 start stick-slips and the fractions
-    of them where the primary prediction's slip interval, force drop, both, are within 10 % of that start's, and
-    where both match an attractor of the set (module docstring)."""
-    out: dict[str, dict[str, Any]] = {}
+    """Per regime label of :func:`peelapprox.estimate`, the rows of an atlas's ``atlas_regimes.csv``
+    (``approximation, regime, observable, stick_slip, compared, within, fraction``): ``approx:default`` for the slip
+    interval, the force drop and both within 10 % of the α0 = 0 start's (the rows
+    ``python -m comparisons.atlas.validity --from`` reads), and ``approx:default:set`` for both matching an attractor
+    of the set (module docstring).  ``stick_slip``: the points whose α0 = 0 start stick-slips; ``compared``: those
+    of them where the prediction stick-slips too; ``fraction``: ``within / stick_slip``."""
+    counts: dict[tuple[str, str, str], list[int]] = {}
     for r, row in zip(ref, rows):
         e, o = r["starts"][0], row["pred"]
         if e["status"] != "stick-slip":
             continue
-        t = out.setdefault(row["regime"], {"label": row["regime"], "points": 0, "slip_interval": 0,
-                                           "force_drop": 0, "both": 0, "both_set": 0})
-        t["points"] += 1
-        ok = {k: o.status == "stick-slip" and abs(getattr(o, k) / e[k] - 1.0) < 0.1
-              for k in ("slip_interval", "force_drop")}
-        t["slip_interval"] += ok["slip_interval"]
-        t["force_drop"] += ok["force_drop"]
-        t["both"] += ok["slip_interval"] and ok["force_drop"]
-        t["both_set"] += bool(row["set"])
-    table = sorted(out.values(), key=lambda t: t["label"])
-    for t in table:
-        for k in ("slip_interval", "force_drop", "both", "both_set"):
-            t[k] = t[k] / t["points"]
-    return table
+        ss = o.status == "stick-slip"
+        ok = {k: ss and abs(getattr(o, k) / e[k] - 1.0) < 0.1 for k in ("slip_interval", "force_drop")}
+        for name, obs, hit in (("approx:default", "slip_interval", ok["slip_interval"]),
+                               ("approx:default", "force_drop", ok["force_drop"]),
+                               ("approx:default", "slip_interval+force_drop", all(ok.values())),
+                               ("approx:default:set", "slip_interval+force_drop", bool(row["set"]))):
+            c = counts.setdefault((name, row["regime"], obs), [0, 0, 0])
+            c[0], c[1], c[2] = c[0] + 1, c[1] + ss, c[2] + hit
+    return [{"approximation": name, "regime": regime, "observable": obs, "stick_slip": n, "compared": m,
+             "within": w, "fraction": w / n} for (name, regime, obs), (n, m, w) in sorted(counts.items())]
 
 
 def plot(ref: list[dict[str, Any]], rows: list[dict[str, Any]], n: int, path: str) -> None:
@@ -176,8 +176,8 @@ def main(argv: list[str] | None = None) -> int:
           f"equal to the default start's {s['labels_equal']} of {s['labels_both_periodic']}")
     table = regime_table(ref, s["rows"])
     for t in table:
-        print(f"  {t['label']}: {t['points']} points, slip interval {pct(t['slip_interval'])} %, force drop "
-              f"{pct(t['force_drop'])} %, both {pct(t['both'])} % (strict), {pct(t['both_set'])} % (set)")
+        print(f"  {t['approximation']:<18} {t['regime']:<36} {t['observable']:<24} {t['within']:>4} of "
+              f"{t['stick_slip']:>4} ({pct(t['fraction'])} %)")
     if args.tables:
         d = Path(args.tables)
         d.mkdir(parents=True, exist_ok=True)
