@@ -132,7 +132,7 @@ def plot(ref: list[dict[str, Any]], rows: list[dict[str, Any]], n: int, path: st
     plt = pyplot()
     V = np.linspace(0.2, 5.0, n)
     I = np.geomspace(1e-6, 1e-1, n)
-    fig, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
+    fig, ax = plt.subplots(figsize=(7.5, 7), layout="constrained")
     kinds = (("strict", "tab:green", "matches the default start"), ("set", "tab:blue", "matches another start only"),
              ("miss", "tab:red", "misses the set"), ("none", "0.7", "default start does not stick-slip"))
     for kind, colour, text in kinds:
@@ -144,7 +144,7 @@ def plot(ref: list[dict[str, Any]], rows: list[dict[str, Any]], n: int, path: st
                            label=f"{text} ({'high' if high else 'low'} confidence)")
     ax.set(xscale="linear", yscale="log", xlabel="V [m/s]", ylabel="I [kg m$^2$]", xlim=(V[0] - 0.1, V[-1] + 0.1),
            ylim=(I[0] / 1.5, I[-1] * 1.5), title="approximate_attractor against the exact set (5 starts)")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    fig.legend(fontsize=7, loc="outside lower center", ncol=2)
     save_figure(fig, path)
     plt.close(fig)
 
