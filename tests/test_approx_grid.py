@@ -91,3 +91,14 @@ def test_regime_table_counts_like_the_atlas():
         ("approx:default", "slip_interval+force_drop"): (3, 2, 1),
         ("approx:default:set", "slip_interval+force_drop"): (3, 2, 2)}
     assert t[("approx:default", "slip_interval")]["fraction"] == pytest.approx(2 / 3, rel=1e-15)
+
+
+def test_unflagged_rows_count_only_points_high_by_the_other_rules():
+    """Hypothesis: ``approx:default:unflagged`` counts, of the stick-slip points that ``others_high`` marks, those
+    matching the set.  Three points by hand: high and matched, high and missed, low (not counted): 1 of 2."""
+    ref = [{"starts": [_start("stick-slip")]}] * 3
+    o = SimpleNamespace(status="stick-slip", slip_interval=0.1, force_drop=10.0)
+    rows = [{"pred": o, "regime": "R", "set": s} for s in (True, False, True)]
+    t = {(r["approximation"], r["observable"]): r for r in g.regime_table(ref, rows, [True, True, False])}
+    u = t[("approx:default:unflagged", "slip_interval+force_drop")]
+    assert (u["stick_slip"], u["within"], u["fraction"]) == (2, 1, 0.5)

@@ -100,15 +100,34 @@ def reference(n: int, workers: int = 2, path: Path | None = None) -> list[dict[s
     return [done[str(i)] for i in range(len(pts))]
 
 
-def regime_table(ref: list[dict[str, Any]], rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def other_rules_high(ref: list[dict[str, Any]]) -> list[bool]:
+    """Per point, whether the primary prediction is high confidence by the rules other than its regime's measured
+    validity (``peelapprox._reduced._validity.VALIDITY`` emptied for the call): the points on which that rule's
+    table is calibrated (:func:`regime_table`'s ``approx:default:unflagged`` rows)."""
+    from unittest import mock
+
+    from peelapprox._reduced._validity import VALIDITY
+
+    out = []
+    with mock.patch.dict(VALIDITY, clear=True), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for r in ref:
+            out.append(approximate_attractor(PeelParams(V=r["V"], I=r["I"])).confidence == "high")
+    return out
+
+
+def regime_table(ref: list[dict[str, Any]], rows: list[dict[str, Any]], others_high: list[bool] | None = None
+                 ) -> list[dict[str, Any]]:
     """Per regime label of :func:`peelapprox.estimate`, the rows of an atlas's ``atlas_regimes.csv``
     (``approximation, regime, observable, stick_slip, compared, within, fraction``): ``approx:default`` for the slip
     interval, the force drop and both within 10 % of the α0 = 0 start's (the rows
     ``python -m comparisons.atlas.validity --from`` reads), and ``approx:default:set`` for both matching an attractor
     of the set (module docstring).  ``stick_slip``: the points whose α0 = 0 start stick-slips; ``compared``: those
-    of them where the prediction stick-slips too; ``fraction``: ``within / stick_slip``."""
+    of them where the prediction stick-slips too; ``fraction``: ``within / stick_slip``.  With ``others_high``
+    (:func:`other_rules_high`), also ``approx:default:unflagged``: of the points high by the other rules, those
+    matching the set (the calibration of the regime rule)."""
     counts: dict[tuple[str, str, str], list[int]] = {}
-    for r, row in zip(ref, rows):
+    for idx, (r, row) in enumerate(zip(ref, rows)):
         e, o = r["starts"][0], row["pred"]
         if e["status"] != "stick-slip":
             continue
@@ -117,7 +136,9 @@ def regime_table(ref: list[dict[str, Any]], rows: list[dict[str, Any]]) -> list[
         for name, obs, hit in (("approx:default", "slip_interval", ok["slip_interval"]),
                                ("approx:default", "force_drop", ok["force_drop"]),
                                ("approx:default", "slip_interval+force_drop", all(ok.values())),
-                               ("approx:default:set", "slip_interval+force_drop", bool(row["set"]))):
+                               ("approx:default:set", "slip_interval+force_drop", bool(row["set"])),
+                               *((("approx:default:unflagged", "slip_interval+force_drop", bool(row["set"])),)
+                                 if others_high is not None and others_high[idx] else ())):
             c = counts.setdefault((name, row["regime"], obs), [0, 0, 0])
             c[0], c[1], c[2] = c[0] + 1, c[1] + ss, c[2] + hit
     return [{"approximation": name, "regime": regime, "observable": obs, "stick_slip": n, "compared": m,
@@ -174,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
           f"starts): set {pct(s['set'])} %, strict {pct(s['strict'])} %, unflagged {pct(s['high_share'])} % of which "
           f"match {pct(s['high_match'])} %, median call {fmt_number(s['cpu_ms_median'], 3)} ms CPU; period labels "
           f"equal to the default start's {s['labels_equal']} of {s['labels_both_periodic']}")
-    table = regime_table(ref, s["rows"])
+    table = regime_table(ref, s["rows"], other_rules_high(ref))
     for t in table:
         print(f"  {t['approximation']:<18} {t['regime']:<36} {t['observable']:<24} {t['within']:>4} of "
               f"{t['stick_slip']:>4} ({pct(t['fraction'])} %)")
