@@ -30,18 +30,24 @@ _HEAD = "VALIDITY: dict[str, Validity] = {\n"
 _SOURCE = re.compile(r'^SOURCE = \(.*?\)\n', re.S | re.M)
 
 
-def read_validity(path: str | Path) -> dict[str, tuple[int, float, float, float]]:
-    """``{regime: (points, slip_interval, force_drop, both)}`` from the ``approx:default`` rows of an atlas's
-    ``atlas_regimes.csv`` (``path`` the file or its directory); ValueError naming ``path`` when the file has no
-    such rows or a regime lacks one of the three observables."""
+def read_validity(path: str | Path) -> dict[str, tuple[int, float, float, float, int, float]]:
+    """``{regime: (points, slip_interval, force_drop, both, unflagged_points, unflagged_match)}`` from the
+    ``approx:default`` rows of an atlas's ``atlas_regimes.csv`` (``path`` the file or its directory, or a file of
+    the same rows such as ``comparisons.benchmark.approx_grid``'s), and its ``approx:default:unflagged`` rows where
+    it has them (the points no rule but the regime's flags, and the share of them matching the exact set; ``(0,
+    0.0)``: not measured); ValueError naming ``path`` when the file has no ``approx:default`` rows or a regime lacks
+    one of the three observables."""
     p = Path(path)
     if p.is_dir():
         p = p / "atlas_regimes.csv"
     rows: dict[str, dict[str, dict[str, str]]] = {}
+    unflagged: dict[str, tuple[int, float]] = {}
     with open(p, newline="") as fh:
         for r in csv.DictReader(fh):
             if r.get("approximation") == "approx:default":
                 rows.setdefault(r["regime"], {})[r["observable"]] = r
+            elif r.get("approximation") == "approx:default:unflagged":
+                unflagged[r["regime"]] = (int(r["stick_slip"]), float(r["fraction"] or 0.0))
     if not rows:
         raise ValueError(f"path: {p} has no approx:default rows (an atlas_regimes.csv of peelapprox atlas)")
     out = {}
@@ -50,13 +56,14 @@ def read_validity(path: str | Path) -> dict[str, tuple[int, float, float, float]
         if missing:
             raise ValueError(f"path: {p}: regime {label!r} lacks the rows {sorted(missing)}")
         frac = [float(r[k]["fraction"] or 0.0) for k in ("slip_interval", "force_drop", "slip_interval+force_drop")]
-        out[label] = (int(r["slip_interval"]["stick_slip"]), frac[0], frac[1], frac[2])
+        out[label] = (int(r["slip_interval"]["stick_slip"]), frac[0], frac[1], frac[2], *unflagged.get(label, (0, 0.0)))
     return out
 
 
-def render(table: dict[str, tuple[int, float, float, float]]) -> str:
+def render(table: dict[str, tuple[int, float, float, float, int, float]]) -> str:
     """The ``VALIDITY = {...}`` block of the table (one line per regime, floats as ``repr``)."""
-    lines = [f"    {label!r}: Validity({n}, {si!r}, {fd!r}, {both!r})," for label, (n, si, fd, both) in table.items()]
+    lines = [f"    {label!r}: Validity({n}, {si!r}, {fd!r}, {both!r}, {nu}, {um!r}),"
+             for label, (n, si, fd, both, nu, um) in table.items()]
     return _HEAD + "\n".join(lines) + "\n}\n"
 
 

@@ -33,17 +33,23 @@ class Validity(NamedTuple):
     """The same for the force drop."""
     both: float
     """The same for both at once."""
+    unflagged_points: int = 0
+    """Stick-slip points of this label where no confidence rule but this table's flags the prediction (0: not
+    measured)."""
+    unflagged_match: float = 0.0
+    """Fraction of those whose prediction matches an attractor of the exact set (both within 10 %): the
+    calibration the regime rule of :func:`peelapprox._reduced._approx_result.confidence` reads."""
 
 
 #: Per regime label (:attr:`peelapprox.RegimeEstimate.label`).
 VALIDITY: dict[str, Validity] = {
-    'high inertia, high V': Validity(315, 0.5079365079365079, 0.49206349206349204, 0.4666666666666667),
-    'high inertia, low V': Validity(345, 0.7420289855072464, 0.8521739130434782, 0.7130434782608696),
-    'intermediate inertia, high V': Validity(153, 0.9150326797385621, 0.9215686274509803, 0.9150326797385621),
-    'intermediate inertia, low V': Validity(231, 0.8008658008658008, 0.8225108225108225, 0.7965367965367965),
-    'low inertia, high V': Validity(92, 0.9891304347826086, 0.9891304347826086, 0.9891304347826086),
-    'low inertia, low V': Validity(283, 0.9399293286219081, 0.9363957597173145, 0.9363957597173145),
-    'no stick-slip (stable fixed point)': Validity(23, 0.782608695652174, 0.782608695652174, 0.6521739130434783),
+    'high inertia, high V': Validity(315, 0.5079365079365079, 0.49206349206349204, 0.4666666666666667, 0, 0.0),
+    'high inertia, low V': Validity(345, 0.7420289855072464, 0.8521739130434782, 0.7130434782608696, 0, 0.0),
+    'intermediate inertia, high V': Validity(153, 0.9150326797385621, 0.9215686274509803, 0.9150326797385621, 0, 0.0),
+    'intermediate inertia, low V': Validity(231, 0.8008658008658008, 0.8225108225108225, 0.7965367965367965, 0, 0.0),
+    'low inertia, high V': Validity(92, 0.9891304347826086, 0.9891304347826086, 0.9891304347826086, 0, 0.0),
+    'low inertia, low V': Validity(283, 0.9399293286219081, 0.9363957597173145, 0.9363957597173145, 0, 0.0),
+    'no stick-slip (stable fixed point)': Validity(23, 0.782608695652174, 0.782608695652174, 0.6521739130434783, 0, 0.0),
 }
 
 
