@@ -219,33 +219,53 @@ def test_benchmark_runs_and_writes(tmp_path):
 
 
 # ------------------------------------------------------------------- estimate() offers the attractor and its validity
-def _atlas_rows() -> dict:
-    """``{regime: {observable: row}}`` of the approx:default rows of docs/atlas/atlas_regimes.csv."""
+def _atlas_rows(approximation: str = "approx:default") -> dict:
+    """``{regime: {observable: row}}`` of the ``approximation`` rows of docs/atlas/approx_grid_regimes.csv (the
+    grid benchmark's table, ``python -m comparisons.benchmark.approx_grid --n 40 --tables docs/atlas``)."""
     import csv
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "docs" / "atlas" / "atlas_regimes.csv"
+    path = Path(__file__).resolve().parents[1] / "docs" / "atlas" / "approx_grid_regimes.csv"
     out: dict = {}
     with open(path, newline="") as fh:
         for r in csv.DictReader(fh):
-            if r["approximation"] == "approx:default":
+            if r["approximation"] == approximation:
                 out.setdefault(r["regime"], {})[r["observable"]] = r
     return out
 
 
 def test_validity_table_is_the_measurement():
     """Hypothesis: the validity estimate() reports is the atlas's measurement, not a second copy that drifted:
-    every regime of the approx:default rows of docs/atlas/atlas_regimes.csv is in peelapprox._reduced._validity.VALIDITY
-    with the same point count and fractions (exact: the same decimal text parsed to the same floats)."""
+    every regime of the approx:default rows of docs/atlas/approx_grid_regimes.csv is in
+    peelapprox._reduced._validity.VALIDITY with the same point count and fractions, and its approx:default:unflagged
+    row with the same count and share (exact: the same decimal text parsed to the same floats)."""
     from peelapprox._reduced._validity import VALIDITY
 
-    rows = _atlas_rows()
-    assert set(rows) == set(VALIDITY)
+    rows, unflagged = _atlas_rows(), _atlas_rows("approx:default:unflagged")
+    assert set(rows) == set(VALIDITY) == set(unflagged)
     for label, r in rows.items():
         v = VALIDITY[label]
-        assert (v.points, v.slip_interval, v.force_drop, v.both) == (
+        u = unflagged[label]["slip_interval+force_drop"]
+        assert tuple(v) == (
             int(r["slip_interval"]["stick_slip"]), float(r["slip_interval"]["fraction"]),
-            float(r["force_drop"]["fraction"]), float(r["slip_interval+force_drop"]["fraction"]))
+            float(r["force_drop"]["fraction"]), float(r["slip_interval+force_drop"]["fraction"]),
+            int(u["stick_slip"]), float(u["fraction"]))
+
+
+def test_regime_rule_flags_exactly_the_regimes_below_the_calibration_floor(monkeypatch):
+    """Hypothesis: a stick-slip prediction is flagged for its regime exactly when the regime's measured share of
+    otherwise-unflagged matches is below CALIBRATION_FLOOR (and at least CALIBRATION_POINTS were measured), with
+    the share quoted.  Checked on a table set by hand: 0.94 of 195 (flagged), 0.96 of 195 and 0.5 of 19 (not)."""
+    from peelapprox import PeelParams, approximate_attractor
+    from peelapprox._reduced import _approx_result as ar
+    from peelapprox._reduced._validity import Validity
+
+    o = dataclasses.replace(approximate_attractor(PeelParams(V=1.0, I=1e-5)), multipliers=None)  # no other rule
+    for share, n, flagged in ((0.94, 195, True), (0.96, 195, False), (0.5, 19, False)):
+        monkeypatch.setitem(ar.VALIDITY, "R", Validity(300, 0.9, 0.9, 0.9, n, share))
+        conf, why = ar.confidence(o, "R", None, (), None)
+        assert (conf == "low") is flagged, (share, n, why)
+        assert ("94 %" in why and "of the 195 points" in why) is flagged
 
 
 def test_estimate_offers_the_attractor_and_says_how_often_it_holds():

@@ -1,6 +1,6 @@
 """The validity table's generator (``python -m comparisons.atlas.validity``): the table of
 peelapprox/_reduced/_validity.py is
-what the generator writes from docs/atlas/atlas_regimes.csv, and a new atlas's rows go into it unchanged."""
+what the generator writes from docs/atlas/approx_grid_regimes.csv, and a new atlas's rows go into it unchanged."""
 
 from __future__ import annotations
 
@@ -16,18 +16,18 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_the_committed_table_is_the_generators_output():
-    """Hypothesis: regenerating peelapprox/_reduced/_validity.py from docs/atlas/atlas_regimes.csv changes nothing (the
-    table
-    was generated, not edited).  Exact text equality: the generator writes ``repr`` of the CSV's floats."""
-    assert validity.regenerate(ROOT / "docs" / "atlas" / "atlas_regimes.csv") == validity.TARGET.read_text()
-    assert validity.main(["--from", str(ROOT / "docs" / "atlas"), "--check"]) == 0
+    """Hypothesis: regenerating peelapprox/_reduced/_validity.py from docs/atlas/approx_grid_regimes.csv changes
+    nothing (the table was generated, not edited).  Exact text equality: the generator writes ``repr`` of the
+    CSV's floats."""
+    assert validity.regenerate(ROOT / "docs" / "atlas" / "approx_grid_regimes.csv") == validity.TARGET.read_text()
+    assert validity.main(["--from", str(ROOT / "docs" / "atlas" / "approx_grid_regimes.csv"), "--check"]) == 0
 
 
 def test_a_new_atlas_rewrites_the_table_and_the_source(tmp_path):
     """Hypothesis: rows of a new atlas (every approx:default fraction halved, one point count changed) appear in the
     rewritten module as the same floats (exact: ``repr`` round-trips), the rest of the file unchanged, ``--source``
     replaces SOURCE, and ``--check`` then reports the committed module as out of date (exit 1)."""
-    src = ROOT / "docs" / "atlas" / "atlas_regimes.csv"
+    src = ROOT / "docs" / "atlas" / "approx_grid_regimes.csv"
     rows = list(csv.DictReader(open(src, newline="")))
     for r in rows:
         if r["approximation"] == "approx:default" and r["fraction"]:

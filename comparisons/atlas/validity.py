@@ -9,7 +9,7 @@ points, the fractions predicted within 10 % for the slip interval, the force dro
 ``VALIDITY`` of the target (default: ``peelapprox/_reduced/_validity.py`` of this checkout), rewritten between its
 ``VALIDITY: dict[str, Validity] = {`` line and the closing brace, floats as ``repr`` (the CSV's text parsed to
 the same floats, which ``tests/test_approx_attractor.py::test_validity_table_is_the_measurement`` checks against
-``docs/atlas/atlas_regimes.csv``); ``--source`` replaces the one-line ``SOURCE`` string (where the numbers come
+the committed source file); ``--source`` replaces the one-line ``SOURCE`` string (where the numbers come
 from, quoted to readers of :attr:`peelapprox.RegimeEstimate.validity`).  ``--check`` writes nothing and exits 1
 when the target differs from what the table would be.  The generated table is the only edit: no hand copy.
 """
@@ -62,7 +62,8 @@ def read_validity(path: str | Path) -> dict[str, tuple[int, float, float, float,
 
 def render(table: dict[str, tuple[int, float, float, float, int, float]]) -> str:
     """The ``VALIDITY = {...}`` block of the table (one line per regime, floats as ``repr``)."""
-    lines = [f"    {label!r}: Validity({n}, {si!r}, {fd!r}, {both!r}, {nu}, {um!r}),"
+    lines = [f"    {label!r}: Validity({n}, {si!r}, {fd!r}, {both!r},\n"
+             f"{' ' * (len(repr(label)) + 15)}{nu}, {um!r}),"
              for label, (n, si, fd, both, nu, um) in table.items()]
     return _HEAD + "\n".join(lines) + "\n}\n"
 

@@ -1,13 +1,17 @@
-"""How often the approximate attractor is right, as the atlas measured it: the validity :func:`peelapprox.estimate`
-reports.
+"""How often the approximate attractor is right, as measured on the atlas's grid: the validity
+:func:`peelapprox.estimate` reports, and the calibration of the confidence rule that reads it.
 
-The numbers are the ``approx:default`` rows of ``docs/atlas/atlas_regimes.csv``, written by the atlas of the paper's
-law (``peelapprox atlas --V 0.2:5:40 --I 1e-6:1e-1:40:log --out DIR``, then ``load_atlas(DIR).write_tables(DIR)``;
-docs/atlas.md): :func:`peelapprox.approximate_attractor` with its defaults against the exact attractor (100 s of
-transient, 20 s measured) on the 40 x 40 grid over V in [0.2, 5] m/s and I in [1e-6, 1e-1] kg m^2, k = 1000 N/m,
-R = 0.1 m.  Per regime label of :func:`peelapprox.estimate`: the exact stick-slip points with that label and the
-fraction of them where the predicted slip interval, force drop, and both, are within 10 % of the exact ones.  A
-test checks that this table equals the file; a new atlas is copied here by hand, with the file.
+The numbers are the rows of ``docs/atlas/approx_grid_regimes.csv``, written by
+``python -m comparisons.benchmark.approx_grid --n 40 --tables docs/atlas`` (docs/atlas.md, "The 40 x 40 grid against
+the exact set"): :func:`peelapprox.approximate_attractor` with its defaults on the atlas's 40 x 40 grid over V in
+[0.2, 5] m/s and I in [1e-6, 1e-1] kg m^2, k = 1000 N/m, R = 0.1 m, against :func:`exact.attractor_observables`
+(30 s of transient, 20 s measured) from the solver's start and, where they can change the answer, four more starts.
+Per regime label of :func:`peelapprox.estimate`: the points whose solver's start stick-slips, the fraction of them
+where the predicted slip interval, force drop, and both, are within 10 % of that start's attractor
+(``approx:default``), and the points no confidence rule but this table's flags with the fraction of them whose
+prediction matches some attractor of the set (``approx:default:unflagged``).  The table is written by
+``python -m comparisons.atlas.validity --from docs/atlas/approx_grid_regimes.csv``, never by hand; a test checks it
+equals the file.
 """
 
 from __future__ import annotations
@@ -18,8 +22,7 @@ __all__ = ["SOURCE", "VALIDITY", "Validity", "validity_text"]
 
 #: Where the numbers come from (the module docstring's command), as a reader of :attr:`RegimeEstimate.validity`
 #: is told.
-SOURCE = ("the atlas of the paper's law, 40 x 40 over V in [0.2, 5] m/s and I in [1e-6, 1e-1] kg m^2, k = 1000 N/m, "
-          "R = 0.1 m: docs/atlas.md")
+SOURCE = ("the atlas's 40 x 40 grid of V and I against the exact set (benchmark approx_grid): docs/atlas.md")
 
 
 class Validity(NamedTuple):
@@ -43,13 +46,20 @@ class Validity(NamedTuple):
 
 #: Per regime label (:attr:`peelapprox.RegimeEstimate.label`).
 VALIDITY: dict[str, Validity] = {
-    'high inertia, high V': Validity(315, 0.5079365079365079, 0.49206349206349204, 0.4666666666666667, 0, 0.0),
-    'high inertia, low V': Validity(345, 0.7420289855072464, 0.8521739130434782, 0.7130434782608696, 0, 0.0),
-    'intermediate inertia, high V': Validity(153, 0.9150326797385621, 0.9215686274509803, 0.9150326797385621, 0, 0.0),
-    'intermediate inertia, low V': Validity(231, 0.8008658008658008, 0.8225108225108225, 0.7965367965367965, 0, 0.0),
-    'low inertia, high V': Validity(92, 0.9891304347826086, 0.9891304347826086, 0.9891304347826086, 0, 0.0),
-    'low inertia, low V': Validity(283, 0.9399293286219081, 0.9363957597173145, 0.9363957597173145, 0, 0.0),
-    'no stick-slip (stable fixed point)': Validity(23, 0.782608695652174, 0.782608695652174, 0.6521739130434783, 0, 0.0),
+    'high inertia, high V': Validity(315, 0.8825396825396825, 0.8507936507936508, 0.8380952380952381,
+                                     195, 0.9333333333333333),
+    'high inertia, low V': Validity(345, 0.9855072463768116, 0.8927536231884058, 0.8927536231884058,
+                                    239, 1.0),
+    'intermediate inertia, high V': Validity(153, 0.9934640522875817, 0.9934640522875817, 0.9934640522875817,
+                                             151, 1.0),
+    'intermediate inertia, low V': Validity(231, 0.961038961038961, 0.961038961038961, 0.961038961038961,
+                                            203, 0.9802955665024631),
+    'low inertia, high V': Validity(92, 1.0, 1.0, 1.0,
+                                    92, 1.0),
+    'low inertia, low V': Validity(283, 0.9858657243816255, 0.9858657243816255, 0.9858657243816255,
+                                   282, 0.9929078014184397),
+    'no stick-slip (stable fixed point)': Validity(23, 1.0, 1.0, 1.0,
+                                                   23, 1.0),
 }
 
 
