@@ -20,6 +20,7 @@ does not depend on where or in which order they ran:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -79,11 +80,12 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
     params : PeelParams
         Any law; a model variant (a tape mass, a constant load) runs its own method and gets no multipliers or
         exponents (their tools need the hybrid solver's section).
-    starts : "default" or sequence
+    starts : "default", sequence or 1-D array
         ``"default"``: :func:`default_starts` (the solver's start, the relaxation cycle's foot at rest, α0 =
         ±0.15, ±0.3 and two states on the AB→CD section: 8 where f has folds at V).  A sequence: each item a
-        float (α0, the rest :func:`exact.initial_state`'s), an :class:`exact.State`, a mapping with keys among
-        ``alpha0``, ``omega0``, ``F0``, ``branch0``, ``name``, or a ``SetStart``; at least one.
+        real number (α0, the rest :func:`exact.initial_state`'s), an :class:`exact.State`, a mapping with keys
+        among ``alpha0``, ``omega0``, ``F0``, ``branch0``, ``name``, or a ``SetStart``; at least one.  A 1-D
+        numpy array: its values as α0.
     t_transient, t_window, rtol : float
         Of each start's run (:func:`exact.attractor_observables`'s defaults: 30 s, 20 s, 1e-10).
     period_rtol, max_period
@@ -109,8 +111,9 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
         stability step (done = total); True writes those lines on stderr.
     max_wall : float or None
         Wall-clock budget [s] of the whole call (default :data:`exact.DEFAULT_MAX_WALL`): a start it leaves
-        out or cuts is an outcome ``"max_wall"``, a stability step it cuts a note; the set is then of the starts
-        read, with status ``"max_wall"``.  None: unbounded.
+        out or cuts is an outcome ``"max_wall"``, a stability step (Newton orbit, exponent) it leaves out or stops
+        a note on the attractor; either makes the set's status ``"max_wall"`` (the set is of the starts read, and
+        where a step was cut its classes are unchecked).  None: unbounded.
 
     Returns
     -------
@@ -140,7 +143,7 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
     outcomes = [*reader.read(valid, runs), *(SetOutcome(s, "invalid start", None, why) for s, why in invalid)]
     counters = dict(reader.counters, runs=float(sum(r.get("trajectory") is not None for r in runs)),
                     run_wall=float(sum(r.get("wall", 0.0) for r in runs)))
-    status, message = _status(reader.attractors, outcomes)
+    status, message = _status(reader.attractors, outcomes, reader.cut)
     return AttractorSet(params=params, status=status, message=message, attractors=tuple(reader.attractors),
                         outcomes=tuple(outcomes), t_transient=t_transient, t_window=t_window, rtol=rtol,
                         counters=counters, wall_time=time.perf_counter() - wall0)
@@ -165,7 +168,10 @@ def _reporter(progress: Any) -> Callable[[int, int, str], None]:
     raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, message), got {progress!r}")
 
 
-def _status(attractors: list[SetAttractor], outcomes: list[SetOutcome]) -> tuple[str, str]:
+def _status(attractors: list[SetAttractor], outcomes: list[SetOutcome], steps_cut: int = 0) -> tuple[str, str]:
+    """The set's status and message; ``steps_cut`` stability steps (a Newton orbit, an exponent) the budget left out
+    make it ``"max_wall"`` too: without its orbit a near-periodic window is read as aperiodic and a run on an
+    unstable orbit as an attractor, so the classes may be wrong."""
     ran = [o for o in outcomes if o.outcome not in ("invalid start", "max_wall")]
     found = [a for a in attractors if a.kind != "breakdown"]
     cut = sum(o.outcome == "max_wall" for o in outcomes)
@@ -173,6 +179,11 @@ def _status(attractors: list[SetAttractor], outcomes: list[SetOutcome]) -> tuple
     if cut:
         return "max_wall", (f"max_wall spent: {cut} of {len(outcomes)} starts not read; the set is of the "
                             f"{len(ran)} read: {names or 'none'}")
+    if steps_cut:
+        return "max_wall", (f"max_wall spent before {steps_cut} stability step{'s' * (steps_cut > 1)} (Newton orbit or "
+                            f"Lyapunov exponent): the classes may be wrong (a near-periodic window is then read as "
+                            f"aperiodic, a run on an unstable orbit as an attractor); the set of the {len(ran)} starts "
+                            f"read: {names or 'none'}")
     if found:
         tr = sum(o.outcome == "transient" for o in outcomes)
         return "ok", f"{len(found)} attractor{'s' * (len(found) > 1)} from {len(ran)} starts: {names}" + (
@@ -200,6 +211,7 @@ class _Reader:
         self.counters: dict[str, float] = {"steps": 0.0, "rhs": 0.0, "orbits": 0.0, "lyapunov": 0.0}
         self.orbits: dict[tuple, Any] = {}
         self.n_starts = 0
+        self.cut = 0  # stability steps the budget left out or stopped (the status says so: _status)
 
     # ------------------------------------------------------------------------------------------ per start
     def read(self, starts: list[SetStart], runs: list[dict[str, Any]]) -> list[SetOutcome]:
@@ -228,9 +240,19 @@ class _Reader:
                 pending.append((i, "run", (tr, obs, r["wall"])))
         for i, _, (tr, obs, wall) in pending:
             outcomes[i] = self._periodic_or_not(starts[i], i, tr, obs, wall)
-        done = [o for o in outcomes if o is not None]
+        done = self._renumber([o for o in outcomes if o is not None])
         self.build(starts, sum(o.outcome not in ("max_wall", "invalid start") for o in done))
         return done
+
+    def _renumber(self, outcomes: list[SetOutcome]) -> list[SetOutcome]:
+        """The groups numbered in the order of the starts that first reach them (so the first start's attractor,
+        :attr:`AttractorSet.primary`, is the first), the outcomes' ids with them: the breakdowns and steady windows
+        are grouped in a first pass and the stick-slip windows after, which numbered them out of that order."""
+        self.groups.sort(key=lambda g: min(g["members"]))
+        new = {g["id"]: k for k, g in enumerate(self.groups)}
+        for g in self.groups:
+            g["id"] = new[g["id"]]
+        return [o if o.attractor is None else dataclasses.replace(o, attractor=new[o.attractor]) for o in outcomes]
 
     def _group(self, kind: str, label: str, i: int, obs: StickSlipObservables | None, **extra: Any) -> int:
         """The id of the group ``label`` (made if new), with start ``i`` added."""
@@ -325,6 +347,7 @@ class _Reader:
         try:
             left = self.deadline.left()
             if left is not None and left <= 0:
+                self.cut += 1
                 return None, "multipliers not computed: max_wall spent"
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
@@ -340,6 +363,7 @@ class _Reader:
             note = "; ".join(str(c.message) for c in caught)[:200]
             res: tuple[Any, str] = (o, f"Newton residual {o.residual:.2g}" + (f"; {note}" if note else ""))
         except (ValueError, ArithmeticError, RuntimeError) as exc:  # no convergence, breakdown, budget, failure
+            self.cut += _spent(exc, self.deadline)
             res = (None, f"multipliers not computed: {type(exc).__name__}: {' '.join(str(exc).split())[:160]}")
         self.orbits[key] = res
         return res
@@ -374,6 +398,7 @@ class _Reader:
             return
         left = self.deadline.left()
         if left is not None and left <= 0:
+            self.cut += 1
             g["note"] = "no exponent: max_wall spent"
             return
         self.say(self.n_starts, self.n_starts, f"Lyapunov exponent from {alpha[0].name}")
@@ -381,6 +406,7 @@ class _Reader:
             L = lyapunov(self.params, "tangent", t_transient=self.t_transient, alpha0=alpha[0].alpha0,
                          T=self.lyapunov_T, max_wall=left)
         except (ValueError, ArithmeticError, RuntimeError) as exc:
+            self.cut += _spent(exc, self.deadline)
             g["note"] = f"no exponent: {type(exc).__name__}: {' '.join(str(exc).split())[:160]}"
             return
         self.counters["lyapunov"] += 1
@@ -410,6 +436,13 @@ class _Reader:
                 stable=None if o is None else bool(o.stable), lyapunov=g.get("lyapunov"),
                 lyapunov_stderr=g.get("lyapunov_stderr"), note=g.get("note", ""),
                 returns=np.asarray(g.get("returns", np.zeros(0)))))
+
+
+def _spent(exc: BaseException, deadline: Deadline) -> int:
+    """1 where a stability step stopped for the call's budget (a wall-time budget error, or the deadline passed),
+    else 0 (no convergence, a breakdown: the step's own outcome)."""
+    left = deadline.left()
+    return int(getattr(exc, "budget", None) == "max_wall" or (left is not None and left <= 0))
 
 
 def _how(tr: Trajectory, s: SetStart, r: _Reader) -> str:

@@ -196,7 +196,8 @@ class AttractorSet:
         One of :data:`SET_STATUSES`: ``"ok"`` (at least one attractor other than a breakdown), ``"transient
         only"`` (every run that finished is still in a transient: lengthen ``t_transient``), ``"breakdown only"``
         (every start that ran breaks down), ``"max_wall"`` (the budget ran out before every start was read: the
-        attractors are those of the starts read), ``"no attractor"`` (every start invalid or failed).
+        attractors are those of the starts read; or before a stability step, whose attractor's ``note`` says so:
+        its class is then unchecked), ``"no attractor"`` (every start invalid or failed).
     message : str
         A sentence saying why.
     attractors : tuple of SetAttractor
