@@ -12,6 +12,7 @@ form, the sinusoid's linear force ramp, the documented rules (confidence, status
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -23,7 +24,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from exact import attractor_set
-from peelapprox import ApproximationWarning, PeelParams, approximate_attractor, estimate, reduced_segment
+from peelapprox import (
+    ApproximationWarning,
+    PeelParams,
+    StickSlipObservables,
+    approximate_attractor,
+    estimate,
+    reduced_segment,
+)
 from peelapprox.errors import ModelBreakdown
 from peelapprox.law import PeelForce
 
@@ -224,6 +232,18 @@ def test_attractors_are_numbered_by_the_start_that_first_reaches_them():
     assert [a.label for a in s.attractors] == ["period-1", "breakdown:no_root"]
     assert [a.id for a in s.attractors] == [0, 1] and [o.attractor for o in s.outcomes] == [0, 1]
     assert s.primary is s.attractors[0]
+    pd = pytest.importorskip("pandas")
+    df = s.to_dataframe()
+    assert isinstance(df, pd.DataFrame) and list(df["label"]) == ["period-1", "breakdown:no_root"]
+    documented = ["id", "kind", "label", "period", "share", "n_starts", "starts", "stable", "max_multiplier",
+                  "multipliers", "lyapunov_bits_per_s", "lyapunov_stderr", "cycle", "note"]
+    observed = ["window_period" if f.name == "period" else f.name for f in dataclasses.fields(StickSlipObservables)
+                if f.name not in ("status", "reason", "method", "V", "I")]
+    assert list(df.columns) == documented + observed  # SetAttractor.row's docstring
+    # the attractor's period is Newton's (the window, 1 s after 2 s, had not settled: its own is None); the window's
+    # None overwrote it in the table before
+    assert s.attractors[0].period == 1 and s.attractors[0].observables.period is None
+    assert df["period"].iloc[0] == 1 and df["window_period"].isna().iloc[0]
 
 
 def test_starts_as_an_array_and_bad_start_values_are_named():

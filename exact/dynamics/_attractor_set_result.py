@@ -167,7 +167,14 @@ class SetAttractor:
         return text
 
     def row(self) -> dict[str, Any]:
-        """One flat row of plain data (the table's)."""
+        """One flat row of plain data (the table's): ``id``, ``kind``, ``label``, ``period``, ``share``,
+        ``n_starts``, ``starts`` (the names, space-separated), ``stable``, ``max_multiplier``, ``multipliers``
+        (``"re+imj"``, space-separated), ``lyapunov_bits_per_s``, ``lyapunov_stderr``, ``cycle`` (floats,
+        space-separated), ``note``; then, where the attractor has observables (not a breakdown), the fields of
+        :meth:`peelapprox.StickSlipObservables.as_dict` but ``status``, ``reason``, ``method``, ``V`` and ``I``
+        (``n_slips``, ``period`` as ``window_period``: the window's own, None where it had not settled,
+        ``period_label``, ``slip_interval``, ``force_drop``, ... ``t_start``, ``t_end``).  None where a value is
+        undefined, never NaN."""
         row: dict[str, Any] = {"id": self.id, "kind": self.kind, "label": self.label, "period": self.period,
                                "share": self.share, "n_starts": len(self.starts), "starts": " ".join(self.starts),
                                "stable": self.stable, "max_multiplier": self.max_multiplier,
@@ -178,7 +185,8 @@ class SetAttractor:
             obs = self.observables.as_dict()
             for name in ("status", "reason", "method", "V", "I"):
                 obs.pop(name)
-            row.update(obs)
+            # the window's own period (None where it had not settled) beside the attractor's (Newton's), not over it
+            row.update({("window_period" if k == "period" else k): v for k, v in obs.items()})
         return row
 
 
@@ -299,7 +307,8 @@ class AttractorSet:
         return rows
 
     def to_dataframe(self):
-        """The attractors as a :class:`pandas.DataFrame` (:meth:`rows`); ``attrs`` hold the status, message,
+        """The attractors as a :class:`pandas.DataFrame`, one row per attractor with the columns of
+        :meth:`SetAttractor.row` (a breakdown's observables' columns empty); ``attrs`` hold the status, message,
         parameters and counters.  ImportError without pandas (``pip install 'peelapprox[data]'``)."""
         pd = optional_import("pandas", "AttractorSet.to_dataframe")
         df = pd.DataFrame(self.rows())

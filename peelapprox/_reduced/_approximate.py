@@ -134,7 +134,8 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         the rest start's answer ranks first: :func:`_starts`). ``status``: ``"stick-slip"``; ``"steady"`` (no folds at
         V, a segment settles on the stable fixed point, or no AB landing while the solver's start lies on that fixed
         point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment, or no return map:
-        a jump without a landing, a fold force not positive), with the reason. Every mean is None for the last three, never NaN.
+        a jump without a landing, a fold force not positive), with the reason. Every mean is None for the last three,
+        never NaN.
 
     Raises
     ------
