@@ -262,6 +262,28 @@ def test_starts_as_an_array_and_bad_start_values_are_named():
         attractor_set(p, starts=np.zeros((1, 1)), **kw)
 
 
+def test_closest_names_its_bad_arguments():
+    """closest() with a min_share that is no number, fields that are no observables (a bare string, an empty tuple,
+    an unknown name) or a NaN observable: a ValueError/TypeError naming the argument (they were float()'s bare
+    message, AttributeError, max()'s "empty sequence" and a NaN distance).  The set is one 1 s window."""
+    s = attractor_set(PeelParams(V=1.0, I=1e-5), starts=[0.0], t_transient=1.0, t_window=1.0, workers=0,
+                      stability=False)
+    obs = {"slip_interval": 0.08, "force_drop": 70.0}
+    mine = s.attractors[0].observables
+    expected = max(abs(mine.slip_interval - 0.08) / mine.slip_interval, abs(mine.force_drop - 70.0) / mine.force_drop)
+    assert s.closest(obs)[1] == pytest.approx(expected, rel=1e-12)  # the documented distance, the same arithmetic
+    bad = [({"min_share": "x"}, TypeError), ({"min_share": None}, TypeError), ({"fields": "slip_interval"}, TypeError),
+           ({"fields": ()}, TypeError), ({"fields": ("bogus",)}, ValueError),
+           ({"fields": ("period_label",)}, ValueError)]
+    for kw, error in bad:
+        with pytest.raises(error, match=next(iter(kw))):
+            s.closest(obs, **kw)
+    with pytest.raises(ValueError, match=r"observables\['slip_interval'\]"):
+        s.closest({"slip_interval": float("nan"), "force_drop": 70.0})
+    with pytest.raises(TypeError, match=r"observables\['force_drop'\]"):
+        s.closest({"slip_interval": 0.08, "force_drop": "70"})
+
+
 @settings(max_examples=8, deadline=None, derandomize=True)
 @given(V=_V, I=_I, starts=st.lists(st.floats(-0.3, 0.3), min_size=1, max_size=3),
        t_transient=st.floats(0.0, 1.0), t_window=st.floats(0.1, 0.5))

@@ -8,7 +8,9 @@ table (:meth:`AttractorSet.to_dataframe`), a plot of each attractor's return map
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -17,6 +19,7 @@ import numpy as np
 
 from peelapprox import PeelParams, StickSlipObservables
 from peelapprox.io import fmt_number, jsonable, optional_import
+from peelapprox.validate import ArgumentTypeError, in_range, real
 
 from ._escape import EscapePrediction
 
@@ -191,6 +194,20 @@ class SetAttractor:
 
 
 _COMPARED = ("slip_interval", "force_drop")
+#: The observables :meth:`AttractorSet.closest` can compare: the numeric fields of StickSlipObservables.
+_COMPARABLE = tuple(f.name for f in dataclasses.fields(StickSlipObservables)
+                    if f.name not in ("status", "reason", "method", "period_label", "V", "I"))
+
+
+def _fields(fields: Any) -> tuple[str, ...]:
+    """``fields`` checked: a non-empty tuple or list of names of :data:`_COMPARABLE`."""
+    if isinstance(fields, str) or not isinstance(fields, (tuple, list)) or not fields:
+        raise ArgumentTypeError(f"fields must be a non-empty tuple of observable names (of {_COMPARABLE}), got "
+                                f"{fields!r}")
+    bad = [f for f in fields if f not in _COMPARABLE]
+    if bad:
+        raise ValueError(f"fields: {bad!r} are not observables; choose among {_COMPARABLE}")
+    return tuple(fields)
 
 
 @dataclass(frozen=True, eq=False)
@@ -259,8 +276,8 @@ class AttractorSet:
         observables : StickSlipObservables or mapping
             Anything with the ``fields`` as attributes or keys (a prediction, statistics of a measured trace).
         fields : tuple of str
-            The observables compared (:class:`peelapprox.StickSlipObservables` field names; default slip interval
-            and force drop).
+            The observables compared (the numeric :class:`peelapprox.StickSlipObservables` field names, at least
+            one; default slip interval and force drop).
         min_share : float
             Only attractors reached from at least this share of the starts, in [0, 1].
 
@@ -269,14 +286,22 @@ class AttractorSet:
         (SetAttractor, float) or None
             The distance is the largest relative difference ``|mine - theirs| / |mine|`` over ``fields``; None
             when no attractor (or ``observables``) defines them.
+
+        Raises
+        ------
+        ValueError, TypeError
+            ``min_share`` outside [0, 1], ``fields`` empty or naming no numeric observable, a value of
+            ``observables`` not a finite number (each named).
         """
-        if not 0.0 <= float(min_share) <= 1.0:
-            raise ValueError(f"min_share must lie in [0, 1], got {min_share!r}")
+        min_share, fields = in_range("min_share", min_share, 0.0, 1.0), _fields(fields)
         get = (observables.get if isinstance(observables, Mapping)
                else lambda name: getattr(observables, name, None))
         theirs = [get(f) for f in fields]
         if any(v is None for v in theirs):
             return None
+        for f, v in zip(fields, theirs, strict=True):  # a number, finite: a NaN distance is no answer
+            if not math.isfinite(real(f"observables[{f!r}]", v)):
+                raise ValueError(f"observables[{f!r}] must be finite, got {v!r}")
         best: tuple[SetAttractor, float] | None = None
         for a in self.stick_slip(min_share):
             mine = [None if a.observables is None else getattr(a.observables, f) for f in fields]
