@@ -262,6 +262,17 @@ def test_starts_as_an_array_and_bad_start_values_are_named():
         attractor_set(p, starts=np.zeros((1, 1)), **kw)
 
 
+def test_a_law_not_defined_at_the_pull_speed_is_named_before_any_start():
+    """A table measured at V = 1 m/s only, asked at V = 2 m/s: a ValueError naming params.force, as simulate's,
+    whatever the starts (it was the status "no attractor" with every default start an "invalid start", and a given
+    start blamed as ``starts[0]``)."""
+    v = np.geomspace(1e-3, 50.0, 60)
+    p = PeelParams(V=2.0, I=1e-4, force=PeelForce.tabulated(v, PeelForce.paper().f(v, 1.0), V=1.0))
+    for starts in ("default", [0.0]):
+        with pytest.raises(ValueError, match=r"params\.force: V=2\.0 m/s: this tabulated law was measured at V=1\.0"):
+            attractor_set(p, starts=starts, t_transient=0.1, t_window=0.1, workers=0)
+
+
 def test_closest_names_its_bad_arguments():
     """closest() with a min_share that is no number, fields that are no observables (a bare string, an empty tuple,
     an unknown name) or a NaN observable: a ValueError/TypeError naming the argument (they were float()'s bare

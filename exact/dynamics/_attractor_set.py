@@ -135,6 +135,7 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
         integer("max_exponents", max_exponents, 0, 1000)
     workers, executor = optional(integer, "workers", workers, 0), _executor(executor)
     say, deadline = _reporter(progress), Deadline(optional(positive, "max_wall", max_wall))
+    _law_at_V(params)
     valid, invalid = check_starts(params, starts)
     say(0, len(valid), f"attractor_set V={params.V:g} I={params.I:g}: {len(valid)} starts")
     runs = run_all(params, valid, t_transient, t_window, rtol, deadline, workers, executor, say)
@@ -147,6 +148,17 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
     return AttractorSet(params=params, status=status, message=message, attractors=tuple(reader.attractors),
                         outcomes=tuple(outcomes), t_transient=t_transient, t_window=t_window, rtol=rtol,
                         counters=counters, wall_time=time.perf_counter() - wall0)
+
+
+def _law_at_V(params: PeelParams) -> None:
+    """A ValueError naming ``params.force`` where the law is not defined at the pull speed V (a table or smoothed law
+    measured at other speeds), as :func:`exact.simulate` raises, before any start: every start would need it (it
+    made each of them an ``"invalid start"``, or a given ``starts[0]`` the culprit)."""
+    lo, hi = params.force.v_range
+    try:
+        params.force.f(min(max(params.V, lo), hi), params.V)
+    except ValueError as exc:
+        raise ValueError(f"params.force: {' '.join(str(exc).split())}") from None
 
 
 def _executor(executor: Any) -> Executor | None:
