@@ -128,6 +128,18 @@ def test_a_closed_form_force_ramp_through_zero_is_a_breakdown():
     assert info.value.t == pytest.approx(t_zero, rel=1e-3)
 
 
+def test_a_multiplier_near_one_is_printed_apart_from_one():
+    """V = 4.5, I = 0.1 (the issue's miss): the map leaves a period-1 orbit with |mu| = 1 + 1.2e-5, which the
+    confidence reason printed as "|mu| = 1" (five digits).  The printed value now reads back within 1e-6 of that
+    orbit's largest |mu| and apart from 1."""
+    import re
+
+    o = approximate_attractor(PeelParams(V=4.5, I=0.1), warn=False)
+    rho = max(max(abs(m) for m in x.multipliers) for x in o.set if x.multipliers)
+    printed = float(re.search(r"\|mu\| = ([0-9.]+)", o.confidence_reason).group(1))
+    assert printed != 1.0 and printed == pytest.approx(rho, rel=1e-6)
+
+
 _V = st.floats(math.log(0.05), math.log(6.0)).map(math.exp)
 _I = st.floats(math.log(1e-7), math.log(0.2)).map(math.exp)
 _K = st.floats(math.log(200.0), math.log(5000.0)).map(math.exp)
@@ -149,13 +161,13 @@ def _check_answer(o) -> None:
     assert "nan" not in repr(o).lower()
 
 
-@settings(max_examples=20, deadline=None, derandomize=True)
+@settings(max_examples=15, deadline=None, derandomize=True)
 @given(V=_V, I=_I, k=_K, start=st.sampled_from(("auto", "solver", "rest")))
 def test_random_points_give_consistent_answers(V, I, k, start):
     """Seeded points over the plane (V 0.05-6 m/s, I 1e-7-0.2 kg m^2, k 200-5000 N/m, log-uniform): every answer is
     rated (high or low, with its reason; high stick-slip only where no rule applies), warns exactly once where its
     confidence is low, carries finite multipliers and escape returns, goes through strict JSON unchanged and is the
-    same, field for field, when asked twice.  20 examples (about 1 s on an idle core); 100 over every family are
+    same, field for field, when asked twice.  15 examples (a few seconds); 100 over every family are
     the slow sweep's."""
     p = PeelParams(V=V, I=I, k=k)
     o, caught = _calls(approximate_attractor, p, start=start, max_wall=None)
@@ -317,3 +329,34 @@ def test_random_small_sets_are_consistent(V, I, starts, t_transient, t_window):
     assert doc["status"] == s.status and len(doc["attractors"]) == len(s.attractors)
     for row in s.rows():
         assert all(not isinstance(v, float) or math.isfinite(v) for v in row.values())
+
+
+@pytest.mark.slow
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(V=_V, I=_I, k=_K, law=st.sampled_from(("paper", "cubic", "power_branches")),
+       starts=st.one_of(st.just("default"), st.lists(st.floats(-0.3, 0.3), min_size=1, max_size=3)),
+       t_transient=st.floats(0.0, 2.0), t_window=st.floats(0.1, 1.0))
+def test_random_sets_with_stability_within_their_budget(V, I, k, law, starts, t_transient, t_window):
+    """The default-tier property (:func:`test_random_small_sets_are_consistent`) with the stability steps on
+    (Newton orbits, exponents over 1 s), over the families and k, under a 5 s budget: the call returns within the
+    budget and 5 s (a run checks the deadline between steps, Newton between iterations, an exponent between its
+    renormalisations; a first compile is not interruptible, which the default tier's tests have done by then);
+    multipliers and exponents finite; transients' escapes finite and after the transient.  A given α0 without a
+    consistent state for the law (the cubic's f(0+) is higher) is the documented ValueError naming ``starts[i]``."""
+    p = PeelParams(V=V, I=I, k=k, force=getattr(PeelForce, law)())
+    t0 = time.perf_counter()
+    try:
+        s = attractor_set(p, starts=starts, t_transient=t_transient, t_window=t_window, workers=0, lyapunov_T=1.0,
+                          max_wall=5.0)
+    except ValueError as exc:  # a given start without a consistent state for this law: documented, named
+        assert starts != "default" and str(exc).startswith("starts[")
+        return
+    assert time.perf_counter() - t0 < 10.0
+    assert [a.id for a in s.attractors] == list(range(len(s.attractors)))
+    for a in s.attractors:
+        assert all(math.isfinite(abs(m)) for m in a.multipliers or ())
+        assert a.lyapunov is None or math.isfinite(a.lyapunov)
+    for o in s.transients:
+        if o.escape is not None:
+            assert math.isfinite(o.escape.returns) and o.escape.time >= s.t_transient
+    json.loads(s.to_json())
