@@ -285,6 +285,20 @@ def test_a_law_not_defined_at_the_pull_speed_is_named_before_any_start():
             attractor_set(p, starts=starts, t_transient=0.1, t_window=0.1, workers=0)
 
 
+def test_a_set_without_return_maps_plots_without_a_warning():
+    """V = 0.5, I = 1e-4 (every start breaks down, docs/dynamics.md) and a budget spent before any run: the plot
+    names the breakdown, or the status, in its legend, without matplotlib's "No artists with labels" warning (its
+    legend was empty)."""
+    pytest.importorskip("matplotlib")
+    for kw in ({}, {"max_wall": 1e-6}):
+        s = attractor_set(PeelParams(V=0.5, I=1e-4), starts=[0.0], t_transient=0.2, t_window=0.2, workers=0, **kw)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            fig = s.plot()
+        texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        assert len(texts) == 1 and texts[0].startswith("A0 breakdown" if not kw else "max_wall")
+
+
 def test_closest_names_its_bad_arguments():
     """closest() with a min_share that is no number, fields that are no observables (a bare string, an empty tuple,
     an unknown name) or a NaN observable: a ValueError/TypeError naming the argument (they were float()'s bare

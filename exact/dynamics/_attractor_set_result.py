@@ -351,7 +351,8 @@ class AttractorSet:
 
     def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
         """Each attractor's return map ``x_{k+1}`` against ``x_k`` (the force at the AB→CD jumps of its first
-        start's window), one colour each, the legend giving label and share; returns the figure drawn into."""
+        start's window), one colour each, the legend giving label and share (an attractor without a map, a transient,
+        or the status where there is neither, in the legend only); returns the figure drawn into."""
         from peelapprox.plotting import new_figure
 
         if ax is None:
@@ -360,10 +361,12 @@ class AttractorSet:
             x = a.returns
             if x.size >= 2:
                 ax.plot(x[:-1], x[1:], ".", ms=4 if x.size < 200 else 2, label=a.describe()[:70])
-            elif a.kind == "steady":
-                ax.plot([], [], " ", label=a.describe())
+            else:  # steady, a breakdown, a window of fewer than two returns: named in the legend only
+                ax.plot([], [], " ", label=a.describe()[:70])
         for o in self.transients:
             ax.plot([], [], " ", label=f"{o.start.name}: {o.message[:60]}")
+        if not self.attractors and not self.transients:  # nothing to draw: the status says why
+            ax.plot([], [], " ", label=f"{self.status}: {self.message[:60]}")
         ax.set_xlabel("F at AB→CD jump k [N]")
         ax.set_ylabel("F at AB→CD jump k+1 [N]")
         ax.legend(fontsize="small")

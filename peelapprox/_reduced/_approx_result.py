@@ -178,7 +178,7 @@ def confidence(o: ApproximateAttractor, label: str, alpha_max: float | None, lef
 
 
 def _near_one(rho: float) -> str:
-    """``|μ|`` with the digits that tell it from 1 (``1.0000123``, not ``1``), at least five significant ones."""
+    """``|μ|`` with the digits that tell it from 1 (``1.000012``, not ``1``), at least five significant ones."""
     digits = 5 if rho == 1.0 else max(5, 2 - int(math.floor(math.log10(abs(rho - 1.0)))))
     return fmt_number(rho, min(digits, 15))
 
