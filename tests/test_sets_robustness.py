@@ -161,13 +161,13 @@ def _check_answer(o) -> None:
     assert "nan" not in repr(o).lower()
 
 
-@settings(max_examples=15, deadline=None, derandomize=True)
+@settings(max_examples=10, deadline=None, derandomize=True)
 @given(V=_V, I=_I, k=_K, start=st.sampled_from(("auto", "solver", "rest")))
 def test_random_points_give_consistent_answers(V, I, k, start):
     """Seeded points over the plane (V 0.05-6 m/s, I 1e-7-0.2 kg m^2, k 200-5000 N/m, log-uniform): every answer is
     rated (high or low, with its reason; high stick-slip only where no rule applies), warns exactly once where its
     confidence is low, carries finite multipliers and escape returns, goes through strict JSON unchanged and is the
-    same, field for field, when asked twice.  15 examples (a few seconds); 100 over every family are
+    same, field for field, when asked twice.  10 examples (a few seconds); 100 over every family are
     the slow sweep's."""
     p = PeelParams(V=V, I=I, k=k)
     o, caught = _calls(approximate_attractor, p, start=start, max_wall=None)
