@@ -299,6 +299,18 @@ def test_a_set_without_return_maps_plots_without_a_warning():
         assert len(texts) == 1 and texts[0].startswith("A0 breakdown" if not kw else "max_wall")
 
 
+def test_an_exponent_that_decides_nothing_leaves_the_class_open():
+    """V = 2, I = 1e-4 is chaotic (docs/dynamics.md: 4.2-5.5 bits/s by four methods over 200 s).  A 1 s tangent
+    estimate measures 7.9 ± 9.3 bits/s there: above the chaos threshold yet within three standard errors of 0.  The
+    attractor was then "quasi-periodic" (an exponent zero within its error, by the rule's else); it is now
+    "aperiodic", its note saying the exponent decides neither, and the exponent is still reported."""
+    s = attractor_set(PeelParams(V=2.0, I=1e-4), starts=[0.0], t_transient=0.5, t_window=0.5, workers=0,
+                      lyapunov_T=1.0)
+    a = s.attractors[0]
+    assert a.lyapunov is not None and a.lyapunov >= 1.0 and a.lyapunov <= 3 * a.lyapunov_stderr  # the premise
+    assert a.kind == a.label == "aperiodic" and "decides neither" in a.note
+
+
 def test_closest_names_its_bad_arguments():
     """closest() with a min_share that is no number, fields that are no observables (a bare string, an empty tuple,
     an unknown name) or a NaN observable: a ValueError/TypeError naming the argument (they were float()'s bare

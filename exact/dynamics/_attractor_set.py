@@ -15,7 +15,8 @@ does not depend on where or in which order they ran:
 3. The other windows are aperiodic attractors, grouped by their observables (slip interval and force drop within
    :data:`APERIODIC_RTOL`) and their return-map range; each group's largest Lyapunov exponent
    (:func:`exact.lyapunov`, ``"tangent"``, from a start that sets α0 only) tells chaos (at least
-   :data:`CHAOS_BITS` bits/s and three standard errors above 0) from a quasi-periodic orbit.
+   :data:`CHAOS_BITS` bits/s and three standard errors above 0) from a quasi-periodic orbit (below
+   :data:`CHAOS_BITS`); an exponent above it but within three standard errors of 0 decides neither (``"aperiodic"``).
 """
 
 from __future__ import annotations
@@ -423,10 +424,18 @@ class _Reader:
             return
         self.counters["lyapunov"] += 1
         lam, err = float(L.bits_per_s), float(L.stderr_bits)
-        g["lyapunov"], g["lyapunov_stderr"] = lam, err if math.isfinite(err) else None
-        chaotic = lam >= CHAOS_BITS and lam > 3 * err
-        g["kind"] = g["label"] = "chaotic" if chaotic else "quasi-periodic"
         g["note"] = f"tangent exponent over {fmt_number(self.lyapunov_T, 3)} s from {alpha[0].name}"
+        if not math.isfinite(lam):  # never NaN in a result: no exponent, the class undecided
+            g["note"] = f"no exponent: the {g['note']} is not finite"
+            return
+        g["lyapunov"], g["lyapunov_stderr"] = lam, err if math.isfinite(err) else None
+        if lam >= CHAOS_BITS and lam > 3 * err:
+            g["kind"] = g["label"] = "chaotic"
+        elif lam < CHAOS_BITS:
+            g["kind"] = g["label"] = "quasi-periodic"
+        else:  # positive beyond the chaos threshold, yet within three standard errors of 0 (or without one)
+            g["note"] += (f": {fmt_number(lam, 3)} bits/s, not three standard errors above 0, decides neither chaos "
+                          "nor a torus (lengthen lyapunov_T)")
 
     def build(self, starts: list[SetStart], n_ran: int) -> None:
         """The :class:`SetAttractor` of each group (exponents measured here, after every start is read)."""

@@ -103,8 +103,9 @@ class SetAttractor:
         Its index in ``AttractorSet.attractors`` (numbered in the order of the starts that first reach it).
     kind : str
         One of :data:`KINDS`: ``"periodic"`` (a stable period-n orbit), ``"quasi-periodic"`` (aperiodic returns,
-        largest Lyapunov exponent zero within its error: a torus, or a period above ``max_period``),
-        ``"chaotic"`` (a positive exponent), ``"aperiodic"`` (no exponent measured), ``"steady"`` (no jump),
+        largest Lyapunov exponent below ``CHAOS_BITS``: a torus, or a period above ``max_period``),
+        ``"chaotic"`` (a positive exponent), ``"aperiodic"`` (no exponent measured, or one at least
+        ``CHAOS_BITS`` yet within three standard errors of 0: undecided), ``"steady"`` (no jump),
         ``"breakdown"`` (the starts break down; ``label`` the reason).
     label : str
         ``"period-n"``, ``"quasi-periodic"``, ``"chaotic"``, ``"aperiodic"``, ``"steady"`` or ``"breakdown:<reason>"``.
