@@ -15,11 +15,13 @@ does not depend on where or in which order they ran:
 3. The other windows are aperiodic attractors, grouped by their observables (slip interval and force drop within
    :data:`APERIODIC_RTOL`) and their return-map range; each group's largest Lyapunov exponent
    (:func:`exact.lyapunov`, ``"tangent"``, from a start that sets α0 only) tells chaos (at least
-   :data:`CHAOS_BITS` bits/s and three standard errors above 0) from a quasi-periodic orbit.
+   :data:`CHAOS_BITS` bits/s and three standard errors above 0) from a quasi-periodic orbit (below
+   :data:`CHAOS_BITS`); an exponent above it but within three standard errors of 0 decides neither (``"aperiodic"``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -79,11 +81,12 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
     params : PeelParams
         Any law; a model variant (a tape mass, a constant load) runs its own method and gets no multipliers or
         exponents (their tools need the hybrid solver's section).
-    starts : "default" or sequence
+    starts : "default", sequence or 1-D array
         ``"default"``: :func:`default_starts` (the solver's start, the relaxation cycle's foot at rest, α0 =
         ±0.15, ±0.3 and two states on the AB→CD section: 8 where f has folds at V).  A sequence: each item a
-        float (α0, the rest :func:`exact.initial_state`'s), an :class:`exact.State`, a mapping with keys among
-        ``alpha0``, ``omega0``, ``F0``, ``branch0``, ``name``, or a ``SetStart``; at least one.
+        real number (α0, the rest :func:`exact.initial_state`'s), an :class:`exact.State`, a mapping with keys
+        among ``alpha0``, ``omega0``, ``F0``, ``branch0``, ``name``, or a ``SetStart``; at least one.  A 1-D
+        numpy array: its values as α0.
     t_transient, t_window, rtol : float
         Of each start's run (:func:`exact.attractor_observables`'s defaults: 30 s, 20 s, 1e-10).
     period_rtol, max_period
@@ -109,8 +112,9 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
         stability step (done = total); True writes those lines on stderr.
     max_wall : float or None
         Wall-clock budget [s] of the whole call (default :data:`exact.DEFAULT_MAX_WALL`): a start it leaves
-        out or cuts is an outcome ``"max_wall"``, a stability step it cuts a note; the set is then of the starts
-        read, with status ``"max_wall"``.  None: unbounded.
+        out or cuts is an outcome ``"max_wall"``, a stability step (Newton orbit, exponent) it leaves out or stops
+        a note on the attractor; either makes the set's status ``"max_wall"`` (the set is of the starts read, and
+        where a step was cut its classes are unchecked).  None: unbounded.
 
     Returns
     -------
@@ -132,6 +136,7 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
         integer("max_exponents", max_exponents, 0, 1000)
     workers, executor = optional(integer, "workers", workers, 0), _executor(executor)
     say, deadline = _reporter(progress), Deadline(optional(positive, "max_wall", max_wall))
+    _law_at_V(params)
     valid, invalid = check_starts(params, starts)
     say(0, len(valid), f"attractor_set V={params.V:g} I={params.I:g}: {len(valid)} starts")
     runs = run_all(params, valid, t_transient, t_window, rtol, deadline, workers, executor, say)
@@ -140,10 +145,21 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
     outcomes = [*reader.read(valid, runs), *(SetOutcome(s, "invalid start", None, why) for s, why in invalid)]
     counters = dict(reader.counters, runs=float(sum(r.get("trajectory") is not None for r in runs)),
                     run_wall=float(sum(r.get("wall", 0.0) for r in runs)))
-    status, message = _status(reader.attractors, outcomes)
+    status, message = _status(reader.attractors, outcomes, reader.cut)
     return AttractorSet(params=params, status=status, message=message, attractors=tuple(reader.attractors),
                         outcomes=tuple(outcomes), t_transient=t_transient, t_window=t_window, rtol=rtol,
                         counters=counters, wall_time=time.perf_counter() - wall0)
+
+
+def _law_at_V(params: PeelParams) -> None:
+    """A ValueError naming ``params.force`` where the law is not defined at the pull speed V (a table or smoothed law
+    measured at other speeds), as :func:`exact.simulate` raises, before any start: every start would need it (it
+    made each of them an ``"invalid start"``, or a given ``starts[0]`` the culprit)."""
+    lo, hi = params.force.v_range
+    try:
+        params.force.f(min(max(params.V, lo), hi), params.V)
+    except ValueError as exc:
+        raise ValueError(f"params.force: {' '.join(str(exc).split())}") from None
 
 
 def _executor(executor: Any) -> Executor | None:
@@ -165,7 +181,10 @@ def _reporter(progress: Any) -> Callable[[int, int, str], None]:
     raise ArgumentTypeError(f"progress must be a bool, None or a callable (done, total, message), got {progress!r}")
 
 
-def _status(attractors: list[SetAttractor], outcomes: list[SetOutcome]) -> tuple[str, str]:
+def _status(attractors: list[SetAttractor], outcomes: list[SetOutcome], steps_cut: int = 0) -> tuple[str, str]:
+    """The set's status and message; ``steps_cut`` stability steps (a Newton orbit, an exponent) the budget left out
+    make it ``"max_wall"`` too: without its orbit a near-periodic window is read as aperiodic and a run on an
+    unstable orbit as an attractor, so the classes may be wrong."""
     ran = [o for o in outcomes if o.outcome not in ("invalid start", "max_wall")]
     found = [a for a in attractors if a.kind != "breakdown"]
     cut = sum(o.outcome == "max_wall" for o in outcomes)
@@ -173,6 +192,11 @@ def _status(attractors: list[SetAttractor], outcomes: list[SetOutcome]) -> tuple
     if cut:
         return "max_wall", (f"max_wall spent: {cut} of {len(outcomes)} starts not read; the set is of the "
                             f"{len(ran)} read: {names or 'none'}")
+    if steps_cut:
+        return "max_wall", (f"max_wall spent before {steps_cut} stability step{'s' * (steps_cut > 1)} (Newton orbit or "
+                            f"Lyapunov exponent): the classes may be wrong (a near-periodic window is then read as "
+                            f"aperiodic, a run on an unstable orbit as an attractor); the set of the {len(ran)} starts "
+                            f"read: {names or 'none'}")
     if found:
         tr = sum(o.outcome == "transient" for o in outcomes)
         return "ok", f"{len(found)} attractor{'s' * (len(found) > 1)} from {len(ran)} starts: {names}" + (
@@ -200,6 +224,7 @@ class _Reader:
         self.counters: dict[str, float] = {"steps": 0.0, "rhs": 0.0, "orbits": 0.0, "lyapunov": 0.0}
         self.orbits: dict[tuple, Any] = {}
         self.n_starts = 0
+        self.cut = 0  # stability steps the budget left out or stopped (the status says so: _status)
 
     # ------------------------------------------------------------------------------------------ per start
     def read(self, starts: list[SetStart], runs: list[dict[str, Any]]) -> list[SetOutcome]:
@@ -228,9 +253,19 @@ class _Reader:
                 pending.append((i, "run", (tr, obs, r["wall"])))
         for i, _, (tr, obs, wall) in pending:
             outcomes[i] = self._periodic_or_not(starts[i], i, tr, obs, wall)
-        done = [o for o in outcomes if o is not None]
+        done = self._renumber([o for o in outcomes if o is not None])
         self.build(starts, sum(o.outcome not in ("max_wall", "invalid start") for o in done))
         return done
+
+    def _renumber(self, outcomes: list[SetOutcome]) -> list[SetOutcome]:
+        """The groups numbered in the order of the starts that first reach them (so the first start's attractor,
+        :attr:`AttractorSet.primary`, is the first), the outcomes' ids with them: the breakdowns and steady windows
+        are grouped in a first pass and the stick-slip windows after, which numbered them out of that order."""
+        self.groups.sort(key=lambda g: min(g["members"]))
+        new = {g["id"]: k for k, g in enumerate(self.groups)}
+        for g in self.groups:
+            g["id"] = new[g["id"]]
+        return [o if o.attractor is None else dataclasses.replace(o, attractor=new[o.attractor]) for o in outcomes]
 
     def _group(self, kind: str, label: str, i: int, obs: StickSlipObservables | None, **extra: Any) -> int:
         """The id of the group ``label`` (made if new), with start ``i`` added."""
@@ -325,6 +360,7 @@ class _Reader:
         try:
             left = self.deadline.left()
             if left is not None and left <= 0:
+                self.cut += 1
                 return None, "multipliers not computed: max_wall spent"
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
@@ -340,6 +376,7 @@ class _Reader:
             note = "; ".join(str(c.message) for c in caught)[:200]
             res: tuple[Any, str] = (o, f"Newton residual {o.residual:.2g}" + (f"; {note}" if note else ""))
         except (ValueError, ArithmeticError, RuntimeError) as exc:  # no convergence, breakdown, budget, failure
+            self.cut += _spent(exc, self.deadline)
             res = (None, f"multipliers not computed: {type(exc).__name__}: {' '.join(str(exc).split())[:160]}")
         self.orbits[key] = res
         return res
@@ -374,6 +411,7 @@ class _Reader:
             return
         left = self.deadline.left()
         if left is not None and left <= 0:
+            self.cut += 1
             g["note"] = "no exponent: max_wall spent"
             return
         self.say(self.n_starts, self.n_starts, f"Lyapunov exponent from {alpha[0].name}")
@@ -381,14 +419,23 @@ class _Reader:
             L = lyapunov(self.params, "tangent", t_transient=self.t_transient, alpha0=alpha[0].alpha0,
                          T=self.lyapunov_T, max_wall=left)
         except (ValueError, ArithmeticError, RuntimeError) as exc:
+            self.cut += _spent(exc, self.deadline)
             g["note"] = f"no exponent: {type(exc).__name__}: {' '.join(str(exc).split())[:160]}"
             return
         self.counters["lyapunov"] += 1
         lam, err = float(L.bits_per_s), float(L.stderr_bits)
-        g["lyapunov"], g["lyapunov_stderr"] = lam, err if math.isfinite(err) else None
-        chaotic = lam >= CHAOS_BITS and lam > 3 * err
-        g["kind"] = g["label"] = "chaotic" if chaotic else "quasi-periodic"
         g["note"] = f"tangent exponent over {fmt_number(self.lyapunov_T, 3)} s from {alpha[0].name}"
+        if not math.isfinite(lam):  # never NaN in a result: no exponent, the class undecided
+            g["note"] = f"no exponent: the {g['note']} is not finite"
+            return
+        g["lyapunov"], g["lyapunov_stderr"] = lam, err if math.isfinite(err) else None
+        if lam >= CHAOS_BITS and lam > 3 * err:
+            g["kind"] = g["label"] = "chaotic"
+        elif lam < CHAOS_BITS:
+            g["kind"] = g["label"] = "quasi-periodic"
+        else:  # positive beyond the chaos threshold, yet within three standard errors of 0 (or without one)
+            g["note"] += (f": {fmt_number(lam, 3)} bits/s, not three standard errors above 0, decides neither chaos "
+                          "nor a torus (lengthen lyapunov_T)")
 
     def build(self, starts: list[SetStart], n_ran: int) -> None:
         """The :class:`SetAttractor` of each group (exponents measured here, after every start is read)."""
@@ -410,6 +457,13 @@ class _Reader:
                 stable=None if o is None else bool(o.stable), lyapunov=g.get("lyapunov"),
                 lyapunov_stderr=g.get("lyapunov_stderr"), note=g.get("note", ""),
                 returns=np.asarray(g.get("returns", np.zeros(0)))))
+
+
+def _spent(exc: BaseException, deadline: Deadline) -> int:
+    """1 where a stability step stopped for the call's budget (a wall-time budget error, or the deadline passed),
+    else 0 (no convergence, a breakdown: the step's own outcome)."""
+    left = deadline.left()
+    return int(getattr(exc, "budget", None) == "max_wall" or (left is not None and left <= 0))
 
 
 def _how(tr: Trajectory, s: SetStart, r: _Reader) -> str:

@@ -8,7 +8,9 @@ table (:meth:`AttractorSet.to_dataframe`), a plot of each attractor's return map
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -17,6 +19,7 @@ import numpy as np
 
 from peelapprox import PeelParams, StickSlipObservables
 from peelapprox.io import fmt_number, jsonable, optional_import
+from peelapprox.validate import ArgumentTypeError, in_range, real
 
 from ._escape import EscapePrediction
 
@@ -100,8 +103,9 @@ class SetAttractor:
         Its index in ``AttractorSet.attractors`` (numbered in the order of the starts that first reach it).
     kind : str
         One of :data:`KINDS`: ``"periodic"`` (a stable period-n orbit), ``"quasi-periodic"`` (aperiodic returns,
-        largest Lyapunov exponent zero within its error: a torus, or a period above ``max_period``),
-        ``"chaotic"`` (a positive exponent), ``"aperiodic"`` (no exponent measured), ``"steady"`` (no jump),
+        largest Lyapunov exponent below ``CHAOS_BITS``: a torus, or a period above ``max_period``),
+        ``"chaotic"`` (a positive exponent), ``"aperiodic"`` (no exponent measured, or one at least
+        ``CHAOS_BITS`` yet within three standard errors of 0: undecided), ``"steady"`` (no jump),
         ``"breakdown"`` (the starts break down; ``label`` the reason).
     label : str
         ``"period-n"``, ``"quasi-periodic"``, ``"chaotic"``, ``"aperiodic"``, ``"steady"`` or ``"breakdown:<reason>"``.
@@ -167,7 +171,14 @@ class SetAttractor:
         return text
 
     def row(self) -> dict[str, Any]:
-        """One flat row of plain data (the table's)."""
+        """One flat row of plain data (the table's): ``id``, ``kind``, ``label``, ``period``, ``share``,
+        ``n_starts``, ``starts`` (the names, space-separated), ``stable``, ``max_multiplier``, ``multipliers``
+        (``"re+imj"``, space-separated), ``lyapunov_bits_per_s``, ``lyapunov_stderr``, ``cycle`` (floats,
+        space-separated), ``note``; then, where the attractor has observables (not a breakdown), the fields of
+        :meth:`peelapprox.StickSlipObservables.as_dict` but ``status``, ``reason``, ``method``, ``V`` and ``I``
+        (``n_slips``, ``period`` as ``window_period``: the window's own, None where it had not settled,
+        ``period_label``, ``slip_interval``, ``force_drop``, ... ``t_start``, ``t_end``).  None where a value is
+        undefined, never NaN."""
         row: dict[str, Any] = {"id": self.id, "kind": self.kind, "label": self.label, "period": self.period,
                                "share": self.share, "n_starts": len(self.starts), "starts": " ".join(self.starts),
                                "stable": self.stable, "max_multiplier": self.max_multiplier,
@@ -178,11 +189,26 @@ class SetAttractor:
             obs = self.observables.as_dict()
             for name in ("status", "reason", "method", "V", "I"):
                 obs.pop(name)
-            row.update(obs)
+            # the window's own period (None where it had not settled) beside the attractor's (Newton's), not over it
+            row.update({("window_period" if k == "period" else k): v for k, v in obs.items()})
         return row
 
 
 _COMPARED = ("slip_interval", "force_drop")
+#: The observables :meth:`AttractorSet.closest` can compare: the numeric fields of StickSlipObservables.
+_COMPARABLE = tuple(f.name for f in dataclasses.fields(StickSlipObservables)
+                    if f.name not in ("status", "reason", "method", "period_label", "V", "I"))
+
+
+def _fields(fields: Any) -> tuple[str, ...]:
+    """``fields`` checked: a non-empty tuple or list of names of :data:`_COMPARABLE`."""
+    if isinstance(fields, str) or not isinstance(fields, (tuple, list)) or not fields:
+        raise ArgumentTypeError(f"fields must be a non-empty tuple of observable names (of {_COMPARABLE}), got "
+                                f"{fields!r}")
+    bad = [f for f in fields if f not in _COMPARABLE]
+    if bad:
+        raise ValueError(f"fields: {bad!r} are not observables; choose among {_COMPARABLE}")
+    return tuple(fields)
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,7 +222,8 @@ class AttractorSet:
         One of :data:`SET_STATUSES`: ``"ok"`` (at least one attractor other than a breakdown), ``"transient
         only"`` (every run that finished is still in a transient: lengthen ``t_transient``), ``"breakdown only"``
         (every start that ran breaks down), ``"max_wall"`` (the budget ran out before every start was read: the
-        attractors are those of the starts read), ``"no attractor"`` (every start invalid or failed).
+        attractors are those of the starts read; or before a stability step, whose attractor's ``note`` says so:
+        its class is then unchecked), ``"no attractor"`` (every start invalid or failed).
     message : str
         A sentence saying why.
     attractors : tuple of SetAttractor
@@ -250,8 +277,8 @@ class AttractorSet:
         observables : StickSlipObservables or mapping
             Anything with the ``fields`` as attributes or keys (a prediction, statistics of a measured trace).
         fields : tuple of str
-            The observables compared (:class:`peelapprox.StickSlipObservables` field names; default slip interval
-            and force drop).
+            The observables compared (the numeric :class:`peelapprox.StickSlipObservables` field names, at least
+            one; default slip interval and force drop).
         min_share : float
             Only attractors reached from at least this share of the starts, in [0, 1].
 
@@ -260,14 +287,22 @@ class AttractorSet:
         (SetAttractor, float) or None
             The distance is the largest relative difference ``|mine - theirs| / |mine|`` over ``fields``; None
             when no attractor (or ``observables``) defines them.
+
+        Raises
+        ------
+        ValueError, TypeError
+            ``min_share`` outside [0, 1], ``fields`` empty or naming no numeric observable, a value of
+            ``observables`` not a finite number (each named).
         """
-        if not 0.0 <= float(min_share) <= 1.0:
-            raise ValueError(f"min_share must lie in [0, 1], got {min_share!r}")
+        min_share, fields = in_range("min_share", min_share, 0.0, 1.0), _fields(fields)
         get = (observables.get if isinstance(observables, Mapping)
                else lambda name: getattr(observables, name, None))
         theirs = [get(f) for f in fields]
         if any(v is None for v in theirs):
             return None
+        for f, v in zip(fields, theirs, strict=True):  # a number, finite: a NaN distance is no answer
+            if not math.isfinite(real(f"observables[{f!r}]", v)):
+                raise ValueError(f"observables[{f!r}] must be finite, got {v!r}")
         best: tuple[SetAttractor, float] | None = None
         for a in self.stick_slip(min_share):
             mine = [None if a.observables is None else getattr(a.observables, f) for f in fields]
@@ -298,7 +333,8 @@ class AttractorSet:
         return rows
 
     def to_dataframe(self):
-        """The attractors as a :class:`pandas.DataFrame` (:meth:`rows`); ``attrs`` hold the status, message,
+        """The attractors as a :class:`pandas.DataFrame`, one row per attractor with the columns of
+        :meth:`SetAttractor.row` (a breakdown's observables' columns empty); ``attrs`` hold the status, message,
         parameters and counters.  ImportError without pandas (``pip install 'peelapprox[data]'``)."""
         pd = optional_import("pandas", "AttractorSet.to_dataframe")
         df = pd.DataFrame(self.rows())
@@ -316,7 +352,8 @@ class AttractorSet:
 
     def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
         """Each attractor's return map ``x_{k+1}`` against ``x_k`` (the force at the AB→CD jumps of its first
-        start's window), one colour each, the legend giving label and share; returns the figure drawn into."""
+        start's window), one colour each, the legend giving label and share (an attractor without a map, a transient,
+        or the status where there is neither, in the legend only); returns the figure drawn into."""
         from peelapprox.plotting import new_figure
 
         if ax is None:
@@ -325,10 +362,12 @@ class AttractorSet:
             x = a.returns
             if x.size >= 2:
                 ax.plot(x[:-1], x[1:], ".", ms=4 if x.size < 200 else 2, label=a.describe()[:70])
-            elif a.kind == "steady":
-                ax.plot([], [], " ", label=a.describe())
+            else:  # steady, a breakdown, a window of fewer than two returns: named in the legend only
+                ax.plot([], [], " ", label=a.describe()[:70])
         for o in self.transients:
             ax.plot([], [], " ", label=f"{o.start.name}: {o.message[:60]}")
+        if not self.attractors and not self.transients:  # nothing to draw: the status says why
+            ax.plot([], [], " ", label=f"{self.status}: {self.message[:60]}")
         ax.set_xlabel("F at AB→CD jump k [N]")
         ax.set_ylabel("F at AB→CD jump k+1 [N]")
         ax.legend(fontsize="small")

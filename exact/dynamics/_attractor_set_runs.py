@@ -6,14 +6,18 @@ an executor) and all of them in the order of the starts under the call's deadlin
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
 from typing import Any
 
+import numpy as np
+
 from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, SolverFailure
 from peelapprox.errors import WallBudget
 from peelapprox.parallel import AUTO, worker_pool
+from peelapprox.validate import real
 
 from .._initial import initial_state
 from .._model import model_of
@@ -82,8 +86,9 @@ def _as_start(i: int, item: Any) -> SetStart:
             raise ValueError(f"starts[{i}] has unknown keys {sorted(extra)}; allowed: alpha0, omega0, F0, branch0, "
                              "name")
         kw = {k: item[k] for k in ("alpha0", "omega0", "F0", "branch0") if item.get(k) is not None}
-        return SetStart(str(item.get("name", f"start[{i}]")), float(kw.pop("alpha0", 0.0)), **kw)
-    if isinstance(item, (int, float)) and not isinstance(item, bool):
+        alpha0 = real(f"starts[{i}]['alpha0']", kw.pop("alpha0", 0.0), rng="[-pi, pi]")  # the rest: initial_state's
+        return SetStart(str(item.get("name", f"start[{i}]")), alpha0, **kw)
+    if isinstance(item, numbers.Real) and not isinstance(item, bool):  # numpy's scalars too, not numpy.bool_
         return SetStart(f"alpha0={float(item):g}", float(item))
     raise TypeError(f"starts[{i}] must be a float (alpha0), an exact.State, a mapping or a SetStart, got "
                     f"{type(item).__name__}")
@@ -100,6 +105,8 @@ def check_starts(params: PeelParams, starts: Any) -> tuple[list[SetStart], list[
             raise ValueError(f"starts must be 'default' or a sequence of starts, got {starts!r}")
         given, design = list(default_starts(params)), True
     else:
+        if isinstance(starts, np.ndarray) and starts.ndim == 1:  # α0 values (np.linspace(-0.3, 0.3, 7))
+            starts = starts.tolist()
         if not isinstance(starts, Sequence):
             raise TypeError(f"starts must be 'default' or a sequence of starts, got {type(starts).__name__}")
         if len(starts) == 0:

@@ -24,6 +24,7 @@ The confidence rules (:func:`confidence`), each measured (docs/theory.md, "The a
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from dataclasses import dataclass
 from typing import Any
@@ -166,7 +167,7 @@ def confidence(o: ApproximateAttractor, label: str, alpha_max: float | None, lef
         if orbit.multipliers is not None:
             rho = max(abs(m) for m in orbit.multipliers)
             if abs(rho - 1.0) < MULTIPLIER_ERROR:
-                why.append(f"{what} a multiplier |mu| = {fmt_number(rho, 5)} within the reduction's multiplier error "
+                why.append(f"{what} a multiplier |mu| = {_near_one(rho)} within the reduction's multiplier error "
                            f"({MULTIPLIER_ERROR:g}) of 1: which attractor the exact run settles on is not decided by "
                            "the map")
                 break
@@ -182,6 +183,12 @@ def confidence(o: ApproximateAttractor, label: str, alpha_max: float | None, lef
                    f"{fmt_number(100 * v.unflagged_match, 3)} % of the {v.unflagged_points} points measured (below "
                    f"{100 * CALIBRATION_FLOOR:.0f} %)")
     return ("low", "; ".join(why)) if why else ("high", "no rule of low confidence applies")
+
+
+def _near_one(rho: float) -> str:
+    """``|μ|`` with the digits that tell it from 1 (``1.000012``, not ``1``), at least five significant ones."""
+    digits = 5 if rho == 1.0 else max(5, 2 - int(math.floor(math.log10(abs(rho - 1.0)))))
+    return fmt_number(rho, min(digits, 15))
 
 
 def warn_low(o: ApproximateAttractor) -> None:

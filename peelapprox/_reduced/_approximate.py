@@ -34,6 +34,7 @@ from .._params import PeelParams
 from .._ranges import F0_FACTOR
 from .._status import LAW_DOMAIN, V_FLOOR
 from ..io import fmt_number
+from ..law import fixed_point
 from ..law._compiled import compiled_law
 from ..validate import choice, flag, integer, optional, positive
 from ..validate import params as _params
@@ -131,8 +132,10 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         ``confidence_reason``, and ``alternatives``: the attractors of the other start and the unstable orbits left on
         the way (the solver start's attractor not where that start was not followed past a weakly unstable orbit because
         the rest start's answer ranks first: :func:`_starts`). ``status``: ``"stick-slip"``; ``"steady"`` (no folds at
-        V, or a segment settles on the stable fixed point); ``"no attractor"`` (a budget spent first) or ``"breakdown"``
-        (of a reduced segment), with the reason. Every mean is None for the last three, never NaN.
+        V, a segment settles on the stable fixed point, or no AB landing while the solver's start lies on that fixed
+        point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment, or no return map:
+        a jump without a landing, a fold force not positive), with the reason. Every mean is None for the last three,
+        never NaN.
 
     Raises
     ------
@@ -152,11 +155,16 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
     common: dict[str, Any] = dict(V=float(params.V), I=float(params.I), t_start=None, t_end=None)
     inertia, velocity, models, chain = _chain(params, law, chosen)
+    names = ("solver", "rest") if start == "auto" else (start,)
     if (no_map := _no_map(params, law.structure, chain, common)) is not None:
-        return no_map
+        at_rest = _at_fixed_point(params, law, common) if "solver" in names and no_map.status == "breakdown" else None
+        answer = _assemble([Found(o, [], None) for o in (at_rest, no_map) if o is not None], "n/a", None)
+        if warn:  # rated as any answer: a breakdown is low confidence
+            warn_low(answer)
+        return answer
     lo = ReturnMap(params, law, models, rtol)  # kernels compiled or loaded: max_wall counts from here (docstring)
     lo.deadline = math.inf if max_wall is None else time.perf_counter() + max_wall
-    maps, names = (lo, lo.at(NEWTON_RTOL)), ("solver", "rest") if start == "auto" else (start,)
+    maps = (lo, lo.at(NEWTON_RTOL))
     solver = _solver_start(params, law) if "solver" in names else None
     found = _starts(params, maps, solver, _rest(law), names, (n_transient, n_returns, rtol, chain, common))
     probe = _probe(params, law, solver, rtol, lo.deadline, lo.book) if solver is not None and models != FULL_CHAIN \
@@ -172,7 +180,13 @@ def _chain(params: PeelParams, law: Any, chosen: list[str | None]
            ) -> tuple[str, str, tuple[tuple[str, str], tuple[str, str]], str]:
     """``estimate()``'s inertia and velocity labels of ``params`` and the chain: the models ``chosen`` (AB α, AB v,
     CD α, CD v), :data:`APPROX_DEFAULTS`' for the regime where None, and the chain's name."""
-    inertia, velocity = regime(params) if law.structure.has_folds else ("n/a", "stable")
+    bs = law.structure
+    if not bs.has_folds:
+        inertia, velocity = "n/a", "stable"
+    elif _landless(bs) is not None:  # no map to label (:func:`_no_map`); the regime's periods need f_min > 0
+        inertia, velocity = "n/a", "n/a"
+    else:
+        inertia, velocity = regime(params)
     (ab_am, ab_ve), (cd_am, cd_ve) = APPROX_DEFAULTS.get(inertia, APPROX_DEFAULTS["low"])
     models = ((chosen[0] or ab_am, chosen[1] or ab_ve), (chosen[2] or cd_am, chosen[3] or cd_ve))
     return inertia, velocity, models, f"approximate: AB {models[0][0]}/{models[0][1]}, CD {models[1][0]}/{models[1][1]}"
@@ -186,10 +200,41 @@ def _no_map(params: PeelParams, bs: Any, chain: str, common: dict[str, Any]) -> 
             status="steady", method="approximate: no folds, nothing to chain", **common,
             reason=f"the law has no folds at V = {fmt_number(params.V, 4)} m/s (f increases in v): steady peeling "
                    "at the stable fixed point v = V"))
+    if (why := _landless(bs)) is not None:
+        return promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
+                                                      reason=f"{why}: no return map"))
+    return None
+
+
+def _at_fixed_point(params: PeelParams, law: Any, common: dict[str, Any]) -> ApproximateAttractor | None:
+    """Where the map has no AB landing (f_min <= f(0+, V): no stick-slip cycle closes) and the fixed point v = V
+    is stable on AB (``f'(V, V) > 0``, V below the fold v_max), the solver's start, F = F0_FACTOR f(V, V) at v = V
+    on AB, relaxes to it: steady peeling (the exact solver's start does, at 30 of 30 random such points of the
+    paper's law, V 0.05-0.2 m/s, I 1e-7-0.2 kg m^2, k 200-5000 N/m); None otherwise."""
+    bs = law.structure
+    lo, hi = law.domain
+    if bs.v_land_ab is not None or not (lo <= params.V <= hi and bs.v_max is not None and params.V < bs.v_max):
+        return None
+    fp = fixed_point(params.V, params.R, force=params.force)
+    if not fp.stable:
+        return None
+    return promote(StickSlipObservables._no_slip(
+        status="steady", method="approximate: no AB landing, the solver's start on the stable fixed point", **common,
+        reason=f"no stick-slip cycle closes (the CD->AB jump has no landing on AB: f_min <= f(0+, V)) and the "
+               f"fixed point v = V = {fmt_number(params.V, 4)} m/s is stable on AB (f'(V, V) = "
+               f"{fmt_number(fp.fprime, 4)} N s/m > 0): the solver's start, on AB at v = V, relaxes to it: steady "
+               "peeling; a start off its basin jumps to CD and breaks down"), start="solver")
+
+
+def _landless(bs: Any) -> str | None:
+    """Why the law's folds at V give the map no jump to land (a fold force not positive, as a law with a negative
+    dip has: the exact model's F reaches 0; a jump without a landing), or None where both jumps land."""
+    if not bs.f_min > 0.0:
+        return (f"the law's lower fold force f_min = {fmt_number(bs.f_min, 5)} N is not positive: F reaches 0 "
+                "before the CD->AB jump (the exact model's breakdown F <= 0)")
     if bs.v_land_ab is None or bs.v_land_cd is None:
         which = "AB (f_min <= f(0+, V))" if bs.v_land_ab is None else "CD (the law's domain ends below f_max)"
-        return promote(StickSlipObservables._no_slip(status="breakdown", method=chain, **common,
-                                                      reason=f"a jump has no landing on {which}: no return map"))
+        return f"a jump has no landing on {which}"
     return None
 
 

@@ -45,6 +45,10 @@ def _labels(params: PeelParams, bs: BranchStructure, fp: FixedPoint
     """The regime labels of :data:`INERTIA_RULE` and :data:`VELOCITY_RULE` at a point with folds, and the numbers
     they are read from: ``(periods, tau_cd, ratio, inertia, gap, velocity)``."""
     assert bs.f_max is not None and bs.f_min is not None  # the caller's: has_folds
+    if not bs.f_min > 0.0:  # a law with a negative dip: no inertial period at F = f_min (sqrt(F R / I))
+        raise ValueError(f"params.force: {params.force!r} at V={params.V} has its lower fold force f_min={bs.f_min} N "
+                         "not positive (the pull force would reach 0 before the CD->AB jump): no stick-slip regime; "
+                         "choose coefficients with f > 0 on the folds")
     per = inertial_periods(params)
     if bs.v_land_cd is None:  # a table that stops below f_max on CD: no AB->CD landing, no CD damping time
         raise ValueError(f"params.force: {params.force!r} at V={params.V} never reaches f_max={bs.f_max} N on its "

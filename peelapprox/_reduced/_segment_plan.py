@@ -19,7 +19,7 @@ import numpy as np
 from .._compiled._jit import wrapper_address as _wrapper_address
 from .._packing import model_block
 from .._params import PeelParams
-from .._status import LAW_DOMAIN, OUT_FULL, V_CEILING, V_FLOOR
+from .._status import LAW_DOMAIN, NONFINITE, OUT_FULL, V_CEILING, V_FLOOR
 from ..law import ALL_LAWS
 from ..law._abi import LAW_SIG, LAW_TYPE
 from ..law._compiled import CompiledLaw
@@ -172,8 +172,11 @@ def run_segment(plan: SegmentPlan, F_in: float, alpha_in: float | None, alphadot
         y = y0.copy()
         out = np.empty((cap, 5))
         cnt = np.zeros(5, dtype=np.int64)
-        code = plan.drive(y, q, plan.law_arg, plan.law.coef, plan.rtol, atol, plan.x_f, plan.x_lo, plan.x_hi,
-                          plan.branch == "AB", t_max, plan.max_steps, mode, te, out, cnt)
+        try:
+            code = plan.drive(y, q, plan.law_arg, plan.law.coef, plan.rtol, atol, plan.x_f, plan.x_lo, plan.x_hi,
+                              plan.branch == "AB", t_max, plan.max_steps, mode, te, out, cnt)
+        except ZeroDivisionError:  # a closed form's ramp F_in + s t at exactly 0 (the sinusoid's F_in/F, s < 0 where
+            code = NONFINITE  # v_in > V): what a step past it gives as NaN, the field's square roots of F < 0
         if code != OUT_FULL:
             return SegmentRun(int(code), y, out[:int(cnt[K.C_NOUT])], cnt, q, float(alpha_in), float(alphadot_in),
                               atol, float(t_max))
