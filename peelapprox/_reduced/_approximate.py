@@ -96,9 +96,8 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     periodic orbits by Newton with their multipliers, leaves the unstable ones, and reads the observables of
     what it reaches with the definitions of :class:`StickSlipObservables`.  The default reductions
     (:data:`APPROX_DEFAULTS`): the full branch dynamics linearised in α (genalpha + fullvdot on both branches) at
-    every inertia; Airy1 + approxvdot, which keeps FLOW1's kinematic term ``-v̇/R``, large near the folds, and drops
-    the O(α) terms, is one choice of the four slots (measurements of both: docs/theory.md, "The approximate
-    attractor").
+    every inertia; Airy1 + approxvdot (FLOW1's ``-v̇/R`` kept, the O(α) terms dropped) and the others are options
+    (measurements: docs/theory.md, "The approximate attractor").
 
     Parameters
     ----------
@@ -119,8 +118,7 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         Relative tolerance of the segments while iterating (1e-6); Newton and its Jacobian run at 1e-9.
     max_wall : float or None
         Wall-clock budget [s] of the iteration (10; None: unbounded), checked every 20,000 integration steps at
-        most.  It counts from when the map's kernels are ready: their one-time compilation (or load from the
-        cache) is not spent from it, so a call's answer does not depend on whether it compiled.
+        most, from when the map's kernels are ready (compiled or loaded: an answer does not depend on that).
     warn : bool
         Warn once (:class:`peelapprox.ApproximationWarning`) if the primary prediction has low confidence (True).
 
@@ -130,38 +128,31 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
         A :class:`StickSlipObservables` (``method`` names the chain, the start and how the attractor was found;
         ``t_start``/``t_end`` on the map's own clock) with ``multipliers``, ``escape_returns``, ``confidence`` and
         ``confidence_reason``, and ``alternatives``: the attractors of the other start and the unstable orbits left on
-        the way (the solver start's attractor not where that start was not followed past a weakly unstable orbit because
-        the rest start's answer ranks first: :func:`_starts`). ``status``: ``"stick-slip"``; ``"steady"`` (no folds at
-        V, a segment settles on the stable fixed point, or no AB landing while the solver's start lies on that fixed
-        point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment, or no return map:
-        a jump without a landing, a fold force not positive), with the reason. Every mean is None for the last three,
-        never NaN.
+        the way (:func:`_starts`: when the solver's start is not followed). ``status``: ``"stick-slip"``; ``"steady"``
+        (no folds at V, a segment settles on the stable fixed point, or no AB landing while the solver's start lies
+        on that fixed point); ``"no attractor"`` (a budget spent first) or ``"breakdown"`` (of a reduced segment, or
+        no return map: a jump without a landing, a fold force not positive), with the reason. Every mean is None for
+        the last three, never NaN.
 
     Raises
     ------
-    ValueError
-        An unknown model, a value out of range, a model variant or a law without a compiled kernel (named).
-    peelapprox.validate.ArgumentTypeError
-        (also a TypeError) An argument of the wrong kind.
+    ValueError, TypeError
+        An unknown model, a value out of range, a model variant or a law without a compiled kernel (named); an
+        argument of the wrong kind (:class:`peelapprox.validate.ArgumentTypeError`, a TypeError).
     """
     params = _params("params", params, where="approximate_attractor", variants=False)
-    chosen = [optional(choice, name, value, ALPHA_MODELS if "alpha" in name else V_EQUATIONS) for name, value in (
-        ("alpha_model", alpha_model), ("v_equation", v_equation), ("cd_alpha_model", cd_alpha_model),
-        ("cd_v_equation", cd_v_equation))]
-    n_transient, n_returns = integer("n_transient", n_transient, lo=0, hi=10**6), \
-        integer("n_returns", n_returns, lo=3, hi=10**6)
-    start, rtol, max_wall, warn = choice("start", start, START_NAMES), _rtol("rtol", rtol), \
-        optional(positive, "max_wall", max_wall), flag("warn", warn)
+    chosen, n_transient, n_returns, start, rtol, max_wall, warn = _checked(
+        alpha_model, v_equation, cd_alpha_model, cd_v_equation, n_transient, n_returns, start, rtol, max_wall, warn)
     law = compiled_law(params.force, params.V)  # ValueError naming params.force for a law without a kernel
     common: dict[str, Any] = dict(V=float(params.V), I=float(params.I), t_start=None, t_end=None)
     inertia, velocity, models, chain = _chain(params, law, chosen)
     names = ("solver", "rest") if start == "auto" else (start,)
     if (no_map := _no_map(params, law.structure, chain, common)) is not None:
         at_rest = _at_fixed_point(params, law, common) if "solver" in names and no_map.status == "breakdown" else None
-        answer = _assemble([Found(o, [], None) for o in (at_rest, no_map) if o is not None], "n/a", None)
+        primary = _assemble([Found(o, [], None) for o in (at_rest, no_map) if o is not None], "n/a", None)
         if warn:  # rated as any answer: a breakdown is low confidence
-            warn_low(answer)
-        return answer
+            warn_low(primary)
+        return primary
     lo = ReturnMap(params, law, models, rtol)  # kernels compiled or loaded: max_wall counts from here (docstring)
     lo.deadline = math.inf if max_wall is None else time.perf_counter() + max_wall
     maps = (lo, lo.at(NEWTON_RTOL))
@@ -174,6 +165,17 @@ def approximate_attractor(params: PeelParams, *, alpha_model: str | None = None,
     if warn:
         warn_low(primary)
     return primary
+
+
+def _checked(alpha_model: Any, v_equation: Any, cd_alpha_model: Any, cd_v_equation: Any, n_transient: Any,
+             n_returns: Any, start: Any, rtol: Any, max_wall: Any, warn: Any) -> tuple:
+    """:func:`approximate_attractor`'s options checked (each error names its argument and range), in its order."""
+    chosen = [optional(choice, name, value, ALPHA_MODELS if "alpha" in name else V_EQUATIONS) for name, value in (
+        ("alpha_model", alpha_model), ("v_equation", v_equation), ("cd_alpha_model", cd_alpha_model),
+        ("cd_v_equation", cd_v_equation))]
+    return (chosen, integer("n_transient", n_transient, lo=0, hi=10**6),
+            integer("n_returns", n_returns, lo=3, hi=10**6), choice("start", start, START_NAMES), _rtol("rtol", rtol),
+            optional(positive, "max_wall", max_wall), flag("warn", warn))
 
 
 def _chain(params: PeelParams, law: Any, chosen: list[str | None]
