@@ -111,10 +111,9 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
         A callable gets ``(done, total, message)`` after each start's run (done of total starts) and before each
         stability step (done = total); True writes those lines on stderr.
     max_wall : float or None
-        Wall-clock budget [s] of the whole call (default :data:`exact.DEFAULT_MAX_WALL`): a start it leaves
-        out or cuts is an outcome ``"max_wall"``, a stability step (Newton orbit, exponent) it leaves out or stops
-        a note on the attractor; either makes the set's status ``"max_wall"`` (the set is of the starts read, and
-        where a step was cut its classes are unchecked).  None: unbounded.
+        Of the whole call [s] (:data:`exact.DEFAULT_MAX_WALL`; None: unbounded): a start it leaves out or cuts is
+        an outcome ``"max_wall"``, a stability step (Newton orbit, exponent) it cuts a note on the attractor; either
+        makes the set's status ``"max_wall"`` (a set of the starts read; classes unchecked where a step was cut).
 
     Returns
     -------
@@ -124,8 +123,7 @@ def attractor_set(params: PeelParams, *, starts: str | Sequence[Any] = "default"
     ------
     ValueError, TypeError
         A bad argument, named with its range: an empty start set, a start outside the model's domain (its field)
-        or without a consistent state (``starts[i]``).  Nothing a start does raises: a breakdown, a solver
-        failure, a spent budget are outcomes.
+        or without a consistent state (``starts[i]``).  A breakdown, a solver failure, a spent budget: outcomes.
     """
     wall0 = time.perf_counter()
     params, t_transient, t_window = _params("params", params), duration("t_transient", t_transient, zero=True), \
