@@ -102,3 +102,23 @@ def test_unflagged_rows_count_only_points_high_by_the_other_rules():
     t = {(r["approximation"], r["observable"]): r for r in g.regime_table(ref, rows, [True, True, False])}
     u = t[("approx:default:unflagged", "slip_interval+force_drop")]
     assert (u["stick_slip"], u["within"], u["fraction"]) == (2, 1, 0.5)
+
+
+def test_other_rules_are_read_off_the_reason(monkeypatch):
+    """Hypothesis: a prediction low by the regime rule alone counts as high by the other rules, one low by another
+    rule (whose clause comes first) does not, and the rule's own clause begins with REGIME_CLAUSE (the text
+    ``confidence`` writes, produced here with a hand-set table: 0.5 of 100 points, below the floor)."""
+    import dataclasses
+
+    from peelapprox import PeelParams, approximate_attractor
+    from peelapprox._reduced import _approx_result as ar
+    from peelapprox._reduced._validity import Validity
+
+    o = dataclasses.replace(approximate_attractor(PeelParams(V=1.0, I=1e-5)), multipliers=None)
+    monkeypatch.setitem(ar.VALIDITY, "R", Validity(300, 0.9, 0.9, 0.9, 100, 0.5))
+    conf, why = ar.confidence(o, "R", None, (), None)
+    assert conf == "low" and why.startswith(g.REGIME_CLAUSE)
+    rows = [{"pred": SimpleNamespace(confidence=c, confidence_reason=r)} for c, r in
+            (("high", "no rule of low confidence applies"), ("low", why),
+             ("low", "its orbit has a multiplier |mu| = 0.99 within ...; " + why))]
+    assert g.other_rules_high(rows) == [True, True, False]

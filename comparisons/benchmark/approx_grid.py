@@ -46,7 +46,7 @@ from peelapprox.io import fmt_number
 
 from .approx_targets import ALPHA0S, DATA, _exact, _match, score
 
-__all__ = ["grid", "main", "reference", "regime_table"]
+__all__ = ["REGIME_CLAUSE", "grid", "main", "other_rules_high", "reference", "regime_table"]
 
 
 def grid(n: int) -> list[tuple[float, float]]:
@@ -100,20 +100,17 @@ def reference(n: int, workers: int = 2, path: Path | None = None) -> list[dict[s
     return [done[str(i)] for i in range(len(pts))]
 
 
-def other_rules_high(ref: list[dict[str, Any]]) -> list[bool]:
-    """Per point, whether the primary prediction is high confidence by the rules other than its regime's measured
-    validity (``peelapprox._reduced._validity.VALIDITY`` emptied for the call): the points on which that rule's
-    table is calibrated (:func:`regime_table`'s ``approx:default:unflagged`` rows)."""
-    from unittest import mock
+#: How the regime rule's clause of ``confidence_reason`` begins: the rule is applied last
+#: (``peelapprox/_reduced/_approx_result.py``, ``confidence``), so a reason that begins with it holds no other rule's.
+REGIME_CLAUSE = "in its regime "
 
-    from peelapprox._reduced._validity import VALIDITY
 
-    out = []
-    with mock.patch.dict(VALIDITY, clear=True), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for r in ref:
-            out.append(approximate_attractor(PeelParams(V=r["V"], I=r["I"])).confidence == "high")
-    return out
+def other_rules_high(rows: list[dict[str, Any]]) -> list[bool]:
+    """Per scored row, whether the primary prediction is high confidence by the rules other than its regime's
+    measured calibration: high, or low by that rule alone (its reason begins with :data:`REGIME_CLAUSE`).  These are
+    the points on which the rule's table is calibrated (:func:`regime_table`'s ``approx:default:unflagged``)."""
+    return [r["pred"].confidence == "high" or (r["pred"].confidence_reason or "").startswith(REGIME_CLAUSE)
+            for r in rows]
 
 
 def regime_table(ref: list[dict[str, Any]], rows: list[dict[str, Any]], others_high: list[bool] | None = None
@@ -195,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
           f"starts): set {pct(s['set'])} %, strict {pct(s['strict'])} %, unflagged {pct(s['high_share'])} % of which "
           f"match {pct(s['high_match'])} %, median call {fmt_number(s['cpu_ms_median'], 3)} ms CPU; period labels "
           f"equal to the default start's {s['labels_equal']} of {s['labels_both_periodic']}")
-    table = regime_table(ref, s["rows"], other_rules_high(ref))
+    table = regime_table(ref, s["rows"], other_rules_high(s["rows"]))
     for t in table:
         print(f"  {t['approximation']:<18} {t['regime']:<36} {t['observable']:<24} {t['within']:>4} of "
               f"{t['stick_slip']:>4} ({pct(t['fraction'])} %)")
