@@ -191,8 +191,8 @@ def settled_period(x: np.ndarray, n: int, rtol: float, min_repeats: int = 2) -> 
     window [30, 50] s repeats after 18 to 6.5e-8 and after 9 to 5.5e-6, its last half after 9 to below 1e-6;
     docs/theory.md, "Period labels").  An orbit of period 2d modulates its returns by a fixed amount that does not
     decay: where that modulation is above ``rtol`` its repeat after d fails over the last half as over the whole,
-    and n stays.  The means of :func:`peelapprox.jump_statistics` are still taken over whole cycles of n (whole
-    cycles of d too)."""
+    and n stays.  The means of :func:`peelapprox._observables.jump_statistics` are still taken over whole cycles of
+    n (whole cycles of d too)."""
     h = x[x.size // 2:]
     scale = float(np.max(np.abs(x)))
     hs = h / scale if scale > 0 else h
