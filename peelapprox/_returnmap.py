@@ -189,7 +189,9 @@ def settled_period(x: np.ndarray, n: int, rtol: float, min_repeats: int = 2) -> 
     and reads as period 2d, though the orbit it settles on has period d (measured on the exact runs of the atlas's
     grid: at V = 3.646 m/s, I = 4.92e-4 the orbit is period 9 with μ = -0.988 (:func:`exact.periodic_orbit`), the
     window [30, 50] s repeats after 18 to 6.5e-8 and after 9 to 5.5e-6, its last half after 9 to below 1e-6;
-    docs/theory.md, "Period labels").  An orbit of period 2d modulates its returns by a fixed amount that does not
+    docs/theory.md, "Period labels").  Near any p-th root of unity likewise after pd (at V = 1.677 m/s, I = 8.4e-5
+    from α0 = 0.15 a period-1 orbit's complex pair, |μ| = 0.994, turns 69.8° per return: the window read period 5).
+    An orbit of period 2d modulates its returns by a fixed amount that does not
     decay: where that modulation is above ``rtol`` its repeat after d fails over the last half as over the whole,
     and n stays.  The means of :func:`peelapprox._observables.jump_statistics` are still taken over whole cycles of
     n (whole cycles of d too)."""

@@ -316,6 +316,26 @@ def test_a_decaying_flip_transient_is_not_read_as_a_period_doubling(seed):
     assert o.period == 2 * d
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_a_transient_turning_by_a_root_of_unity_is_not_read_as_its_period(seed):
+    """Constructed oracle (seeded): a period-1 orbit (F = F0 in 250-320 N) approached along a complex pair turning by
+    2π/p per return (p in 3..7, |μ| = rho in [0.97, 0.995]; the exact run at V = 1.677, I = 8.4e-5 from α0 = 0.15: p =
+    5, |μ| = 0.994).  The amplitude is set so that the whole window repeats after p to below 1e-6 of F (the deviation
+    times ``1 - rho^p``) but not after 1, and the deviation falls by 1e-8 over the window: periodicity reads period p,
+    the observables period 1."""
+    rng = np.random.default_rng(100 + seed)
+    per, rho, F0 = int(rng.integers(3, 8)), float(rng.uniform(0.97, 0.995)), float(rng.uniform(250.0, 320.0))
+    m = int(np.ceil(2 * np.log(1e-8) / np.log(rho)))
+    k = np.arange(m)
+    x = F0 + 0.9e-6 * F0 / (1.0 - rho ** per) * rho ** k * np.cos(2 * np.pi * k / per + rng.uniform(0, 2 * np.pi))
+    t = np.cumsum(np.tile([0.004, 0.001], m))
+    F = np.column_stack([x, x - 10.0]).ravel()
+    raw = peelapprox.periodicity(x, rtol=1e-6, max_period=32)
+    assert raw.period == per, raw  # the case is the defect's
+    o = StickSlipObservables.from_trajectory(_fake(t, F, np.tile([AB, CD], m), t_end=float(t[-1]) + 1e-3))
+    assert (o.period, o.period_label) == (1, "period-1")
+
+
 @pytest.mark.slow
 def test_exact_flip_transients_read_as_the_newton_orbits_period():
     """Independent oracle, :func:`exact.periodic_orbit` (Newton on the section, its minimal period and
