@@ -8,7 +8,7 @@ the package: it reads the reduced map's internals, which no public name offers).
 ``classify``: at every point whose primary prediction's period differs from the matched exact start's (the grid's
 ``labels_matched`` False), the map's orbit of the predicted period (Newton on P^n from the end of 600 (then 2600)
 returns of the prediction's start) and :func:`exact.periodic_orbit` with n the map's period seeded from the map's
-own orbit (the exact state on AB at v = v_max with the map's section point α, α̇ and F on CONSTR, run 3 periods
+own orbit (the exact state on AB at v = v_max with the map's section point α, α̇ and F on CONSTR less 1e-9, run 3 periods
 before Newton): its period, leading |μ|, stability and F range at the slips beside the map's.
 
 ``relabel``: every stick-slip start of ``comparisons/benchmark/data/approx_grid_n40.json`` re-run (30 s transient, 20 s
@@ -65,7 +65,7 @@ def classify(scored: str, out: str) -> None:
             row["map"] = dict(mu=float(max(abs(np.linalg.eigvals(J)))), Fmin=float(rr[:, 0].min()),
                               Fmax=float(rr[:, 0].max()))
             a, ad, v = float(xs[0]), float(xs[1]), float(bs.v_max) * (1 - 1e-9)
-            st = exact.State(t=0.0, alpha=a, omega=ad + v / p.R, F=lo.force(0, a), v=v, branch="AB")
+            st = exact.State(t=0.0, alpha=a, omega=ad + v / p.R, F=lo.force(0, a) * (1 - 1e-9), v=v, branch="AB")
             try:
                 po = exact.periodic_orbit(p, start=st, n=pp, t_transient=0.0,
                                           window=max(0.5, 3 * pp * pred["slip_interval"]), max_wall=90)
