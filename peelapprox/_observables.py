@@ -16,10 +16,14 @@ the window's edges are never measured):
 * ``slip_time`` — mean CD stay (an AB→CD jump to the next CD→AB jump) [s];
 * ``stick_time`` — mean AB stay (a CD→AB jump to the next AB→CD jump) [s];
 * ``F_max``, ``F_min`` — the largest and smallest F at any jump of the window [N];
-* ``period`` — the return map's period n (:func:`peelapprox.periodicity`), None if it has none.
+* ``period`` — the return map's period n (:func:`peelapprox.periodicity`), None if it has none; where the whole
+  sample repeats after n but its last half already after a divisor d of n, d (a period-d orbit still settling along
+  a multiplier near -1, whose decaying transient repeats after 2d sooner than after d:
+  :func:`peelapprox._returnmap.settled_period`).
 
 On a periodic attractor (period n) each mean is taken over the last whole cycles of its sample (its last
-``n·floor(size/n)`` values), so it is the orbit's mean, independent of where the window cuts the cycle.
+``n·floor(size/n)`` values, n the repeat found over the whole sample, a multiple of the period), so it is the
+orbit's mean, independent of where the window cuts the cycle.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ._returnmap import HasJumps, _trajectory, periodicity
+from ._returnmap import HasJumps, _trajectory, periodicity, settled_period
 from .io import fmt_number, html_table, jsonable, optional_import
 from .law import BRANCHES, fixed_point
 from .validate import duration, integer, positive
@@ -112,14 +116,17 @@ def jump_statistics(t: np.ndarray, F: np.ndarray, fb: np.ndarray, *, period_rtol
                "slip_time": t[to_cd + 1] - t[to_cd], "stick_time": t[to_ab + 1] - t[to_ab]}
     if slips.size >= 2:
         per = periodicity(F[slips], rtol=period_rtol, max_period=max_period)
-        period, label = per.period, per.label
+        repeat, period, label = per.period, per.period, per.label
+        if repeat is not None and repeat > 1:  # a decaying flip transient of a shorter orbit read as its double
+            period = settled_period(np.ascontiguousarray(F[slips]), repeat, period_rtol)
+            label = f"period-{period}"
     else:
-        period, label = None, "too short" if slips.size else "no stick-slip"
+        repeat, period, label = None, None, "too short" if slips.size else "no stick-slip"
     values: dict[str, Any] = {"n_slips": int(slips.size), "period": period, "period_label": label,
                               "F_max": float(F.max()), "F_min": float(F.min())}
-    for name, x in samples.items():
-        values[name], values[f"{name}_spread"] = _mean_spread(_whole_cycles(x, period))
-    cycles = None if period is None else len(_whole_cycles(samples["slip_interval"], period)) // period
+    for name, x in samples.items():  # whole cycles of the repeat found over the whole sample (of the period too)
+        values[name], values[f"{name}_spread"] = _mean_spread(_whole_cycles(x, repeat))
+    cycles = None if period is None else len(_whole_cycles(samples["slip_interval"], repeat)) // period
     return values, cycles
 
 

@@ -177,6 +177,33 @@ def _periodicity(x: np.ndarray, rtol: float, max_period: int, min_repeats: int =
     return Periodicity("aperiodic" if enough else "too short", None, best, x.size, rtol)
 
 
+def settled_period(x: np.ndarray, n: int, rtol: float, min_repeats: int = 2) -> int:
+    """The period of returns ``x`` that :func:`periodicity` reads as period ``n`` over the whole sample, once the
+    sample's decaying transient is set aside: the smallest divisor ``d < n`` of n whose repeat holds to ``rtol``
+    (relative to the whole sample's ``max|x|``, as in :func:`periodicity`) over the sample's last half (at least
+    ``min_repeats · d`` pairs there), n where none does.
+
+    A period-d orbit approached along a multiplier μ of ``P^d`` near -1 (a flip mode still decaying, the deviation's
+    sign turned every d returns) repeats after 2d to ``|1 - μ²|`` of its deviation but after d only to ``|1 - μ|``,
+    about twice it: a sample whose deviation has not yet fallen below ``rtol/2`` repeats after 2d and not after d,
+    and reads as period 2d, though the orbit it settles on has period d (measured on the exact runs of the atlas's
+    grid: at V = 3.646 m/s, I = 4.92e-4 the orbit is period 9 with μ = -0.988 (:func:`exact.periodic_orbit`), the
+    window [30, 50] s repeats after 18 to 6.5e-8 and after 9 to 5.5e-6, its last half after 9 to below 1e-6;
+    docs/theory.md, "Period labels").  Near any p-th root of unity likewise after pd (at V = 1.677 m/s, I = 8.4e-5
+    from α0 = 0.15 a period-1 orbit's complex pair, |μ| = 0.994, turns 69.8° per return: the window read period 5).
+    An orbit of period 2d modulates its returns by a fixed amount that does not
+    decay: where that modulation is above ``rtol`` its repeat after d fails over the last half as over the whole,
+    and n stays.  The means of :func:`peelapprox._observables.jump_statistics` are still taken over whole cycles of
+    n (whole cycles of d too)."""
+    h = x[x.size // 2:]
+    scale = float(np.max(np.abs(x)))
+    hs = h / scale if scale > 0 else h
+    for d in range(1, n):
+        if n % d == 0 and hs.size - d >= min_repeats * d and float(np.max(np.abs(hs[d:] - hs[:-d]))) <= rtol:
+            return d
+    return n
+
+
 def force_drops(trajectory: HasJumps) -> np.ndarray:
     """Force drop of each slip [N]: ``F`` at an AB→CD jump minus ``F`` at the next CD→AB jump.
 

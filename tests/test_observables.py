@@ -271,3 +271,84 @@ def test_mean_spread_is_numpys_mean_and_std_bitwise():
             if y.size:
                 assert _mean_spread(y) == (float(np.mean(y)), float(np.std(y, ddof=1)) if y.size > 1 else 0.0)
     assert _mean_spread(np.empty(0)) == (None, None)
+
+
+def _flip_sequence(rng, d, cycles, *, amp, rho, modulation=0.0):
+    """AB→CD forces of a period-d orbit (seeded random cycle values in 250-320 N) approached along a flip mode:
+    the deviation ``amp·w_j·(-rho)^c`` in the c-th cycle (w_j seeded in [0.5, 1]), plus a fixed period-2d
+    modulation ``±modulation·w_j`` (0: the orbit has period d); returns (jump times, forces, branches)."""
+    cyc, w = rng.uniform(250.0, 320.0, d), rng.uniform(0.5, 1.0, d)
+    x = np.concatenate([cyc + w * (amp * (-rho) ** c + modulation * (-1) ** c) for c in range(cycles)])
+    stays = rng.uniform(0.004, 0.006, x.size)
+    t = np.cumsum(np.repeat(stays, 2) * np.tile([1.0, 0.25], x.size))
+    F = np.column_stack([x, x - 10.0]).ravel()
+    return t, F, np.tile([AB, CD], x.size)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_decaying_flip_transient_is_not_read_as_a_period_doubling(seed):
+    """Constructed oracle (seeded): a period-d orbit (d in 3..12) approached along a flip mode of ``P^d``
+    (multiplier -rho, rho in [0.9, 0.99]) whose deviation in the window decays from ``amp`` to below 1e-6 of the
+    forces by the window's middle.  The whole window then repeats after 2d to ``|1 - rho²| amp`` (below 1e-6) and
+    after d only to ~2 amp (above it): :func:`peelapprox.periodicity` reads period 2d, the observables the orbit's
+    own period d (the amplitude is chosen from rho so that both hold, checked here first).  The same orbit with a
+    fixed period-2d modulation of 1e-4 of the forces (100 times the tolerance) stays period 2d.  The means are
+    those over whole cycles of 2d either way: 1e-12 relative (summation order) against numpy's on the same
+    values."""
+    rng = np.random.default_rng(seed)
+    d, rho = int(rng.integers(3, 13)), float(rng.uniform(0.9, 0.99))
+    cycles = int(np.ceil(2 * np.log(1e-8) / np.log(rho)))  # the deviation falls by 1e-8 over the window
+    amp = 0.9e-6 * 250.0 / (1.0 - rho * rho)  # the 2d-repeat below 0.9e-6 relative (the forces are >= 250 N)
+    t, F, fb = _flip_sequence(rng, d, cycles + cycles % 2, amp=amp, rho=rho)
+    x = F[::2]
+    raw = peelapprox.periodicity(x, rtol=1e-6, max_period=32)
+    lhs = np.max(np.abs(x[d:] - x[:-d])) / np.max(x)
+    assert raw.period == 2 * d and lhs > 1e-6, (raw, lhs)  # the case is the defect's: read as its double
+    o = StickSlipObservables.from_trajectory(_fake(t, F, fb, t_end=float(t[-1]) + 1e-3))
+    assert (o.period, o.period_label) == (d, f"period-{d}")
+    whole = np.diff(t[::2])
+    whole = whole[whole.size % (2 * d):]
+    assert o.slip_interval == pytest.approx(np.mean(whole), rel=1e-12)
+    assert f"means over the last {whole.size // d} whole cycles" in o.reason
+    t, F, fb = _flip_sequence(np.random.default_rng(seed), d, cycles + cycles % 2, amp=amp, rho=rho,
+                              modulation=1e-4 * 320.0)
+    o = StickSlipObservables.from_trajectory(_fake(t, F, fb, t_end=float(t[-1]) + 1e-3))
+    assert o.period == 2 * d
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_transient_turning_by_a_root_of_unity_is_not_read_as_its_period(seed):
+    """Constructed oracle (seeded): a period-1 orbit (F = F0 in 250-320 N) approached along a complex pair turning by
+    2π/p per return (p in 3..7, |μ| = rho in [0.97, 0.995]; the exact run at V = 1.677, I = 8.4e-5 from α0 = 0.15: p =
+    5, |μ| = 0.994).  The amplitude is set so that the whole window repeats after p to below 1e-6 of F (the deviation
+    times ``1 - rho^p``) but not after 1, and the deviation falls by 1e-8 over the window: periodicity reads period p,
+    the observables period 1."""
+    rng = np.random.default_rng(100 + seed)
+    per, rho, F0 = int(rng.integers(3, 8)), float(rng.uniform(0.97, 0.995)), float(rng.uniform(250.0, 320.0))
+    m = int(np.ceil(2 * np.log(1e-8) / np.log(rho)))
+    k = np.arange(m)
+    x = F0 + 0.9e-6 * F0 / (1.0 - rho ** per) * rho ** k * np.cos(2 * np.pi * k / per + rng.uniform(0, 2 * np.pi))
+    t = np.cumsum(np.tile([0.004, 0.001], m))
+    F = np.column_stack([x, x - 10.0]).ravel()
+    raw = peelapprox.periodicity(x, rtol=1e-6, max_period=32)
+    assert raw.period == per, raw  # the case is the defect's
+    o = StickSlipObservables.from_trajectory(_fake(t, F, np.tile([AB, CD], m), t_end=float(t[-1]) + 1e-3))
+    assert (o.period, o.period_label) == (1, "period-1")
+
+
+@pytest.mark.slow
+def test_exact_flip_transients_read_as_the_newton_orbits_period():
+    """Independent oracle, :func:`exact.periodic_orbit` (Newton on the section, its minimal period and
+    multipliers): at two points of the atlas's grid where the exact window [30, 50] s repeats after 2n to 1e-6 but
+    after n only to 4.5e-6-5.5e-6 (V = 3.646 m/s, I = 4.92e-4; V = 0.446 m/s, I = 0.0229) the orbit is period n (9,
+    7) and stable with a multiplier near -1 (-0.988, -0.860): the window's label is n.  At V = 3.031 m/s, I = 4.92e-4
+    the period-9 orbit is unstable (-1.015) and the period-18 orbit it doubled into stable, modulating the returns
+    by 1.2 % of the forces: the label stays 18.  Cover in the default tier:
+    ``test_a_decaying_flip_transient_is_not_read_as_a_period_doubling``."""
+    for V, I, want in ((3.646153846153846, 0.0004923882631706737, 9), (0.4461538461538461, 0.022854638641349883, 7),
+                       (3.0307692307692307, 0.0004923882631706737, 18)):
+        p = PeelParams(V=V, I=I)
+        o = exact.attractor_observables(p)
+        orbit = exact.periodic_orbit(p, n=want)
+        assert orbit.n == want and orbit.stable, (V, I, orbit.n, orbit.multipliers)
+        assert o.period == want, (V, I, o.period_label)
