@@ -292,7 +292,8 @@ def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], 
             out.append(f)
             continue
         sd, stable, n = replicate_spread(apply(problem.params0, problem.names, x, f.V), f.series, d.threshold,
-                                         d.noise, problem.t_transient, problem.rtol, left - (time.perf_counter() - t0))
+                                         d.noise, problem.t_transient, problem.rtol, left - (time.perf_counter() - t0),
+                                         target=d.target(problem.sel))
         if sd is None:
             out.append(f)
             continue
