@@ -412,6 +412,7 @@ def test_the_neighbours_set_an_aperiodic_sigma(monkeypatch):
                  Point(x + 0.1, 7 * (0.6 / 0.4) ** 2, [np.full(7, 1.6)], [SetReading(np.ones(7), "solver", None, 1)])]
 
     def fake(problem, fits, xn, left):
+        assert problem.attractors == search.CHECK_STARTS  # each neighbour: the closest of the set's first starts
         m = np.full(7, 1.0 + (0.3 if xn[0] > x[0] else -0.3))
         return (m - 1.0) / fits[0].data.sigma, [m], [SetReading(m, "solver", None, 1)]
 
@@ -470,3 +471,51 @@ def test_a_quasi_periodic_replicate_spread_keeps_the_datas_torus():
     low = model_statistics(p.replace(I=0.75 * p.I), s, d.threshold, d.noise, 30.0, 1e-8, 120.0)
     assert at is not None and low is not None
     assert low[j] / at[j] == pytest.approx(0.75 ** -0.5, rel=0.01)
+
+
+def test_a_chaotic_neighbour_is_read_from_the_datas_attractor():
+    """Hypothesis (``replicate_check`` reads each neighbour from the closest of ``CHECK_STARTS`` starts): at the
+    chaotic truth V = 0.6854 m/s, I = 2.459e-5, k = 1317 (``infer_targets`` seed 3, trace 0, 10 s), the neighbour
+    at I +0.3 % from the solver's start alone falls into a periodic window (measured period 6, χ² 149 on 6: over
+    50), while among the first 4 starts one reaches the chaotic attractor, aperiodic, every residual within the
+    3 σ at which ``set_statistics`` stops (measured χ² 2.1)."""
+    from exact.dynamics._infer_search import CHECK_STARTS
+    from exact.dynamics._infer_stats import data_statistics, set_statistics
+
+    p = PeelParams(V=0.6854, I=2.459e-05, k=1317.0)
+    s = exact.simulate(p, 40.0, t_eval=30.0 + np.arange(100000) / 1e4).as_series(1e4, noise=0.5, drift=5.0,
+                                                                                  seed=3000)
+    d = data_statistics(s)
+    assert s.observables().period is None
+    tgt = d.target(np.arange(7))
+    q = p.replace(I=p.I * np.exp(3e-3))
+    one = set_statistics(q, s, d.threshold, d.noise, 30.0, 1e-8, 120.0, tgt, 1)
+    assert one.values is not None and one.period is not None
+    z1 = ((one.values - d.values) / d.sigma)[d.used]
+    assert z1 @ z1 > 50.0
+    wide = set_statistics(q, s, d.threshold, d.noise, 30.0, 1e-8, 120.0, tgt, CHECK_STARTS)
+    assert wide.values is not None and wide.period is None
+    assert np.all(np.abs((wide.values - d.values) / d.sigma)[d.used] <= 3.0)
+
+
+def test_an_aperiodic_interval_is_no_finer_than_the_search():
+    """An aperiodic fit's 95 % interval is at least ± the search's finest spacing (``Outcome.resolution``).
+    Closed form: best point χ² 1 at ln k = ln 1000, neighbours ±0.01 at χ² 20 (outside the threshold 4.84: the
+    profile alone is the point), resolution 0.07: the interval is [1000 e^-0.07, 1000 e^0.07] = [932.4, 1072.5]
+    (to 1e-9), still identified (a factor 1.15 < 2), and the verdict quotes the factor e^0.07 = 1.07 (3 digits); with no
+    resolution the interval is the point."""
+    from exact.dynamics._infer_result import Outcome, assemble
+    from exact.dynamics._infer_search import Point, Problem, SeriesFit
+    from exact.dynamics._infer_stats import SeriesData
+
+    x = np.log(1000.0)
+    evaluated = [Point(np.array([x + d]), c, [np.ones(7)], []) for d, c in ((0.0, 1.0), (0.01, 20.0), (-0.01, 20.0))]
+    fits = [SeriesFit(None, 1.0, SeriesData(np.ones(7), np.full(7, 0.1), 1.0, 0.5, np.ones(7, dtype=bool)), True)]
+    box = (np.array([x - 1.0]), np.array([x + 1.0]))
+    problem = Problem(PeelParams(V=1.0, I=1e-2), ("k",), np.arange(7), 30.0, 1e-8, 1)
+    outcome = Outcome(evaluated, None, box, 6, "converged", "", 1.0, poor_fit=0.05)
+    bare = assemble(problem, fits, outcome)
+    assert bare.intervals["k"] == pytest.approx((1000.0, 1000.0), rel=1e-12)
+    res = assemble(problem, fits, dataclasses.replace(outcome, resolution=np.array([0.07])))
+    assert res.intervals["k"] == pytest.approx((1000.0 * np.exp(-0.07), 1000.0 * np.exp(0.07)), rel=1e-9)
+    assert res.identified["k"] and "factor 1.07 " in res.verdicts["k"]

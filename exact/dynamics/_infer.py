@@ -345,6 +345,7 @@ class _Search:
         """Grid, fit, and the box extended while the 95 % interval reaches its edge (module docstring)."""
         names = self.problem.names
         axes, box_lo, box_hi = grid(names, x0, limits[0], limits[1], search, len(self.fits))
+        first = axes
         status, message, jac, n_extended = "converged", "", None, 0
         aperiodic = [f.aperiodic for f in self.fits]
         try:
@@ -374,5 +375,11 @@ class _Search:
             status, message = "budget", f"max_wall = {fmt_number(self.max_wall, 3)} s spent; the best point so far"
         if n_extended:
             message += f" (the search box extended {n_extended} time(s): the best points reached its edge)"
+        resolution = None
+        if any(aperiodic):  # the search's finest spacing: refine's quarter of the first grid's (Outcome.resolution)
+            resolution = 0.25 * np.array([float(a[1] - a[0]) if a.size > 1 else 0.0 for a in first])
+            notes += ("an aperiodic fit: each 95 % interval at least the search's finest spacing (a quarter of the "
+                      "grid's), below which an aperiodic trace's chi2 is a comb of windows",)
         return Outcome(self.evaluated, jac, (box_lo, box_hi), n_obs, status, message,
-                       time.perf_counter() - self.t_wall, notes, GOOD_FIT if any(aperiodic) else POOR_FIT)
+                       time.perf_counter() - self.t_wall, notes, GOOD_FIT if any(aperiodic) else POOR_FIT,
+                       resolution=resolution)
