@@ -21,10 +21,12 @@ from peelapprox import ForceSeries, PeelParams
 from peelapprox.io import fmt_number
 
 from ._infer_stats import (
+    NOISE_REPLICATES,
     REPEATABILITY,
     STATISTICS,
     SeriesData,
     SetReading,
+    noise_spread,
     replicate_mean,
     replicate_spread,
     set_statistics,
@@ -278,9 +280,11 @@ def n_fitted(problem: Problem, fits: Sequence[SeriesFit]) -> int:
 
 def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], left: float
                ) -> tuple[list[SeriesFit], int, tuple[str, ...]]:
-    """For each aperiodic series, the model's replicate spread at the best grid point (:func:`replicate_spread`)
-    added in quadrature to the statistics' σ (a diagonal synthetic likelihood, Wood 2010; divided by √m where the
-    model's statistics are a mean over m = ``problem.replicates`` replicates), and the cycle line
+    """For each aperiodic series, the model's replicate spread at the best grid point (:func:`replicate_spread`,
+    the replicates on the data's attractor) added in quadrature to the statistics' σ (a diagonal synthetic
+    likelihood, Wood 2010; divided by √m where the model's statistics are a mean over m = ``problem.replicates``
+    replicates), and √2 times the detector's spread under noise there (:func:`noise_spread`, from the start of
+    the replicate closest to the data: the data and the model each carry one noise draw), and the cycle line
     dropped where it is not stable across the replicates; the χ² of every point evaluated so far (``evaluated``,
     updated in place) recomputed with the new σ.  Returns the series, the number of fitted statistics and the
     notes."""
@@ -291,16 +295,25 @@ def replicated(problem: Problem, evaluated: list[Point], fits: list[SeriesFit], 
         if not f.aperiodic or left - (time.perf_counter() - t0) <= 1.0:
             out.append(f)
             continue
-        sd, stable, n = replicate_spread(apply(problem.params0, problem.names, x, f.V), f.series, d.threshold,
-                                         d.noise, problem.t_transient, problem.rtol, left - (time.perf_counter() - t0),
-                                         target=d.target(problem.sel))
-        if sd is None:
+        p = apply(problem.params0, problem.names, x, f.V)
+        sd, stable, n, start = replicate_spread(p, f.series, d.threshold, d.noise, problem.t_transient, problem.rtol,
+                                                left - (time.perf_counter() - t0), target=d.target(problem.sel))
+        nsd = None if start is None or left - (time.perf_counter() - t0) <= 1.0 else noise_spread(
+            p, f.series, d.threshold, d.noise, problem.t_transient, problem.rtol, left - (time.perf_counter() - t0),
+            start)
+        if sd is None and nsd is None:
             out.append(f)
             continue
-        sig, used = np.hypot(d.sigma, sd / math.sqrt(problem.replicates)), d.used.copy()
-        notes.append(f"V = {fmt_number(f.V, 4)} m/s: an aperiodic trace; the model's spread over {n} replicates "
-                     "added to each statistic's sigma")
-        if used[_F_CYCLE] and not stable:
+        sig, used = d.sigma.copy(), d.used.copy()
+        if nsd is not None:  # the data's noise draw and the model's: twice the variance
+            sig = np.hypot(sig, math.sqrt(2.0) * nsd)
+            notes.append(f"V = {fmt_number(f.V, 4)} m/s: an aperiodic trace; the detector's spread over "
+                         f"{NOISE_REPLICATES} noise draws (times sqrt 2) added to each statistic's sigma")
+        if sd is not None:
+            sig = np.hypot(sig, sd / math.sqrt(problem.replicates))
+            notes.append(f"V = {fmt_number(f.V, 4)} m/s: an aperiodic trace; the model's spread over {n} replicates "
+                         "on its attractor added to each statistic's sigma")
+        if used[_F_CYCLE] and sd is not None and not stable:
             used[_F_CYCLE] = False
             notes.append(f"f_cycle is not fitted at V = {fmt_number(f.V, 4)} m/s: the model's cycle line is not "
                          f"stable across its replicates (absent in one, or spread over "
