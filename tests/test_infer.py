@@ -557,3 +557,29 @@ def test_the_detectors_spread_under_noise():
     assert nsd[0] / d.values[0] < 0.015
     quiet = noise_spread(p, s, d.threshold, 0.0, 30.0, 1e-8, 120.0, {})
     assert quiet is not None and np.all(quiet == 0.0)
+
+
+def test_an_aperiodic_sigma_joins_both_spreads(monkeypatch):
+    """``replicated`` for an aperiodic series, closed form with the model runs replaced: data σ 0.4 for every
+    statistic, the replicate spread 0.3 (over 3 replicates, ``replicates`` 1) and the noise spread 0.1 give
+    σ = hypot(0.4, 0.3, √2 · 0.1) = 0.5196 for each statistic but the cycle line, whose 0.4 is first replaced by
+    half a periodogram bin, 0.5 / (10 s) = 0.05: hypot(0.05, 0.3, √2 · 0.1) = 0.3358; a periodic series is left as
+    it was."""
+    import exact.dynamics._infer_search as search
+    from exact.dynamics._infer_search import Point, Problem, SeriesFit, replicated
+    from exact.dynamics._infer_stats import STATISTICS, SeriesData, Spread
+
+    t = np.arange(100001) / 1e4  # 10 s
+    s = ForceSeries(t, np.sin(t), V=1.0)
+    data = SeriesData(np.ones(7), np.full(7, 0.4), 1.0, 0.5, np.ones(7, dtype=bool))
+    fits = [SeriesFit(s, 1.0, data, True), SeriesFit(s, 1.0, data, False)]
+    problem = Problem(PeelParams(V=1.0, I=1e-2), ("k",), np.arange(7), 30.0, 1e-8, 1)
+    evaluated = [Point(np.array([np.log(1000.0)]), 0.0, [np.ones(7), np.ones(7)], [])]
+    monkeypatch.setattr(search, "replicate_spread", lambda *a, **k: Spread(np.full(7, 0.3), True, 3, {}))
+    monkeypatch.setattr(search, "noise_spread", lambda *a, **k: np.full(7, 0.1))
+    out, n_obs, notes = replicated(problem, evaluated, fits, 100.0)
+    j = STATISTICS.index("f_cycle")
+    want = np.full(7, np.sqrt(0.4 ** 2 + 0.3 ** 2 + 2 * 0.1 ** 2))
+    want[j] = np.sqrt(0.05 ** 2 + 0.3 ** 2 + 2 * 0.1 ** 2)
+    assert np.allclose(out[0].data.sigma, want, rtol=1e-12) and out[1] is fits[1] and n_obs == 14
+    assert len(notes) == 2
