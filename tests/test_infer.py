@@ -527,8 +527,9 @@ def test_an_aperiodic_interval_is_no_finer_than_the_search():
 def test_I_and_k_of_a_quasi_periodic_trace():
     """Hypothesis (issue 35's goal on a quasi-periodic trace): ``infer_targets``' seed 2 trace 3 (V = 3.149 m/s,
     I = 0.05665, k = 1173, quasi-periodic; 10 s, the benchmark's noise, drift and seed), from its start I0 = 0.04875,
-    k0 = 1020: I and k recovered within 10 % and both identified (measured I -1.4 %, k -0.1 %, χ² 0.059 on 5,
-    275 s on 2 loaded cores; before the replicate spread kept to the data's torus: I -25 %, not identified)."""
+    k0 = 1020: I and k recovered within 10 % and both identified (measured with ``run_trace`` at the last commit
+    I -1.3 %, k -0.2 %, χ² 0.078 on 5, 379 s on 2 loaded cores; before the replicate spread kept to the data's
+    torus: I -25 %, not identified)."""
     p = PeelParams(V=3.149, I=0.05665, k=1173.0)
     tr = exact.simulate(p, 40.0, t_eval=(30.0 + np.arange(100000) / 1e4).tolist())
     s = tr.as_series(1e4, noise=0.5, drift=5.0, seed=2003)
