@@ -14,7 +14,8 @@ several (one series per V).
   among those reached from the first ``attractors`` starts of :func:`exact.attractor_set`'s design
   (:func:`set_statistics`); at the best point the whole design runs once to name that attractor and its share
   (:attr:`Inference.attractors`).  For an aperiodic series the model's spread over replicates at the best grid
-  point joins each σ and the cycle line is kept only where it is stable across them (:func:`replicate_spread`);
+  point (those on the data's attractor) joins each σ and the cycle line is kept only where it is stable across
+  them (:func:`replicate_spread`);
   with ``replicates`` > 1 the model's statistics at every trial point are the mean over that many replicates
   (:func:`replicate_mean`: a synthetic likelihood's mean, Wood 2010) and the spread's share of σ shrinks by
   √replicates.
@@ -29,17 +30,18 @@ several (one series per V).
   repeated, at most :data:`MAX_EXTEND` times: a verdict "the edge of the search" then means the data, not the
   box.
 * **Intervals.**  95 %, the union of two: the profile of every evaluated point (the parameter's range among the
-  points with χ² ≤ χ²_min + 3.84 · s, s = max(1, χ²_min/dof)) and the Jacobian's at the optimum (±1.96
-  standard errors of ``s (JᵀJ)⁻¹``).  A parameter is *not identified* when that interval spans more than a
-  factor 2 (log-fitted) or its value (coefficients), or reaches the edge of the search: the data do not
-  determine it, and the report says so instead of quoting a number.  None is identified when the best fit is
-  poor (χ² improbable at :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes
-  the data nowhere in the search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each
-  parameter) are read too: each trial point's statistics are one window's, a draw, and the best of many draws
-  is biased low.  Each statistic's σ is joined by its spread over the best point and its neighbours (every χ²
-  recomputed with it); where the neighbours' χ² (summed) is still improbable at :data:`GOOD_FIT` nothing is
-  identified, and their χ² spread widens the profile's threshold (``replicate_check`` in
-  ``exact/dynamics/_infer_search.py``).
+  points with χ² ≤ χ²_min + 3.84 · s, s = max(1, χ²_min/dof)) and the Jacobian's at the optimum (±1.96 standard
+  errors of ``s (JᵀJ)⁻¹``); for an aperiodic series at least ± a quarter of the first grid's node spacing, the
+  search's finest (below it such a χ² is a comb of windows).  A parameter is *not identified* when that interval
+  spans more than a factor 2 (log-fitted) or its value (coefficients), or reaches the edge of the search: the data
+  do not determine it, and the report says so instead of quoting a number.  None is identified when the best fit is
+  poor (χ² improbable at :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes the
+  data nowhere in the search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each
+  parameter; each from the attractor closest to the data among the set's first ``CHECK_STARTS`` starts) are read
+  too: each trial point's statistics are one window's, a draw, and the best of many draws is biased low.  Each
+  statistic's σ is joined by its spread over the best point and its neighbours (every χ² recomputed with it); where
+  the neighbours' χ² (summed) is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread
+  widens the profile's threshold (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
 """
 
 from __future__ import annotations
@@ -345,6 +347,7 @@ class _Search:
         """Grid, fit, and the box extended while the 95 % interval reaches its edge (module docstring)."""
         names = self.problem.names
         axes, box_lo, box_hi = grid(names, x0, limits[0], limits[1], search, len(self.fits))
+        first = axes
         status, message, jac, n_extended = "converged", "", None, 0
         aperiodic = [f.aperiodic for f in self.fits]
         try:
@@ -374,5 +377,11 @@ class _Search:
             status, message = "budget", f"max_wall = {fmt_number(self.max_wall, 3)} s spent; the best point so far"
         if n_extended:
             message += f" (the search box extended {n_extended} time(s): the best points reached its edge)"
+        resolution = None
+        if any(aperiodic):  # the search's finest spacing: refine's quarter of the first grid's (Outcome.resolution)
+            resolution = 0.25 * np.array([float(a[1] - a[0]) if a.size > 1 else 0.0 for a in first])
+            notes += ("an aperiodic fit: each 95 % interval at least the search's finest spacing (a quarter of the "
+                      "grid's), below which an aperiodic trace's chi2 is a comb of windows",)
         return Outcome(self.evaluated, jac, (box_lo, box_hi), n_obs, status, message,
-                       time.perf_counter() - self.t_wall, notes, GOOD_FIT if any(aperiodic) else POOR_FIT)
+                       time.perf_counter() - self.t_wall, notes, GOOD_FIT if any(aperiodic) else POOR_FIT,
+                       resolution=resolution)
