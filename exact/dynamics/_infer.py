@@ -68,6 +68,7 @@ from ._infer_search import (
     LOG,
     Point,
     Problem,
+    ReplicateCheck,
     SeriesFit,
     attractor_lines,
     edge_sides,
@@ -147,19 +148,15 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         Seconds of each model run before its sampled window, in (0, 1e4] (30).
     rtol : float
         Of every model run (1e-8, :func:`exact.simulate`'s default): at 12 seeded points of
-        ``comparisons.benchmark.infer_targets`` (seeds 2, 3, 4) the statistics at 1e-8 lie within 0.01 σ of those
-        at 1e-10 wherever the trace is periodic or quasi-periodic, at 28 % less simulation CPU; at a chaotic
-        point a change of rtol, like one of the parameters, puts the window on another stretch of the attractor
-        (1-2.3 σ there: the replicate spread that joins σ for an aperiodic series).
+        ``comparisons.benchmark.infer_targets`` the statistics lie within 0.01 σ of those at 1e-10 (28 % less
+        CPU) except where chaotic, where a change of rtol moves the window along the attractor (1-2.3 σ).
     max_wall : float
         Wall-clock budget [s] (600): at its end the best point so far is returned with status ``"budget"``.
     attractors : int
         At each trial point, the statistics are those of the attractor closest to the data among those reached
         from the first ``attractors`` starts of :func:`exact.attractor_set`'s design (the solver's start first;
         the further starts run only while none fits within 3 σ), in [1, 8]; 1 (the default): the solver's start
-        alone; 3 is the opt-in for multistable traces (docs/your-data.md; measured not yet to rescue the needle
-        basin at V = 1, I = 1e-5, and on ``comparisons.benchmark.infer_targets``' 6 traces under a 600 s budget
-        it hit none where 1 hit 3: its extra starts spend the budget).
+        alone; 3: the opt-in for multistable traces (docs/your-data.md: it measured no better under a budget).
         At the best point every start of the design runs once, to name the attractor and its share.
     replicates : int
         For an aperiodic (chaotic or quasi-periodic) series, the model's statistics at each trial point are the
@@ -194,15 +191,7 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     run = _Search(problem, fits, t_wall, positive("max_wall", max_wall), say, executor,
                   optional(integer, "max_workers", max_workers, 0))
     outcome = run.run(x0, limits, float(search), n_obs, notes)
-    check = replicate_check(problem, run.evaluated, run.fits, run.left())
-    if check is not None:
-        run.fits = check.fits
-        note = (f"an aperiodic fit: each statistic's sigma joined by its spread over the best point and its "
-                f"{2 * len(problem.names)} neighbours; chi2 at those neighbours {fmt_number(100 * JITTER, 2)} % away "
-                f"= {fmt_number(check.chi2, 4)} on {check.n_stat} statistics, from neighbour to neighbour "
-                f"± {fmt_number(check.chi2_sd, 3)} (the profile's threshold widened by twice that)")
-        outcome = dataclasses.replace(outcome, replicate=(check.chi2, check.n_stat), chi2_noise=check.chi2_sd,
-                                      notes=outcome.notes + (note,))
+    check, outcome = _replicated(problem, run, outcome)
     full = shares(problem, run.evaluated, run.fits, run.left())
     res = assemble(problem, run.fits, dataclasses.replace(outcome, wall=time.perf_counter() - t_wall))
     n_runs = (sum(r.n_runs for e in run.evaluated for r in e.readings) + sum(r.n_runs for r in full if r is not None)
@@ -210,6 +199,21 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     lines = attractor_lines(run.evaluated, full, [f.V for f in run.fits])
     return dataclasses.replace(res, n_evaluations=n_runs, attractors=lines,
                                verdicts={k: f"{v}; {'; '.join(lines)}" for k, v in res.verdicts.items()})
+
+
+def _replicated(problem: Problem, run: _Search, outcome: Outcome) -> tuple[ReplicateCheck | None, Outcome]:
+    """The neighbours' check of an aperiodic fit (:func:`replicate_check`): the fits' σ joined by the spread (set
+    on ``run``) and the outcome with its χ², its noise and a note; ``(None, outcome)`` for a periodic fit."""
+    check = replicate_check(problem, run.evaluated, run.fits, run.left())
+    if check is None:
+        return None, outcome
+    run.fits = check.fits
+    note = (f"an aperiodic fit: each statistic's sigma joined by its spread over the best point and its "
+            f"{2 * len(problem.names)} neighbours; chi2 at those neighbours {fmt_number(100 * JITTER, 2)} % away "
+            f"= {fmt_number(check.chi2, 4)} on {check.n_stat} statistics, from neighbour to neighbour "
+            f"± {fmt_number(check.chi2_sd, 3)} (the profile's threshold widened by twice that)")
+    return check, dataclasses.replace(outcome, replicate=(check.chi2, check.n_stat), chi2_noise=check.chi2_sd,
+                                      notes=outcome.notes + (note,))
 
 
 def _progress(progress: Callable[[str], None] | bool | None) -> Callable[[str], None] | None:
