@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from _parse import parse
 
 API = {
     "peelapprox": {
@@ -160,7 +161,7 @@ def _public_modules() -> list[tuple[str, Path]]:
 
 
 def _defines_all(path: Path) -> bool:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = parse(path.read_text(encoding="utf-8"))
     for node in tree.body:
         targets = (node.targets if isinstance(node, ast.Assign)
                    else [node.target] if isinstance(node, ast.AnnAssign) else [])

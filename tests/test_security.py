@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _parse import parse
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -747,7 +748,7 @@ def test_the_package_evaluates_no_text():
     for pkg in ("peelapprox", "exact", "comparisons"):
         for path in sorted((ROOT / pkg).rglob("*.py")):
             rel = path.relative_to(ROOT).as_posix()
-            for node in ast.walk(ast.parse(path.read_text())):
+            for node in ast.walk(parse(path.read_text())):
                 if not isinstance(node, ast.Call):
                     continue
                 name = _dotted(node.func)
