@@ -161,15 +161,12 @@ def _periodicity(x: np.ndarray, rtol: float, max_period: int, min_repeats: int =
     """:func:`periodicity` of arguments it has checked: ``x`` a 1-D finite float array of at least 2 returns,
     ``rtol`` a finite positive float, ``max_period`` and ``min_repeats`` positive ints (the observables of a reduced
     map read a period for every orbit it finds, and these checks cost more than the search)."""
-    scale = float(np.max(np.abs(x)))
-    # differences of x / max|x| (in [-1, 1]): no overflow for |x| near the float maximum, and all-zero
-    # returns (scale 0) are the constant sequence, mismatch 0
-    xs = x / scale if scale > 0 else x
+    xs = _scaled(x)
     best = math.inf
     for n in range(1, int(max_period) + 1):
         if x.size - n < int(min_repeats) * n:
             break
-        mis = float(np.max(np.abs(xs[n:] - xs[:-n])))
+        mis = _mismatch(xs, n)
         if mis <= rtol:
             return Periodicity("periodic", n, mis, x.size, rtol)
         best = min(best, mis)
@@ -195,13 +192,23 @@ def settled_period(x: np.ndarray, n: int, rtol: float, min_repeats: int = 2) -> 
     decay: where that modulation is above ``rtol`` its repeat after d fails over the last half as over the whole,
     and n stays.  The means of :func:`peelapprox._observables.jump_statistics` are still taken over whole cycles of
     n (whole cycles of d too)."""
-    h = x[x.size // 2:]
-    scale = float(np.max(np.abs(x)))
-    hs = h / scale if scale > 0 else h
+    hs = _scaled(x)[x.size // 2:]
     for d in range(1, n):
-        if n % d == 0 and hs.size - d >= min_repeats * d and float(np.max(np.abs(hs[d:] - hs[:-d]))) <= rtol:
+        if n % d == 0 and hs.size - d >= min_repeats * d and _mismatch(hs, d) <= rtol:
             return d
     return n
+
+
+def _scaled(x: np.ndarray) -> np.ndarray:
+    """``x / max|x|`` (in [-1, 1]): no overflow for |x| near the float maximum; all-zero returns (scale 0) are the
+    constant sequence, mismatch 0."""
+    scale = float(np.max(np.abs(x)))
+    return x / scale if scale > 0 else x
+
+
+def _mismatch(xs: np.ndarray, n: int) -> float:
+    """How far scaled returns ``xs`` are from repeating after ``n``: ``max |xs[k + n] - xs[k]|``."""
+    return float(np.max(np.abs(xs[n:] - xs[:-n])))
 
 
 def force_drops(trajectory: HasJumps) -> np.ndarray:

@@ -42,8 +42,8 @@ def test_k_alone_is_recovered():
 
 @pytest.mark.slow
 def test_a_start_a_third_of_the_truth_extends_the_box():
-    """Hypothesis (issue 35, item 4): with I a factor 3 below the truth (V = 1, I = 1e-2, k known, 5 s of the
-    period-8 trace) the truth lies on the initial box's edge (params0 · search); the search extends the box
+    """Hypothesis (inference over attractor sets): with I a factor 3 below the truth (V = 1, I = 1e-2, k known, 5 s
+    of the period-8 trace) the truth lies on the initial box's edge (params0 · search); the search extends the box
     instead of calling I "not identified: ... the edge of the search", and recovers I within 10 % (the issue's
     goal), identified, its 95 % interval inside the extended box and covering the truth (about 30 exact runs,
     1-2 min)."""
@@ -92,10 +92,10 @@ def test_the_refined_grid_covers_the_best_cells():
 
 
 def test_the_closest_attractor_of_the_set_is_read():
-    """Hypothesis (issue 35, item 4): at V = 1, I = 1e-5 the solver's start and the rest start reach the period-3
-    orbit, alpha0 = -0.3 the period-1 (exact.attractor_set). Given a trace of the period-1 attractor, the set's
-    reading over the first three starts picks alpha0 = -0.3, labels it period-1, and its statistics equal the data's
-    within 3 sigma (the same orbit; the data carry another noise draw and a drift); from the solver's start
+    """Hypothesis (inference over attractor sets): at V = 1, I = 1e-5 the solver's start and the rest start reach
+    the period-3 orbit, alpha0 = -0.3 the period-1 (exact.attractor_set). Given a trace of the period-1 attractor, the
+    set's reading over the first three starts picks alpha0 = -0.3, labels it period-1, and its statistics equal the
+    data's within 3 sigma (the same orbit; the data carry another noise draw and a drift); from the solver's start
     alone the reading is period-3, off by more than 3 sigma (slip interval 0.080 vs 0.071 s: 6 sigma)."""
     from exact.dynamics._infer_stats import data_statistics, set_statistics
 
@@ -113,8 +113,8 @@ def test_the_closest_attractor_of_the_set_is_read():
 
 
 def test_the_replicate_spread_of_a_chaotic_trace():
-    """Hypothesis (issue 35, item 4, synthetic likelihood): at the chaotic point V = 2.5, I = 1e-4 (5 s windows)
-    the model's spread over replicates (three starts of the attractor set's design, each another phase of the
+    """Hypothesis (inference over attractor sets, synthetic likelihood): at the chaotic point V = 2.5, I = 1e-4 (5 s
+    windows) the model's spread over replicates (three starts of the attractor set's design, each another phase of the
     attractor) of the window means of the slip interval, drop, stick and slip times matches the standard error
     of the mean the data's own slips give (spread / sqrt(n - 1)) within a factor 4: the sd of three replicates
     lies within [0.16, 1.92] of its true value at 95 % (chi-squared, 2 dof) and the slips' correlation makes the
@@ -525,7 +525,8 @@ def test_an_aperiodic_interval_is_no_finer_than_the_search():
 
 @pytest.mark.slow
 def test_I_and_k_of_a_quasi_periodic_trace():
-    """Hypothesis (issue 35's goal on a quasi-periodic trace): ``infer_targets``' seed 2 trace 3 (V = 3.149 m/s,
+    """Hypothesis (the inference goal on a quasi-periodic trace: I and k within 10 %, identified):
+    ``infer_targets``' seed 2 trace 3 (V = 3.149 m/s,
     I = 0.05665, k = 1173, quasi-periodic; 10 s, the benchmark's noise, drift and seed), from its start I0 = 0.04875,
     k0 = 1020: I and k recovered within 10 % and both identified (measured with ``run_trace`` at the last commit
     I -1.3 %, k -0.2 %, χ² 0.078 on 5, 379 s on 2 loaded cores; before the replicate spread kept to the data's

@@ -1,4 +1,4 @@
-"""Issue 35's public surface under hostile input: :func:`peelapprox.approximate_attractor` and
+"""The attractor sets' public surface under hostile input: :func:`peelapprox.approximate_attractor` and
 :func:`exact.attractor_set` on seeded random points of the plane and on laws and starts at the edge of the model.
 
 Found by a fuzz of a few hundred random calls (V 0.05-6 m/s, I 1e-7-0.2 kg m^2, k 200-5000 N/m, R, the law

@@ -44,7 +44,7 @@ import numpy as np
 from peelapprox import PeelParams, approximate_attractor
 from peelapprox.io import fmt_number
 
-from .approx_targets import ALPHA0S, DATA, _exact, _match, score
+from .approx_targets import ALPHA0S, DATA, _exact, _match, score, within
 
 __all__ = ["REGIME_CLAUSE", "grid", "main", "other_rules_high", "reference", "regime_table"]
 
@@ -66,11 +66,12 @@ def _needs_set(p: PeelParams, start0: dict[str, Any]) -> bool:
         return not _match(approximate_attractor(p), start0)
 
 
-def _point(V: float, I: float, starts: list[dict[str, Any]]) -> dict[str, Any]:
-    """One grid point: its α0 = 0 start (run unless given), and the other starts where they are needed."""
+def _point(V: float, I: float, starts: list[dict[str, Any]], more: bool | None = None) -> dict[str, Any]:
+    """One grid point: its α0 = 0 start (run unless given), and the other starts where they are needed (``more``:
+    already decided by the caller; None: decided here)."""
     p = PeelParams(V=V, I=I)
     starts = list(starts) or [_exact(p, ALPHA0S[0])]
-    if len(starts) < len(ALPHA0S) and _needs_set(p, starts[0]):
+    if len(starts) < len(ALPHA0S) and (_needs_set(p, starts[0]) if more is None else more):
         starts += [_exact(p, a0) for a0 in ALPHA0S[len(starts):]]
     return {"V": V, "I": I, "starts": starts}
 
@@ -82,12 +83,12 @@ def reference(n: int, workers: int = 2, path: Path | None = None) -> list[dict[s
     path = path or DATA / f"approx_grid_n{n}.json"
     pts = grid(n)
     done: dict[str, dict[str, Any]] = json.loads(path.read_text())["points"] if path.exists() else {}
-    todo = [i for i in range(len(pts)) if str(i) not in done]
-    todo += [i for i in range(len(pts)) if str(i) in done and len(done[str(i)]["starts"]) < len(ALPHA0S)
+    todo: list[tuple[int, bool | None]] = [(i, None) for i in range(len(pts)) if str(i) not in done]
+    todo += [(i, True) for i in range(len(pts)) if str(i) in done and len(done[str(i)]["starts"]) < len(ALPHA0S)
              and _needs_set(PeelParams(V=pts[i][0], I=pts[i][1]), done[str(i)]["starts"][0])]
     t0, k = time.perf_counter(), 0
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futs = {pool.submit(_point, *pts[i], done.get(str(i), {}).get("starts", [])): i for i in todo}
+    with ProcessPoolExecutor(max_workers=workers) as pool:  # a held point's need is decided once, here
+        futs = {pool.submit(_point, *pts[i], done.get(str(i), {}).get("starts", []), more): i for i, more in todo}
         for fut in as_completed(futs):
             done[str(futs[fut])] = fut.result()
             k += 1
@@ -129,7 +130,7 @@ def regime_table(ref: list[dict[str, Any]], rows: list[dict[str, Any]], others_h
         if e["status"] != "stick-slip":
             continue
         ss = o.status == "stick-slip"
-        ok = {k: ss and abs(getattr(o, k) / e[k] - 1.0) < 0.1 for k in ("slip_interval", "force_drop")}
+        ok = {k: within(o, e, k) for k in ("slip_interval", "force_drop")}
         for name, obs, hit in (("approx:default", "slip_interval", ok["slip_interval"]),
                                ("approx:default", "force_drop", ok["force_drop"]),
                                ("approx:default", "slip_interval+force_drop", all(ok.values())),

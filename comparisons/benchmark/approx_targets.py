@@ -66,7 +66,7 @@ from peelapprox import ModelBreakdown, PeelParams, SolverBudgetExceeded, approxi
 from peelapprox.io import fmt_number
 
 __all__ = ["ALPHA0S", "CHAINS", "DATA", "escapes", "main", "matched_start", "multiplier_errors", "points", "reference",
-           "score"]
+           "score", "within"]
 
 #: The exact run's starts: α0 of :func:`exact.attractor_observables` (0 first: the strict reference).
 ALPHA0S = (0.0, 0.15, -0.15, 0.3, -0.3)
@@ -127,10 +127,16 @@ def reference(n: int, seed: int, path: Path | None = None) -> list[dict[str, Any
     return done
 
 
-def _match(pred: Any, e: dict[str, Any]) -> bool:
+def within(pred: Any, e: dict[str, Any], key: str) -> bool:
+    """Whether the prediction's ``key`` (an observable) lies within 10 % of the exact start's, both stick-slip: the
+    criterion of every measure here and of ``approx_grid``."""
     if e["status"] != "stick-slip" or pred is None or getattr(pred, "status", None) != "stick-slip":
         return False
-    return all(abs(getattr(pred, k) / e[k] - 1.0) < 0.1 for k in ("slip_interval", "force_drop"))
+    return abs(getattr(pred, key) / e[key] - 1.0) < 0.1
+
+
+def _match(pred: Any, e: dict[str, Any]) -> bool:
+    return all(within(pred, e, k) for k in ("slip_interval", "force_drop"))
 
 
 def _distance(pred: Any, e: dict[str, Any]) -> float:

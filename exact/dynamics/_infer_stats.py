@@ -269,7 +269,7 @@ def set_statistics(p: PeelParams, series: ForceSeries, threshold: float, noise: 
     readings: list[tuple[float, str, np.ndarray | None, int | None]] = []
     for st in chosen:
         m, period, _ = _reading(p, series, threshold, noise, t_transient, rtol, max_wall, st.kwargs())
-        cost = math.inf if m is None else float(np.sum((((m - vals) / sig)[used]) ** 2))
+        cost = math.inf if m is None else _chi2(m, (vals, sig, used))
         readings.append((cost, st.name, m, period))
         if not share and m is not None and np.all(np.abs(((m - vals) / sig)[used]) <= CLOSE):
             break
@@ -303,7 +303,7 @@ def replicate_spread(p: PeelParams, series: ForceSeries, threshold: float, noise
     if not reads:
         return Spread(None, False, 0, None)
     ref = reads[0] if target is None else min(
-        reads, key=lambda r: float(np.sum((((r[0] - target[0]) / target[1])[target[2]]) ** 2)))
+        reads, key=lambda r: _chi2(r[0], target))
     reads = [r for r in reads if same_attractor(r[0], ref[0])]
     if len(reads) < 2:
         return Spread(None, False, len(reads), ref[2])
@@ -321,6 +321,13 @@ class Spread(NamedTuple):
     stable: bool                    #: the cycle line in every replicate, its spread within its repeatability
     n: int                          #: the replicates kept (on the data's attractor)
     start: dict[str, Any] | None    #: the start of the replicate closest to the data (None: no aperiodic one)
+
+
+def _chi2(m: np.ndarray, target: tuple[np.ndarray, np.ndarray, np.ndarray]) -> float:
+    """χ² of model statistics ``m`` against ``target`` = the data's ``(values, σ, mask of the fitted ones)``: how
+    close a reading is to the data, by which the closest attractor or replicate is picked."""
+    values, sigma, used = target
+    return float(np.sum((((m - values) / sigma)[used]) ** 2))
 
 
 def same_attractor(a: np.ndarray, b: np.ndarray) -> bool:
@@ -350,10 +357,10 @@ def replicate_mean(p: PeelParams, series: ForceSeries, threshold: float, noise: 
         if m is not None and period is None:
             reads.append(m)
         else:
-            cost = math.inf if m is None else float(np.sum((((m - vals) / sig)[used]) ** 2))
+            cost = math.inf if m is None else _chi2(m, (vals, sig, used))
             periodic.append((cost, st.name, m, period))
     if reads:  # those on the attractor of the replicate closest to the data (same_attractor)
-        ref = min(reads, key=lambda m: float(np.sum((((m - vals) / sig)[used]) ** 2)))
+        ref = min(reads, key=lambda m: _chi2(m, (vals, sig, used)))
         reads = [m for m in reads if same_attractor(m, ref)]
         return SetReading(np.mean(np.array(reads), axis=0), f"mean of {len(reads)} aperiodic replicates", None,
                           max(1, n))
