@@ -15,6 +15,12 @@ before Newton): its period, leading |μ|, stability and F range at the slips bes
 window, rtol 1e-10, as :func:`exact.attractor_observables`), its jumps saved to JUMPS.npz (re-used when present), the
 old rule (:func:`peelapprox.periodicity` alone) checked against the cached label and slip interval, and the labels
 measure recounted with today's :func:`peelapprox.StickSlipObservables` period (~25 min of CPU on 2 loaded cores).
+
+``write``: the same windows (JUMPS.npz, made by ``relabel``) re-read with today's rule and the cache's ``period`` and
+``label`` rewritten where they changed, after checking that every other cached observable is today's to the last
+digit (it refuses otherwise): the cache then holds what :func:`exact.attractor_observables` returns today.
+
+    python docs/benchmark/period_labels_grid.py write JUMPS.npz
 """
 
 from __future__ import annotations
@@ -125,6 +131,23 @@ def relabel(scored: str, npz: str) -> None:
     print(f"labels equal to the matched attractor's: {eq} of {both}")
 
 
+def write(npz: str) -> None:
+    data = json.loads(CACHE.read_text())
+    cache, changed = data["points"], []
+    for key, (t, F, fb) in sorted(_windows(npz).items()):
+        i, a0 = key.split("_")
+        st = next(s for s in cache[i]["starts"] if s["alpha0"] == float(a0))
+        stats, _ = jump_statistics(t, F, fb, period_rtol=1e-6, max_period=32)
+        differ = [k for k in ("slip_interval", "force_drop", "F_max", "F_min") if stats[k] != st[k]]
+        if differ:
+            raise SystemExit(f"point {i}, alpha0 {a0}: {differ} not the cache's; refusing to write")
+        if (stats["period"], stats["period_label"]) != (st["period"], st["label"]):
+            changed.append((int(i), float(a0), st["label"], stats["period_label"]))
+            st["period"], st["label"] = stats["period"], stats["period_label"]
+    CACHE.write_text(json.dumps(data, indent=0))
+    print(f"{len(changed)} windows relabelled: {changed}")
+
+
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
-    {"classify": classify, "relabel": relabel}[sys.argv[1]](*sys.argv[2:4])
+    {"classify": classify, "relabel": relabel, "write": write}[sys.argv[1]](*sys.argv[2:4])
