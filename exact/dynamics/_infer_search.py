@@ -160,12 +160,14 @@ def nodes(axes: list[np.ndarray]) -> np.ndarray:
 
 
 def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | None, n_obs: int,
-          chi2_noise: float = 0.0) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
+          chi2_noise: float = 0.0, coarse: np.ndarray | None = None
+          ) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
     """The best evaluated point, its χ², the scale s, the 95 % interval ``(low, high)`` per parameter in fitted
     coordinates (the union of the profile and the Jacobian's) and the covariance (or None).  ``chi2_noise``: the
     standard deviation of χ² over the best point's neighbours (:func:`replicate_check`; 0 without an aperiodic
     series), twice which widens the profile's threshold: a point whose χ² is a draw is as good as the best where
-    it lies within the draws' scatter."""
+    it lies within the draws' scatter.  ``coarse``: a second Jacobian at the best point, the valley walk's at the
+    search's resolution (``exact/dynamics/_infer_valley.py``), whose ±1.96 standard errors join the union too."""
     dof = n_obs - len(names)
     top = best(evaluated)
     x, chi2 = top.x, top.chi2
@@ -173,10 +175,12 @@ def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | No
     accept = np.array([e.x for e in evaluated if e.chi2 <= chi2 + 3.84 * s + 2.0 * chi2_noise])
     lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
     cov = None if jac is None else np.linalg.pinv(jac.T @ jac) * s
-    if cov is not None:
+    for c in (cov, None if coarse is None else np.linalg.pinv(coarse.T @ coarse) * s):
+        if c is None:
+            continue
         for i in range(len(names)):
-            if math.isfinite(float(cov[i, i])) and cov[i, i] > 0:
-                se = math.sqrt(float(cov[i, i]))
+            if math.isfinite(float(c[i, i])) and c[i, i] > 0:
+                se = math.sqrt(float(c[i, i]))
                 lo_[i], hi_[i] = min(lo_[i], x[i] - 1.96 * se), max(hi_[i], x[i] + 1.96 * se)
     return np.asarray(x), float(chi2), s, lo_, hi_, cov
 
