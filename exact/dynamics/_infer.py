@@ -32,16 +32,19 @@ several (one series per V).
 * **Intervals.**  95 %, the union of two: the profile of every evaluated point (the parameter's range among the
   points with χ² ≤ χ²_min + 3.84 · s, s = max(1, χ²_min/dof)) and the Jacobian's at the optimum (±1.96 standard
   errors of ``s (JᵀJ)⁻¹``); for an aperiodic series at least ± a quarter of the first grid's node spacing, the
-  search's finest (below it such a χ² is a comb of windows).  A parameter is *not identified* when that interval
-  spans more than a factor 2 (log-fitted) or its value (coefficients), or reaches the edge of the search: the data
-  do not determine it, and the report says so instead of quoting a number.  None is identified when the best fit is
-  poor (χ² improbable at :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes the
-  data nowhere in the search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each
-  parameter; each from the attractor closest to the data among the set's first ``CHECK_STARTS`` starts) are read
-  too: each trial point's statistics are one window's, a draw, and the best of many draws is biased low.  Each
-  statistic's σ is joined by its spread over the best point and its neighbours (every χ² recomputed with it); where
-  the neighbours' χ² (summed) is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread
-  widens the profile's threshold (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
+  search's finest (below it such a χ² is a comb of windows).  Where a parameter would be identified, the χ² is first
+  walked along its least-curved direction from the best point at that spacing (``exact/dynamics/_infer_valley.py``:
+  a long narrow valley oblique to the grid, or a comb of windows along one, widens the interval; the probes'
+  Jacobian at that spacing joins it).  A parameter is *not identified* when that interval spans more than a factor 2
+  (log-fitted) or its value (coefficients), or reaches the edge of the search: the data do not determine it, and the
+  report says so instead of quoting a number.  None is identified when the best fit is poor (χ² improbable at
+  :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes the data nowhere in the
+  search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each parameter; each from the
+  attractor closest to the data among the set's first ``CHECK_STARTS`` starts) are read too: each trial point's
+  statistics are one window's, a draw, and the best of many draws is biased low.  Each statistic's σ is joined by
+  its spread over the best point and its neighbours (every χ² recomputed with it); where the neighbours' χ² (summed)
+  is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread widens the profile's threshold
+  (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
 """
 
 from __future__ import annotations
