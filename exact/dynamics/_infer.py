@@ -248,9 +248,9 @@ def _walked(problem: Problem, run: _Search, outcome: Outcome) -> Outcome:
     walk = valley_walk(problem.names, run.evaluated, evaluate, residual_of, outcome.spacing, outcome.box, threshold)
     after = best(run.evaluated)
     names = problem.names
-    # the least-squares Jacobian is at the former best: where the walk moved it, the probes' alone (the valley's
-    # Jacobian at the search's resolution, a few steps along it)
-    jac, coarse, n_runs = (None if walk.moved else outcome.jac), walk.jac, walk.n_runs
+    # both Jacobians are at the former best where the walk moved it (a few steps along the valley): both kept, the
+    # union of their intervals counts (a local curvature of the same valley; dropping one could only narrow it)
+    jac, coarse, n_runs = outcome.jac, walk.jac, walk.n_runs
     note = (f"the valley walk before a verdict: {n_runs} runs (the residuals at a quarter of the grid's "
             f"spacing along each parameter, then up to {VALLEY_STEPS} such steps each way along the least-curved "
             f"direction of chi2, {walk.reach[0]} and {walk.reach[1]} taken; the Jacobian of those residuals joins "
@@ -258,8 +258,8 @@ def _walked(problem: Problem, run: _Search, outcome: Outcome) -> Outcome:
     if walk.moved:
         note += (": it found a better point, " + ", ".join(f"{n} = {fmt_number(v, 5)}" for n, v in
                                                          zip(names, values_of(names, after.x)))
-                 + f" (chi2 {fmt_number(after.chi2, 4)} against {fmt_number(before.chi2, 4)}); the least-squares "
-                 "Jacobian, at the former best, is left out")
+                 + f" (chi2 {fmt_number(after.chi2, 4)} against {fmt_number(before.chi2, 4)}); both Jacobians are "
+                 "the former best's")
     status, message = outcome.status, outcome.message
     if n_runs and run.left() <= 0:
         status, message = "budget", f"max_wall = {fmt_number(run.max_wall, 3)} s spent; the best point so far"

@@ -183,8 +183,7 @@ class Outcome:
     coarse : ndarray or None
         The residuals' Jacobian at the best point by central differences at a quarter of the first grid's node
         spacing (the valley walk's probes, at the best point before the walk): its ±1.96 standard errors join the
-        95 % interval (``spans``).  Where the walk moved the best point, ``jac`` (the least-squares fit's, at the
-        former best) is None.
+        95 % interval (``spans``), centred, like ``jac``'s, on the best point after the walk.
     """
 
     evaluated: Sequence[Point]
