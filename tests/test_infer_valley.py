@@ -146,10 +146,11 @@ def _infer_pieces(offset: float):
 
 def test_infer_walks_only_where_a_parameter_would_be_identified():
     """Through ``infer``'s own step (``_walked``) on the closed-form valley: a fit that would identify I and k is
-    walked (its note says so, ``Outcome.walk`` counts the runs, all among the evaluated points) and its I interval
-    becomes TRUE_I ± 0.196 within one step (0.067) or wider (the probes' Jacobian joins it), where before the walk
-    it was a factor 1.00 wide; a fit that identifies nothing (χ² 100 more from a third residual of 10 on every
-    point: probability 1e-20 on 5 dof) is returned unchanged, with no run."""
+    walked (its note says so, ``Outcome.walk`` counts the runs, all among the evaluated points) and its I
+    interval becomes TRUE_I ± 0.196 within one step (0.067) or wider (the probes' Jacobian joins it), where
+    before the walk it was a factor 1.00 wide, and its standard error is the probes' (closed form 0.1); a fit
+    that identifies nothing (χ² 100 more from a third residual of 10 on every point: probability 1e-20 on 5 dof)
+    is returned unchanged, with no run."""
     from exact.dynamics._infer import _walked
     from exact.dynamics._infer_result import assemble
 
@@ -163,6 +164,9 @@ def test_infer_walks_only_where_a_parameter_would_be_identified():
     lo, hi = np.log(res.intervals["I"])
     assert lo <= TRUE_I - 1.96 * WIDTH + 0.067 and hi >= TRUE_I + 1.96 * WIDTH - 0.067
     assert res.identified["I"]  # 0.39 wide in ln I, under ln 2
+    # the probes' Jacobian of the linear residuals is exact: [[25, 100], [10, 0]], so (JᵀJ)⁻¹[0, 0] = 1e4 / 1e6 and the
+    # standard error of ln I is 0.1 (= WIDTH, the valley's own σ along I; s = 1 with χ²_min < dof)
+    assert res.stderr["I"] == pytest.approx(WIDTH, rel=1e-9)
     problem, fits, run, outcome = _infer_pieces(10.0)
     assert not any(assemble(problem, fits, outcome).identified.values())
     assert _walked(problem, run, outcome) is outcome and len(run.evaluated) == 3

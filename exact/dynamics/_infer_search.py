@@ -167,7 +167,8 @@ def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | No
     standard deviation of χ² over the best point's neighbours (:func:`replicate_check`; 0 without an aperiodic
     series), twice which widens the profile's threshold: a point whose χ² is a draw is as good as the best where
     it lies within the draws' scatter.  ``coarse``: a second Jacobian at the best point, the valley walk's at the
-    search's resolution (``exact/dynamics/_infer_valley.py``), whose ±1.96 standard errors join the union too."""
+    search's resolution (``exact/dynamics/_infer_valley.py``), whose ±1.96 standard errors join the union too; the
+    covariance returned then has on its diagonal the larger of the two variances (the standard errors quoted)."""
     dof = n_obs - len(names)
     top = best(evaluated)
     x, chi2 = top.x, top.chi2
@@ -175,13 +176,17 @@ def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | No
     accept = np.array([e.x for e in evaluated if e.chi2 <= chi2 + 3.84 * s + 2.0 * chi2_noise])
     lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
     cov = None if jac is None else np.linalg.pinv(jac.T @ jac) * s
-    for c in (cov, None if coarse is None else np.linalg.pinv(coarse.T @ coarse) * s):
+    wide = None if coarse is None else np.linalg.pinv(coarse.T @ coarse) * s
+    for c in (cov, wide):
         if c is None:
             continue
         for i in range(len(names)):
             if math.isfinite(float(c[i, i])) and c[i, i] > 0:
                 se = math.sqrt(float(c[i, i]))
                 lo_[i], hi_[i] = min(lo_[i], x[i] - 1.96 * se), max(hi_[i], x[i] + 1.96 * se)
+    if wide is not None:  # each variance the larger of the two (the standard errors quoted)
+        cov = wide.copy() if cov is None else cov.copy()
+        np.fill_diagonal(cov, np.fmax(np.diag(cov), np.diag(wide)))
     return np.asarray(x), float(chi2), s, lo_, hi_, cov
 
 
