@@ -4,7 +4,7 @@ crossed obliquely, or a comb of periodic windows, widens the 95 % interval inste
 
 Why (``comparisons.benchmark.infer_targets`` seed 6, docs/your-data.md): at V = 0.5328 m/s, I = 0.01636 (period 4)
 the fit sat at I +12.5 % with an interval a factor 1.003 wide, while the χ² along the line from it to the truth
-stays at 0.6-4 (the truth's 0.6 below the best's 3.0): a valley 2 % wide across k, oblique to the grid, whose
+stays at 0.6-4 (0.9 at the truth, 3.1 at the fit): a valley 2 % wide across k, oblique to the grid, whose
 points near the best are a few least-squares steps and whose Jacobian is the jitter of a statistic (the mean
 rise jumps by 2 σ over 0.6 % in I).  At V = 3.147 m/s, I = 2.54e-3 (period 23, read aperiodic) the fit sat at
 I -26 % on a period-19 window, the χ² of the fitted statistics along the line to the truth 0.3-10: the same
@@ -17,8 +17,8 @@ then steps of that length along it, both ways from the best point, each step's p
 point, until two steps in a row lie above the profile's threshold (χ²_min + 3.84 s + 2 · the window scatter, as
 in ``spans``), the span of the walked points within it (both sides together) exceeds a factor 2 (log-fitted; the
 value for a coefficient: the parameter is then not identified anyway), the box's edge, or :data:`VALLEY_STEPS`
-steps.  Its points join the
-evaluated ones: the profile interval spans them, and a better point found becomes the best.
+steps.  Its points join the evaluated ones: the profile interval spans them, and a better point found becomes the
+best.
 """
 
 from __future__ import annotations
@@ -34,8 +34,9 @@ from ._infer_search import LOG, Point, best
 __all__ = ["VALLEY_STEPS", "Walk", "jacobian", "probes", "valley_direction", "valley_walk"]
 
 #: The most steps of the walk on each side of the best point (each a quarter of the first grid's node spacing,
-#: in the walk's direction): 6 reach 1.5 node spacings (a factor 1.5 in I with ``search=3``), past the factor 2
-#: of a verdict with the spread on the other side.
+#: in the walk's direction): 10 reach 2.5 node spacings, 0.69 in ln I with ``search=3``, about the factor 2 of a
+#: verdict on one side alone.  With 6, the fit at V = 3.147 m/s, I = 2.54e-3 (``infer_targets`` seed 6 trace 1)
+#: stopped at I -26 % ... +12 %, called identified within a factor 1.41; with 10 its interval spans a factor 2.1.
 VALLEY_STEPS = 10
 
 
