@@ -23,7 +23,8 @@ identified, on multistable, quasi-periodic and chaotic traces drawn over the pla
   its grid serial in the trace's own process.
 * **Measures** per class and overall: *recovered* (both within the tolerances above), *identified* (both verdicts),
   *hit* (both: the target), and the verdict's calibration: the share of identified fits that are recovered (an
-  identified verdict should be right) and of recovered fits that are identified.
+  identified verdict should be right) and of recovered fits that are identified.  Each row also carries the 95 %
+  intervals (``I_lo``, ``I_hi``, ``k_lo``, ``k_hi``) and ``inside``: whether both hold the truth.
 
 ``--jobs`` runs that many traces at once in separate processes (each trace's runs are serial): the rows do not
 depend on it.  Every trace's line goes to stderr as it ends; the summary to stdout.
@@ -117,6 +118,10 @@ def run_trace(i: int, truth: dict[str, float], seed: int, seconds: float, max_wa
                 "identified_k": res.identified["k"], "recovered": recovered, "identified": identified,
                 "hit": recovered and identified, "runs": res.n_evaluations, "infer_s": time.perf_counter() - t0,
                 "attractor": "; ".join(res.attractors), "verdict_I": res.verdicts["I"][:200]})
+    for name in ("I", "k"):  # the 95 % intervals, and whether both hold the truth
+        lo, hi = res.intervals[name] or (math.nan, math.nan)
+        row.update({f"{name}_lo": lo, f"{name}_hi": hi})
+    row["inside"] = bool(row["I_lo"] <= I <= row["I_hi"] and row["k_lo"] <= k <= row["k_hi"])
     return row
 
 

@@ -32,16 +32,19 @@ several (one series per V).
 * **Intervals.**  95 %, the union of two: the profile of every evaluated point (the parameter's range among the
   points with χ² ≤ χ²_min + 3.84 · s, s = max(1, χ²_min/dof)) and the Jacobian's at the optimum (±1.96 standard
   errors of ``s (JᵀJ)⁻¹``); for an aperiodic series at least ± a quarter of the first grid's node spacing, the
-  search's finest (below it such a χ² is a comb of windows).  A parameter is *not identified* when that interval
-  spans more than a factor 2 (log-fitted) or its value (coefficients), or reaches the edge of the search: the data
-  do not determine it, and the report says so instead of quoting a number.  None is identified when the best fit is
-  poor (χ² improbable at :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes the
-  data nowhere in the search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each
-  parameter; each from the attractor closest to the data among the set's first ``CHECK_STARTS`` starts) are read
-  too: each trial point's statistics are one window's, a draw, and the best of many draws is biased low.  Each
-  statistic's σ is joined by its spread over the best point and its neighbours (every χ² recomputed with it); where
-  the neighbours' χ² (summed) is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread
-  widens the profile's threshold (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
+  search's finest (below it such a χ² is a comb of windows).  Where a parameter would be identified, the χ² is first
+  walked along its least-curved direction from the best point at that spacing (``exact/dynamics/_infer_valley.py``:
+  a long narrow valley oblique to the grid, or a comb of windows along one, widens the interval; the probes'
+  Jacobian at that spacing joins it).  A parameter is *not identified* when that interval spans more than a factor 2
+  (log-fitted) or its value (coefficients), or reaches the edge of the search: the data do not determine it, and the
+  report says so instead of quoting a number.  None is identified when the best fit is poor (χ² improbable at
+  :data:`POOR_FIT`, at :data:`GOOD_FIT` where a series is aperiodic): the model describes the data nowhere in the
+  search.  With an aperiodic series the best point's neighbours (±``JITTER`` along each parameter; each from the
+  attractor closest to the data among the set's first ``CHECK_STARTS`` starts) are read too: each trial point's
+  statistics are one window's, a draw, and the best of many draws is biased low.  Each statistic's σ is joined by
+  its spread over the best point and its neighbours (every χ² recomputed with it); where the neighbours' χ² (summed)
+  is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread widens the profile's threshold
+  (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
 """
 
 from __future__ import annotations
@@ -66,11 +69,13 @@ from ._infer_search import (
     GRID_RUNS,
     JITTER,
     LOG,
+    PENALTY,
     Point,
     Problem,
     ReplicateCheck,
     SeriesFit,
     attractor_lines,
+    best,
     edge_sides,
     extend,
     free_names,
@@ -86,6 +91,7 @@ from ._infer_search import (
     values_of,
 )
 from ._infer_stats import STATISTICS, data_statistics
+from ._infer_valley import VALLEY_STEPS, valley_walk
 
 __all__ = ["DIFF_STEP", "GOOD_FIT", "GRID_RUNS", "Inference", "MAX_EXTEND", "POOR_FIT", "N_STARTS", "REFINE_TOP",
            "XTOL", "infer"]
@@ -192,6 +198,7 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
                   optional(integer, "max_workers", max_workers, 0))
     outcome = run.run(x0, limits, float(search), n_obs, notes)
     check, outcome = _replicated(problem, run, outcome)
+    outcome = _walked(problem, run, outcome)
     full = shares(problem, run.evaluated, run.fits, run.left())
     res = assemble(problem, run.fits, dataclasses.replace(outcome, wall=time.perf_counter() - t_wall))
     n_runs = (sum(r.n_runs for e in run.evaluated for r in e.readings) + sum(r.n_runs for r in full if r is not None)
@@ -214,6 +221,50 @@ def _replicated(problem: Problem, run: _Search, outcome: Outcome) -> tuple[Repli
             f"± {fmt_number(check.chi2_sd, 3)} (the profile's threshold widened by twice that)")
     return check, dataclasses.replace(outcome, replicate=(check.chi2, check.n_stat), chi2_noise=check.chi2_sd,
                                       notes=outcome.notes + (note,))
+
+
+def _walked(problem: Problem, run: _Search, outcome: Outcome) -> Outcome:
+    """The valley walk (``exact/dynamics/_infer_valley.py``) where the search would call a parameter identified:
+    its points join ``run.evaluated`` (the outcome's list) and a note says what it found.  A fit identifying
+    nothing is left as it is (the walk could only widen its intervals)."""
+    if outcome.spacing is None or not any(assemble(problem, run.fits, outcome).identified.values()):
+        return outcome
+    dof = outcome.n_obs - len(problem.names)
+
+    def threshold() -> float:
+        low = min(e.chi2 for e in run.evaluated)
+        return low + 3.84 * (max(1.0, low / dof) if dof > 0 else 1.0) + 2.0 * outcome.chi2_noise
+
+    def evaluate(x: np.ndarray) -> np.ndarray | None:
+        try:
+            return run.residuals(x)
+        except _Spent:
+            return None
+
+    def residual_of(e: Point) -> np.ndarray:
+        return np.concatenate([f.data.residuals(m, problem.sel, PENALTY) for m, f in zip(e.models, run.fits)])
+
+    before = best(run.evaluated)
+    walk = valley_walk(problem.names, run.evaluated, evaluate, residual_of, outcome.spacing, outcome.box, threshold)
+    after = best(run.evaluated)
+    names = problem.names
+    # both Jacobians are at the former best where the walk moved it (a few steps along the valley): both kept, the
+    # union of their intervals counts (a local curvature of the same valley; dropping one could only narrow it)
+    jac, coarse, n_runs = outcome.jac, walk.jac, walk.n_runs
+    note = (f"the valley walk before a verdict: {n_runs} runs (the residuals at a quarter of the grid's "
+            f"spacing along each parameter, then up to {VALLEY_STEPS} such steps each way along the least-curved "
+            f"direction of chi2, {walk.reach[0]} and {walk.reach[1]} taken; the Jacobian of those residuals joins "
+            "the 95 % intervals)")
+    if walk.moved:
+        note += (": it found a better point, " + ", ".join(f"{n} = {fmt_number(v, 5)}" for n, v in
+                                                         zip(names, values_of(names, after.x)))
+                 + f" (chi2 {fmt_number(after.chi2, 4)} against {fmt_number(before.chi2, 4)}); both Jacobians are "
+                 "the former best's")
+    status, message = outcome.status, outcome.message
+    if n_runs and run.left() <= 0:
+        status, message = "budget", f"max_wall = {fmt_number(run.max_wall, 3)} s spent; the best point so far"
+    return dataclasses.replace(outcome, notes=outcome.notes + (note,), status=status, message=message,
+                               walk=n_runs, jac=jac, coarse=coarse)
 
 
 def _progress(progress: Callable[[str], None] | bool | None) -> Callable[[str], None] | None:
@@ -386,6 +437,7 @@ class _Search:
             resolution = 0.25 * np.array([float(a[1] - a[0]) if a.size > 1 else 0.0 for a in first])
             notes += ("an aperiodic fit: each 95 % interval at least the search's finest spacing (a quarter of the "
                       "grid's), below which an aperiodic trace's chi2 is a comb of windows",)
+        spacing = np.array([float(a[1] - a[0]) if a.size > 1 else 0.0 for a in first])
         return Outcome(self.evaluated, jac, (box_lo, box_hi), n_obs, status, message,
                        time.perf_counter() - self.t_wall, notes, GOOD_FIT if any(aperiodic) else POOR_FIT,
-                       resolution=resolution)
+                       resolution=resolution, spacing=spacing)

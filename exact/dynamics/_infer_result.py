@@ -175,6 +175,15 @@ class Outcome:
         aperiodic trace's χ² is a comb of windows, so neither the profile nor the Jacobian resolves finer: at
         V = 0.6854 m/s, I = 2.459e-5 (chaotic) the fit at I -2.7 % had a profile interval of ±1 %.  None: the
         interval as found.
+    spacing : ndarray or None
+        The first grid's node spacing per axis in fitted coordinates (the valley walk's step is a quarter of it,
+        ``exact/dynamics/_infer_valley.py``); None: no walk.
+    walk : int
+        The valley walk's runs (0: no walk; they are among ``evaluated``).
+    coarse : ndarray or None
+        The residuals' Jacobian at the best point by central differences at a quarter of the first grid's node
+        spacing (the valley walk's probes, at the best point before the walk): its ±1.96 standard errors join the
+        95 % interval (``spans``), centred, like ``jac``'s, on the best point after the walk.
     """
 
     evaluated: Sequence[Point]
@@ -189,6 +198,9 @@ class Outcome:
     replicate: tuple[float, int] | None = None
     chi2_noise: float = 0.0
     resolution: np.ndarray | None = None
+    spacing: np.ndarray | None = None
+    walk: int = 0
+    coarse: np.ndarray | None = None
 
 
 def _verdict(name: str, i: int, x: np.ndarray, lo_i: float, hi_i: float, box: tuple, fit: tuple[float, int, float],
@@ -234,7 +246,8 @@ def assemble(problem: Problem, fits: Sequence[SeriesFit], outcome: Outcome) -> I
     dof = outcome.n_obs - len(names)
     if not outcome.evaluated:
         raise ValueError("max_wall was spent before the first model run: give a larger max_wall")
-    x, chi2, s, lo_all, hi_all, cov = spans(names, outcome.evaluated, outcome.jac, outcome.n_obs, outcome.chi2_noise)
+    x, chi2, s, lo_all, hi_all, cov = spans(names, outcome.evaluated, outcome.jac, outcome.n_obs, outcome.chi2_noise,
+                                            outcome.coarse)
     # as many statistics as parameters (dof 0) should fit exactly: judge its χ² as on one degree of freedom
     p_fit = float(chi2_dist.sf(chi2, max(dof, 1)))
     poor = p_fit < outcome.poor_fit

@@ -160,12 +160,15 @@ def nodes(axes: list[np.ndarray]) -> np.ndarray:
 
 
 def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | None, n_obs: int,
-          chi2_noise: float = 0.0) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
+          chi2_noise: float = 0.0, coarse: np.ndarray | None = None
+          ) -> tuple[np.ndarray, float, float, np.ndarray, np.ndarray, np.ndarray | None]:
     """The best evaluated point, its χ², the scale s, the 95 % interval ``(low, high)`` per parameter in fitted
     coordinates (the union of the profile and the Jacobian's) and the covariance (or None).  ``chi2_noise``: the
     standard deviation of χ² over the best point's neighbours (:func:`replicate_check`; 0 without an aperiodic
     series), twice which widens the profile's threshold: a point whose χ² is a draw is as good as the best where
-    it lies within the draws' scatter."""
+    it lies within the draws' scatter.  ``coarse``: a second Jacobian at the best point, the valley walk's at the
+    search's resolution (``exact/dynamics/_infer_valley.py``), whose ±1.96 standard errors join the union too; the
+    covariance returned then has on its diagonal the larger of the two variances (the standard errors quoted)."""
     dof = n_obs - len(names)
     top = best(evaluated)
     x, chi2 = top.x, top.chi2
@@ -173,11 +176,17 @@ def spans(names: Sequence[str], evaluated: Sequence[Point], jac: np.ndarray | No
     accept = np.array([e.x for e in evaluated if e.chi2 <= chi2 + 3.84 * s + 2.0 * chi2_noise])
     lo_, hi_ = accept.min(axis=0), accept.max(axis=0)
     cov = None if jac is None else np.linalg.pinv(jac.T @ jac) * s
-    if cov is not None:
+    wide = None if coarse is None else np.linalg.pinv(coarse.T @ coarse) * s
+    for c in (cov, wide):
+        if c is None:
+            continue
         for i in range(len(names)):
-            if math.isfinite(float(cov[i, i])) and cov[i, i] > 0:
-                se = math.sqrt(float(cov[i, i]))
+            if math.isfinite(float(c[i, i])) and c[i, i] > 0:
+                se = math.sqrt(float(c[i, i]))
                 lo_[i], hi_[i] = min(lo_[i], x[i] - 1.96 * se), max(hi_[i], x[i] + 1.96 * se)
+    if wide is not None:  # each variance the larger of the two (the standard errors quoted)
+        cov = wide.copy() if cov is None else cov.copy()
+        np.fill_diagonal(cov, np.fmax(np.diag(cov), np.diag(wide)))
     return np.asarray(x), float(chi2), s, lo_, hi_, cov
 
 
