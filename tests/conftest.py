@@ -21,9 +21,13 @@ def p_high():
 #: under 2 xdist workers, ``--durations=0``, 2026-11-29: 44 ... 10 s; the median file takes ~2 s).  Handed out
 #: first (pyproject's ``--no-loadscope-reorder`` keeps this order; xdist's own reorder puts files with many
 #: tests first and these few-test files last, where one of them alone kept a worker busy while the other idled).
-HEAVY_FIRST = ("test_bounded.py", "test_cold_start.py", "test_named_errors.py", "test_front.py", "test_readme.py",
-               "test_atlas_sets.py", "test_branch_events.py", "test_sweep.py", "test_law.py", "test_plotting.py",
-               "test_infer.py", "test_basins.py", "test_orbits.py", "test_parallel.py", "test_variants_cli.py",
+#: A file's cost depends on its place: the first to need a kernel compiles it (~75 s of the tier's CPU).  Later the
+#: same day test_infer.py had grown to ~30 s of CPU (its aperiodic fits; each test's process CPU with its
+#: subprocesses, empty cache, 2 workers, loaded machine), the costliest after test_bounded.py, test_cold_start.py
+#: and test_front.py: handed out fifth, no longer eleventh, where it came among the last long files.
+HEAVY_FIRST = ("test_bounded.py", "test_cold_start.py", "test_named_errors.py", "test_front.py", "test_infer.py",
+               "test_readme.py", "test_atlas_sets.py", "test_branch_events.py", "test_sweep.py", "test_law.py",
+               "test_plotting.py", "test_basins.py", "test_orbits.py", "test_parallel.py", "test_variants_cli.py",
                "test_law_dynamics.py", "test_kernel_cache.py", "test_law_reduced.py", "test_examples.py",
                "test_series_lyapunov.py")
 

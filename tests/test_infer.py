@@ -25,6 +25,43 @@ def high_inertia() -> ForceSeries:
     return _trace(1.0, 1e-2)
 
 
+def _infer_stats():
+    import exact.dynamics._infer_stats as stats
+
+    return stats
+
+
+def _read_once(monkeypatch) -> None:
+    """Within one test, each exact run and each model reading of ``exact.dynamics._infer_stats`` made once: the
+    module's ``simulate`` and ``_readings`` memoised on their arguments (the run's parameters, end time, sampling
+    times, tolerance, budget and start, with the solver's start ``alpha0=0.0`` spelled out; the reading's series,
+    threshold, noise level and seeds).  Both are deterministic (the same inputs give the same run, bitwise, and
+    the noise has fixed seeds), so a test sees the values it would see without: fewer runs, the same checks."""
+    stats = _infer_stats()
+    runs: dict = {}
+    reads: dict = {}
+    simulate, readings = stats.simulate, stats._readings
+
+    def start_key(kw: dict) -> tuple:
+        return tuple(sorted({"alpha0": 0.0, **kw}.items()))
+
+    def simulate_once(p, t_end, *, t_eval=None, **kw):
+        key = (repr(p), t_end, None if t_eval is None else np.asarray(t_eval).tobytes(),
+               kw.pop("rtol", 1e-8), kw.pop("max_wall", None), start_key(kw))
+        if key not in runs:
+            runs[key] = simulate(p, t_end, t_eval=t_eval, rtol=key[3], max_wall=key[4], **kw)
+        return runs[key]
+
+    def readings_once(p, series, threshold, noise, t_transient, rtol, max_wall, start, seeds):
+        key = (repr(p), id(series), threshold, noise, t_transient, rtol, max_wall, start_key(start), seeds)
+        if key not in reads:
+            reads[key] = readings(p, series, threshold, noise, t_transient, rtol, max_wall, start, seeds)
+        return reads[key]
+
+    monkeypatch.setattr(stats, "simulate", simulate_once)
+    monkeypatch.setattr(stats, "_readings", readings_once)
+
+
 def test_k_alone_is_recovered():
     """Hypothesis: with I known, the stiffness k of a periodic high-inertia trace (V = 1, I = 1e-2, k = 1000 N/m;
     5 s of it, 20 cycles of the period-8 orbit, to keep the test short) is recovered from a start at 900 N/m
@@ -446,17 +483,19 @@ def test_same_attractor_compares_three_statistics():
             assert same_attractor(moved, base) is same
 
 
-def test_a_quasi_periodic_replicate_spread_keeps_the_datas_torus():
+def test_a_quasi_periodic_replicate_spread_keeps_the_datas_torus(monkeypatch):
     """Hypothesis (the quasi-periodic point V = 3.149 m/s, I = 0.05665, k = 1173 of ``infer_targets``' seed 2,
     5 s): of the first 4 starts the one at rest reaches another torus (slip interval over 50 % longer: measured
     70 %); the replicate spread keeps the other three, so the cycle frequency's spread over them stays within its
     3 % repeatability and the line is kept (before, the other torus made every σ a multiple of the data's spread
     and I free within a factor 4).  The cycle frequency (the torus' modulation, an α oscillation) goes as
     I^-1/2 at this inertia: the model's at 0.75 I over its value at I is (0.75)^-1/2 = 1.1547 within 1 %
-    (measured 1.1544)."""
+    (measured 1.1544).  Each model reading is made once (:func:`_read_once`: the rest start's and the solver's are
+    asked twice, by the test and by ``replicate_spread``; a reading is deterministic): 5 readings instead of 7."""
     from exact.dynamics._attractor_set_runs import default_starts
     from exact.dynamics._infer_stats import STATISTICS, _reading, data_statistics, model_statistics, replicate_spread
 
+    _read_once(monkeypatch)
     p = PeelParams(V=3.149, I=0.05665, k=1173.0)
     s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
     d = data_statistics(s)
@@ -541,14 +580,17 @@ def test_I_and_k_of_a_quasi_periodic_trace():
     assert abs(res.values["I"] / 0.05665 - 1) < 0.10 and abs(res.values["k"] / 1173.0 - 1) < 0.10
 
 
-def test_the_detectors_spread_under_noise():
+def test_the_detectors_spread_under_noise(monkeypatch):
     """Hypothesis (``noise_spread``): at the quasi-periodic V = 3.923 m/s, I = 0.01045, k = 994.6
     (``infer_targets`` seed 5, trace 0; 1.5 ms sticks, 15 samples each) the mean stick slope of one model run read
     with 4 draws of 0.5 N noise spreads by 1-4 % (measured 2.2 % on 10 s, here 5 s: about √2 more), more than its
     2 % repeatability's half, while the slip interval spreads by under 1.5 % (measured 0.8 %); without noise every
-    draw reads the same trace: the spread is exactly 0."""
+    draw reads the same trace: the spread is exactly 0 (2 draws: the least a spread has; 4 as with noise read the
+    same trace twice more).  The quiet reading's model run is the noisy one's (the same call of ``exact.simulate``):
+    :func:`_read_once` runs it once."""
     from exact.dynamics._infer_stats import STATISTICS, data_statistics, noise_spread
 
+    _read_once(monkeypatch)
     p = PeelParams(V=3.923, I=0.01045, k=994.6)
     s = exact.simulate(p, 35.0, t_eval=30.0 + np.arange(50000) / 1e4).as_series(1e4, noise=0.5, drift=5.0, seed=1)
     d = data_statistics(s)
@@ -557,7 +599,7 @@ def test_the_detectors_spread_under_noise():
     rise = STATISTICS.index("rise")
     assert 0.01 <= nsd[rise] / d.values[rise] <= 0.04
     assert nsd[0] / d.values[0] < 0.015
-    quiet = noise_spread(p, s, d.threshold, 0.0, 30.0, 1e-8, 120.0, {})
+    quiet = noise_spread(p, s, d.threshold, 0.0, 30.0, 1e-8, 120.0, {}, n=2)
     assert quiet is not None and np.all(quiet == 0.0)
 
 

@@ -117,8 +117,8 @@ def test_changed_model_source_recompiles_the_kernel(tmp_path, driver):
     stamped and cached by the same code (``peelapprox._compiled._jit._dispatcher``); the driver itself
     (``driver=True``, two compilations of ~20 s) is slow: covered in the default tier by this test's
     ``law_kernel`` case, and its cross-process cache hit by
-    tests/test_cold_start.py::test_plain_hybrid_simulate_compiles_only_the_hybrid_driver (the inlined driver,
-    the same rebound body and ``RUN_SIG``)."""
+    tests/test_cold_start.py::test_first_simulate_imports_only_what_it_needs (the inlined driver, compiled by
+    that module's first probe, loaded by a later process: the same rebound body and ``RUN_SIG``)."""
     _copy_packages(tmp_path)
     before = _probe(tmp_path, driver=driver)  # compiles, caches in $XDG_CACHE_HOME/peelapprox/numba (the private root)
     assert abs(before["kern"] - before["ref"]) <= 1e-12 * abs(before["ref"])

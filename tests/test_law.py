@@ -9,6 +9,7 @@ and landings in closed form, sympy's derivatives of the same formula, and the da
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import os
@@ -331,12 +332,21 @@ def test_saved_trajectory_records_the_law(tmp_path):
     assert PeelParams(**old) == p and PeelParams(**old).force is PeelForce.paper()
 
 
+#: fvV as each kind of law, made when a test first asks (:func:`_law_of_kind`), not at import: every pytest-xdist
+#: worker imports this module to collect it, and the expression law's parse and derivatives alone cost ~0.85 s of CPU.
 LAW_KINDS = {
-    "power_branches": PeelForce.power_branches(),
-    "expression": PeelForce.expression(PAPER_TEXT),
-    "tabulated": PeelForce.tabulated(np.logspace(-8, 2, 300), PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
-    "smoothed": PeelForce.smoothed(np.logspace(-8, 2, 300), PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
+    "power_branches": PeelForce.power_branches,
+    "expression": lambda: PeelForce.expression(PAPER_TEXT),
+    "tabulated": lambda: PeelForce.tabulated(np.logspace(-8, 2, 300),
+                                             PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
+    "smoothed": lambda: PeelForce.smoothed(np.logspace(-8, 2, 300), PeelForce.paper().f(np.logspace(-8, 2, 300), 1.0)),
 }
+
+
+@functools.cache
+def _law_of_kind(kind: str) -> PeelForce:
+    return LAW_KINDS[kind]()
+
 CONSUMERS = {
     "estimate": lambda p: pa.estimate(p).v_max,
     "reduced_segment": lambda p: pa.reduced_segment(p, "AB", F_in=220.0, alpha_in=0.0, alphadot_in=0.0).dt,
@@ -352,7 +362,7 @@ def test_consumers_honour_every_kind_of_law(name, kind):
     """Hypothesis: every consumer of params takes every kind of law (any tape's law runs everywhere; the refusals of the
     transition are gone): with fvV written as each kind (the power branches calibrated to it), each returns a
     value, never a ValueError refusing the law."""
-    p = PeelParams(V=1.0, I=1e-5, force=LAW_KINDS[kind])
+    p = PeelParams(V=1.0, I=1e-5, force=_law_of_kind(kind))
     assert CONSUMERS[name](p) is not None
 
 

@@ -7,6 +7,7 @@ and the interpolants themselves, evaluated by scipy's own code.  The tables are 
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -225,8 +226,7 @@ def test_nan_in_nan_out():
         assert math.isnan(table_law(math.nan, coef, form)[1 if form == LAW_LNV else 0])
 
 
-@njit(types.float64(LAW_TYPE, types.float64[::1], types.float64, types.float64, types.int64))
-def _drive(law, coef, u0, du, n):
+def _drive_py(law, coef, u0, du, n):
     """A loop compiled once for the law's function type, as the solvers' drivers are."""
     s = 0.0
     for i in range(n):
@@ -235,11 +235,19 @@ def _drive(law, coef, u0, du, n):
     return s
 
 
+@functools.cache
+def _driver():
+    """:func:`_drive_py` compiled for its explicit signature when the test first asks, not at import (every
+    pytest-xdist worker imports this module to collect it: ~0.45 s of CPU each)."""
+    return njit(types.float64(LAW_TYPE, types.float64[::1], types.float64, types.float64, types.int64))(_drive_py)
+
+
 def test_a_new_table_costs_no_compilation():
     """Hypothesis: table_law is compiled once for LAW_SIG, so tables of other lengths (20, 1000 points), two
     tables or the paper's law through the same compiled driver compile nothing: the dispatchers keep one
     signature each, and numba's compile-event recorder sees no compilation.  The driver's sum equals the law's
     own calls summed in Python (same numbers: tolerance 0)."""
+    _drive = _driver()
     _drive(table_law, table_coefficients(ONE, 1.0), -5.0, 1e-3, 10)  # compile the driver once, outside
     _drive(paper_law, paper_coefficients(1.0), -5.0, 1e-3, 1)  # and the paper's law (compiled on first use)
     coefs = [table_coefficients(PeelForce.tabulated(*_table(1.0, n, 1e-3, 30.0)[1:]).tables, 1.0)

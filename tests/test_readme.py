@@ -111,11 +111,13 @@ def _env() -> dict[str, str]:
     return env
 
 
-def _write_tape(directory: Path) -> None:
+def _write_tape(directory: Path, seconds: float = 10.0) -> None:
     """The files the README's data lines read: ``my_tape.csv`` (``--force-table``: fvV at V = 1.2 m/s, 30 points
     per decade), ``pts.csv`` (``--smooth``: 60 points of fvV at V = 1.2 m/s over v in [1e-3, 31.6] m/s with 1 %
-    seeded noise, as measured points would be) and ``trace.csv`` (``series``/``infer``: 10 s of the pull force at
-    V = 1 m/s, I = 1e-2 kg m², k = 1000 N/m after a 10 s transient, sampled at 10 kHz with 0.5 N of noise)."""
+    seeded noise, as measured points would be) and ``trace.csv`` (``series``/``infer``: ``seconds`` of the pull
+    force at V = 1 m/s, I = 1e-2 kg m², k = 1000 N/m after a 10 s transient, sampled at 10 kHz with 0.5 N of noise;
+    10 s for the slow ``infer``, which fits I and k to it; 2 s for the default tier's ``series``, which reads it
+    (65 slips, the period-8 return map) and writes its slips: ~1.4 s of CPU less than 10 s, run and read)."""
     import exact
     from peelapprox import PeelParams, peel_force
 
@@ -124,8 +126,8 @@ def _write_tape(directory: Path) -> None:
     v = np.logspace(-3, 1.5, 60)
     f = peel_force(v, 1.2) * (1 + 0.01 * np.random.default_rng(36).standard_normal(v.size))
     np.savetxt(directory / "pts.csv", np.c_[v, f], delimiter=",", header="v,f", comments="")
-    grid = 10.0 + np.arange(100_000) / 1e4
-    tr = exact.simulate(PeelParams(V=1.0, I=1e-2), 20.0, t_eval=grid)
+    grid = 10.0 + np.arange(round(seconds * 1e4)) / 1e4
+    tr = exact.simulate(PeelParams(V=1.0, I=1e-2), 10.0 + seconds, t_eval=grid)
     tr.as_series(1e4, noise=0.5, seed=7).to_csv(str(directory / "trace.csv"))
 
 
@@ -156,7 +158,7 @@ def started(request, tmp_path_factory):
     commands = CHEAP if any(name.startswith("test_cheap_command") for name in selected) else []
     d = tmp_path_factory.mktemp("commands")
     if commands:
-        _write_tape(d)
+        _write_tape(d, seconds=2.0)
     proc = None
     if blocks or commands:
         proc = subprocess.Popen([sys.executable, "-c", _DRIVER, str(d / "results.json"), json.dumps(blocks),
