@@ -45,6 +45,13 @@ several (one series per V).
   its spread over the best point and its neighbours (every χ² recomputed with it); where the neighbours' χ² (summed)
   is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread widens the profile's threshold
   (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
+* **The period check.**  Where the data's return map is periodic and the best point's attractor clearly periodic
+  of another period (read by :meth:`peelapprox.ForceSeries.observables` at the tolerance of the series' noise, the
+  model's trace noised like the data; still so at ``PERIOD_MARGIN`` times that tolerance), nothing is identified
+  and the verdicts say why (``period_check`` in ``exact/dynamics/_infer_search.py``): the statistics are means over
+  a cycle, and the one that carries the period, the cycle frequency, is not fitted where the data's periodogram
+  holds no line, so χ² cannot see it (docs/your-data.md, seed 8 trace 2).  It judges after the valley walk and
+  steers nothing.
 """
 
 from __future__ import annotations
