@@ -93,6 +93,31 @@ def test_a_period_disagreement_leaves_nothing_identified():
     assert checked.values == plain.values and checked.intervals == plain.intervals
 
 
+def test_period_check_reads_the_fitted_attractor_again():
+    """``period_check`` at seed 8 trace 2's fitted point (I = 6.5745e-6, k = 721.09, V = 1.386: a period-4
+    attractor from the solver's start, F before a slip 4.5 N peak to peak) against constructed data: period-1 data
+    (an unmodulated sawtooth, 0.5 N of noise) give one clear disagreement for one run; data carrying that period-4
+    modulation none, without a run; with the budget spent (``left`` 0.5 s) the disagreement is kept, its margin
+    unmeasured, without a run.  Exact periods: no tolerance."""
+    from exact.dynamics._infer_search import Point, Problem, SeriesFit, period_check
+    from exact.dynamics._infer_stats import SeriesData, SetReading
+
+    x = np.log([6.5744875552006885e-06, 721.0933659844474])
+    problem = Problem(PeelParams(V=1.386, I=2e-5, k=827.0), ("I", "k"), np.arange(6), 30.0, 1e-8, 1)
+    evaluated = [Point(x, 5.0, [np.ones(7)], [SetReading(np.ones(7), "solver", 4, 1)])]
+
+    def fits(ptp: float) -> list:
+        return [SeriesFit(_sawtooth(ptp, 0), 1.386, SeriesData(np.ones(7), np.ones(7), 2.67, 0.5,
+                                                                np.ones(7, dtype=bool)))]
+
+    said, n_runs = period_check(problem, evaluated, fits(0.0), 600.0)
+    assert n_runs == 1 and said == ("at V = 1.386 m/s the fit's attractor is period 4 where the data's is period 1 "
+                                    "(at 2 times the data's period tolerance it reads period 4)",)
+    assert period_check(problem, evaluated, fits(4.5), 600.0) == ((), 0)
+    late, n_late = period_check(problem, evaluated, fits(0.0), 0.5)
+    assert n_late == 0 and len(late) == 1 and "margin not measured" in late[0]
+
+
 @pytest.mark.slow
 def test_seed8_trace2_is_not_identified_on_a_period4_attractor():
     """End to end, ``comparisons.benchmark.infer_targets`` seed 8 trace 2 (V = 1.386 m/s, I = 3.051e-5, k = 719.2;
