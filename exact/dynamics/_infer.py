@@ -45,6 +45,13 @@ several (one series per V).
   its spread over the best point and its neighbours (every χ² recomputed with it); where the neighbours' χ² (summed)
   is still improbable at :data:`GOOD_FIT` nothing is identified, and their χ² spread widens the profile's threshold
   (``replicate_check`` in ``exact/dynamics/_infer_search.py``).
+* **The period check.**  Where the data's return map is periodic and the best point's attractor clearly periodic
+  of another period (read by :meth:`peelapprox.ForceSeries.observables` at the tolerance of the series' noise, the
+  model's trace noised like the data; still so at ``PERIOD_MARGIN`` times that tolerance), nothing is identified
+  and the verdicts say why (``period_check`` in ``exact/dynamics/_infer_search.py``): the statistics are means over
+  a cycle, and the one that carries the period, the cycle frequency, is not fitted where the data's periodogram
+  holds no line, so χ² cannot see it (docs/your-data.md, seed 8 trace 2).  It judges after the valley walk and
+  steers nothing.
 """
 
 from __future__ import annotations
@@ -83,6 +90,7 @@ from ._infer_search import (
     grid_point,
     n_fitted,
     nodes,
+    period_check,
     refine,
     replicate_check,
     replicated,
@@ -199,10 +207,11 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     outcome = run.run(x0, limits, float(search), n_obs, notes)
     check, outcome = _replicated(problem, run, outcome)
     outcome = _walked(problem, run, outcome)
+    outcome, n_period = _period_checked(problem, run, outcome)
     full = shares(problem, run.evaluated, run.fits, run.left())
     res = assemble(problem, run.fits, dataclasses.replace(outcome, wall=time.perf_counter() - t_wall))
     n_runs = (sum(r.n_runs for e in run.evaluated for r in e.readings) + sum(r.n_runs for r in full if r is not None)
-              + (check.n_runs if check is not None else 0))
+              + (check.n_runs if check is not None else 0) + n_period)
     lines = attractor_lines(run.evaluated, full, [f.V for f in run.fits])
     return dataclasses.replace(res, n_evaluations=n_runs, attractors=lines,
                                verdicts={k: f"{v}; {'; '.join(lines)}" for k, v in res.verdicts.items()})
@@ -265,6 +274,18 @@ def _walked(problem: Problem, run: _Search, outcome: Outcome) -> Outcome:
         status, message = "budget", f"max_wall = {fmt_number(run.max_wall, 3)} s spent; the best point so far"
     return dataclasses.replace(outcome, notes=outcome.notes + (note,), status=status, message=message,
                                walk=n_runs, jac=jac, coarse=coarse)
+
+
+def _period_checked(problem: Problem, run: _Search, outcome: Outcome) -> tuple[Outcome, int]:
+    """The period check at the best point (``period_check``): where the fit's attractor and the data are both
+    periodic of clearly different periods, the outcome says so (nothing is then identified) with a note; and the
+    runs it spent."""
+    periods, n_runs = period_check(problem, run.evaluated, run.fits, run.left())
+    if not periods:
+        return outcome, n_runs
+    note = (f"the period check: {'; '.join(periods)}; each period read by ForceSeries.observables at the tolerance "
+            "of the series' noise (the model's trace noised like the data): nothing identified")
+    return dataclasses.replace(outcome, periods=periods, notes=outcome.notes + (note,)), n_runs
 
 
 def _progress(progress: Callable[[str], None] | bool | None) -> Callable[[str], None] | None:

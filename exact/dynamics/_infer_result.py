@@ -184,6 +184,10 @@ class Outcome:
         The residuals' Jacobian at the best point by central differences at a quarter of the first grid's node
         spacing (the valley walk's probes, at the best point before the walk): its ±1.96 standard errors join the
         95 % interval (``spans``), centred, like ``jac``'s, on the best point after the walk.
+    periods : tuple of str
+        Where the best point's attractor and the data are both periodic of clearly different periods, the
+        sentences saying so (``period_check`` in ``exact/dynamics/_infer_search.py``): no parameter is then
+        identified.  ``()``: none.
     """
 
     evaluated: Sequence[Point]
@@ -201,6 +205,7 @@ class Outcome:
     spacing: np.ndarray | None = None
     walk: int = 0
     coarse: np.ndarray | None = None
+    periods: tuple[str, ...] = ()
 
 
 def _verdict(name: str, i: int, x: np.ndarray, lo_i: float, hi_i: float, box: tuple, fit: tuple[float, int, float],
@@ -275,6 +280,11 @@ def assemble(problem: Problem, fits: Sequence[SeriesFit], outcome: Outcome) -> I
             verdicts[name] = (f"not identified: the best point fits (chi2 = {fmt_number(chi2, 4)} on {dof} dof) "
                               f"but its neighbours do not (chi2 = {fmt_number(chi2_rep[0], 4)} on {chi2_rep[1]}, "
                               f"probability {fmt_number(p_rep, 2)}): the best of many windows was a lucky draw")
+    if outcome.periods:  # the statistics' chi2 does not see a period the data show (docs/your-data.md)
+        identified = dict.fromkeys(names, False)
+        verdicts = {n: f"not identified: {'; '.join(outcome.periods)}; chi2 = {fmt_number(chi2, 4)} on {dof} dof "
+                    "does not see it (the statistics are means over a cycle, and the cycle frequency is not fitted "
+                    "where the data's periodogram holds no line)" for n in names}
     return Inference(params=apply(problem.params0, names, x, fits[0].V), values=dict(zip(names, values_of(names, x))),
                      stderr=stderr, intervals=intervals, identified=identified, verdicts=verdicts,
                      residuals=_residual_rows(problem, fits, best(outcome.evaluated).models), chi2=chi2, dof=dof,

@@ -20,21 +20,26 @@ import numpy as np
 from peelapprox import ForceSeries, PeelParams
 from peelapprox.io import fmt_number
 
+from ._attractor_set_runs import default_starts
 from ._infer_stats import (
     NOISE_REPLICATES,
+    PERIOD_MARGIN,
     REPEATABILITY,
     STATISTICS,
     SeriesData,
     SetReading,
+    data_period,
+    model_period,
     noise_spread,
+    period_disagreements,
     replicate_mean,
     replicate_spread,
     set_statistics,
 )
 
 __all__ = ["CHECK_STARTS", "GRID_RUNS", "JITTER", "LOG", "PENALTY", "Point", "Problem", "ReplicateCheck", "SeriesFit",
-           "apply", "attractor_lines", "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes", "refine",
-           "replicate_check", "replicated", "residuals", "shares", "spans", "values_of"]
+           "apply", "attractor_lines", "edge_sides", "extend", "free_names", "grid", "grid_point", "nodes",
+           "period_check", "refine", "replicate_check", "replicated", "residuals", "shares", "spans", "values_of"]
 
 #: The most grid points of the search per series (an odd number per axis, params0 at the centre: 9 x 9 for two
 #: parameters).
@@ -452,3 +457,37 @@ def attractor_lines(evaluated: Sequence[Point], full: Sequence[SetReading | None
                  else f"share {fmt_number(100 * whole.share, 3)} % of the set's {whole.n_runs} starts")
         out.append(f"at V = {fmt_number(V, 4)} m/s on the {r.label} attractor (from the start {r.start!r}; {share})")
     return tuple(out)
+
+
+def period_check(problem: Problem, evaluated: Sequence[Point], fits: Sequence[SeriesFit], left: float
+                 ) -> tuple[tuple[str, ...], int]:
+    """Whether the best point's attractor has the data's period, per series (:func:`period_disagreements` in
+    ``exact/dynamics/_infer_stats.py``): the sentences of the clear disagreements and the model runs spent.  Where
+    the data read periodic and the best point's reading (the knee detector's) another period or none, its trace is
+    run again from the same start and read as the data are (:func:`model_period`: at its noise's tolerance and at
+    :data:`PERIOD_MARGIN` times the data's); once ``left`` seconds are spent it is not, and a periodic reading of
+    another period counts, its margin unmeasured."""
+    if not evaluated:
+        return (), 0
+    top = best(evaluated)
+    t0, n_runs = time.perf_counter(), 0
+    data, model, wide, Vs = [], [], [], []
+    for f, r in zip(fits, top.readings):
+        p, tol = data_period(f.series)
+        q: int | None = None
+        w: int | None | bool = None
+        if p is not None and r.values is not None and r.period != p:
+            spent = time.perf_counter() - t0
+            params = apply(problem.params0, problem.names, top.x, f.V)
+            start = next((st.kwargs() for st in default_starts(params) if st.name == r.start), None)
+            if left - spent <= 1.0 or start is None:
+                q, w = r.period, False
+            else:
+                q, w = model_period(params, f.series, f.data.threshold, f.data.noise, problem.t_transient,
+                                    problem.rtol, left - spent, start, PERIOD_MARGIN * tol)
+                n_runs += 1
+        data.append(p)
+        model.append(q)
+        wide.append(w)
+        Vs.append(f.V)
+    return period_disagreements(data, model, wide, Vs), n_runs

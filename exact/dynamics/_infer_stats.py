@@ -21,6 +21,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -33,9 +34,10 @@ from peelapprox.io import fmt_number
 from .._simulate import simulate
 from ._attractor_set_runs import default_starts
 
-__all__ = ["CLOSE", "LINE_RATIO", "NOISE_REPLICATES", "NOISE_SEED", "STATISTICS", "REPEATABILITY", "SAME_ATTRACTOR",
-           "SeriesData", "SetReading", "Spread", "data_statistics", "model_statistics", "noise_spread",
-           "replicate_mean", "replicate_spread", "same_attractor", "set_statistics", "trace_statistics"]
+__all__ = ["CLOSE", "LINE_RATIO", "NOISE_REPLICATES", "NOISE_SEED", "PERIOD_MARGIN", "STATISTICS", "REPEATABILITY",
+           "SAME_ATTRACTOR", "SeriesData", "SetReading", "Spread", "data_period", "data_statistics", "model_period",
+           "model_statistics", "noise_spread", "period_disagreements", "period_tolerance", "replicate_mean",
+           "replicate_spread", "same_attractor", "set_statistics", "trace_statistics"]
 
 #: The statistics fitted, in this order (module docstring).
 STATISTICS = ("slip_interval", "force_drop", "stick_time", "slip_time", "rise", "F_start", "f_cycle")
@@ -65,6 +67,13 @@ NOISE_REPLICATES = 4
 #: The seed of the noise added to every model trace (the same at every parameter point: the statistics move with
 #: the parameters, not with a new draw).
 NOISE_SEED = 20041
+#: The fitted attractor's period differs clearly from the data's (:func:`period_disagreements`) where its trace,
+#: read at this many times the data's period tolerance (:func:`period_tolerance`), still repeats neither after the
+#: data's period nor after a divisor of it.  The tolerance is set so that the noise alone stays below it (the
+#: largest |F_{k+n} - F_k| of a noisy period-n trace), so a mismatch above twice it is a modulation above the
+#: tolerance itself, which any noise draw shows: a sawtooth at 0.5 N of noise whose forces before a slip carry a
+#: period-4 modulation of 0.6 N peak to peak reads period 2 at the tolerance (0.95 N) and period 1 at twice it.
+PERIOD_MARGIN = 2.0
 
 
 def trace_statistics(series: ForceSeries, threshold: float | None
@@ -366,3 +375,71 @@ def replicate_mean(p: PeelParams, series: ForceSeries, threshold: float, noise: 
                           max(1, n))
     best = min(periodic, key=lambda r: r[0])
     return SetReading(best[2], best[1], best[3], max(1, n))
+
+
+def period_tolerance(slips: Any) -> float:
+    """The return map's period tolerance :meth:`peelapprox.ForceSeries.observables` uses by default, relative to
+    the largest force before a slip: the largest of 6 fit errors (``6 · 2σ/√40``, σ the slips' noise estimate),
+    2 % of the range of F before the slips and 3e-4 of the largest (that method's docstring)."""
+    fb = np.asarray(slips.F_before)
+    top = float(np.max(np.abs(fb)))
+    return max(6.0 * 2.0 * float(slips.noise) / math.sqrt(40.0), 0.02 * float(np.ptp(fb)), 3e-4 * top) / top
+
+
+def data_period(series: ForceSeries) -> tuple[int | None, float]:
+    """The series' return-map period as :meth:`peelapprox.ForceSeries.observables` reads it by default (its
+    default detector, whose line fits place F before a slip closer than the knee's: at seed 8 trace 2 of
+    ``comparisons.benchmark.infer_targets`` the knee's returns jump once by 4.2 N, the line fits' by at most
+    0.54 N; None: aperiodic or too few slips) and its period tolerance (:func:`period_tolerance`)."""
+    slips = series.slips(None)
+    if len(slips) < 2:
+        return None, math.nan
+    return series.observables(slips=slips).period, period_tolerance(slips)
+
+
+def model_period(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
+                 rtol: float, max_wall: float, start: dict[str, Any], period_rtol: float
+                 ) -> tuple[int | None, int | None]:
+    """The return-map period of the model's trace at ``p`` from ``start`` (run, sampled and noised as
+    :func:`model_statistics`: the same run and noise draw), read as :func:`data_period` reads the data (the
+    default detector at the data's ``threshold``) at its own noise's tolerance, and at ``period_rtol``; None
+    where it does not stick-slip, breaks down or is aperiodic at that tolerance."""
+    t_eval = t_transient + (series.t - series.t[0])
+    try:
+        tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall, **start)
+    except (ModelBreakdown, SolverBudgetExceeded, ValueError):
+        return None, None
+    F = tr.F + np.random.default_rng(NOISE_SEED).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
+    model = ForceSeries(tr.t, F, V=p.V, source="model")
+    slips = model.slips(threshold)
+    if len(slips) < 2:
+        return None, None
+    return model.observables(slips=slips).period, model.observables(slips=slips, period_rtol=period_rtol).period
+
+
+def period_disagreements(data: Sequence[int | None], model: Sequence[int | None],
+                         wide: Sequence[int | None | bool], Vs: Sequence[float]) -> tuple[str, ...]:
+    """Per series where the data and the fitted attractor are both periodic of clearly different periods, the
+    sentence saying so; ``()`` where none is.
+
+    ``data``: the series' periods (:func:`data_period`); ``model``: the best point's attractor's, its trace noised
+    like the data and read with the same rule (:func:`model_period`), None where not read; ``wide``: the model
+    trace's period at :data:`PERIOD_MARGIN` times the data's tolerance (:func:`model_period`), or False where not
+    measured
+    (``max_wall`` spent: the disagreement is kept, and the sentence says the margin was not measured).  Clear: p
+    and q periodic, q ≠ p, and the wide reading neither p nor a divisor of it.  An aperiodic side is not compared:
+    a periodic trace of a long period, or one near the tolerance, can read aperiodic under noise (seed 6 trace 3
+    of ``comparisons.benchmark.infer_targets``: data period 6, the fit's reading aperiodic, I within 0.1 %)."""
+    if not len(data) == len(model) == len(wide) == len(Vs):
+        raise ValueError(f"data, model, wide and Vs must have one entry per series, got {len(data)}, {len(model)}, "
+                         f"{len(wide)} and {len(Vs)}")
+    out = []
+    for p, q, w, V in zip(data, model, wide, Vs):
+        if p is None or q is None or p == q or (w is not False and w is not None and p % int(w) == 0):
+            continue
+        margin = ("its margin not measured (max_wall spent)" if w is False else
+                  f"at {fmt_number(PERIOD_MARGIN, 2)} times the data's period tolerance it reads "
+                  + (f"period {w}" if w is not None else "aperiodic"))
+        out.append(f"at V = {fmt_number(float(V), 4)} m/s the fit's attractor is period {q} where the data's is period "
+                   f"{p} ({margin})")
+    return tuple(out)
