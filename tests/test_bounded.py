@@ -150,17 +150,23 @@ def test_orbit_diagram_refuses_a_grid_too_large_at_once():
         exact.orbit_diagram(PAPER, "V", [1.0, -1.0])
 
 
-def test_orbit_diagram_returns_what_it_has_when_max_wall_is_spent():
+@pytest.mark.parametrize("executor", ["serial", None])
+def test_orbit_diagram_returns_what_it_has_when_max_wall_is_spent(executor):
     """200 values of 50 s runs (minutes) under a 0.5 s budget: the diagram comes back within :data:`BOUND` with
     all 200 values in order, the ones not run labelled ``budget:max_wall`` with no returns (at least the last:
-    a run takes far more than 0.5 s / 200), the others labelled as usual."""
+    a run takes far more than 0.5 s / 200), the others labelled as usual.  Run serially, the values cut are a
+    tail (once the budget is spent no later value runs).  On the default pool (two workers here) they need not
+    be: a run beside other jobs saw value 0 cut on a worker still loading its kernels while value 1 finished on the
+    other (29 Nov), so there the cut values' empty returns and the cut last value are asserted."""
     vals = np.linspace(0.9, 1.1, 200)
-    d, took = _timed(exact.orbit_diagram, PAPER, "V", vals, max_wall=BUDGET)
+    d, took = _timed(exact.orbit_diagram, PAPER, "V", vals, max_wall=BUDGET, executor=executor)
     assert took < BOUND
     assert np.array_equal(d.values, vals) and len(d.labels) == len(d.returns) == 200
     cut = [i for i, lab in enumerate(d.labels) if lab == "budget:max_wall"]
-    assert cut and cut == list(range(cut[0], 200))
+    assert cut and cut[-1] == 199
     assert all(d.returns[i].size == 0 for i in cut)
+    if executor == "serial":
+        assert cut == list(range(cut[0], 200))
 
 
 # ---------------------------------------------------------------------------------------------- basins
