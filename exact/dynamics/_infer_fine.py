@@ -165,9 +165,9 @@ def second_pass(problem: Problem, run: Any, outcome: Outcome, first: Outcome, x0
     except spent:
         status, message = "budget", f"max_wall = {fmt_number(run.max_wall, 3)} s spent; the best point so far"
     after = best(run.evaluated)
-    note = (f"a second pass, since {why}: {len(run.evaluated) - n0} runs around {len(centres)} nodes (the start, "
-            "then the nodes on the data's period, then the best) at a quarter of the grid's spacing and a fit from "
-            "the best of them: ")
+    note = (f"a second pass, since {why}: {len(run.evaluated) - n0} runs (the cells of {len(centres)} nodes, the "
+            "start, then the nodes on the data's period, then the best, at a quarter of the grid's spacing, and a "
+            "least-squares fit from the best of them): ")
     if after.chi2 >= before.chi2:  # the verdicts stand (nothing identified); the note joins them
         low = min((e.chi2 for e in run.evaluated[n0:]), default=math.inf)
         return None, dataclasses.replace(outcome, notes=outcome.notes + (
