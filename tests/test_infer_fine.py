@@ -11,6 +11,7 @@ seed 8 trace 2 end to end (docs/your-data.md).
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -135,3 +136,82 @@ def test_seed8_trace2_is_recovered_by_the_second_pass():
     assert row["identified"] and row["hit"], row
     assert abs(row["I_err"]) < 0.05 and abs(row["k_err"]) < 0.05, row
     assert row["inside"], row
+
+
+class _Spent(Exception):
+    pass
+
+
+class _FakeRun:
+    """``infer``'s search as ``second_pass`` uses it, on the constructed landscape: cells recorded as given, the
+    least-squares fit's residuals ``(x - tooth) / HALF`` inside the tooth (χ² = 1 + |d|² there is replaced by the
+    plain |d|², so the fit's optimum is the tooth's centre, χ² 0) and the landscape's χ² as one residual outside."""
+
+    def __init__(self, at, tooth: np.ndarray, evaluated: list[Point], left: float = 1e9):
+        self.at, self.tooth, self.evaluated = at, tooth, evaluated
+        self.fits = [SimpleNamespace(series=None)]
+        self.progress, self.max_wall, self._left = None, 600.0, left
+
+    def left(self) -> float:
+        return self._left
+
+    def run_nodes(self, points) -> None:
+        for x in points:
+            if self._left <= 0:
+                raise _Spent
+            self.evaluated.append(self.at(x))
+
+    def residuals(self, x: np.ndarray) -> np.ndarray:
+        d = (x - self.tooth) / HALF
+        r = d if np.all(np.abs(d) <= 1.0) else np.array([math.sqrt(self.at(x).chi2), 0.0])
+        self.evaluated.append(Point(np.array(x), float(r @ r), [], self.at(x).readings))
+        return r
+
+
+def _second_pass(monkeypatch, identified: bool, periods: tuple[str, ...], tooth: np.ndarray, left: float = 1e9):
+    import exact.dynamics._infer_fine as fine
+    from exact.dynamics._infer_result import Outcome
+
+    at = _landscape(tooth)
+    run = _FakeRun(at, tooth, _first_pass(at), left)
+    top = min(run.evaluated, key=lambda e: e.chi2)
+    monkeypatch.setattr(fine, "data_period", lambda series: (1, 0.003))
+    monkeypatch.setattr(fine, "assemble", lambda problem, fits, outcome: SimpleNamespace(
+        identified={"I": identified, "k": identified}, chi2=top.chi2, dof=4))
+    outcome = Outcome(run.evaluated, None, BOX, 6, "converged", "", 1.0, ("first",), 1e-3, spacing=SPACING,
+                      periods=periods)
+    found, after = fine.second_pass(SimpleNamespace(names=("I", "k")), run, outcome, outcome, X0, _Spent,
+                                    {"diff_step": 1e-3, "xtol": 1e-8})
+    return run, found, after
+
+
+def test_the_second_pass_finds_the_tooth_and_hands_back_the_search(monkeypatch):
+    """End to end on the constructed landscape (a tooth at (+1.55, -0.51) spacings, seed 8 trace 2's place; the
+    first pass's best the false valley at χ² 20 on 4 dof, probability 5e-4 < 1e-3): the pass runs, its fit ends at
+    the tooth's centre (χ² below 1e-6: the residuals are linear there), and it hands back the search's outcome with
+    a note naming the better point, the Jacobian of the fit; a fit that identified something is left alone."""
+    tooth = X0 + H * np.array([1.55, -0.51])
+    run, found, _ = _second_pass(monkeypatch, False, (), tooth)
+    assert found is not None and found.jac is not None
+    top = min(run.evaluated, key=lambda e: e.chi2)
+    assert top.chi2 < 1e-6 and np.allclose(top.x, tooth, atol=1e-3 * H)
+    assert "better point" in found.notes[-1] and "the best fit is poor" in found.notes[-1]
+    run, found, after = _second_pass(monkeypatch, True, (), tooth)
+    assert found is None and after.notes == ("first",)
+    assert len(run.evaluated) == len(_first_pass(_landscape(tooth)))  # nothing run: the first pass's points only
+
+
+def test_the_second_pass_reports_no_better_point_and_the_budget(monkeypatch):
+    """With the start's cell alone visited (FINE_CENTRES 1) and the tooth 2.5 spacings from it (outside that cell,
+    whose comb χ² is 40-80, above the first pass's 20), the first verdicts stand with a note saying so and the
+    cell's 24 points and the fit's runs are recorded; with no budget left the pass does not run."""
+    import exact.dynamics._infer_fine as fine
+
+    tooth = X0 + H * np.array([2.5, -2.5])
+    monkeypatch.setattr(fine, "FINE_CENTRES", 1)
+    run, found, after = _second_pass(monkeypatch, False, ("period 4 where the data's is period 1",), tooth)
+    assert found is None and len(after.notes) == 2 and "no better point" in after.notes[-1]
+    assert "the best fit is poor" in after.notes[-1]  # chi2 20 on 4 dof: probability 5e-4, judged before the period
+    assert len(run.evaluated) >= len(_first_pass(_landscape(tooth))) + 24
+    run, found, after = _second_pass(monkeypatch, False, (), tooth, left=0.0)
+    assert found is None and after.notes == ("first",) and len(run.evaluated) == len(_first_pass(_landscape(tooth)))
