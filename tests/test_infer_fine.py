@@ -180,7 +180,7 @@ def _second_pass(monkeypatch, identified: bool, periods: tuple[str, ...], tooth:
         identified={"I": identified, "k": identified}, chi2=top.chi2, dof=4))
     outcome = Outcome(run.evaluated, None, BOX, 6, "converged", "", 1.0, ("first",), 1e-3, spacing=SPACING,
                       periods=periods)
-    found, after = fine.second_pass(SimpleNamespace(names=("I", "k")), run, outcome, outcome, X0, _Spent,
+    found, after = fine.second_pass(SimpleNamespace(names=("I", "k")), run, outcome, outcome, X0, _Spent,  # type: ignore[arg-type]
                                     {"diff_step": 1e-3, "xtol": 1e-8})
     return run, found, after
 
