@@ -129,7 +129,7 @@ def test_seed8_trace2_is_recovered_by_the_second_pass():
     (I -78.5 %), the second pass's cells hold the window, and the fit is a hit: both identified, I and k within the
     benchmark's tolerances (I 10 %, k 10 %; measured +0.5 % and -0.1 %, so 5 % is asserted: a fit in a neighbouring
     window of the comb, 8 % away at the refined grid's spacing, would fail it), the intervals holding the truth.
-    About 3 min wall (niced, 2 shared cores; docs/your-data.md)."""
+    302 s wall (niced, 2 shared cores, load 3-4; docs/your-data.md)."""
     from comparisons.benchmark.infer_targets import draw, run_trace
 
     row = run_trace(2, draw(3, 8)[2], 8, 10.0, 600.0, 1)
