@@ -119,11 +119,14 @@ def test_period_check_reads_the_fitted_attractor_again():
 
 
 @pytest.mark.slow
-def test_seed8_trace2_is_not_identified_on_a_period4_attractor():
+def test_seed8_trace2_is_not_identified_on_a_period4_attractor(monkeypatch):
     """End to end, ``comparisons.benchmark.infer_targets`` seed 8 trace 2 (V = 1.386 m/s, I = 3.051e-5, k = 719.2;
-    the data period 1): the fit lands on a period-4 attractor at I -78.5 % (chi2 5.0 on 4 dof) and, with the
+    the data period 1), without the second pass (``FINE_CENTRES`` 0; with it the trace is recovered,
+    tests/test_infer_fine.py): the fit lands on a period-4 attractor at I -78.5 % (chi2 5.0 on 4 dof) and, with the
     period check, identifies nothing and says why.  96 s wall (niced, 2 shared cores, load 2-3; docs/your-data.md)."""
     from comparisons.benchmark.infer_targets import draw, run_trace
+
+    monkeypatch.setattr("exact.dynamics._infer_fine.FINE_CENTRES", 0)
 
     row = run_trace(2, draw(3, 8)[2], 8, 10.0, 600.0, 1)
     assert not row["identified"] and not row["hit"]

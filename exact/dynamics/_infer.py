@@ -52,6 +52,13 @@ several (one series per V).
   a cycle, and the one that carries the period, the cycle frequency, is not fitted where the data's periodogram
   holds no line, so χ² cannot see it (docs/your-data.md, seed 8 trace 2).  It judges after the valley walk and
   steers nothing.
+* **A second pass.**  Where those verdicts identify nothing because the best fit is poor (its χ², or an aperiodic
+  fit's neighbours', improbable at ``poor_fit``) or the period check disagrees, the comb was not resolved: a window
+  narrower than the grid's spacing holds the truth and no node (docs/your-data.md, seed 8 traces 2 and 3).  The
+  cells of a few coarse nodes (the start, the nodes on the data's period, the best ones) are evaluated at a quarter
+  of the spacing and a least-squares fit runs from the best new point; where it is better than the first pass's
+  best, the replicate check, the valley walk and the period check run again on it (``exact/dynamics/_infer_fine.py``).
+  A fit identifying anything never runs it.
 """
 
 from __future__ import annotations
@@ -71,6 +78,7 @@ from peelapprox.io import fmt_number
 from peelapprox.parallel import AUTO, POOL_KINDS, map_points
 from peelapprox.validate import choice, integer, optional, positive
 
+from ._infer_fine import second_pass
 from ._infer_result import POOR_FIT, Inference, Outcome, assemble
 from ._infer_search import (
     GRID_RUNS,
@@ -207,14 +215,26 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
         max_wall=max_wall, attractors=attractors, replicates=replicates, executor=executor, max_workers=max_workers)
     run = _Search(problem, fits, t_wall, positive("max_wall", max_wall), say, executor,
                   optional(integer, "max_workers", max_workers, 0))
-    outcome = run.run(x0, limits, float(search), n_obs, notes)
-    check, outcome = _replicated(problem, run, outcome)
+    first = run.run(x0, limits, float(search), n_obs, notes)
+    base = run.fits
+    check, outcome = _replicated(problem, run, first)
     outcome = _walked(problem, run, outcome)
     outcome, n_period = _period_checked(problem, run, outcome)
+    found, outcome = second_pass(problem, run, outcome, first, x0, _Spent, {"diff_step": DIFF_STEP, "xtol": XTOL})
+    n_fine = 0
+    if found is not None:  # a better point: the verdict machinery again, on it (the replicate check from base σ)
+        former, run.fits = check, base
+        check, outcome = _replicated(problem, run, found)
+        if check is None and former is not None:  # the budget spent before the check: the former σ kept
+            check, run.fits = former, former.fits
+            outcome = dataclasses.replace(outcome, replicate=(former.chi2, former.n_stat), chi2_noise=former.chi2_sd)
+        outcome = _walked(problem, run, outcome)
+        outcome, n_more = _period_checked(problem, run, outcome)
+        n_fine = n_more + (former.n_runs if former is not None and former is not check else 0)
     full = shares(problem, run.evaluated, run.fits, run.left())
     res = assemble(problem, run.fits, dataclasses.replace(outcome, wall=time.perf_counter() - t_wall))
     n_runs = (sum(r.n_runs for e in run.evaluated for r in e.readings) + sum(r.n_runs for r in full if r is not None)
-              + (check.n_runs if check is not None else 0) + n_period)
+              + (check.n_runs if check is not None else 0) + n_period + n_fine)
     lines = attractor_lines(run.evaluated, full, [f.V for f in run.fits])
     return dataclasses.replace(res, n_evaluations=n_runs, attractors=lines,
                                verdicts={k: f"{v}; {'; '.join(lines)}" for k, v in res.verdicts.items()})
