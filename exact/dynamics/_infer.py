@@ -222,15 +222,8 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     outcome, n_period = _period_checked(problem, run, outcome)
     found, outcome = second_pass(problem, run, outcome, first, x0, _Spent, {"diff_step": DIFF_STEP, "xtol": XTOL})
     n_fine = 0
-    if found is not None:  # a better point: the verdict machinery again, on it (the replicate check from base σ)
-        former, run.fits = check, base
-        check, outcome = _replicated(problem, run, found)
-        if check is None and former is not None:  # the budget spent before the check: the former σ kept
-            check, run.fits = former, former.fits
-            outcome = dataclasses.replace(outcome, replicate=(former.chi2, former.n_stat), chi2_noise=former.chi2_sd)
-        outcome = _walked(problem, run, outcome)
-        outcome, n_more = _period_checked(problem, run, outcome)
-        n_fine = n_more + (former.n_runs if former is not None and former is not check else 0)
+    if found is not None:  # a better point: the verdict machinery again, on it
+        check, outcome, n_fine = _verdicts_again(problem, run, found, check, base)
     full = shares(problem, run.evaluated, run.fits, run.left())
     res = assemble(problem, run.fits, dataclasses.replace(outcome, wall=time.perf_counter() - t_wall))
     n_runs = (sum(r.n_runs for e in run.evaluated for r in e.readings) + sum(r.n_runs for r in full if r is not None)
@@ -238,6 +231,21 @@ def infer(series: ForceSeries, params0: PeelParams, free: Sequence[str] = ("I", 
     lines = attractor_lines(run.evaluated, full, [f.V for f in run.fits])
     return dataclasses.replace(res, n_evaluations=n_runs, attractors=lines,
                                verdicts={k: f"{v}; {'; '.join(lines)}" for k, v in res.verdicts.items()})
+
+
+def _verdicts_again(problem: Problem, run: _Search, found: Outcome, former: ReplicateCheck | None,
+                    base: list) -> tuple[ReplicateCheck | None, Outcome, int]:
+    """The neighbours' check (from the first pass's σ, ``base``), the valley walk and the period check on the
+    second pass's better point ``found``: the check kept, the outcome and the runs to count beyond the evaluated
+    points' (the period check's, and the former check's where a new one replaced it)."""
+    run.fits = base
+    check, outcome = _replicated(problem, run, found)
+    if check is None and former is not None:  # the budget spent before the check: the former σ kept
+        check, run.fits = former, former.fits
+        outcome = dataclasses.replace(outcome, replicate=(former.chi2, former.n_stat), chi2_noise=former.chi2_sd)
+    outcome = _walked(problem, run, outcome)
+    outcome, n_more = _period_checked(problem, run, outcome)
+    return check, outcome, n_more + (former.n_runs if former is not None and former is not check else 0)
 
 
 def _replicated(problem: Problem, run: _Search, outcome: Outcome) -> tuple[ReplicateCheck | None, Outcome]:

@@ -213,17 +213,28 @@ def _readings(p: PeelParams, series: ForceSeries, threshold: float, noise: float
               max_wall: float, start: dict[str, Any], seeds: tuple[int, ...]
               ) -> list[tuple[np.ndarray | None, int | None, bool]]:
     """:func:`_reading` of one model run with the noise of each of ``seeds`` (one run, read once per seed)."""
+    traces = _model_series(p, series, noise, t_transient, rtol, max_wall, start, seeds)
+    if traces is None:
+        return [(None, None, False)] * len(seeds)
+    out: list[tuple[np.ndarray | None, int | None, bool]] = []
+    for model in traces:
+        vals, o, line, _ = trace_statistics(model, threshold)
+        out.append((vals, (o.period if vals is not None else None), line))
+    return out
+
+
+def _model_series(p: PeelParams, series: ForceSeries, noise: float, t_transient: float, rtol: float,
+                  max_wall: float, start: dict[str, Any], seeds: tuple[int, ...]) -> list[ForceSeries] | None:
+    """The model's trace at ``p`` from ``start``, sampled at the series' times after ``t_transient``, once per
+    noise seed of ``seeds`` (one run); None where it breaks down, exceeds ``max_wall`` or the start lies outside
+    the model's domain (ValueError)."""
     t_eval = t_transient + (series.t - series.t[0])
     try:
         tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall, **start)
-    except (ModelBreakdown, SolverBudgetExceeded, ValueError):  # ValueError: a start outside the model's domain
-        return [(None, None, False)] * len(seeds)
-    out: list[tuple[np.ndarray | None, int | None, bool]] = []
-    for seed in seeds:
-        F = tr.F + np.random.default_rng(seed).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
-        vals, o, line, _ = trace_statistics(ForceSeries(tr.t, F, V=p.V, source="model"), threshold)
-        out.append((vals, (o.period if vals is not None else None), line))
-    return out
+    except (ModelBreakdown, SolverBudgetExceeded, ValueError):
+        return None
+    return [ForceSeries(tr.t, tr.F + np.random.default_rng(seed).normal(0.0, noise, tr.F.size) if noise > 0
+                        else tr.F, V=p.V, source="model") for seed in seeds]
 
 
 def noise_spread(p: PeelParams, series: ForceSeries, threshold: float, noise: float, t_transient: float,
@@ -379,11 +390,8 @@ def replicate_mean(p: PeelParams, series: ForceSeries, threshold: float, noise: 
 
 def period_tolerance(slips: Any) -> float:
     """The return map's period tolerance :meth:`peelapprox.ForceSeries.observables` uses by default, relative to
-    the largest force before a slip: the largest of 6 fit errors (``6 · 2σ/√40``, σ the slips' noise estimate),
-    2 % of the range of F before the slips and 3e-4 of the largest (that method's docstring)."""
-    fb = np.asarray(slips.F_before)
-    top = float(np.max(np.abs(fb)))
-    return max(6.0 * 2.0 * float(slips.noise) / math.sqrt(40.0), 0.02 * float(np.ptp(fb)), 3e-4 * top) / top
+    the largest force before a slip (:meth:`peelapprox.Slips.period_tolerance`, its one definition)."""
+    return float(slips.period_tolerance())
 
 
 def data_period(series: ForceSeries) -> tuple[int | None, float]:
@@ -404,13 +412,10 @@ def model_period(p: PeelParams, series: ForceSeries, threshold: float, noise: fl
     :func:`model_statistics`: the same run and noise draw), read as :func:`data_period` reads the data (the
     default detector at the data's ``threshold``) at its own noise's tolerance, and at ``period_rtol``; None
     where it does not stick-slip, breaks down or is aperiodic at that tolerance."""
-    t_eval = t_transient + (series.t - series.t[0])
-    try:
-        tr = simulate(p, float(t_eval[-1]), t_eval=t_eval, rtol=rtol, max_wall=max_wall, **start)
-    except (ModelBreakdown, SolverBudgetExceeded, ValueError):
+    traces = _model_series(p, series, noise, t_transient, rtol, max_wall, start, (NOISE_SEED,))
+    if traces is None:
         return None, None
-    F = tr.F + np.random.default_rng(NOISE_SEED).normal(0.0, noise, tr.F.size) if noise > 0 else tr.F
-    model = ForceSeries(tr.t, F, V=p.V, source="model")
+    model = traces[0]
     slips = model.slips(threshold)
     if len(slips) < 2:
         return None, None

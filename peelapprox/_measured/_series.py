@@ -212,9 +212,7 @@ class ForceSeries:
             Of :meth:`slips`.
         period_rtol : float, optional
             The return map's period tolerance (:func:`peelapprox.periodicity`), relative to the largest F
-            before a slip; None: the detector's repeatability, the largest of 6 fit errors (``6 · 2σ/√fit``),
-            2 % of the range of F before the slips and 3e-4 of the largest (on noiseless model traces sampled
-            at 10 kHz the corners repeat to ~0.03 N of 300 N, 1e-4).
+            before a slip; None: :meth:`Slips.period_tolerance` (the detector's repeatability).
         max_period : int
             Largest period tried (1 to 64; 32).
         slips : Slips, optional
@@ -236,10 +234,7 @@ class ForceSeries:
                 status="steady", method=s.method, **common,
                 reason=f"no fall of the force by more than {fmt_number(s.threshold, 3)} N in the trace")
         tj, Fj, bj = s.jumps()
-        top = float(np.max(np.abs(s.F_before)))
-        spread = float(np.ptp(s.F_before))
-        rtol = (max(6.0 * 2.0 * s.noise / math.sqrt(40.0), 0.02 * spread, 3e-4 * top) / top if period_rtol is None
-                else positive("period_rtol", period_rtol))
+        rtol = s.period_tolerance() if period_rtol is None else positive("period_rtol", period_rtol)
         stats, cycles = jump_statistics(tj, Fj, bj, period_rtol=rtol, max_period=max_period)
         status = "stick-slip" if len(s) >= 2 else "too few slips"
         reason = (f"{len(s)} slips in the trace, return map {stats['period_label']} (period tolerance "
